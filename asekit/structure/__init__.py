@@ -1,0 +1,9 @@
+"""Structural finite-element model of a lifting surface (thesis Ch. 2.1, 3.1).
+
+mesh (structured quadrilateral meshes) -> plate (MITC4 element) -> assembly (sparse K, M,
+supports) -> modes (eigen-analysis, mode selection, the modal model).
+"""
+
+from .modes import ModalModel, fin_modal_model, mode_shapes_at
+
+__all__ = ["ModalModel", "fin_modal_model", "mode_shapes_at"]

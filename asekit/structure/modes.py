@@ -1,0 +1,323 @@
+"""Normal modes, mode selection and the fin's modal model (thesis Eqs. (2.2)-(2.6), (2.45)-(2.46),
+Sections 3.1.1-3.1.2, Tables 4-6).
+
+The eigenproblem K phi = omega^2 M phi (Eq. (2.4)) is solved for the lowest modes with the
+sparse Lanczos solver of ARPACK in shift-invert mode (:func:`scipy.sparse.linalg.eigsh`), the
+same family of method as MSC Nastran SOL 103's default.
+
+:func:`fin_modal_model` builds the thesis's model FN2 (fictitious-mass method, Sec. 3.1.1): one
+eigen-analysis gives the rigid pitch mode and the elastic modes. The fictitious inertia is then
+removed: the rigid mode is scaled to a unit (1 rad) pitch rotation and the elastic modes are
+re-diagonalised by a Rayleigh-Ritz step with the fin's own mass matrix and the FN1 stiffness
+(the shaft spring to ground) in the span of the FN2 elastic modes. Because those modes differ
+from the FN1 modes by O(J_fin / I_f) ~ 1e-6, the Ritz frequencies agree with FN1 to O(1e-12),
+and the elastic set is exactly mass-normalised (M_ss = I), as the thesis's Eq. (2.46) assumes.
+The rigid-elastic inertial coupling M_cs = phi_c^T M phi_s of Eq. (2.46) remains.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse.linalg as spla
+
+from ..geometry import FinDefinition, load_fin
+from .assembly import SupportedSystem, assemble, rigid_pitch_vector, shaft_support
+from .mesh import PlateMesh, structured_mesh
+from .plate import shape_functions
+
+#: Modes whose share of kinetic energy in the out-of-plane translation w is below this are
+#: "modes with no out-of-plane motion" and are dropped (thesis Fig. 15/16: in-plane mode).
+MIN_OUT_OF_PLANE = 0.01
+
+
+@dataclass(frozen=True)
+class NormalModes:
+    """Eigen-solution of a supported structure.
+
+    frequencies_hz : (n,) natural frequencies (Hz), ascending (sqrt of max(lambda, 0) / 2 pi).
+    eigenvalues : (n,) omega^2 (rad^2/s^2) as solved (may be ~ -0 for a rigid mode).
+    q : (n_q, n) eigenvectors in the reduced coordinates, mass-normalised: q^T M q = I.
+    fin : (3 n_nodes, n) the same modes on the fin's DOFs (w, theta_x, theta_y per node).
+    out_of_plane : (n,) share of each mode's kinetic energy in the w translations.
+    system : the supported system solved.
+    """
+
+    frequencies_hz: np.ndarray
+    eigenvalues: np.ndarray
+    q: np.ndarray
+    fin: np.ndarray
+    out_of_plane: np.ndarray
+    system: SupportedSystem
+
+
+def _fin_mass_share(fin_vecs: np.ndarray, M_fin) -> np.ndarray:
+    """Share of kinetic energy in the w DOFs (M is block-diagonal in w / rotations)."""
+    Mphi = M_fin @ fin_vecs
+    total = np.einsum("ij,ij->j", fin_vecs, Mphi)
+    w_part = np.einsum("ij,ij->j", fin_vecs[0::3], Mphi[0::3])
+    return np.divide(w_part, total, out=np.zeros_like(total), where=total > 0)
+
+
+def normal_modes(system: SupportedSystem, n_modes: int = 10, M_fin=None,
+                 shift_hz: float = 1.0) -> NormalModes:
+    """Lowest ``n_modes`` natural modes of a supported system (thesis Eq. (2.4)).
+
+    Shift-invert Lanczos (``eigsh``) about the negative shift -(2 pi ``shift_hz``)^2, so that a
+    singular K (rigid mode) is handled; dense ``scipy.linalg.eigh`` for small systems. The start
+    vector is fixed and each mode's sign is fixed (largest |w| positive; the rigid mode's shaft
+    rotation positive), so results are reproducible bit for bit.
+
+    M_fin : the fin's global mass (for the out-of-plane energy share); default T-projection of
+    the reduced M is not possible, so without it the share is computed from ``system.M``'s
+    fin part.
+    """
+    n_q = system.K.shape[0]
+    if int(n_modes) != n_modes or n_modes < 1:
+        raise ValueError(f"n_modes must be an integer >= 1, got {n_modes!r}")
+    n_modes = int(min(n_modes, n_q))
+    sigma = -(2 * math.pi * shift_hz) ** 2
+    if n_q <= 600 or n_modes >= n_q - 1:
+        lam, q = sla.eigh(system.K.toarray(), system.M.toarray(), subset_by_index=(0, n_modes - 1))
+    else:
+        v0 = np.ones(n_q) / math.sqrt(n_q)
+        lam, q = spla.eigsh(system.K, k=n_modes, M=system.M, sigma=sigma, which="LM", v0=v0)
+    order = np.argsort(lam)
+    lam, q = lam[order], q[:, order]
+    # exact mass normalisation (ARPACK returns M-orthonormal vectors to ~1e-12)
+    q = q / np.sqrt(np.einsum("ij,ij->j", q, system.M @ q))
+    fin = system.T @ q
+    # deterministic signs
+    for j in range(q.shape[1]):
+        if system.ground_index is not None and abs(q[system.ground_index, j]) > 0.5 * np.abs(q[:, j]).max():
+            sgn = np.sign(q[system.shaft_index, j])
+        else:
+            w = fin[0::3, j]
+            sgn = np.sign(w[np.argmax(np.abs(w))]) if np.abs(w).max() > 0 else 1.0
+        if sgn < 0:
+            q[:, j] *= -1
+            fin[:, j] *= -1
+    if M_fin is not None:
+        share = _fin_mass_share(fin, M_fin)
+    else:
+        share = np.full(q.shape[1], np.nan)
+    freqs = np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi)
+    return NormalModes(frequencies_hz=freqs, eigenvalues=lam, q=q, fin=fin, out_of_plane=share,
+                       system=system)
+
+
+def modes_up_to(system: SupportedSystem, f_max_hz: float, M_fin=None, n_start: int = 12) -> NormalModes:
+    """All modes below ``f_max_hz`` plus at least one above it (to show where the cut falls)."""
+    n = n_start
+    n_q = system.K.shape[0]
+    while True:
+        modes = normal_modes(system, n, M_fin=M_fin)
+        if modes.frequencies_hz[-1] > f_max_hz or n >= n_q:
+            return modes
+        n = min(2 * n, n_q)
+
+
+@dataclass(frozen=True)
+class ModalModel:
+    """The fin's reduced structural model in the m-set (thesis Eqs. (2.5), (2.45)-(2.46)).
+
+    frequencies_hz : (n_modes,) rigid mode(s) first (0 Hz), then the elastic modes kept.
+    M : (n_modes, n_modes) modal mass, fictitious inertia removed; M[0, 0] = J_fin for FN2.
+    K : (n_modes, n_modes) modal stiffness (zero row/col for the rigid mode).
+    C : (n_modes, n_modes) modal damping, zeros by default (the conference paper: C_mm = 0).
+    n_rigid : number of rigid modes at the front: 1 for FN2, 0 for FN1 / clamped.
+    J_fin : pitch inertia of the fin about the shaft axis (kg m^2).
+    nodes : (n_nodes, 2) FE node coordinates x, y (m).
+    shapes : (n_nodes, 3, n_modes) w (m), theta_x, theta_y (rad) per node and unit modal coordinate.
+        The rigid mode is a unit (1 rad) nose-up pitch: w = -(x - x_axis), theta_y = 1.
+        Elastic modes are mass-normalised with the fin's own mass matrix (M_ss = I).
+    elements : (n_elem, 4) node indices, counter-clockwise.
+    label : e.g. "FN2 6x7 single-node shaft".
+    """
+
+    frequencies_hz: np.ndarray
+    M: np.ndarray
+    K: np.ndarray
+    C: np.ndarray
+    n_rigid: int
+    J_fin: float
+    nodes: np.ndarray
+    shapes: np.ndarray
+    elements: np.ndarray
+    label: str
+
+
+def locate_points(nodes: np.ndarray, elements: np.ndarray, points: np.ndarray,
+                  tol: float = 1e-9) -> tuple[np.ndarray, np.ndarray]:
+    """Element index and natural coordinates (r, s) of each (x, y) point.
+
+    Inverts the bilinear isoparametric map of the candidate elements (bounding-box filter, then
+    Newton iterations). Raises ValueError naming the points that lie on no element.
+    """
+    p = np.atleast_2d(np.asarray(points, float))
+    if p.ndim != 2 or p.shape[1] != 2 or not np.all(np.isfinite(p)):
+        raise ValueError(f"points must be a finite (n_points, 2) array of x, y in m, got shape {p.shape}")
+    xy = nodes[elements]
+    size = float(np.ptp(nodes, axis=0).max())
+    atol = tol * max(size, 1.0)
+    lo, hi = xy.min(axis=1) - atol, xy.max(axis=1) + atol
+    elem = np.full(p.shape[0], -1)
+    rs = np.zeros((p.shape[0], 2))
+    chunk = max(1, 2_000_000 // max(elements.shape[0], 1))
+    for start in range(0, p.shape[0], chunk):
+        pc = p[start:start + chunk]
+        cand = np.all((pc[:, None, :] >= lo[None]) & (pc[:, None, :] <= hi[None]), axis=2)
+        pi, ei = np.nonzero(cand)
+        if pi.size == 0:
+            continue
+        X = xy[ei]
+        r = np.zeros(pi.size)
+        s = np.zeros(pi.size)
+        for _ in range(25):
+            N, dNr, dNs = shape_functions(r, s)
+            res = np.einsum("pk,pkd->pd", N, X) - pc[pi]
+            a = np.einsum("pk,pk->p", dNr, X[:, :, 0]); b = np.einsum("pk,pk->p", dNs, X[:, :, 0])
+            c = np.einsum("pk,pk->p", dNr, X[:, :, 1]); d = np.einsum("pk,pk->p", dNs, X[:, :, 1])
+            det = a * d - b * c
+            dr = (d * res[:, 0] - b * res[:, 1]) / det
+            ds = (-c * res[:, 0] + a * res[:, 1]) / det
+            r -= dr
+            s -= ds
+            if np.max(np.abs(dr) + np.abs(ds)) < 1e-14:
+                break
+        ok = (np.abs(r) <= 1 + 1e-7) & (np.abs(s) <= 1 + 1e-7)
+        for k in np.flatnonzero(ok)[::-1]:          # reversed: the first hit wins
+            elem[start + pi[k]] = ei[k]
+            rs[start + pi[k]] = np.clip([r[k], s[k]], -1, 1)
+    missing = np.flatnonzero(elem < 0)
+    if missing.size:
+        raise ValueError(f"points {missing[:10].tolist()} (e.g. {tuple(p[missing[0]])}) lie "
+                         f"outside the structural surface")
+    return elem, rs
+
+
+def mode_shapes_at(model: ModalModel, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """w (n_points, n_modes) in m and dw/dx (n_points, n_modes) at (x, y) points on the surface.
+
+    Both are interpolated with the element's bilinear shape functions. The streamwise slope is
+    the Mindlin rotation field, dw/dx = -theta_y (exact in the Kirchhoff limit, where the
+    transverse shear strain gamma_xz = dw/dx + theta_y vanishes; continuous across elements,
+    unlike the derivative of the bilinear w). For the rigid pitch mode it is exactly -1.
+    Points outside the planform raise ValueError.
+    """
+    elem, rs = locate_points(model.nodes, model.elements, points)
+    N, _, _ = shape_functions(rs[:, 0], rs[:, 1])            # (n_points, 4)
+    conn = model.elements[elem]                              # (n_points, 4)
+    w = np.einsum("pk,pkm->pm", N, model.shapes[conn, 0, :])
+    dwdx = -np.einsum("pk,pkm->pm", N, model.shapes[conn, 2, :])
+    return w, dwdx
+
+
+def fin_mesh(fin: FinDefinition, n_chord: int | None = None, n_span: int | None = None) -> PlateMesh:
+    """The fin's structured mesh (default: the thesis's 6 x 7 from ``data/fin.toml``)."""
+    return structured_mesh(fin.planform, fin.thickness,
+                           fin.n_chord if n_chord is None else n_chord,
+                           fin.n_span if n_span is None else n_span)
+
+
+def _region(shaft: str) -> str:
+    if shaft not in ("single_node", "distributed"):
+        raise ValueError(f"shaft must be 'single_node' or 'distributed', got {shaft!r}")
+    return shaft
+
+
+def fin_supported(fin: FinDefinition, mesh: PlateMesh, model: str, shaft: str = "single_node",
+                  K=None, M=None) -> SupportedSystem:
+    """The fin on its shaft: model "FN1" or "FN2" with the single-node or distributed shaft."""
+    if K is None or M is None:
+        K, M = assemble(mesh, fin.material)
+    s = fin.shaft
+    return shaft_support(mesh, K, M, s.axis_point, s.torsional_stiffness, model=model,
+                         region=_region(shaft), radius=s.radius,
+                         fictitious_inertia_factor=s.fictitious_inertia_factor)
+
+
+def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None,
+                    n_span: int | None = None, shaft: str = "single_node",
+                    f_max_hz: float = 1000.0) -> ModalModel:
+    """The FN2 modal model: rigid pitch mode + elastic modes below ``f_max_hz`` with
+    out-of-plane motion (thesis Sec. 3.1, Table 6, Eqs. (2.45)-(2.46)).
+
+    Parameters
+    ----------
+    fin : fin definition (default ``load_fin()``).
+    n_chord, n_span : elements per direction (default the fin's 6 x 7).
+    shaft : "single_node" (thesis) or "distributed" (rigid region of radius fin.shaft.radius).
+    f_max_hz : frequency limit for the elastic modes kept (Hz), > 0.
+
+    Returns
+    -------
+    ModalModel with n_rigid = 1: M[0, 0] = J_fin, M_ss = I, K = diag(0, omega_s^2), C = 0.
+    """
+    fin = load_fin() if fin is None else fin
+    if not np.isfinite(f_max_hz) or f_max_hz <= 0:
+        raise ValueError(f"f_max_hz must be a finite number > 0 (Hz), got {f_max_hz!r}")
+    mesh = fin_mesh(fin, n_chord, n_span)
+    K, M = assemble(mesh, fin.material)
+    fn2 = fin_supported(fin, mesh, "FN2", shaft, K, M)
+    fn1 = fin_supported(fin, mesh, "FN1", shaft, K, M)
+    modes = modes_up_to(fn2, f_max_hz, M_fin=M)
+    g, s_i = fn2.ground_index, fn2.shaft_index
+    # the rigid mode: almost all of its kinetic energy sits in the fictitious inertia
+    energy_g = fn2.fictitious_inertia * modes.q[g] ** 2
+    i_rigid = int(np.argmax(energy_g))
+    q_c = modes.q[:, i_rigid] / modes.q[s_i, i_rigid]            # unit shaft rotation
+    phi_c = fn2.T @ q_c
+    # elastic: drop the ground coordinate, re-diagonalise with the fin's mass + FN1 stiffness
+    elastic = [j for j in range(modes.q.shape[1]) if j != i_rigid]
+    Qs = modes.q[:g, elastic]
+    Kt = Qs.T @ (fn1.K @ Qs)
+    Mt = Qs.T @ (fn1.M @ Qs)
+    lam, V = sla.eigh(0.5 * (Kt + Kt.T), 0.5 * (Mt + Mt.T))
+    Qs = Qs @ V
+    phi_s = fn1.T @ Qs
+    for j in range(phi_s.shape[1]):                             # deterministic sign
+        w = phi_s[0::3, j]
+        if w[np.argmax(np.abs(w))] < 0:
+            phi_s[:, j] *= -1
+            Qs[:, j] *= -1
+    f_s = np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi)
+    share = _fin_mass_share(phi_s, M)
+    keep = (f_s < f_max_hz) & (share >= MIN_OUT_OF_PLANE)
+    phi_s, Qs, lam_s = phi_s[:, keep], Qs[:, keep], lam[keep]
+    Phi = np.column_stack([phi_c, phi_s])
+    M_mm = Phi.T @ (M @ Phi)
+    M_mm = 0.5 * (M_mm + M_mm.T)
+    K_ss = Qs.T @ (fn1.K @ Qs)
+    n = Phi.shape[1]
+    K_mm = np.zeros((n, n))
+    K_mm[1:, 1:] = 0.5 * (K_ss + K_ss.T)
+    # the rigid row of K (plate strain energy of a rigid pitch, spring unstretched) is zero
+    k_c = float(phi_c @ (K @ phi_c))
+    if abs(k_c) > 1e-8 * max(1.0, float(np.max(np.abs(K_ss))) if K_ss.size else 1.0):
+        raise RuntimeError(f"rigid mode carries strain energy {k_c:g}: support model broken")
+    f_rigid = math.sqrt(max(modes.eigenvalues[i_rigid], 0.0)) / (2 * math.pi)
+    freqs = np.concatenate([[f_rigid], np.sqrt(np.maximum(lam_s, 0.0)) / (2 * math.pi)])
+    shapes = Phi.reshape(mesh.n_nodes, 3, n)
+    return ModalModel(frequencies_hz=freqs, M=M_mm, K=K_mm, C=np.zeros((n, n)), n_rigid=1,
+                      J_fin=float(M_mm[0, 0]), nodes=mesh.nodes.copy(), shapes=shapes,
+                      elements=mesh.elements.copy(), label=fn2.label)
+
+
+def pitch_inertia_exact(fin: FinDefinition) -> float:
+    """Pitch inertia (kg m^2) of the flat trapezoidal plate about the shaft axis, by exact
+    integration: J = int_y rho h(y) int_x [(x - x_a)^2 + h^2 / 12] dx dy (the second term is the
+    plate's own rotary inertia). Gauss-Legendre in y is exact for this polynomial integrand."""
+    p, t, rho = fin.planform, fin.thickness, fin.material.density
+    x_a = fin.shaft.axis_point[0]
+    g, wg = np.polynomial.legendre.leggauss(8)
+    eta = 0.5 * (g + 1)
+    h = t.at(eta)
+    x0 = p.root_le[0] + eta * (p.tip_le[0] - p.root_le[0]) - x_a
+    c = p.root_chord + eta * (p.tip_chord - p.root_chord)
+    x1 = x0 + c
+    inner = (x1**3 - x0**3) / 3 + h**2 / 12 * c
+    return float(0.5 * p.span * np.sum(wg * rho * h * inner))
