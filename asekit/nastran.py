@@ -1,0 +1,173 @@
+"""A small reader for formatted (ASCII) Nastran OUTPUT4 (OP4) matrix files.
+
+Format (MSC Nastran DMAP Programmer's Guide, module OUTPUT4, formatted non-sparse form):
+
+* header record per matrix: ``NCOL NROW NFORM NTYPE NAME FORMAT`` in (4I8, 2A4 name, format
+  string such as ``1P,5E16.9``). NTYPE 1/2 = real single/double, 3/4 = complex single/double.
+* then, per stored column, a record ``ICOL IROW NW`` (3I8): column number (1-based), first
+  row stored (1-based) and the number of *words* that follow (a complex value is two words),
+  followed by the NW values in the stated Fortran E format (5 per line for ``5E16.9``).
+* a terminating record with ``ICOL = NCOL + 1`` and one dummy word.
+
+Columns not listed are zero. The sparse "BIGMAT" form (negative NW or row-index strings) is not
+supported and raises a ValueError naming the matrix. Values are parsed by fixed field width
+read from the format string, so adjacent negative numbers without spaces read correctly.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Op4Matrix:
+    """One matrix of an OP4 file: ``name``, ``form`` (Nastran form code: 1 square,
+    2 rectangular, 6 symmetric, ...), ``ntype`` (1..4) and the dense ``data`` array
+    (nrow x ncol, float or complex)."""
+
+    name: str
+    form: int
+    ntype: int
+    data: np.ndarray
+
+
+_FMT = re.compile(r"(\d+)\s*[EeDd]\s*(\d+)\.(\d+)")
+
+
+def _field_width(fmt: str) -> tuple[int, int]:
+    """(values per line, field width) from a Fortran format like ``1P,5E16.9``."""
+    m = _FMT.search(fmt)
+    if m is None:
+        raise ValueError(f"unsupported OP4 number format {fmt!r} (expected like '1P,5E16.9')")
+    return int(m.group(1)), int(m.group(2))
+
+
+def _parse_values(lines: list[str], nwords: int, width: int) -> np.ndarray:
+    vals = []
+    for line in lines:
+        s = line.rstrip("\n")
+        for j in range(0, len(s), width):
+            field = s[j:j + width].strip()
+            if field:
+                vals.append(float(field.replace("D", "E").replace("d", "e")))
+    if len(vals) != nwords:
+        raise ValueError(f"OP4 column record expected {nwords} words, read {len(vals)}")
+    return np.asarray(vals)
+
+
+def read_op4(path: str | Path) -> dict[str, Op4Matrix]:
+    """Read every matrix of a formatted OP4 file.
+
+    Parameters
+    ----------
+    path : the ``.op4`` file (ASCII, written with OUTPUT4 ``form=formatted``).
+
+    Returns
+    -------
+    dict name -> :class:`Op4Matrix`, in file order. Symmetric matrices (form 6) stored as one
+    triangle are NOT symmetrised: the columns are returned exactly as stored.
+
+    Raises
+    ------
+    ValueError
+        On a malformed header or column record, or an unsupported (sparse/BIGMAT) layout.
+    """
+    lines = Path(path).read_text().splitlines()
+    out: dict[str, Op4Matrix] = {}
+    i = 0
+    n = len(lines)
+    while i < n:
+        head = lines[i]
+        if not head.strip():
+            i += 1
+            continue
+        try:
+            ncol, nrow, form, ntype = (int(head[j:j + 8]) for j in range(0, 32, 8))
+        except ValueError as exc:
+            raise ValueError(f"{path}: line {i + 1} is not an OP4 header: {head!r}") from exc
+        rest = head[32:]
+        name = rest[:8].strip()
+        fmt = rest[8:].strip()
+        if ntype not in (1, 2, 3, 4):
+            raise ValueError(f"{path}: matrix {name!r} has unsupported type {ntype}")
+        if ncol <= 0 or nrow <= 0:
+            raise ValueError(f"{path}: matrix {name!r} has a sparse/BIGMAT header "
+                             f"(ncol={ncol}, nrow={nrow}); not supported")
+        per_line, width = _field_width(fmt)
+        is_complex = ntype in (3, 4)
+        data = np.zeros((nrow, ncol), dtype=complex if is_complex else float)
+        i += 1
+        while True:
+            if i >= n:
+                raise ValueError(f"{path}: matrix {name!r} ends without its terminating record")
+            rec = lines[i]
+            try:
+                icol, irow, nw = (int(rec[j:j + 8]) for j in range(0, 24, 8))
+            except ValueError as exc:
+                raise ValueError(f"{path}: line {i + 1}: bad column record {rec!r}") from exc
+            if nw < 0 or irow < 0:
+                raise ValueError(f"{path}: matrix {name!r} uses the sparse (BIGMAT) layout, "
+                                 "not supported")
+            nlines = -(-nw // per_line)
+            vals = _parse_values(lines[i + 1:i + 1 + nlines], nw, width)
+            i += 1 + nlines
+            if icol > ncol:
+                break
+            if icol < 1 or irow < 1:
+                raise ValueError(f"{path}: matrix {name!r}: column/row index < 1")
+            if is_complex:
+                if nw % 2:
+                    raise ValueError(f"{path}: complex matrix {name!r} has an odd word count")
+                col = vals[0::2] + 1j * vals[1::2]
+            else:
+                col = vals
+            if irow - 1 + len(col) > nrow:
+                raise ValueError(f"{path}: matrix {name!r} column {icol} overruns {nrow} rows")
+            data[irow - 1:irow - 1 + len(col), icol - 1] = col
+        out[name] = Op4Matrix(name=name, form=form, ntype=ntype, data=data)
+    return out
+
+
+def split_qhhl(qhhl: np.ndarray, n_k: int) -> np.ndarray:
+    """Split Nastran's QHHL (n x n*n_k, blocks side by side per reduced frequency) into an
+    array (n_k, n, n)."""
+    n, ncol = qhhl.shape
+    if ncol != n * n_k:
+        raise ValueError(f"QHHL has {ncol} columns; expected n * n_k = {n} * {n_k}")
+    return np.stack([qhhl[:, j * n:(j + 1) * n] for j in range(n_k)])
+
+
+def write_op4(path: str | Path, matrices: dict[str, np.ndarray], digits: int = 9) -> Path:
+    """Write dense matrices as a formatted OP4 file (``1P,5E{digits+7}.{digits}``); used to
+    test :func:`read_op4` round trip and to export models to other codes."""
+    width = digits + 7
+    fmt = f"1P,5E{width}.{digits}"
+    lines = []
+
+    def fmt_vals(vals):
+        s = [f"{v: .{digits}E}".rjust(width) for v in vals]
+        return ["".join(s[j:j + 5]) for j in range(0, len(s), 5)]
+
+    for name, a in matrices.items():
+        a = np.atleast_2d(np.asarray(a))
+        cplx = np.iscomplexobj(a)
+        nrow, ncol = a.shape
+        lines.append(f"{ncol:8d}{nrow:8d}{2:8d}{4 if cplx else 2:8d}{name:<8s}{fmt}")
+        for j in range(ncol):
+            col = a[:, j]
+            nz = np.nonzero(col)[0]
+            if nz.size == 0:
+                continue
+            r0, r1 = nz[0], nz[-1] + 1
+            seg = col[r0:r1]
+            words = np.column_stack([seg.real, seg.imag]).ravel() if cplx else seg
+            lines.append(f"{j + 1:8d}{r0 + 1:8d}{len(words):8d}")
+            lines.extend(fmt_vals(words))
+        lines.append(f"{ncol + 1:8d}{1:8d}{1:8d}")
+        lines.extend(fmt_vals([1.0]))
+    Path(path).write_text("\n".join(lines) + "\n")
+    return Path(path)
