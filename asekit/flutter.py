@@ -610,8 +610,9 @@ def simulate_free_response(A: np.ndarray, z0: np.ndarray, t_end: float = 0.25,
         return TimeResponse(t=t, z=z, steps=np.array([]), method="exact")
     if not (np.isfinite(max_step) and max_step > 0):
         raise ValueError(f"max_step must be > 0, got {max_step}")
+    extra = {"jac": A} if method in ("Radau", "BDF", "LSODA") else {}
     sol = solve_ivp(lambda _t, y: A @ y, (0.0, t_end), z0, method=method, t_eval=t,
-                    max_step=max_step, rtol=rtol, atol=atol, jac=A, dense_output=False)
+                    max_step=max_step, rtol=rtol, atol=atol, **extra)
     if not sol.success:
         raise RuntimeError(f"solve_ivp failed: {sol.message}")
     # accepted step sizes are not returned by solve_ivp's t_eval output: rerun cheaply

@@ -171,3 +171,49 @@ def write_op4(path: str | Path, matrices: dict[str, np.ndarray], digits: int = 9
         lines.extend(fmt_vals([1.0]))
     Path(path).write_text("\n".join(lines) + "\n")
     return Path(path)
+
+
+# --------------------------------------------------------------------------------------------
+# MSC Nastran example HA145B (BAH wing), shipped in ../shared/benchmarks/bah_ha145b/
+# --------------------------------------------------------------------------------------------
+#: Facts of the HA145B deck (from the benchmark's README): Nastran k = omega (refc/2) / V.
+HA145B_K = (0.000001, 0.001, 0.05, 0.10, 0.20, 0.50, 1.0)
+HA145B_REFC = 131.232          # in
+HA145B_RHO = 1.1468e-7         # lbf s^2 / in^4
+HA145B_VELOCITIES = (4800.0, 25200.0)   # in/s, the p-k sweep range of the deck
+
+
+@dataclass(frozen=True)
+class NastranFlutterCase:
+    """A modal flutter case read from Nastran output: M, K (n x n), Q (n_k, n, n) at
+    reduced frequencies k, semi-chord b_ref, density rho (consistent units), label."""
+
+    M: np.ndarray
+    K: np.ndarray
+    Q: np.ndarray
+    k: np.ndarray
+    b_ref: float
+    rho: float
+    label: str
+
+
+def ha145b_path() -> Path:
+    """Location of ``ha145b.op4``: ``<repo>/../shared/benchmarks/bah_ha145b/ha145b.op4``."""
+    from .paths import DATA_DIR
+    return DATA_DIR.parent.parent / "shared" / "benchmarks" / "bah_ha145b" / "ha145b.op4"
+
+
+def load_ha145b(path: str | Path | None = None) -> NastranFlutterCase:
+    """Read Nastran's HA145B matrices (KHH, MHH, QHHL) with :func:`read_op4`.
+
+    Units inch, lbf, s. Raises FileNotFoundError if the benchmark file is absent.
+    """
+    path = ha145b_path() if path is None else Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"HA145B benchmark file not found: {path}")
+    mats = read_op4(path)
+    k = np.array(HA145B_K)
+    return NastranFlutterCase(M=mats["MHH"].data, K=mats["KHH"].data,
+                              Q=split_qhhl(mats["QHHL"].data, k.size), k=k,
+                              b_ref=HA145B_REFC / 2, rho=HA145B_RHO,
+                              label="MSC Nastran HA145B (BAH wing, Mach 0)")
