@@ -1,0 +1,349 @@
+"""Chapter 3.2.2-3.3 reproduction: RFA fit, p-k (Tables 9-10), root locus, time domain
+(Table 11) and divergence for the reference fin, plus the HA145B cross-check.
+
+The fin's GAF database comes from :func:`asekit.aero.gaf.fin_gaf_database` (rigid pitch mode
+first). When that module or its cache is not available the fin quantities are reported as None
+with a note, and only the Nastran HA145B validation is computed.
+
+Conventions: densities from the 1976 standard atmosphere (the thesis's Table 9/10 densities at
+2500 m and 5000 m, 1.173 and 0.902 kg/m^3, are not standard: 0.957 and 0.736); rigid pitch mode
+held (actuator clamped, Eq. 3.12 s-set); airspeed sweep 100-460 m/s (the thesis swept 180-340
+m/s; the first instability of any kind is searched up to 460 m/s). Flutter keys report the first
+oscillatory instability in the sweep, None if there is none.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..atmosphere import standard_atmosphere
+from ..flutter import (TabulatedGaf, divergence_speeds, first_of, pk_flutter, pk_instabilities,
+                       root_locus, root_locus_instabilities, time_domain_sweep)
+from ..reproduce import ChapterResult, Quantity
+
+VELOCITIES = np.arange(100.0, 460.0 + 1e-9, 2.0)      # m/s
+ALTITUDES = (0.0, 2500.0, 5000.0)                       # m
+MACHS = {"M075": 0.75, "M06": 0.6}
+N_LAGS = 4
+
+
+def load_fin_gafs():
+    """(GafDatabase, ModalModel) of the fin, or (None, reason) when not available."""
+    try:
+        from ..aero.gaf import fin_gaf_database
+    except ImportError as exc:           # the aerodynamics module is not there yet
+        return None, f"asekit.aero.gaf not available ({exc.__class__.__name__})"
+    try:
+        db, modal = fin_gaf_database(rebuild=False, progress=False)
+    except Exception as exc:             # noqa: BLE001 - report any build/cache failure as a note
+        return None, f"fin GAF database unavailable: {exc}"
+    return (db, modal), ""
+
+
+def fin_gaf(db, mach: float) -> TabulatedGaf:
+    """The database's GAFs at one Mach as a :class:`TabulatedGaf` (exact Mach required)."""
+    from ..rfa import gaf_at_mach
+    k, q = gaf_at_mach(db, mach)
+    return TabulatedGaf(k, q, db.b_ref, mach=mach)
+
+
+def fin_rfa(db, mach: float, n_lags: int = N_LAGS, constrain_k0: bool = False, lag_roots=None):
+    """Roger fit of the fin's GAFs at ``mach`` (default lag roots over the database's k)."""
+    from ..rfa import roger_fit_database
+    return roger_fit_database(db, mach, n_lags=n_lags, constrain_k0=constrain_k0,
+                              lag_roots=lag_roots)
+
+
+def analyse_condition(modal, db, mach: float, altitude: float, velocities=VELOCITIES,
+                      density: float | None = None) -> dict:
+    """p-k at one (Mach, altitude): result, instabilities, first flutter and first of any kind."""
+    rho = float(standard_atmosphere(altitude).density) if density is None else density
+    gaf = fin_gaf(db, mach)
+    res = pk_flutter(modal, gaf, rho, velocities)
+    inst = pk_instabilities(res, modal, gaf)
+    return {"density": rho, "gaf": gaf, "pk": res, "instabilities": inst,
+            "flutter": first_of(inst, "flutter"), "divergence": first_of(inst, "divergence"),
+            "first": first_of(inst)}
+
+
+def time_domain_first(modal, fit, rho: float, velocities=np.arange(100.0, 461.0, 10.0)):
+    """Time-domain growth sweep and the onset kind (flutter if the A_sys root crossing near the
+    onset is oscillatory, else divergence)."""
+    from ..aeroelastic import aeroelastic_matrices
+    td = time_domain_sweep(modal, fit, rho, velocities, coordinate=1)
+    kind = None
+    if td.onset_speed is not None:
+        ev = np.linalg.eigvals(aeroelastic_matrices(modal, fit, rho, td.onset_speed).A)
+        crit = ev[np.argmin(np.abs(ev.real))]
+        kind = "flutter" if abs(crit.imag) > 1e-3 * max(abs(crit), 1.0) else "divergence"
+    return td, kind
+
+
+def ha145b_check() -> dict | None:
+    """p-k, root locus and time domain on Nastran's HA145B (None if the file is absent)."""
+    from ..aeroelastic import modal_arrays
+    from ..nastran import ha145b_path, load_ha145b
+    from ..rfa import roger_fit
+    if not ha145b_path().exists():
+        return None
+    case = load_ha145b()
+    modal = modal_arrays(M=case.M, K=case.K, n_rigid=0)
+    gaf = TabulatedGaf(case.k, case.Q, case.b_ref, mach=0.0)
+    U = np.linspace(4800.0, 25200.0, 69)
+    res = pk_flutter(modal, gaf, case.rho, U)
+    pk = first_of(pk_instabilities(res, modal, gaf), "flutter")
+    fit = roger_fit(case.k, case.Q, case.b_ref, n_lags=4)
+    rl = root_locus(modal, fit, case.rho, U)
+    rlf = first_of(root_locus_instabilities(rl, modal, fit), "flutter")
+    td = time_domain_sweep(modal, fit, case.rho, np.linspace(11500, 14000, 6), t_end=3.0)
+    return {"case": case, "pk_result": res, "pk": pk, "fit": fit, "root_locus": rl,
+            "rl": rlf, "td": td}
+
+
+def _val(x, attr):
+    return None if x is None else float(getattr(x, attr))
+
+
+def run(figures: bool = False) -> ChapterResult:
+    """Compute the chapter's quantities (and figures when ``figures``)."""
+    q = []
+    figs = {}
+    ha = ha145b_check()
+    note_ha = "" if ha is not None else "HA145B benchmark file not present"
+    q.append(Quantity("flutter.ha145b.pk.speed_ins", _val(ha and ha["pk"], "speed"), "in/s",
+                      "Nastran HA145B: published ~12672 in/s" if ha else note_ha))
+    q.append(Quantity("flutter.ha145b.pk.freq_hz", _val(ha and ha["pk"], "frequency_hz"), "Hz",
+                      "Nastran HA145B: published ~3.1 Hz" if ha else note_ha))
+    q.append(Quantity("flutter.ha145b.root_locus.speed_ins", _val(ha and ha["rl"], "speed"),
+                      "in/s", "Roger RFA, 4 lags" if ha else note_ha))
+    q.append(Quantity("flutter.ha145b.time_domain.speed_ins",
+                      None if ha is None else ha["td"].onset_speed, "in/s", note_ha))
+
+    data, reason = load_fin_gafs()
+    fin_keys = [f"flutter.pk.{mk}.h{int(h)}.{s}" for mk in MACHS for h in ALTITUDES
+                for s in ("speed_ms", "freq_hz")]
+    fin_keys += ["flutter.root_locus.M075.h0.speed_ms", "flutter.root_locus.M075.h0.freq_hz",
+                 "flutter.time_domain.M075.h0.speed_ms", "rfa.M075.fit_error",
+                 "flutter.divergence.M075.h0.speed_ms",
+                 "flutter.first_instability.pk.M075.h0.speed_ms",
+                 "flutter.first_instability.root_locus.M075.h0.speed_ms",
+                 "flutter.first_instability.time_domain.M075.h0.speed_ms"]
+    if data is None:
+        for key in fin_keys:
+            unit = "Hz" if key.endswith("freq_hz") else ("-" if "fit_error" in key else "m/s")
+            q.append(Quantity(key, None, unit, reason))
+        if figures and ha is not None:
+            figs.update(ha145b_figures(ha))
+        return ChapterResult(chapter="flutter", quantities=tuple(q), figures=figs)
+
+    db, modal = data
+    sweep_note = "1976 std atm; sweep 100-460 m/s"
+    conds = {}
+    for mk, mach in MACHS.items():
+        for h in ALTITUDES:
+            c = analyse_condition(modal, db, mach, h)
+            conds[(mk, h)] = c
+            fl = c["flutter"]
+            note = sweep_note if fl is None else f"mode {fl.mode + 1}; {sweep_note}"
+            q.append(Quantity(f"flutter.pk.{mk}.h{int(h)}.speed_ms", _val(fl, "speed"), "m/s",
+                              note + ("; none found" if fl is None else "")))
+            q.append(Quantity(f"flutter.pk.{mk}.h{int(h)}.freq_hz", _val(fl, "frequency_hz"),
+                              "Hz", note))
+    c0 = conds[("M075", 0.0)]
+    fit = fin_rfa(db, 0.75)
+    rl = root_locus(modal, fit, c0["density"], VELOCITIES)
+    rl_inst = root_locus_instabilities(rl, modal, fit)
+    rl_fl = first_of(rl_inst, "flutter")
+    q.append(Quantity("flutter.root_locus.M075.h0.speed_ms", _val(rl_fl, "speed"), "m/s",
+                      f"Roger, {fit.n_lags} lags"))
+    q.append(Quantity("flutter.root_locus.M075.h0.freq_hz", _val(rl_fl, "frequency_hz"), "Hz",
+                      ""))
+    td, td_kind = time_domain_first(modal, fit, c0["density"])
+    q.append(Quantity("flutter.time_domain.M075.h0.speed_ms",
+                      td.onset_speed if td_kind == "flutter" else None, "m/s",
+                      f"onset is {td_kind}" if td_kind else "no growth up to 460 m/s"))
+    q.append(Quantity("rfa.M075.fit_error", fit.fit_error, "-",
+                      "||Q - Q~||_F / ||Q||_F over all k"))
+    gaf0 = c0["gaf"]
+    dv = divergence_speeds(modal, gaf0.Q[0], c0["density"])
+    q.append(Quantity("flutter.divergence.M075.h0.speed_ms",
+                      float(dv[0]) if dv.size else None, "m/s",
+                      "static, det(K_ss - q Q_ss^R(k_min)) = 0"))
+    q.append(Quantity("flutter.first_instability.pk.M075.h0.speed_ms",
+                      _val(c0["first"], "speed"), "m/s",
+                      c0["first"].kind if c0["first"] else "none up to 460 m/s"))
+    rl_first = first_of(rl_inst)
+    q.append(Quantity("flutter.first_instability.root_locus.M075.h0.speed_ms",
+                      _val(rl_first, "speed"), "m/s",
+                      rl_first.kind if rl_first else "none up to 460 m/s"))
+    q.append(Quantity("flutter.first_instability.time_domain.M075.h0.speed_ms",
+                      td.onset_speed, "m/s", td_kind or "none up to 460 m/s"))
+    if figures:
+        figs.update(fin_figures(modal, db, fit, conds, rl, td))
+        if ha is not None:
+            figs.update(ha145b_figures(ha))
+    return ChapterResult(chapter="flutter", quantities=tuple(q), figures=figs)
+
+
+# --------------------------------------------------------------------------------------------
+# figures (also used by notebooks/ch3_flutter.ipynb)
+# --------------------------------------------------------------------------------------------
+def fig_rfa_element(fit, i: int, j: int, thesis_figure: str = "Fig 23"):
+    """Data vs Roger fit of element Q_ij in the complex plane (Figs 23-24)."""
+    from ..plotting import new_figure
+    fig, ax = new_figure(f"RFA fit of Q_{i + 1}{j + 1} (Mach {fit.mach})", thesis_figure)
+    kk = np.geomspace(max(fit.k[0], 1e-4), fit.k[-1], 300)
+    qf = fit.evaluate(kk)[:, i, j]
+    ax.plot(fit.Q[:, i, j].real, fit.Q[:, i, j].imag, "o", label="GAF data")
+    ax.plot(qf.real, qf.imag, "-", label=f"Roger, {fit.n_lags} lags")
+    ax.set_xlabel("Re Q (per unit q)")
+    ax.set_ylabel("Im Q (per unit q)")
+    ax.legend()
+    return fig
+
+
+def fig_mach_airspeed_altitude(points=(), thesis_figure: str = "Fig 25"):
+    """Mach lines in the airspeed-altitude plane (Fig 25), optional (U, h, label) points."""
+    from ..plotting import new_figure
+    fig, ax = new_figure("Mach - airspeed - altitude (1976 standard atmosphere)", thesis_figure)
+    h = np.linspace(0, 12000, 100)
+    a = standard_atmosphere(h).speed_of_sound
+    for m in (0.4, 0.5, 0.6, 0.7, 0.75, 0.8, 0.9, 1.0):
+        ax.plot(m * a, h / 1000, lw=1, label=f"M {m}")
+    for u, hh, lab in points:
+        ax.plot(u, hh / 1000, "k*", ms=10)
+        ax.annotate(lab, (u, hh / 1000))
+    ax.set_xlabel("true airspeed (m/s)")
+    ax.set_ylabel("altitude (km)")
+    ax.legend(ncol=2, fontsize=8)
+    return fig
+
+
+def fig_pk(res, title="p-k damping and frequency", thesis_figure="Figs 30-31", unit="m/s"):
+    """Damping g and frequency vs airspeed of every tracked mode (Figs 30-31)."""
+    from ..plotting import new_figure
+    fig, (a1, a2) = new_figure(title, thesis_figure, nrows=2, figsize=(6.4, 6.5))
+    for j in range(res.p.shape[1]):
+        a1.plot(res.velocities, res.damping_g[:, j], label=f"mode {j + 1}")
+        a2.plot(res.velocities, res.frequency_hz[:, j])
+    a1.axhline(0, color="k", lw=0.8)
+    a1.set_ylabel("damping g = 2 Re p / |p|")
+    a1.set_ylim(max(a1.get_ylim()[0], -1.0), min(a1.get_ylim()[1], 0.5))
+    a1.legend(fontsize=8)
+    a2.set_xlabel(f"airspeed ({unit})")
+    a2.set_ylabel("frequency (Hz)")
+    return fig
+
+
+def fig_root_locus(rl, thesis_figure="Figs 32, 35"):
+    """Aeroelastic roots over airspeed in the complex plane (Figs 32, 35)."""
+    from ..plotting import new_figure
+    fig, ax = new_figure("Root locus of A_sys (aeroelastic roots)", thesis_figure)
+    for j in range(rl.elastic.shape[1]):
+        ax.plot(rl.elastic[:, j].real, rl.elastic[:, j].imag / (2 * np.pi), ".-", ms=3,
+                label=f"mode {j + 1}")
+    ax.axvline(0, color="k", lw=0.8)
+    ax.set_xlabel("Re lambda (1/s)")
+    ax.set_ylabel("Im lambda / 2 pi (Hz)")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def fig_root_locus_damping(rl, thesis_figure="Figs 33-34", unit="m/s"):
+    """Damping ratio and natural frequency of the aeroelastic roots vs airspeed (Eq. 3.13)."""
+    from ..plotting import new_figure
+    fig, (a1, a2) = new_figure("Root locus: damping ratio and frequency", thesis_figure,
+                               nrows=2, figsize=(6.4, 6.5))
+    for j in range(rl.elastic.shape[1]):
+        a1.plot(rl.velocities, rl.damping_ratio[:, j], label=f"mode {j + 1}")
+        a2.plot(rl.velocities, rl.frequency_hz[:, j])
+    a1.axhline(0, color="k", lw=0.8)
+    a1.set_ylabel("damping ratio xi")
+    a1.legend(fontsize=8)
+    a2.set_xlabel(f"airspeed ({unit})")
+    a2.set_ylabel("frequency (Hz)")
+    return fig
+
+
+def fig_time_response(resp, coordinate=1, speed=None, thesis_figure="Figs 36-38"):
+    """Elastic coordinate history (Figs 36-38)."""
+    from ..plotting import new_figure
+    fig, ax = new_figure(f"Free response, zeta_{coordinate + 1}"
+                         + (f" at {speed:.0f} m/s" if speed else ""), thesis_figure)
+    ax.plot(resp.t, resp.z[:, coordinate], lw=0.8)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel(f"zeta_{coordinate + 1}")
+    return fig
+
+
+def fig_growth(td, thesis_figure="Table 11", unit="m/s"):
+    """Growth rate of the free response vs airspeed."""
+    from ..plotting import new_figure
+    fig, ax = new_figure("Time domain: growth rate vs airspeed", thesis_figure)
+    ax.plot(td.velocities, td.growth, "o-")
+    ax.axhline(0, color="k", lw=0.8)
+    if td.onset_speed:
+        ax.axvline(td.onset_speed, color="C3", ls="--", label=f"onset {td.onset_speed:.1f}")
+        ax.legend()
+    ax.set_xlabel(f"airspeed ({unit})")
+    ax.set_ylabel("growth rate (1/s)")
+    return fig
+
+
+def fin_figures(modal, db, fit, conds, rl, td) -> dict:
+    from ..aeroelastic import aeroelastic_matrices
+    from ..flutter import initial_state, simulate_free_response
+    figs = {"fig23_rfa_q45": fig_rfa_element(fit, min(3, fit.n_modes - 1),
+                                             min(4, fit.n_modes - 1), "Fig 23"),
+            "fig24_rfa_q12": fig_rfa_element(fit, 0, 1, "Fig 24")}
+    pts = [(c["flutter"].speed, h, f"{mk}") for (mk, h), c in conds.items()
+           if c["flutter"] is not None]
+    figs["fig25_mach_airspeed_altitude"] = fig_mach_airspeed_altitude(pts)
+    figs["fig30_31_pk"] = fig_pk(conds[("M075", 0.0)]["pk"], "p-k, Mach 0.75, sea level")
+    figs["fig32_35_root_locus"] = fig_root_locus(rl)
+    figs["fig33_34_root_locus_damping"] = fig_root_locus_damping(rl)
+    figs["fig_growth"] = fig_growth(td)
+    u = td.onset_speed or 300.0
+    mats = aeroelastic_matrices(modal, fit, conds[("M075", 0.0)]["density"], u)
+    resp = simulate_free_response(mats.A, initial_state(mats.n_states, 1), 0.25, 1e-4, "RK45")
+    figs["fig37_time_response"] = fig_time_response(resp, 1, u, "Fig 37")
+    return figs
+
+
+def ha145b_figures(ha) -> dict:
+    return {"ha145b_pk": fig_pk(ha["pk_result"], "HA145B p-k (Nastran matrices)", "HA145B",
+                                unit="in/s"),
+            "ha145b_root_locus": fig_root_locus(ha["root_locus"], "HA145B")}
+
+
+def root_locus_panel(modal, db, mach: float = 0.75, n_lags: int = N_LAGS):
+    """Interactive airspeed/altitude panel over the root locus (ipywidgets). Returns the widget
+    box, or None when ipywidgets is not installed. Safe without a front-end."""
+    try:
+        import ipywidgets as w
+    except ImportError:
+        return None
+    import matplotlib.pyplot as plt
+    from ..aeroelastic import aeroelastic_matrices
+    fit = fin_rfa(db, mach, n_lags=n_lags)
+    out = w.Output()
+    speed = w.FloatSlider(value=250.0, min=100.0, max=460.0, step=2.0, description="U (m/s)")
+    alt = w.FloatSlider(value=0.0, min=0.0, max=10000.0, step=500.0, description="h (m)")
+
+    def draw(*_):
+        rho = float(standard_atmosphere(alt.value).density)
+        ev = np.linalg.eigvals(aeroelastic_matrices(modal, fit, rho, speed.value).A)
+        with out:
+            out.clear_output(wait=True)
+            fig, ax = plt.subplots(figsize=(6, 4))
+            ax.plot(ev.real, ev.imag / (2 * np.pi), "x")
+            ax.axvline(0, color="k", lw=0.8)
+            ax.set_xlabel("Re lambda (1/s)")
+            ax.set_ylabel("Im lambda / 2 pi (Hz)")
+            ax.set_title(f"A_sys roots, M {mach}, U {speed.value:.0f} m/s, h {alt.value:.0f} m")
+            plt.show()
+
+    speed.observe(draw, "value")
+    alt.observe(draw, "value")
+    draw()
+    return w.VBox([speed, alt, out])
