@@ -1,0 +1,460 @@
+"""Subsonic doublet-lattice method (DLM) for harmonically oscillating lifting surfaces.
+
+References (equation numbers below refer to these):
+
+- [AR69] E. Albano, W. P. Rodden, "A doublet-lattice method for calculating lift distributions
+  on oscillating surfaces in subsonic flows", AIAA J. 7(2), 1969, 279-285.
+- [R71] W. P. Rodden, J. P. Giesing, T. P. Kalman, "New developments and applications of the
+  subsonic doublet-lattice method for nonplanar configurations", AGARD CP-80-71, 1971
+  (refined kernel, parabolic approximation of the numerator, Laschka's approximation of the
+  kernel integrals, Appendix A).
+- [R98] W. P. Rodden, P. F. Taylor, S. C. McIntosh, "Further refinement of the subsonic
+  doublet-lattice method", J. Aircraft 35(5), 1998, 720-727 (quartic approximation, Desmarais'
+  12-term approximation of the integrals).
+
+Formulation. Every box carries a line of acceleration-potential doublets of constant strength on
+its quarter chord (from P1 to P3, half-width e, sweep Lambda, dihedral gamma) and a control point
+at three-quarter chord, mid-span. The normalwash at control point r due to the pressure jump of
+box s is ([R98] Eq. 1-3)
+
+    w_r / U = sum_s D_rs DeltaCp_s,     D_rs = D0_rs + D1_rs + D2_rs,
+
+where D0 is the steady (k = 0) part, computed by the horseshoe vortex lattice
+(:mod:`asekit.aero.vlm`), and D1, D2 are the planar and nonplanar *incremental* oscillatory
+parts, ([R71] Eqs. 22, 27, 36; [R98] Eqs. 4-5)
+
+    D1_rs = dx_s / (8 pi) int_{-e}^{e} P1(eta) / r1^2 d eta,
+    D2_rs = dx_s / (8 pi) int_{-e}^{e} P2(eta) / r1^4 d eta,
+    P1 = -(K1 exp(-i omega x0 / U) - K10) T1,      P2 = -(K2 exp(-i omega x0 / U) - K20) T2*,
+
+with x0 = xbar - eta tan(Lambda), r1^2 = (ybar - eta)^2 + zbar^2 in the sending box's local
+axes, T1 = cos(gamma_r - gamma_s), T2* = zbar (zbar cos(gamma_s - gamma_r) + (ybar - eta)
+sin(gamma_s - gamma_r)) ([R71] Eqs. 5, 21), K1, K2 Landahl's kernel functions ([R71] Eqs. 7-8,
+with R, u1, k1 of Eqs. 9-12) and K10, K20 their steady values ([R71] Eqs. 15-16). The kernel
+integrals I1, I2 are approximated by Laschka's 11-term ([R71] Eqs. A.1-A.9) or Desmarais'
+12-term ([R98] Eq. 11 and the table following it) exponential series.
+
+The numerators P1, P2 are replaced by the polynomial through their values at eta = -e, 0, e
+(parabolic, [R71] Eqs. 28-30 and 37-39) or -e, -e/2, 0, e/2, e (quartic, [R98] Eqs. 15-19 and
+28-32), and the remaining integrals of eta^m / r1^(2p) are done exactly. asekit writes that
+step as a fixed, k-independent quadrature: D1_rs = sum_j P1(eta_j) W1_j with weights
+W1_j = dx/(8 pi) sum_m V^-1[m, j] e^-m int eta^m / r1^2 d eta (V the Vandermonde matrix of the
+normalised points); the closed forms of the integrals are those of [R71] Eqs. 31-34, 40-41 and
+[R98] Eqs. 20-34 in expanded form. Pairs whose receiver is farther than 2e from the doublet
+line use 8-point Gauss-Legendre quadrature for the same integrals (error below 1e-12 there,
+and free of the cancellation of the closed forms far away). The weights and all kernel
+geometry depend on the Mach number but not on k: they are computed once per row chunk and
+reused for every reduced frequency of a sweep.
+
+Conventions. x downstream, y span, z up; time dependence exp(i omega t); reduced frequency
+k = omega b / U with the reference semi-chord ``b_ref`` given by the caller (for the reference
+fin, 0.078 m: the root semi-chord). Delta Cp is positive when it pushes the box along its normal
+(+z for a horizontal box); w/U is the normalwash along the receiving box normal that the
+surface motion imposes, w/U = dh/dx + i k h / b for a normal displacement h(x, y). The
+aerodynamic influence matrix returned by :func:`aic_matrix` is AIC = D^-1, so
+DeltaCp = AIC (w/U). A flat plate at incidence alpha has w/U = -alpha and a positive Delta Cp.
+
+Planar pairs (|zbar| <= 0.001 e, the threshold of [R71] and NASTRAN) use zbar = 0 in the
+integrals and have no nonplanar part; the limit r1 -> 0 of the kernel is taken explicitly
+([R71]: K1 -> -2, K2 -> 4 downstream, 0 upstream).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .boxes import BoxMesh
+from .vlm import check_mach, vlm_normalwash_matrix, CHUNK_BYTES
+
+#: Laschka's approximation of u / sqrt(1 + u^2) ~ 1 - sum a_n exp(-n c u) ([R71] Eq. A.4;
+#: coefficients as tabulated by Blair 1992, WL-TR-92-3028, p. 89).
+LASCHKA_C = 0.372
+LASCHKA_A = np.array([+0.24186198, -2.7918027, +24.991079, -111.59196, +271.43549, -305.75288,
+                      -41.183630, +545.98537, -644.78155, +328.72755, -64.279511])
+#: Desmarais' 12-term approximation, exponents 2^n b ([R98] Eq. 11 and its coefficient table).
+DESMARAIS_B = 0.009054814793
+DESMARAIS_A = np.array([0.000319759140, -0.000055461471, 0.002726074362, 0.005749551566,
+                        0.031455895072, 0.106031126212, 0.406838011567, 0.798112357155,
+                        -0.417749229098, 0.077480713894, -0.012677284771, 0.001787032960])
+
+_METHODS = {
+    # name: (normalised kernel stations, exponents p_n, coefficients a_n)
+    "parabolic": (np.array([-1.0, 0.0, 1.0]), LASCHKA_C * np.arange(1, 12), LASCHKA_A),
+    "quartic": (np.array([-1.0, -0.5, 0.0, 0.5, 1.0]), DESMARAIS_B * 2.0 ** np.arange(1, 13),
+                DESMARAIS_A),
+}
+_PLANAR_TOL = 1e-3          # |zbar| / e below which a pair is planar ([R71], NASTRAN)
+_FAR = 3.0                  # receiver farther than _FAR * e from the doublet line: quadrature
+_GAUSS = np.polynomial.legendre.leggauss(8)
+#: Receiver-sender pairs per row chunk: small enough for the arrays to stay in the CPU cache.
+PAIRS_PER_CHUNK = 32768
+
+
+def check_k(k) -> np.ndarray:
+    """Validate reduced frequencies: finite and >= 0 (raises ValueError). Returns a 1-D array."""
+    ks = np.atleast_1d(np.asarray(k, float))
+    if ks.ndim != 1 or ks.size == 0 or not np.all(np.isfinite(ks)) or np.any(ks < 0):
+        raise ValueError(f"k must be finite reduced frequencies >= 0, got {k!r}")
+    return ks
+
+
+def _check_bref(b_ref: float) -> float:
+    b = float(b_ref)
+    if not math.isfinite(b) or b <= 0:
+        raise ValueError(f"b_ref must be a finite reference semi-chord > 0 m, got {b_ref!r}")
+    return b
+
+
+def _check_method(method: str):
+    if method not in _METHODS:
+        raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}")
+    return _METHODS[method]
+
+
+# ---------------------------------------------------------------------------------------------
+# k-independent geometry of a row chunk
+# ---------------------------------------------------------------------------------------------
+class _Senders:
+    """Sending-box arrays (isolated mesh, or mesh plus its image in y = 0)."""
+
+    def __init__(self, mesh: BoxMesh, symmetric: bool):
+        parts = (mesh, mesh.mirrored()) if symmetric else (mesh,)
+        cat = lambda f: np.concatenate([f(p) for p in parts])  # noqa: E731
+        self.mid = cat(lambda p: p.load_point)
+        self.e = cat(lambda p: p.half_width)
+        self.tan_sweep = cat(lambda p: p.tan_sweep)
+        self.gamma = cat(lambda p: p.dihedral)
+        self.chord = cat(lambda p: p.chord)
+        self.n_images = len(parts)
+
+
+def _line_integrals(ybar, zbar, e, planar, power, m_max):
+    """Closed forms of int_{-e}^{e} eta^m / ((ybar-eta)^2 + zbar^2)^power d eta, m = 0..m_max.
+
+    Written with t = eta - ybar: int t^j / (t^2 + z^2) (J_j) and / (t^2 + z^2)^2 (L_j) by the
+    recurrences J_j = [t^(j-1)]/(j-1) - z^2 J_(j-2), L_j = J_(j-2) - z^2 L_(j-2) and the
+    binomial expansion of eta^m. Planar pairs (z = 0) take the finite-part values of [R71]
+    (F = 2e / (ybar^2 - e^2), Eq. 31a). Returns a list of arrays (one per m).
+    """
+    ta = -e - ybar
+    tb = e - ybar
+    z = np.where(planar, 0.0, zbar)
+    z2 = z * z
+    da = ta * ta + z2
+    db = tb * tb + z2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # F: [R71] Eq. 31 (arctan form) and its planar limit
+        az = np.abs(z)
+        f_np = np.arctan2(2.0 * e * az, ybar * ybar + z2 - e * e) / np.where(planar, 1.0, az)
+        f_pl = 2.0 * e / (ybar * ybar - e * e)
+        j = [np.where(planar, f_pl, f_np), 0.5 * np.log(db / da)]
+        for n in range(2, m_max + 1):
+            j.append((tb ** (n - 1) - ta ** (n - 1)) / (n - 1) - z2 * j[n - 2])
+        if power == 1:
+            base = j
+        else:
+            inv2z2 = 0.5 / np.where(planar, 1.0, z2)
+            lst = [inv2z2 * (tb / db - ta / da + j[0]), -0.5 / db + 0.5 / da]
+            for n in range(2, m_max + 1):
+                lst.append(j[n - 2] - z2 * lst[n - 2])
+            base = lst
+    out = []
+    for m in range(m_max + 1):
+        acc = np.zeros_like(ybar)
+        for jj in range(m + 1):
+            acc = acc + math.comb(m, jj) * ybar ** (m - jj) * base[jj]
+        out.append(acc)
+    return out
+
+
+def _far_weights(ybar, zbar, e, chord, stations, power):
+    """Weights W_j for distant pairs by 8-point Gauss-Legendre quadrature of the interpolating
+    polynomial over r1^(2 power): W_j = dx/(8 pi) sum_g w_g e l_j(xi_g) / r1(xi_g e)^(2 power),
+    l_j the Lagrange basis of the stations (error below 1e-12 for receivers farther than 3e)."""
+    xg, wg = _GAUSS
+    ns = stations.size
+    # Lagrange basis of the stations at the Gauss points, lag[g, j]
+    vinv = np.linalg.inv(np.vander(stations, ns, increasing=True))
+    lag = np.vander(xg, ns, increasing=True) @ vinv
+    w = [np.zeros_like(ybar) for _ in range(ns)]
+    z2 = zbar * zbar
+    for g in range(xg.size):
+        r2 = ybar - xg[g] * e
+        r2 *= r2
+        r2 += z2
+        if power == 2:
+            r2 *= r2
+        inv = e / r2
+        for j in range(ns):
+            w[j] += (wg[g] * lag[g, j]) * inv
+    fac = chord / (8.0 * np.pi)
+    return [fac * wj for wj in w]
+
+
+def _weights(ybar, zbar, e, chord, stations, planar, power):
+    """Quadrature weights W_j (n_stations arrays) of [module docstring]: the exact integral of the
+    interpolating polynomial of the numerator through the stations, times dx / (8 pi)."""
+    ns = stations.size
+    dist2 = np.maximum(np.abs(ybar) - e, 0.0) ** 2 + zbar * zbar
+    near = np.nonzero(dist2 <= (_FAR * e) ** 2)
+    w = _far_weights(ybar, zbar, e, chord, stations, power)
+    if near[0].size:
+        vinv = np.linalg.inv(np.vander(stations, ns, increasing=True))   # a_m = vinv[m, j] P_j
+        yb, zb, en = ybar[near], zbar[near], e[near]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            closed = _line_integrals(yb, zb, en, planar[near], power, ns - 1)
+            fac = chord[near] / (8.0 * np.pi)
+            for jst in range(ns):
+                acc = np.zeros_like(yb)
+                for m in range(ns):
+                    acc = acc + vinv[m, jst] * closed[m] / en ** m
+                w[jst][near] = fac * acc
+    return w
+
+
+class _ChunkGeometry:
+    """Everything k-independent for receivers ``rows`` against all senders at one Mach."""
+
+    def __init__(self, mesh: BoxMesh, snd: _Senders, rows: slice, mach: float, method: str):
+        stations, _, _ = _METHODS[method]
+        beta2 = 1.0 - mach * mach
+        pr = mesh.control_point[rows]
+        gr = mesh.dihedral[rows]
+        d = pr[:, None, :] - snd.mid[None, :, :]
+        cg, sg = np.cos(snd.gamma)[None, :], np.sin(snd.gamma)[None, :]
+        xbar = d[..., 0]
+        ybar = d[..., 1] * cg + d[..., 2] * sg               # [R71] Eq. 4 (local axes)
+        zbar = d[..., 2] * cg - d[..., 1] * sg
+        e = np.broadcast_to(snd.e[None, :], xbar.shape)
+        chord = np.broadcast_to(snd.chord[None, :], xbar.shape)
+        gsr = snd.gamma[None, :] - gr[:, None]
+        planar = np.abs(zbar) <= _PLANAR_TOL * e
+        self.nonplanar = bool(np.any(~planar))
+        self.t1 = np.cos(gsr)                                 # [R71] Eq. 5
+        self.w1 = _weights(ybar, zbar, e, chord, stations, planar, 1)
+        self.w2 = _weights(ybar, zbar, e, chord, stations, planar, 2) if self.nonplanar else None
+        if self.nonplanar:
+            self.w2 = [np.where(planar, 0.0, w) for w in self.w2]
+        self.points = []
+        tl = snd.tan_sweep[None, :]
+        for s in stations:
+            eta = s * e
+            x0 = xbar - eta * tl
+            r1 = np.sqrt((ybar - eta) ** 2 + zbar ** 2)       # [R71] Eq. 4
+            small = r1 <= 1e-12 * e
+            r1s = np.where(small, 1.0, r1)
+            big_r = np.sqrt(x0 * x0 + beta2 * r1 * r1)        # [R71] Eq. 10
+            big_rs = np.where(big_r > 0, big_r, 1.0)
+            u1 = np.where(small, 0.0, (mach * big_r - x0) / (beta2 * r1s))   # [R71] Eq. 11
+            sq = np.sqrt(1.0 + u1 * u1)
+            p = {"x0": x0, "r1": np.where(small, 0.0, r1), "u1": u1, "neg": u1 < 0.0,
+                 "small": np.nonzero(small), "down": np.where(x0[small] >= 0.0, 1.0, 0.0)}
+            p["k10"] = -1.0 - x0 / big_rs                     # [R71] Eq. 15
+            p["c1"] = mach * r1 / (big_rs * sq)               # second term of [R71] Eq. 7
+            if self.nonplanar:
+                t2 = zbar * (zbar * np.cos(gsr) + (ybar - eta) * np.sin(gsr))   # [R71] Eq. 21
+                p["t2"] = np.where(planar, 0.0, t2)
+                rr = r1 / big_rs
+                p["k20"] = 2.0 + x0 * (2.0 + beta2 * rr * rr) / big_rs          # [R71] Eq. 16
+                p["c2a"] = mach * mach * rr * rr / sq                          # [R71] Eq. 8 terms
+                p["c2b"] = (mach * rr * ((1.0 + u1 * u1) * beta2 * rr * rr + 2.0 + mach * rr * u1)
+                            / (sq ** 3))
+            self.points.append(p)
+        for p, w in zip(self.points, self.w1):
+            p["t1w"] = self.t1 * w                            # T1 W1_j (k-independent)
+
+
+# ---------------------------------------------------------------------------------------------
+# k-dependent kernel
+# ---------------------------------------------------------------------------------------------
+def _i0_j0(u, k1, p_n, a_n, need_j):
+    """Series approximations of I0 and J0 ([R71] Eqs. A.4, A.8) for u >= 0: returns
+    (I0 real, I0 imag, J0 real, J0 imag) (J0 parts None if not needed). Powers of one
+    exponential give all terms (exp(-n c u) = exp(-c u)^n; exp(-2^n b u) by squaring).
+
+    I0 = sum a_n exp(-p_n u) (p_n - i k1) / (p_n^2 + k1^2),
+    J0 = sum a_n exp(-p_n u) / (p_n^2 + k1^2)^2 [p_n^2 - k1^2 + p_n u (p_n^2 + k1^2)
+         - i k1 (2 p_n + u (p_n^2 + k1^2))].
+    """
+    k1sq = k1 * k1
+    s_p = np.zeros_like(u)      # sum a e p / den
+    s_1 = np.zeros_like(u)      # sum a e / den
+    s_3 = np.zeros_like(u) if need_j else None   # sum a e (p^2 - k1^2) / den^2
+    s_5 = np.zeros_like(u) if need_j else None   # sum a e p / den^2
+    desmarais = p_n.size == 12
+    en = np.exp(-p_n[0] * u)
+    base = None if desmarais else en.copy()
+    t = np.empty_like(u)
+    den = np.empty_like(u)
+    for i, (p, a) in enumerate(zip(p_n, a_n)):
+        if i > 0:
+            if desmarais:
+                np.multiply(en, en, out=en)
+            else:
+                np.multiply(en, base, out=en)
+        np.add(k1sq, p * p, out=den)
+        np.divide(en, den, out=t)
+        t *= a
+        s_1 += t
+        if need_j:
+            np.divide(t, den, out=den)       # a e / den^2 (den no longer needed)
+            s_5 += p * den
+            s_3 += den * (p * p - k1sq)
+        t *= p
+        s_p += t
+    i0r, i0i = s_p, -k1 * s_1
+    if not need_j:
+        return i0r, i0i, None, None
+    j0r = s_3 + u * s_p
+    j0i = -k1 * (2.0 * s_5 + u * s_1)
+    return i0r, i0i, j0r, j0i
+
+
+def _re_at_zero(k1, p_n, a_n, need_i2):
+    """Re I1(0) and Re I2(0) ([R71] Eqs. A.5, A.9 need them for u1 < 0):
+    Re I1(0) = 1 - k1^2 S, Re I2(0) = (2 - k1^2 S + k1^2 Re J0(0)) / 3 with
+    S = sum a/(p^2+k1^2), Re J0(0) = sum a (p^2 - k1^2)/(p^2+k1^2)^2."""
+    k1sq = k1 * k1
+    s = np.zeros_like(k1)
+    sj = np.zeros_like(k1) if need_i2 else None
+    den = np.empty_like(k1)
+    for p, a in zip(p_n, a_n):
+        np.add(k1sq, p * p, out=den)
+        np.divide(a, den, out=den)
+        s += den
+        if need_i2:
+            sj += den * (p * p - k1sq) / (p * p + k1sq)
+    re1 = 1.0 - k1sq * s
+    re2 = (2.0 - k1sq * s + k1sq * sj) / 3.0 if need_i2 else None
+    return re1, re2
+
+
+def _integrals(u1, k1, p_n, a_n, need_i2, eku_abs):
+    """I1 (and I2) of [R71] Eqs. A.1, A.6 at u1 of either sign (Eqs. A.5, A.9 for u1 < 0).
+    ``eku_abs`` = exp(-i k1 |u1|)."""
+    neg = u1 < 0.0
+    u = np.abs(u1)
+    any_neg = bool(neg.any())
+    sq = np.sqrt(1.0 + u * u)
+    g = 1.0 - u / sq
+    i0r, i0i, j0r, j0i = _i0_j0(u, k1, p_n, a_n, need_i2)
+    # I1(u) = (1 - u/sqrt(1+u^2) - i k1 I0) exp(-i k1 u)
+    i1 = (g + k1 * i0i) + 1j * (-k1 * i0r)
+    i1 *= eku_abs
+    i2 = None
+    if need_i2:
+        # I2(u) = ((2 + i k1 u) g - u/(1+u^2)^1.5 - i k1 I0 + k1^2 J0) exp(-i k1 u) / 3
+        i2 = ((2.0 * g - u / sq ** 3 + k1 * i0i + k1 * k1 * j0r)
+              + 1j * (k1 * u * g - k1 * i0r + k1 * k1 * j0i)) * eku_abs / 3.0
+    if any_neg:
+        re1, re2 = _re_at_zero(k1, p_n, a_n, need_i2)
+        i1 = np.where(neg, (2.0 * re1 - i1.real) + 1j * i1.imag, i1)
+        if need_i2:
+            i2 = np.where(neg, (2.0 * re2 - i2.real) + 1j * i2.imag, i2)
+    return i1, i2
+
+
+def _increment(geo: _ChunkGeometry, mach: float, kd: float, method: str) -> np.ndarray:
+    """D1 + D2 of the chunk at omega / U = kd (1/m)."""
+    _, p_n, a_n = _METHODS[method]
+    out = np.zeros(geo.t1.shape, complex)
+    for p, w1, w2 in zip(geo.points, geo.w1, geo.w2 or [None] * len(geo.points)):
+        k1 = kd * p["r1"]                                   # [R71] Eq. 12
+        eku_abs = np.exp(-1j * (k1 * np.abs(p["u1"])))
+        i1, i2 = _integrals(p["u1"], k1, p_n, a_n, geo.nonplanar, eku_abs)
+        eku = np.where(p["neg"], eku_abs.conj(), eku_abs)
+        # K1 = -I1 - exp(-i k1 u1) M r1 / (R sqrt(1 + u1^2))      [R71] Eq. 7
+        k1v = eku * p["c1"]
+        k1v += i1
+        k1v[p["small"]] = 2.0 * p["down"]                  # r1 -> 0 limit; k1v holds -K1
+        px = np.exp(-1j * (kd * p["x0"]))
+        # P1 = -(K1 exp(-i kd x0) - K10) T1                      [R71] Eq. 27b
+        k1v *= px
+        k1v += p["k10"]
+        k1v *= p["t1w"]
+        out += k1v
+        if geo.nonplanar:
+            k2v = (3.0 * i2 + 1j * k1 * eku * p["c2a"] + eku * p["c2b"])   # [R71] Eq. 8
+            k2v[p["small"]] = 4.0 * p["down"]
+            out += (-(k2v * px - p["k20"]) * p["t2"]) * w2  # [R71] Eq. 36b
+    return out
+
+
+def _fold(d: np.ndarray, n: int, n_images: int) -> np.ndarray:
+    return d if n_images == 1 else d[..., :n] + d[..., n:]
+
+
+# ---------------------------------------------------------------------------------------------
+# public API
+# ---------------------------------------------------------------------------------------------
+def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str = "quartic",
+                        symmetric: bool = False, progress=None) -> np.ndarray:
+    """DLM normalwash matrices D(M, k) for several reduced frequencies at one Mach number.
+
+    Parameters
+    ----------
+    mesh : the boxes (:class:`~asekit.aero.boxes.BoxMesh`).
+    mach : Mach number, 0 <= M < 1.
+    k : reduced frequencies k = omega b_ref / U (>= 0), scalar or 1-D.
+    b_ref : reference semi-chord (m) of k.
+    method : "quartic" ([R98], Desmarais integrals; default) or "parabolic" ([R71], Laschka).
+    symmetric : add the mirror image in y = 0 (wall/symmetry plane at the root).
+    progress : optional callable(n_done, n_total) called after each row chunk.
+
+    Returns
+    -------
+    D (n_k, n, n) complex with w/U = D DeltaCp (module docstring). The steady part D0 is the
+    vortex lattice; the kernel geometry of each row chunk is computed once and reused for all k.
+    Memory: the result plus one chunk of about ``asekit.aero.vlm.CHUNK_BYTES``.
+    """
+    mach = check_mach(mach)
+    ks = check_k(k)
+    b = _check_bref(b_ref)
+    stations = _check_method(method)[0]
+    snd = _Senders(mesh, symmetric)
+    n, ns = mesh.n, snd.mid.shape[0]
+    d0 = vlm_normalwash_matrix(mesh, mach, symmetric)
+    out = np.empty((ks.size, n, n), complex)
+    out[:] = d0[None]
+    # bytes per (receiver, sender) pair held by one chunk: geometry (~14 arrays per station,
+    # more if nonplanar) + kernel temporaries (~20 complex)
+    per_pair = 8 * (stations.size * 22 + 40)
+    rows = max(1, min(n, int(CHUNK_BYTES // (ns * per_pair)), PAIRS_PER_CHUNK // ns))
+    nonzero = ks > 0.0
+    for i0 in range(0, n, rows):
+        sl = slice(i0, min(n, i0 + rows))
+        if np.any(nonzero):
+            geo = _ChunkGeometry(mesh, snd, sl, mach, method)
+            for ik in np.flatnonzero(nonzero):
+                out[ik, sl] += _fold(_increment(geo, mach, ks[ik] / b, method), n, snd.n_images)
+        if progress is not None:
+            progress(sl.stop, n)
+    return out
+
+
+def normalwash_matrix(mesh: BoxMesh, mach: float, k: float, b_ref: float,
+                      method: str = "quartic", symmetric: bool = False) -> np.ndarray:
+    """DLM normalwash matrix D(M, k) (n, n) complex, w/U = D DeltaCp; see
+    :func:`normalwash_matrices` for the arguments and conventions."""
+    if np.ndim(k) != 0:
+        raise ValueError(f"k must be a scalar reduced frequency, got shape {np.shape(k)}")
+    return normalwash_matrices(mesh, mach, [k], b_ref, method, symmetric)[0]
+
+
+def aic_matrix(mesh: BoxMesh, mach: float, k: float, b_ref: float, method: str = "quartic",
+               symmetric: bool = False) -> np.ndarray:
+    """Aerodynamic influence matrix AIC = D^-1 (n, n) complex: DeltaCp = AIC (w/U) with the
+    normalwash w/U = dh/dx + i k h / b_ref at the control points (module docstring)."""
+    d = normalwash_matrix(mesh, mach, k, b_ref, method, symmetric)
+    return np.linalg.solve(d, np.eye(d.shape[0]))
+
+
+def pressure_jump(mesh: BoxMesh, mach: float, k: float, b_ref: float, normalwash: np.ndarray,
+                  method: str = "quartic", symmetric: bool = False) -> np.ndarray:
+    """DeltaCp (n,) or (n, m) for the normalwash w/U (n,) or (n, m): solves D DeltaCp = w/U."""
+    w = np.asarray(normalwash)
+    if w.shape[0] != mesh.n or not np.all(np.isfinite(w)):
+        raise ValueError(f"normalwash must be finite with first dimension {mesh.n}, got {w.shape}")
+    return np.linalg.solve(normalwash_matrix(mesh, mach, k, b_ref, method, symmetric), w)

@@ -1,0 +1,145 @@
+"""Steady vortex-lattice method (horseshoe vortices) with Prandtl-Glauert compressibility.
+
+Each box of a :class:`~asekit.aero.boxes.BoxMesh` carries a horseshoe vortex: a bound segment on
+the quarter-chord line from its inboard end P1 to its outboard end P3 and two trailing legs to
+x = +infinity (Katz & Plotkin, *Low-Speed Aerodynamics*, 2nd ed., Sec. 10.4.5-10.4.7, Biot-Savart
+law Eq. 10.115 for a straight segment). Compressibility enters by the Goethert / Prandtl-Glauert
+transformation x -> x / beta, beta = sqrt(1 - M^2), of all points before the Biot-Savart law is
+applied (Hedman 1965); the induced normal velocity is invariant under that transformation.
+
+Sign and normalisation (shared with :mod:`asekit.aero.dlm`): the pressure jump Delta Cp of a box
+is positive when it pushes the box along its normal (+z for a horizontal box). A box of chord c
+and span 2e with uniform Delta Cp carries circulation Gamma = Delta Cp U c / 2 (Kutta-Joukowski,
+rho U Gamma 2e = q Delta Cp c 2e). The matrix returned maps Delta Cp to the normalwash w/U at the
+control points along the receiving box normal: w/U = D0 Delta Cp. Upward load induces a
+downwash, so D0 has a negative diagonal.
+
+This is the k = 0 part ("D0") of the doublet-lattice method (Albano & Rodden 1969, Eq. 21;
+Rodden, Taylor & McIntosh 1998, Eq. 1).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .boxes import BoxMesh
+
+#: Memory budget (bytes) for the temporaries of one row chunk.
+CHUNK_BYTES = 256 * 2**20
+
+
+def check_mach(mach: float) -> float:
+    """Validate a subsonic Mach number: finite and 0 <= M < 1 (raises ValueError)."""
+    m = float(mach)
+    if not math.isfinite(m) or m < 0.0 or m >= 1.0:
+        raise ValueError(f"mach must be a finite number with 0 <= mach < 1 (subsonic), got {mach!r}")
+    return m
+
+
+def _rows(n_rows: int, n_cols: int, bytes_per_pair: int) -> int:
+    return max(1, min(n_rows, int(CHUNK_BYTES // max(1, n_cols * bytes_per_pair))))
+
+
+def _senders(mesh: BoxMesh, symmetric: bool):
+    """Sending boxes: the mesh, plus its image in y = 0 when ``symmetric``."""
+    return (mesh, mesh.mirrored()) if symmetric else (mesh,)
+
+
+def _horseshoe_normalwash(p: np.ndarray, n_r: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Normal velocity at points ``p`` (m, 3) along normals ``n_r`` (m, 3) induced by unit-strength
+    horseshoe vortices ``inf -> a -> b -> inf`` (a, b: (s, 3), legs along +x). Returns (m, s).
+
+    Points on a vortex line (the singular limit) receive zero from that segment, the usual
+    VLM convention; control points never lie on their own box's vortices.
+    """
+    col = lambda v: v[:, None]  # noqa: E731
+    r1x, r1y, r1z = (col(p[:, i]) - a[None, :, i] for i in range(3))
+    r2x, r2y, r2z = (col(p[:, i]) - b[None, :, i] for i in range(3))
+    r0 = b - a
+    ny, nz = col(n_r[:, 1]), col(n_r[:, 2])
+    scale = float(np.max(np.linalg.norm(r0, axis=1)))
+    eps = (1e-10 * scale) ** 2
+    n1 = np.sqrt(r1x * r1x + r1y * r1y + r1z * r1z)
+    n2 = np.sqrt(r2x * r2x + r2y * r2y + r2z * r2z)
+    # bound segment a -> b, Katz & Plotkin Eq. (10.115): (r1 x r2)/|r1 x r2|^2 r0.(r1/|r1| - r2/|r2|)
+    cx = r1y * r2z - r1z * r2y
+    cy = r1z * r2x - r1x * r2z
+    cz = r1x * r2y - r1y * r2x
+    c2 = cx * cx + cy * cy + cz * cz
+    ok = (c2 > eps) & (n1 > 0) & (n2 > 0)
+    n1s = np.where(n1 > 0, n1, 1.0)
+    n2s = np.where(n2 > 0, n2, 1.0)
+    fac = ((r0[None, :, 0] * r1x + r0[None, :, 1] * r1y + r0[None, :, 2] * r1z) / n1s
+           - (r0[None, :, 0] * r2x + r0[None, :, 1] * r2y + r0[None, :, 2] * r2z) / n2s)
+    fac = np.where(ok, fac / np.where(ok, c2, 1.0), 0.0)
+    w = fac * (cy * ny + cz * nz)
+    # semi-infinite legs along x: from b to +inf (+Gamma) and from +inf to a (-Gamma); a leg
+    # from q to +inf induces (x_hat x r)/|x_hat x r|^2 (1 + r_x/|r|), x_hat x r = (0, -r_z, r_y)
+    for rx, ry, rz, nr, sign in ((r2x, r2y, r2z, n2s, 1.0), (r1x, r1y, r1z, n1s, -1.0)):
+        d2 = ry * ry + rz * rz
+        okl = d2 > eps
+        f = np.where(okl, (1.0 + rx / nr) / np.where(okl, d2, 1.0), 0.0)
+        w += sign * f * (ry * nz - rz * ny)
+    w *= 1.0 / (4.0 * np.pi)
+    return w
+
+
+def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False) -> np.ndarray:
+    """Steady normalwash matrix D0 (n, n): w/U at control points per unit Delta Cp of each box.
+
+    Parameters
+    ----------
+    mesh : the boxes.
+    mach : free-stream Mach number, 0 <= M < 1 (Prandtl-Glauert x -> x / beta).
+    symmetric : add the image of every box in the plane y = 0 with the same loading (a wall
+        or symmetry plane at the root, e.g. a fin mounted on a body); default isolated.
+
+    Returns
+    -------
+    D0 (n, n) float: ``w_r / U = sum_s D0[r, s] DeltaCp_s`` (module docstring for the signs).
+    """
+    mach = check_mach(mach)
+    beta = math.sqrt(1.0 - mach * mach)
+    sx = np.array([1.0 / beta, 1.0, 1.0])
+    p = mesh.control_point * sx
+    n_r = mesh.normal
+    d = np.zeros((mesh.n, mesh.n))
+    rows = max(1, min(mesh.n, 32768 // mesh.n))
+    for img in _senders(mesh, symmetric):
+        a = img.doublet_p1 * sx
+        b = img.doublet_p3 * sx
+        half_chord = 0.5 * img.chord
+        for i0 in range(0, mesh.n, rows):
+            sl = slice(i0, min(mesh.n, i0 + rows))
+            d[sl] += _horseshoe_normalwash(p[sl], n_r[sl], a, b) * half_chord[None, :]
+    return d
+
+
+def steady_pressure(mesh: BoxMesh, mach: float, normalwash: np.ndarray,
+                    symmetric: bool = False) -> np.ndarray:
+    """Steady Delta Cp (n,) or (n, m) for the normalwash ``w/U`` (n,) or (n, m) at the control
+    points (for a flat surface at angle of attack alpha: w/U = -alpha). Solves D0 Cp = w/U."""
+    w = np.asarray(normalwash, float)
+    if w.shape[0] != mesh.n or not np.all(np.isfinite(w)):
+        raise ValueError(f"normalwash must be finite with first dimension {mesh.n}, got {w.shape}")
+    return np.linalg.solve(vlm_normalwash_matrix(mesh, mach, symmetric), w)
+
+
+def lift_curve_slope(mesh: BoxMesh, mach: float, reference_area: float | None = None,
+                     symmetric: bool = False) -> float:
+    """Lift-curve slope CL_alpha (1/rad) of a flat mesh at Mach ``mach`` from the VLM.
+
+    The lift is the sum of Delta Cp A n_z for a unit angle of attack (w/U = -n_z at every
+    control point); the reference area defaults to the mesh area (doubled if ``symmetric``).
+    """
+    nz = mesh.normal[:, 2]
+    cp = steady_pressure(mesh, mach, -nz, symmetric)
+    lift = float(np.sum(cp * mesh.area * nz))
+    s = float(np.sum(mesh.area)) if reference_area is None else float(reference_area)
+    if symmetric:
+        lift *= 2.0
+        if reference_area is None:
+            s *= 2.0
+    return lift / s
