@@ -356,6 +356,21 @@ def actuator_state_space(params: ActuatorParameters, name: str = "actuator") -> 
                  name=name)
 
 
+def pd_state_space(controller: PDController, name: str = "pd") -> ct.StateSpace:
+    """The PD controller as a static python-control system for :func:`control.interconnect`.
+
+    ``voltage = K_c (K_P (theta_cmd - theta_fb) + K_D (theta_cmd_rate - omega_fb))`` with inputs
+    ``theta_cmd`` (rad), ``theta_cmd_rate`` (rad/s), ``theta_fb`` (rad), ``omega_fb`` (rad/s) and
+    output ``voltage`` (V). Feeding the derivative from the measured rate keeps the system proper;
+    with ``theta_cmd_rate`` = d(theta_cmd)/dt it equals Eq. (4.17)'s K_c (K_P + K_D s) on the error.
+    """
+    k, kp, kd = controller.gain, controller.kp, controller.kd
+    return ct.ss(np.zeros((0, 0)), np.zeros((0, 4)), np.zeros((1, 0)),
+                 [[k * kp, k * kd, -k * kp, -k * kd]],
+                 inputs=["theta_cmd", "theta_cmd_rate", "theta_fb", "omega_fb"],
+                 outputs=["voltage"], name=name)
+
+
 def root_locus_data(params: ActuatorParameters, controller: PDController | None = None,
                     gains=None) -> tuple[np.ndarray, np.ndarray]:
     """Closed-loop poles of the unity loop as K_c varies (Figs 47, 48, 50).

@@ -28,7 +28,19 @@ derivative impulse, present in the linear Eq. (4.18), is clipped to zero duratio
 limit and is omitted here.
 
 The public right-hand sides :func:`motor_rhs` and :func:`actuator_rhs` are pure functions of
-their arguments, meant to be called inside a larger ``solve_ivp`` right-hand side (Ch. 5).
+their arguments, meant to be called inside a larger ``solve_ivp`` right-hand side (Ch. 5);
+:func:`actuator_signals` returns the applied voltage, current and torque for a state.
+
+Coupling to an aeroelastic fin (Ch. 5)
+--------------------------------------
+* AEM1 (encoder on the motor shaft): ``theta_feedback = x_act[0]``, ``omega_feedback = x_act[1]``
+  (the motor angle divided by N). AEM2 (potentiometer at the fin root): pass the fin-root angle
+  and rate computed from the aeroelastic states.
+* The aeroelastic hinge moment (thesis Eq. 2.68) contains the fin's own inertia through its
+  acceleration input, ``T = T0(z, theta, theta') - M_eff theta''``. Do not count the fin twice
+  and avoid the algebraic loop: build the actuator with ``fin_inertia = M_eff`` (the coefficient
+  of theta'' in D_hinge@fin, thesis Eq. 2.70) and pass ``hinge_moment_fin = T0``; Eqs. 2.33 and
+  2.34 reflect both identically (M_eff theta'' / (N eta) at the motor).
 """
 
 from __future__ import annotations
@@ -156,6 +168,33 @@ def actuator_rhs(params: ActuatorParameters, controller: PDController, limits: P
     v_cmd = controller_voltage(controller, theta_cmd, theta_feedback, omega_feedback,
                                theta_cmd_rate)
     return motor_rhs(params, limits, x_act, v_cmd, hinge_moment_fin)
+
+
+@dataclass(frozen=True)
+class ActuatorSignals:
+    """Signals of the actuator at one instant (SI): ``voltage_command`` (PD demand, V),
+    ``voltage`` (applied, V), ``current`` (A), ``torque`` (motor torque at the fin, N m),
+    ``alpha`` (transmission output acceleration, rad/s^2)."""
+
+    voltage_command: float
+    voltage: float
+    current: float
+    torque: float
+    alpha: float
+
+
+def actuator_signals(params: ActuatorParameters, controller: PDController, limits: PowerLimits,
+                     x_act, theta_cmd: float, theta_feedback: float, omega_feedback: float,
+                     hinge_moment_fin: float, theta_cmd_rate: float = 0.0) -> ActuatorSignals:
+    """Applied voltage, current, motor torque and acceleration for a state; same arguments as
+    :func:`actuator_rhs` (use it to post-process a solution, e.g. Ch. 5's Figs 77-78)."""
+    v_cmd = controller_voltage(controller, theta_cmd, theta_feedback, omega_feedback,
+                               theta_cmd_rate)
+    v = applied_voltage(params, limits, x_act, v_cmd)
+    alpha = motor_rhs(params, limits, x_act, v_cmd, hinge_moment_fin)[1]
+    current = float(x_act[2])
+    return ActuatorSignals(v_cmd, v, current, float(motor_torque_at_fin(params, current)),
+                           float(alpha))
 
 
 def motor_torque_at_fin(params: ActuatorParameters, current):

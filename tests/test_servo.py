@@ -184,3 +184,22 @@ def test_widget_panel_builds_without_a_front_end():
     bad = servo_snapshot(1.0, 1e6, 0.0)
     assert not bad.stable and bad.simulation is None
     plt.close("all")
+
+
+def test_interconnected_state_space_loop_has_the_design_poles():
+    # actuator SS + static PD (derivative on the measured rate) closed through python-control:
+    # same characteristic polynomial as Eq. 4.18
+    from asekit.servo import pd_state_space
+    loop = ct.interconnect(
+        [actuator_state_space(P), pd_state_space(SYSTEM_3)],
+        connections=[["actuator.voltage", "pd.voltage"], ["pd.theta_fb", "actuator.theta"],
+                     ["pd.omega_fb", "actuator.omega"]],
+        inplist=["pd.theta_cmd", "pd.theta_cmd_rate", "actuator.hinge_moment"],
+        outlist=["actuator.theta"], ignore_outputs=["actuator.alpha", "actuator.current"])
+    np.testing.assert_allclose(np.sort(ct.poles(loop).real), np.sort(closed_loop_poles(P, SYSTEM_3)),
+                               rtol=1e-9)
+    dc = np.ravel(ct.dcgain(loop))
+    assert dc[0] == pytest.approx(1.0, rel=1e-9)
+    # a constant hinge moment T gives the analytic offset R T / (N eta K_t K_c K_P)
+    kckp = SYSTEM_3.gain * SYSTEM_3.kp
+    assert dc[2] == pytest.approx(5.78 / (66 * 0.7 * 34.6e-3 * kckp), rel=1e-9)

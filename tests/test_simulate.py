@@ -158,3 +158,27 @@ def test_custom_hinge_moment_callable():
 def test_bad_input(factory, word):
     with pytest.raises(ValueError, match=word):
         factory()
+
+
+def test_actuator_signals_agree_with_the_simulation():
+    from asekit.simulate import actuator_signals
+    sim = simulate(P, SYSTEM_3, 0.0, t_final=0.02, theta0=15 * DEG, n_out=41)
+    k = 10
+    x = np.array([sim.theta[k], sim.omega[k], sim.current[k]])
+    sig = actuator_signals(P, SYSTEM_3, THESIS_LIMITS, x, 0.0, x[0], x[1], sim.hinge_moment[k])
+    assert sig.voltage == pytest.approx(sim.voltage[k])
+    assert sig.torque == pytest.approx(sim.torque[k])
+    assert sig.alpha == pytest.approx(sim.alpha[k])
+
+
+def test_fin_inertia_through_the_hinge_moment_is_equivalent():
+    # Ch. 5 recipe: a hinge moment -M theta'' with fin_inertia = 0 equals fin_inertia = M
+    x = np.array([0.1, 2.0, 1.5])
+    m_eff = 2.958e-4
+    p0 = ActuatorParameters(fin_inertia=0.0)
+    a = motor_rhs(P, NO_LIMITS, x, 10.0, 0.3)
+    # solve alpha = f(T0 - M alpha) for the zero-inertia actuator by fixed point (linear)
+    alpha = 0.0
+    for _ in range(200):
+        alpha = motor_rhs(p0, NO_LIMITS, x, 10.0, 0.3 - m_eff * alpha)[1]
+    assert alpha == pytest.approx(a[1], rel=1e-9)
