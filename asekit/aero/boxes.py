@@ -275,14 +275,14 @@ def fin_surface(fin, n_chord: int | None = None, n_span: int | None = None,
     """The reference fin's planform as a :class:`TrapezoidSurface` (z = 0).
 
     Without ``n_chord``/``n_span`` the box counts follow the mesh rules with a margin: the
-    smallest ``n_chord >= 4`` giving ``BPW >= bpw_min`` on the root strip (Eq. 3.5 with the
-    fin's U_min and f_max), and the smallest ``n_span`` keeping every box aspect ratio below
+    smallest ``n_chord >= 4`` giving ``BPW > bpw_min`` (strictly) on the root strip (Eq. 3.5
+    with the fin's U_min and f_max; 14 for the reference fin, BPW 16.2), and the smallest ``n_span`` keeping every box aspect ratio below
     ``ar_max`` with a 10 % margin.
     """
     p = fin.planform
     if n_chord is None:
         dx_max = fin.aero.u_min / (bpw_min * fin.aero.f_max)
-        n_chord = max(4, math.ceil(p.root_chord / dx_max * (1 + 1e-9)))
+        n_chord = max(4, math.floor(p.root_chord / dx_max) + 1)
     if n_span is None:
         dx_tip = p.tip_chord / n_chord
         n_span = max(1, math.ceil(p.span / (0.9 * ar_max * dx_tip)))
