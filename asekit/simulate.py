@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Callable
 
 import numpy as np
@@ -229,7 +230,7 @@ class SteadyHingeMoment:
             raise ValueError(f"q_cc must be finite, got {self.q_cc!r}")
         dynamic_pressure(self.mach, self.density, self.speed_of_sound)   # validates
 
-    @property
+    @cached_property
     def stiffness(self) -> float:
         """q Q_cc (N m/rad)."""
         return dynamic_pressure(self.mach, self.density, self.speed_of_sound) * self.q_cc

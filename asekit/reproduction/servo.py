@@ -238,7 +238,7 @@ def fig_root_locus_pd(ch: ServoChapter):
 
 
 def fig_step_systems12(ch: ServoChapter):
-    fig, ax = new_figure("unit step of the linear closed loops, Systems 1 and 2", "Fig 51")
+    fig, ax = new_figure("unit step of the linear closed loops, Systems 1, 2 (and 3)", "Fig 51")
     for c in (SYSTEM_1, SYSTEM_2, SYSTEM_3):
         t, y = step_response(ch.params, c, t_final=0.05)
         ax.plot(1e3 * t, y, label=f"{c.name} (K_c {c.gain:g}, zero {c.zero:.0f})")
