@@ -347,3 +347,94 @@ def root_locus_panel(modal, db, mach: float = 0.75, n_lags: int = N_LAGS):
     alt.observe(draw, "value")
     draw()
     return w.VBox([speed, alt, out])
+
+
+# --------------------------------------------------------------------------------------------
+# sensitivity of the fin's flutter point to modelling choices (notebook investigation)
+# --------------------------------------------------------------------------------------------
+#: The thesis's FN2 elastic frequencies (Table 6 via fin.md), Hz, and its fin pitch inertia.
+THESIS_ELASTIC_HZ = (86.8891, 159.6022, 566.0895, 627.1564, 972.5351)
+THESIS_J_FIN = 2.958e-4
+#: Table 9/10 densities (kg/m^3) the thesis used at 0, 2500, 5000 m (not the standard ones).
+THESIS_DENSITIES = (1.226, 1.173, 0.902)
+
+
+def scaled_modal(modal, mass_scale: float = 1.0, elastic_hz=None):
+    """A variant of the modal model (as :class:`ModalArrays`): all masses scaled by
+    ``mass_scale`` (a different material density with the same mode shapes: M -> s M, K and
+    the GAFs unchanged), and/or the elastic stiffnesses set so that the elastic frequencies
+    become ``elastic_hz`` (same shapes, K_ss diagonal rescaled; assumes M_ss diagonal)."""
+    from ..aeroelastic import ModalArrays, modal_arrays
+    m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
+    M = m.M * mass_scale
+    K = m.K.copy()
+    if elastic_hz is not None:
+        s = slice(m.n_rigid, m.n_modes)
+        f = np.asarray(elastic_hz, float)[: m.n_elastic]
+        K[s, s] = np.diag((2 * np.pi * f) ** 2 * np.diag(M[s, s]))
+    return ModalArrays(M=M, K=K, C=m.C, n_rigid=m.n_rigid)
+
+
+def sensitivity_study(modal, db, mach: float = 0.75, altitude: float = 0.0,
+                      velocities=VELOCITIES) -> list[dict]:
+    """p-k (and root-locus) flutter speed of the fin under modelling variants that the thesis
+    leaves open or states differently. Returns rows {label, speed, freq, first, first_kind}."""
+    from ..aeroelastic import modal_arrays
+    rho0 = float(standard_atmosphere(altitude).density)
+    gaf = fin_gaf(db, mach)
+    base = modal_arrays(modal)
+    J = float(base.M[0, 0]) if base.n_rigid else None
+    variants = [
+        ("baseline (asekit structure + GAFs, 1976 atm, linear k-interp.)", base, gaf, rho0, {}),
+        ("cubic interpolation of Q in k", base, gaf, rho0, {"interpolation": "cubic"}),
+        ("thesis density 1.226 kg/m^3", base, gaf, 1.226, {}),
+        ("mass x J_thesis/J_asekit (heavier plate, same shapes)",
+         scaled_modal(base, THESIS_J_FIN / J) if J else base, gaf, rho0, {}),
+        ("elastic frequencies set to the thesis's", scaled_modal(base, 1.0, THESIS_ELASTIC_HZ),
+         gaf, rho0, {}),
+        ("both: thesis mass and thesis frequencies",
+         scaled_modal(base, THESIS_J_FIN / J if J else 1.0, THESIS_ELASTIC_HZ), gaf, rho0, {}),
+        ("first two elastic modes only", None, None, rho0, {"modes": [0, 1]}),
+    ]
+    other = [mm for mm in np.asarray(db.machs, float) if abs(mm - mach) > 1e-9]
+    for mm in other:
+        variants.append((f"GAFs at Mach {mm:g}", base, fin_gaf(db, float(mm)), rho0, {}))
+    rows = []
+    for label, mod, g, rho, kw in variants:
+        if mod is None:      # truncated modal basis
+            n = base.n_rigid + 2
+            from ..aeroelastic import ModalArrays
+            mod = ModalArrays(M=base.M[:n, :n], K=base.K[:n, :n], C=base.C[:n, :n],
+                              n_rigid=base.n_rigid)
+            g = TabulatedGaf(gaf.k, gaf.Q[:, :n, :n], gaf.b_ref, gaf.mach)
+            kw = {}
+        interp = kw.get("interpolation", "linear")
+        res = pk_flutter(mod, g, rho, velocities, interpolation=interp)
+        inst = pk_instabilities(res, mod, g, interpolation=interp)
+        fl, first = first_of(inst, "flutter"), first_of(inst)
+        rows.append({"label": label, "speed": _val(fl, "speed"),
+                     "freq": _val(fl, "frequency_hz"), "first": _val(first, "speed"),
+                     "first_kind": None if first is None else first.kind})
+    return rows
+
+
+def rfa_sensitivity(modal, db, mach: float = 0.75, altitude: float = 0.0,
+                    velocities=VELOCITIES) -> list[dict]:
+    """Root-locus flutter speed for several Roger fits (lag count, lag spread, steady-load
+    constraint): the RFA-side spread the thesis names in Section 3.3.4."""
+    from ..rfa import default_lag_roots
+    rho = float(standard_atmosphere(altitude).density)
+    kmax = float(np.max(db.k))
+    cases = [("2 lags", {"n_lags": 2}), ("4 lags (default)", {"n_lags": 4}),
+             ("6 lags", {"n_lags": 6}),
+             ("4 lags, roots x0.5", {"lag_roots": 0.5 * default_lag_roots(kmax, 4)}),
+             ("4 lags, constrained at k_min", {"n_lags": 4, "constrain_k0": True})]
+    rows = []
+    for label, kw in cases:
+        fit = fin_rfa(db, mach, **kw)
+        rl = root_locus(modal, fit, rho, velocities)
+        inst = root_locus_instabilities(rl, modal, fit)
+        fl = first_of(inst, "flutter")
+        rows.append({"label": label, "fit_error": fit.fit_error, "speed": _val(fl, "speed"),
+                     "freq": _val(fl, "frequency_hz"), "first": _val(first_of(inst), "speed")})
+    return rows
