@@ -276,7 +276,8 @@ def fin_surface(fin, n_chord: int | None = None, n_span: int | None = None,
 
     Without ``n_chord``/``n_span`` the box counts follow the mesh rules with a margin: the
     smallest ``n_chord >= 4`` giving ``BPW > bpw_min`` (strictly) on the root strip (Eq. 3.5
-    with the fin's U_min and f_max; 14 for the reference fin, BPW 16.2), and the smallest ``n_span`` keeping every box aspect ratio below
+    with the fin's U_min and f_max; 14 for the reference fin: BPW 16.6 on the root strip
+    with its mid-span box chord), and the smallest ``n_span`` keeping every box aspect ratio below
     ``ar_max`` with a 10 % margin.
     """
     p = fin.planform
