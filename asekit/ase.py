@@ -1,0 +1,554 @@
+"""The aeroservoelastic model: servo-actuator + aeroelastic fin through the hinge moment
+(thesis Ch. 5, Figs 58-84).
+
+Interconnection (Fig 58). The actuator (:func:`asekit.servo.actuator_state_space`: inputs
+``voltage`` and ``hinge_moment`` at the fin; outputs transmission angle ``theta``, rate
+``omega``, acceleration ``alpha``, ``current``) drives the rigid-mode inputs ``theta``,
+``theta_dot``, ``theta_ddot`` of the aeroelastic model (:func:`asekit.aeroelastic.aeroelastic_model`,
+Eq. 2.63), whose hinge-moment output (Eqs. 2.68-2.70) loads the transmission (Eq. 2.71).
+
+The hinge moment has a direct term in the rigid acceleration, ``D_hinge[2] theta''``, and the
+actuator's acceleration depends directly on the hinge moment: an algebraic loop. It is removed
+exactly, not approximated: ``-D_hinge[2] = M_bar_cc - M_bar_cs M_bar_ss^-1 M_bar_sc`` is the
+effective inertia of the elastic fin (plus its apparent air mass) about the shaft, so it is moved
+into the actuator as its load inertia, and the aeroelastic model feeds back the remaining hinge
+moment ``C_hinge z + D_hinge[0] theta + D_hinge[1] theta'``. The fin's inertia therefore enters
+once, through the aeroelastic model. With the single-node shaft the first elastic mode is largely
+the fin pitching on the 120 N m/rad shaft spring, so this effective inertia is tiny (the
+transmission feels the fin through the spring). Counting J_fin in J_total@motor (Eq. 2.33) as
+well as in the hinge moment would count it twice; ``count_fin_inertia_twice=True`` does so, for
+comparison. (The thesis's FWTF 1 phase margin, 79.5 deg at 131 Hz against 78.4 deg for the
+Ch. 4 design with J_fin, is what the actuator gives without the fin's inertia: its Ch. 5 model,
+too, carried the fin's inertia through the hinge moment only.)
+
+Topologies (Section 5.1): ``"AEM1"`` closes the PD loop on the transmission output (motor
+encoder, Fig 60); ``"AEM2"`` on the fin-root pitch angle (potentiometer at the fin shaft,
+Fig 61), which includes the elastic rotation at the root.
+
+Open-loop and forward-path functions (Section 5.2): OPLOOP 1 = voltage -> transmission angle of
+the actuator alone (Eq. 2.41); OPLOOP 2 = the same with the aeroelastic hinge moment fed back;
+OPLOOP 3 = voltage -> fin-root angle with the hinge moment fed back; FWTF i = PD x OPLOOP i.
+
+All quantities SI (rad, rad/s, V, A, N m); Hz and degrees only in the reporting helpers.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import control as ct
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .aeroelastic import aeroelastic_matrices, aeroelastic_model
+from .servo import ActuatorParameters, PDController, actuator_state_space
+from .simulate import THESIS_LIMITS, PowerLimits, applied_voltage, controller_voltage, motor_rhs
+
+TOPOLOGIES = ("AEM1", "AEM2")
+#: Name of the aeroelastic output that the AEM2 potentiometer measures.
+FIN_ROOT = "fin_root_pitch"
+
+
+def _check_topology(topology: str) -> str:
+    if topology not in TOPOLOGIES:
+        raise ValueError(f"topology must be one of {TOPOLOGIES}, got {topology!r}")
+    return topology
+
+
+def _check_finite(name: str, value: float) -> float:
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite number, got {value!r}")
+    return value
+
+
+def _check_controller(controller: PDController) -> PDController:
+    if not isinstance(controller, PDController):
+        raise ValueError(f"controller must be a PDController, got {type(controller).__name__}")
+    for n in ("gain", "kp", "kd"):
+        _check_finite(f"controller.{n}", getattr(controller, n))
+    return controller
+
+
+@dataclass(frozen=True)
+class AeroservoelasticModel:
+    """The actuator and the aeroelastic fin at one flight condition, ready to interconnect.
+
+    Attributes
+    ----------
+    actuator : the actuator with its load inertia set to the fin's effective inertia
+        (``-D_hinge[2]``; see the module docstring).
+    aeroelastic : python-control StateSpace, inputs ``theta``, ``theta_dot``, ``theta_ddot``;
+        outputs ``hinge_moment`` (without the acceleration term), the elastic modal coordinates
+        ``zeta1..``, ``fin_root_pitch`` and any named point outputs.
+    A, B : the aeroelastic state matrices (Eq. 2.63), for the nonlinear simulation.
+    output_C, output_D : rows of the aeroelastic outputs (same order as
+        ``aeroelastic.output_labels``).
+    effective_fin_inertia : -D_hinge[2] (kg m^2).
+    mach, density (kg/m^3), velocity (m/s) : the flight condition.
+    """
+
+    actuator: ActuatorParameters
+    aeroelastic: ct.StateSpace
+    A: np.ndarray
+    B: np.ndarray
+    output_C: np.ndarray
+    output_D: np.ndarray
+    effective_fin_inertia: float
+    mach: float | None
+    density: float
+    velocity: float
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def output_names(self) -> list[str]:
+        return list(self.aeroelastic.output_labels)
+
+    def output_index(self, name: str) -> int:
+        names = self.output_names
+        if name not in names:
+            raise ValueError(f"unknown output {name!r}; available: {names}")
+        return names.index(name)
+
+    @property
+    def n_elastic(self) -> int:
+        return sum(1 for n in self.output_names if n.startswith("zeta"))
+
+
+def build_model(modal, rfa, density: float, velocity: float, point_outputs: dict,
+                actuator: ActuatorParameters | None = None, mach: float | None = None,
+                count_fin_inertia_twice: bool = False) -> AeroservoelasticModel:
+    """Assemble actuator and aeroelastic fin at (density, velocity).
+
+    Parameters
+    ----------
+    modal : ModalModel-like (M, K, C, n_rigid = 1: the rigid pitch mode first, unit rotation).
+    rfa : :class:`asekit.rfa.RogerFit` of the fin's GAFs at the flight Mach.
+    density : air density (kg/m^3), > 0. velocity : true airspeed (m/s), > 0.
+    point_outputs : ``{name: row (n_modes,)}`` modal-superposition rows (Eq. 2.64) of the
+        outputs to carry; must contain ``"fin_root_pitch"`` (the AEM2 feedback). See
+        :func:`asekit.aeroelastic.fin_outputs`.
+    actuator : motor and transmission (default thesis values); its ``fin_inertia`` is replaced
+        by the fin's effective inertia unless ``count_fin_inertia_twice``.
+    mach : the Mach number the RFA belongs to (informational).
+    count_fin_inertia_twice : reproduce the thesis's Simulink choice (J_fin in the actuator and
+        the full hinge moment fed back).
+    """
+    if getattr(modal, "n_rigid", 0) != 1:
+        raise ValueError("the modal model needs exactly one rigid (actuator) mode first, "
+                         f"got n_rigid = {getattr(modal, 'n_rigid', None)}")
+    if FIN_ROOT not in point_outputs:
+        raise ValueError(f"point_outputs must contain {FIN_ROOT!r} (the AEM2 feedback)")
+    actuator = ActuatorParameters() if actuator is None else actuator
+    mats = aeroelastic_matrices(modal, rfa, density, velocity)
+    j_eff = float(-mats.D_hinge[0, 2])
+    if not j_eff > 0:
+        raise ValueError(f"effective fin inertia -D_hinge[2] = {j_eff:g} is not positive: the "
+                         "modal mass matrix or the RFA's A2 term is inconsistent")
+    sys = aeroelastic_model(modal, rfa, density, velocity, outputs=point_outputs)
+    C, D = np.array(sys.C), np.array(sys.D)
+    ih = list(sys.output_labels).index("hinge_moment")
+    if count_fin_inertia_twice:
+        act = actuator
+    else:
+        D = D.copy()
+        D[ih, 2] = 0.0            # the acceleration term moves into the actuator's inertia
+        act = replace(actuator, fin_inertia=j_eff)
+    sys = ct.ss(sys.A, sys.B, C, D, states=list(sys.state_labels),
+                inputs=list(sys.input_labels), outputs=list(sys.output_labels),
+                name="aeroelastic")
+    return AeroservoelasticModel(actuator=act, aeroelastic=sys, A=np.array(sys.A),
+                                 B=np.array(sys.B), output_C=C, output_D=D,
+                                 effective_fin_inertia=j_eff, mach=mach, density=float(density),
+                                 velocity=float(velocity),
+                                 meta={"count_fin_inertia_twice": bool(count_fin_inertia_twice)})
+
+
+# ---------------------------------------------------------------------------------------------
+# linear interconnections (python-control, named signals)
+# ---------------------------------------------------------------------------------------------
+def _plant(model: AeroservoelasticModel, fin: ct.StateSpace | None = None) -> ct.StateSpace:
+    """Actuator + aeroelastic fin with the hinge moment fed back (Fig 58); input ``voltage``,
+    outputs every actuator output (``theta``, ``omega``, ``alpha``, ``current``) and every fin
+    output.
+
+    Built in two python-control steps, both exact: :func:`control.interconnect` joins the
+    actuator's transmission angle, rate and acceleration to the fin's rigid-mode inputs (an open
+    chain, named signals), then :func:`control.feedback` closes the hinge-moment path. (A single
+    ``interconnect`` of the loop trips python-control's static-signal iteration, which allows
+    one pass per subsystem: both ends of this loop have direct feedthrough.)
+    """
+    act = actuator_state_space(model.actuator, name="actuator")
+    fin = model.aeroelastic if fin is None else fin
+    outs = list(act.output_labels) + list(fin.output_labels)
+    chain = ct.interconnect(
+        [act, fin],
+        connections=[["aeroelastic.theta", "actuator.theta"],
+                     ["aeroelastic.theta_dot", "actuator.omega"],
+                     ["aeroelastic.theta_ddot", "actuator.alpha"]],
+        inplist=["actuator.voltage", "actuator.hinge_moment"],
+        inputs=["voltage", "hinge_moment"],
+        outlist=[f"actuator.{o}" for o in act.output_labels]
+        + [f"aeroelastic.{o}" for o in fin.output_labels],
+        outputs=outs, name="chain", check_unused=False)
+    k = np.zeros((2, len(outs)))
+    k[1, outs.index("hinge_moment")] = 1.0      # hinge-moment output -> hinge-moment input
+    gain = ct.ss(np.zeros((0, 0)), np.zeros((0, len(outs))), np.zeros((2, 0)), k)
+    loop = ct.feedback(chain, gain, sign=+1)
+    return ct.ss(loop.A, loop.B[:, :1], loop.C, loop.D[:, :1], inputs=["voltage"],
+                 outputs=outs, states=list(chain.state_labels), name="plant")
+
+
+def open_loop(model: AeroservoelasticModel, which: int) -> ct.StateSpace:
+    """OPLOOP ``which`` (Section 5.2) from voltage (V) to an angle (rad).
+
+    1: transmission angle of the actuator alone (rigid fin, no hinge moment; Eq. 2.41 with the
+       actuator's own load inertia); 2: transmission angle with the aeroelastic hinge moment fed
+       back; 3: fin-root pitch angle with the hinge moment fed back.
+    """
+    if which == 1:
+        act = actuator_state_space(model.actuator, name="actuator")
+        return ct.ss(act.A, act.B[:, :1], act.C[:1], act.D[:1, :1], inputs=["voltage"],
+                     outputs=["theta"], states=list(act.state_labels), name="OPLOOP1")
+    if which not in (2, 3):
+        raise ValueError(f"which must be 1, 2 or 3, got {which!r}")
+    sys = _plant(model)
+    name = "theta" if which == 2 else FIN_ROOT
+    i = list(sys.output_labels).index(name)
+    return ct.ss(sys.A, sys.B, sys.C[i:i + 1], sys.D[i:i + 1], inputs=["voltage"],
+                 outputs=[name], states=list(sys.state_labels), name=f"OPLOOP{which}")
+
+
+def forward_path(model: AeroservoelasticModel, controller: PDController, which: int):
+    """FWTF ``which`` = K_c (K_P + K_D s) x OPLOOP ``which`` (Section 5.2), rad -> rad.
+
+    The PD is improper, so the product is formed in state space: for a strictly proper
+    OPLOOP (A, B, C, 0), s y = C A x + C B u, hence FWTF = (A, B, K_c (K_P C + K_D C A),
+    K_c K_D C B) -- exact, without a transfer-function round trip.
+    """
+    _check_controller(controller)
+    ol = open_loop(model, which)
+    A, B, C, D = (np.array(m) for m in (ol.A, ol.B, ol.C, ol.D))
+    if np.any(D != 0):
+        raise ValueError(f"OPLOOP{which} is not strictly proper; cannot apply the PD exactly")
+    kc, kp, kd = controller.gain, controller.kp, controller.kd
+    return ct.ss(A, B, kc * (kp * C + kd * C @ A), kc * kd * C @ B, inputs=["error"],
+                 outputs=list(ol.output_labels), states=list(ol.state_labels),
+                 name=f"FWTF{which}")
+
+
+def closed_loop(model: AeroservoelasticModel, controller: PDController, topology: str,
+                outputs: list[str] | None = None) -> ct.StateSpace:
+    """Linear closed loop from ``theta_cmd`` (rad) to ``outputs`` (default: transmission angle,
+    fin-root angle, hinge moment, voltage, current and every aeroelastic output).
+
+    The PD acts on the error ``theta_cmd - feedback`` with feedback the transmission angle
+    (AEM1) or the fin-root angle (AEM2); the derivative term is K_c K_D d/dt(error), realised
+    exactly by using the feedback rate (transmission ``omega``, or the fin-root rate from the
+    aeroelastic states) so the interconnection stays proper.
+    """
+    _check_topology(topology)
+    _check_controller(controller)
+    fin = model.aeroelastic
+    # fin-root rate output: d/dt (C_r z + D_r0 theta) = C_r (A z + B u) + D_r0 omega
+    ir = list(fin.output_labels).index(FIN_ROOT)
+    Cr, Dr = np.array(fin.C[ir:ir + 1]), np.array(fin.D[ir:ir + 1])
+    rate_C = Cr @ np.array(fin.A)
+    rate_D = Cr @ np.array(fin.B) + np.array([[0.0, Dr[0, 0], 0.0]])
+    fin2 = ct.ss(fin.A, fin.B, np.vstack([fin.C, rate_C]), np.vstack([fin.D, rate_D]),
+                 states=list(fin.state_labels), inputs=list(fin.input_labels),
+                 outputs=list(fin.output_labels) + ["fin_root_rate"], name="aeroelastic")
+    plant = _plant(model, fin2)
+    fb, fb_rate = ("theta", "omega") if topology == "AEM1" else (FIN_ROOT, "fin_root_rate")
+    kc, kp, kd = controller.gain, controller.kp, controller.kd
+    # PD with the derivative on the feedback rate only (a step's derivative impulse is absent):
+    # voltage = Kc Kp (cmd - fb) - Kc Kd fb_rate (+ Kc Kd cmd_rate, zero for steps)
+    pd = ct.ss(np.zeros((0, 0)), np.zeros((0, 3)), np.zeros((1, 0)),
+               [[kc * kp, -kc * kp, -kc * kd]], inputs=["cmd", "fb", "fb_rate"],
+               outputs=["voltage"], name="pd")
+    default = (["theta", "omega", "current", "voltage", FIN_ROOT, "hinge_moment"]
+               + [o for o in fin.output_labels if o not in (FIN_ROOT, "hinge_moment")])
+    outputs = default if outputs is None else list(outputs)
+    outlist = []
+    for o in outputs:
+        if o == "voltage":
+            outlist.append("pd.voltage")
+        elif o in plant.output_labels:
+            outlist.append(f"plant.{o}")
+        else:
+            raise ValueError(f"unknown output {o!r}; available: voltage, "
+                             f"{list(plant.output_labels)}")
+    return ct.interconnect(
+        [plant, pd],
+        connections=[["plant.voltage", "pd.voltage"], ["pd.fb", f"plant.{fb}"],
+                     ["pd.fb_rate", f"plant.{fb_rate}"]],
+        inplist=["pd.cmd"], inputs=["theta_cmd"], outlist=outlist, outputs=outputs,
+        name=f"{topology}_closed_loop", check_unused=False)
+
+
+def is_stable(sys) -> bool:
+    """All poles in the open left half plane."""
+    return bool(np.all(np.real(ct.poles(sys)) < 0))
+
+
+# ---------------------------------------------------------------------------------------------
+# frequency-domain reporting
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Crossovers:
+    """All crossovers of a loop L(j omega) on a frequency grid (Hz, deg, dB).
+
+    gain_crossovers_hz with phase_margins_deg (phase + 180 deg, wrapped to (-180, 180]);
+    phase_crossovers_hz (phase = -180 deg mod 360) with gain_margins_db (-20 log10 |L|).
+    """
+
+    gain_crossovers_hz: np.ndarray
+    phase_margins_deg: np.ndarray
+    phase_crossovers_hz: np.ndarray
+    gain_margins_db: np.ndarray
+
+    @property
+    def phase_margin_deg(self) -> float:
+        """Smallest phase margin (deg); inf without a gain crossover."""
+        return float(np.min(self.phase_margins_deg)) if self.phase_margins_deg.size else math.inf
+
+    @property
+    def gain_margin_db(self) -> float:
+        """Gain margin at the first phase crossover (dB); inf without one."""
+        return float(self.gain_margins_db[0]) if self.gain_margins_db.size else math.inf
+
+
+def frequency_response(sys, f_hz: np.ndarray) -> np.ndarray:
+    """Complex frequency response of a SISO system at frequencies ``f_hz`` (Hz)."""
+    return np.asarray(ct.frequency_response(sys, 2 * np.pi * np.asarray(f_hz)).complex).ravel()
+
+
+def crossovers(loop, f_hz: np.ndarray | None = None) -> Crossovers:
+    """Every gain and phase crossover of the SISO loop ``loop`` over ``f_hz`` (default
+    1 Hz - 10 kHz, 20000 log-spaced points), each refined by linear interpolation.
+
+    The phase is unwrapped along the grid, so a phase crossover is where it passes an odd
+    multiple of -180 deg.
+    """
+    f = np.logspace(0, 4, 20000) if f_hz is None else np.asarray(f_hz, float)
+    h = frequency_response(loop, f)
+    mag_db = 20 * np.log10(np.abs(h))
+    ph = np.degrees(np.unwrap(np.angle(h)))
+    gc, pm = [], []
+    for i in np.nonzero(np.sign(mag_db[:-1]) != np.sign(mag_db[1:]))[0]:
+        t = mag_db[i] / (mag_db[i] - mag_db[i + 1])
+        fc = f[i] * (f[i + 1] / f[i]) ** t
+        p = ph[i] + t * (ph[i + 1] - ph[i])
+        gc.append(fc)
+        pm.append((p + 180.0 + 180.0) % 360.0 - 180.0)
+    pc, gm = [], []
+    shifted = (ph + 180.0) / 360.0            # integer where phase = -180 + 360 n
+    level = np.floor(shifted)
+    for i in np.nonzero(level[:-1] != level[1:])[0]:
+        target = max(level[i], level[i + 1])
+        t = (target - shifted[i]) / (shifted[i + 1] - shifted[i])
+        fc = f[i] * (f[i + 1] / f[i]) ** t
+        pc.append(fc)
+        gm.append(-(mag_db[i] + t * (mag_db[i + 1] - mag_db[i])))
+    return Crossovers(np.array(gc), np.array(pm), np.array(pc), np.array(gm))
+
+
+def resonances(sys, f_hz: np.ndarray | None = None, min_prominence_db: float = 1.0) -> np.ndarray:
+    """Frequencies (Hz) of the local maxima of |sys(j 2 pi f)| over ``f_hz`` (default
+    10 Hz - 2 kHz), keeping peaks at least ``min_prominence_db`` above the neighbouring minima."""
+    from scipy.signal import find_peaks
+
+    f = np.logspace(1, np.log10(2000.0), 40000) if f_hz is None else np.asarray(f_hz, float)
+    mag_db = 20 * np.log10(np.abs(frequency_response(sys, f)))
+    idx, _ = find_peaks(mag_db, prominence=min_prominence_db)
+    return f[idx]
+
+
+# ---------------------------------------------------------------------------------------------
+# nonlinear (power-limited) closed loop
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class AseSimulation:
+    """Time histories of a closed-loop aeroservoelastic simulation (SI).
+
+    t (s); command, theta (transmission angle), omega, alpha, current (A), voltage (applied, V);
+    outputs: ``{name: history}`` for every aeroelastic output (hinge_moment in N m without the
+    acceleration term is replaced by the full hinge moment; fin_root_pitch; zeta*; points);
+    topology, limits.
+    """
+
+    t: np.ndarray
+    command: np.ndarray
+    theta: np.ndarray
+    omega: np.ndarray
+    alpha: np.ndarray
+    current: np.ndarray
+    voltage: np.ndarray
+    outputs: dict
+    topology: str
+    limits: PowerLimits | None
+    theta0: float = 0.0
+
+    @property
+    def fin_root(self) -> np.ndarray:
+        return self.outputs[FIN_ROOT]
+
+
+def _fb_rows(model: AeroservoelasticModel):
+    ir = model.output_index(FIN_ROOT)
+    Cr, Dr = model.output_C[ir], model.output_D[ir]
+    return Cr, Dr
+
+
+def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController, command: float,
+                         topology: str = "AEM1", limits: PowerLimits | None = THESIS_LIMITS,
+                         t_final: float = 0.2, theta0: float = 0.0, n_out: int = 4001,
+                         max_step: float = 5e-5, angle_limit: float = math.radians(15.0),
+                         method: str = "RK45") -> AseSimulation:
+    """Closed-loop step response of the actuator + aeroelastic fin (Figs 70-84).
+
+    The nonlinear actuator of :mod:`asekit.simulate` (``limits``: supply and current limits,
+    None for the linear model) is integrated together with the linear aeroelastic states of
+    Eq. (2.63) in one ``solve_ivp``. The PD acts on the transmission angle (AEM1) or the fin-root
+    angle (AEM2) and their rates.
+
+    Parameters
+    ----------
+    command : commanded fin angle (rad); |command| must not exceed ``angle_limit`` (thesis
+        Table 2: 15 deg) -- a larger command is refused with ValueError.
+    t_final : simulated time (s), > 0. theta0 : initial angle (rad), the system at rest.
+    n_out : output samples (uniform). max_step : largest integrator step (s); the lag roots
+        and the motor's electrical pole are near 1e4 rad/s.
+    """
+    _check_topology(topology)
+    _check_controller(controller)
+    command = _check_finite("command", command)
+    if abs(command) > angle_limit + 1e-12:
+        raise ValueError(f"command {math.degrees(command):.3g} deg exceeds the angular position "
+                         f"limit of {math.degrees(angle_limit):.3g} deg (thesis Table 2)")
+    if not (t_final > 0 and math.isfinite(t_final)):
+        raise ValueError(f"t_final must be a finite number > 0, got {t_final!r}")
+    lim = limits if limits is not None else PowerLimits(supply_voltage=None, current_limit=None)
+    act = model.actuator
+    A, B = model.A, model.B
+    ih = model.output_index("hinge_moment")
+    Ch, Dh = model.output_C[ih], model.output_D[ih]
+    Cr, Dr = _fb_rows(model)
+    nz = A.shape[0]
+    aem2 = topology == "AEM2"
+
+    def derivatives(x):
+        """(dx/dt, feedback angle, feedback rate, applied-voltage demand) at state x."""
+        z = x[3:]
+        hm = Ch @ z + Dh[0] * x[0] + Dh[1] * x[1]
+        # the acceleration does not depend on the voltage (it acts through the current state)
+        alpha = motor_rhs(act, lim, x[:3], 0.0, hm)[1]
+        zdot = A @ z + B @ np.array([x[0], x[1], alpha])
+        if aem2:
+            th_fb = Cr @ z + Dr[0] * x[0]
+            om_fb = Cr @ zdot + Dr[0] * x[1]
+        else:
+            th_fb, om_fb = x[0], x[1]
+        v_cmd = controller_voltage(controller, command, th_fb, om_fb)
+        dx_act = motor_rhs(act, lim, x[:3], v_cmd, hm)
+        return np.concatenate([dx_act, zdot]), th_fb, om_fb, v_cmd
+
+    def rhs(t, x):
+        return derivatives(x)[0]
+
+    x0 = np.zeros(3 + nz)
+    x0[0] = float(theta0)
+    t_out = np.linspace(0.0, t_final, n_out)
+    sol = solve_ivp(rhs, (0.0, t_final), x0, method=method, t_eval=t_out, max_step=max_step,
+                    rtol=1e-7, atol=1e-10)
+    if not sol.success:
+        raise RuntimeError(f"integration failed: {sol.message}")
+    x = sol.y
+    z = x[3:]
+    # derived histories
+    volt = np.empty(n_out)
+    alpha = np.empty(n_out)
+    for i in range(n_out):
+        dx, _, _, v_cmd = derivatives(x[:, i])
+        alpha[i] = dx[1]
+        volt[i] = applied_voltage(act, lim, x[:3, i], v_cmd)
+    hm_part = Ch @ z + Dh[0] * x[0] + Dh[1] * x[1]
+    u = np.vstack([x[0], x[1], alpha])
+    y = model.output_C @ z + model.output_D @ u
+    outputs = {name: y[j] for j, name in enumerate(model.output_names)}
+    # the full hinge moment, including the acceleration term moved into the actuator
+    outputs["hinge_moment"] = hm_part - model.effective_fin_inertia * alpha \
+        if not model.meta.get("count_fin_inertia_twice") else hm_part
+    return AseSimulation(t=t_out, command=np.full(n_out, command), theta=x[0], omega=x[1],
+                         alpha=alpha, current=x[2], voltage=volt, outputs=outputs,
+                         topology=topology, limits=limits, theta0=float(theta0))
+
+
+# ---------------------------------------------------------------------------------------------
+# time-domain metrics
+# ---------------------------------------------------------------------------------------------
+def settling_time(t: np.ndarray, y: np.ndarray, target: float, step: float,
+                  band: float = 0.02) -> float:
+    """Time (s) after which ``y`` stays within ``band`` |step| of ``target``; inf if it is
+    outside at the end."""
+    outside = np.abs(y - target) > band * abs(step)
+    if outside[-1]:
+        return math.inf
+    if not outside.any():
+        return 0.0
+    return float(t[int(np.nonzero(outside)[0][-1]) + 1])
+
+
+def overshoot(y: np.ndarray, command: float, theta0: float = 0.0) -> float:
+    """Largest excursion past ``command`` as a fraction of the step (0 if none)."""
+    step = command - theta0
+    return float(max(0.0, np.max(np.sign(step) * (y - command))) / abs(step))
+
+
+def spectrum_after_rise(t: np.ndarray, y: np.ndarray, command: float, fraction: float = 0.95,
+                        theta0: float = 0.0, pad: int = 8):
+    """Amplitude spectrum of ``y`` after it first reaches ``fraction`` of the step, mean removed
+    (thesis Figs 73, 81). Returns (f_hz, amplitude) with a Hann window and zero padding
+    (``pad`` x the record length); amplitudes are single-sided, window-corrected."""
+    step = command - theta0
+    reached = np.nonzero(np.sign(step) * (y - theta0) >= fraction * abs(step))[0]
+    if reached.size == 0:
+        raise ValueError(f"the response never reaches {fraction:.0%} of the command")
+    seg = y[reached[0]:] - np.mean(y[reached[0]:])
+    if seg.size < 16:
+        raise ValueError("too few samples after the rise for a spectrum")
+    dt = float(t[1] - t[0])
+    w = np.hanning(seg.size)
+    n_fft = int(2 ** math.ceil(math.log2(seg.size * pad)))
+    spec = np.fft.rfft(seg * w, n_fft)
+    amp = 2.0 * np.abs(spec) / np.sum(w)
+    return np.fft.rfftfreq(n_fft, dt), amp
+
+
+def spectrum_peaks(f_hz: np.ndarray, amp: np.ndarray, n: int = 2, f_min: float = 20.0,
+                   rel_height: float = 0.02) -> np.ndarray:
+    """The ``n`` largest spectral peaks above ``f_min`` Hz (at least ``rel_height`` of the
+    largest), returned in ascending frequency."""
+    from scipy.signal import find_peaks
+
+    sel = f_hz >= f_min
+    idx, props = find_peaks(amp[sel], height=rel_height * amp[sel].max())
+    if idx.size == 0:
+        return np.array([])
+    best = idx[np.argsort(props["peak_heights"])[::-1][:n]]
+    return np.sort(f_hz[sel][best])
+
+
+def limit_cycle(t: np.ndarray, y: np.ndarray, window: float = 0.05):
+    """Amplitude (half peak-to-peak, same unit as y) and frequency (Hz, from zero crossings of
+    the mean-removed signal) of a sustained oscillation over the last ``window`` s."""
+    sel = t >= t[-1] - window
+    seg = y[sel] - np.mean(y[sel])
+    amp = 0.5 * (np.max(seg) - np.min(seg))
+    ts = t[sel]
+    up = np.nonzero((seg[:-1] < 0) & (seg[1:] >= 0))[0]
+    if up.size < 2:
+        return float(amp), math.nan
+    tc = ts[up] - seg[up] * (ts[up + 1] - ts[up]) / (seg[up + 1] - seg[up])
+    return float(amp), float((up.size - 1) / (tc[-1] - tc[0]))
