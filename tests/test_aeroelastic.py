@@ -148,3 +148,31 @@ def test_roger_fit_into_model_end_to_end():
     f2 = roger_fit(fit.k, Q, fit.b_ref, lag_roots=fit.lag_roots)
     sys = aeroelastic_model(modal, f2, 1.225, 250.0)
     assert sys.nstates == 2 * 3 + 2 * 3 + 2 * 1
+
+
+def test_fin_outputs_root_pitch_and_corners():
+    """With asekit's fin modal model: the fin-root pitch output is theta + elastic rotation at
+    the shaft node, with the rigid mode contributing exactly theta; corner outputs exist."""
+    pytest.importorskip("asekit.structure.modes")
+    from asekit.aeroelastic import fin_outputs
+    from asekit.structure.modes import fin_modal_model
+    modal = fin_modal_model()
+    corners = np.array([[0.0, 0.0], [0.156, 0.0], [0.078, 0.15], [0.156, 0.15]])
+    out = fin_outputs(modal, corners, names=["rle", "rte", "tle", "tte"],
+                      shaft_point=(0.078, 0.0))
+    assert out["fin_root_pitch"][0] == pytest.approx(1.0)
+    for nm in ("rle", "rte", "tle", "tte"):
+        assert out[f"theta_{nm}"][0] == pytest.approx(1.0)
+    # the rigid pitch mode moves the leading edge up: w = -(x - x_axis) per rad
+    assert out["w_rle"][0] == pytest.approx(0.078, rel=1e-6)
+    assert out["w_tte"][0] == pytest.approx(-0.078, rel=1e-6)
+    n = modal.M.shape[0]
+    A = np.zeros((5, n, n))
+    A[0, 0, 0] = 6e-4
+    fit = RogerFit(A=A, lag_roots=np.array([0.5, 1.5]), b_ref=0.078, k=np.array([0.0, 1.0]),
+                   Q=np.zeros((2, n, n)), element_error=np.zeros((n, n)), fit_error=0.0)
+    sys = aeroelastic_model(modal, fit, 1.225, 250.0, outputs=out)
+    assert "fin_root_pitch" in sys.output_labels and "w_tte" in sys.output_labels
+    # static: no elastic coupling in this GAF -> root pitch equals theta
+    y0 = sys(0.0) @ np.array([1.0, 0.0, 0.0])
+    assert y0[list(sys.output_labels).index("fin_root_pitch")] == pytest.approx(1.0)

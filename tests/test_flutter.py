@@ -151,3 +151,23 @@ def test_bad_input():
         TabulatedGaf(np.array([0.0, 1.0]), np.array([Q, Q]), -1.0)
     with pytest.raises(ValueError, match="modes"):
         pk_flutter(modal, gaf, 1.0, [1.0], modes=[5])
+
+
+def test_match_point_table_and_matched_mach():
+    """Flutter speed independent of Mach (same GAFs): M_eq = U_f / a is the same for every
+    analysis Mach, so the matched Mach is M_eq itself when bracketed."""
+    M, K, C, Q, q_f, _ = _coalescence_case()
+    gaf = TabulatedGaf(np.array([0.0, 10.0]), np.array([Q, Q]), 1.0)
+    modal = modal_arrays(M=M, K=K, C=C)
+    from asekit.atmosphere import speed_of_sound
+    from asekit.flutter import match_point_table, matched_mach
+    rho = 1.225
+    U_f = np.sqrt(2 * q_f / rho)
+    rows = match_point_table(modal, lambda mach: gaf, [0.01, 0.9], [0.0],
+                             np.linspace(0.5 * U_f, 1.5 * U_f, 11))
+    m_eq = U_f / float(speed_of_sound(0.0))
+    assert all(r.speed == pytest.approx(U_f, rel=1e-6) for r in rows)
+    assert rows[0].mach_equivalent == pytest.approx(m_eq, rel=1e-6)
+    assert rows[0].equivalent_speed == pytest.approx(U_f, rel=1e-3)
+    assert 0.01 < m_eq < 0.9 and matched_mach(rows, 0.0) == pytest.approx(m_eq, rel=1e-6)
+    assert matched_mach(rows, 2500.0) is None

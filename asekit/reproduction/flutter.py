@@ -438,3 +438,40 @@ def rfa_sensitivity(modal, db, mach: float = 0.75, altitude: float = 0.0,
         rows.append({"label": label, "fit_error": fit.fit_error, "speed": _val(fl, "speed"),
                      "freq": _val(fl, "frequency_hz"), "first": _val(first_of(inst), "speed")})
     return rows
+
+
+def aero_variant_gafs(modal, db, mach: float = 0.75, symmetric: bool = False,
+                      n_chord: int | None = None, n_span: int | None = None) -> TabulatedGaf:
+    """The fin's GAFs at one Mach recomputed with another aerodynamic model choice: a
+    symmetry wall at the root (``symmetric``) or another box mesh (``n_chord`` x ``n_span``),
+    on the database's k and b_ref (uses asekit.aero; a few seconds per variant)."""
+    from ..aero.boxes import fin_boxes
+    from ..aero.gaf import gaf_from_box_modes
+    from ..aero.spline import fe_spline
+    from ..geometry import load_fin
+    boxes = fin_boxes(load_fin(), n_chord, n_span)
+    q = gaf_from_box_modes(fe_spline(modal, boxes), boxes, mach, db.k, db.b_ref,
+                           symmetric=symmetric)
+    return TabulatedGaf(db.k, q, db.b_ref, mach=mach)
+
+
+def aero_sensitivity(modal, db, mach: float = 0.75, altitude: float = 0.0,
+                     velocities=VELOCITIES, variants=None) -> list[dict]:
+    """p-k flutter speed with the GAFs recomputed for aerodynamic modelling variants:
+    default ``[("symmetry wall at the root", {"symmetric": True}), ("finer boxes 20 x 14",
+    {"n_chord": 20, "n_span": 14})]``."""
+    rho = float(standard_atmosphere(altitude).density)
+    if variants is None:
+        variants = [("symmetry wall at the root (fin on a body)", {"symmetric": True}),
+                    ("finer aerodynamic mesh 20 x 14 boxes", {"n_chord": 20, "n_span": 14})]
+    rows = []
+    for label, kw in variants:
+        g = aero_variant_gafs(modal, db, mach, **kw)
+        res = pk_flutter(modal, g, rho, velocities)
+        inst = pk_instabilities(res, modal, g)
+        fl, first = first_of(inst, "flutter"), first_of(inst)
+        rows.append({"label": label, "speed": _val(fl, "speed"),
+                     "freq": _val(fl, "frequency_hz"), "first": _val(first, "speed"),
+                     "first_kind": None if first is None else first.kind,
+                     "Q_cc": float(g.Q[0, 0, 0].real)})
+    return rows
