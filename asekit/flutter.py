@@ -471,8 +471,8 @@ def root_locus(modal, rfa, density: float, velocities, substeps: int | None = No
     """Eigenvalues of A_sys (Eq. 2.63) over ``velocities`` with the aeroelastic roots tracked.
 
     Tracking starts from the structural roots at a speed 1e-3 of the first velocity and
-    continues in small steps (``substeps`` between list points; default so that U changes by at
-    most 5 % or 2 m/s-equivalent fraction per step); each step assigns the new roots to the
+    continues in small steps (``substeps`` between list points; by default enough that U
+    changes by at most 5 % per step); each step assigns the new roots to the
     branches by a cost combining eigenvalue distance and eigenvector correlation (Hungarian
     assignment), so lag roots, which start near the origin on the real axis, are never taken
     for aeroelastic roots.
