@@ -441,37 +441,60 @@ def rfa_sensitivity(modal, db, mach: float = 0.75, altitude: float = 0.0,
 
 
 def aero_variant_gafs(modal, db, mach: float = 0.75, symmetric: bool = False,
-                      n_chord: int | None = None, n_span: int | None = None) -> TabulatedGaf:
+                      n_chord: int | None = None, n_span: int | None = None,
+                      spline: str = "fe") -> TabulatedGaf:
     """The fin's GAFs at one Mach recomputed with another aerodynamic model choice: a
-    symmetry wall at the root (``symmetric``) or another box mesh (``n_chord`` x ``n_span``),
-    on the database's k and b_ref (uses asekit.aero; a few seconds per variant)."""
+    symmetry wall at the root (``symmetric``), another box mesh (``n_chord`` x ``n_span``), or
+    the infinite-plate spline (``spline="ips"``, Harder & Desmarais) through the structural
+    nodes instead of the finite-element shape functions, on the database's k and b_ref (uses
+    asekit.aero; a few seconds per variant). ``modal`` is the ModalModel whose shapes are used.
+    """
     from ..aero.boxes import fin_boxes
     from ..aero.gaf import gaf_from_box_modes
-    from ..aero.spline import fe_spline
+    from ..aero.spline import InfinitePlateSpline, fe_spline
     from ..geometry import load_fin
     boxes = fin_boxes(load_fin(), n_chord, n_span)
-    q = gaf_from_box_modes(fe_spline(modal, boxes), boxes, mach, db.k, db.b_ref,
-                           symmetric=symmetric)
+    if spline == "fe":
+        bm = fe_spline(modal, boxes)
+    elif spline == "ips":
+        bm = InfinitePlateSpline(modal.nodes).box_modes(boxes, modal.shapes[:, 0, :])
+    else:
+        raise ValueError(f"spline must be 'fe' or 'ips', got {spline!r}")
+    q = gaf_from_box_modes(bm, boxes, mach, db.k, db.b_ref, symmetric=symmetric)
     return TabulatedGaf(db.k, q, db.b_ref, mach=mach)
 
 
-def aero_sensitivity(modal, db, mach: float = 0.75, altitude: float = 0.0,
-                     velocities=VELOCITIES, variants=None) -> list[dict]:
-    """p-k flutter speed with the GAFs recomputed for aerodynamic modelling variants:
-    default ``[("symmetry wall at the root", {"symmetric": True}), ("finer boxes 20 x 14",
-    {"n_chord": 20, "n_span": 14})]``."""
+#: Modelling variants of :func:`model_sensitivity`: (label, structure kwargs for
+#: ``fin_modal_model``, aerodynamic kwargs for :func:`aero_variant_gafs`).
+MODEL_VARIANTS = (
+    ("symmetry wall at the root (fin on a body)", {}, {"symmetric": True}),
+    ("finer aerodynamic mesh 20 x 14 boxes", {}, {"n_chord": 20, "n_span": 14}),
+    ("infinite-plate spline instead of FE shape functions", {}, {"spline": "ips"}),
+    ("finer structural mesh 12 x 14 elements", {"n_chord": 12, "n_span": 14}, {}),
+    ("12 x 14 mesh + distributed (rigid-region) shaft",
+     {"n_chord": 12, "n_span": 14, "shaft": "distributed"}, {}),
+)
+
+
+def model_sensitivity(db, mach: float = 0.75, altitude: float = 0.0, velocities=VELOCITIES,
+                      variants=MODEL_VARIANTS) -> list[dict]:
+    """p-k flutter speed with the structure and/or GAFs rebuilt for modelling variants (support
+    model, structural mesh, spline, symmetry plane, aerodynamic mesh) at one Mach and altitude.
+    Rows: label, elastic frequencies (Hz), Q_cc(k_min), speed, freq, first, first_kind."""
+    from ..aeroelastic import modal_arrays
+    from ..structure.modes import fin_modal_model
     rho = float(standard_atmosphere(altitude).density)
-    if variants is None:
-        variants = [("symmetry wall at the root (fin on a body)", {"symmetric": True}),
-                    ("finer aerodynamic mesh 20 x 14 boxes", {"n_chord": 20, "n_span": 14})]
     rows = []
-    for label, kw in variants:
-        g = aero_variant_gafs(modal, db, mach, **kw)
-        res = pk_flutter(modal, g, rho, velocities)
-        inst = pk_instabilities(res, modal, g)
+    for label, skw, akw in variants:
+        model = fin_modal_model(**skw)
+        g = aero_variant_gafs(model, db, mach, **akw)
+        m = modal_arrays(model)
+        res = pk_flutter(m, g, rho, velocities)
+        inst = pk_instabilities(res, m, g)
         fl, first = first_of(inst, "flutter"), first_of(inst)
-        rows.append({"label": label, "speed": _val(fl, "speed"),
-                     "freq": _val(fl, "frequency_hz"), "first": _val(first, "speed"),
+        rows.append({"label": label, "elastic_hz": model.frequencies_hz[model.n_rigid:].tolist(),
+                     "speed": _val(fl, "speed"), "freq": _val(fl, "frequency_hz"),
+                     "first": _val(first, "speed"),
                      "first_kind": None if first is None else first.kind,
                      "Q_cc": float(g.Q[0, 0, 0].real)})
     return rows
