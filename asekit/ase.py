@@ -552,3 +552,94 @@ def limit_cycle(t: np.ndarray, y: np.ndarray, window: float = 0.05):
         return float(amp), math.nan
     tc = ts[up] - seg[up] * (ts[up + 1] - ts[up]) / (seg[up + 1] - seg[up])
     return float(amp), float((up.size - 1) / (tc[-1] - tc[0]))
+
+
+# ---------------------------------------------------------------------------------------------
+# the reference fin (thesis Ch. 5: Mach 0.5, sea level)
+# ---------------------------------------------------------------------------------------------
+#: The fin corners reported in Fig 71-72, as planform fractions (chord xi, span eta).
+CORNERS = {"root_le": (0.0, 0.0), "root_te": (1.0, 0.0), "tip_le": (0.0, 1.0),
+           "tip_te": (1.0, 1.0)}
+
+
+@dataclass(frozen=True)
+class FinAse:
+    """The reference fin's aeroservoelastic model at one flight condition and what it was
+    built from: ``model`` (:class:`AeroservoelasticModel`), ``modal`` (ModalModel), ``rfa``
+    (RogerFit at ``mach``), ``q_cc`` (steady Re Q_cc at ``mach``, m^3), ``mach``, ``altitude``
+    (m), ``density`` (kg/m^3), ``velocity`` (m/s), ``dynamic_pressure`` (Pa)."""
+
+    model: AeroservoelasticModel
+    modal: object
+    rfa: object
+    q_cc: float
+    mach: float
+    altitude: float
+    density: float
+    velocity: float
+
+    @property
+    def dynamic_pressure(self) -> float:
+        return 0.5 * self.density * self.velocity ** 2
+
+    def rigid_fin_actuator(self) -> ActuatorParameters:
+        """The Ch. 4 design model: the actuator with the rigid fin's inertia J_fin (asekit's
+        structural value) as its load."""
+        return replace(self.model.actuator, fin_inertia=float(self.modal.J_fin))
+
+    def steady_hinge_moment(self):
+        """The Ch. 4 steady hinge moment q Q_cc theta at this flight condition (asekit's Q_cc)."""
+        from .simulate import SteadyHingeMoment
+        from .atmosphere import standard_atmosphere
+
+        atm = standard_atmosphere(self.altitude)
+        return SteadyHingeMoment(q_cc=self.q_cc, mach=self.mach, density=float(atm.density),
+                                 speed_of_sound=float(atm.speed_of_sound))
+
+
+def fin_ase(mach: float = 0.5, altitude: float = 0.0, actuator: ActuatorParameters | None = None,
+            count_fin_inertia_twice: bool = False, n_lags: int = 4, database=None,
+            modal=None) -> FinAse:
+    """The reference fin's aeroservoelastic model at (mach, altitude) (thesis Ch. 5).
+
+    Uses the cached GAF database (:func:`asekit.aero.gaf.fin_gaf_database`, single-node shaft,
+    6 x 7 FE mesh as the thesis), a Roger fit with ``n_lags`` lag roots at ``mach`` (Machs
+    between the database's are interpolated linearly; outside them a ValueError), the 1976
+    standard atmosphere at ``altitude`` (m) and U = mach x speed of sound. Outputs: the fin-root
+    pitch (AEM2 feedback), the pitch rotations ``theta_<corner>`` and normal displacements
+    ``w_<corner>`` at the four planform corners (:data:`CORNERS`), and the modal coordinates.
+    """
+    from .aero.gaf import fin_gaf_database, steady_hinge_coefficient
+    from .aeroelastic import fin_outputs
+    from .atmosphere import standard_atmosphere
+    from .geometry import load_fin
+    from .rfa import roger_fit, gaf_at_mach
+
+    mach = _check_finite("mach", mach)
+    altitude = _check_finite("altitude", altitude)
+    if database is None or modal is None:
+        database, modal = fin_gaf_database(progress=False)
+    lo, hi = float(np.min(database.machs)), float(np.max(database.machs))
+    if not lo <= mach <= hi:
+        raise ValueError(f"mach must lie within the GAF database's range [{lo}, {hi}], "
+                         f"got {mach}")
+    k, q = gaf_at_mach(database, mach, interpolate=True)
+    rfa = roger_fit(k, q, database.b_ref, n_lags=n_lags, mach=mach)
+    atm = standard_atmosphere(altitude)
+    rho, a = float(atm.density), float(atm.speed_of_sound)
+    fin = load_fin()
+    pts = fin.planform.point(np.array([c[0] for c in CORNERS.values()]),
+                             np.array([c[1] for c in CORNERS.values()]))
+    rows = fin_outputs(modal, pts, names=list(CORNERS), shaft_point=fin.shaft.axis_point)
+    model = build_model(modal, rfa, rho, mach * a, rows, actuator=actuator, mach=mach,
+                        count_fin_inertia_twice=count_fin_inertia_twice)
+    q_cc = float(np.real(q[0, 0, 0]))
+    return FinAse(model=model, modal=modal, rfa=rfa, q_cc=q_cc, mach=mach, altitude=altitude,
+                  density=rho, velocity=mach * a)
+
+
+def static_gains(sys, outputs: list[str]) -> dict:
+    """DC gains of a stable closed loop from ``theta_cmd`` to each named output."""
+    g = np.asarray(ct.dcgain(sys)).ravel()
+    names = list(sys.output_labels)
+    return {o: float(g[names.index(o)]) for o in outputs}
