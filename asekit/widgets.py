@@ -118,3 +118,129 @@ def servo_panel(controller: PDController = SYSTEM_3, supply_voltage: float = 24.
     panel.sliders = sliders
     redraw()
     return panel
+
+
+# ---------------------------------------------------------------------------------------------
+# Ch. 5: controller design with the elastic fin in the loop
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class AseSnapshot:
+    """What the Ch. 5 panel shows: the forward path ``fwtf`` (FWTF 2 for AEM1, FWTF 3 for
+    AEM2) and its ``crossovers``, closed-loop ``stable``, the linear unit step of the elastic fin
+    (``t`` s, ``outputs`` name -> rad: transmission, fin root, corners) and of the rigid-fin
+    design model (``theta_rigid``, Eq. 4.18 with the fin's J_fin)."""
+
+    controller: PDController
+    topology: str
+    mach: float
+    altitude: float
+    fwtf: object
+    crossovers: object
+    stable: bool
+    t: np.ndarray
+    outputs: dict
+    theta_rigid: np.ndarray
+
+
+def ase_snapshot(gain: float, kp: float, kd: float, mach: float = 0.5, altitude: float = 0.0,
+                 topology: str = "AEM1", t_final: float = 0.1, fin=None) -> AseSnapshot:
+    """Forward path, margins and the linear closed-loop unit step of the elastic fin for PD
+    gains at (mach, altitude) (SI; altitude in m). ``fin``: a prebuilt
+    :class:`asekit.ase.FinAse` to reuse (else built with :func:`asekit.ase.fin_ase`)."""
+    import control as ct
+
+    from . import ase
+
+    ctrl = PDController(gain, kp, kd, name="panel")
+    fin = ase.fin_ase(mach=mach, altitude=altitude) if fin is None else fin
+    which = 2 if topology == "AEM1" else 3
+    fwtf = ase.forward_path(fin.model, ctrl, which)
+    names = ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in ase.CORNERS]
+    cl = ase.closed_loop(fin.model, ctrl, topology, outputs=names)
+    t = np.linspace(0.0, t_final, 1001)
+    y = np.asarray(ct.forced_response(cl, t, np.ones_like(t)).outputs)
+    _, theta_rigid = step_response(fin.rigid_fin_actuator(), ctrl, t_final=t_final,
+                                   amplitude=1.0, n=t.size)
+    return AseSnapshot(ctrl, topology, float(mach), float(altitude), fwtf, ase.crossovers(fwtf),
+                       ase.is_stable(cl), t, dict(zip(names, y)), np.asarray(theta_rigid))
+
+
+def _draw_ase(snap: AseSnapshot):
+    import matplotlib.pyplot as plt
+
+    from . import ase
+    from .plotting import THESIS_COLOR, new_figure
+
+    c = snap.controller
+    fig, axes = new_figure(f"{snap.topology}, M {snap.mach:g}, h {snap.altitude:g} m, K_c {c.gain:g}"
+                           f", K_P {c.kp:g}, K_D {c.kd:g}", "Figs 65-71 (live)", nrows=1, ncols=2,
+                           figsize=(12, 4.2))
+    ax1, ax2 = axes
+    f = np.logspace(0, np.log10(3000.0), 3000)
+    h = ase.frequency_response(snap.fwtf, f)
+    ax1.semilogx(f, 20 * np.log10(np.abs(h)))
+    ax1.axhline(0.0, color=THESIS_COLOR, lw=0.8)
+    x = snap.crossovers
+    ax1.set_title(f"FWTF{2 if snap.topology == 'AEM1' else 3}: PM {x.phase_margin_deg:.1f} deg, "
+                  f"GM {x.gain_margin_db:.1f} dB", fontsize=9)
+    ax1.set(xlabel="frequency (Hz)", ylabel="|forward path| (dB)")
+    for name, y in snap.outputs.items():
+        ax2.plot(1e3 * snap.t, y, lw=1.0 if name != "theta" else 1.8, label=name)
+    ax2.plot(1e3 * snap.t, snap.theta_rigid, color="g", lw=2, ls="--", label="rigid-fin design")
+    ax2.set_title("closed loop " + ("stable" if snap.stable else "UNSTABLE"), fontsize=9,
+                  color="k" if snap.stable else "C3")
+    if not snap.stable:
+        ax2.set_yscale("symlog", linthresh=1.0)
+    ax2.set(xlabel="time (ms)", ylabel="unit-step response (-)")
+    ax2.legend(fontsize=7)
+    plt.show()
+    return fig
+
+
+def ase_panel(controller: PDController = SYSTEM_3, mach: float = 0.5, altitude: float = 0.0,
+              topology: str = "AEM1"):
+    """An ipywidgets panel for Ch. 5: sliders K_c, K_P, K_D, Mach, altitude and the feedback
+    topology; redraws the forward-path Bode magnitude with margins and the closed-loop unit step
+    of the elastic fin beside the rigid-fin design response. Returns the ``ipywidgets.VBox``;
+    builds without a front-end. Models are kept per (Mach, altitude) inside the panel."""
+    import ipywidgets as w
+
+    from . import ase
+
+    sliders = {
+        "gain": w.FloatSlider(value=controller.gain, min=0.5, max=30.0, step=0.5,
+                              description="K_c", continuous_update=False),
+        "kp": w.FloatSlider(value=controller.kp, min=10.0, max=600.0, step=5.0,
+                            description="K_P", continuous_update=False),
+        "kd": w.FloatSlider(value=controller.kd, min=0.0, max=3.0, step=0.05,
+                            description="K_D", continuous_update=False),
+        "mach": w.FloatSlider(value=mach, min=0.4, max=0.75, step=0.05, description="Mach",
+                              continuous_update=False),
+        "altitude": w.FloatSlider(value=altitude, min=0.0, max=5000.0, step=500.0,
+                                  description="h (m)", continuous_update=False),
+        "topology": w.Dropdown(options=list(ase.TOPOLOGIES), value=topology,
+                               description="feedback"),
+    }
+    out = w.Output()
+    fins = {}
+
+    def redraw(*_):
+        v = {k: s.value for k, s in sliders.items()}
+        key = (round(v["mach"], 4), round(v["altitude"], 1))
+        if key not in fins:
+            fins[key] = ase.fin_ase(mach=key[0], altitude=key[1])
+        snap = ase_snapshot(v["gain"], v["kp"], v["kd"], key[0], key[1], v["topology"],
+                            fin=fins[key])
+        out.clear_output(wait=True)
+        with out:
+            _draw_ase(snap)
+        return snap
+
+    for s in sliders.values():
+        s.observe(redraw, names="value")
+    items = list(sliders.values())
+    panel = w.VBox([w.HBox(items[:3]), w.HBox(items[3:]), out])
+    panel.redraw = redraw
+    panel.sliders = sliders
+    redraw()
+    return panel
