@@ -171,3 +171,22 @@ def test_match_point_table_and_matched_mach():
     assert rows[0].equivalent_speed == pytest.approx(U_f, rel=1e-3)
     assert 0.01 < m_eq < 0.9 and matched_mach(rows, 0.0) == pytest.approx(m_eq, rel=1e-6)
     assert matched_mach(rows, 2500.0) is None
+
+
+def test_tracking_follows_eigenvectors_through_a_frequency_crossing():
+    """Two uncoupled modes; aerodynamic stiffness lowers the 150 rad/s mode below the 100 rad/s
+    one. Sorting by frequency would swap the labels; eigenvector correlation keeps each mode on
+    its own branch: omega^2 = k1 - q a exactly."""
+    k1, k2, a = 150.0 ** 2, 100.0 ** 2, 20.0
+    Q = np.array([[0.0, 0.0], [0.0, a]], complex)     # acts on dof 1 (the 150 rad/s mode)
+    gaf = TabulatedGaf(np.array([0.0, 10.0]), np.array([Q, Q]), 1.0)
+    U = np.linspace(1.0, 40.0, 40)                    # q up to 800: omega down to ~77 rad/s
+    res = pk_flutter(modal_arrays(M=np.eye(2), K=np.diag([k2, k1])), gaf, 1.0, U)
+    q = 0.5 * U ** 2
+    w1 = np.sqrt(np.clip(k1 - q * a, 0, None))
+    ok = k1 - q * a > 0
+    assert np.any(w1[ok] < 100.0)                      # the branches really cross
+    np.testing.assert_allclose(res.frequency_hz[:, 0], 100.0 / (2 * np.pi), rtol=1e-9)
+    np.testing.assert_allclose(res.frequency_hz[ok, 1], w1[ok] / (2 * np.pi), rtol=1e-9)
+    assert np.all(np.abs(res.vectors[:, 0, 1]) < 1e-9 * np.abs(res.vectors[:, 0, 0]))
+    assert np.all(np.abs(res.vectors[ok, 1, 0]) < 1e-9 * np.abs(res.vectors[ok, 1, 1]))

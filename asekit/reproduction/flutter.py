@@ -471,8 +471,6 @@ MODEL_VARIANTS = (
     ("finer aerodynamic mesh 20 x 14 boxes", {}, {"n_chord": 20, "n_span": 14}),
     ("infinite-plate spline instead of FE shape functions", {}, {"spline": "ips"}),
     ("finer structural mesh 12 x 14 elements", {"n_chord": 12, "n_span": 14}, {}),
-    ("12 x 14 mesh + distributed (rigid-region) shaft",
-     {"n_chord": 12, "n_span": 14, "shaft": "distributed"}, {}),
 )
 
 
