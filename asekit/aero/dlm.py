@@ -41,7 +41,7 @@ step as a fixed, k-independent quadrature: D1_rs = sum_j P1(eta_j) W1_j with wei
 W1_j = dx/(8 pi) sum_m V^-1[m, j] e^-m int eta^m / r1^2 d eta (V the Vandermonde matrix of the
 normalised points); the closed forms of the integrals are those of [R71] Eqs. 31-34, 40-41 and
 [R98] Eqs. 20-34 in expanded form. Pairs whose receiver is farther than 2e from the doublet
-line use 8-point Gauss-Legendre quadrature for the same integrals (error below 1e-12 there,
+line use 6-point Gauss-Legendre quadrature for the same integrals (error about 1e-11 there,
 and free of the cancellation of the closed forms far away). The weights and all kernel
 geometry depend on the Mach number but not on k: they are computed once per row chunk and
 reused for every reduced frequency of a sweep.
@@ -86,8 +86,8 @@ _METHODS = {
                 DESMARAIS_A),
 }
 _PLANAR_TOL = 1e-3          # |zbar| / e below which a pair is planar ([R71], NASTRAN)
-_FAR = 3.0                  # receiver farther than _FAR * e from the doublet line: quadrature
-_GAUSS = np.polynomial.legendre.leggauss(8)
+_FAR = 4.0                  # receiver farther than _FAR * e from the doublet line: quadrature
+_GAUSS = np.polynomial.legendre.leggauss(6)
 #: Receiver-sender pairs per row chunk: small enough for the arrays to stay in the CPU cache.
 PAIRS_PER_CHUNK = 32768
 
@@ -170,9 +170,10 @@ def _line_integrals(ybar, zbar, e, planar, power, m_max):
 
 
 def _far_weights(ybar, zbar, e, chord, stations, power):
-    """Weights W_j for distant pairs by 8-point Gauss-Legendre quadrature of the interpolating
+    """Weights W_j for distant pairs by 6-point Gauss-Legendre quadrature of the interpolating
     polynomial over r1^(2 power): W_j = dx/(8 pi) sum_g w_g e l_j(xi_g) / r1(xi_g e)^(2 power),
-    l_j the Lagrange basis of the stations (error below 1e-12 for receivers farther than 3e)."""
+    l_j the Lagrange basis of the stations (the integrand's poles lie at least 4e from the
+    doublet line, a Bernstein ellipse rho >= 8: relative error about rho^-12 ~ 1e-11)."""
     xg, wg = _GAUSS
     ns = stations.size
     # Lagrange basis of the stations at the Gauss points, lag[g, j]
@@ -238,32 +239,53 @@ class _ChunkGeometry:
         if self.nonplanar:
             self.w2 = [np.where(planar, 0.0, w) for w in self.w2]
         self.points = []
+        self.k10_sum = np.zeros(xbar.shape)      # sum_j K10_j T1 W1_j: the k-independent part
         tl = snd.tan_sweep[None, :]
-        for s in stations:
+        z2 = zbar * zbar
+        for s, w1 in zip(stations, self.w1):
             eta = s * e
             x0 = xbar - eta * tl
-            r1 = np.sqrt((ybar - eta) ** 2 + zbar ** 2)       # [R71] Eq. 4
+            r1 = ybar - eta
+            r1 *= r1
+            r1 += z2
+            big_r = x0 * x0 + beta2 * r1
+            np.sqrt(big_r, out=big_r)                         # [R71] Eq. 10
+            np.sqrt(r1, out=r1)                               # [R71] Eq. 4
             small = r1 <= 1e-12 * e
-            r1s = np.where(small, 1.0, r1)
-            big_r = np.sqrt(x0 * x0 + beta2 * r1 * r1)        # [R71] Eq. 10
-            big_rs = np.where(big_r > 0, big_r, 1.0)
-            u1 = np.where(small, 0.0, (mach * big_r - x0) / (beta2 * r1s))   # [R71] Eq. 11
+            any_small = bool(small.any())
+            if any_small:                                     # receiver on the doublet line
+                r1 = np.where(small, 1.0, r1)
+                big_r = np.where(big_r > 0, big_r, 1.0)
+            t = mach * big_r - x0
+            u1 = t / (beta2 * r1)                             # [R71] Eq. 11
+            if any_small:
+                u1[small] = 0.0
             sq = np.sqrt(1.0 + u1 * u1)
-            p = {"x0": x0, "r1": np.where(small, 0.0, r1), "u1": u1, "neg": u1 < 0.0,
-                 "small": np.nonzero(small), "down": np.where(x0[small] >= 0.0, 1.0, 0.0)}
-            p["k10"] = -1.0 - x0 / big_rs                     # [R71] Eq. 15
-            p["c1"] = mach * r1 / (big_rs * sq)               # second term of [R71] Eq. 7
+            neg = u1 < 0.0
+            p = {"small": np.nonzero(small), "down": np.where(x0[small] >= 0.0, 1.0, 0.0)}
+            p["neg_idx"] = np.nonzero(neg)
+            p["x0_neg"] = x0[p["neg_idx"]]
+            p["x0_small"] = x0[p["small"]]
+            c1 = mach * r1 / (big_r * sq)                     # second term of [R71] Eq. 7
+            k10 = -1.0 - x0 / big_r                           # [R71] Eq. 15
+            if any_small:
+                r1[small] = 0.0
+            t1w = self.t1 * w1                                # T1 W1_j
+            self.k10_sum += k10 * t1w
+            absu = np.abs(u1)
+            p.update(r1=r1, absu=absu, c1=c1, t1w=t1w,
+                     g=1.0 - absu / sq, sgn=np.where(neg, -1.0, 1.0),
+                     phase=t / beta2 + x0)                    # k1 u1 + kd x0 = kd * phase
             if self.nonplanar:
+                p.update(x0=x0, u1=u1, neg=neg, k10=k10)
                 t2 = zbar * (zbar * np.cos(gsr) + (ybar - eta) * np.sin(gsr))   # [R71] Eq. 21
                 p["t2"] = np.where(planar, 0.0, t2)
-                rr = r1 / big_rs
-                p["k20"] = 2.0 + x0 * (2.0 + beta2 * rr * rr) / big_rs          # [R71] Eq. 16
+                rr = r1 / big_r
+                p["k20"] = 2.0 + x0 * (2.0 + beta2 * rr * rr) / big_r          # [R71] Eq. 16
                 p["c2a"] = mach * mach * rr * rr / sq                          # [R71] Eq. 8 terms
                 p["c2b"] = (mach * rr * ((1.0 + u1 * u1) * beta2 * rr * rr + 2.0 + mach * rr * u1)
                             / (sq ** 3))
             self.points.append(p)
-        for p, w in zip(self.points, self.w1):
-            p["t1w"] = self.t1 * w                            # T1 W1_j (k-independent)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -356,9 +378,69 @@ def _integrals(u1, k1, p_n, a_n, need_i2, eku_abs):
     return i1, i2
 
 
+def _i0_sums(u, k1sq, p_n, a_n):
+    """s_p = sum a_n p_n e^(-p_n u) / (p_n^2 + k1^2) and s_1 = sum a_n e^(-p_n u) / (p_n^2 + k1^2):
+    I0 = s_p - i k1 s_1 ([R71] Eq. A.4), with powers of one exponential for the terms."""
+    s_p = np.zeros_like(u)
+    s_1 = np.zeros_like(u)
+    desmarais = p_n.size == 12
+    en = np.exp(-p_n[0] * u)
+    base = None if desmarais else en.copy()
+    t = np.empty_like(u)
+    for i, (pp, a) in enumerate(zip(p_n, a_n)):
+        if i > 0:
+            np.multiply(en, en if desmarais else base, out=en)
+        np.add(k1sq, pp * pp, out=t)
+        np.divide(en, t, out=t)
+        t *= a
+        s_1 += t
+        t *= pp
+        s_p += t
+    return s_p, s_1
+
+
+def _increment_planar(geo: _ChunkGeometry, kd: float, p_n, a_n) -> np.ndarray:
+    """D1 of a chunk without nonplanar pairs at omega / U = kd (1/m).
+
+    With A = 1 - u/sqrt(1+u^2) - i k1 I0 evaluated at |u1|, [R71] Eqs. A.1 and A.5 give
+    I1 = A e^(-i k1 u1) for u1 >= 0 and I1 = 2 Re I1(0) - conj(A) e^(-i k1 u1) for u1 < 0, so
+    -K1 e^(-i kd x0) = (sgn Re A + i Im A + M r1/(R sqrt(1+u1^2))) e^(-i kd (r1 u1 + x0))
+    + [u1 < 0] 2 Re I1(0) e^(-i kd x0): one complex exponential per pair and station.
+    """
+    out = geo.k10_sum.astype(complex)                       # sum_j K10_j T1 W1_j
+    for p in geo.points:
+        k1 = kd * p["r1"]                                   # [R71] Eq. 12
+        k1sq = k1 * k1
+        s_p, s_1 = _i0_sums(p["absu"], k1sq, p_n, a_n)
+        v = np.empty(k1.shape, complex)
+        re = k1sq * s_1
+        np.subtract(p["g"], re, out=re)                     # Re A = g - k1^2 s_1
+        re *= p["sgn"]
+        re += p["c1"]
+        v.real = re
+        np.multiply(k1, s_p, out=re)
+        v.imag = -re                                        # Im A = -k1 s_p
+        v *= np.exp(-1j * (kd * p["phase"]))
+        ni = p["neg_idx"]
+        if ni[0].size:
+            kn = k1sq[ni]
+            acc = np.zeros_like(kn)
+            for pp, a in zip(p_n, a_n):
+                acc += a / (kn + pp * pp)
+            v[ni] += 2.0 * (1.0 - kn * acc) * np.exp(-1j * (kd * p["x0_neg"]))  # 2 Re I1(0)
+        si = p["small"]
+        if si[0].size:                                      # r1 -> 0: -K1 = 2 downstream
+            v[si] = 2.0 * p["down"] * np.exp(-1j * (kd * p["x0_small"]))
+        v *= p["t1w"]                                       # P1 = -(K1 e - K10) T1, Eq. 27b
+        out += v
+    return out
+
+
 def _increment(geo: _ChunkGeometry, mach: float, kd: float, method: str) -> np.ndarray:
     """D1 + D2 of the chunk at omega / U = kd (1/m)."""
     _, p_n, a_n = _METHODS[method]
+    if not geo.nonplanar:
+        return _increment_planar(geo, kd, p_n, a_n)
     out = np.zeros(geo.t1.shape, complex)
     for p, w1, w2 in zip(geo.points, geo.w1, geo.w2 or [None] * len(geo.points)):
         k1 = kd * p["r1"]                                   # [R71] Eq. 12
@@ -375,10 +457,9 @@ def _increment(geo: _ChunkGeometry, mach: float, kd: float, method: str) -> np.n
         k1v += p["k10"]
         k1v *= p["t1w"]
         out += k1v
-        if geo.nonplanar:
-            k2v = (3.0 * i2 + 1j * k1 * eku * p["c2a"] + eku * p["c2b"])   # [R71] Eq. 8
-            k2v[p["small"]] = 4.0 * p["down"]
-            out += (-(k2v * px - p["k20"]) * p["t2"]) * w2  # [R71] Eq. 36b
+        k2v = (3.0 * i2 + 1j * k1 * eku * p["c2a"] + eku * p["c2b"])   # [R71] Eq. 8
+        k2v[p["small"]] = 4.0 * p["down"]
+        out += (-(k2v * px - p["k20"]) * p["t2"]) * w2      # [R71] Eq. 36b
     return out
 
 
