@@ -264,7 +264,7 @@ def aeroelastic_model(modal, rfa, rho: float, velocity: float, outputs: dict | N
     D = np.vstack(D_rows) if ni else np.zeros((C.shape[0], 0))
     return control.ss(mats.A, mats.B, C, D, states=list(mats.state_names),
                       inputs=list(INPUT_NAMES[:ni]), outputs=names,
-                      name=f"aeroelastic_U{velocity:g}")
+                      name=f"aeroelastic_U{velocity:g}".replace(".", "p"))
 
 
 def fin_outputs(modal_model, points, names=None, shaft_point=None) -> dict:
