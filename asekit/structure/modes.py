@@ -67,20 +67,22 @@ def normal_modes(system: SupportedSystem, n_modes: int = 10, M_fin=None,
     """Lowest ``n_modes`` natural modes of a supported system (thesis Eq. (2.4)).
 
     Shift-invert Lanczos (``eigsh``) about the negative shift -(2 pi ``shift_hz``)^2, so that a
-    singular K (rigid mode) is handled; dense ``scipy.linalg.eigh`` for small systems. The start
+    singular K (rigid mode) is handled; dense ``scipy.linalg.eigh`` only when nearly all modes
+    of a tiny system are requested. The start
     vector is fixed and each mode's sign is fixed (largest |w| positive; the rigid mode's shaft
     rotation positive), so results are reproducible bit for bit.
 
-    M_fin : the fin's global mass (for the out-of-plane energy share); default T-projection of
-    the reduced M is not possible, so without it the share is computed from ``system.M``'s
-    fin part.
+    M_fin : the fin's global (unsupported) mass matrix, used for each mode's out-of-plane
+    kinetic-energy share; without it ``out_of_plane`` is NaN.
     """
     n_q = system.K.shape[0]
     if int(n_modes) != n_modes or n_modes < 1:
         raise ValueError(f"n_modes must be an integer >= 1, got {n_modes!r}")
     n_modes = int(min(n_modes, n_q))
     sigma = -(2 * math.pi * shift_hz) ** 2
-    if n_q <= 600 or n_modes >= n_q - 1:
+    if n_modes >= n_q - 1:
+        # tiny systems: dense solve (less accurate for a near-zero rigid mode next to a huge
+        # fictitious inertia, because the Cholesky factor of M is ill-conditioned)
         lam, q = sla.eigh(system.K.toarray(), system.M.toarray(), subset_by_index=(0, n_modes - 1))
     else:
         v0 = np.ones(n_q) / math.sqrt(n_q)
@@ -107,6 +109,23 @@ def normal_modes(system: SupportedSystem, n_modes: int = 10, M_fin=None,
     freqs = np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi)
     return NormalModes(frequencies_hz=freqs, eigenvalues=lam, q=q, fin=fin, out_of_plane=share,
                        system=system)
+
+
+def select_modes(frequencies_hz: np.ndarray, out_of_plane: np.ndarray, f_max_hz: float = 1000.0,
+                 min_out_of_plane: float = MIN_OUT_OF_PLANE) -> np.ndarray:
+    """Boolean mask of the elastic modes kept (thesis Sec. 3.1.1, Fig. 15 MODESELECT): below
+    ``f_max_hz`` and with at least ``min_out_of_plane`` of their kinetic energy in the
+    out-of-plane translation w (a mode with no out-of-plane motion does not interact with the
+    aerodynamics of a flat fin, like the thesis's discarded in-plane mode of Fig. 16)."""
+    f = np.asarray(frequencies_hz, float)
+    share = np.asarray(out_of_plane, float)
+    if f.shape != share.shape:
+        raise ValueError(f"frequencies_hz {f.shape} and out_of_plane {share.shape} must match")
+    if not np.isfinite(f_max_hz) or f_max_hz <= 0:
+        raise ValueError(f"f_max_hz must be a finite number > 0 (Hz), got {f_max_hz!r}")
+    if not 0 <= min_out_of_plane <= 1:
+        raise ValueError(f"min_out_of_plane must lie in [0, 1], got {min_out_of_plane!r}")
+    return (f < f_max_hz) & (np.nan_to_num(share, nan=0.0) >= min_out_of_plane)
 
 
 def modes_up_to(system: SupportedSystem, f_max_hz: float, M_fin=None, n_start: int = 12) -> NormalModes:
@@ -286,7 +305,7 @@ def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None
             Qs[:, j] *= -1
     f_s = np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi)
     share = _fin_mass_share(phi_s, M)
-    keep = (f_s < f_max_hz) & (share >= MIN_OUT_OF_PLANE)
+    keep = select_modes(f_s, share, f_max_hz)
     phi_s, Qs, lam_s = phi_s[:, keep], Qs[:, keep], lam[keep]
     Phi = np.column_stack([phi_c, phi_s])
     M_mm = Phi.T @ (M @ Phi)
