@@ -105,6 +105,34 @@ def _json_value(v):
     return v
 
 
+def comparison_rows(quantities) -> list[tuple[str, str, str, str, str, str]]:
+    """(key, thesis, asekit, unit, difference, note) strings for computed quantities, the
+    thesis values looked up in ``data/thesis.toml``."""
+    rows = []
+    for q in quantities:
+        tv = thesis_value(q.key)
+        rows.append((q.key, _fmt(tv.value), _fmt(q.asekit), q.unit,
+                     difference(tv.value, q.asekit), q.note))
+    return rows
+
+
+def format_table(rows) -> str:
+    """The thesis-vs-asekit table of :func:`comparison_rows` as aligned text."""
+    head = ("quantity", "thesis", "asekit", "unit", "difference")
+    widths = [max(len(r[i]) for r in list(rows) + [head]) for i in range(5)]
+    lines = ["  ".join(h.ljust(w) for h, w in zip(head, widths)),
+             "  ".join("-" * w for w in widths)]
+    for r in rows:
+        line = "  ".join(c.ljust(w) for c, w in zip(r[:5], widths))
+        lines.append(line + (f"  # {r[5]}" if r[5] else ""))
+    return "\n".join(lines)
+
+
+def comparison_table(quantities) -> str:
+    """Thesis-vs-asekit text table for a chapter's quantities (as in ``reproduce``)."""
+    return format_table(comparison_rows(quantities))
+
+
 def reproduce(chapters: list[str] | None = None, figures_dir: str | Path | None = None,
               json_path: str | Path | None = None, echo=print) -> dict:
     """Run the chapters, print the table, optionally write JSON and PNG figures.
@@ -122,23 +150,14 @@ def reproduce(chapters: list[str] | None = None, figures_dir: str | Path | None 
         result = run_chapter(name, figures=figures_dir is not None)
         out["seconds"][name] = round(time.perf_counter() - t0, 3)
         for q in result.quantities:
-            tv = thesis_value(q.key)
-            out["quantities"][q.key] = {"thesis": _json_value(tv.value),
+            out["quantities"][q.key] = {"thesis": _json_value(thesis_value(q.key).value),
                                         "asekit": _json_value(q.asekit), "unit": q.unit}
-            rows.append((q.key, _fmt(tv.value), _fmt(q.asekit), q.unit,
-                         difference(tv.value, q.asekit), q.note))
+        rows += comparison_rows(result.quantities)
         if figures_dir is not None:
             from .plotting import save_figure
             for fig_name, fig in result.figures.items():
                 save_figure(fig, figures_dir, fig_name)
-    widths = [max(len(r[i]) for r in rows + [("quantity", "thesis", "asekit", "unit",
-                                               "difference", "")]) for i in range(5)]
-    head = ("quantity", "thesis", "asekit", "unit", "difference")
-    echo("  ".join(h.ljust(w) for h, w in zip(head, widths)))
-    echo("  ".join("-" * w for w in widths))
-    for r in rows:
-        line = "  ".join(c.ljust(w) for c, w in zip(r[:5], widths))
-        echo(line + (f"  # {r[5]}" if r[5] else ""))
+    echo(format_table(rows))
     echo("")
     echo("seconds: " + ", ".join(f"{k} {v:.2f}" for k, v in out["seconds"].items()))
     if json_path is not None:
