@@ -196,6 +196,10 @@ def fig_rfa_element(fit, i: int, j: int, thesis_figure: str = "Fig 23"):
     qf = fit.evaluate(kk)[:, i, j]
     ax.plot(fit.Q[:, i, j].real, fit.Q[:, i, j].imag, "o", label="GAF data")
     ax.plot(qf.real, qf.imag, "-", label=f"Roger, {fit.n_lags} lags")
+    qd = fit.evaluate(fit.k)[:, i, j]
+    ax.plot(qd.real, qd.imag, "x", color="C1", label="fit at the data k")
+    for a, b in zip(fit.Q[:, i, j], qd):
+        ax.plot([a.real, b.real], [a.imag, b.imag], color="0.6", lw=0.6)
     ax.set_xlabel("Re Q (per unit q)")
     ax.set_ylabel("Im Q (per unit q)")
     ax.legend()
