@@ -1,0 +1,276 @@
+"""Thesis Ch. 3.1 (structure): normal modes of the fin, FN1 vs FN2, the modal model (Tables 4-6,
+Figs 3, 4, 12, 13, 17-19) and asekit's mesh-convergence study of the shaft models.
+
+:func:`compute` runs the analyses, :func:`run` gives the reproduce rows, the ``fig_*`` functions
+draw the figures (the chapter notebook ``notebooks/ch3_structure.ipynb`` calls them too).
+
+The thesis's values come from MSC Nastran QUAD4 elements on the same 6 x 7 mesh with the same
+single-node shaft; asekit uses MITC4 plate elements, density 2700 kg/m^3 (not given by the
+thesis) and the exact spanwise thickness at the integration points. In-plane (membrane)
+behaviour is not modelled: it is uncoupled from bending for a flat plate and from the
+aerodynamics; the thesis's 16.57 Hz "in-plane bending" mode (its Fig. 16) is the fin turning in
+its own plane about the single pinned shaft node, restrained only by the shell element's
+artificial drilling stiffness, and the thesis discards it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry import FinDefinition, load_fin
+from ..plotting import THESIS_COLOR, new_figure
+from ..reproduce import ChapterResult, Quantity
+from ..structure.assembly import assemble, rigid_pitch_vector
+from ..structure.modes import (ModalModel, NormalModes, fin_mesh, fin_modal_model, fin_supported,
+                               normal_modes, pitch_inertia_exact)
+from ..thesis import thesis_value
+
+#: Mesh used for the converged distributed-shaft result (the shaft radius of data/fin.toml is
+#: resolved by about 23 nodes here).
+CONVERGED_MESH = (96, 112)
+#: Meshes of the convergence study (issue 3: 6x7 up to at least 48x56).
+CONVERGENCE_MESHES = ((6, 7), (12, 14), (24, 28), (48, 56), (96, 112))
+
+
+@dataclass(frozen=True)
+class StructureChapter:
+    """Every computed Ch. 3.1 result (SI units, frequencies in Hz)."""
+
+    fin: FinDefinition
+    fn2: ModalModel                 # thesis model: FN2 6x7 single-node shaft, modes kept
+    fn1_modes: NormalModes          # FN1 6x7, 9 modes (Table 4 left column, no in-plane mode)
+    fn2_modes: NormalModes          # FN2 6x7 raw eigen-solution, rigid + 9 elastic (Table 4/5)
+    J_exact: float                  # exact integral of the pitch inertia (kg m^2)
+    distributed: ModalModel         # FN2 with the distributed shaft on CONVERGED_MESH
+
+
+def compute(fin: FinDefinition | None = None) -> StructureChapter:
+    """Run the Ch. 3.1 analyses on the reference fin (default ``data/fin.toml``)."""
+    fin = load_fin() if fin is None else fin
+    mesh = fin_mesh(fin)
+    K, M = assemble(mesh, fin.material)
+    fn1 = normal_modes(fin_supported(fin, mesh, "FN1", "single_node", K, M), 9, M_fin=M)
+    fn2 = normal_modes(fin_supported(fin, mesh, "FN2", "single_node", K, M), 10, M_fin=M)
+    return StructureChapter(fin=fin, fn2=fin_modal_model(fin), fn1_modes=fn1, fn2_modes=fn2,
+                            J_exact=pitch_inertia_exact(fin),
+                            distributed=fin_modal_model(fin, *CONVERGED_MESH, shaft="distributed"))
+
+
+def convergence_study(fin: FinDefinition | None = None, meshes=CONVERGENCE_MESHES,
+                      shaft: str = "single_node", radius: float | None = None,
+                      n_elastic: int = 5, progress: bool = False) -> np.ndarray:
+    """Elastic frequencies (Hz), shape (len(meshes), n_elastic), of the FN2 model per mesh.
+
+    ``radius`` (m) overrides the shaft radius of the distributed model. Modes above 1000 Hz are
+    included here (f_max raised) so that every mesh gives ``n_elastic`` values.
+    """
+    fin = load_fin() if fin is None else fin
+    if radius is not None:
+        fin = dataclasses.replace(fin, shaft=dataclasses.replace(fin.shaft, radius=radius))
+    iterator = meshes
+    if progress:
+        from tqdm.auto import tqdm
+        iterator = tqdm(meshes, desc=f"{shaft} shaft meshes")
+    out = []
+    for n_c, n_s in iterator:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")            # unresolved-region warning on coarse meshes
+            m = fin_modal_model(fin, n_c, n_s, shaft=shaft, f_max_hz=5000.0)
+        out.append(m.frequencies_hz[m.n_rigid:m.n_rigid + n_elastic])
+    return np.array(out)
+
+
+def run(figures: bool = False) -> ChapterResult:
+    """The reproduce rows of Ch. 3.1 (and figures if asked)."""
+    ch = compute()
+    f_el = [float(f) for f in ch.fn2.frequencies_hz[ch.fn2.n_rigid:]]
+    q = (
+        Quantity("structure.frequencies_hz", f_el, "Hz",
+                 "MITC4, 6x7, single-node shaft; thesis: Nastran QUAD4 (element, density, point "
+                 "support differ; see ch3_structure.ipynb)"),
+        Quantity("structure.fn1_frequencies_hz", [float(f) for f in ch.fn1_modes.frequencies_hz[:8]],
+                 "Hz", "FN1 6x7, out-of-plane modes (no membrane model)"),
+        Quantity("structure.inplane_mode_hz", None, "Hz",
+                 "membrane not modelled: in-plane motion is uncoupled from bending and from the "
+                 "aerodynamics; thesis mode is a drilling-stiffness artefact it discards"),
+        Quantity("structure.rigid_mode_hz", float(ch.fn2_modes.frequencies_hz[0]), "Hz",
+                 "FN2 fictitious-mass eigen-solution (factor 1e6)"),
+        Quantity("structure.J_fin_kgm2", float(ch.fn2.J_fin), "kg m^2",
+                 "r^T M r of the FE model, density 2700 kg/m^3; thesis value not reproducible "
+                 "from its stated geometry"),
+        Quantity("structure.J_fin_exact_kgm2", float(ch.J_exact), "kg m^2",
+                 "exact integral over the planform"),
+        Quantity("structure.distributed_frequencies_hz",
+                 [float(f) for f in ch.distributed.frequencies_hz[1:]], "Hz",
+                 f"rigid shaft region r={ch.fin.shaft.radius * 1e3:g} mm, "
+                 f"{CONVERGED_MESH[0]}x{CONVERGED_MESH[1]} mesh"),
+    )
+    figs = {}
+    if figures:
+        figs = {"fig03_planform": fig_planform(ch.fin), "fig04_thickness": fig_thickness(ch.fin),
+                "fig12_fn1": fig_fe_model(ch.fn2, ch.fin, "FN1"),
+                "fig13_fn2": fig_fe_model(ch.fn2, ch.fin, "FN2"),
+                "fig17_modes": fig_mode_shapes(ch.fn2),
+                "fig18_rigid": fig_rigid_mode(ch),
+                "fig19_fn1_fn2": fig_fn1_vs_fn2(ch)}
+    return ChapterResult("structure", q, figs)
+
+
+# ---- figures -------------------------------------------------------------------------------
+
+def _outline(ax, fin: FinDefinition, **kw):
+    c = fin.planform.corners
+    c = np.vstack([c, c[:1]])
+    ax.plot(c[:, 0] * 1e3, c[:, 1] * 1e3, "k-", **kw)
+
+
+def fig_planform(fin: FinDefinition):
+    """Fig 3: the fin's planform with the shaft axis (mm)."""
+    fig, ax = new_figure("Missile control fin planform", "Fig 3", figsize=(5.5, 5))
+    _outline(ax, fin)
+    xa, ya = fin.shaft.axis_point
+    ax.axvline(xa * 1e3, color="C3", ls="--", lw=1, label="pitch (shaft) axis")
+    ax.plot(xa * 1e3, ya * 1e3, "o", color="C3")
+    for x, y in fin.planform.corners:
+        ax.annotate(f"({x * 1e3:.0f}, {y * 1e3:.0f})", (x * 1e3, y * 1e3), fontsize=8,
+                    textcoords="offset points", xytext=(4, 4))
+    ax.set_xlabel("x, chordwise (mm)")
+    ax.set_ylabel("y, spanwise (mm)")
+    ax.set_aspect("equal")
+    ax.legend(loc="lower right")
+    return fig
+
+
+def fig_thickness(fin: FinDefinition):
+    """Fig 4: thickness profile along the span (mm)."""
+    fig, ax = new_figure("Fin thickness profile", "Fig 4", figsize=(5.5, 3.5))
+    eta = np.linspace(0, 1, 11)
+    ax.plot(fin.planform.root_le[1] * 1e3 + eta * fin.planform.span * 1e3,
+            fin.thickness.at(eta) * 1e3)
+    ax.set_xlabel("y, spanwise (mm)")
+    ax.set_ylabel("thickness h (mm)")
+    ax.set_ylim(0, None)
+    return fig
+
+
+def _mesh_lines(ax, model: ModalModel, **kw):
+    for e in model.elements:
+        p = model.nodes[np.append(e, e[0])] * 1e3
+        ax.plot(p[:, 0], p[:, 1], "-", color="0.5", lw=0.7, **kw)
+
+
+def fig_fe_model(model: ModalModel, fin: FinDefinition, which: str = "FN1"):
+    """Figs 12/13: the 6x7 QUAD mesh, the shaft node, its spring (FN1) or spring + fictitious
+    inertia at the free ground point (FN2)."""
+    number = "Fig 12" if which == "FN1" else "Fig 13"
+    fig, ax = new_figure(f"Finite-element model {which}", number, figsize=(5.5, 5))
+    _mesh_lines(ax, model)
+    xa, ya = fin.shaft.axis_point
+    ax.plot(xa * 1e3, ya * 1e3, "s", color="C3", ms=8, label="shaft node (w, theta_x held)")
+    k = fin.shaft.torsional_stiffness
+    if which == "FN1":
+        text = f"theta_y: spring {k:g} N m/rad to ground"
+    else:
+        I_f = fin.shaft.fictitious_inertia_factor * model.J_fin
+        text = (f"theta_y: spring {k:g} N m/rad to a free ground point\n"
+                f"with fictitious inertia {I_f:.3g} kg m^2 (1e6 J_fin)")
+    ax.annotate(text, (xa * 1e3, ya * 1e3), xytext=(-60, -45), textcoords="offset points",
+                fontsize=8, arrowprops=dict(arrowstyle="->"))
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_aspect("equal")
+    ax.set_ylim(-40, 160)
+    ax.legend(loc="upper left", fontsize=8)
+    ax.set_title(f"{model.elements.shape[0]} elements, {model.nodes.shape[0]} nodes", fontsize=9)
+    return fig
+
+
+def _triangles(elements: np.ndarray) -> np.ndarray:
+    return np.vstack([elements[:, [0, 1, 2]], elements[:, [0, 2, 3]]])
+
+
+def fig_mode_shapes(model: ModalModel, title: str = "FN2 mode shapes (w, contours)",
+                    thesis_figure: str = "Fig 17"):
+    """Fig 17 (and Fig 18's rigid mode): contour plots of w of every mode of the modal model."""
+    n = model.frequencies_hz.size
+    ncols = 3
+    nrows = math.ceil(n / ncols)
+    fig, axes = new_figure(title, thesis_figure, nrows=nrows, ncols=ncols,
+                           figsize=(11, 3.6 * nrows + 0.6))
+    tri = _triangles(model.elements)
+    for j, ax in enumerate(np.atleast_1d(axes).flat):
+        if j >= n:
+            ax.set_visible(False)
+            continue
+        w = model.shapes[:, 0, j]
+        lim = np.abs(w).max()
+        cs = ax.tricontourf(model.nodes[:, 0] * 1e3, model.nodes[:, 1] * 1e3, tri, w,
+                            levels=np.linspace(-lim, lim, 17), cmap="RdBu_r")
+        ax.tricontour(model.nodes[:, 0] * 1e3, model.nodes[:, 1] * 1e3, tri, w, levels=[0.0],
+                      colors="k", linewidths=0.8)
+        kind = "rigid pitch, unit rad" if j < model.n_rigid else f"elastic mode {j - model.n_rigid + 1}"
+        ax.set_title(f"{kind}: {model.frequencies_hz[j]:.1f} Hz", fontsize=9)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (mm)")
+        ax.set_ylabel("y (mm)")
+        fig.colorbar(cs, ax=ax, shrink=0.8, label="w (m)")
+    return fig
+
+
+def fig_rigid_mode(ch: StructureChapter):
+    """Fig 18: the rigid-body mode vector from the FN2 eigen-solution vs the analytic unit pitch
+    rotation, over the fin's degrees of freedom (the thesis compares Nastran with MATLAB)."""
+    modes = ch.fn2_modes
+    sys = modes.system
+    q = modes.q[:, 0] / modes.q[sys.shaft_index, 0]
+    phi = sys.T @ q
+    r = rigid_pitch_vector(sys.mesh, ch.fin.shaft.axis_point[0])
+    fig, ax = new_figure("Rigid-body mode: FN2 eigenvector vs exact rigid pitch", "Fig 18")
+    dof = np.arange(phi.size)
+    ax.plot(dof, r, "-", color=THESIS_COLOR, lw=3, label="exact unit pitch rotation")
+    ax.plot(dof, phi, ".", ms=3, label="FN2 eigen-solution (scaled to 1 rad)")
+    ax.set_xlabel("fin degree of freedom (w, theta_x, theta_y per node)")
+    ax.set_ylabel("mode shape (m or rad)")
+    ax.legend()
+    return fig
+
+
+def fig_fn1_vs_fn2(ch: StructureChapter, mode: int = 1):
+    """Fig 19: an elastic mode of FN1 and FN2 (mass-normalised, 0-based elastic index ``mode``;
+    default the second out-of-plane mode, the thesis's "elastic mode 3")."""
+    a = ch.fn1_modes.fin[:, mode]
+    b = ch.fn2_modes.fin[:, mode + 1]
+    b = b * np.sign(a @ b)
+    fig, ax = new_figure(f"Elastic mode {mode + 1}: FN1 vs FN2 "
+                         f"({ch.fn1_modes.frequencies_hz[mode]:.2f} Hz)", "Fig 19")
+    dof = np.arange(a.size)
+    ax.plot(dof, a, "-", color=THESIS_COLOR, lw=3, label="FN1 (spring to ground)")
+    ax.plot(dof, b, ".", ms=3, label="FN2 (fictitious inertia)")
+    ax.set_xlabel("fin degree of freedom (w, theta_x, theta_y per node)")
+    ax.set_ylabel("mass-normalised shape")
+    ax.legend(title=f"max |difference| = {np.abs(a - b).max():.1e}")
+    return fig
+
+
+def fig_convergence(meshes, single: np.ndarray, distributed: dict, n_modes: int = 2):
+    """Mesh convergence of the first elastic frequencies: single-node vs distributed shafts.
+    ``distributed`` maps a label (e.g. "r = 5 mm") to an array like ``single``."""
+    fig, axes = new_figure("Mesh convergence of the FN2 elastic frequencies", None, ncols=n_modes)
+    n_el = [a * b for a, b in meshes]
+    thesis = thesis_value("structure.frequencies_hz").value
+    for j, ax in enumerate(np.atleast_1d(axes)):
+        ax.semilogx(n_el, single[:, j], "o-", label="single-node shaft (thesis model)")
+        for k, (lab, arr) in enumerate(distributed.items()):
+            ax.semilogx(n_el, arr[:, j], "s-", color=f"C{k + 1}", label=f"distributed, {lab}")
+        ax.axhline(thesis[j], color=THESIS_COLOR, ls="--", label="thesis (Nastran 6x7)")
+        ax.set_xlabel("number of elements")
+        ax.set_ylabel(f"elastic mode {j + 1} frequency (Hz)")
+        ax.set_xticks(n_el)
+        ax.set_xticklabels([f"{a}x{b}" for a, b in meshes], rotation=30, fontsize=8)
+    np.atleast_1d(axes)[0].legend(fontsize=8)
+    return fig
