@@ -198,9 +198,10 @@ class NastranFlutterCase:
 
 
 def ha145b_path() -> Path:
-    """Location of ``ha145b.op4``: ``<repo>/../shared/benchmarks/bah_ha145b/ha145b.op4``."""
+    """Location of ``ha145b.op4``: the copy shipped in ``data/benchmarks/ha145b/`` (MSC
+    Nastran's own output for its example HA145B, with its README)."""
     from .paths import DATA_DIR
-    return DATA_DIR.parent.parent / "shared" / "benchmarks" / "bah_ha145b" / "ha145b.op4"
+    return DATA_DIR / "benchmarks" / "ha145b" / "ha145b.op4"
 
 
 def load_ha145b(path: str | Path | None = None) -> NastranFlutterCase:

@@ -9,11 +9,8 @@ from asekit.flutter import (TabulatedGaf, divergence_speeds, first_of, pk_flutte
                             pk_instabilities, root_locus, root_locus_instabilities,
                             simulate_free_response, time_domain_sweep, initial_state)
 from asekit.aeroelastic import aeroelastic_matrices
-from asekit.nastran import ha145b_path, load_ha145b
+from asekit.nastran import load_ha145b
 from asekit.rfa import RogerFit, roger_fit
-
-needs_ha145b = pytest.mark.skipif(not ha145b_path().exists(),
-                                  reason="shared/benchmarks/bah_ha145b not present")
 
 # MSC Nastran Aeroelastic Analysis User's Guide, Example HA145B (BAH wing, PK method, Mach 0,
 # sea level): flutter of the second mode at about 12,672 in/s (1056 ft/s) near 3.1 Hz, as
@@ -32,7 +29,6 @@ def ha145b():
     return case, modal, gaf, res
 
 
-@needs_ha145b
 def test_ha145b_pk_matches_nastran(ha145b):
     case, modal, gaf, res = ha145b
     fl = first_of(pk_instabilities(res, modal, gaf), "flutter")
@@ -42,7 +38,6 @@ def test_ha145b_pk_matches_nastran(ha145b):
     assert res.converged.mean() > 0.95
 
 
-@needs_ha145b
 def test_ha145b_divergence_pk_equals_static(ha145b):
     case, modal, gaf, res = ha145b
     dv = first_of(pk_instabilities(res, modal, gaf), "divergence")
@@ -50,7 +45,6 @@ def test_ha145b_divergence_pk_equals_static(ha145b):
     assert dv is not None and dv.speed == pytest.approx(static[0], rel=1e-4)
 
 
-@needs_ha145b
 def test_ha145b_three_methods_agree(ha145b):
     case, modal, gaf, res = ha145b
     pk = first_of(pk_instabilities(res, modal, gaf), "flutter")

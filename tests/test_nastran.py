@@ -3,10 +3,7 @@
 import numpy as np
 import pytest
 
-from asekit.nastran import ha145b_path, load_ha145b, read_op4, split_qhhl, write_op4
-
-needs_ha145b = pytest.mark.skipif(not ha145b_path().exists(),
-                                  reason="shared/benchmarks/bah_ha145b not present")
+from asekit.nastran import load_ha145b, read_op4, split_qhhl, write_op4
 
 
 def test_round_trip_real_and_complex(tmp_path):
@@ -49,7 +46,6 @@ def test_split_qhhl_shape_check():
         split_qhhl(np.zeros((3, 10)), 3)
 
 
-@needs_ha145b
 def test_ha145b_contents():
     case = load_ha145b()
     assert case.M.shape == case.K.shape == (10, 10)
