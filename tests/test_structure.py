@@ -239,3 +239,26 @@ def test_shaft_support_bad_input(fin):
         shaft_support(mesh, K, M, (0.078, 0.0), 120.0, model="FN3")
     with pytest.raises(ValueError, match="radius"):
         shaft_support(mesh, K, M, (0.5, 0.5), 120.0, region="distributed", radius=0.001)
+
+
+def test_distributed_shaft_region_moves_rigidly_in_every_mode(fin):
+    # rigid multi-point constraint: w = -(x - x_a) theta_s, theta_x = 0, theta_y = theta_s
+    big = dataclasses.replace(fin, shaft=dataclasses.replace(fin.shaft, radius=0.026))
+    m = fin_modal_model(big, 12, 14, shaft="distributed")
+    x_a, y_a = fin.shaft.axis_point
+    inside = np.hypot(m.nodes[:, 0] - x_a, m.nodes[:, 1] - y_a) <= 0.026 * (1 + 1e-9)
+    assert inside.sum() >= 4
+    th = m.shapes[inside, 2, :]
+    np.testing.assert_allclose(th, np.broadcast_to(th[:1], th.shape), atol=1e-12)
+    np.testing.assert_allclose(m.shapes[inside, 1, :], 0.0, atol=1e-12)
+    np.testing.assert_allclose(m.shapes[inside, 0, :], -(m.nodes[inside, 0, None] - x_a) * th,
+                               atol=1e-12)
+    np.testing.assert_allclose(m.M[1:, 1:], np.eye(m.M.shape[0] - 1), atol=1e-10)
+    assert m.label == "FN2 12x14 distributed r=26 mm shaft"
+
+
+def test_eigen_solution_reproducible_bit_for_bit(fin):
+    a = fin_modal_model(fin)
+    b = fin_modal_model(fin)
+    assert np.array_equal(a.frequencies_hz, b.frequencies_hz)
+    assert np.array_equal(a.shapes, b.shapes) and np.array_equal(a.M, b.M)
