@@ -40,7 +40,7 @@ The numerators P1, P2 are replaced by the polynomial through their values at eta
 step as a fixed, k-independent quadrature: D1_rs = sum_j P1(eta_j) W1_j with weights
 W1_j = dx/(8 pi) sum_m V^-1[m, j] e^-m int eta^m / r1^2 d eta (V the Vandermonde matrix of the
 normalised points); the closed forms of the integrals are those of [R71] Eqs. 31-34, 40-41 and
-[R98] Eqs. 20-34 in expanded form. Pairs whose receiver is farther than 2e from the doublet
+[R98] Eqs. 20-34 in expanded form. Pairs whose receiver is farther than 4e from the doublet
 line use 6-point Gauss-Legendre quadrature for the same integrals (error about 1e-11 there,
 and free of the cancellation of the closed forms far away). The weights and all kernel
 geometry depend on the Mach number but not on k: they are computed once per row chunk and
