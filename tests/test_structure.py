@@ -262,3 +262,19 @@ def test_eigen_solution_reproducible_bit_for_bit(fin):
     b = fin_modal_model(fin)
     assert np.array_equal(a.frequencies_hz, b.frequencies_hz)
     assert np.array_equal(a.shapes, b.shapes) and np.array_equal(a.M, b.M)
+
+
+def test_fn1_and_clamped_modal_models(fin, fn2):
+    from asekit.structure.modes import elastic_modal_model, fin_fn1_modal_model
+    m1 = fin_fn1_modal_model(fin)
+    assert m1.n_rigid == 0 and m1.label.startswith("FN1 6x7")
+    np.testing.assert_allclose(m1.frequencies_hz, fn2.frequencies_hz[1:], rtol=1e-6)
+    np.testing.assert_allclose(m1.M, np.eye(5), atol=1e-10)
+    np.testing.assert_allclose(np.diag(m1.K), (2 * np.pi * m1.frequencies_hz) ** 2, rtol=1e-9)
+    assert m1.J_fin == pytest.approx(fn2.J_fin, rel=1e-12)
+    mesh = rectangular_mesh(1.0, 0.5, 0.01, 8, 4)
+    K, M = assemble(mesh, ALU)
+    mc = elastic_modal_model(normal_modes(clamped_edge(mesh, K, M), 6, M_fin=M), M, 1000.0)
+    assert mc.n_rigid == 0 and math.isnan(mc.J_fin) and mc.frequencies_hz.size >= 3
+    w, _ = mode_shapes_at(mc, np.array([[0.5, 0.0]]))          # clamped root: w = 0
+    np.testing.assert_allclose(w, 0.0, atol=1e-14)

@@ -326,6 +326,46 @@ def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None
                       elements=mesh.elements.copy(), label=fn2.label)
 
 
+def elastic_modal_model(modes: NormalModes, M_fin, f_max_hz: float = 1000.0,
+                        axis_x: float | None = None) -> ModalModel:
+    """A ModalModel without rigid modes (n_rigid = 0) from an FN1 or clamped eigen-solution:
+    the modes below ``f_max_hz`` with out-of-plane motion, mass-normalised (M = I,
+    K = diag(omega^2), C = 0). ``J_fin`` is the plate's pitch inertia about x = ``axis_x``
+    (default: the shaft axis of the support, or NaN when clamped)."""
+    sys_ = modes.system
+    keep = select_modes(modes.frequencies_hz, _fin_mass_share(modes.fin, M_fin), f_max_hz)
+    phi = modes.fin[:, keep]
+    n = phi.shape[1]
+    M_mm = phi.T @ (M_fin @ phi)
+    K_red = modes.q[:, keep].T @ (sys_.K @ modes.q[:, keep])
+    if axis_x is None and sys_.shaft_nodes.size:
+        axis_x = float(sys_.mesh.nodes[sys_.shaft_nodes, 0].mean())
+    J = float("nan")
+    if axis_x is not None:
+        r = rigid_pitch_vector(sys_.mesh, axis_x)
+        J = float(r @ (M_fin @ r))
+    return ModalModel(frequencies_hz=modes.frequencies_hz[keep].copy(),
+                      M=0.5 * (M_mm + M_mm.T), K=0.5 * (K_red + K_red.T), C=np.zeros((n, n)),
+                      n_rigid=0, J_fin=J, nodes=sys_.mesh.nodes.copy(),
+                      shapes=phi.reshape(sys_.mesh.n_nodes, 3, n),
+                      elements=sys_.mesh.elements.copy(), label=sys_.label)
+
+
+def fin_fn1_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None,
+                        n_span: int | None = None, shaft: str = "single_node",
+                        f_max_hz: float = 1000.0) -> ModalModel:
+    """The thesis's model FN1 (shaft spring to ground, no rigid mode; thesis Sec. 3.1.1, Fig 12)
+    as a ModalModel with n_rigid = 0; arguments as :func:`fin_modal_model`."""
+    fin = load_fin() if fin is None else fin
+    if not np.isfinite(f_max_hz) or f_max_hz <= 0:
+        raise ValueError(f"f_max_hz must be a finite number > 0 (Hz), got {f_max_hz!r}")
+    mesh = fin_mesh(fin, n_chord, n_span)
+    K, M = assemble(mesh, fin.material)
+    fn1 = fin_supported(fin, mesh, "FN1", shaft, K, M)
+    return elastic_modal_model(modes_up_to(fn1, f_max_hz, M_fin=M), M, f_max_hz,
+                               axis_x=fin.shaft.axis_point[0])
+
+
 def pitch_inertia_exact(fin: FinDefinition) -> float:
     """Pitch inertia (kg m^2) of the flat trapezoidal plate about the shaft axis, by exact
     integration: J = int_y rho h(y) int_x [(x - x_a)^2 + h^2 / 12] dx dy (the second term is the
