@@ -221,7 +221,7 @@ def fig_gaf_vs_k(db=None, elements=((0, 0), (0, 1), (1, 0), (2, 2))):
 
 
 def convergence(box_counts=((4, 4), (8, 6), (14, 10), (20, 16), (28, 24)), mach=STEADY_MACH):
-    """Q_cc (steady) vs box count: returns (n_boxes, Q_cc isolated)."""
+    """Q_cc (steady, isolated) vs box count, refining both directions: (n_boxes, Q_cc)."""
     n, q = [], []
     for nc, ns in box_counts:
         m = fin_boxes(n_chord=nc, n_span=ns)
@@ -230,14 +230,36 @@ def convergence(box_counts=((4, 4), (8, 6), (14, 10), (20, 16), (28, 24)), mach=
     return np.array(n), np.array(q)
 
 
-def fig_convergence(result=None):
+def convergence_by_direction(mach=STEADY_MACH, chordwise=(4, 7, 14, 28), spanwise=(5, 10, 20, 40)):
+    """Q_cc refined in one direction at a time around the 14 x 10 fin mesh:
+    returns {"chordwise": (counts, Q_cc) at 10 strips, "spanwise": (counts, Q_cc) at 14 boxes
+    per chord}."""
+    return {"chordwise": (np.array(chordwise),
+                          np.array([hinge_coefficient(fin_boxes(n_chord=c, n_span=10), mach)
+                                    for c in chordwise])),
+            "spanwise": (np.array(spanwise),
+                         np.array([hinge_coefficient(fin_boxes(n_chord=14, n_span=s), mach)
+                                   for s in spanwise]))}
+
+
+def fig_convergence(result=None, by_direction=None):
     n, q = convergence() if result is None else result
     thesis = thesis_value("aero.Qcc_steady_m3").value
-    fig, ax = new_figure("Convergence of the steady hinge-moment coefficient, M 0.6")
-    ax.plot(n, q * 1e4, "o-", label="asekit DLM (isolated fin)")
+    fig, axes = new_figure("Convergence of the steady hinge-moment coefficient, M 0.6", ncols=2)
+    ax = axes[0]
+    ax.plot(n, q * 1e4, "o-", label="both directions")
     ax.axhline(thesis * 1e4, color=THESIS_COLOR, ls="--", label="thesis (FlightLoads)")
     ax.set_xscale("log")
     ax.set_xlabel("number of boxes")
+    ax.set_ylabel("Re Q_cc (1e-4 m^3 / rad)")
+    ax.legend()
+    d = convergence_by_direction() if by_direction is None else by_direction
+    ax = axes[1]
+    ax.plot(d["chordwise"][0], d["chordwise"][1] * 1e4, "o-", label="boxes per chord (10 strips)")
+    ax.plot(d["spanwise"][0], d["spanwise"][1] * 1e4, "s-", label="strips (14 boxes per chord)")
+    ax.axhline(thesis * 1e4, color=THESIS_COLOR, ls="--", label="thesis")
+    ax.set_xscale("log")
+    ax.set_xlabel("boxes per chord / number of strips")
     ax.set_ylabel("Re Q_cc (1e-4 m^3 / rad)")
     ax.legend()
     return fig
