@@ -83,6 +83,48 @@ def compute(params: ActuatorParameters | None = None,
         full_reversal=full, hinge_moment=hm)
 
 
+@dataclass(frozen=True)
+class FinInputs:
+    """asekit's own values of the two fin inputs of Ch. 4: ``fin_inertia`` (kg m^2, exact
+    integral over the reference geometry, :func:`asekit.structure.modes.pitch_inertia_exact`)
+    and ``q_cc`` (Re Q_cc at M 0.6, k 0.001 from the cached DLM database, m^3/rad; None when the
+    database file is not available). ``source`` says where each came from."""
+
+    fin_inertia: float | None
+    q_cc: float | None
+    source: str
+
+
+def asekit_fin_inputs(mach: float = 0.6) -> FinInputs:
+    """asekit's J_fin and steady Q_cc for the design check beside the thesis's inputs.
+
+    Reads only what is cheap: the exact plate integral and, if present, the cached GAF database
+    ``data/gaf_fin.npz`` (never rebuilt here)."""
+    notes = []
+    j_fin = q_cc = None
+    try:
+        from ..geometry import load_fin
+        from ..structure.modes import pitch_inertia_exact
+        j_fin = pitch_inertia_exact(load_fin())
+        notes.append("J_fin: exact plate integral")
+    except (ImportError, AttributeError, ValueError) as exc:      # structure not available
+        notes.append(f"J_fin unavailable ({exc})")
+    try:
+        from ..aero.gaf import GAF_FILE, GafDatabase, steady_hinge_coefficient
+        from ..cache import CacheError, load_npz
+        try:
+            arrays, meta = load_npz(GAF_FILE)
+            db = GafDatabase(arrays["machs"], arrays["k"], arrays["Q"], float(meta["b_ref"]),
+                             int(meta["n_rigid"]), meta)
+            q_cc = steady_hinge_coefficient(db, mach)
+            notes.append(f"Q_cc: DLM database {GAF_FILE.name}, k = {float(db.k[0]):g}")
+        except (CacheError, KeyError, OSError, ValueError) as exc:
+            notes.append(f"Q_cc unavailable ({type(exc).__name__})")
+    except ImportError as exc:
+        notes.append(f"Q_cc unavailable ({exc})")
+    return FinInputs(j_fin, q_cc, "; ".join(notes))
+
+
 def _floats(a) -> list[float]:
     return [float(np.real(v)) for v in a]
 
