@@ -191,3 +191,23 @@ def test_fin_hinge_moment_panelaero_and_scale_invariance():
     d_pa = VLM.calc_Ajj(copy.deepcopy(g), 0.6)[0] + DLM.calc_Ajj(copy.deepcopy(g), 0.6, 0.001 / 0.078,
                                                                   method="quartic")
     assert _fin_qcc(m1, 1.0, d_pa) == pytest.approx(q1, rel=1e-9)
+
+
+def test_quartic_kernel_better_for_long_boxes_at_high_k():
+    # Rodden, Taylor & McIntosh (1998) introduced the quartic numerator because the parabola
+    # fails for boxes much wider than long at high k: boxes of aspect ratio 8 (3 strips on a
+    # semi-span of 3 chords, 8 boxes per chord), k = 2 and 3, against a 48-strip reference.
+    b = 0.5
+
+    def lift(ns, method, k):
+        m = mesh_surfaces(TrapezoidSurface((0, 0, 0), 1.0, (0, 3, 0), 1.0, 8, ns))
+        x = m.control_point[:, 0]
+        cp = pressure_jump(m, 0.5, k, b, -1 + 1j * k * (-(x - 0.25)) / b, method=method,
+                           symmetric=True)
+        return np.sum(cp * m.area)
+
+    for k in (2.0, 3.0):
+        ref = lift(48, "quartic", k)
+        err_p = abs(lift(3, "parabolic", k) / ref - 1)
+        err_q = abs(lift(3, "quartic", k) / ref - 1)
+        assert err_q < 0.5 * err_p

@@ -1,3 +1,22 @@
-"""Aerodynamics of lifting surfaces: boxes and mesh rules, the steady vortex-lattice method,
-the subsonic doublet-lattice method, structure-to-aero splines and generalised aerodynamic
-forces (thesis Sections 2.2 and 3.2)."""
+"""Aerodynamics of lifting surfaces (thesis Sections 2.2 and 3.2).
+
+- :mod:`asekit.aero.boxes`: trapezoidal surfaces, box meshes and the DLM mesh rules.
+- :mod:`asekit.aero.vlm`: steady vortex lattice with Prandtl-Glauert compressibility.
+- :mod:`asekit.aero.dlm`: subsonic doublet-lattice method (parabolic and quartic kernels).
+- :mod:`asekit.aero.spline`: structure -> aero interpolation and the force transpose.
+- :mod:`asekit.aero.gaf`: generalised aerodynamic forces and the fin's cached GAF database.
+
+Conventions: x downstream, y span, z up; e^{i omega t}; k = omega b / U with the reference
+semi-chord b stated by the caller (the fin: root semi-chord 0.078 m); Delta Cp > 0 pushes a box
+along its normal (+z); normalwash w/U = dh/dx + i k h / b.
+"""
+
+from .boxes import (BoxMesh, MeshRuleReport, MeshRuleWarning, TrapezoidSurface,
+                    check_mesh_rules, fin_boxes, fin_surface, mesh_surfaces)
+from .dlm import aic_matrix, normalwash_matrices, normalwash_matrix, pressure_jump
+from .vlm import lift_curve_slope, steady_pressure, vlm_normalwash_matrix
+
+__all__ = ["BoxMesh", "MeshRuleReport", "MeshRuleWarning", "TrapezoidSurface", "check_mesh_rules",
+           "fin_boxes", "fin_surface", "mesh_surfaces", "aic_matrix", "normalwash_matrices",
+           "normalwash_matrix", "pressure_jump", "lift_curve_slope", "steady_pressure",
+           "vlm_normalwash_matrix"]
