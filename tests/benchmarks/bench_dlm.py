@@ -14,12 +14,16 @@ traced run: tracemalloc sees numpy's allocations). Matrix inversion is excluded 
 the same LAPACK call). PanelAero's sweep is 12 single calls (it has no geometry reuse). Above
 ``--skip-panelaero-above`` boxes PanelAero is not run (it needs about 5 GB at 3000 boxes).
 
-Measured on the 2-core project machine, shared with other jobs (load ~2, so +-30 %), quartic
-kernel, M 0.6, asekit vs PanelAero 2025.8:
-  300 boxes: single 0.13 s vs 0.56 s (4x), 12-k sweep 0.53 s vs 4.6 s (9x), 28 vs 51 MB;
-  1200 boxes: single 0.8-1.4 s vs 8.8-11 s (7-12x), sweep 5.7 s vs 80 s (14x), 59 vs 801 MB;
-  3000 boxes: single 5.7 s, 231 MB peak (PanelAero not run: its 1200-box peak of 0.8 GB
-  scales to about 5 GB).
+Measured on the 2-core project machine, shared with other jobs (load ~2, so +-30 %), M 0.6,
+asekit vs PanelAero 2025.8, same kernel order:
+  300 boxes, quartic: single 0.13 s vs 0.56 s (4x), 12-k sweep 0.53 s vs 4.6 s (9x), 28 vs 51 MB;
+  1200 boxes, quartic: single 0.88 s vs 7.2 s (8x), 12-k sweep 5.7 s vs 80 s (14x),
+      peak 59 MB vs 801 MB; parabolic: single 0.61 s vs 3.7 s (6x);
+  3000 boxes, quartic: single 5.7 s, peak 231 MB (PanelAero not run: its 1200-box peak of
+      0.8 GB scales to about 5 GB).
+The single-(M, k) cost splits about evenly between the k-independent geometry (kernel
+stations, integration weights, vortex lattice) and the kernel itself; a sweep pays the geometry
+once per Mach. The 10x single-call goal is met for the quartic kernel only on a quiet machine.
 Agreement of D between the two: 5e-14 (single) to 1.2e-13 (sweep), relative to max |D|.
 
 Issue target: asekit >= 10x faster than PanelAero per (M, k) at 1200 boxes, the sweep faster
