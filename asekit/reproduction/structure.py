@@ -21,6 +21,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
+from matplotlib.ticker import NullLocator
 
 from ..geometry import FinDefinition, load_fin
 from ..plotting import THESIS_COLOR, new_figure
@@ -171,7 +172,7 @@ def fig_fe_model(model: ModalModel, fin: FinDefinition, which: str = "FN1"):
     fig, ax = new_figure(f"Finite-element model {which}", number, figsize=(5.5, 5))
     _mesh_lines(ax, model)
     xa, ya = fin.shaft.axis_point
-    ax.plot(xa * 1e3, ya * 1e3, "s", color="C3", ms=8, label="shaft node (w, theta_x held)")
+    ax.plot(xa * 1e3, ya * 1e3, "s", color="C3", ms=8, label="shaft node")
     k = fin.shaft.torsional_stiffness
     if which == "FN1":
         text = f"theta_y: spring {k:g} N m/rad to ground"
@@ -232,7 +233,7 @@ def fig_rigid_mode(ch: StructureChapter):
     r = rigid_pitch_vector(sys.mesh, ch.fin.shaft.axis_point[0])
     fig, ax = new_figure("Rigid-body mode: FN2 eigenvector vs exact rigid pitch", "Fig 18")
     dof = np.arange(phi.size)
-    ax.plot(dof, r, "-", color=THESIS_COLOR, lw=3, label="exact unit pitch rotation")
+    ax.plot(dof, r, "o", mfc="none", color=THESIS_COLOR, ms=5, label="exact unit pitch rotation")
     ax.plot(dof, phi, ".", ms=3, label="FN2 eigen-solution (scaled to 1 rad)")
     ax.set_xlabel("fin degree of freedom (w, theta_x, theta_y per node)")
     ax.set_ylabel("mode shape (m or rad)")
@@ -249,10 +250,11 @@ def fig_fn1_vs_fn2(ch: StructureChapter, mode: int = 1):
     fig, ax = new_figure(f"Elastic mode {mode + 1}: FN1 vs FN2 "
                          f"({ch.fn1_modes.frequencies_hz[mode]:.2f} Hz)", "Fig 19")
     dof = np.arange(a.size)
-    ax.plot(dof, a, "-", color=THESIS_COLOR, lw=3, label="FN1 (spring to ground)")
+    ax.plot(dof, a, "o", mfc="none", color=THESIS_COLOR, ms=5, label="FN1 (spring to ground)")
     ax.plot(dof, b, ".", ms=3, label="FN2 (fictitious inertia)")
+    ax.set_title("thesis numbering: elastic mode 3 (its mode 1 is the in-plane mode)", fontsize=9)
     ax.set_xlabel("fin degree of freedom (w, theta_x, theta_y per node)")
-    ax.set_ylabel("mass-normalised shape")
+    ax.set_ylabel("mass-normalised shape (m/kg^0.5, rad/kg^0.5)")
     ax.legend(title=f"max |difference| = {np.abs(a - b).max():.1e}")
     return fig
 
