@@ -116,14 +116,15 @@ def test_sweep_equals_single_calls_and_chunking(monkeypatch):
                            rtol=0, atol=1e-14 * np.abs(sweep[ik]).max())
 
 
-def test_symmetry_plane_equals_explicit_image():
-    m = _planar()
+@pytest.mark.parametrize("geom", ["planar", "nonplanar"])
+def test_symmetry_plane_equals_explicit_image(geom):
+    m = _planar() if geom == "planar" else _nonplanar()
     im = m.mirrored()
     full = BoxMesh(np.concatenate([m.corners, im.corners]), np.r_[m.strip, m.strip + 100],
                    np.r_[m.surface, m.surface])
     k, b = 0.8, 0.5
-    h = -(m.control_point[:, 0] - 0.3)
-    w = -1.0 + 1j * k * h / b
+    h = -(m.control_point[:, 0] - 0.3) * m.normal[:, 2]
+    w = -m.normal[:, 2] + 1j * k * h / b
     cp_sym = pressure_jump(m, 0.6, k, b, w, symmetric=True)
     cp_full = pressure_jump(full, 0.6, k, b, np.r_[w, w])
     assert np.allclose(cp_sym, cp_full[:m.n], rtol=1e-10, atol=1e-12)
