@@ -405,7 +405,7 @@ def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController,
                          topology: str = "AEM1", limits: PowerLimits | None = THESIS_LIMITS,
                          t_final: float = 0.2, theta0: float = 0.0, n_out: int = 4001,
                          max_step: float = 5e-5, angle_limit: float = math.radians(15.0),
-                         method: str = "RK45") -> AseSimulation:
+                         method: str = "RK45", sample_time: float | None = None) -> AseSimulation:
     """Closed-loop step response of the actuator + aeroelastic fin (Figs 70-84).
 
     The nonlinear actuator of :mod:`asekit.simulate` (``limits``: supply and current limits,
@@ -420,6 +420,9 @@ def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController,
     t_final : simulated time (s), > 0. theta0 : initial angle (rad), the system at rest.
     n_out : output samples (uniform). max_step : largest integrator step (s); the lag roots
         and the motor's electrical pole are near 1e4 rad/s.
+    sample_time : None for a continuous PD; else a digital PD with zero-order hold sampling
+        every ``sample_time`` s (thesis Table 2: 1 kHz -> 1e-3), its derivative the backward
+        difference of the sampled feedback (as :func:`asekit.simulate.simulate`).
     """
     _check_topology(topology)
     _check_controller(controller)
@@ -429,6 +432,9 @@ def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController,
                          f"limit of {math.degrees(angle_limit):.3g} deg (thesis Table 2)")
     if not (t_final > 0 and math.isfinite(t_final)):
         raise ValueError(f"t_final must be a finite number > 0, got {t_final!r}")
+    if sample_time is not None and not (sample_time > 0 and math.isfinite(sample_time)):
+        raise ValueError(f"sample_time must be None or a finite number > 0 (s), got "
+                         f"{sample_time!r}")
     lim = limits if limits is not None else PowerLimits(supply_voltage=None, current_limit=None)
     act = model.actuator
     A, B = model.A, model.B
@@ -438,8 +444,9 @@ def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController,
     nz = A.shape[0]
     aem2 = topology == "AEM2"
 
-    def derivatives(x):
-        """(dx/dt, feedback angle, feedback rate, applied-voltage demand) at state x."""
+    def derivatives(x, v_hold=None):
+        """(dx/dt, feedback angle, feedback rate, voltage demand) at state x; ``v_hold``: a
+        held (sampled) voltage demand instead of the continuous PD."""
         z = x[3:]
         hm = Ch @ z + Dh[0] * x[0] + Dh[1] * x[1]
         # the acceleration does not depend on the voltage (it acts through the current state)
@@ -450,27 +457,31 @@ def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController,
             om_fb = Cr @ zdot + Dr[0] * x[1]
         else:
             th_fb, om_fb = x[0], x[1]
-        v_cmd = controller_voltage(controller, command, th_fb, om_fb)
+        v_cmd = (controller_voltage(controller, command, th_fb, om_fb) if v_hold is None
+                 else v_hold)
         dx_act = motor_rhs(act, lim, x[:3], v_cmd, hm)
         return np.concatenate([dx_act, zdot]), th_fb, om_fb, v_cmd
-
-    def rhs(t, x):
-        return derivatives(x)[0]
 
     x0 = np.zeros(3 + nz)
     x0[0] = float(theta0)
     t_out = np.linspace(0.0, t_final, n_out)
-    sol = solve_ivp(rhs, (0.0, t_final), x0, method=method, t_eval=t_out, max_step=max_step,
-                    rtol=1e-7, atol=1e-10)
-    if not sol.success:
-        raise RuntimeError(f"integration failed: {sol.message}")
-    x = sol.y
+    opts = dict(method=method, max_step=max_step, rtol=1e-7, atol=1e-10)
+    v_out = None
+    if sample_time is None:
+        sol = solve_ivp(lambda t, x: derivatives(x)[0], (0.0, t_final), x0, t_eval=t_out,
+                        **opts)
+        if not sol.success:
+            raise RuntimeError(f"integration failed: {sol.message}")
+        x = sol.y
+    else:
+        x, v_out = _integrate_zoh(derivatives, controller, command, x0, t_out, sample_time,
+                                  opts)
     z = x[3:]
     # derived histories
     volt = np.empty(n_out)
     alpha = np.empty(n_out)
     for i in range(n_out):
-        dx, _, _, v_cmd = derivatives(x[:, i])
+        dx, _, _, v_cmd = derivatives(x[:, i], None if v_out is None else v_out[i])
         alpha[i] = dx[1]
         volt[i] = applied_voltage(act, lim, x[:3, i], v_cmd)
     hm_part = Ch @ z + Dh[0] * x[0] + Dh[1] * x[1]
@@ -483,6 +494,35 @@ def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController,
     return AseSimulation(t=t_out, command=np.full(n_out, command), theta=x[0], omega=x[1],
                          alpha=alpha, current=x[2], voltage=volt, outputs=outputs,
                          topology=topology, limits=limits, theta0=float(theta0))
+
+
+def _integrate_zoh(derivatives, controller, command, x0, t_out, ts, opts):
+    """Digital PD with zero-order hold: integrate sample interval by sample interval, the
+    voltage demand held over each interval. Returns (x (n_states, n_out), held demand)."""
+    t_final = float(t_out[-1])
+    n_samples = int(math.ceil(t_final / ts - 1e-9))
+    x = np.empty((x0.size, t_out.size))
+    v_out = np.empty(t_out.size)
+    state = x0.copy()
+    y_prev = None
+    for k in range(n_samples):
+        t0, t1 = k * ts, min((k + 1) * ts, t_final)
+        _, y, yd, _ = derivatives(state)
+        if y_prev is None:
+            y_prev = y - yd * ts                   # at rest: consistent with the initial rate
+        v_k = float(controller.voltage(command - y, -(y - y_prev) / ts))
+        y_prev = y
+        sol = solve_ivp(lambda t, s: derivatives(s, v_k)[0], (t0, t1), state,
+                        dense_output=True, **opts)
+        if not sol.success:
+            raise RuntimeError(f"integration failed: {sol.message}")
+        last = k == n_samples - 1
+        mask = (t_out >= t0) & ((t_out < t1) | (last & (t_out <= t1)))
+        if mask.any():
+            x[:, mask] = sol.sol(t_out[mask])
+            v_out[mask] = v_k
+        state = sol.y[:, -1]
+    return x, v_out
 
 
 # ---------------------------------------------------------------------------------------------

@@ -137,3 +137,19 @@ def test_bad_input(fin):
         ase.open_loop(fin.model, 4)
     with pytest.raises(ValueError, match="finite"):
         PDController(math.nan, 1.0, 1.0)
+
+
+def test_digital_controller_tends_to_the_continuous_one(fin):
+    # a zero-order-hold PD sampled fast enough must reproduce the continuous loop; at 1 kHz
+    # (thesis Table 2) it differs visibly but stays bounded
+    cmd = math.radians(1.0)
+    cont = ase.simulate_closed_loop(fin.model, SYSTEM_3, cmd, "AEM1", t_final=0.03, n_out=301)
+    fast = ase.simulate_closed_loop(fin.model, SYSTEM_3, cmd, "AEM1", t_final=0.03, n_out=301,
+                                    sample_time=1e-5)
+    slow = ase.simulate_closed_loop(fin.model, SYSTEM_3, cmd, "AEM1", t_final=0.03, n_out=301,
+                                    sample_time=1e-3)
+    assert np.max(np.abs(fast.theta - cont.theta)) < 2e-3 * cmd
+    assert np.max(np.abs(slow.theta - cont.theta)) > 1e-2 * cmd
+    assert np.max(np.abs(slow.voltage)) <= 24.0 + 1e-9
+    with pytest.raises(ValueError, match="sample_time"):
+        ase.simulate_closed_loop(fin.model, SYSTEM_3, cmd, "AEM1", sample_time=-1.0)
