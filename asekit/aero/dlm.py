@@ -242,15 +242,18 @@ class _ChunkGeometry:
         self.k10_sum = np.zeros(xbar.shape)      # sum_j K10_j T1 W1_j: the k-independent part
         tl = snd.tan_sweep[None, :]
         z2 = zbar * zbar
+        coplanar = not np.any(gsr)                            # T1 = 1 everywhere
         for s, w1 in zip(stations, self.w1):
-            eta = s * e
-            x0 = xbar - eta * tl
-            r1 = ybar - eta
+            eta_row = (s * snd.e)[None, :]                    # eta of this station, per sender
+            x0 = xbar - eta_row * tl
+            r1 = ybar - eta_row
             r1 *= r1
             r1 += z2
-            big_r = x0 * x0 + beta2 * r1
+            big_r = x0 * x0
+            big_r += beta2 * r1
             np.sqrt(big_r, out=big_r)                         # [R71] Eq. 10
             np.sqrt(r1, out=r1)                               # [R71] Eq. 4
+            eta = np.broadcast_to(eta_row, xbar.shape)
             small = r1 <= 1e-12 * e
             any_small = bool(small.any())
             if any_small:                                     # receiver on the doublet line
@@ -270,7 +273,7 @@ class _ChunkGeometry:
             k10 = -1.0 - x0 / big_r                           # [R71] Eq. 15
             if any_small:
                 r1[small] = 0.0
-            t1w = self.t1 * w1                                # T1 W1_j
+            t1w = w1 if coplanar else self.t1 * w1            # T1 W1_j
             self.k10_sum += k10 * t1w
             absu = np.abs(u1)
             p.update(r1=r1, absu=absu, c1=c1, t1w=t1w,
