@@ -26,8 +26,10 @@ import numpy as np
 
 from .boxes import BoxMesh
 
-#: Memory budget (bytes) for the temporaries of one row chunk.
+#: Upper bound (bytes) for the temporaries of one row chunk (VLM and DLM).
 CHUNK_BYTES = 256 * 2**20
+#: Receiver-sender pairs per row chunk of the vortex lattice (cache-sized).
+VLM_PAIRS_PER_CHUNK = 32768
 
 
 def check_mach(mach: float) -> float:
@@ -36,10 +38,6 @@ def check_mach(mach: float) -> float:
     if not math.isfinite(m) or m < 0.0 or m >= 1.0:
         raise ValueError(f"mach must be a finite number with 0 <= mach < 1 (subsonic), got {mach!r}")
     return m
-
-
-def _rows(n_rows: int, n_cols: int, bytes_per_pair: int) -> int:
-    return max(1, min(n_rows, int(CHUNK_BYTES // max(1, n_cols * bytes_per_pair))))
 
 
 def _senders(mesh: BoxMesh, symmetric: bool):
@@ -106,7 +104,7 @@ def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False) -
     p = mesh.control_point * sx
     n_r = mesh.normal
     d = np.zeros((mesh.n, mesh.n))
-    rows = max(1, min(mesh.n, 32768 // mesh.n))
+    rows = max(1, min(mesh.n, VLM_PAIRS_PER_CHUNK // mesh.n))
     for img in _senders(mesh, symmetric):
         a = img.doublet_p1 * sx
         b = img.doublet_p3 * sx
