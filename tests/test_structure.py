@@ -278,3 +278,21 @@ def test_fn1_and_clamped_modal_models(fin, fn2):
     assert mc.n_rigid == 0 and math.isnan(mc.J_fin) and mc.frequencies_hz.size >= 3
     w, _ = mode_shapes_at(mc, np.array([[0.5, 0.0]]))          # clamped root: w = 0
     np.testing.assert_allclose(w, 0.0, atol=1e-14)
+
+
+def test_inplane_mode_of_single_node_shaft_is_a_mechanism(fin):
+    # Membrane check behind the thesis's discarded 16.57 Hz in-plane mode (Fig 16): pinned at one
+    # node, a fin of bilinear membrane elements turns in its plane at zero frequency (no drilling
+    # stiffness); the first genuine in-plane mode lies far above the 1000 Hz limit.
+    from asekit.structure.modes import fin_inplane_modes
+    ip = fin_inplane_modes(fin)
+    assert ip.frequencies_hz[0] < 0.1
+    assert ip.frequencies_hz[1] > 3000.0
+    # in-plane polar inertia about the node = pitch inertia about y + inertia about x (thin plate)
+    assert ip.J_z > 2 * 2.4e-4
+    # the rigid rotation shape: u = -(y - y_a) theta_z, v = (x - x_a) theta_z
+    uv = ip.shapes[:, :, 0]
+    x, y = fin_mesh(fin).nodes.T
+    theta = uv[:, 1][np.argmax(np.abs(x - 0.078))] / (x - 0.078)[np.argmax(np.abs(x - 0.078))]
+    np.testing.assert_allclose(uv[:, 0], -(y - 0.0) * theta, atol=1e-6 * np.abs(uv).max())
+    np.testing.assert_allclose(uv[:, 1], (x - 0.078) * theta, atol=1e-6 * np.abs(uv).max())

@@ -366,6 +366,53 @@ def fin_fn1_modal_model(fin: FinDefinition | None = None, n_chord: int | None = 
                                axis_x=fin.shaft.axis_point[0])
 
 
+@dataclass(frozen=True)
+class InPlaneModes:
+    """In-plane (membrane) modes of the fin pinned at one node (u = v = 0), the situation of the
+    thesis's discarded mode (Fig. 16).
+
+    frequencies_hz : (n,) ascending; the first is the in-plane rigid rotation about the pinned
+        node (0 Hz up to round-off: nothing but an artificial drilling stiffness restrains it).
+    shapes : (n_nodes, 2, n) u, v per node (mass-normalised).
+    J_z : in-plane rotational inertia of the fin about the pinned node (kg m^2).
+    """
+
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray
+    J_z: float
+
+
+def fin_inplane_modes(fin: FinDefinition | None = None, n_chord: int | None = None,
+                      n_span: int | None = None, n_modes: int = 4) -> InPlaneModes:
+    """In-plane modes of the fin held only at the shaft node (plane-stress Q4 membrane, see
+    :func:`asekit.structure.plate.membrane_matrices`). Not part of the modal model: a flat fin's
+    in-plane motion does not couple with bending or with the aerodynamics."""
+    import scipy.sparse as sp
+
+    from .plate import membrane_matrices
+    fin = load_fin() if fin is None else fin
+    mesh = fin_mesh(fin, n_chord, n_span)
+    Ke, Me = membrane_matrices(mesh, fin.material)
+    dofs = (2 * mesh.elements[:, :, None] + np.arange(2)).reshape(-1, 8)
+    rows, cols = np.repeat(dofs, 8, axis=1).ravel(), np.tile(dofs, (1, 8)).ravel()
+    n = 2 * mesh.n_nodes
+    K = sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(n, n))
+    M = sp.csr_matrix((Me.ravel(), (rows, cols)), shape=(n, n))
+    node = mesh.node_at(fin.shaft.axis_point, name="shaft axis_point")
+    free = np.setdiff1d(np.arange(n), [2 * node, 2 * node + 1])
+    Kf = K[free][:, free].toarray()
+    Mf = M[free][:, free].toarray()
+    lam, q = sla.eigh(0.5 * (Kf + Kf.T), 0.5 * (Mf + Mf.T), subset_by_index=(0, n_modes - 1))
+    phi = np.zeros((n, n_modes))
+    phi[free] = q
+    xa, ya = mesh.nodes[node]
+    rz = np.zeros(n)
+    rz[0::2] = -(mesh.nodes[:, 1] - ya)
+    rz[1::2] = mesh.nodes[:, 0] - xa
+    return InPlaneModes(frequencies_hz=np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi),
+                        shapes=phi.reshape(mesh.n_nodes, 2, n_modes), J_z=float(rz @ (M @ rz)))
+
+
 def pitch_inertia_exact(fin: FinDefinition) -> float:
     """Pitch inertia (kg m^2) of the flat trapezoidal plate about the shaft axis, by exact
     integration: J = int_y rho h(y) int_x [(x - x_a)^2 + h^2 / 12] dx dy (the second term is the

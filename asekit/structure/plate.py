@@ -182,3 +182,44 @@ def consistent_mass(mesh: PlateMesh, material: Material, thickness_rule: str = "
         for k, inertia in enumerate((h, h**3 / 12, h**3 / 12)):
             M[:, k::3, k::3] += (f * inertia)[:, None, None] * NN
     return M
+
+
+def membrane_matrices(mesh: PlateMesh, material: Material, thickness_rule: str = "gauss",
+                      n_gauss: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """Plane-stress bilinear (Q4) membrane stiffness and consistent mass, (n_elem, 8, 8) each,
+    DOFs (u, v) per node.
+
+    K_e = int B^T D B dA, D = E h / (1 - nu^2) [[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu)/2]],
+    B = [[N_x, 0], [0, N_y], [N_y, N_x]]; M_e = int rho h N^T N dA (3 x 3 Gauss). Used only to
+    examine the in-plane behaviour that the bending model leaves out (the flat plate's membrane
+    and bending fields are uncoupled). The element has no drilling stiffness: an in-plane rigid
+    rotation costs no energy (cf. the artificial drilling stiffness of shell elements).
+    """
+    xy = mesh.nodes[mesh.elements]
+    E, nu, rho = material.youngs_modulus, material.poisson_ratio, material.density
+    D0 = E / (1 - nu**2) * np.array([[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu) / 2]])
+    ne = xy.shape[0]
+    K = np.zeros((ne, 8, 8))
+    M = np.zeros((ne, 8, 8))
+    pts, wts = gauss_points(n_gauss)
+    for (r, s), wgt in zip(pts, wts):
+        N, dNr, dNs, J, det = _jacobian(xy, r, s)
+        _check_geometry(det)
+        h = _thickness(mesh, xy, N, thickness_rule)
+        Jinv = np.linalg.inv(J)
+        dNx = Jinv[:, 0, 0][:, None] * dNr + Jinv[:, 0, 1][:, None] * dNs
+        dNy = Jinv[:, 1, 0][:, None] * dNr + Jinv[:, 1, 1][:, None] * dNs
+        B = np.zeros((ne, 3, 8))
+        B[:, 0, 0::2] = dNx
+        B[:, 1, 1::2] = dNy
+        B[:, 2, 0::2] = dNy
+        B[:, 2, 1::2] = dNx
+        K += (wgt * det * h)[:, None, None] * np.einsum("eji,jk,ekl->eil", B, D0, B)
+    pts, wts = gauss_points(3)
+    for (r, s), wgt in zip(pts, wts):
+        N, _, _, _, det = _jacobian(xy, r, s)
+        h = _thickness(mesh, xy, N, thickness_rule)
+        NN = (wgt * det * rho * h)[:, None, None] * np.outer(N, N)
+        M[:, 0::2, 0::2] += NN
+        M[:, 1::2, 1::2] += NN
+    return K, M
