@@ -157,6 +157,9 @@ def fin_gaf_database(rebuild: bool = False, progress: bool = True, path=None,
     :func:`database_k`, isolated fin, default structure ``fin_modal_model()`` (FN2, 6 x 7
     single-node shaft) on :func:`~asekit.aero.boxes.fin_boxes` -- and writes it atomically.
 
+    ``symmetric`` (a wall at the root) or ``method="parabolic"`` select another database, kept in
+    its own file (``data/gaf_fin_wall_quartic.npz`` etc.) unless ``path`` is given.
+
     Returns
     -------
     (GafDatabase, ModalModel)
@@ -169,7 +172,10 @@ def fin_gaf_database(rebuild: bool = False, progress: bool = True, path=None,
     settings = _fin_settings(fin, boxes, symmetric, method)
     fp = _fingerprint({"shapes": model.shapes, "nodes": model.nodes,
                        "frequencies_hz": model.frequencies_hz}, settings)
-    path = GAF_FILE if path is None else path
+    if path is None:      # only the default settings live in the committed file
+        default = not symmetric and method == "quartic"
+        path = GAF_FILE if default else DATA_DIR / (
+            f"gaf_fin_{'wall' if symmetric else 'isolated'}_{method}.npz")
     if not rebuild:
         try:
             arrays, meta = load_npz(path)
