@@ -400,9 +400,15 @@ def fin_inplane_modes(fin: FinDefinition | None = None, n_chord: int | None = No
     M = sp.csr_matrix((Me.ravel(), (rows, cols)), shape=(n, n))
     node = mesh.node_at(fin.shaft.axis_point, name="shaft axis_point")
     free = np.setdiff1d(np.arange(n), [2 * node, 2 * node + 1])
-    Kf = K[free][:, free].toarray()
-    Mf = M[free][:, free].toarray()
-    lam, q = sla.eigh(0.5 * (Kf + Kf.T), 0.5 * (Mf + Mf.T), subset_by_index=(0, n_modes - 1))
+    Kf = K[free][:, free]
+    Mf = M[free][:, free]
+    if free.size <= 2000:
+        lam, q = sla.eigh(Kf.toarray(), Mf.toarray(), subset_by_index=(0, n_modes - 1))
+    else:
+        lam, q = spla.eigsh(Kf.tocsc(), k=n_modes, M=Mf.tocsc(), sigma=-(2 * math.pi) ** 2,
+                            which="LM", v0=np.ones(free.size) / math.sqrt(free.size))
+        order = np.argsort(lam)
+        lam, q = lam[order], q[:, order]
     phi = np.zeros((n, n_modes))
     phi[free] = q
     xa, ya = mesh.nodes[node]
