@@ -103,15 +103,17 @@ def database_k(fin) -> np.ndarray:
 
 
 def _fingerprint(arrays: dict, settings: dict) -> str:
-    """SHA-256 over the mode set (rounded to 9 significant digits, so round-off differences
-    between machines do not invalidate the file) and the settings."""
+    """SHA-256 over the mode set and the settings. Each array is scaled by its largest magnitude
+    and rounded to 8 decimals first, so round-off differences between machines (including the
+    sign of values that are zero in exact arithmetic) do not invalidate the file."""
     h = hashlib.sha256()
     for name in sorted(arrays):
         a = np.asarray(arrays[name], float)
-        r = np.array([float(f"{v:.9g}") for v in a.ravel()]) + 0.0     # -0.0 -> 0.0
+        scale = float(np.max(np.abs(a))) if a.size else 1.0
+        r = np.round(a / (scale if scale > 0 else 1.0), 8) + 0.0       # -0.0 -> 0.0
         h.update(name.encode())
         h.update(str(a.shape).encode())
-        h.update(r.tobytes())
+        h.update(np.ascontiguousarray(r).tobytes())
     h.update(json.dumps(settings, sort_keys=True).encode())
     return h.hexdigest()
 
