@@ -296,3 +296,15 @@ def test_inplane_mode_of_single_node_shaft_is_a_mechanism(fin):
     theta = uv[:, 1][np.argmax(np.abs(x - 0.078))] / (x - 0.078)[np.argmax(np.abs(x - 0.078))]
     np.testing.assert_allclose(uv[:, 0], -(y - 0.0) * theta, atol=1e-6 * np.abs(uv).max())
     np.testing.assert_allclose(uv[:, 1], (x - 0.078) * theta, atol=1e-6 * np.abs(uv).max())
+
+
+def test_modal_partition_eq_2_46(fn2):
+    from asekit.structure.modes import modal_partition
+    p = modal_partition(fn2)
+    assert p.M_cc.shape == (1, 1) and p.M_cs.shape == (1, 5) and p.K_ss.shape == (5, 5)
+    assert p.M_cc[0, 0] == pytest.approx(fn2.J_fin)
+    np.testing.assert_array_equal(p.M_sc, p.M_cs.T)
+    np.testing.assert_allclose(p.M_ss, np.eye(5), atol=1e-10)
+    # M_cs = phi_c^T M phi_s: for a unit pitch it is the pitch participation of each elastic
+    # mode; the rigid pitch expands in the elastic modes, so sum M_cs^2 <= J_fin (Bessel)
+    assert float(p.M_cs @ p.M_cs.T) <= fn2.J_fin

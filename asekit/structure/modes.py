@@ -169,6 +169,28 @@ class ModalModel:
     label: str
 
 
+@dataclass(frozen=True)
+class ModalPartition:
+    """The rigid (c) / elastic (s) partition of the m-set matrices (thesis Eqs. (2.45)-(2.46)):
+    M_cc (n_c x n_c), M_cs (n_c x n_s), M_sc = M_cs^T, M_ss, C_ss and K_ss (n_s x n_s); damping
+    and stiffness have no rigid part."""
+
+    M_cc: np.ndarray
+    M_cs: np.ndarray
+    M_sc: np.ndarray
+    M_ss: np.ndarray
+    C_ss: np.ndarray
+    K_ss: np.ndarray
+
+
+def modal_partition(model: ModalModel) -> ModalPartition:
+    """Split a ModalModel into the c-set (its first ``n_rigid`` modes) and the s-set (Eq. 2.46)."""
+    c = model.n_rigid
+    return ModalPartition(M_cc=model.M[:c, :c].copy(), M_cs=model.M[:c, c:].copy(),
+                          M_sc=model.M[c:, :c].copy(), M_ss=model.M[c:, c:].copy(),
+                          C_ss=model.C[c:, c:].copy(), K_ss=model.K[c:, c:].copy())
+
+
 def locate_points(nodes: np.ndarray, elements: np.ndarray, points: np.ndarray,
                   tol: float = 1e-9) -> tuple[np.ndarray, np.ndarray]:
     """Element index and natural coordinates (r, s) of each (x, y) point.
