@@ -307,4 +307,4 @@ def test_modal_partition_eq_2_46(fn2):
     np.testing.assert_allclose(p.M_ss, np.eye(5), atol=1e-10)
     # M_cs = phi_c^T M phi_s: for a unit pitch it is the pitch participation of each elastic
     # mode; the rigid pitch expands in the elastic modes, so sum M_cs^2 <= J_fin (Bessel)
-    assert float(p.M_cs @ p.M_cs.T) <= fn2.J_fin
+    assert (p.M_cs @ p.M_cs.T).item() <= fn2.J_fin
