@@ -415,15 +415,17 @@ def _increment_planar(geo: _ChunkGeometry, kd: float, p_n, a_n) -> np.ndarray:
         k1 = kd * p["r1"]                                   # [R71] Eq. 12
         k1sq = k1 * k1
         s_p, s_1 = _i0_sums(p["absu"], k1sq, p_n, a_n)
-        v = np.empty(k1.shape, complex)
         re = k1sq * s_1
         np.subtract(p["g"], re, out=re)                     # Re A = g - k1^2 s_1
         re *= p["sgn"]
         re += p["c1"]
-        v.real = re
-        np.multiply(k1, s_p, out=re)
-        v.imag = -re                                        # Im A = -k1 s_p
-        v *= np.exp(-1j * (kd * p["phase"]))
+        im = np.multiply(k1, s_p, out=s_p)
+        np.negative(im, out=im)                             # Im A = -k1 s_p
+        ph = kd * p["phase"]
+        c, sn = np.cos(ph), np.sin(ph, out=ph)
+        v = np.empty(k1.shape, complex)                     # (re + i im)(cos - i sin)
+        v.real = re * c + im * sn
+        v.imag = im * c - re * sn
         ni = p["neg_idx"]
         if ni[0].size:
             kn = k1sq[ni]
