@@ -2,7 +2,8 @@
 
 Reference: K.-J. Bathe and E. N. Dvorkin, "A four-node plate bending element based on
 Mindlin/Reissner plate theory and a mixed interpolation", Int. J. Numer. Meth. Eng. 21 (1985)
-367-383 (the "MITC4" element); also Bathe, *Finite Element Procedures* (1996), Section 5.4.2.
+367-383 (the "MITC4" element); also Bathe, *Finite Element Procedures* (1996), Ch. 5
+(plate bending elements based on Reissner-Mindlin theory).
 
 Degrees of freedom per node, in this order: ``w`` (m, +z), ``theta_x``, ``theta_y`` (rad,
 right-handed rotations about +x and +y). A positive ``theta_y`` is nose-up: the trailing edge
@@ -17,17 +18,17 @@ so that the curvatures and transverse shear strains are
 
 and the Kirchhoff limit (gamma = 0) is ``theta_y = -dw/dx``, ``theta_x = dw/dy``.
 
-Bending uses the bilinear interpolation of the rotations (Bathe & Dvorkin 1985, Eq. (1)).
+Bending uses the bilinear interpolation of w and of the rotations (isoparametric Q4).
 Transverse shear uses the MITC4 assumed covariant strains tied at the mid-sides
-A (0, 1), B (-1, 0), C (0, -1), D (1, 0) (Bathe & Dvorkin 1985, Eqs. (7)-(8)):
+A (0, 1), B (-1, 0), C (0, -1), D (1, 0) (the mixed interpolation of Bathe & Dvorkin 1985):
 
     e_rz = 1/2 (1 + s) e_rz^A + 1/2 (1 - s) e_rz^C
     e_sz = 1/2 (1 + r) e_sz^D + 1/2 (1 - r) e_sz^B
 
 which removes shear locking: the element passes the patch test and stays accurate as h -> 0.
 The in-plane (membrane) behaviour of the flat fin is uncoupled from bending and does not interact
-with the aerodynamics; it is not part of this element (see :mod:`asekit.structure.membrane`
-if present, otherwise it is left out).
+with the aerodynamics; it is not part of this element or of the modal model.
+:func:`membrane_matrices` (plane-stress Q4) exists only to examine the thesis's in-plane mode.
 
 The thickness ``h`` may vary in the element: it is evaluated at each integration point from the
 mesh's spanwise law (``thickness_rule="gauss"``) or taken constant at the element centroid
@@ -121,7 +122,7 @@ def mitc4_stiffness(mesh: PlateMesh, material: Material, thickness_rule: str = "
     K_e = int B_b^T D_b B_b dA + int B_s^T D_s B_s dA with
     D_b = E h^3 / (12 (1 - nu^2)) [[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu)/2]] and
     D_s = k G h I (k = 5/6), the shear strains from the MITC4 assumed covariant field
-    (Bathe & Dvorkin 1985, Eqs. (7)-(8)); ``n_gauss`` x ``n_gauss`` Gauss integration (2 is the
+    (Bathe & Dvorkin 1985); ``n_gauss`` x ``n_gauss`` Gauss integration (2 is the
     standard MITC4 rule).
     """
     xy = mesh.nodes[mesh.elements]                   # (ne, 4, 2)
