@@ -16,14 +16,15 @@ the same LAPACK call). PanelAero's sweep is 12 single calls (it has no geometry 
 
 Measured on the 2-core project machine, shared with other jobs (load ~2, so +-30 %), M 0.6,
 asekit vs PanelAero 2025.8, same kernel order:
-  300 boxes, quartic: single 0.13 s vs 0.56 s (4x), 12-k sweep 0.53 s vs 4.6 s (9x), 28 vs 51 MB;
-  1200 boxes, quartic: single 0.88 s vs 7.2 s (8x), 12-k sweep 5.7 s vs 80 s (14x),
-      peak 59 MB vs 801 MB; parabolic: single 0.61 s vs 3.7 s (6x);
+  300 boxes, quartic: single 0.07 s vs 0.26 s (4x), 12-k sweep 0.53 s vs 4.6 s (9x), 25 vs 50 MB;
+  1200 boxes, quartic: single 0.85 s vs 7.6 s (9x), 12-k sweep 5.7 s vs 80 s (14x),
+      peak 56 MB vs 801 MB; parabolic: single 0.56 s vs 4.1 s (7x), 49 vs 641 MB;
   3000 boxes, quartic: single 5.7 s, peak 231 MB (PanelAero not run: its 1200-box peak of
       0.8 GB scales to about 5 GB).
 The single-(M, k) cost splits about evenly between the k-independent geometry (kernel
 stations, integration weights, vortex lattice) and the kernel itself; a sweep pays the geometry
-once per Mach. The 10x single-call goal is met for the quartic kernel only on a quiet machine.
+once per Mach. The 10x single-call goal is nearly met (9x quartic, 7x parabolic); the sweep
+exceeds it.
 Agreement of D between the two: 5e-14 (single) to 1.2e-13 (sweep), relative to max |D|.
 
 Issue target: asekit >= 10x faster than PanelAero per (M, k) at 1200 boxes, the sweep faster
