@@ -34,6 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .validate import positive
+
 INPUT_NAMES = ("theta", "theta_dot", "theta_ddot")
 
 
@@ -85,13 +87,6 @@ def modal_arrays(model=None, *, M=None, K=None, C=None, n_rigid=None) -> ModalAr
     return ModalArrays(M=M, K=K, C=C, n_rigid=n_rigid)
 
 
-def _positive(name, value):
-    value = float(value)
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    return value
-
-
 @dataclass(frozen=True)
 class AeroelasticMatrices:
     """Matrices of Eqs. (2.63), (2.68)-(2.70) at one (rho, U).
@@ -132,8 +127,8 @@ def aeroelastic_matrices(modal, rfa, rho: float, velocity: float) -> Aeroelastic
     velocity : true airspeed U (m/s), > 0.
     """
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
-    rho = _positive("rho", rho)
-    U = _positive("velocity", velocity)
+    rho = positive("rho", rho)
+    U = positive("velocity", velocity)
     if rfa.A.shape[1] != m.n_modes:
         raise ValueError(f"rfa has {rfa.A.shape[1]} modes, the modal model {m.n_modes}")
     b = rfa.b_ref

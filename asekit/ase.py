@@ -44,6 +44,7 @@ from scipy.integrate import solve_ivp
 from .aeroelastic import aeroelastic_matrices, aeroelastic_model
 from .servo import ActuatorParameters, PDController, actuator_state_space
 from .simulate import THESIS_LIMITS, PowerLimits, applied_voltage, controller_voltage, motor_rhs
+from .validate import finite
 
 TOPOLOGIES = ("AEM1", "AEM2")
 #: Name of the aeroelastic output that the AEM2 potentiometer measures.
@@ -56,18 +57,11 @@ def _check_topology(topology: str) -> str:
     return topology
 
 
-def _check_finite(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return value
-
-
 def _check_controller(controller: PDController) -> PDController:
     if not isinstance(controller, PDController):
         raise ValueError(f"controller must be a PDController, got {type(controller).__name__}")
     for n in ("gain", "kp", "kd"):
-        _check_finite(f"controller.{n}", getattr(controller, n))
+        finite(f"controller.{n}", getattr(controller, n))
     return controller
 
 
@@ -426,7 +420,7 @@ def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController,
     """
     _check_topology(topology)
     _check_controller(controller)
-    command = _check_finite("command", command)
+    command = finite("command", command)
     if abs(command) > angle_limit + 1e-12:
         raise ValueError(f"command {math.degrees(command):.3g} deg exceeds the angular position "
                          f"limit of {math.degrees(angle_limit):.3g} deg (thesis Table 2)")
@@ -649,14 +643,14 @@ def fin_ase(mach: float = 0.5, altitude: float = 0.0, actuator: ActuatorParamete
     pitch (AEM2 feedback), the pitch rotations ``theta_<corner>`` and normal displacements
     ``w_<corner>`` at the four planform corners (:data:`CORNERS`), and the modal coordinates.
     """
-    from .aero.gaf import fin_gaf_database, steady_hinge_coefficient
+    from .aero.gaf import fin_gaf_database
     from .aeroelastic import fin_outputs
     from .atmosphere import standard_atmosphere
     from .geometry import load_fin
     from .rfa import roger_fit, gaf_at_mach
 
-    mach = _check_finite("mach", mach)
-    altitude = _check_finite("altitude", altitude)
+    mach = finite("mach", mach)
+    altitude = finite("altitude", altitude)
     if database is None or modal is None:
         database, modal = fin_gaf_database(progress=False)
     lo, hi = float(np.min(database.machs)), float(np.max(database.machs))

@@ -32,6 +32,7 @@ import numpy as np
 from scipy import linalg, optimize
 
 from .aeroelastic import ModalArrays, aeroelastic_matrices, modal_arrays
+from .validate import positive_array
 
 
 # --------------------------------------------------------------------------------------------
@@ -84,13 +85,6 @@ class TabulatedGaf:
         else:
             raise ValueError(f"method must be 'linear' or 'cubic', got {method!r}")
         return qr, qik
-
-
-def _positive_array(name, v):
-    a = np.atleast_1d(np.asarray(v, dtype=float))
-    if a.size == 0 or not np.all(np.isfinite(a)) or np.any(a <= 0):
-        raise ValueError(f"{name} must be finite and > 0, got {v}")
-    return a
 
 
 def _mac(a: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -251,8 +245,8 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
     :class:`PkResult`
     """
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
-    rho = float(_positive_array("density", density)[0])
-    U = _positive_array("velocities", velocities)
+    rho = float(positive_array("density", density)[0])
+    U = positive_array("velocities", velocities)
     if np.any(np.diff(U) <= 0):
         raise ValueError("velocities must be strictly ascending")
     if gaf.Q.shape[1] != m.n_modes:
@@ -359,7 +353,7 @@ def divergence_speeds(modal, Q0: np.ndarray, density: float, include_rigid: bool
     unless ``include_rigid``.
     """
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
-    rho = float(_positive_array("density", density)[0])
+    rho = float(positive_array("density", density)[0])
     Q0 = np.asarray(Q0)
     _, K, _, Qs = _elastic_part(m, Q0[None], include_rigid)
     mu = linalg.eigvals(Qs[0].real, K)                # Q x = mu K x, q = 1/mu
@@ -478,8 +472,8 @@ def root_locus(modal, rfa, density: float, velocities, substeps: int | None = No
     for aeroelastic roots.
     """
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
-    rho = float(_positive_array("density", density)[0])
-    U = _positive_array("velocities", velocities)
+    rho = float(positive_array("density", density)[0])
+    U = positive_array("velocities", velocities)
     if np.any(np.diff(U) <= 0):
         raise ValueError("velocities must be strictly ascending")
     ns = m.n_elastic
@@ -663,8 +657,8 @@ def time_domain_sweep(modal, rfa, density: float, velocities, coordinate: int = 
     refined by Brent's method when ``refine``). The growth is measured on the elastic modal
     coordinates zeta_s. ``method`` "exact" (matrix exponential) or a solve_ivp method."""
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
-    U = _positive_array("velocities", velocities)
-    rho = float(_positive_array("density", density)[0])
+    U = positive_array("velocities", velocities)
+    rho = float(positive_array("density", density)[0])
     ns = m.n_elastic
     if window is None:
         s = slice(m.n_rigid, m.n_modes)

@@ -16,13 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .paths import FIN_FILE
-
-
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    return value
+from .validate import positive
 
 
 @dataclass(frozen=True)
@@ -43,8 +37,8 @@ class Planform:
     def __post_init__(self):
         object.__setattr__(self, "root_le", tuple(float(v) for v in self.root_le))
         object.__setattr__(self, "tip_le", tuple(float(v) for v in self.tip_le))
-        _positive("root_chord", self.root_chord)
-        _positive("tip_chord", self.tip_chord)
+        positive("root_chord", self.root_chord)
+        positive("tip_chord", self.tip_chord)
         if not all(math.isfinite(v) for v in self.root_le + self.tip_le):
             raise ValueError("root_le and tip_le must be finite (x, y) pairs")
         if self.tip_le[1] - self.root_le[1] <= 0.0:
@@ -125,8 +119,8 @@ class LinearThickness:
     tip: float
 
     def __post_init__(self):
-        _positive("thickness root", self.root)
-        _positive("thickness tip", self.tip)
+        positive("thickness root", self.root)
+        positive("thickness tip", self.tip)
 
     def at(self, eta: np.ndarray) -> np.ndarray:
         """Thickness (m) at span fraction ``eta`` in [0, 1]."""
@@ -143,8 +137,8 @@ class Material:
     name: str = ""
 
     def __post_init__(self):
-        _positive("youngs_modulus", self.youngs_modulus)
-        _positive("density", self.density)
+        positive("youngs_modulus", self.youngs_modulus)
+        positive("density", self.density)
         nu = float(self.poisson_ratio)
         if not (-1.0 < nu < 0.5):
             raise ValueError(f"poisson_ratio must lie in (-1, 0.5), got {nu!r}")
@@ -165,9 +159,9 @@ class Shaft:
 
     def __post_init__(self):
         object.__setattr__(self, "axis_point", tuple(float(v) for v in self.axis_point))
-        _positive("torsional_stiffness", self.torsional_stiffness)
-        _positive("radius", self.radius)
-        _positive("fictitious_inertia_factor", self.fictitious_inertia_factor)
+        positive("torsional_stiffness", self.torsional_stiffness)
+        positive("radius", self.radius)
+        positive("fictitious_inertia_factor", self.fictitious_inertia_factor)
 
 
 @dataclass(frozen=True)

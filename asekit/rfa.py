@@ -25,6 +25,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .validate import positive
+
 
 def default_lag_roots(k_max: float, n_lags: int = 4) -> np.ndarray:
     """Lag roots spread over the reduced-frequency range, beta_n = 1.7 k_max (n/(N+1))^2
@@ -88,19 +90,12 @@ class RogerFit:
 
     def evaluate_laplace(self, s, velocity: float) -> np.ndarray:
         """Q~ at complex Laplace variable(s) ``s`` (1/s) and airspeed ``velocity``, Eq. (2.28)."""
-        _positive("velocity", velocity)
+        positive("velocity", velocity)
         s_arr = np.atleast_1d(np.asarray(s, dtype=complex))
         sb = s_arr * self.b_ref / velocity
         terms = [np.ones_like(sb), sb, sb ** 2] + [sb / (sb + b) for b in self.lag_roots]
         out = np.einsum("fc,cij->fij", np.stack(terms, axis=1), self.A)
         return out[0] if np.ndim(s) == 0 else out
-
-
-def _positive(name, value):
-    value = float(value)
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    return value
 
 
 def design_rows(k: np.ndarray, lag_roots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -144,7 +139,7 @@ def roger_fit(k, Q, b_ref: float, lag_roots=None, n_lags: int = 4, weights=None,
     """
     k = np.asarray(k, dtype=float)
     Q = np.asarray(Q, dtype=complex)
-    _positive("b_ref", b_ref)
+    positive("b_ref", b_ref)
     if k.ndim != 1 or Q.ndim != 3 or Q.shape[0] != k.size or Q.shape[1] != Q.shape[2]:
         raise ValueError(f"Q must have shape (n_k, n, n) with n_k = len(k) = {k.size}; "
                          f"got Q {Q.shape}")

@@ -36,18 +36,7 @@ from dataclasses import dataclass
 import control as ct
 import numpy as np
 
-
-def _check(name: str, value, low: float = 0.0, inclusive: bool = False,
-           high: float = math.inf, high_inclusive: bool = True) -> float:
-    """Return ``float(value)`` or raise ValueError naming ``name`` and its valid range."""
-    value = float(value)
-    lo_ok = value >= low if inclusive else value > low
-    hi_ok = value <= high if high_inclusive else value < high
-    if not math.isfinite(value) or not lo_ok or not hi_ok:
-        lb = "[" if inclusive else "("
-        rb = "]" if high_inclusive and math.isfinite(high) else ")"
-        raise ValueError(f"{name} must be a finite number in {lb}{low:g}, {high:g}{rb}, got {value!r}")
-    return value
+from .validate import in_range
 
 
 @dataclass(frozen=True)
@@ -74,8 +63,8 @@ class DCMotor:
     def __post_init__(self):
         for name in ("resistance", "inductance", "torque_constant", "back_emf_constant",
                      "rotor_inertia"):
-            _check(name, getattr(self, name))
-        _check("viscous_damping", self.viscous_damping, inclusive=True)
+            in_range(name, getattr(self, name))
+        in_range("viscous_damping", self.viscous_damping, inclusive=True)
 
 
 @dataclass(frozen=True)
@@ -94,9 +83,9 @@ class Transmission:
     inertia: float = 0.5e-7
 
     def __post_init__(self):
-        _check("ratio", self.ratio)
-        _check("efficiency", self.efficiency, high=1.0)
-        _check("inertia", self.inertia, inclusive=True)
+        in_range("ratio", self.ratio)
+        in_range("efficiency", self.efficiency, high=1.0)
+        in_range("inertia", self.inertia, inclusive=True)
 
 
 #: The thesis's fin pitch inertia about the shaft (kg m^2, Eq. 4.11, from its PATRAN model).
@@ -126,7 +115,7 @@ class ActuatorParameters:
         if not isinstance(self.transmission, Transmission):
             raise ValueError(
                 f"transmission must be a Transmission, got {type(self.transmission).__name__}")
-        _check("fin_inertia", self.fin_inertia, inclusive=True)
+        in_range("fin_inertia", self.fin_inertia, inclusive=True)
 
     @property
     def inertia_at_motor(self) -> float:
@@ -401,7 +390,7 @@ def step_response(params: ActuatorParameters, controller: PDController, t_final:
     """Linear closed-loop step response of Eq. (4.18) (Figs 49, 51, 52, 53).
 
     Returns (t in s, theta in the unit of ``amplitude``)."""
-    _check("t_final", t_final)
+    in_range("t_final", t_final)
     t = np.linspace(0.0, t_final, n)
     resp = ct.step_response(closed_loop(params, controller, require_stable=False), T=t)
     return resp.time, amplitude * np.squeeze(resp.outputs)

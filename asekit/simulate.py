@@ -53,7 +53,8 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .servo import ActuatorParameters, PDController, _check
+from .servo import ActuatorParameters, PDController
+from .validate import in_range
 from .torque_requirement import (SEA_LEVEL_DENSITY, SEA_LEVEL_SPEED_OF_SOUND, THESIS_Q_CC,
                                  dynamic_pressure)
 
@@ -80,13 +81,13 @@ class PowerLimits:
 
     def __post_init__(self):
         if self.supply_voltage is not None:
-            _check("supply_voltage", self.supply_voltage)
+            in_range("supply_voltage", self.supply_voltage)
         if self.current_limit is not None:
-            _check("current_limit", self.current_limit)
+            in_range("current_limit", self.current_limit)
         if self.current_limit_model not in _CURRENT_MODELS:
             raise ValueError(f"current_limit_model must be one of {_CURRENT_MODELS}, "
                              f"got {self.current_limit_model!r}")
-        _check("current_loop_time_constant", self.current_loop_time_constant)
+        in_range("current_loop_time_constant", self.current_loop_time_constant)
 
     @property
     def is_linear(self) -> bool:
@@ -322,10 +323,10 @@ def simulate(params: ActuatorParameters, controller: PDController,
         backward difference of the sampled feedback.
     n_out : number of output samples. max_step : integrator's largest step (s).
     """
-    _check("t_final", t_final)
-    _check("max_step", max_step)
+    in_range("t_final", t_final)
+    in_range("max_step", max_step)
     if sample_time is not None:
-        _check("sample_time", sample_time)
+        in_range("sample_time", sample_time)
     hm = SteadyHingeMoment() if hinge_moment is None else hinge_moment
     if not callable(hm):
         raise ValueError("hinge_moment must be a callable hinge_moment(t, theta, omega)")

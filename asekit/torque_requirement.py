@@ -45,7 +45,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from .servo import THESIS_FIN_INERTIA, _check
+from .servo import THESIS_FIN_INERTIA
+from .validate import in_range
 
 #: Sea-level standard atmosphere (ISA / US 1976): density (kg/m^3), speed of sound (m/s).
 SEA_LEVEL_DENSITY = 1.225
@@ -58,9 +59,9 @@ def dynamic_pressure(mach: float, density: float = SEA_LEVEL_DENSITY,
                      speed_of_sound: float = SEA_LEVEL_SPEED_OF_SOUND) -> float:
     """q = 0.5 rho (M a)^2 (Pa) for a Mach number (>= 0), density (kg/m^3, > 0) and speed of
     sound (m/s, > 0)."""
-    mach = _check("mach", mach, inclusive=True)
-    density = _check("density", density)
-    speed_of_sound = _check("speed_of_sound", speed_of_sound)
+    mach = in_range("mach", mach, inclusive=True)
+    density = in_range("density", density)
+    speed_of_sound = in_range("speed_of_sound", speed_of_sound)
     return 0.5 * density * (mach * speed_of_sound) ** 2
 
 
@@ -82,11 +83,11 @@ class SecondOrderProfile:
     position_limit: float = math.radians(15.0)
 
     def __post_init__(self):
-        _check("natural_frequency", self.natural_frequency)
-        _check("damping_ratio", self.damping_ratio)
+        in_range("natural_frequency", self.natural_frequency)
+        in_range("damping_ratio", self.damping_ratio)
         if not (float(self.rate_limit) > 0.0):
             raise ValueError(f"rate_limit must be > 0 (inf allowed), got {self.rate_limit!r}")
-        _check("position_limit", self.position_limit)
+        in_range("position_limit", self.position_limit)
 
     @property
     def peak_acceleration_bound(self) -> float:
@@ -139,8 +140,8 @@ def profile_step(profile: SecondOrderProfile, step: float = math.radians(15.0),
     step = float(step)
     if not math.isfinite(step) or step == 0.0:
         raise ValueError(f"step must be a finite non-zero angle, got {step!r}")
-    _check("t_final", t_final)
-    _check("band", band, high=1.0, high_inclusive=False)
+    in_range("t_final", t_final)
+    in_range("band", band, high=1.0, high_inclusive=False)
     sol = solve_ivp(lambda t, x: profile_rhs(profile, step, x), (0.0, t_final), [0.0, 0.0],
                     method="RK45", rtol=1e-10, atol=1e-12, dense_output=True,
                     max_step=t_final / 2000)
@@ -177,7 +178,7 @@ def tune_rate_limit(natural_frequency: float = 157.0, damping_ratio: float = 1.0
 
     Raises ValueError if even the upper bracket (nearly linear) cannot settle in time.
     """
-    _check("settling_time", settling_time)
+    in_range("settling_time", settling_time)
 
     def excess(rate):
         prof = SecondOrderProfile(natural_frequency, damping_ratio, rate)
@@ -226,10 +227,10 @@ def required_stall_torque(max_acceleration: float, fin_inertia: float = THESIS_F
     safety_factor : >= 1 (thesis: 1.25). round_up_to : the design torque is the factored one
         rounded up to a multiple of this (N m; thesis: 4.74 x 1.25 "taken as 6"); 0 for none.
     """
-    _check("max_acceleration", max_acceleration, inclusive=True)
-    _check("fin_inertia", fin_inertia, inclusive=True)
-    _check("safety_factor", safety_factor, low=1.0, inclusive=True)
-    _check("round_up_to", round_up_to, inclusive=True)
+    in_range("max_acceleration", max_acceleration, inclusive=True)
+    in_range("fin_inertia", fin_inertia, inclusive=True)
+    in_range("safety_factor", safety_factor, low=1.0, inclusive=True)
+    in_range("round_up_to", round_up_to, inclusive=True)
     q = dynamic_pressure(mach, density, speed_of_sound)
     inertial = fin_inertia * max_acceleration
     aero = abs(q * float(q_cc) * theta_max)

@@ -21,7 +21,6 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from matplotlib.ticker import NullLocator
 
 from ..geometry import FinDefinition, load_fin
 from ..plotting import THESIS_COLOR, new_figure

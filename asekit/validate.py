@@ -1,0 +1,47 @@
+"""Argument checks shared by every module: a clear ValueError naming the argument and its valid
+range, never a silent NaN."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def in_range(name: str, value, low: float = 0.0, inclusive: bool = False,
+             high: float = math.inf, high_inclusive: bool = True) -> float:
+    """Return ``float(value)`` if it is finite and within the range, else raise ValueError
+    naming ``name`` and the range (default: ``(0, inf)``)."""
+    value = float(value)
+    lo_ok = value >= low if inclusive else value > low
+    hi_ok = value <= high if high_inclusive else value < high
+    if not math.isfinite(value) or not lo_ok or not hi_ok:
+        lb = "[" if inclusive else "("
+        rb = "]" if high_inclusive and math.isfinite(high) else ")"
+        raise ValueError(f"{name} must be a finite number in {lb}{low:g}, {high:g}{rb}, "
+                         f"got {value!r}")
+    return value
+
+
+def positive(name: str, value) -> float:
+    """``float(value)`` if finite and > 0, else ValueError naming ``name``."""
+    value = float(value)
+    if not math.isfinite(value) or value <= 0.0:
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    return value
+
+
+def finite(name: str, value) -> float:
+    """``float(value)`` if finite, else ValueError naming ``name``."""
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite number, got {value!r}")
+    return value
+
+
+def positive_array(name: str, values) -> np.ndarray:
+    """A non-empty 1-D float array of finite values > 0, else ValueError naming ``name``."""
+    a = np.atleast_1d(np.asarray(values, dtype=float))
+    if a.size == 0 or not np.all(np.isfinite(a)) or np.any(a <= 0):
+        raise ValueError(f"{name} must be finite and > 0, got {values}")
+    return a
