@@ -1,6 +1,5 @@
 """Geometry, thesis table, cache and the reproduce command's plumbing."""
 
-import json
 import math
 
 import numpy as np

@@ -2,7 +2,6 @@
 
 import dataclasses
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -315,7 +314,6 @@ def test_mitc4_passes_the_constant_curvature_patch_test_on_a_distorted_mesh():
     # w = a x^2 + b y^2 + c xy, theta_y = -dw/dx, theta_x = dw/dy on the boundary of a patch of
     # distorted quadrilaterals; without load the interior nodes must reproduce it exactly
     # (MITC4's tied shear strains vanish for this field, Bathe & Dvorkin 1985).
-    from asekit.structure.mesh import PlateMesh
     rng = np.random.default_rng(3)
     mesh0 = rectangular_mesh(0.24, 0.12, 0.001, 4, 3)
     nodes = mesh0.nodes.copy()
