@@ -53,6 +53,7 @@ from typing import Callable
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from . import metrics
 from .servo import ActuatorParameters, PDController
 from .validate import in_range
 from .torque_requirement import (SEA_LEVEL_DENSITY, SEA_LEVEL_SPEED_OF_SOUND, THESIS_Q_CC,
@@ -268,15 +269,9 @@ class SimulationResult:
         """Time (s) after which theta stays within ``band`` x |step| of the ``reference``:
         ``"final"`` (the last simulated value, the usual definition) or ``"command"``.
         The step is command[-1] - theta0. inf if it leaves the band at the end."""
-        step = self.command[-1] - self.theta0
         target = self.theta[-1] if reference == "final" else self.command[-1]
-        outside = np.abs(self.theta - target) > band * abs(step)
-        if outside[-1]:
-            return math.inf
-        if not outside.any():
-            return 0.0
-        i = int(np.nonzero(outside)[0][-1])
-        return float(self.t[i + 1])
+        return metrics.settling_time(self.t, self.theta, target, self.command[-1] - self.theta0,
+                                     band)
 
     @property
     def steady_error(self) -> float:
@@ -296,9 +291,7 @@ class SimulationResult:
     @property
     def overshoot(self) -> float:
         """Largest excursion past the command, as a fraction of |step| (0 if none)."""
-        step = self.command[-1] - self.theta0
-        past = np.sign(step) * (self.theta - self.command[-1])
-        return float(max(0.0, np.max(past)) / abs(step))
+        return metrics.overshoot(self.theta, self.command[-1], self.theta0)
 
 
 def simulate(params: ActuatorParameters, controller: PDController,

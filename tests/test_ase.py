@@ -7,7 +7,7 @@ import control as ct
 import numpy as np
 import pytest
 
-from asekit import ase
+from asekit import ase, metrics
 from asekit.servo import SYSTEM_3, ActuatorParameters, PDController, actuator_transfer_function
 from asekit.servo import margins as servo_margins
 
@@ -108,7 +108,7 @@ def test_thesis_behaviour_aem1_stable_aem2_unstable(fin):
 def test_power_limits_hold_and_bound_the_aem2_oscillation(fin):
     r = ase.simulate_closed_loop(fin.model, SYSTEM_3, math.radians(1.0), "AEM2", t_final=0.15)
     assert np.max(np.abs(r.voltage)) <= 24.0 + 1e-9
-    amp, freq = ase.limit_cycle(r.t, r.fin_root)
+    amp, freq = metrics.limit_cycle(r.t, r.fin_root)
     assert math.isfinite(amp) and amp < math.radians(10.0)      # bounded: a limit cycle
     assert 60.0 < freq < 200.0                                   # near the first elastic mode
 
@@ -117,9 +117,9 @@ def test_spectrum_and_limit_cycle_of_known_signals():
     t = np.linspace(0, 0.5, 20001)
     y = 1.0 + 0.1 * np.sin(2 * np.pi * 90 * t) + 0.05 * np.sin(2 * np.pi * 150 * t)
     y[0] = 0.0                       # starts at rest, reaches 95 % of the command at once
-    f, amp = ase.spectrum_after_rise(t, y, 1.0)
-    assert ase.spectrum_peaks(f, amp, n=2) == pytest.approx([90.0, 150.0], abs=0.5)
-    a, fr = ase.limit_cycle(t, 0.2 * np.sin(2 * np.pi * 92 * t))
+    f, amp = metrics.spectrum_after_rise(t, y, 1.0)
+    assert metrics.spectrum_peaks(f, amp, n=2) == pytest.approx([90.0, 150.0], abs=0.5)
+    a, fr = metrics.limit_cycle(t, 0.2 * np.sin(2 * np.pi * 92 * t))
     assert a == pytest.approx(0.2, rel=1e-3)
     assert fr == pytest.approx(92.0, rel=1e-3)
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import ase
+from .. import ase, metrics
 from ..plotting import THESIS_COLOR, new_figure
 from ..reproduce import ChapterResult, Quantity
 from ..servo import SYSTEM_3, PDController
@@ -88,21 +88,21 @@ def compute(mach: float = 0.5, altitude: float = 0.0,
                           hinge_moment=hm)
     corner_names = [f"theta_{c}" for c in ase.CORNERS]
     gains = ase.static_gains(loops["AEM1"], ["theta", ase.FIN_ROOT] + corner_names)
-    spec1 = ase.spectrum_after_rise(aem1_nl.t, aem1_nl.fin_root, UNIT_STEP)
-    spec2 = ase.spectrum_after_rise(aem2_nl.t, aem2_nl.fin_root, UNIT_STEP)
+    spec1 = metrics.spectrum_after_rise(aem1_nl.t, aem1_nl.fin_root, UNIT_STEP)
+    spec2 = metrics.spectrum_after_rise(aem2_nl.t, aem2_nl.fin_root, UNIT_STEP)
     return AseChapter(
         fin=fin, controller=controller, oploops=oploops, fwtfs=fwtfs, crossovers=cross,
         oploop3_resonances_hz=ase.resonances(oploops[3]), closed_loops=loops,
         aem1_linear=aem1_lin, aem1_nonlinear=aem1_nl, aem1_full=aem1_full,
         aem2_linear=aem2_lin, aem2_nonlinear=aem2_nl, rigid_unit=rigid_unit,
         rigid_full=rigid_full, static_gains=gains, aem1_spectrum=spec1, aem2_spectrum=spec2,
-        aem2_limit_cycle=ase.limit_cycle(aem2_nl.t, aem2_nl.fin_root))
+        aem2_limit_cycle=metrics.limit_cycle(aem2_nl.t, aem2_nl.fin_root))
 
 
 def corner_overshoots(ch: AseChapter) -> dict:
     """Overshoot (fraction) of each corner rotation in the power-limited AEM1 unit step."""
     r = ch.aem1_nonlinear
-    return {c: ase.overshoot(r.outputs[f"theta_{c}"], UNIT_STEP) for c in ase.CORNERS}
+    return {c: metrics.overshoot(r.outputs[f"theta_{c}"], UNIT_STEP) for c in ase.CORNERS}
 
 
 def requirement_table(ch: AseChapter) -> list[tuple[str, str, str, bool]]:
@@ -110,10 +110,10 @@ def requirement_table(ch: AseChapter) -> list[tuple[str, str, str, bool]]:
     (requirement, limit, asekit value, pass)."""
     r = ch.aem1_nonlinear
     rows = []
-    st = ase.settling_time(r.t, r.theta, r.theta[-1], UNIT_STEP)
+    st = metrics.settling_time(r.t, r.theta, r.theta[-1], UNIT_STEP)
     rows.append(("settling time, transmission", "< 50 ms", f"{st * 1e3:.1f} ms",
                  st < SETTLING_REQUIREMENT))
-    st_root = ase.settling_time(r.t, r.fin_root, r.fin_root[-1], UNIT_STEP)
+    st_root = metrics.settling_time(r.t, r.fin_root, r.fin_root[-1], UNIT_STEP)
     rows.append(("settling time, fin root", "< 50 ms", f"{st_root * 1e3:.1f} ms",
                  st_root < SETTLING_REQUIREMENT))
     for name in ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in ase.CORNERS]:
@@ -136,7 +136,7 @@ def quantities(ch: AseChapter) -> tuple[Quantity, ...]:
     r = ch.aem1_nonlinear
     ov = corner_overshoots(ch)
     corner_gain = [ch.static_gains[f"theta_{c}"] for c in ase.CORNERS]
-    peaks1 = ase.spectrum_peaks(*ch.aem1_spectrum, n=2)
+    peaks1 = metrics.spectrum_peaks(*ch.aem1_spectrum, n=2)
     amp, freq = ch.aem2_limit_cycle
     note_struct = "asekit 6x7 MITC4 modes + own DLM, M 0.5 sea level"
     return (
@@ -151,7 +151,7 @@ def quantities(ch: AseChapter) -> tuple[Quantity, ...]:
         Quantity("ase.fwtf3.gain_margin_db", float(c3.gain_margin_db), "dB",
                  "first phase crossover"),
         Quantity("ase.aem1.settling_ms",
-                 1e3 * ase.settling_time(r.t, r.theta, r.theta[-1], UNIT_STEP), "ms",
+                 1e3 * metrics.settling_time(r.t, r.theta, r.theta[-1], UNIT_STEP), "ms",
                  "transmission output, power-limited 1 deg step"),
         Quantity("ase.aem1.corner_overshoot_pct",
                  [100 * min(ov.values()), 100 * max(ov.values())], "%", "min, max of 4 corners"),
@@ -269,7 +269,7 @@ def fig_spectrum(ch: AseChapter, topology: str):
                          "Fig 73" if topology == "AEM1" else "Fig 81")
     sel = f <= 1000
     ax.plot(f[sel], np.degrees(amp[sel]))
-    for p in ase.spectrum_peaks(f, amp, n=2):
+    for p in metrics.spectrum_peaks(f, amp, n=2):
         ax.axvline(p, color=THESIS_COLOR, ls="--", lw=0.8)
         ax.annotate(f"{p:.1f} Hz", (p, ax.get_ylim()[1]), va="top", fontsize=8)
     ax.set_xlabel("frequency (Hz)")
