@@ -80,6 +80,36 @@ def _draw(snap: ServoSnapshot, supply_voltage: float):
     return fig
 
 
+def _pd_sliders(controller: PDController) -> dict:
+    """Sliders for K_c, K_P, K_D starting at ``controller``'s gains (released-value updates)."""
+    import ipywidgets as w
+
+    return {
+        "gain": w.FloatSlider(value=controller.gain, min=0.5, max=30.0, step=0.5,
+                              description="K_c", continuous_update=False),
+        "kp": w.FloatSlider(value=controller.kp, min=10.0, max=600.0, step=5.0,
+                            description="K_P", continuous_update=False),
+        "kd": w.FloatSlider(value=controller.kd, min=0.0, max=3.0, step=0.05,
+                            description="K_D", continuous_update=False),
+    }
+
+
+def _panel(sliders: dict, out, redraw, per_row: int):
+    """Wire ``redraw`` to every slider, lay the sliders out ``per_row`` to a row above the
+    output area, draw once, and return the VBox (with ``.redraw`` and ``.sliders``)."""
+    import ipywidgets as w
+
+    for s in sliders.values():
+        s.observe(redraw, names="value")
+    items = list(sliders.values())
+    rows = [w.HBox(items[i:i + per_row]) for i in range(0, len(items), per_row)]
+    panel = w.VBox(rows + [out])
+    panel.redraw = redraw
+    panel.sliders = sliders
+    redraw()
+    return panel
+
+
 def servo_panel(controller: PDController = SYSTEM_3, supply_voltage: float = 24.0,
                 params: ActuatorParameters | None = None,
                 hinge_moment: SteadyHingeMoment | None = None):
@@ -91,12 +121,7 @@ def servo_panel(controller: PDController = SYSTEM_3, supply_voltage: float = 24.
     import ipywidgets as w
 
     sliders = {
-        "gain": w.FloatSlider(value=controller.gain, min=0.5, max=30.0, step=0.5,
-                              description="K_c", continuous_update=False),
-        "kp": w.FloatSlider(value=controller.kp, min=10.0, max=600.0, step=5.0,
-                            description="K_P", continuous_update=False),
-        "kd": w.FloatSlider(value=controller.kd, min=0.0, max=3.0, step=0.05,
-                            description="K_D", continuous_update=False),
+        **_pd_sliders(controller),
         "supply_voltage": w.FloatSlider(value=supply_voltage, min=6.0, max=60.0, step=1.0,
                                         description="V limit", continuous_update=False),
     }
@@ -111,13 +136,7 @@ def servo_panel(controller: PDController = SYSTEM_3, supply_voltage: float = 24.
             _draw(snap, vals["supply_voltage"])
         return snap
 
-    for s in sliders.values():
-        s.observe(redraw, names="value")
-    panel = w.VBox([w.HBox(list(sliders.values())[:2]), w.HBox(list(sliders.values())[2:]), out])
-    panel.redraw = redraw
-    panel.sliders = sliders
-    redraw()
-    return panel
+    return _panel(sliders, out, redraw, per_row=2)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -208,12 +227,7 @@ def ase_panel(controller: PDController = SYSTEM_3, mach: float = 0.5, altitude: 
     from . import ase
 
     sliders = {
-        "gain": w.FloatSlider(value=controller.gain, min=0.5, max=30.0, step=0.5,
-                              description="K_c", continuous_update=False),
-        "kp": w.FloatSlider(value=controller.kp, min=10.0, max=600.0, step=5.0,
-                            description="K_P", continuous_update=False),
-        "kd": w.FloatSlider(value=controller.kd, min=0.0, max=3.0, step=0.05,
-                            description="K_D", continuous_update=False),
+        **_pd_sliders(controller),
         "mach": w.FloatSlider(value=mach, min=0.4, max=0.75, step=0.05, description="Mach",
                               continuous_update=False),
         "altitude": w.FloatSlider(value=altitude, min=0.0, max=5000.0, step=500.0,
@@ -236,11 +250,4 @@ def ase_panel(controller: PDController = SYSTEM_3, mach: float = 0.5, altitude: 
             _draw_ase(snap)
         return snap
 
-    for s in sliders.values():
-        s.observe(redraw, names="value")
-    items = list(sliders.values())
-    panel = w.VBox([w.HBox(items[:3]), w.HBox(items[3:]), out])
-    panel.redraw = redraw
-    panel.sliders = sliders
-    redraw()
-    return panel
+    return _panel(sliders, out, redraw, per_row=3)
