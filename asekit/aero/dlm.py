@@ -152,8 +152,11 @@ def _line_integrals(ybar, zbar, e, planar, power, m_max):
         f_np = np.arctan2(2.0 * e * az, ybar * ybar + z2 - e * e) / np.where(planar, 1.0, az)
         f_pl = 2.0 * e / (ybar * ybar - e * e)
         j = [np.where(planar, f_pl, f_np), 0.5 * np.log(db / da)]
+        pa, pb = ta, tb                                         # t^(n-1) at both ends
         for n in range(2, m_max + 1):
-            j.append((tb ** (n - 1) - ta ** (n - 1)) / (n - 1) - z2 * j[n - 2])
+            if n > 2:
+                pa, pb = pa * ta, pb * tb
+            j.append((pb - pa) / (n - 1) - z2 * j[n - 2])
         if power == 1:
             base = j
         else:
@@ -162,13 +165,22 @@ def _line_integrals(ybar, zbar, e, planar, power, m_max):
             for n in range(2, m_max + 1):
                 lst.append(j[n - 2] - z2 * lst[n - 2])
             base = lst
+    ypow = _powers(ybar, m_max)
     out = []
     for m in range(m_max + 1):
         acc = np.zeros_like(ybar)
         for jj in range(m + 1):
-            acc = acc + math.comb(m, jj) * ybar ** (m - jj) * base[jj]
+            acc = acc + math.comb(m, jj) * ypow[m - jj] * base[jj]
         out.append(acc)
     return out
+
+
+def _powers(x, m_max):
+    """[1, x, x^2, ..., x^m_max] by repeated multiplication."""
+    out = [np.ones_like(x), x]
+    for _ in range(2, m_max + 1):
+        out.append(out[-1] * x)
+    return out[:m_max + 1]
 
 
 def _far_weights(ybar, zbar, e, chord, stations, power):
@@ -182,7 +194,7 @@ def _far_weights(ybar, zbar, e, chord, stations, power):
     vinv = np.linalg.inv(np.vander(stations, ns, increasing=True))
     lag = np.vander(xg, ns, increasing=True) @ vinv
     # e / r1^(2 power) at the Gauss points (n_gauss, ...), then W_j = sum_g wg lag[g, j] (...)_g
-    r2 = ybar[None] - xg.reshape((-1,) + (1,) * ybar.ndim) * e[None]
+    r2 = ybar[None] - xg.reshape((-1,) + (1,) * ybar.ndim) * e[None]   # e may broadcast
     r2 *= r2
     r2 += zbar * zbar
     if power == 2:
@@ -196,21 +208,24 @@ def _far_weights(ybar, zbar, e, chord, stations, power):
 
 def _weights(ybar, zbar, e, chord, stations, planar, power):
     """Quadrature weights W_j (n_stations arrays) of [module docstring]: the exact integral of the
-    interpolating polynomial of the numerator through the stations, times dx / (8 pi)."""
+    interpolating polynomial of the numerator through the stations, times dx / (8 pi).
+    ``e`` and ``chord`` may be per-sender rows (1, n_senders) that broadcast against ybar."""
     ns = stations.size
     dist2 = np.maximum(np.abs(ybar) - e, 0.0) ** 2 + zbar * zbar
     near = np.nonzero(dist2 <= (_FAR * e) ** 2)
     w = _far_weights(ybar, zbar, e, chord, stations, power)
     if near[0].size:
         vinv = np.linalg.inv(np.vander(stations, ns, increasing=True))   # a_m = vinv[m, j] P_j
-        yb, zb, en = ybar[near], zbar[near], e[near]
+        yb, zb = ybar[near], zbar[near]
+        en = np.broadcast_to(e, ybar.shape)[near]
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             closed = _line_integrals(yb, zb, en, planar[near], power, ns - 1)
-            fac = chord[near] / (8.0 * np.pi)
+            fac = np.broadcast_to(chord, ybar.shape)[near] / (8.0 * np.pi)
+            epow = _powers(en, ns - 1)
             for jst in range(ns):
                 acc = np.zeros_like(yb)
                 for m in range(ns):
-                    acc = acc + vinv[m, jst] * closed[m] / en ** m
+                    acc = acc + vinv[m, jst] * closed[m] / epow[m]
                 w[jst][near] = fac * acc
     return w
 
@@ -528,6 +543,26 @@ class _StationPoints:
         self.r_yz, self.r_class = _classes(mesh.control_point[:, 1:])
 
 
+def _planar_weights(mesh: BoxMesh, snd: _Senders, rows: slice, stations) -> list:
+    """T1 W1_j (one (rows, n_senders) array per station) of all-planar pairs: the weights of
+    :func:`_weights` times T1 = cos(gamma_s - gamma_r) ([R71] Eq. 5)."""
+    pr = mesh.control_point[rows]
+    cg, sg = np.cos(snd.gamma), np.sin(snd.gamma)
+    dy = np.subtract.outer(pr[:, 1], snd.mid[:, 1])
+    dz = np.subtract.outer(pr[:, 2], snd.mid[:, 2])
+    ybar = dy * cg                                              # [R71] Eq. 4 (local axes)
+    ybar += dz * sg
+    zbar = dz * cg
+    zbar -= dy * sg
+    w1 = _weights(ybar, zbar, snd.e[None, :], snd.chord[None, :], stations,
+                  np.ones(ybar.shape, bool), 1)
+    gsr = snd.gamma[None, :] - mesh.dihedral[rows][:, None]
+    if np.any(gsr):
+        t1 = np.cos(gsr)
+        w1 = [t1 * w for w in w1]
+    return w1
+
+
 class _PlanarChunk:
     """k-independent data of a row chunk of an all-planar mesh at one Mach.
 
@@ -538,29 +573,13 @@ class _PlanarChunk:
     K10 = -1 - x0 / R (the steady part of P1 that the incremental kernel subtracts, Eq. 27b).
     """
 
-    def __init__(self, mesh: BoxMesh, snd: _Senders, pts: _StationPoints, rows: slice,
-                 mach: float, method: str):
-        stations, _, _ = _METHODS[method]
+    def __init__(self, mesh: BoxMesh, pts: _StationPoints, rows: slice, mach: float,
+                 t1w: list):
         beta2 = 1.0 - mach * mach
         pr = mesh.control_point[rows]
-        gr = mesh.dihedral[rows]
-        # pair geometry for the integration weights, [R71] Eq. 4 (sender's local axes)
-        cg, sg = np.cos(snd.gamma), np.sin(snd.gamma)
-        dy = np.subtract.outer(pr[:, 1], snd.mid[:, 1])
-        dz = np.subtract.outer(pr[:, 2], snd.mid[:, 2])
-        ybar = dy * cg
-        ybar += dz * sg
-        zbar = dz * cg
-        zbar -= dy * sg
-        e = np.broadcast_to(snd.e[None, :], ybar.shape)
-        chord = np.broadcast_to(snd.chord[None, :], ybar.shape)
-        w1 = _weights(ybar, zbar, e, chord, stations, np.ones(ybar.shape, bool), 1)
-        gsr = snd.gamma[None, :] - gr[:, None]
-        if np.any(gsr):                                         # T1 = cos(gamma_s - gamma_r)
-            t1 = np.cos(gsr)                                    # [R71] Eq. 5
-            w1 = [t1 * w for w in w1]
-        self.t1w = w1
+        self.t1w = t1w
         self.index = pts.index
+        shape = t1w[0].shape
         # kernel geometry per distinct station point
         x0 = np.subtract.outer(pr[:, 0], pts.xyz[:, 0])         # xbar - eta tan(Lambda)
         r1sq = np.subtract.outer(pr[:, 1], pts.xyz[:, 1])
@@ -588,7 +607,7 @@ class _PlanarChunk:
         k10 = np.divide(x0, big_r)
         k10 += 1.0
         np.negative(k10, out=k10)
-        self.k10_sum = np.zeros(ybar.shape)
+        self.k10_sum = np.zeros(shape)
         for j, w in enumerate(self.t1w):
             self.k10_sum += np.take(k10, pts.index[:, j], axis=1) * w
         sq = np.multiply(u1, u1, out=k10)
@@ -748,14 +767,24 @@ def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str
         rows = max(1, min(n, PLANAR_POINTS_PER_CHUNK // nq,
                           int(CHUNK_BYTES // (8 * (16 * nq + (stations.size + 6) * ns)))))
         _, p_n, a_n = _METHODS[method]
+        # the weights (per pair) in blocks of several point chunks
+        block = rows * max(1, PAIRS_PER_CHUNK // (ns * rows))
+        for i0 in range(0, n, block):
+            bl = slice(i0, min(n, i0 + block))
+            t1w = _planar_weights(mesh, snd, bl, stations)
+            for j0 in range(bl.start, bl.stop, rows):
+                sl = slice(j0, min(bl.stop, j0 + rows))
+                sub = slice(sl.start - i0, sl.stop - i0)
+                geo = _PlanarChunk(mesh, pts, sl, mach, [w[sub] for w in t1w])
+                for ik in np.flatnonzero(nonzero):
+                    out[ik, sl] += _fold(_planar_increment(geo, ks[ik] / b, p_n, a_n), n,
+                                         snd.n_images)
+            if progress is not None:
+                progress(bl.stop, n)
+        return out
     for i0 in range(0, n, rows):
         sl = slice(i0, min(n, i0 + rows))
-        if pts is not None:
-            geo = _PlanarChunk(mesh, snd, pts, sl, mach, method)
-            for ik in np.flatnonzero(nonzero):
-                out[ik, sl] += _fold(_planar_increment(geo, ks[ik] / b, p_n, a_n), n,
-                                     snd.n_images)
-        elif np.any(nonzero):
+        if np.any(nonzero):
             geo = _ChunkGeometry(mesh, snd, sl, mach, method)
             for ik in np.flatnonzero(nonzero):
                 out[ik, sl] += _fold(_increment(geo, mach, ks[ik] / b, method), n, snd.n_images)

@@ -45,41 +45,63 @@ def _senders(mesh: BoxMesh, symmetric: bool):
     return (mesh, mesh.mirrored()) if symmetric else (mesh,)
 
 
-def _horseshoe_normalwash(p: np.ndarray, n_r: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Normal velocity at points ``p`` (m, 3) along normals ``n_r`` (m, 3) induced by unit-strength
-    horseshoe vortices ``inf -> a -> b -> inf`` (a, b: (s, 3), legs along +x). Returns (m, s).
+def _distinct_vertices(a: np.ndarray, b: np.ndarray):
+    """The distinct corners of the horseshoes ``a -> b`` (spanwise neighbours share one: b of
+    a box is a of the next) and the index of each box's a and b among them. Corners closer
+    than 1e-13 of the mesh size are one (they differ by rounding only)."""
+    ab = np.concatenate([a, b])
+    scale = 1e-13 * max(float(np.abs(ab).max()), 1e-300)
+    keys = np.round(ab / scale).astype(np.int64)
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    return ab[first], inverse[:a.shape[0]], inverse[a.shape[0]:]
 
+
+def _horseshoe_normalwash(p: np.ndarray, n_r: np.ndarray, v: np.ndarray, ia: np.ndarray,
+                          ib: np.ndarray, scale: float) -> np.ndarray:
+    """Normal velocity at points ``p`` (m, 3) along normals ``n_r`` (m, 3) induced by unit-strength
+    horseshoe vortices ``inf -> a -> b -> inf`` with a = v[ia], b = v[ib] (legs along +x;
+    v (q, 3) the distinct corners, ``scale`` the longest bound vortex). Returns (m, s).
+
+    The trailing legs and the distances are evaluated once per corner and gathered per box.
     Points on a vortex line (the singular limit) receive zero from that segment, the usual
     VLM convention; control points never lie on their own box's vortices.
     """
-    col = lambda v: v[:, None]  # noqa: E731
-    r1x, r1y, r1z = (col(p[:, i]) - a[None, :, i] for i in range(3))
-    r2x, r2y, r2z = (col(p[:, i]) - b[None, :, i] for i in range(3))
-    r0 = b - a
-    ny, nz = col(n_r[:, 1]), col(n_r[:, 2])
-    scale = float(np.max(np.linalg.norm(r0, axis=1)))
     eps = (1e-10 * scale) ** 2
-    n1 = np.sqrt(r1x * r1x + r1y * r1y + r1z * r1z)
-    n2 = np.sqrt(r2x * r2x + r2y * r2y + r2z * r2z)
+    rx = np.subtract.outer(p[:, 0], v[:, 0])
+    ry = np.subtract.outer(p[:, 1], v[:, 1])
+    rz = np.subtract.outer(p[:, 2], v[:, 2])
+    ny, nz = n_r[:, 1:2], n_r[:, 2:3]
+    d2 = ry * ry
+    d2 += rz * rz
+    nrm = rx * rx
+    nrm += d2
+    np.sqrt(nrm, out=nrm)
+    nrm[nrm == 0.0] = 1.0            # only where r = 0, then every term below is masked
+    # semi-infinite leg from a corner q to +inf: (x_hat x r)/|x_hat x r|^2 (1 + r_x/|r|),
+    # x_hat x r = (0, -r_z, r_y); zero on the leg's line
+    leg = rx / nrm
+    leg += 1.0
+    okl = d2 > eps
+    leg /= np.where(okl, d2, 1.0)
+    leg *= ry * nz - rz * ny
+    leg[~okl] = 0.0
+    take = lambda arr, idx: np.take(arr, idx, axis=1)  # noqa: E731
+    r1x, r1y, r1z, n1 = (take(q, ia) for q in (rx, ry, rz, nrm))
+    r2x, r2y, r2z, n2 = (take(q, ib) for q in (rx, ry, rz, nrm))
+    r0 = v[ib] - v[ia]
     # bound segment a -> b, Katz & Plotkin Eq. (10.115): (r1 x r2)/|r1 x r2|^2 r0.(r1/|r1| - r2/|r2|)
     cx = r1y * r2z - r1z * r2y
     cy = r1z * r2x - r1x * r2z
     cz = r1x * r2y - r1y * r2x
     c2 = cx * cx + cy * cy + cz * cz
-    ok = (c2 > eps) & (n1 > 0) & (n2 > 0)
-    n1s = np.where(n1 > 0, n1, 1.0)
-    n2s = np.where(n2 > 0, n2, 1.0)
-    fac = ((r0[None, :, 0] * r1x + r0[None, :, 1] * r1y + r0[None, :, 2] * r1z) / n1s
-           - (r0[None, :, 0] * r2x + r0[None, :, 1] * r2y + r0[None, :, 2] * r2z) / n2s)
+    ok = c2 > eps
+    fac = ((r0[None, :, 0] * r1x + r0[None, :, 1] * r1y + r0[None, :, 2] * r1z) / n1
+           - (r0[None, :, 0] * r2x + r0[None, :, 1] * r2y + r0[None, :, 2] * r2z) / n2)
     fac = np.where(ok, fac / np.where(ok, c2, 1.0), 0.0)
     w = fac * (cy * ny + cz * nz)
-    # semi-infinite legs along x: from b to +inf (+Gamma) and from +inf to a (-Gamma); a leg
-    # from q to +inf induces (x_hat x r)/|x_hat x r|^2 (1 + r_x/|r|), x_hat x r = (0, -r_z, r_y)
-    for rx, ry, rz, nr, sign in ((r2x, r2y, r2z, n2s, 1.0), (r1x, r1y, r1z, n1s, -1.0)):
-        d2 = ry * ry + rz * rz
-        okl = d2 > eps
-        f = np.where(okl, (1.0 + rx / nr) / np.where(okl, d2, 1.0), 0.0)
-        w += sign * f * (ry * nz - rz * ny)
+    w += take(leg, ib)               # leg b -> +inf (+Gamma)
+    w -= take(leg, ia)               # leg +inf -> a (-Gamma)
     w *= 1.0 / (4.0 * np.pi)
     return w
 
@@ -108,10 +130,12 @@ def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False) -
     for img in _senders(mesh, symmetric):
         a = img.doublet_p1 * sx
         b = img.doublet_p3 * sx
+        scale = float(np.max(np.linalg.norm(b - a, axis=1)))
+        v, ia, ib = _distinct_vertices(a, b)
         half_chord = 0.5 * img.chord
         for i0 in range(0, mesh.n, rows):
             sl = slice(i0, min(mesh.n, i0 + rows))
-            d[sl] += _horseshoe_normalwash(p[sl], n_r[sl], a, b) * half_chord[None, :]
+            d[sl] += _horseshoe_normalwash(p[sl], n_r[sl], v, ia, ib, scale) * half_chord[None, :]
     return d
 
 
