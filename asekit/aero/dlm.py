@@ -92,6 +92,8 @@ _GAUSS = np.polynomial.legendre.leggauss(6)
 PAIRS_PER_CHUNK = 32768
 #: (Receiver, station point) pairs per row chunk of the planar path (:class:`_PlanarChunk`).
 PLANAR_POINTS_PER_CHUNK = 32768
+#: Largest table of planar weights per (receiver group, sender group) (:class:`_PlanarWeights`).
+PLANAR_WEIGHT_TABLE_BYTES = 64 * 2**20
 
 
 def check_k(k) -> np.ndarray:
@@ -563,6 +565,47 @@ def _planar_weights(mesh: BoxMesh, snd: _Senders, rows: slice, stations) -> list
     return w1
 
 
+class _PlanarWeights:
+    """T1 W1_j of all-planar pairs from a table over (receiver group, sender group).
+
+    W1_j / dx_s depends on ybar, zbar and e only, and T1 on the two dihedrals: receivers with
+    equal (y, z, gamma) and senders with equal (y, z, e, gamma) -- the boxes of one strip --
+    share them. The table (n_stations, receiver groups, sender groups) is computed once per
+    call (the weights do not depend on Mach or k) and expanded per row chunk. If it would
+    exceed ``max_bytes`` (meshes without strips), the weights are computed per row block by
+    :func:`_planar_weights` instead.
+    """
+
+    def __init__(self, mesh: BoxMesh, snd: _Senders, stations: np.ndarray, max_bytes: int):
+        self.mesh, self.snd, self.stations = mesh, snd, stations
+        r_uniq, self.r_group = _classes(np.column_stack([mesh.control_point[:, 1:],
+                                                         mesh.dihedral]))
+        s_uniq, self.s_group = _classes(np.column_stack([snd.mid[:, 1:], snd.e, snd.gamma]))
+        self.table = None
+        if 8 * stations.size * r_uniq.shape[0] * s_uniq.shape[0] > max_bytes:
+            return
+        ry, rz, rgam = r_uniq.T
+        sy, sz, se, sgam = s_uniq.T
+        cg, sg = np.cos(sgam), np.sin(sgam)
+        dy = np.subtract.outer(ry, sy)
+        dz = np.subtract.outer(rz, sz)
+        ybar = dy * cg                                          # [R71] Eq. 4 (local axes)
+        ybar += dz * sg
+        zbar = dz * cg
+        zbar -= dy * sg
+        w1 = _weights(ybar, zbar, se[None, :], np.ones((1, se.size)), stations,
+                      np.ones(ybar.shape, bool), 1)
+        t1 = np.cos(sgam[None, :] - rgam[:, None])              # [R71] Eq. 5
+        self.table = [w * t1 for w in w1]
+
+    def rows(self, rows: slice) -> list:
+        """T1 W1_j for receivers ``rows``: one (rows, n_senders) array per station."""
+        if self.table is None:
+            return _planar_weights(self.mesh, self.snd, rows, self.stations)
+        rg = self.r_group[rows]
+        return [np.take(tab[rg], self.s_group, axis=1) * self.snd.chord for tab in self.table]
+
+
 class _PlanarChunk:
     """k-independent data of a row chunk of an all-planar mesh at one Mach.
 
@@ -763,6 +806,7 @@ def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str
         # distinct station points; the chunk holds ~12 real arrays per (row, point) and
         # ~stations + 4 per (row, sender)
         pts = _StationPoints(mesh, snd, stations)
+        weights = _PlanarWeights(mesh, snd, stations, PLANAR_WEIGHT_TABLE_BYTES)
         nq = pts.xyz.shape[0]
         rows = max(1, min(n, PLANAR_POINTS_PER_CHUNK // nq,
                           int(CHUNK_BYTES // (8 * (16 * nq + (stations.size + 6) * ns)))))
@@ -771,7 +815,7 @@ def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str
         block = rows * max(1, PAIRS_PER_CHUNK // (ns * rows))
         for i0 in range(0, n, block):
             bl = slice(i0, min(n, i0 + block))
-            t1w = _planar_weights(mesh, snd, bl, stations)
+            t1w = weights.rows(bl)
             for j0 in range(bl.start, bl.stop, rows):
                 sl = slice(j0, min(bl.stop, j0 + rows))
                 sub = slice(sl.start - i0, sl.stop - i0)
