@@ -57,6 +57,14 @@ DeltaCp = AIC (w/U). A flat plate at incidence alpha has w/U = -alpha and a posi
 Planar pairs (|zbar| <= 0.001 e, the threshold of [R71] and NASTRAN) use zbar = 0 in the
 integrals and have no nonplanar part; the limit r1 -> 0 of the kernel is taken explicitly
 ([R71]: K1 -> -2, K2 -> 4 downstream, 0 upstream).
+
+All-planar meshes (every pair planar: one flat surface such as the fin, with or without its
+image) take a cheaper path with the same equations: D2 is skipped; the planar kernel depends
+on the receiver and the station point only, so it is evaluated once per distinct station
+(spanwise neighbours share their end stations) and gathered per sender; the weights, which
+depend on ybar, zbar and e only, come from a table over (receiver strip, sender strip); and
+Re I1(0) of Eq. A.5, a function of r1 only, from a table over the (y, z) groups. The result
+equals the pairwise path to rounding (tests/test_dlm.py).
 """
 
 from __future__ import annotations

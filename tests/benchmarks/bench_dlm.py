@@ -2,30 +2,42 @@
 
 Run on demand (not collected by pytest):
 
-    python tests/benchmarks/bench_dlm.py [--sizes 300 1200 3000] [--method quartic]
-                                         [--skip-panelaero-above 1200] [--no-sweep]
+    python tests/benchmarks/bench_dlm.py [--sizes 300 1200 3000] [--method quartic parabolic]
+                                         [--skip-panelaero-above 1200] [--no-sweep] [--repeat 3]
 
 For each grid (a swept, tapered wing of about 1 m chord: PanelAero's VLM uses an absolute
 1e-5 tolerance and loses bound vortices on millimetre-sized boxes, so the fin itself is not
 used here) it times the normalwash matrix D(M, k) = VLM + DLM increment at one (M 0.6, k 0.5)
 and over a 12-k sweep, with the same kernel order in both codes, and prints the wall-clock
-times (one untraced run each), their ratio and the peak memory of each call (a second,
+times (best of ``--repeat`` untraced runs for a single (M, k), one run for a sweep), their ratio and the peak memory of each call (a second,
 traced run: tracemalloc sees numpy's allocations). Matrix inversion is excluded from both (it is
 the same LAPACK call). PanelAero's sweep is 12 single calls (it has no geometry reuse). Above
 ``--skip-panelaero-above`` boxes PanelAero is not run (it needs about 5 GB at 3000 boxes).
 
-Measured on the 2-core project machine, shared with other jobs (load ~2, so +-30 %), M 0.6,
-asekit vs PanelAero 2025.8, same kernel order:
-  300 boxes, quartic: single 0.07 s vs 0.26 s (4x), 12-k sweep 0.53 s vs 4.6 s (9x), 25 vs 50 MB;
-  1200 boxes, quartic: single 0.85 s vs 7.6 s (9x), 12-k sweep 5.7 s vs 80 s (14x),
-      peak 56 MB vs 801 MB; parabolic: single 0.56 s vs 4.1 s (7x), 49 vs 641 MB;
-  3000 boxes, quartic: single 5.7 s, peak 231 MB (PanelAero not run: its 1200-box peak of
-      0.8 GB scales to about 5 GB).
-The single-(M, k) cost splits about evenly between the k-independent geometry (kernel
-stations, integration weights, vortex lattice) and the kernel itself; a sweep pays the geometry
-once per Mach. The 10x single-call goal is nearly met (9x quartic, 7x parabolic); the sweep
-exceeds it.
-Agreement of D between the two: 5e-14 (single) to 1.2e-13 (sweep), relative to max |D|.
+Measured on the 2-core project machine (shared, load ~1), M 0.6, best of 3 runs per single
+case, asekit vs PanelAero 2025.8 with the same kernel order:
+
+    kernel     boxes  case        asekit s  PanelAero s  ratio  asekit MB  PanelAero MB
+    quartic      300  single          0.04         0.25    6.8          9            50
+    quartic      300  12-k sweep      0.22         2.64   11.8         24             -
+    quartic     1200  single          0.45         5.86   13.0         40           801
+    quartic     1200  12-k sweep      3.26        64.9    19.9        281             -
+    quartic     3000  single          3.03            -      -        213             -
+    quartic     3000  12-k sweep     26.0             -      -       1724             -
+    parabolic    300  single          0.02         0.13    7.0          8            40
+    parabolic    300  12-k sweep      0.11         1.59   14.0         23             -
+    parabolic   1200  single          0.28         3.48   12.6         39           641
+    parabolic   1200  12-k sweep      1.74        41.0    23.5        281             -
+    parabolic   3000  single          1.66            -      -        213             -
+    parabolic   3000  12-k sweep     14.4             -      -       1723             -
+
+(PanelAero is not run at 3000 boxes: its 1200-box peak of 0.8 GB scales to about 5 GB. The
+sweep peaks are dominated by the 12 returned matrices, 12 x 3000^2 x 16 B = 1.7 GB; one 3000-box
+matrix needs 213 MB in all.) Before the planar path of asekit.aero.dlm (same script, same day):
+quartic 1200 single 0.75 s (7.8x), parabolic 0.45 s (7.7x), quartic 3000 single 4.3 s. The
+bench grid is one flat wing, so it takes the all-planar path; nonplanar meshes use the pairwise
+path (about the old speed). Agreement of D between the two codes: 5e-14 (single) to 1.2e-13
+(sweep), relative to max |D|.
 
 Issue target: asekit >= 10x faster than PanelAero per (M, k) at 1200 boxes, the sweep faster
 still; a 3000-box AIC in under about 2 GB.
@@ -60,11 +72,15 @@ def grid(n_boxes: int):
     return mesh_surfaces(TrapezoidSurface((0, 0, 0), 1.0, (0.6, 3.0, 0.0), 0.5, nc, ns, "wing"))
 
 
-def measure(fn, memory: bool = True):
-    """(result, seconds of an untraced run, peak MB of a second traced run or nan)."""
-    t0 = time.perf_counter()
-    out = fn()
-    dt = time.perf_counter() - t0
+def measure(fn, memory: bool = True, repeat: int = 1):
+    """(result, best seconds of ``repeat`` untraced runs, peak MB of a further traced run or
+    nan)."""
+    dt = float("inf")
+    for _ in range(repeat):
+        out = None
+        t0 = time.perf_counter()
+        out = fn()
+        dt = min(dt, time.perf_counter() - t0)
     peak = float("nan")
     if memory:
         del out
@@ -86,33 +102,40 @@ def panelaero_d(mesh, ks, method):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sizes", type=int, nargs="+", default=[300, 1200, 3000])
-    ap.add_argument("--method", choices=["parabolic", "quartic"], default="quartic")
+    ap.add_argument("--method", choices=["parabolic", "quartic"], nargs="+", default=["quartic"])
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="untraced runs of each single-(M, k) case, best taken (sweeps: 1)")
     ap.add_argument("--skip-panelaero-above", type=int, default=1200)
     ap.add_argument("--no-sweep", action="store_true")
     args = ap.parse_args(argv)
-    print(f"DLM benchmark, M {MACH}, kernel '{args.method}', numpy {np.__version__}, "
-          f"{os.cpu_count()} CPUs")
-    head = (f"{'boxes':>6s} {'case':>10s} {'asekit s':>9s} {'PanelAero s':>12s} {'ratio':>7s} "
-            f"{'asekit MB':>10s} {'PanelAero MB':>13s} {'max |dD|/|D|':>13s}")
+    print(f"DLM benchmark, M {MACH}, numpy {np.__version__}, {os.cpu_count()} CPUs, "
+          f"best of {args.repeat} runs per single case")
+    head = (f"{'kernel':>9s} {'boxes':>6s} {'case':>10s} {'asekit s':>9s} {'PanelAero s':>12s} "
+            f"{'ratio':>7s} {'asekit MB':>10s} {'PanelAero MB':>13s} {'max |dD|/|D|':>13s}")
     print(head)
     print("-" * len(head))
-    for n in args.sizes:
-        mesh = grid(n)
-        cases = [("single", [K_SINGLE])] + ([] if args.no_sweep else [("12-k sweep", list(K_SWEEP))])
-        for name, ks in cases:
-            d_a, t_a, m_a = measure(lambda: normalwash_matrices(mesh, MACH, ks, B_REF, args.method))
-            if mesh.n <= args.skip_panelaero_above:
-                # PanelAero's sweep memory is its single-call memory plus the stored results
-                d_p, t_p, m_p = measure(lambda: panelaero_d(mesh, ks, args.method),
-                                        memory=(name == "single"))
-                err = max(np.abs(a - p).max() / np.abs(a).max() for a, p in zip(d_a, d_p))
-                print(f"{mesh.n:6d} {name:>10s} {t_a:9.2f} {t_p:12.2f} {t_p / t_a:7.1f} "
-                      f"{m_a:10.0f} {m_p:13.0f} {err:13.1e}")
-                del d_p
-            else:
-                print(f"{mesh.n:6d} {name:>10s} {t_a:9.2f} {'-':>12s} {'-':>7s} {m_a:10.0f} "
-                      f"{'-':>13s} {'-':>13s}")
-            del d_a
+    normalwash_matrices(grid(300), MACH, [K_SINGLE], B_REF)          # warm-up
+    for method in args.method:
+        for n in args.sizes:
+            mesh = grid(n)
+            cases = [("single", [K_SINGLE])] + ([] if args.no_sweep else
+                                                 [("12-k sweep", list(K_SWEEP))])
+            for name, ks in cases:
+                rep = args.repeat if name == "single" else 1
+                d_a, t_a, m_a = measure(lambda: normalwash_matrices(mesh, MACH, ks, B_REF, method),
+                                        repeat=rep)
+                if mesh.n <= args.skip_panelaero_above:
+                    # PanelAero's sweep memory is its single-call memory plus the stored results
+                    d_p, t_p, m_p = measure(lambda: panelaero_d(mesh, ks, method),
+                                            memory=(name == "single"), repeat=rep)
+                    err = max(np.abs(a - p).max() / np.abs(a).max() for a, p in zip(d_a, d_p))
+                    print(f"{method:>9s} {mesh.n:6d} {name:>10s} {t_a:9.2f} {t_p:12.2f} "
+                          f"{t_p / t_a:7.1f} {m_a:10.0f} {m_p:13.0f} {err:13.1e}", flush=True)
+                    del d_p
+                else:
+                    print(f"{method:>9s} {mesh.n:6d} {name:>10s} {t_a:9.2f} {'-':>12s} {'-':>7s} "
+                          f"{m_a:10.0f} {'-':>13s} {'-':>13s}", flush=True)
+                del d_a
     return 0
 
 
