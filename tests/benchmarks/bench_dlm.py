@@ -9,8 +9,9 @@ For each grid (a swept, tapered wing of about 1 m chord: PanelAero's VLM uses an
 1e-5 tolerance and loses bound vortices on millimetre-sized boxes, so the fin itself is not
 used here) it times the normalwash matrix D(M, k) = VLM + DLM increment at one (M 0.6, k 0.5)
 and over a 12-k sweep, with the same kernel order in both codes, and prints the wall-clock
-times (best of ``--repeat`` untraced runs for a single (M, k), one run for a sweep), their ratio and the peak memory of each call (a second,
-traced run: tracemalloc sees numpy's allocations). Matrix inversion is excluded from both (it is
+times (best of ``--repeat`` untraced runs for a single (M, k), one run for a sweep), their
+ratio and the peak memory of each call (a further, traced run: tracemalloc sees numpy's
+allocations). Matrix inversion is excluded from both (it is
 the same LAPACK call). PanelAero's sweep is 12 single calls (it has no geometry reuse). Above
 ``--skip-panelaero-above`` boxes PanelAero is not run (it needs about 5 GB at 3000 boxes).
 
