@@ -398,11 +398,12 @@ def _integrals(u1, k1, p_n, a_n, need_i2, eku_abs):
         # I2(u) = ((2 + i k1 u) g - u/(1+u^2)^1.5 - i k1 I0 + k1^2 J0) exp(-i k1 u) / 3
         i2 = ((2.0 * g - u / sq ** 3 + k1 * i0i + k1 * k1 * j0r)
               + 1j * (k1 * u * g - k1 * i0r + k1 * k1 * j0i)) * eku_abs / 3.0
-    if any_neg:
-        re1, re2 = _re_at_zero(k1, p_n, a_n, need_i2)
-        i1 = np.where(neg, (2.0 * re1 - i1.real) + 1j * i1.imag, i1)
+    if any_neg:                                   # Re I(u1) = 2 Re I(0) - Re I(|u1|)
+        idx = np.nonzero(neg)
+        re1, re2 = _re_at_zero(k1[idx], p_n, a_n, need_i2)
+        i1.real[idx] = 2.0 * re1 - i1.real[idx]
         if need_i2:
-            i2 = np.where(neg, (2.0 * re2 - i2.real) + 1j * i2.imag, i2)
+            i2.real[idx] = 2.0 * re2 - i2.real[idx]
     return i1, i2
 
 
@@ -474,14 +475,14 @@ def _increment(geo: _ChunkGeometry, mach: float, kd: float, method: str) -> np.n
     out = np.zeros(geo.t1.shape, complex)
     for p, w1, w2 in zip(geo.points, geo.w1, geo.w2 or [None] * len(geo.points)):
         k1 = kd * p["r1"]                                   # [R71] Eq. 12
-        eku_abs = np.exp(-1j * (k1 * np.abs(p["u1"])))
+        eku_abs = _cis_minus(k1 * np.abs(p["u1"]))
         i1, i2 = _integrals(p["u1"], k1, p_n, a_n, geo.nonplanar, eku_abs)
         eku = np.where(p["neg"], eku_abs.conj(), eku_abs)
         # K1 = -I1 - exp(-i k1 u1) M r1 / (R sqrt(1 + u1^2))      [R71] Eq. 7
         k1v = eku * p["c1"]
         k1v += i1
         k1v[p["small"]] = 2.0 * p["down"]                  # r1 -> 0 limit; k1v holds -K1
-        px = np.exp(-1j * (kd * p["x0"]))
+        px = _cis_minus(kd * p["x0"])
         # P1 = -(K1 exp(-i kd x0) - K10) T1                      [R71] Eq. 27b
         k1v *= px
         k1v += p["k10"]
@@ -721,6 +722,15 @@ def _cos_sin(ph: np.ndarray):
     t *= 2.0
     t *= den                                                    # 2 t / (1 + t^2)
     return c, t
+
+
+def _cis_minus(ph: np.ndarray) -> np.ndarray:
+    """exp(-i ph) (complex) via :func:`_cos_sin`; ``ph`` is overwritten."""
+    c, s = _cos_sin(ph)
+    out = np.empty(c.shape, complex)
+    out.real = c
+    np.negative(s, out=out.imag)
+    return out
 
 
 def _planar_increment(geo: _PlanarChunk, kd: float, p_n, a_n) -> np.ndarray:
