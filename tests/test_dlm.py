@@ -139,6 +139,25 @@ def test_planar_path_equals_pairwise_path(monkeypatch, method, case):
             assert np.abs(f - s).max() <= 1e-12 * np.abs(s - slow[0].real).max()
 
 
+@pytest.mark.parametrize("method", ["parabolic", "quartic"])
+@pytest.mark.parametrize("symmetric", [False, True])
+def test_plane_blocks_equal_pairwise_path(monkeypatch, method, symmetric):
+    """Surfaces in several planes: blocks of coplanar receivers and senders take the planar
+    path, the rest the pairwise one; the matrix must be the all-pairwise one to rounding. The
+    second surface is a vertical fin in y = 0, so with the symmetry plane a box and its image
+    share a plane (separate columns of one block)."""
+    m = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0.3, 1.2, 0.0), 0.7, 5, 6, "wing"),
+                       TrapezoidSurface((1.3, 0, 0.05), 0.8, (1.6, 0.0, 0.9), 0.5, 4, 4, "fin")])
+    assert len(dlm._plane_blocks(m, dlm._Senders(m, symmetric))) == 4   # {wing, fin}^2
+    ks = [0.001, 0.4, 2.5]
+    fast = normalwash_matrices(m, 0.6, ks, 0.5, method, symmetric=symmetric)
+    with monkeypatch.context() as mp:
+        mp.setattr(dlm, "_plane_blocks", lambda *args: None)
+        slow = normalwash_matrices(m, 0.6, ks, 0.5, method, symmetric=symmetric)
+    for f, s in zip(fast, slow):
+        assert np.abs(f - s).max() <= 1e-13 * np.abs(s).max()
+
+
 @pytest.mark.parametrize("geom", ["planar", "nonplanar"])
 def test_symmetry_plane_equals_explicit_image(geom):
     m = _planar() if geom == "planar" else _nonplanar()

@@ -63,8 +63,10 @@ image) take a cheaper path with the same equations: D2 is skipped; the planar ke
 on the receiver and the station point only, so it is evaluated once per distinct station
 (spanwise neighbours share their end stations) and gathered per sender; the weights, which
 depend on ybar, zbar and e only, come from a table over (receiver strip, sender strip); and
-Re I1(0) of Eq. A.5, a function of r1 only, from a table over the (y, z) groups. The result
-equals the pairwise path to rounding (tests/test_dlm.py).
+Re I1(0) of Eq. A.5, a function of r1 only, from a table over the (y, z) groups. Meshes with
+surfaces in several planes are cut into blocks of (receivers in one plane, senders in one
+plane): coplanar blocks take this path, the others the pairwise one. The result equals the
+pairwise path to rounding (tests/test_dlm.py).
 """
 
 from __future__ import annotations
@@ -140,6 +142,23 @@ class _Senders:
         self.gamma = cat(lambda p: p.dihedral)
         self.chord = cat(lambda p: p.chord)
         self.n_images = len(parts)
+
+    def subset(self, idx: np.ndarray) -> "_Senders":
+        """The senders ``idx`` (indices into the concatenated list) as a _Senders."""
+        new = object.__new__(_Senders)
+        for name in ("mid", "e", "tan_sweep", "gamma", "chord"):
+            setattr(new, name, getattr(self, name)[idx])
+        new.n_images = 1
+        return new
+
+
+class _Receivers:
+    """The receiving boxes ``idx`` of a mesh (what the kernel needs of them)."""
+
+    def __init__(self, mesh: BoxMesh, idx: np.ndarray):
+        self.control_point = mesh.control_point[idx]
+        self.dihedral = mesh.dihedral[idx]
+        self.n = idx.size
 
 
 def _line_integrals(ybar, zbar, e, planar, power, m_max):
@@ -808,51 +827,114 @@ def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str
     mach = check_mach(mach)
     ks = check_k(k)
     b = _check_bref(b_ref)
-    stations = _check_method(method)[0]
+    _check_method(method)
     snd = _Senders(mesh, symmetric)
-    n, ns = mesh.n, snd.mid.shape[0]
+    n = mesh.n
     d0 = vlm_normalwash_matrix(mesh, mach, symmetric)
     out = np.empty((ks.size, n, n), complex)
     out[:] = d0[None]
+    ik_nz = np.flatnonzero(ks > 0.0)
+    if ik_nz.size == 0:
+        if progress is not None:
+            progress(n, n)
+        return out
+    kds = ks / b
+
+    def add_all(ik, sl, d1):
+        out[ik, sl] += _fold(d1, n, snd.n_images)
+
+    if _all_planar(mesh, snd):
+        _planar_rows(mesh, snd, mach, method, kds, ik_nz, add_all, progress)
+        return out
+    blocks = _plane_blocks(mesh, snd)
+    if blocks is None:
+        _pairwise_rows(mesh, snd, mach, method, kds, ik_nz, add_all, progress)
+        return out
+    # surfaces in different planes: all-planar blocks (receivers and senders in one plane)
+    # by the planar path, the others pairwise
+    done, total = 0, n * snd.mid.shape[0]
+    for r_idx, s_idx in blocks:
+        rec, sub = _Receivers(mesh, r_idx), snd.subset(s_idx)
+        cols, original = s_idx % n, s_idx < n
+
+        def add_block(ik, sl, d1, r_idx=r_idx, cols=cols, original=original):
+            rows = r_idx[sl]
+            for part in (original, ~original):       # a box and its image: separate columns
+                if part.any():
+                    out[ik][np.ix_(rows, cols[part])] += d1[:, part]
+
+        path = _planar_rows if _all_planar(rec, sub) else _pairwise_rows
+        path(rec, sub, mach, method, kds, ik_nz, add_block, None)
+        done += r_idx.size * s_idx.size
+        if progress is not None:
+            progress(int(round(n * done / total)), n)
+    return out
+
+
+def _plane_blocks(mesh: BoxMesh, snd: _Senders, max_blocks: int = 64):
+    """(receiver indices, sender indices) of the blocks of boxes by plane (|normal . x| and
+    the normal up to sign, to 1e-6), or None for a single plane or more than ``max_blocks``
+    blocks. Only a partition: each block is checked for planarity before the planar path."""
+    scale = float(np.abs(snd.mid).max()) + float(snd.e.max())
+
+    def groups(points, gamma):
+        nrm = np.column_stack([-np.sin(gamma), np.cos(gamma)])      # (y, z) of the normal
+        flip = (nrm[:, 0] < -1e-12) | ((np.abs(nrm[:, 0]) <= 1e-12) & (nrm[:, 1] < 0.0))
+        nrm[flip] *= -1.0
+        offset = nrm[:, 0] * points[:, 1] + nrm[:, 1] * points[:, 2]
+        key = np.round(np.column_stack([nrm / 1e-6, offset / (1e-6 * scale)]))
+        _, inverse = _classes(key.astype(np.int64))
+        return [np.flatnonzero(inverse == g) for g in range(inverse.max() + 1)]
+
+    r_groups = groups(mesh.control_point, mesh.dihedral)
+    s_groups = groups(snd.mid, snd.gamma)
+    if len(r_groups) * len(s_groups) > max_blocks or len(r_groups) * len(s_groups) == 1:
+        return None
+    return [(r, s) for r in r_groups for s in s_groups]
+
+
+def _pairwise_rows(rec, snd: _Senders, mach: float, method: str, kds, ik_nz, add, progress):
+    """D1 + D2 of receivers ``rec`` against senders ``snd`` by row chunks of pairs
+    (:class:`_ChunkGeometry`, :func:`_increment`): ``add(ik, rows, d1)`` per chunk and k."""
+    stations = _METHODS[method][0]
+    n, ns = rec.n, snd.mid.shape[0]
     # bytes per (receiver, sender) pair held by one chunk: geometry (~14 arrays per station,
     # more if nonplanar) + kernel temporaries (~20 complex)
     per_pair = 8 * (stations.size * 22 + 40)
     rows = max(1, min(n, int(CHUNK_BYTES // (ns * per_pair)), PAIRS_PER_CHUNK // ns))
-    nonzero = ks > 0.0
-    pts = None
-    if np.any(nonzero) and _all_planar(mesh, snd):
-        # distinct station points; the chunk holds ~12 real arrays per (row, point) and
-        # ~stations + 4 per (row, sender)
-        pts = _StationPoints(mesh, snd, stations)
-        weights = _PlanarWeights(mesh, snd, stations, PLANAR_WEIGHT_TABLE_BYTES)
-        nq = pts.xyz.shape[0]
-        rows = max(1, min(n, PLANAR_POINTS_PER_CHUNK // nq,
-                          int(CHUNK_BYTES // (8 * (16 * nq + (stations.size + 6) * ns)))))
-        _, p_n, a_n = _METHODS[method]
-        # the weights (per pair) in blocks of several point chunks
-        block = rows * max(1, PAIRS_PER_CHUNK // (ns * rows))
-        for i0 in range(0, n, block):
-            bl = slice(i0, min(n, i0 + block))
-            t1w = weights.rows(bl)
-            for j0 in range(bl.start, bl.stop, rows):
-                sl = slice(j0, min(bl.stop, j0 + rows))
-                sub = slice(sl.start - i0, sl.stop - i0)
-                geo = _PlanarChunk(mesh, pts, sl, mach, [w[sub] for w in t1w])
-                for ik in np.flatnonzero(nonzero):
-                    out[ik, sl] += _fold(_planar_increment(geo, ks[ik] / b, p_n, a_n), n,
-                                         snd.n_images)
-            if progress is not None:
-                progress(bl.stop, n)
-        return out
     for i0 in range(0, n, rows):
         sl = slice(i0, min(n, i0 + rows))
-        if np.any(nonzero):
-            geo = _ChunkGeometry(mesh, snd, sl, mach, method)
-            for ik in np.flatnonzero(nonzero):
-                out[ik, sl] += _fold(_increment(geo, mach, ks[ik] / b, method), n, snd.n_images)
+        geo = _ChunkGeometry(rec, snd, sl, mach, method)
+        for ik in ik_nz:
+            add(ik, sl, _increment(geo, mach, kds[ik], method))
         if progress is not None:
             progress(sl.stop, n)
-    return out
+
+
+def _planar_rows(rec, snd: _Senders, mach: float, method: str, kds, ik_nz, add, progress):
+    """D1 of receivers ``rec`` against senders ``snd``, all pairs planar (module docstring):
+    kernel per distinct station point in row chunks of about PLANAR_POINTS_PER_CHUNK
+    (receiver, point) pairs, weights per block of chunks; ``add(ik, rows, d1)``."""
+    stations, p_n, a_n = _METHODS[method]
+    n, ns = rec.n, snd.mid.shape[0]
+    pts = _StationPoints(rec, snd, stations)
+    weights = _PlanarWeights(rec, snd, stations, PLANAR_WEIGHT_TABLE_BYTES)
+    nq = pts.xyz.shape[0]
+    # the chunk holds ~12 real arrays per (row, point) and ~stations + 4 per (row, sender)
+    rows = max(1, min(n, PLANAR_POINTS_PER_CHUNK // nq,
+                      int(CHUNK_BYTES // (8 * (16 * nq + (stations.size + 6) * ns)))))
+    block = rows * max(1, PAIRS_PER_CHUNK // (ns * rows))
+    for i0 in range(0, n, block):
+        bl = slice(i0, min(n, i0 + block))
+        t1w = weights.rows(bl)
+        for j0 in range(bl.start, bl.stop, rows):
+            sl = slice(j0, min(bl.stop, j0 + rows))
+            sub = slice(sl.start - i0, sl.stop - i0)
+            geo = _PlanarChunk(rec, pts, sl, mach, [w[sub] for w in t1w])
+            for ik in ik_nz:
+                add(ik, sl, _planar_increment(geo, kds[ik], p_n, a_n))
+        if progress is not None:
+            progress(bl.stop, n)
 
 
 def normalwash_matrix(mesh: BoxMesh, mach: float, k: float, b_ref: float,

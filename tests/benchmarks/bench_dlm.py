@@ -67,9 +67,19 @@ K_SWEEP = np.concatenate([[0.001], np.geomspace(0.01, 2.7, 11)])
 GRIDS = {300: (10, 30), 1200: (20, 60), 3000: (30, 100)}
 
 
-def grid(n_boxes: int):
-    nc, ns = GRIDS.get(n_boxes, (max(4, int(round((n_boxes / 3) ** 0.5))),
-                                 max(1, int(round(n_boxes / max(4, int(round((n_boxes / 3) ** 0.5))))))))
+def grid(n_boxes: int, nonplanar: bool = False):
+    """The flat swept wing of about ``n_boxes`` boxes, or (``nonplanar``) three quarters of
+    them on the wing and one quarter on a vertical fin behind it (pairwise DLM path)."""
+    if nonplanar:
+        nc = max(4, int(round((n_boxes / 3) ** 0.5)))
+        ns_w = max(1, int(round(0.75 * n_boxes / nc)))
+        ns_f = max(1, int(round(0.25 * n_boxes / nc)))
+        return mesh_surfaces([
+            TrapezoidSurface((0, 0, 0), 1.0, (0.6, 3.0, 0.0), 0.5, nc, ns_w, "wing"),
+            TrapezoidSurface((1.5, 0, 0.05), 0.8, (1.9, 0.0, 1.0), 0.5, nc, ns_f, "fin")])
+    default = (max(4, int(round((n_boxes / 3) ** 0.5))),
+               max(1, int(round(n_boxes / max(4, int(round((n_boxes / 3) ** 0.5)))))))
+    nc, ns = GRIDS.get(n_boxes, default)
     return mesh_surfaces(TrapezoidSurface((0, 0, 0), 1.0, (0.6, 3.0, 0.0), 0.5, nc, ns, "wing"))
 
 
@@ -108,6 +118,8 @@ def main(argv=None):
                     help="untraced runs of each single-(M, k) case, best taken (sweeps: 1)")
     ap.add_argument("--skip-panelaero-above", type=int, default=1200)
     ap.add_argument("--no-sweep", action="store_true")
+    ap.add_argument("--nonplanar", action="store_true",
+                    help="wing plus vertical fin (the pairwise, nonplanar DLM path)")
     args = ap.parse_args(argv)
     print(f"DLM benchmark, M {MACH}, numpy {np.__version__}, {os.cpu_count()} CPUs, "
           f"best of {args.repeat} runs per single case")
@@ -118,7 +130,7 @@ def main(argv=None):
     normalwash_matrices(grid(300), MACH, [K_SINGLE], B_REF)          # warm-up
     for method in args.method:
         for n in args.sizes:
-            mesh = grid(n)
+            mesh = grid(n, args.nonplanar)
             cases = [("single", [K_SINGLE])] + ([] if args.no_sweep else
                                                  [("12-k sweep", list(K_SWEEP))])
             for name, ks in cases:
