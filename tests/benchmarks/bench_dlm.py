@@ -15,30 +15,34 @@ allocations). Matrix inversion is excluded from both (it is
 the same LAPACK call). PanelAero's sweep is 12 single calls (it has no geometry reuse). Above
 ``--skip-panelaero-above`` boxes PanelAero is not run (it needs about 5 GB at 3000 boxes).
 
-Measured on the 2-core project machine (shared, load ~1), M 0.6, best of 3 runs per single
+Measured on the 2-core project machine (shared, load ~0.6), M 0.6, best of 3 runs per single
 case, asekit vs PanelAero 2025.8 with the same kernel order:
 
     kernel     boxes  case        asekit s  PanelAero s  ratio  asekit MB  PanelAero MB
-    quartic      300  single          0.04         0.25    6.8          9            50
-    quartic      300  12-k sweep      0.22         2.64   11.8         24             -
-    quartic     1200  single          0.45         5.86   13.0         40           801
-    quartic     1200  12-k sweep      3.26        64.9    19.9        281             -
-    quartic     3000  single          3.03            -      -        213             -
-    quartic     3000  12-k sweep     26.0             -      -       1724             -
-    parabolic    300  single          0.02         0.13    7.0          8            40
-    parabolic    300  12-k sweep      0.11         1.59   14.0         23             -
-    parabolic   1200  single          0.28         3.48   12.6         39           641
-    parabolic   1200  12-k sweep      1.74        41.0    23.5        281             -
-    parabolic   3000  single          1.66            -      -        213             -
-    parabolic   3000  12-k sweep     14.4             -      -       1723             -
+    quartic      300  single          0.04         0.26    6.5          9            50
+    quartic      300  12-k sweep      0.23         2.72   12.0         24             -
+    quartic     1200  single          0.45         6.03   13.4         40           801
+    quartic     1200  12-k sweep      3.28        72.5    22.1        281             -
+    quartic     3000  single          2.95            -      -        213             -
+    quartic     3000  12-k sweep     25.9             -      -       1724             -
+    parabolic    300  single          0.02         0.13    7.4          8            40
+    parabolic    300  12-k sweep      0.11         1.59   15.1         23             -
+    parabolic   1200  single          0.27         3.74   14.0         39           641
+    parabolic   1200  12-k sweep      1.73        42.9    24.7        281             -
+    parabolic   3000  single          1.74            -      -        213             -
+    parabolic   3000  12-k sweep     14.8             -      -       1723             -
+    --nonplanar (wing + vertical fin):
+    quartic     1200  single          0.96         6.48    6.7         83           805
+    parabolic   1200  single          0.62         3.71    6.0         65           630
 
 (PanelAero is not run at 3000 boxes: its 1200-box peak of 0.8 GB scales to about 5 GB. The
 sweep peaks are dominated by the 12 returned matrices, 12 x 3000^2 x 16 B = 1.7 GB; one 3000-box
 matrix needs 213 MB in all.) Before the planar path of asekit.aero.dlm (same script, same day):
-quartic 1200 single 0.75 s (7.8x), parabolic 0.45 s (7.7x), quartic 3000 single 4.3 s. The
-bench grid is one flat wing, so it takes the all-planar path; nonplanar meshes use the pairwise
-path (about the old speed). Agreement of D between the two codes: 5e-14 (single) to 1.2e-13
-(sweep), relative to max |D|.
+quartic 1200 single 0.75 s (7.8x), parabolic 0.45 s (7.7x), quartic 3000 single 4.3 s,
+parabolic 2.8 s; wing + fin 1200 quartic 2.0 s, parabolic 1.2 s. The flat wing takes the
+all-planar path; the wing + fin mesh takes it for its coplanar blocks (wing-wing, fin-fin)
+and the pairwise path for the rest. Agreement of D between the two codes: 5e-14 (single) to
+1.2e-13 (sweep), 4.4e-13 with the fin, relative to max |D|.
 
 Issue target: asekit >= 10x faster than PanelAero per (M, k) at 1200 boxes, the sweep faster
 still; a 3000-box AIC in under about 2 GB.
