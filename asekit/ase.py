@@ -44,7 +44,7 @@ from scipy.integrate import solve_ivp
 from .aeroelastic import aeroelastic_matrices, aeroelastic_model
 from .servo import ActuatorParameters, PDController, actuator_state_space
 from .simulate import THESIS_LIMITS, PowerLimits, applied_voltage, controller_voltage, motor_rhs
-from .validate import finite
+from .validate import finite, positive
 
 TOPOLOGIES = ("AEM1", "AEM2")
 #: Name of the aeroelastic output that the AEM2 potentiometer measures.
@@ -424,11 +424,9 @@ def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController,
     if abs(command) > angle_limit + 1e-12:
         raise ValueError(f"command {math.degrees(command):.3g} deg exceeds the angular position "
                          f"limit of {math.degrees(angle_limit):.3g} deg (thesis Table 2)")
-    if not (t_final > 0 and math.isfinite(t_final)):
-        raise ValueError(f"t_final must be a finite number > 0, got {t_final!r}")
-    if sample_time is not None and not (sample_time > 0 and math.isfinite(sample_time)):
-        raise ValueError(f"sample_time must be None or a finite number > 0 (s), got "
-                         f"{sample_time!r}")
+    positive("t_final", t_final)
+    if sample_time is not None:
+        positive("sample_time", sample_time)
     lim = limits if limits is not None else PowerLimits(supply_voltage=None, current_limit=None)
     act = model.actuator
     A, B = model.A, model.B

@@ -31,8 +31,7 @@ from .validate import positive
 def default_lag_roots(k_max: float, n_lags: int = 4) -> np.ndarray:
     """Lag roots spread over the reduced-frequency range, beta_n = 1.7 k_max (n/(N+1))^2
     (Tiffany & Adams, NASA TP-2776, 1988, recommended spacing). Returns (n_lags,) > 0."""
-    if not np.isfinite(k_max) or k_max <= 0:
-        raise ValueError(f"k_max must be a finite number > 0, got {k_max}")
+    positive("k_max", k_max)
     if int(n_lags) < 0:
         raise ValueError(f"n_lags must be >= 0, got {n_lags}")
     n = np.arange(1, int(n_lags) + 1)

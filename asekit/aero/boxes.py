@@ -25,6 +25,8 @@ from functools import cached_property
 
 import numpy as np
 
+from ..validate import positive
+
 
 class MeshRuleWarning(UserWarning):
     """An aerodynamic mesh violates a doublet-lattice guideline (BPW, boxes per chord, AR)."""
@@ -64,10 +66,7 @@ class TrapezoidSurface:
         object.__setattr__(self, "root_le", _finite_point("root_le", self.root_le))
         object.__setattr__(self, "tip_le", _finite_point("tip_le", self.tip_le))
         for nm in ("root_chord", "tip_chord"):
-            v = float(getattr(self, nm))
-            if not math.isfinite(v) or v <= 0.0:
-                raise ValueError(f"{nm} must be a finite number > 0 m, got {v!r}")
-            object.__setattr__(self, nm, v)
+            object.__setattr__(self, nm, positive(nm, getattr(self, nm)))
         for nm in ("n_chord", "n_span"):
             v = getattr(self, nm)
             if int(v) != v or int(v) < 1:
@@ -348,8 +347,7 @@ def check_mesh_rules(mesh: BoxMesh, u_min: float, f_max: float, bpw_min: float =
     warn : emit a :class:`MeshRuleWarning` naming the offending strips / boxes.
     """
     for nm, v in (("u_min", u_min), ("f_max", f_max)):
-        if not math.isfinite(float(v)) or float(v) <= 0:
-            raise ValueError(f"{nm} must be a finite number > 0, got {v!r}")
+        positive(nm, v)
     strips = np.unique(mesh.strip)
     n_strips = int(strips.max()) + 1
     dx_max = np.zeros(n_strips)

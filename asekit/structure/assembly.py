@@ -35,6 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..geometry import Material
+from ..validate import positive
 from .mesh import PlateMesh
 from .plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness
 
@@ -129,8 +130,7 @@ def shaft_region_nodes(mesh: PlateMesh, axis_point, region: str, radius: float) 
     if region == "single_node":
         return np.array([mesh.node_at(p, tol=1e-9 * max(mesh.span, 1.0), name="shaft axis_point")])
     if region == "distributed":
-        if not np.isfinite(radius) or radius <= 0:
-            raise ValueError(f"radius must be a finite number > 0 (m), got {radius!r}")
+        positive("radius", radius)
         d = np.hypot(*(mesh.nodes - p).T)
         nodes = np.flatnonzero(d <= radius * (1 + 1e-9))
         if nodes.size == 0:

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry import LinearThickness, Planform
+from ..validate import positive
 
 
 @dataclass(frozen=True)
@@ -107,7 +108,6 @@ def rectangular_mesh(a: float, b: float, thickness: float, n_x: int, n_y: int) -
     """A uniform ``n_x x n_y`` mesh of the rectangle [0, a] x [0, b] with constant thickness
     (validation plates). Lengths in m."""
     for name, v in (("a", a), ("b", b), ("thickness", thickness)):
-        if not np.isfinite(v) or v <= 0:
-            raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
+        positive(name, v)
     planform = Planform((0.0, 0.0), a, (0.0, b), a)
     return structured_mesh(planform, LinearThickness(thickness, thickness), n_x, n_y)

@@ -25,6 +25,7 @@ import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
 from ..geometry import FinDefinition, load_fin
+from ..validate import positive
 from .assembly import SupportedSystem, assemble, rigid_pitch_vector, shaft_support
 from .mesh import PlateMesh, structured_mesh
 from .plate import shape_functions
@@ -121,8 +122,7 @@ def select_modes(frequencies_hz: np.ndarray, out_of_plane: np.ndarray, f_max_hz:
     share = np.asarray(out_of_plane, float)
     if f.shape != share.shape:
         raise ValueError(f"frequencies_hz {f.shape} and out_of_plane {share.shape} must match")
-    if not np.isfinite(f_max_hz) or f_max_hz <= 0:
-        raise ValueError(f"f_max_hz must be a finite number > 0 (Hz), got {f_max_hz!r}")
+    positive("f_max_hz", f_max_hz)
     if not 0 <= min_out_of_plane <= 1:
         raise ValueError(f"min_out_of_plane must lie in [0, 1], got {min_out_of_plane!r}")
     return (f < f_max_hz) & (np.nan_to_num(share, nan=0.0) >= min_out_of_plane)
@@ -299,8 +299,7 @@ def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None
     ModalModel with n_rigid = 1: M[0, 0] = J_fin, M_ss = I, K = diag(0, omega_s^2), C = 0.
     """
     fin = load_fin() if fin is None else fin
-    if not np.isfinite(f_max_hz) or f_max_hz <= 0:
-        raise ValueError(f"f_max_hz must be a finite number > 0 (Hz), got {f_max_hz!r}")
+    positive("f_max_hz", f_max_hz)
     mesh = fin_mesh(fin, n_chord, n_span)
     K, M = assemble(mesh, fin.material)
     fn2 = fin_supported(fin, mesh, "FN2", shaft, K, M)
@@ -379,8 +378,7 @@ def fin_fn1_modal_model(fin: FinDefinition | None = None, n_chord: int | None = 
     """The thesis's model FN1 (shaft spring to ground, no rigid mode; thesis Sec. 3.1.1, Fig 12)
     as a ModalModel with n_rigid = 0; arguments as :func:`fin_modal_model`."""
     fin = load_fin() if fin is None else fin
-    if not np.isfinite(f_max_hz) or f_max_hz <= 0:
-        raise ValueError(f"f_max_hz must be a finite number > 0 (Hz), got {f_max_hz!r}")
+    positive("f_max_hz", f_max_hz)
     mesh = fin_mesh(fin, n_chord, n_span)
     K, M = assemble(mesh, fin.material)
     fn1 = fin_supported(fin, mesh, "FN1", shaft, K, M)
