@@ -20,19 +20,63 @@
 
 Instabilities: flutter where an oscillatory root crosses to Re(p) > 0, divergence where a real
 (zero-frequency) root does. All interpolated to Re(p) = 0 and refined by a scalar root search.
+A root already unstable at the first airspeed of the sweep is reported as its own result
+(``Instability.at_first_point``: "flutter at or below U0"), never dropped. "Unstable" means
+Re(p) > tol with a tolerance scaled to the roots' magnitude (``crossing_tolerance``), so that
+rounding (Re p = +1e-14 on an undamped structure at U -> 0) is not taken for an instability.
 
 Units: any consistent set (SI for the fin; inch-lbf-s for Nastran's HA145B).
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import linalg, optimize
 
 from .aeroelastic import ModalArrays, aeroelastic_matrices, modal_arrays
-from .validate import positive_array
+from .validate import positive, positive_array
+
+#: relative tolerance of the stability test: a root is unstable when Re p > RTOL_UNSTABLE * scale,
+#: ``scale`` the largest root magnitude of the sweep (rounding of eigenvalues is ~1e-16 of it).
+RTOL_UNSTABLE = 1e-9
+#: largest number of steps / samples a single call may ask for before it is refused.
+MAX_STEPS = 5_000_000
+
+
+class FlutterConvergenceWarning(RuntimeWarning):
+    """The p-k frequency iteration did not converge within ``max_iter`` for some (mode, speed)."""
+
+
+def crossing_tolerance(roots) -> float:
+    """Tolerance of the stability test for a set of roots (any shape, complex, 1/s):
+    ``RTOL_UNSTABLE * max |p|`` over the finite roots (0 if there are none). A root counts as
+    unstable when Re p > tolerance."""
+    r = np.abs(np.asarray(roots))
+    r = r[np.isfinite(r)]
+    return float(RTOL_UNSTABLE * r.max()) if r.size else 0.0
+
+
+def _ascending(name: str, values) -> np.ndarray:
+    """Finite, > 0, strictly ascending 1-D array, else ValueError naming ``name``."""
+    U = positive_array(name, values)
+    if U.ndim != 1:
+        raise ValueError(f"{name} must be a 1-D sequence of airspeeds, got shape {U.shape}")
+    if np.any(np.diff(U) <= 0):
+        raise ValueError(f"{name} must be strictly ascending (no repeats); got {U}. Pass "
+                         f"np.unique({name}) to sort them.")
+    return U
+
+
+def _count(name: str, value, low: int = 1) -> int:
+    """An integer >= low (bool refused), else TypeError/ValueError naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} must be an integer >= {low}, got {value!r}")
+    if value < low:
+        raise ValueError(f"{name} must be an integer >= {low}, got {value}")
+    return int(value)
 
 
 # --------------------------------------------------------------------------------------------
@@ -144,7 +188,13 @@ class PkResult:
 class Instability:
     """A flutter or divergence point: ``kind`` ('flutter' or 'divergence'), tracked ``mode``
     index (0-based among the modes solved), ``speed`` (m/s), ``frequency_hz`` (0 for divergence),
-    ``vector`` (modal eigenvector at the point, if known), ``method``."""
+    ``vector`` (modal eigenvector at the point, if known), ``method``.
+
+    ``at_first_point`` marks the other result kind: the root is already unstable at the first
+    airspeed of the sweep, so the instability is *at or below* ``speed`` (= U0, an upper bound,
+    not a crossing); ``frequency_hz`` is then the frequency at U0. Start the sweep lower to
+    locate it.
+    """
 
     kind: str
     mode: int
@@ -152,6 +202,17 @@ class Instability:
     frequency_hz: float
     vector: np.ndarray | None = field(default=None, repr=False)
     method: str = ""
+    at_first_point: bool = False
+
+    def describe(self, unit: str = "m/s") -> str:
+        """One-line description, e.g. 'flutter at 218.1 m/s, 140.9 Hz (mode 2, p-k)' or
+        'unstable at the first point of the sweep: flutter at or below 250 m/s (mode 2, p-k)'."""
+        where = f"mode {self.mode + 1}" + (f", {self.method}" if self.method else "")
+        if self.at_first_point:
+            return (f"unstable at the first point of the sweep: {self.kind} at or below "
+                    f"{self.speed:.6g} {unit} ({where})")
+        freq = f", {self.frequency_hz:.4g} Hz" if self.kind == "flutter" else ""
+        return f"{self.kind} at {self.speed:.6g} {unit}{freq} ({where})"
 
 
 class _PkProblem:
@@ -245,10 +306,14 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
     :class:`PkResult`
     """
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
-    rho = float(positive_array("density", density)[0])
-    U = positive_array("velocities", velocities)
-    if np.any(np.diff(U) <= 0):
-        raise ValueError("velocities must be strictly ascending")
+    rho = positive("density", density)
+    U = _ascending("velocities", velocities)
+    max_iter = _count("max_iter", max_iter)
+    tol = positive("tol", tol)
+    if interpolation not in ("linear", "cubic"):
+        raise ValueError(f"interpolation must be 'linear' or 'cubic', got {interpolation!r}")
+    if not isinstance(gaf, TabulatedGaf):
+        raise TypeError(f"gaf must be a TabulatedGaf, got {type(gaf).__name__}")
     if gaf.Q.shape[1] != m.n_modes:
         raise ValueError(f"gaf has {gaf.Q.shape[1]} modes, the modal model {m.n_modes}")
     M, K, C, _ = _elastic_part(m, gaf.Q, include_rigid)
@@ -274,32 +339,52 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
             p, v, k, ok = prob.solve_mode(u, omega, ref, tol, max_iter)
             P[i, jt], V[i, jt], KK[i, jt], conv[i, jt] = p, v, k, ok
             omega, ref = abs(p.imag), v
+    if not conv.all():
+        bad = np.argwhere(~conv)
+        listed = ", ".join(f"mode {modes[jt] + 1} at U = {U[i]:.6g}" for i, jt in bad[:8])
+        more = f" and {len(bad) - 8} more" if len(bad) > 8 else ""
+        warnings.warn(f"p-k: the k-iteration did not converge within max_iter = {max_iter} "
+                      f"(tol {tol:g}) at {len(bad)} of {conv.size} points: {listed}{more}; "
+                      "their roots are the last iterate (PkResult.converged is False there). "
+                      "Raise max_iter or check those points.",
+                      FlutterConvergenceWarning, stacklevel=2)
     return PkResult(velocities=U, p=P, k=KK, vectors=V, converged=conv,
                     structural_frequencies_hz=w[modes] / (2 * np.pi), density=rho,
                     mach=gaf.mach, b_ref=gaf.b_ref)
 
 
-def _crossings(U, sigma, freq_hz, real_mask):
-    """Indices i with sigma[i-1] <= 0 < sigma[i], linear interpolation to sigma = 0."""
+def _crossings(U, sigma, freq_hz, real_mask, tol: float = 0.0):
+    """Onsets of instability along one branch: (i, U*, f*, kind, at_first_point) tuples.
+
+    Unstable means sigma > tol. A branch unstable at the first point gives (0, U[0], f[0], kind,
+    True) ("at or below U0"); each later stable-to-unstable change between i-1 and i gives the
+    linear interpolation to sigma = tol (clipped to [U[i-1], U[i]]).
+    """
+    unstable = np.asarray(sigma) > tol
     out = []
+    if unstable.size and unstable[0]:
+        kind = "divergence" if real_mask[0] else "flutter"
+        out.append((0, float(U[0]), float(freq_hz[0]), kind, True))
     for i in range(1, len(U)):
-        if sigma[i - 1] <= 0 < sigma[i]:
-            t = -sigma[i - 1] / (sigma[i] - sigma[i - 1])
+        if not unstable[i - 1] and unstable[i]:
+            t = float(np.clip((tol - sigma[i - 1]) / (sigma[i] - sigma[i - 1]), 0.0, 1.0))
             us = U[i - 1] + t * (U[i] - U[i - 1])
             f = freq_hz[i - 1] + t * (freq_hz[i] - freq_hz[i - 1])
             kind = "divergence" if real_mask[i] else "flutter"
-            out.append((i, us, f, kind))
+            out.append((i, us, f, kind, False))
     return out
 
 
 def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = None,
                      refine: bool = True, include_rigid: bool = False,
                      interpolation: str = "linear") -> list[Instability]:
-    """All flutter / divergence crossings of a p-k sweep, sorted by speed.
+    """All flutter / divergence onsets of a p-k sweep, sorted by speed.
 
     Linear interpolation of Re(p) to zero between sweep points; with ``refine`` (needs the
     ``modal`` and ``gaf`` of the sweep) the crossing is refined by Brent's method on Re(p)(U) of
-    the tracked root, continued from the sub-critical sweep point.
+    the tracked root, continued from the sub-critical sweep point. A root unstable at the first
+    airspeed (Re p > :func:`crossing_tolerance`) is returned with ``at_first_point=True`` and
+    ``speed = velocities[0]`` (flutter or divergence at or below U0).
     """
     found = []
     U = result.velocities
@@ -311,16 +396,26 @@ def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = No
             m.n_rigid, m.n_modes)
         prob = _PkProblem(M, K, C, TabulatedGaf(gaf.k, gaf.Q[:, sel, sel], gaf.b_ref),
                           result.density, interpolation)
+    tol = crossing_tolerance(result.p)
     for jt in range(result.p.shape[1]):
         p = result.p[:, jt]
         real_mask = np.abs(p.imag) <= 1e-6 * np.maximum(np.abs(p), 1e-12)
-        for i, us, f, kind in _crossings(U, p.real, np.abs(p.imag) / (2 * np.pi), real_mask):
+        for i, us, f, kind, first in _crossings(U, p.real, np.abs(p.imag) / (2 * np.pi),
+                                                real_mask, tol):
             vec = result.vectors[i, jt]
+            if first:
+                found.append(Instability(kind=kind, mode=jt, speed=float(us),
+                                         frequency_hz=0.0 if kind == "divergence" else float(f),
+                                         vector=vec, method="p-k", at_first_point=True))
+                continue
             if prob is not None:
-                w0, ref0 = abs(result.p[i - 1, jt].imag), result.vectors[i - 1, jt]
+                # continue from the unstable side: at an undamped coalescence the sub-critical
+                # vector correlates equally with the stable and the unstable partner
+                w0, ref0 = abs(result.p[i, jt].imag), result.vectors[i, jt]
 
                 def re_p(u, w0=w0, ref0=ref0):
-                    return prob.solve_mode(u, w0, ref0)[0].real
+                    # Re p - tol: an undamped sub-critical root (Re = 0 +- rounding) stays < 0
+                    return prob.solve_mode(u, w0, ref0)[0].real - tol
 
                 try:
                     us = optimize.brentq(re_p, U[i - 1], U[i], xtol=1e-6 * U[i])
@@ -368,7 +463,12 @@ def divergence_speeds(modal, Q0: np.ndarray, density: float, include_rigid: bool
 @dataclass(frozen=True)
 class MatchPointRow:
     """One row of Tables 9-10: Mach, altitude (m), density, speed of sound, the first flutter
-    speed (None if none below the sweep top) and frequency, U_eq (Eq. 3.10) and M_eq = U_f/a."""
+    speed (None if none below the sweep top) and frequency, U_eq (Eq. 3.10) and M_eq = U_f/a.
+
+    ``at_first_point``: the sweep was already unstable at its first airspeed, so ``speed``,
+    ``equivalent_speed`` and ``mach_equivalent`` are upper bounds (flutter at or below U0), not
+    values; :func:`matched_mach` does not interpolate through such rows.
+    """
 
     mach: float
     altitude: float
@@ -379,6 +479,17 @@ class MatchPointRow:
     equivalent_speed: float | None
     mach_equivalent: float | None
     kind: str | None = None
+    at_first_point: bool = False
+
+    def describe(self, unit: str = "m/s") -> str:
+        """'none in the sweep', 'flutter at 218.1 m/s' or 'unstable at the first point of the
+        sweep: flutter at or below 250 m/s'."""
+        if self.speed is None:
+            return "no instability in the sweep"
+        if self.at_first_point:
+            return (f"unstable at the first point of the sweep: {self.kind} at or below "
+                    f"{self.speed:.6g} {unit}")
+        return f"{self.kind} at {self.speed:.6g} {unit}"
 
 
 def match_point_table(modal, gaf_for_mach, machs, altitudes, velocities, kind="flutter",
@@ -387,16 +498,24 @@ def match_point_table(modal, gaf_for_mach, machs, altitudes, velocities, kind="f
 
     ``gaf_for_mach(mach) -> TabulatedGaf``; densities default to the 1976 standard atmosphere
     (pass ``densities`` (per altitude) to use others, e.g. the thesis's). ``kind`` selects
-    'flutter', 'divergence' or None (first instability of any kind).
+    'flutter', 'divergence' or None (first instability of any kind). A condition unstable at the
+    first airspeed gives a row with ``at_first_point=True`` (and a warning naming it).
     """
     from .atmosphere import standard_atmosphere
 
+    if kind not in ("flutter", "divergence", None):
+        raise ValueError(f"kind must be 'flutter', 'divergence' or None, got {kind!r}")
+    altitudes = list(np.atleast_1d(altitudes))
+    if densities is not None and len(np.atleast_1d(densities)) != len(altitudes):
+        raise ValueError(f"densities must have one value per altitude ({len(altitudes)}), "
+                         f"got {len(np.atleast_1d(densities))}")
     rows = []
-    for mach in machs:
+    for mach in np.atleast_1d(machs):
         g = gaf_for_mach(mach)
         for ia, h in enumerate(altitudes):
             atm = standard_atmosphere(h)
-            rho = float(atm.density) if densities is None else float(densities[ia])
+            rho = float(atm.density) if densities is None else float(
+                np.atleast_1d(densities)[ia])
             a = float(atm.speed_of_sound)
             res = pk_flutter(modal, g, rho, velocities)
             inst = first_of(pk_instabilities(res, modal, g), kind)
@@ -405,21 +524,37 @@ def match_point_table(modal, gaf_for_mach, machs, altitudes, velocities, kind="f
             else:
                 ueq = inst.speed * np.sqrt(rho / 1.225)
                 rows.append(MatchPointRow(mach, h, rho, a, inst.speed, inst.frequency_hz,
-                                          float(ueq), inst.speed / a, inst.kind))
+                                          float(ueq), inst.speed / a, inst.kind,
+                                          inst.at_first_point))
+                if inst.at_first_point:
+                    warnings.warn(f"match point Mach {mach:g}, altitude {h:g} m: "
+                                  f"{inst.describe()}; lower the first velocity",
+                                  RuntimeWarning, stacklevel=2)
     return rows
 
 
 def matched_mach(rows: list[MatchPointRow], altitude: float) -> float | None:
     """Mach at which the flutter Mach M_eq equals the analysis Mach, by linear interpolation of
-    M_eq - M over the analysed Machs at ``altitude`` (None if no sign change or no flutter)."""
-    pts = sorted((r.mach, r.mach_equivalent) for r in rows
-                 if r.altitude == altitude and r.mach_equivalent is not None)
+    M_eq - M over the analysed Machs at ``altitude`` (None if no sign change or no flutter).
+
+    Rows flagged ``at_first_point`` (flutter at or below the sweep's first speed: only an upper
+    bound of M_eq) are not interpolated through; if the match lies next to such a row the
+    result is None and a warning says so.
+    """
+    here = [r for r in rows if r.altitude == altitude and r.mach_equivalent is not None]
+    bounded = sorted(r.mach for r in here if r.at_first_point)
+    pts = sorted((r.mach, r.mach_equivalent) for r in here if not r.at_first_point)
     for (m0, e0), (m1, e1) in zip(pts[:-1], pts[1:]):
         d0, d1 = e0 - m0, e1 - m1
         if d0 == 0:
             return m0
         if d0 * d1 <= 0:
             return m0 + (m1 - m0) * d0 / (d0 - d1)
+    if bounded:
+        warnings.warn(f"matched_mach at altitude {altitude:g} m: the sweep was unstable at its "
+                      f"first point for Mach {', '.join(f'{b:g}' for b in bounded)} (flutter at "
+                      "or below U0); the match cannot be located there", RuntimeWarning,
+                      stacklevel=2)
     return None
 
 
@@ -472,10 +607,10 @@ def root_locus(modal, rfa, density: float, velocities, substeps: int | None = No
     for aeroelastic roots.
     """
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
-    rho = float(positive_array("density", density)[0])
-    U = positive_array("velocities", velocities)
-    if np.any(np.diff(U) <= 0):
-        raise ValueError("velocities must be strictly ascending")
+    rho = positive("density", density)
+    U = _ascending("velocities", velocities)
+    if substeps is not None:
+        substeps = _count("substeps", substeps)
     ns = m.n_elastic
     s = slice(m.n_rigid, m.n_modes)
     w2, phi = linalg.eigh(m.K[s, s], m.M[s, s])
@@ -492,6 +627,10 @@ def root_locus(modal, rfa, density: float, velocities, substeps: int | None = No
             path += list(np.linspace(U[i - 1], U[i], max(n_sub, 1) + 1)[1:-1])
         marks.append(len(path))
         path.append(u)
+    if len(path) > MAX_STEPS // 100:
+        raise ValueError(f"root_locus would solve {len(path)} eigenproblems (velocities "
+                         f"{U.size}, substeps {substeps}); limit {MAX_STEPS // 100}: use fewer "
+                         "velocities or substeps")
     from scipy.optimize import linear_sum_assignment
     all_eigs, elastic = [], []
     for ip, u in enumerate(path):
@@ -522,31 +661,38 @@ def root_locus_instabilities(result: RootLocusResult, modal=None, rfa=None,
                              refine: bool = True) -> list[Instability]:
     """Crossings of the aeroelastic roots into Re > 0, interpolated (and, given ``modal`` and
     ``rfa``, refined by Brent's method on the real part of the eigenvalue of A_sys nearest the
-    crossing root)."""
+    crossing root). A root unstable at the first airspeed (Re > :func:`crossing_tolerance`) is
+    returned with ``at_first_point=True`` and ``speed = velocities[0]`` (at or below U0)."""
     U = result.velocities
     out = []
+    tol = crossing_tolerance(result.elastic)
     for j in range(result.elastic.shape[1]):
         lam = result.elastic[:, j]
         real_mask = np.abs(lam.imag) <= 1e-6 * np.maximum(np.abs(lam), 1e-12)
-        for i, us, f, kind in _crossings(U, lam.real, np.abs(lam.imag) / (2 * np.pi),
-                                         real_mask):
+        for i, us, f, kind, first in _crossings(U, lam.real, np.abs(lam.imag) / (2 * np.pi),
+                                                real_mask, tol):
+            if first:
+                out.append(Instability(kind=kind, mode=j, speed=float(us),
+                                       frequency_hz=0.0 if kind == "divergence" else float(f),
+                                       method="root locus", at_first_point=True))
+                continue
             if refine and modal is not None and rfa is not None:
-                target = [lam[i - 1]]
-
-                def re_lam(u):
+                # follow the tracked branch: the eigenvalue nearest its linear interpolation
+                # between the sweep points (at a coalescence the sub-critical root alone would
+                # be equidistant from the stable and the unstable partner)
+                def pick_at(u, i=i, lam=lam):
                     ev = np.linalg.eigvals(aeroelastic_matrices(modal, rfa, result.density,
                                                                 u).A)
                     ev = ev[ev.imag >= -1e-9]
-                    pick = ev[np.argmin(np.abs(ev - target[0]))]
-                    return pick.real
+                    t = (u - U[i - 1]) / (U[i] - U[i - 1])
+                    return ev[np.argmin(np.abs(ev - (lam[i - 1] + t * (lam[i] - lam[i - 1]))))]
+
+                def re_lam(u):
+                    return pick_at(u).real - tol     # undamped: Re = 0 +- rounding stays < 0
 
                 try:
                     us = optimize.brentq(re_lam, U[i - 1], U[i], xtol=1e-6 * U[i])
-                    ev = np.linalg.eigvals(aeroelastic_matrices(modal, rfa, result.density,
-                                                                us).A)
-                    ev = ev[ev.imag >= -1e-9]
-                    pick = ev[np.argmin(np.abs(ev - target[0]))]
-                    f = abs(pick.imag) / (2 * np.pi)
+                    f = abs(pick_at(us).imag) / (2 * np.pi)
                 except ValueError:
                     pass
             out.append(Instability(kind=kind, mode=j, speed=float(us),
@@ -587,14 +733,24 @@ def simulate_free_response(A: np.ndarray, z0: np.ndarray, t_end: float = 0.25,
     ``method="RK45"`` (or any scipy solve_ivp method) with ``max_step`` (s; the thesis capped
     ode45's step at 1e-4 s), or ``method="exact"``: the matrix exponential, z(t_j) =
     expm(A dt)^j z0 on a uniform grid of ``n_out`` points.
+
+    Raises ValueError (before any work) when the record would need more than ``MAX_STEPS``
+    steps (t_end / max_step) or output samples (n_out), naming the estimate and the knob.
     """
     from scipy.integrate import solve_ivp
 
     A = np.asarray(A, dtype=float)
     z0 = np.asarray(z0, dtype=float)
-    if not (np.isfinite(t_end) and t_end > 0):
-        raise ValueError(f"t_end must be > 0, got {t_end}")
-    t = np.linspace(0.0, t_end, int(n_out))
+    if A.ndim != 2 or A.shape[0] != A.shape[1] or z0.shape != (A.shape[0],):
+        raise ValueError(f"A must be square (n, n) and z0 (n,); got A {A.shape}, z0 {z0.shape}")
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(z0))):
+        raise ValueError("A and z0 must be finite")
+    t_end = positive("t_end", t_end)
+    n_out = _count("n_out", n_out, 2)
+    if n_out > MAX_STEPS:
+        raise ValueError(f"n_out = {n_out} output samples exceeds the limit {MAX_STEPS}; "
+                         "lower n_out")
+    t = np.linspace(0.0, t_end, n_out)
     if method == "exact":
         E = linalg.expm(A * (t[1] - t[0]))
         z = np.empty((t.size, z0.size))
@@ -602,8 +758,11 @@ def simulate_free_response(A: np.ndarray, z0: np.ndarray, t_end: float = 0.25,
         for j in range(1, t.size):
             z[j] = E @ z[j - 1]
         return TimeResponse(t=t, z=z, steps=np.array([]), method="exact")
-    if not (np.isfinite(max_step) and max_step > 0):
-        raise ValueError(f"max_step must be > 0, got {max_step}")
+    max_step = positive("max_step", max_step)
+    if t_end / max_step > MAX_STEPS:
+        raise ValueError(f"t_end / max_step = {t_end / max_step:.3g} steps exceeds the limit "
+                         f"{MAX_STEPS}; raise max_step or shorten t_end (or use "
+                         "method='exact')")
     extra = {"jac": A} if method in ("Radau", "BDF", "LSODA") else {}
     sol = solve_ivp(lambda _t, y: A @ y, (0.0, t_end), z0, method=method, t_eval=t,
                     max_step=max_step, rtol=rtol, atol=atol, **extra)
@@ -619,9 +778,25 @@ def growth_rate(t: np.ndarray, y: np.ndarray, window: float) -> float:
     """Exponential growth rate (1/s) of a response: slope of log(max |y| per window) over the
     second half of the record (windows of ``window`` s, at least a period of the slowest
     oscillation). Negative = decaying, positive = growing. ``y`` may be (n_t,) or (n_t, m)
-    (its row norms are used)."""
+    (its row norms are used).
+
+    Raises ValueError if ``window`` is not > 0, the record holds fewer than 4 windows, or more
+    windows than samples (a window shorter than the sampling step measures nothing).
+    """
+    t = np.asarray(t, dtype=float)
     y = np.asarray(y)
-    mag = np.abs(y) if y.ndim == 1 else np.linalg.norm(y, axis=1)
+    if t.ndim != 1 or t.size < 2 or y.shape[0] != t.size:
+        raise ValueError(f"t must be (n_t,) with n_t >= 2 and y (n_t, ...); got t {t.shape}, "
+                         f"y {y.shape}")
+    window = positive("window", window)
+    n_win = (t[-1] - t[0]) / window
+    if n_win > t.size:
+        raise ValueError(f"window = {window:g} s is shorter than the sampling step "
+                         f"({(t[-1] - t[0]) / (t.size - 1):g} s): {n_win:.3g} windows for "
+                         f"{t.size} samples; use a window of at least a period")
+    mag = np.abs(y) if y.ndim == 1 else np.linalg.norm(y.reshape(t.size, -1), axis=1)
+    if not np.all(np.isfinite(mag)):
+        raise ValueError("y holds non-finite values (the response overflowed: shorten t_end)")
     edges = np.arange(t[0], t[-1] + 1e-15, window)
     centers, peaks = [], []
     for a, b in zip(edges[:-1], edges[1:]):
@@ -633,7 +808,8 @@ def growth_rate(t: np.ndarray, y: np.ndarray, window: float) -> float:
     centers, peaks = np.array(centers), np.array(peaks)
     half = centers >= t[0] + 0.5 * (t[-1] - t[0])
     if half.sum() < 2:
-        raise ValueError("record too short for the window: need at least 4 windows")
+        raise ValueError(f"record too short for the window: need at least 4 windows of "
+                         f"{window:g} s, the record is {t[-1] - t[0]:g} s")
     peaks = np.maximum(peaks, 1e-300)
     return float(np.polyfit(centers[half], np.log(peaks[half]), 1)[0])
 
@@ -641,12 +817,27 @@ def growth_rate(t: np.ndarray, y: np.ndarray, window: float) -> float:
 @dataclass(frozen=True)
 class TimeDomainSweep:
     """Growth rate of the free response over airspeed: velocities, growth (1/s), and the onset
-    speed (growth = 0, None if none in the range)."""
+    speed (growth = 0, None if none in the range).
+
+    ``at_first_point``: the response already grows at the first airspeed, so the onset is at or
+    below ``velocities[0]``; ``onset_speed`` is then that first airspeed (an upper bound).
+    """
 
     velocities: np.ndarray
     growth: np.ndarray
     onset_speed: float | None
     method: str
+    at_first_point: bool = False
+
+    def describe(self, unit: str = "m/s") -> str:
+        """'onset at 219.6 m/s', 'unstable at the first point of the sweep: onset at or below
+        250 m/s' or 'no growth up to 460 m/s'."""
+        if self.onset_speed is None:
+            return f"no growth up to {self.velocities[-1]:.6g} {unit}"
+        if self.at_first_point:
+            return (f"unstable at the first point of the sweep: onset at or below "
+                    f"{self.onset_speed:.6g} {unit}")
+        return f"onset at {self.onset_speed:.6g} {unit}"
 
 
 def time_domain_sweep(modal, rfa, density: float, velocities, coordinate: int = 1,
@@ -655,15 +846,37 @@ def time_domain_sweep(modal, rfa, density: float, velocities, coordinate: int = 
     """Growth rate of the response of z' = A_sys z (unit initial value on elastic coordinate
     ``coordinate``) over ``velocities``, and the onset speed where it crosses zero (interpolated,
     refined by Brent's method when ``refine``). The growth is measured on the elastic modal
-    coordinates zeta_s. ``method`` "exact" (matrix exponential) or a solve_ivp method."""
+    coordinates zeta_s. ``method`` "exact" (matrix exponential) or a solve_ivp method.
+
+    ``window`` (s) must be at least one period T1 = 2 pi / omega_1 of the slowest elastic
+    structural mode, and ``t_end`` at least 4 windows; the default window is
+    max(T1, min(2 T1, t_end / 8)). A response growing at the first airspeed (growth > tol, tol
+    = 1e-9 omega_max of the structure) gives ``at_first_point=True``, ``onset_speed = U0``.
+    """
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
-    U = positive_array("velocities", velocities)
-    rho = float(positive_array("density", density)[0])
+    U = _ascending("velocities", velocities)
+    rho = positive("density", density)
+    t_end = positive("t_end", t_end)
     ns = m.n_elastic
+    if ns == 0:
+        raise ValueError("modal has no elastic modes: nothing to measure")
+    s = slice(m.n_rigid, m.n_modes)
+    w2 = linalg.eigvalsh(m.K[s, s], m.M[s, s])
+    w1 = np.sqrt(max(w2.min(), 1e-12))
+    period = 2 * np.pi / w1
     if window is None:
-        s = slice(m.n_rigid, m.n_modes)
-        w1 = np.sqrt(max(linalg.eigvalsh(m.K[s, s], m.M[s, s]).min(), 1e-12))
-        window = min(2 * 2 * np.pi / w1, t_end / 8)
+        window = max(period, min(2 * period, t_end / 8))
+    else:
+        window = positive("window", window)
+        if window < period * (1 - 1e-9):
+            raise ValueError(f"window = {window:g} s is shorter than a period of the slowest "
+                             f"elastic mode ({period:g} s, {w1 / 2 / np.pi:.4g} Hz): the peaks "
+                             f"per window would not measure growth; use window >= {period:g}")
+    if t_end < 4 * window:
+        raise ValueError(f"t_end = {t_end:g} s holds fewer than 4 windows of {window:g} s "
+                         f"(one or two periods of the slowest elastic mode, {period:g} s): "
+                         f"use t_end >= {4 * window:g}")
+    tol = RTOL_UNSTABLE * np.sqrt(max(w2.max(), 0.0))
 
     def rate(u):
         mats = aeroelastic_matrices(m, rfa, rho, u)
@@ -672,13 +885,18 @@ def time_domain_sweep(modal, rfa, density: float, velocities, coordinate: int = 
         return growth_rate(r.t, r.z[:, :ns], window)
 
     g = np.array([rate(u) for u in U])
+    if g[0] > tol:
+        return TimeDomainSweep(velocities=U, growth=g, onset_speed=float(U[0]), method=method,
+                               at_first_point=True)
     onset = None
     for i in range(1, U.size):
-        if g[i - 1] <= 0 < g[i]:
-            onset = U[i - 1] - g[i - 1] * (U[i] - U[i - 1]) / (g[i] - g[i - 1])
+        if g[i - 1] <= tol < g[i]:
+            onset = U[i - 1] + (tol - g[i - 1]) * (U[i] - U[i - 1]) / (g[i] - g[i - 1])
+            onset = float(np.clip(onset, U[i - 1], U[i]))
             if refine:
                 try:
-                    onset = optimize.brentq(rate, U[i - 1], U[i], xtol=1e-4 * U[i])
+                    onset = optimize.brentq(lambda u: rate(u) - tol, U[i - 1], U[i],
+                                            xtol=1e-4 * U[i])
                 except ValueError:
                     pass
             break

@@ -144,7 +144,7 @@ def run(figures: bool = False) -> ChapterResult:
             c = analyse_condition(modal, db, mach, h)
             conds[(mk, h)] = c
             fl = c["flutter"]
-            note = sweep_note if fl is None else f"mode {fl.mode + 1}; {sweep_note}"
+            note = sweep_note if fl is None else f"{fl.describe()}; {sweep_note}"
             q.append(Quantity(f"flutter.pk.{mk}.h{int(h)}.speed_ms", _val(fl, "speed"), "m/s",
                               note + ("; none found" if fl is None else "")))
             q.append(Quantity(f"flutter.pk.{mk}.h{int(h)}.freq_hz", _val(fl, "frequency_hz"),
@@ -161,7 +161,7 @@ def run(figures: bool = False) -> ChapterResult:
     td, td_kind = time_domain_first(modal, fit, c0["density"])
     q.append(Quantity("flutter.time_domain.M075.h0.speed_ms",
                       td.onset_speed if td_kind == "flutter" else None, "m/s",
-                      f"onset is {td_kind}" if td_kind else "no growth up to 460 m/s"))
+                      f"{td.describe()} ({td_kind})" if td_kind else td.describe()))
     q.append(Quantity("rfa.M075.fit_error", fit.fit_error, "-",
                       "||Q - Q~||_F / ||Q||_F over all k"))
     gaf0 = c0["gaf"]
