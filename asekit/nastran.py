@@ -43,7 +43,26 @@ def _field_width(fmt: str) -> tuple[int, int]:
     m = _FMT.search(fmt)
     if m is None:
         raise ValueError(f"unsupported OP4 number format {fmt!r} (expected like '1P,5E16.9')")
-    return int(m.group(1)), int(m.group(2))
+    per_line, width, digits = int(m.group(1)), int(m.group(2)), int(m.group(3))
+    if per_line < 1 or width < 2 or digits >= width:
+        raise ValueError(f"OP4 number format {fmt!r} must have >= 1 value per line and a field "
+                         "width larger than its digits (like '1P,5E16.9')")
+    return per_line, width
+
+
+#: Fortran E output drops the 'E' of three-digit exponents: 1.234567890+100
+_NO_E = re.compile(r"^([+-]?[0-9.]+)([+-][0-9]{3})$")
+
+
+def _to_float(field: str) -> float:
+    f = field.replace("D", "E").replace("d", "e")
+    m = _NO_E.match(f)
+    if m:
+        f = m.group(1) + "E" + m.group(2)
+    try:
+        return float(f)
+    except ValueError:
+        raise ValueError(f"OP4 value {field!r} is not a number") from None
 
 
 def _parse_values(lines: list[str], nwords: int, width: int) -> np.ndarray:
@@ -53,7 +72,7 @@ def _parse_values(lines: list[str], nwords: int, width: int) -> np.ndarray:
         for j in range(0, len(s), width):
             field = s[j:j + width].strip()
             if field:
-                vals.append(float(field.replace("D", "E").replace("d", "e")))
+                vals.append(_to_float(field))
     if len(vals) != nwords:
         raise ValueError(f"OP4 column record expected {nwords} words, read {len(vals)}")
     return np.asarray(vals)
@@ -74,9 +93,12 @@ def read_op4(path: str | Path) -> dict[str, Op4Matrix]:
     Raises
     ------
     ValueError
-        On a malformed header or column record, or an unsupported (sparse/BIGMAT) layout.
+        On a malformed header or column record, an unsupported (sparse/BIGMAT) layout or a file
+        holding no matrix.
     """
     lines = Path(path).read_text().splitlines()
+    if not any(line.strip() for line in lines):
+        raise ValueError(f"{path}: the OP4 file holds no matrix (it is empty)")
     out: dict[str, Op4Matrix] = {}
     i = 0
     n = len(lines)
@@ -113,7 +135,11 @@ def read_op4(path: str | Path) -> dict[str, Op4Matrix]:
                 raise ValueError(f"{path}: matrix {name!r} uses the sparse (BIGMAT) layout, "
                                  "not supported")
             nlines = -(-nw // per_line)
-            vals = _parse_values(lines[i + 1:i + 1 + nlines], nw, width)
+            try:
+                vals = _parse_values(lines[i + 1:i + 1 + nlines], nw, width)
+            except ValueError as exc:
+                raise ValueError(f"{path}: matrix {name!r}, record at line {i + 1}: {exc}") \
+                    from None
             i += 1 + nlines
             if icol > ncol:
                 break
@@ -128,6 +154,8 @@ def read_op4(path: str | Path) -> dict[str, Op4Matrix]:
             if irow - 1 + len(col) > nrow:
                 raise ValueError(f"{path}: matrix {name!r} column {icol} overruns {nrow} rows")
             data[irow - 1:irow - 1 + len(col), icol - 1] = col
+        if not np.all(np.isfinite(data)):
+            raise ValueError(f"{path}: matrix {name!r} holds non-finite values")
         out[name] = Op4Matrix(name=name, form=form, ntype=ntype, data=data)
     return out
 
@@ -143,17 +171,44 @@ def split_qhhl(qhhl: np.ndarray, n_k: int) -> np.ndarray:
 
 def write_op4(path: str | Path, matrices: dict[str, np.ndarray], digits: int = 9) -> Path:
     """Write dense matrices as a formatted OP4 file (``1P,5E{digits+7}.{digits}``); used to
-    test :func:`read_op4` round trip and to export models to other codes."""
+    test :func:`read_op4` round trip and to export models to other codes.
+
+    Values with a three-digit exponent are written the Fortran way, without the 'E'
+    (``1.000000000+100``), so every field keeps its width. ``matrices``: name (1-8 characters,
+    no spaces) -> finite 1-D or 2-D real or complex array; ``digits`` an integer in [1, 16].
+    """
+    if isinstance(digits, bool) or not isinstance(digits, (int, np.integer)) or \
+            not 1 <= digits <= 16:
+        raise ValueError(f"digits must be an integer in [1, 16], got {digits!r}")
+    if not isinstance(matrices, dict) or not matrices:
+        raise ValueError("matrices must be a non-empty dict of name -> array")
     width = digits + 7
     fmt = f"1P,5E{width}.{digits}"
     lines = []
 
+    def one(v: float) -> str:
+        t = f"{v: .{digits}E}"
+        if len(t) > width:                               # E+100 .. E+308: drop the 'E'
+            t = t.replace("E", "")
+        return t.rjust(width)
+
     def fmt_vals(vals):
-        s = [f"{v: .{digits}E}".rjust(width) for v in vals]
+        s = [one(float(v)) for v in vals]
         return ["".join(s[j:j + 5]) for j in range(0, len(s), 5)]
 
     for name, a in matrices.items():
-        a = np.atleast_2d(np.asarray(a))
+        if not isinstance(name, str) or not 1 <= len(name) <= 8 or not name.isprintable() \
+                or " " in name:
+            raise ValueError(f"matrix names must be 1-8 printable characters without spaces, "
+                             f"got {name!r}")
+        a = np.asarray(a)
+        if a.ndim > 2 or a.size == 0 or not (np.issubdtype(a.dtype, np.number)
+                                            and not np.issubdtype(a.dtype, np.timedelta64)):
+            raise ValueError(f"matrix {name!r} must be a non-empty 1-D or 2-D numeric array, "
+                             f"got shape {a.shape}, dtype {a.dtype}")
+        a = np.atleast_2d(a)
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"matrix {name!r} holds non-finite values")
         cplx = np.iscomplexobj(a)
         nrow, ncol = a.shape
         lines.append(f"{ncol:8d}{nrow:8d}{2:8d}{4 if cplx else 2:8d}{name:<8s}{fmt}")

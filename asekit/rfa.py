@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .validate import positive
+from .validate import in_range, positive
 
 
 def default_lag_roots(k_max: float, n_lags: int = 4) -> np.ndarray:
@@ -199,7 +199,7 @@ def gaf_at_mach(database, mach: float, interpolate: bool = False, atol: float = 
 
     Raises ValueError naming ``mach`` and the database's range otherwise.
     """
-    machs = np.asarray(database.machs, dtype=float)
+    machs, mach = np.asarray(database.machs, dtype=float), in_range("mach", mach, 0.0, True)
     hit = np.nonzero(np.abs(machs - mach) <= atol)[0]
     if hit.size:
         return np.asarray(database.k), np.asarray(database.Q[hit[0]])

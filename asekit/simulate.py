@@ -294,6 +294,36 @@ class SimulationResult:
         return metrics.overshoot(self.theta, self.command[-1], self.theta0)
 
 
+#: largest estimated integrator step count a single :func:`simulate` call may take.
+MAX_SIM_STEPS = 200_000
+
+
+def estimate_steps(params: ActuatorParameters, controller: PDController, t_final: float,
+                   max_step: float, sample_time: float | None = None) -> tuple[int, float]:
+    """Up-front estimate of the RK45 steps of :func:`simulate` and the fastest pole (1/s).
+
+    The explicit integrator's step is bounded by ``max_step`` and by stability, dt <~ 3.3 /
+    |lambda_max| (the RK45 stability interval on the negative real axis, Hairer & Wanner, Solving
+    ODEs II, Sec. IV.2), lambda_max the largest-magnitude root of the linear closed loop (Eq.
+    4.18, :func:`asekit.servo.closed_loop_polynomial`) or of the open-loop motor (when the supply
+    clips the voltage or between zero-order-hold samples). A zero-order-hold controller adds at
+    least 6 steps per sample. Returns (steps, |lambda_max|)."""
+    from .servo import closed_loop_polynomial
+    cl = closed_loop_polynomial(params, controller)
+    ol = closed_loop_polynomial(params, PDController(0.0, 0.0, 0.0))
+    lam = 0.0
+    for poly in (cl, ol):
+        with np.errstate(all="ignore"):
+            r = np.roots(poly / np.max(np.abs(poly)))
+        r = r[np.isfinite(r)]
+        if r.size:
+            lam = max(lam, float(np.abs(r).max()))
+    steps = max(t_final / max_step, t_final * lam / 3.3)
+    if sample_time is not None:
+        steps = max(steps, 6.0 * t_final / sample_time)
+    return int(min(steps, 1e18)), lam
+
+
 def simulate(params: ActuatorParameters, controller: PDController,
              command: float | Callable[[float], float], t_final: float = 0.1,
              theta0: float = 0.0, limits: PowerLimits = THESIS_LIMITS,
@@ -315,16 +345,40 @@ def simulate(params: ActuatorParameters, controller: PDController,
         sampling every ``sample_time`` s (thesis Table 2: 1 kHz -> 1e-3), its derivative the
         backward difference of the sampled feedback.
     n_out : number of output samples. max_step : integrator's largest step (s).
+
+    Raises ValueError/TypeError naming the argument for bad input, and ValueError before any
+    work when the estimated step count (:func:`estimate_steps`) exceeds :data:`MAX_SIM_STEPS`.
     """
+    if not isinstance(params, ActuatorParameters):
+        raise TypeError(f"params must be an ActuatorParameters, got {type(params).__name__}")
+    if not isinstance(controller, PDController):
+        raise TypeError(f"controller must be a PDController, got {type(controller).__name__}")
+    if not isinstance(limits, PowerLimits):
+        raise TypeError(f"limits must be a PowerLimits (e.g. THESIS_LIMITS, NO_LIMITS), got "
+                        f"{limits!r}")
     in_range("t_final", t_final)
     in_range("max_step", max_step)
     if sample_time is not None:
         in_range("sample_time", sample_time)
+    if isinstance(n_out, bool) or not isinstance(n_out, (int, np.integer)) or not \
+            2 <= n_out <= 10_000_000:
+        raise ValueError(f"n_out must be an integer in [2, 1e7], got {n_out!r}")
+    steps, lam = estimate_steps(params, controller, t_final, max_step, sample_time)
+    if steps > MAX_SIM_STEPS:
+        raise ValueError(
+            f"simulate would take about {steps:.3g} integrator steps (limit {MAX_SIM_STEPS}, "
+            f"asekit.simulate.MAX_SIM_STEPS): t_final = {t_final:g} s, max_step = "
+            f"{max_step:g} s, sample_time = {sample_time}, fastest pole |lambda| = {lam:.3g} "
+            "1/s (from the motor inductance and the controller gains). Shorten t_final, raise "
+            "max_step or sample_time, or use a less stiff motor/controller.")
     hm = SteadyHingeMoment() if hinge_moment is None else hinge_moment
     if not callable(hm):
         raise ValueError("hinge_moment must be a callable hinge_moment(t, theta, omega)")
-    cmd = command if callable(command) else (lambda t, c=float(command): c)
-    theta0 = float(theta0)
+    if callable(command):
+        cmd = command
+    else:
+        cmd = (lambda t, c=in_range("command", command, -math.inf): c)
+    theta0 = in_range("theta0", theta0, -math.inf)
     x0 = np.array([theta0, 0.0, holding_current(params, hm(0.0, theta0, 0.0))])
     t_out = np.linspace(0.0, t_final, n_out)
 

@@ -8,11 +8,24 @@ import math
 import numpy as np
 
 
+def _float(name: str, value) -> float:
+    """``float(value)``, or TypeError/ValueError naming ``name`` (never a bare conversion
+    error). Booleans and complex numbers are refused."""
+    if isinstance(value, (str, bytes)):
+        raise ValueError(f"{name} must be a real number, got the string {value!r}")
+    if isinstance(value, (bool, np.bool_, complex, np.complexfloating)):
+        raise TypeError(f"{name} must be a real number, got {value!r}")
+    try:
+        return float(value)
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"{name} must be a real number, got {value!r}") from exc
+
+
 def in_range(name: str, value, low: float = 0.0, inclusive: bool = False,
              high: float = math.inf, high_inclusive: bool = True) -> float:
     """Return ``float(value)`` if it is finite and within the range, else raise ValueError
     naming ``name`` and the range (default: ``(0, inf)``)."""
-    value = float(value)
+    value = _float(name, value)
     lo_ok = value >= low if inclusive else value > low
     hi_ok = value <= high if high_inclusive else value < high
     if not math.isfinite(value) or not lo_ok or not hi_ok:
@@ -25,7 +38,7 @@ def in_range(name: str, value, low: float = 0.0, inclusive: bool = False,
 
 def positive(name: str, value) -> float:
     """``float(value)`` if finite and > 0, else ValueError naming ``name``."""
-    value = float(value)
+    value = _float(name, value)
     if not math.isfinite(value) or value <= 0.0:
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
     return value
@@ -33,7 +46,7 @@ def positive(name: str, value) -> float:
 
 def finite(name: str, value) -> float:
     """``float(value)`` if finite, else ValueError naming ``name``."""
-    value = float(value)
+    value = _float(name, value)
     if not math.isfinite(value):
         raise ValueError(f"{name} must be a finite number, got {value!r}")
     return value
@@ -41,7 +54,10 @@ def finite(name: str, value) -> float:
 
 def positive_array(name: str, values) -> np.ndarray:
     """A non-empty 1-D float array of finite values > 0, else ValueError naming ``name``."""
-    a = np.atleast_1d(np.asarray(values, dtype=float))
+    try:
+        a = np.atleast_1d(np.asarray(values, dtype=float))
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"{name} must be a sequence of real numbers, got {values!r}") from exc
     if a.size == 0 or not np.all(np.isfinite(a)) or np.any(a <= 0):
         raise ValueError(f"{name} must be finite and > 0, got {values}")
     return a

@@ -28,6 +28,24 @@ import numpy as np
 from ..validate import positive
 
 
+#: largest dense aerodynamic matrix set a single call may allocate (bytes); calls that would need
+#: more are refused up front with the estimate and the setting to change.
+MAX_MATRIX_BYTES = 4 * 2 ** 30
+#: largest number of boxes of one surface (the corners alone of 1e6 boxes are 96 MB)
+MAX_BOXES = 200_000
+
+
+def check_matrix_memory(n_boxes: int, n_matrices: int, itemsize: int, what: str,
+                        knob: str) -> None:
+    """Refuse (ValueError) a dense (n_matrices, n_boxes, n_boxes) allocation above
+    :data:`MAX_MATRIX_BYTES`, naming the estimate, ``what`` is built and the ``knob`` to change."""
+    need = float(n_matrices) * float(n_boxes) ** 2 * itemsize
+    if need > MAX_MATRIX_BYTES:
+        raise ValueError(f"{what} for {n_boxes} boxes x {n_matrices} matrices needs about "
+                         f"{need / 2 ** 30:.3g} GiB (limit {MAX_MATRIX_BYTES / 2 ** 30:.3g} GiB, "
+                         f"asekit.aero.boxes.MAX_MATRIX_BYTES): {knob}")
+
+
 class MeshRuleWarning(UserWarning):
     """An aerodynamic mesh violates a doublet-lattice guideline (BPW, boxes per chord, AR)."""
 
@@ -72,6 +90,10 @@ class TrapezoidSurface:
             if int(v) != v or int(v) < 1:
                 raise ValueError(f"{nm} must be an integer >= 1, got {v!r}")
             object.__setattr__(self, nm, int(v))
+        if self.n_chord * self.n_span > MAX_BOXES:
+            raise ValueError(f"n_chord x n_span = {self.n_chord} x {self.n_span} = "
+                             f"{self.n_chord * self.n_span} boxes exceeds the limit {MAX_BOXES} "
+                             "(asekit.aero.boxes.MAX_BOXES): use fewer boxes")
         dy = self.tip_le[1] - self.root_le[1]
         dz = self.tip_le[2] - self.root_le[2]
         if math.hypot(dy, dz) <= 0.0:
@@ -212,36 +234,73 @@ class BoxMesh:
 
     def mirrored(self) -> BoxMesh:
         """The image of the mesh in the plane y = 0, corners re-ordered so that corner 1 is again
-        inboard (the image box carries the same upward-symmetric loading: a wall at y = 0)."""
+        inboard (the image box carries the same upward-symmetric loading: a wall at y = 0).
+
+        Raises ValueError if the mesh crosses y = 0 (``symmetric=True`` needs a half model on
+        one side of the plane: its image would overlap it and silently change the loads)."""
+        y = self.corners[:, :, 1]
+        tol = 1e-9 * (np.ptp(self.corners.reshape(-1, 3), axis=0).max() + 1e-300)
+        if y.min() < -tol and y.max() > tol:
+            raise ValueError(f"symmetric=True needs the mesh on one side of y = 0 (a half model "
+                             f"at a wall), but its boxes span y = {y.min():.6g} .. "
+                             f"{y.max():.6g} m: the image would overlap the mesh; pass "
+                             "symmetric=False or mesh one half")
         c = self.corners * np.array([1.0, -1.0, 1.0])
         c = c[:, [3, 2, 1, 0]]
         return BoxMesh(c, self.strip, self.surface, self.surface_names)
 
+    def _local_inside(self, pts: np.ndarray, boxes: np.ndarray, tol: float) -> np.ndarray:
+        """(len(pts), len(boxes)) bool: point strictly inside box (in its plane, within tol)."""
+        c = self.corners[boxes]                                    # (m, 4, 3)
+        s_hat = self.doublet_p3[boxes] - self.doublet_p1[boxes]
+        s_hat[:, 0] = 0.0
+        s_hat /= np.linalg.norm(s_hat, axis=1)[:, None]
+        nrm = self.normal[boxes]
+        d = pts[:, None, :] - c[None, :, 0, :]                     # from corner 1
+        off = np.abs(np.einsum("pmk,mk->pm", d, nrm))
+        sp = np.einsum("pmk,mk->pm", d, s_hat)
+        s4 = np.einsum("mk,mk->m", c[:, 3] - c[:, 0], s_hat)       # outboard edge station
+        t = sp / s4[None, :]
+        xle = c[None, :, 0, 0] + t * (c[None, :, 3, 0] - c[None, :, 0, 0])
+        xte = c[None, :, 1, 0] + t * (c[None, :, 2, 0] - c[None, :, 1, 0])
+        x = pts[:, None, 0]
+        return ((off <= tol) & (sp > tol) & (sp < s4[None, :] - tol)
+                & (x > xle + tol) & (x < xte - tol))
+
     def _check_overlap(self) -> None:
-        """Raise if two boxes of different surfaces overlap (same plane, intersecting)."""
-        if len(self.surface_names) < 2 or np.unique(self.surface).size < 2:
+        """Raise ValueError if two boxes are duplicated or overlap: the load point, control point
+        or centre of one box lies strictly inside another box of the same plane (the VLM/DLM
+        matrix would be singular -- a raw LinAlgError -- or ill-conditioned garbage)."""
+        n = self.n
+        if n < 2:
             return
         c = self.corners
-        xmin, xmax = c[:, :, 0].min(1), c[:, :, 0].max(1)
-        ymin, ymax = c[:, :, 1].min(1), c[:, :, 1].max(1)
-        zmin, zmax = c[:, :, 2].min(1), c[:, :, 2].max(1)
-        tol = 1e-9 * (np.ptp(c[:, :, 0]) + np.ptp(c[:, :, 1]) + 1e-300)
-        for s in np.unique(self.surface):
-            a = np.flatnonzero(self.surface == s)
-            b = np.flatnonzero(self.surface > s)
-            if not b.size:
-                continue
-            ox = (np.minimum(xmax[a, None], xmax[None, b]) - np.maximum(xmin[a, None], xmin[None, b])) > tol
-            oy = (np.minimum(ymax[a, None], ymax[None, b]) - np.maximum(ymin[a, None], ymin[None, b])) > tol
-            oz = ((np.minimum(zmax[a, None], zmax[None, b]) - np.maximum(zmin[a, None], zmin[None, b]))
-                  >= -tol)
-            flat = (np.abs(zmax - zmin) <= tol)
-            same_plane = flat[a, None] & flat[None, b] & (np.abs(zmin[a, None] - zmin[None, b]) <= tol)
-            hit = ox & oy & oz & same_plane
-            if hit.any():
-                i, j = np.argwhere(hit)[0]
-                raise ValueError(f"surfaces overlap: box {a[i]} of '{self.surface_names[s]}' and box "
-                                 f"{b[j]} of '{self.surface_names[self.surface[b[j]]]}'")
+        scale = float(np.ptp(c.reshape(-1, 3), axis=0).max()) + 1e-300
+        tol = 1e-9 * scale
+        centre = c.mean(axis=1)
+        radius = np.linalg.norm(c - centre[:, None, :], axis=2).max(axis=1)
+        from scipy.spatial import cKDTree
+        tree = cKDTree(centre)
+        probes = (("load point", self.load_point), ("control point", self.control_point),
+                  ("centre", centre))
+        r = float(radius.max()) * (1 + 1e-9) + tol
+        for label, pts in probes:
+            cand = tree.query_ball_point(pts, r)
+            for i, js in enumerate(cand):
+                js = np.array([j for j in js if j != i], dtype=int)
+                if not js.size:
+                    continue
+                hit = self._local_inside(pts[i:i + 1], js, tol)[0]
+                if hit.any():
+                    j = int(js[np.argmax(hit)])
+                    names = self.surface_names
+                    sa = names[self.surface[i]] if self.surface[i] < len(names) else "?"
+                    sb = names[self.surface[j]] if self.surface[j] < len(names) else "?"
+                    what = "surfaces overlap" if self.surface[i] != self.surface[j] else \
+                        "boxes are duplicated or overlap"
+                    raise ValueError(f"corners: {what}: the {label} of box {i} ('{sa}') lies "
+                                     f"inside box {j} ('{sb}'); every box must cover its own "
+                                     "area")
 
 
 def mesh_surfaces(surfaces) -> BoxMesh:
@@ -280,12 +339,19 @@ def fin_surface(fin, n_chord: int | None = None, n_span: int | None = None,
     ``ar_max`` with a 10 % margin.
     """
     p = fin.planform
+    bpw_min, ar_max = positive("bpw_min", bpw_min), positive("ar_max", ar_max)
     if n_chord is None:
-        dx_max = fin.aero.u_min / (bpw_min * fin.aero.f_max)
+        dx_max = positive("fin.aero.u_min", fin.aero.u_min) / (
+            bpw_min * positive("fin.aero.f_max", fin.aero.f_max))
         n_chord = max(4, math.floor(p.root_chord / dx_max) + 1)
     if n_span is None:
         dx_tip = p.tip_chord / n_chord
         n_span = max(1, math.ceil(p.span / (0.9 * ar_max * dx_tip)))
+    n_boxes = int(n_chord) * int(n_span)
+    check_matrix_memory(n_boxes, 1, 16, f"one DLM matrix of the fin ({n_chord} x {n_span} boxes "
+                        f"from f_max = {fin.aero.f_max:g} Hz, u_min = {fin.aero.u_min:g} m/s, "
+                        f"bpw_min = {bpw_min:g})", "lower f_max, raise u_min or pass n_chord / "
+                        "n_span")
     return TrapezoidSurface(p.root_le + (0.0,), p.root_chord, p.tip_le + (0.0,), p.tip_chord,
                             n_chord, n_span, name="fin")
 

@@ -75,7 +75,7 @@ import math
 
 import numpy as np
 
-from .boxes import BoxMesh
+from .boxes import BoxMesh, check_matrix_memory
 from .vlm import check_mach, vlm_normalwash_matrix, CHUNK_BYTES
 
 #: Laschka's approximation of u / sqrt(1 + u^2) ~ 1 - sum a_n exp(-n c u) ([R71] Eq. A.4;
@@ -828,6 +828,10 @@ def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str
     ks = check_k(k)
     b = _check_bref(b_ref)
     _check_method(method)
+    if not isinstance(mesh, BoxMesh):
+        raise TypeError(f"mesh must be a BoxMesh, got {type(mesh).__name__}")
+    check_matrix_memory(mesh.n, ks.size, 16, "the DLM normalwash matrices",
+                        "use fewer boxes or fewer reduced frequencies per call")
     snd = _Senders(mesh, symmetric)
     n = mesh.n
     d0 = vlm_normalwash_matrix(mesh, mach, symmetric)

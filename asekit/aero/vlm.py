@@ -24,7 +24,8 @@ import math
 
 import numpy as np
 
-from .boxes import BoxMesh
+from ..validate import positive
+from .boxes import BoxMesh, check_matrix_memory
 
 #: Upper bound (bytes) for the temporaries of one row chunk (VLM and DLM).
 CHUNK_BYTES = 256 * 2**20
@@ -121,6 +122,9 @@ def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False) -
     D0 (n, n) float: ``w_r / U = sum_s D0[r, s] DeltaCp_s`` (module docstring for the signs).
     """
     mach = check_mach(mach)
+    if not isinstance(mesh, BoxMesh):
+        raise TypeError(f"mesh must be a BoxMesh, got {type(mesh).__name__}")
+    check_matrix_memory(mesh.n, 1, 8, "the VLM normalwash matrix", "use fewer boxes")
     beta = math.sqrt(1.0 - mach * mach)
     sx = np.array([1.0 / beta, 1.0, 1.0])
     p = mesh.control_point * sx
@@ -143,8 +147,10 @@ def steady_pressure(mesh: BoxMesh, mach: float, normalwash: np.ndarray,
                     symmetric: bool = False) -> np.ndarray:
     """Steady Delta Cp (n,) or (n, m) for the normalwash ``w/U`` (n,) or (n, m) at the control
     points (for a flat surface at angle of attack alpha: w/U = -alpha). Solves D0 Cp = w/U."""
+    if not isinstance(mesh, BoxMesh):
+        raise TypeError(f"mesh must be a BoxMesh, got {type(mesh).__name__}")
     w = np.asarray(normalwash, float)
-    if w.shape[0] != mesh.n or not np.all(np.isfinite(w)):
+    if w.ndim not in (1, 2) or w.shape[0] != mesh.n or not np.all(np.isfinite(w)):
         raise ValueError(f"normalwash must be finite with first dimension {mesh.n}, got {w.shape}")
     return np.linalg.solve(vlm_normalwash_matrix(mesh, mach, symmetric), w)
 
@@ -156,10 +162,13 @@ def lift_curve_slope(mesh: BoxMesh, mach: float, reference_area: float | None = 
     The lift is the sum of Delta Cp A n_z for a unit angle of attack (w/U = -n_z at every
     control point); the reference area defaults to the mesh area (doubled if ``symmetric``).
     """
+    if not isinstance(mesh, BoxMesh):
+        raise TypeError(f"mesh must be a BoxMesh, got {type(mesh).__name__}")
     nz = mesh.normal[:, 2]
     cp = steady_pressure(mesh, mach, -nz, symmetric)
     lift = float(np.sum(cp * mesh.area * nz))
-    s = float(np.sum(mesh.area)) if reference_area is None else float(reference_area)
+    s = float(np.sum(mesh.area)) if reference_area is None else positive("reference_area",
+                                                                          reference_area)
     if symmetric:
         lift *= 2.0
         if reference_area is None:
