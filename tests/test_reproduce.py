@@ -14,14 +14,16 @@ def test_reproduce_cli_writes_schema(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "asekit", "reproduce", "--json", str(out)],
                           capture_output=True, text=True, timeout=1800)
     assert proc.returncode == 0, proc.stderr
-    assert "quantity" in proc.stdout
+    assert "quantity" in proc.stdout and "verdict" in proc.stdout
+    assert max(len(line) for line in proc.stdout.splitlines()) <= 100
     data = json.loads(out.read_text())
-    assert set(data) == {"quantities", "seconds"}
+    assert set(data) == {"quantities", "seconds", "failures"}
+    assert data["failures"] == {}
     assert set(data["seconds"]) == set(available_chapters())
     known = set(all_keys())
     for key, entry in data["quantities"].items():
         assert key in known
-        assert set(entry) == {"thesis", "asekit", "unit"}
+        assert set(entry) == {"thesis", "asekit", "unit", "note", "verdict"}
         v = entry["asekit"]
         flat = v if isinstance(v, list) else [v]
         for x in flat:
@@ -31,5 +33,6 @@ def test_reproduce_cli_writes_schema(tmp_path):
 def test_reproduce_rejects_unknown_chapter():
     proc = subprocess.run([sys.executable, "-m", "asekit", "reproduce", "--only", "nope"],
                           capture_output=True, text=True)
-    assert proc.returncode != 0
-    assert "unknown chapter" in proc.stderr
+    assert proc.returncode == 2                                   # an argparse error
+    assert "unknown chapter 'nope'; choose from servo" in proc.stderr
+    assert "Traceback" not in proc.stderr

@@ -134,7 +134,8 @@ def run(figures: bool = False) -> ChapterResult:
             q.append(Quantity(key, None, unit, reason))
         if figures and ha is not None:
             figs.update(ha145b_figures(ha))
-        return ChapterResult(chapter="flutter", quantities=tuple(q), figures=figs)
+        return ChapterResult(chapter="flutter", quantities=tuple(q), figures=figs,
+                             failures=(reason,))
 
     db, modal = data
     sweep_note = "1976 std atm; sweep 100-460 m/s"
