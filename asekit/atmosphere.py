@@ -117,7 +117,11 @@ def true_airspeed(mach, altitude) -> np.ndarray:
     m = np.asarray(mach, dtype=float)
     if np.any(m < 0) or not np.all(np.isfinite(m)):
         raise ValueError(f"mach must be finite and >= 0, got {m}")
-    return m * speed_of_sound(altitude)
+    with np.errstate(over="ignore"):
+        u = m * speed_of_sound(altitude)
+    if not np.all(np.isfinite(u)):
+        raise ValueError(f"mach = {m} is too large: the airspeed overflows")
+    return u
 
 
 def mach_number(true_airspeed_ms, altitude) -> np.ndarray:
@@ -131,4 +135,10 @@ def mach_number(true_airspeed_ms, altitude) -> np.ndarray:
 def dynamic_pressure(true_airspeed_ms, altitude) -> np.ndarray:
     """Dynamic pressure q = rho U^2 / 2 (Pa)."""
     u = np.asarray(true_airspeed_ms, dtype=float)
-    return 0.5 * density(altitude) * u ** 2
+    if np.any(u < 0) or not np.all(np.isfinite(u)):
+        raise ValueError(f"true_airspeed_ms must be finite and >= 0 m/s, got {u}")
+    with np.errstate(over="ignore"):
+        q = 0.5 * density(altitude) * u ** 2
+    if not np.all(np.isfinite(q)):
+        raise ValueError(f"true_airspeed_ms = {u} is too large: q overflows")
+    return q

@@ -70,6 +70,15 @@ def _ascending(name: str, values) -> np.ndarray:
     return U
 
 
+def _pressure_ok(rho: float, U: np.ndarray) -> None:
+    """Refuse density x velocities whose dynamic pressure overflows (ValueError naming both)."""
+    with np.errstate(over="ignore"):
+        q = 0.5 * rho * np.square(np.max(U))
+    if not np.isfinite(q):
+        raise ValueError(f"density = {rho:g} and velocities up to {np.max(U):g} give an "
+                         "infinite dynamic pressure")
+
+
 def _count(name: str, value, low: int = 1) -> int:
     """An integer >= low (bool refused), else TypeError/ValueError naming ``name``."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
@@ -308,6 +317,7 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
     rho = positive("density", density)
     U = _ascending("velocities", velocities)
+    _pressure_ok(rho, U)
     max_iter = _count("max_iter", max_iter)
     tol = positive("tol", tol)
     if interpolation not in ("linear", "cubic"):
@@ -609,6 +619,7 @@ def root_locus(modal, rfa, density: float, velocities, substeps: int | None = No
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
     rho = positive("density", density)
     U = _ascending("velocities", velocities)
+    _pressure_ok(rho, U)
     if substeps is not None:
         substeps = _count("substeps", substeps)
     ns = m.n_elastic
@@ -856,6 +867,7 @@ def time_domain_sweep(modal, rfa, density: float, velocities, coordinate: int = 
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
     U = _ascending("velocities", velocities)
     rho = positive("density", density)
+    _pressure_ok(rho, U)
     t_end = positive("t_end", t_end)
     ns = m.n_elastic
     if ns == 0:

@@ -367,14 +367,16 @@ def reproduce(chapters: list[str] | None = None, figures_dir: str | Path | None 
             bar.close()
     echo(format_table(rows, wide=wide))
     echo("")
-    echo("seconds: " + ", ".join(f"{k} {v:.2f}" for k, v in out["seconds"].items()))
     counts: dict[str, int] = {}
     for r in rows:
         counts[r[6]] = counts.get(r[6], 0) + 1
-    echo("verdicts: " + ", ".join(f"{v} {k}" for k, v in counts.items()))
-    for name, reasons in out["failures"].items():
-        for reason in reasons:
-            echo(f"FAILED chapter {name} ({_chapter_label(name)}): {reason}")
+    summary = ["seconds: " + ", ".join(f"{k} {v:.2f}" for k, v in out["seconds"].items()),
+               "verdicts: " + ", ".join(f"{v} {k}" for k, v in counts.items())]
+    summary += [f"FAILED chapter {name} ({_chapter_label(name)}): {reason}"
+                for name, reasons in out["failures"].items() for reason in reasons]
+    for line in summary:
+        echo("\n".join(textwrap.wrap(line, 100, subsequent_indent="  ")) if not wide
+             else line)
     if json_path is not None:
         text = json.dumps(out, indent=2)
         if str(json_path) == "-":

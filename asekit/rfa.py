@@ -142,9 +142,9 @@ def roger_fit(k, Q, b_ref: float, lag_roots=None, n_lags: int = 4, weights=None,
     if k.ndim != 1 or Q.ndim != 3 or Q.shape[0] != k.size or Q.shape[1] != Q.shape[2]:
         raise ValueError(f"Q must have shape (n_k, n, n) with n_k = len(k) = {k.size}; "
                          f"got Q {Q.shape}")
-    if not (np.all(np.isfinite(k)) and np.all(np.isfinite(Q))):
-        raise ValueError("k and Q must be finite")
-    if np.any(k < 0) or np.any(np.diff(k) <= 0):
+    if not (np.all(np.isfinite(k)) and np.all(np.isfinite(Q))) or np.abs(Q).max(initial=0) > 1e150:
+        raise ValueError("k and Q must be finite (|Q| <= 1e150: its squares must not overflow)")
+    if k.size == 0 or np.any(k < 0) or np.any(np.diff(k) <= 0):
         raise ValueError(f"k must be >= 0 and strictly ascending, got {k}")
     if lag_roots is None:
         lag_roots = default_lag_roots(float(k.max()), n_lags)

@@ -410,7 +410,7 @@ def simulate(params: ActuatorParameters, controller: PDController,
 def _simulate_zoh(params, controller, limits, cmd, hm, x0, t_out, ts, max_step):
     """Zero-order-hold PD: integrate sample interval by sample interval."""
     t_final = t_out[-1]
-    n_samples = int(math.ceil(t_final / ts - 1e-9))
+    n_samples = max(1, int(math.ceil(t_final / ts - 1e-9)))   # t_final < ts: one sample
     x = np.empty((3, t_out.size))
     v_hold = np.empty(t_out.size)
     state = x0.copy()

@@ -144,11 +144,16 @@ def test_planar_path_equals_pairwise_path(monkeypatch, method, case):
 def test_plane_blocks_equal_pairwise_path(monkeypatch, method, symmetric):
     """Surfaces in several planes: blocks of coplanar receivers and senders take the planar
     path, the rest the pairwise one; the matrix must be the all-pairwise one to rounding. The
-    second surface is a vertical fin in y = 0, so with the symmetry plane a box and its image
-    share a plane (separate columns of one block)."""
+    second surface is a vertical fin; with the symmetry plane the wing and its image share the
+    plane z = 0 (separate columns of one block). The symmetric case moves the fin off y = 0 (to
+    y = 0.3): a fin in the plane y = 0 coincides with its own image (D singular, cond ~ 1e18)
+    and is refused by BoxMesh.mirrored."""
+    y_fin = 0.3 if symmetric else 0.0
     m = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0.3, 1.2, 0.0), 0.7, 5, 6, "wing"),
-                       TrapezoidSurface((1.3, 0, 0.05), 0.8, (1.6, 0.0, 0.9), 0.5, 4, 4, "fin")])
-    assert len(dlm._plane_blocks(m, dlm._Senders(m, symmetric))) == 4   # {wing, fin}^2
+                       TrapezoidSurface((1.3, y_fin, 0.05), 0.8, (1.6, y_fin, 0.9), 0.5, 4, 4,
+                                        "fin")])
+    # receivers {wing, fin} x sender planes {z = 0, y = y_fin (, y = -y_fin with the image)}
+    assert len(dlm._plane_blocks(m, dlm._Senders(m, symmetric))) == (6 if symmetric else 4)
     ks = [0.001, 0.4, 2.5]
     fast = normalwash_matrices(m, 0.6, ks, 0.5, method, symmetric=symmetric)
     with monkeypatch.context() as mp:

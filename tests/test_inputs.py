@@ -52,6 +52,10 @@ def test_symmetric_mesh_crossing_y0_refused():
         lift_curve_slope(crossing, 0.5, symmetric=True)
     with pytest.raises(ValueError, match="symmetric=True"):
         normalwash_matrix(crossing, 0.5, 0.1, 1.0, symmetric=True)
+    vertical = mesh_surfaces([TrapezoidSurface((0.0, 0.0, 0.0), 1.0, (0.0, 0.0, 1.0), 1.0, 2, 2)])
+    with pytest.raises(ValueError, match="lie in the plane y = 0"):     # found by hypothesis
+        lift_curve_slope(vertical, 0.5, symmetric=True)
+    assert lift_curve_slope(vertical, 0.5) == pytest.approx(0.0, abs=1e-12)   # no lift: nz = 0
     # a half model touching the wall is fine, and equals the full mesh (image = other half)
     half = _plate(n_span=4, y0=0.0)
     full = mesh_surfaces([TrapezoidSurface((0.0, -2.0, 0.0), 1.0, (0.0, 2.0, 0.0), 1.0, 4, 8)])

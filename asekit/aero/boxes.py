@@ -245,6 +245,11 @@ class BoxMesh:
                              f"at a wall), but its boxes span y = {y.min():.6g} .. "
                              f"{y.max():.6g} m: the image would overlap the mesh; pass "
                              "symmetric=False or mesh one half")
+        in_plane = np.flatnonzero(np.abs(y).max(axis=1) <= tol)
+        if in_plane.size:
+            raise ValueError(f"symmetric=True: boxes {in_plane[:10].tolist()} lie in the plane "
+                             "y = 0 and would coincide with their own images; pass "
+                             "symmetric=False for a surface in the symmetry plane")
         c = self.corners * np.array([1.0, -1.0, 1.0])
         c = c[:, [3, 2, 1, 0]]
         return BoxMesh(c, self.strip, self.surface, self.surface_names)

@@ -832,6 +832,11 @@ def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str
         raise TypeError(f"mesh must be a BoxMesh, got {type(mesh).__name__}")
     check_matrix_memory(mesh.n, ks.size, 16, "the DLM normalwash matrices",
                         "use fewer boxes or fewer reduced frequencies per call")
+    extent = float(np.ptp(mesh.corners.reshape(-1, 3), axis=0).max())
+    if ks.max() / b * extent > 1e6:
+        raise ValueError(f"k / b_ref = {ks.max() / b:.3g} 1/m puts {ks.max() / b * extent:.3g} "
+                         f"rad of phase across the {extent:.3g} m mesh (> 1e6: the kernel "
+                         "overflows and the result would be noise); check k and b_ref")
     snd = _Senders(mesh, symmetric)
     n = mesh.n
     d0 = vlm_normalwash_matrix(mesh, mach, symmetric)
