@@ -391,6 +391,8 @@ def step_response(params: ActuatorParameters, controller: PDController, t_final:
 
     Returns (t in s, theta in the unit of ``amplitude``)."""
     in_range("t_final", t_final)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 2 <= n <= 10_000_000:
+        raise ValueError(f"n must be an integer in [2, 1e7], got {n!r}")
     t = np.linspace(0.0, t_final, n)
     resp = ct.step_response(closed_loop(params, controller, require_stable=False), T=t)
     return resp.time, amplitude * np.squeeze(resp.outputs)
