@@ -27,7 +27,7 @@ from property_targets import TARGETS, Outcome, classify  # noqa: E402
 KINDS = ("ok", "refused", "unnamed", "nan", "implausible", "crash", "timeout")
 
 
-class _Timeout(Exception):
+class _Timeout(BaseException):     # not caught by classify's "except Exception"
     pass
 
 
@@ -43,7 +43,7 @@ def count(target, examples: int, timeout: float, show: int = 3):
               suppress_health_check=list(HealthCheck))
     @given(target.strategy)
     def run(kwargs):
-        signal.setitimer(signal.ITIMER_REAL, timeout)
+        signal.setitimer(signal.ITIMER_REAL, timeout, timeout)   # re-fires if swallowed
         try:
             out = classify(target, kwargs)
         except _Timeout:
