@@ -222,13 +222,19 @@ def closed_loop_polynomial(params: ActuatorParameters, controller: PDController)
     first: N J L s^3 + N (J R + c L) s^2 + (N (K_b K_t + c R) + K_c K_D K_t) s + K_c K_P K_t."""
     m, n = params.motor, params.transmission.ratio
     j = params.inertia_at_motor
-    return np.array([
-        n * j * m.inductance,
-        n * (j * m.resistance + m.viscous_damping * m.inductance),
-        n * (m.back_emf_constant * m.torque_constant + m.viscous_damping * m.resistance)
-        + controller.gain * controller.kd * m.torque_constant,
-        controller.gain * controller.kp * m.torque_constant,
-    ])
+    with np.errstate(over="ignore", invalid="ignore"):
+        c = np.array([
+            n * j * m.inductance,
+            n * (j * m.resistance + m.viscous_damping * m.inductance),
+            n * (m.back_emf_constant * m.torque_constant + m.viscous_damping * m.resistance)
+            + controller.gain * controller.kd * m.torque_constant,
+            controller.gain * controller.kp * m.torque_constant,
+        ])
+    if not np.all(np.isfinite(c)) or c[0] <= 0.0:
+        raise ValueError(f"controller gains (gain {controller.gain:g}, kp {controller.kp:g}, kd "
+                         f"{controller.kd:g}) with this motor give a characteristic polynomial "
+                         f"{c} that overflows or degenerates")
+    return c
 
 
 def stable_kp_range(params: ActuatorParameters, controller: PDController) -> tuple[float, float]:

@@ -31,8 +31,12 @@ class _Timeout(BaseException):     # not caught by classify's "except Exception"
     pass
 
 
+_ACTIVE = {"on": False}
+
+
 def _alarm(signum, frame):
-    raise _Timeout()
+    if _ACTIVE["on"]:                # only while a target call runs (not while handling one)
+        raise _Timeout()
 
 
 def count(target, examples: int, timeout: float, show: int = 3):
@@ -43,12 +47,15 @@ def count(target, examples: int, timeout: float, show: int = 3):
               suppress_health_check=list(HealthCheck))
     @given(target.strategy)
     def run(kwargs):
+        _ACTIVE["on"] = True
         signal.setitimer(signal.ITIMER_REAL, timeout, timeout)   # re-fires if swallowed
         try:
             out = classify(target, kwargs)
         except _Timeout:
+            _ACTIVE["on"] = False
             out = Outcome("timeout", f"> {timeout} s")
         finally:
+            _ACTIVE["on"] = False
             signal.setitimer(signal.ITIMER_REAL, 0)
         seen[out.kind] += 1
         if out.kind not in ("ok", "refused") and len(samples.setdefault(out.kind, [])) < show:
