@@ -230,7 +230,7 @@ def closed_loop_polynomial(params: ActuatorParameters, controller: PDController)
             + controller.gain * controller.kd * m.torque_constant,
             controller.gain * controller.kp * m.torque_constant,
         ])
-    if not np.all(np.isfinite(c)) or c[0] <= 0.0:
+    if not np.all(np.isfinite(c)) or c[0] <= 0.0 or np.max(np.abs(c / c[0])) > 1e200:
         raise ValueError(f"controller gains (gain {controller.gain:g}, kp {controller.kp:g}, kd "
                          f"{controller.kd:g}) with this motor give a characteristic polynomial "
                          f"{c} that overflows or degenerates")
