@@ -5,3 +5,15 @@ from pathlib import Path
 DATA_DIR = Path(__file__).resolve().parent.parent / "data"
 FIN_FILE = DATA_DIR / "fin.toml"
 THESIS_FILE = DATA_DIR / "thesis.toml"
+
+
+def user_cache_dir() -> Path:
+    """Where asekit writes rebuilt caches (GAF databases): ``$ASEKIT_CACHE_DIR`` if set, else
+    ``$XDG_CACHE_HOME/asekit``, else ``~/.cache/asekit``. Never inside the repository or the
+    installed package, so running anything leaves tracked files as they are."""
+    import os
+    env = os.environ.get("ASEKIT_CACHE_DIR")
+    if env:
+        return Path(env).expanduser()
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    return (Path(xdg).expanduser() if xdg else Path.home() / ".cache") / "asekit"
