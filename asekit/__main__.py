@@ -1,4 +1,5 @@
-"""Command line: ``python -m asekit reproduce [--json PATH] [--figures DIR] [--only CH ...]``."""
+"""Command line: ``python -m asekit reproduce [--json PATH] [--figures DIR] [--only CH ...]`` and
+``python -m asekit analyse CASE.toml [--json PATH] [--report DIR]``."""
 
 from __future__ import annotations
 
@@ -16,7 +17,15 @@ def main(argv: list[str] | None = None) -> int:
     rep.add_argument("--figures", metavar="DIR", help="write every chapter figure as PNG")
     rep.add_argument("--only", nargs="+", metavar="CHAPTER",
                      help="run only these chapters (servo, structure, aero, flutter, ase)")
+    from .cli_analyse import add_parser as add_analyse
+    add_analyse(sub)
     args = parser.parse_args(argv)
+    if hasattr(args, "func"):
+        try:
+            return args.func(args)
+        except KeyboardInterrupt:
+            print("interrupted", file=sys.stderr)
+            return 130
     if args.command == "reproduce":
         import matplotlib
         matplotlib.use("Agg")

@@ -159,7 +159,8 @@ def panels_mesh(panels, thickness: Thickness, n_chord: int, n_spans) -> PlateMes
     return PlateMesh(nodes=nodes, elements=elements.astype(np.int64),
                      thickness_root=thickness.root, thickness_tip=thickness.tip,
                      y_root=y0, span=y1 - y0, n_chord=n_chord, n_span=n_stations,
-                     thickness_field=ThicknessField(panels, thickness))
+                     thickness_field=None if thickness.profile.is_flat and len(panels) == 1
+                     else ThicknessField(panels, thickness))
 
 
 def rectangular_mesh(a: float, b: float, thickness: float, n_x: int, n_y: int) -> PlateMesh:

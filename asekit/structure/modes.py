@@ -285,7 +285,7 @@ def _keep_modes(f_hz, share, f_max_hz, n_modes):
     """Mask of the elastic modes kept: out-of-plane ones below f_max_hz, or the first n_modes."""
     if n_modes is None:
         return select_modes(f_hz, share, f_max_hz)
-    oop = np.flatnonzero(select_modes(f_hz, share, np.inf))
+    oop = np.flatnonzero(select_modes(f_hz, share, 1e300))
     if oop.size < n_modes:
         raise ValueError(f"modes.count = {n_modes} elastic out-of-plane modes requested but only "
                          f"{oop.size} were found: lower the count or refine the mesh")
