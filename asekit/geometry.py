@@ -3,13 +3,12 @@
 Axes: x chordwise (downstream, the free-stream direction), y spanwise, z normal (up). A positive
 rotation about +y moves the trailing edge down: nose-up, i.e. a positive angle of attack.
 
-The reference fin is defined once, in ``data/fin.toml``; :func:`load_fin` reads it.
+The reference fin is one case file, ``data/cases/nalci2013_fin.toml``; :func:`load_fin` reads it.
 """
 
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -420,21 +419,32 @@ class FinDefinition:
     aero: AeroSettings
 
 
-def load_fin(path: str | Path = FIN_FILE) -> FinDefinition:
-    """Read a fin definition from a TOML file (default: the reference fin, ``data/fin.toml``)."""
-    with open(path, "rb") as fh:
-        d = tomllib.load(fh)
-    p, t, m, s, mesh, a = (d["planform"], d["thickness"], d["material"], d["shaft"], d["mesh"],
-                          d["aero"])
+#: Radius (m) of the fin's physical shaft region assumed for the distributed-shaft model when
+#: the case file holds the single-node shaft (the thesis gives no radius).
+DEFAULT_SHAFT_RADIUS = 0.005
+
+
+def fin_definition(case) -> FinDefinition:
+    """The :class:`FinDefinition` of a one-panel shaft-supported case
+    (:class:`asekit.case.Case`): planform, thickness, material, shaft, FE mesh, aero settings."""
+    if len(case.panels) != 1 or case.support.kind != "shaft":
+        raise ValueError(f"case {case.name!r}: a fin definition needs one panel and a shaft "
+                         f"support, got {len(case.panels)} panel(s), support {case.support.kind!r}")
+    s, a, f = case.support, case.aero, case.flight
+    p = case.panels[0]
+    altitudes = tuple(f.altitudes) if f.altitudes is not None else ()
     return FinDefinition(
-        planform=Planform(tuple(p["root_leading_edge"]), p["root_chord"],
-                          tuple(p["tip_leading_edge"]), p["tip_chord"]),
-        thickness=LinearThickness(t["root"], t["tip"]),
-        material=Material(m["youngs_modulus"], m["poisson_ratio"], m["density"], m.get("name", "")),
-        shaft=Shaft(tuple(s["axis_point"]), s["torsional_stiffness"], s["radius"],
-                    s.get("fictitious_inertia_factor", 1.0e6)),
-        n_chord=int(mesh["n_chord"]),
-        n_span=int(mesh["n_span"]),
-        aero=AeroSettings(a["reference_semichord"], tuple(a["machs"]), a["f_max"], a["u_min"],
-                          a["u_max"], tuple(a["altitudes"])),
-    )
+        planform=p.planform, thickness=case.thickness, material=case.material,
+        shaft=Shaft(s.axis_point, s.torsional_stiffness,
+                    DEFAULT_SHAFT_RADIUS if s.radius is None else s.radius,
+                    s.fictitious_inertia_factor),
+        n_chord=p.n_chord, n_span=p.n_span,
+        aero=AeroSettings(a.reference_semichord, tuple(a.machs), a.f_max, a.u_min,
+                          float(f.velocities[-1]), altitudes))
+
+
+def load_fin(path: str | Path = FIN_FILE) -> FinDefinition:
+    """The fin definition of a case file (default: the reference fin,
+    ``data/cases/nalci2013_fin.toml``), see :func:`fin_definition`."""
+    from .case.schema import load_case
+    return fin_definition(load_case(path))

@@ -3,7 +3,9 @@
 from pathlib import Path
 
 DATA_DIR = Path(__file__).resolve().parent.parent / "data"
-FIN_FILE = DATA_DIR / "fin.toml"
+#: The reference fin, one case among the shipped cases.
+CASES_DIR = DATA_DIR / "cases"
+FIN_FILE = CASES_DIR / "nalci2013_fin.toml"
 THESIS_FILE = DATA_DIR / "thesis.toml"
 
 

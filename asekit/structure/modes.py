@@ -258,7 +258,7 @@ def mode_shapes_at(model: ModalModel, points: np.ndarray) -> tuple[np.ndarray, n
 
 
 def fin_mesh(fin: FinDefinition, n_chord: int | None = None, n_span: int | None = None) -> PlateMesh:
-    """The fin's structured mesh (default: the thesis's 6 x 7 from ``data/fin.toml``)."""
+    """The fin's structured mesh (default: the thesis's 6 x 7 from ``data/cases/nalci2013_fin.toml``)."""
     return structured_mesh(fin.planform, fin.thickness,
                            fin.n_chord if n_chord is None else n_chord,
                            fin.n_span if n_span is None else n_span)
