@@ -356,14 +356,16 @@ class OrthotropicMaterial:
         c, s = math.cos(self.fibre_angle), math.sin(self.fibre_angle)
         T = np.array([[c * c, s * s, c * s], [s * s, c * c, -c * s],
                       [-2 * c * s, 2 * c * s, c * c - s * s]])
-        return T.T @ Q @ T
+        Qxy = T.T @ Q @ T
+        return 0.5 * (Qxy + Qxy.T)                 # exactly symmetric
 
     def transverse_shear_matrix(self) -> np.ndarray:
         """Transverse shear moduli in x-y axes (2 x 2, Pa): R^T diag(g13, g23) R with
         [g_1z, g_2z] = R [g_xz, g_yz], R = [[c, s], [-s, c]]."""
         c, s = math.cos(self.fibre_angle), math.sin(self.fibre_angle)
         R = np.array([[c, s], [-s, c]])
-        return R.T @ np.diag([self.g13, self.g23]) @ R
+        G = R.T @ np.diag([self.g13, self.g23]) @ R
+        return 0.5 * (G + G.T)
 
 
 @dataclass(frozen=True)
