@@ -307,3 +307,14 @@ def test_modal_damping_raises_flutter_speed():
     u0 = P.analyse_condition(base, db, 0.75, c0).flutter.speed
     u1 = P.analyse_condition(damped, db, 0.75, c0, m).flutter.speed
     assert u1 > u0 + 5.0
+
+
+def test_documented_example_is_a_valid_case():
+    """The commented example of docs/case-format.md parses and builds its modal model."""
+    import re
+    from pathlib import Path
+    doc = (Path(__file__).resolve().parent.parent / "docs" / "case-format.md").read_text()
+    block = re.search(r"```toml\n(.*?)```", doc, re.S).group(1)
+    case = case_from_dict(tomllib.loads(block))
+    m = P.modal_model(case)
+    assert m.n_rigid == 1 and len(m.frequencies_hz) == 6 and np.all(np.diag(m.C)[1:] > 0)

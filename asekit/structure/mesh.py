@@ -74,9 +74,10 @@ class PlateMesh:
         i = int(np.argmin(d))
         if d[i] > tol:
             raise ValueError(
-                f"{name} {tuple(p)} is not a node of the mesh (nearest node {i} at "
-                f"{tuple(self.nodes[i])}, {d[i]:.3g} m away); for the fin's root mid-chord shaft "
-                f"node use an even n_chord")
+                f"{name} ({p[0]:.6g}, {p[1]:.6g}) m is not a node of the mesh (nearest node {i} "
+                f"at ({self.nodes[i, 0]:.6g}, {self.nodes[i, 1]:.6g}) m, {d[i]:.3g} m away): "
+                f"choose n_chord so that a node falls there (e.g. an even n_chord for a "
+                f"mid-chord axis) or use a shaft region of finite radius")
         return i
 
 
