@@ -265,11 +265,18 @@ def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -
             if d0 == 0 or d0 * d1 < 0:
                 mm = m0 + (m1 - m0) * d0 / (d0 - d1)
                 break
-        if mm is None and d and all(v < 0 for _, v in d):
-            notes.append(f"altitude {c.altitude:g} m: flutter below the analysed Mach numbers' "
-                         f"speeds at every Mach (matched Mach below {d[0][0]:g})")
+        why = None
+        if mm is None:
+            if not d:
+                why = "no flutter in the sweep at any analysed Mach"
+            elif all(v > 0 for _, v in d):
+                why = (f"U_f > M a at every analysed Mach: no match up to M {d[-1][0]:g} "
+                       f"(flutter-free there)")
+            else:
+                why = (f"U_f < M a at every analysed Mach: the match lies below M {d[0][0]:g}")
         matches.append({"altitude_m": c.altitude, "matched_mach": mm,
-                        "matched_speed_ms": None if mm is None else mm * c.speed_of_sound})
+                        "matched_speed_ms": None if mm is None else mm * c.speed_of_sound,
+                        "no_match": why})
         if env_m is not None and (env_h is None or c.altitude is None
                                   or env_h[0] <= c.altitude <= env_h[1]):
             u_env = env_m[1] * c.speed_of_sound

@@ -11,6 +11,7 @@ from __future__ import annotations
 import html
 import json
 import math
+import textwrap
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -111,8 +112,8 @@ def _cell(v, fmt="{:.4g}"):
 
 def format_summary(s: dict, width: int = 100) -> str:
     """A plain-text summary of :func:`summary` that fits ``width`` columns."""
-    lines = [f"case {s['case']}" + (f"  ({s['reference']})" if s.get("reference") else "")]
-    lines = [ln[:width] for ln in lines]
+    lines = textwrap.wrap(f"case {s['case']}" + (f"  ({s['reference']})" if s.get("reference")
+                                                  else ""), width, subsequent_indent="  ")
     f = s["modes"]["frequencies_hz"]
     r = s["modes"]["n_rigid"]
     lines.append("modes (Hz): " + ", ".join(f"{v:.4g}" for v in f[r:])
@@ -137,12 +138,12 @@ def format_summary(s: dict, width: int = 100) -> str:
         lines.append(ln[:width])
     div = [d for d in s["divergence"] if d["speed_ms"] is not None]
     if div:
-        lines += ["", "static divergence: " + ", ".join(
-            f"M {d['mach']:g}/{_cell(d['altitude_m'], '{:.0f}')} m {d['speed_ms']:.1f} m/s"
-            for d in div[:6]) + (" ..." if len(div) > 6 else "")]
+        lines += [""] + textwrap.wrap("static divergence (m/s): " + ", ".join(
+            f"M {d['mach']:g} {_cell(d['altitude_m'], '{:.0f} m')} {d['speed_ms']:.1f}"
+            for d in div), width, subsequent_indent="  ")
     for m in s["match_points"]:
         lines.append(f"match point at {_cell(m['altitude_m'], '{:.0f}')} m: "
-                     + ("none in the analysed Machs" if m["matched_mach"] is None else
+                     + (f"none ({m['no_match']})" if m["matched_mach"] is None else
                         f"M {m['matched_mach']:.3f} ({m['matched_speed_ms']:.1f} m/s)"))
     for m in s["flutter_margins"]:
         lines.append(f"flutter margin at {_cell(m['altitude_m'], '{:.0f}')} m, envelope top "
@@ -154,13 +155,16 @@ def format_summary(s: dict, width: int = 100) -> str:
         lines += ["", f"ASE loop at M {a['mach']:g}, {a['altitude_m']:g} m:"]
         for t in a["stable"]:
             ov = a["corner_overshoot_pct"][t]
-            lines.append(f"  {t}: {'stable' if a['stable'][t] else 'UNSTABLE'} (max Re pole "
-                         f"{a['max_real_pole'][t]:.3g} 1/s), settling "
-                         f"{_cell(a['settling_ms'][t], '{:.1f}')} ms, steady error "
-                         f"{_cell(a['steady_error_pct'][t], '{:.2f}')} %, corner overshoot "
-                         f"{min(ov.values()):.0f}-{max(ov.values()):.0f} %")
+            st = a["settling_ms"][t]
+            lines += textwrap.wrap(
+                f"{t}: {'stable' if a['stable'][t] else 'UNSTABLE'} (max Re pole "
+                f"{a['max_real_pole'][t]:.3g} 1/s); fin root "
+                + ("never inside the 2 % band" if st is None else f"settles in {st:.1f} ms")
+                + f", final error {_cell(a['steady_error_pct'][t], '{:.2f}')} %; corner "
+                f"overshoot {min(ov.values()):.0f}-{max(ov.values()):.0f} %", width,
+                initial_indent="  ", subsequent_indent="    ")
     for n in s["notes"]:
-        lines.append(("note: " + n)[:width])
+        lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")
     lines.append("times (s): " + ", ".join(f"{k} {v:.2f}" for k, v in s["seconds"].items()))
     return "\n".join(ln[:width] for ln in lines)
