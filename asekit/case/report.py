@@ -167,7 +167,10 @@ def format_summary(s: dict, width: int = 100) -> str:
         lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")
     lines.append("times (s): " + ", ".join(f"{k} {v:.2f}" for k, v in s["seconds"].items()))
-    return "\n".join(ln[:width] for ln in lines)
+    out = []
+    for ln in lines:
+        out += textwrap.wrap(ln, width, subsequent_indent="    ") if len(ln) > width else [ln]
+    return "\n".join(out)
 
 
 # ---------------------------------------------------------------------------------------------
