@@ -1,8 +1,12 @@
-"""Locations of the repository's data files (``data/``)."""
+"""Locations of asekit's data files: the repository's ``data/`` folder in a source checkout
+(an editable install), the package ``asekit.data`` inside an installed wheel."""
 
 from pathlib import Path
 
-DATA_DIR = Path(__file__).resolve().parent.parent / "data"
+_SOURCE_DATA = Path(__file__).resolve().parent.parent / "data"
+#: data/ of the checkout, else asekit/data/ of the installed wheel (pyproject maps one to the other)
+DATA_DIR = (_SOURCE_DATA if (_SOURCE_DATA / "thesis.toml").exists()
+            else Path(__file__).resolve().parent / "data")
 #: The reference fin, one case among the shipped cases.
 CASES_DIR = DATA_DIR / "cases"
 FIN_FILE = CASES_DIR / "nalci2013_fin.toml"
