@@ -159,15 +159,38 @@ def test_modes_count_beyond_mesh_refused():
         P.modal_model(case_from_dict(d))
 
 
-def test_cli_bad_case_one_line_exit_2(tmp_path, capsys):
+CLI_BAD = [  # issue 9: missing key, unknown key, negative thickness, crossed planform,
+             # Mach >= 1 for the DLM, zero modes
+    (("youngs_modulus = 70.0e9", ""), "material.youngs_modulus is missing"),
+    (("poisson_ratio = 0.3 ", "poisson_ratio = 0.3\nyoungs_modulos = 7e10 "),
+     "material.youngs_modulos is not a known key"),
+    (("root = 0.004", "root = -0.004"), "thickness.root must be > 0 m, got -0.004"),
+    (("tip_leading_edge = [0.078, 0.150]", "tip_leading_edge = [0.078, -0.150]"),
+     "planform is crossed or has zero span"),
+    (("machs = [0.4, 0.5, 0.6, 0.75]", "machs = [0.4, 0.5, 0.6, 1.2]"),
+     "aero.machs[3] must be < 1, got 1.2"),
+    (("f_max = 1000.0                       # Hz (thesis Sec. 3.1.1)", "count = 0"),
+     "modes.count must be an integer in [1, 500], got 0"),
+    (("tip_chord = 0.078", "tip_chord = -0.1"), "panel[0].tip_chord must be > 0 m, got -0.1"),
+]
+
+
+@pytest.mark.parametrize("edit, message", CLI_BAD)
+def test_cli_bad_case_one_line_exit_2(tmp_path, capsys, edit, message):
     from asekit.__main__ import main
-    text = FIN.read_text().replace("tip_chord = 0.078", "tip_chord = -0.1")
+    text = FIN.read_text()
+    assert edit[0] in text
     bad = tmp_path / "bad.toml"
-    bad.write_text(text)
+    bad.write_text(text.replace(edit[0], edit[1], 1))
     assert main(["analyse", str(bad)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "panel[0].tip_chord must be > 0 m, got -0.1" in err[0]
+    assert len(err) == 1 and message in err[0], err
+
+
+def test_cli_missing_case_file(tmp_path, capsys):
+    from asekit.__main__ import main
     assert main(["analyse", str(tmp_path / "missing.toml")]) == 2
+    assert "not found" in capsys.readouterr().err
 
 
 def test_cli_analyse_json(tmp_path):
