@@ -219,20 +219,18 @@ def analyse_condition(case: Case, db: GafDatabase, mach: float, cond: FlightCond
                            first_of(list(inst), "divergence"), j0 is not None, j0)
 
 
-def _interp_speed(points: list[tuple[float, float]], mach: float) -> float | None:
-    """Linear interpolation (and end-point extrapolation within 0.05 in Mach) of U_f(M)."""
+def _interp_speed(points: list[tuple[float, float]], mach: float,
+                  reach: float = 0.05) -> float | None:
+    """U_f at ``mach`` from (Mach, U_f) points: linear between them, linear extrapolation of
+    the end segment at most ``reach`` in Mach beyond them; None farther out."""
     pts = sorted(points)
-    if not pts:
+    if not pts or not pts[0][0] - reach <= mach <= pts[-1][0] + reach:
         return None
-    ms = np.array([p[0] for p in pts])
-    us = np.array([p[1] for p in pts])
-    if mach < ms[0] - 0.05 or mach > ms[-1] + 0.05:
-        return None
-    if len(pts) == 1:
+    ms, us = np.array(pts).T
+    if ms.size == 1:
         return float(us[0])
-    return float(np.interp(mach, ms, us, left=None, right=None)) if ms[0] <= mach <= ms[-1] \
-        else float(us[0] + (us[1] - us[0]) * (mach - ms[0]) / (ms[1] - ms[0])) if mach < ms[0] \
-        else float(us[-2] + (us[-1] - us[-2]) * (mach - ms[-2]) / (ms[-1] - ms[-2]))
+    i = int(np.clip(np.searchsorted(ms, mach) - 1, 0, ms.size - 2))   # segment [i, i+1]
+    return float(us[i] + (us[i + 1] - us[i]) * (mach - ms[i]) / (ms[i + 1] - ms[i]))
 
 
 def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -> FlutterAnalysis:
