@@ -132,6 +132,21 @@ def _fingerprint(arrays: dict, settings: dict) -> str:
     return h.hexdigest()
 
 
+#: Below this many boxes the dense LU solves of a database run on one BLAS thread: on a shared
+#: 2-core machine OpenBLAS's threads stall on small matrices (the fin's 140-box rebuild: 2.4-5.5 s
+#: wall with 2 threads, 0.8-0.9 s with one, measured on the project machine in issue 12).
+SMALL_SOLVE_BOXES = 2000
+
+
+def _blas_threads_for(n_boxes: int):
+    """A context limiting BLAS to one thread for small systems (threadpoolctl), else a no-op."""
+    import contextlib
+    if n_boxes >= SMALL_SOLVE_BOXES:
+        return contextlib.nullcontext()
+    from threadpoolctl import threadpool_limits
+    return threadpool_limits(limits=1, user_api="blas")
+
+
 def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: float, n_rigid: int,
                        symmetric: bool = False, method: str = "quartic", progress: bool = True,
                        metadata: dict | None = None) -> GafDatabase:
@@ -147,9 +162,10 @@ def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: flo
         from tqdm.auto import tqdm
         bar = tqdm(total=machs.size * ks.size, desc="GAF database (Mach x k)", leave=False)
     try:
-        for im, mach in enumerate(machs):
-            q[im] = gaf_from_box_modes(box_modes, mesh, mach, ks, b_ref, symmetric, method,
-                                       progress=None if bar is None else bar.update)
+        with _blas_threads_for(mesh.n):
+            for im, mach in enumerate(machs):
+                q[im] = gaf_from_box_modes(box_modes, mesh, mach, ks, b_ref, symmetric, method,
+                                           progress=None if bar is None else bar.update)
     finally:
         if bar is not None:
             bar.close()
