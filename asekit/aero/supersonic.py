@@ -46,9 +46,12 @@ from phi = 0 at their centres; the pressure is evaluated at the wing-cell centre
 
 Transfer to the box mesh. The input is the normalwash w/U at the DLM control points (3/4 chord
 of each box, w/U = dh/dx + i k h / b); it is interpolated linearly in x along each chordwise
-strip to the cell centres. Each cell's force (weighted so that a box's cells carry exactly its
-area) goes back to the strip's load points (1/4 chord) by the transpose of the same linear
-interpolation, which keeps the virtual work of rigid plunge and pitch exact. The result is a
+strip to the cell centres. Each box's force (the pressures of the cells whose centres it holds,
+weighted so that they carry exactly its area) is placed at the box centroid and goes back to
+the strip's load points (1/4 chord) by the transpose of the linear interpolation from the load
+points, which keeps the virtual work of rigid plunge and pitch exact up to the midpoint rule
+(as in :mod:`asekit.aero.piston`). A uniform load gives equal lumped pressures on interior
+boxes; the first and last box of a strip carry the redistribution (0.75 and 1.25 times). The result is a
 pressure-per-normalwash matrix DeltaCp = A (w/U) with DeltaCp lumped at the load points, the
 same kind of matrix as the DLM's AIC, so :mod:`asekit.aero.gaf` uses either.
 
@@ -72,13 +75,15 @@ import scipy.fft as sfft
 import scipy.linalg as sla
 
 from .boxes import BoxMesh, MeshRuleWarning
-from .piston import _check_k, check_supersonic_mach, strip_interpolation
+from .piston import _check_k, check_supersonic_mach, piston_transfer, strip_interpolation
 
 _GAUSS_PHI = np.polynomial.legendre.leggauss(12)
 _GAUSS_F = np.polynomial.legendre.leggauss(32)
 #: Largest share of the mesh area allowed in boxes too small to hold a cell centre (the
 #: slivers at a delta wing's tip); their area goes to the nearest cell of the grid.
 EMPTY_AREA_FRACTION = 0.02
+#: dx / (beta dy) of the grid when the strips do not fix dy (see :func:`mach_grid`).
+MACH_BOX_RATIO = 0.75
 
 
 # ---------------------------------------------------------------------------------------------
@@ -220,11 +225,12 @@ def kernel_wavelength(mach: float, k: float, b_ref: float) -> float:
 
 def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric: bool = False,
               cells_per_box: float = 2.5, cells_per_wavelength: float = 8.0,
-              max_cells: int = 6000, aspect: float = 1.0) -> MachGrid:
+              max_cells: int = 6000) -> MachGrid:
     """Build the cell grid (:class:`MachGrid`) for ``mesh`` at ``mach`` and the highest reduced
     frequency ``k_max``: dx from ``cells_per_box`` cells across the area-weighted mean box chord and
-    ``cells_per_wavelength`` cells per :func:`kernel_wavelength`; dy about ``aspect`` dx,
-    adjusted so that cell boundaries fall on the strip edges when the strips are equally wide.
+    ``cells_per_wavelength`` cells per :func:`kernel_wavelength`; dy in Mach-box proportion,
+    1/2 <= dx / (beta dy) <= 1, with cell boundaries on the strip edges when the strips are
+    equally wide.
     The grid extends (x_max - x_min) / (2 beta) beyond the spanwise extremes of the mesh: no
     off-wing point farther out both feels the wing and influences it.
 
@@ -250,21 +256,24 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     x_min, x_max = float(all_c[:, :, 0].min()), float(all_c[:, :, 0].max())
     dx = float(np.sum(mesh.chord * mesh.area) / np.sum(mesh.area)) / cells_per_box
     dx = min(dx, kernel_wavelength(m, k_max, b_ref) / cells_per_wavelength)
-    nx = max(1, math.ceil((x_max - x_min) / dx - 1e-9))
-    dx = (x_max - x_min) / nx
-    # spanwise: align cell boundaries with the strip edges when the strips are equally wide
+    # spanwise: Mach-box proportions, 1/2 <= dx / (beta dy) <= 1. At most 1 keeps cells of one
+    # row out of each other's Mach cones (the diaphragm is solved by forward substitution);
+    # at least 1/2 keeps the diaphragm march stable (asekit's tests: narrower cells, ratio
+    # about 0.3-0.45, let it oscillate and grow). Cell boundaries fall on the strip edges
+    # when the strips are equally wide.
     ylo = np.minimum(all_c[:, 0, 1], all_c[:, 3, 1])
     yhi = np.maximum(all_c[:, 0, 1], all_c[:, 3, 1])
     edges = np.unique(np.round(np.concatenate([ylo, yhi]), 12))
     y_wmin, y_wmax = float(edges[0]), float(edges[-1])
     widths = np.diff(edges)
-    # dy >= dx / beta keeps cells of one row out of each other's Mach cones (the diaphragm
-    # is then solved by forward substitution)
-    dy_target = max(dx * float(aspect), dx / beta)
-    if widths.size and np.allclose(widths, widths[0], rtol=1e-6):
-        dy = widths[0] / max(1, math.floor(widths[0] / dy_target + 1e-9))
-    else:
-        dy = dy_target
+    width = float(widths[0]) if (widths.size and np.allclose(widths, widths[0], rtol=1e-6)) \
+        else dx / (MACH_BOX_RATIO * beta)
+    a = beta * width / dx
+    n_per = max(1, math.ceil(a / 2.0 - 1e-9))
+    dy = width / n_per
+    dx = min(dx, beta * dy)
+    nx = max(1, math.ceil((x_max - x_min) / dx - 1e-9))
+    dx = (x_max - x_min) / nx
     margin = (x_max - x_min) / (2.0 * beta) + dy
     n_lo = math.ceil(margin / dy)
     ny_w = max(1, round((y_wmax - y_wmin) / dy))
@@ -396,22 +405,27 @@ def grid_pressure_operator(grid: MachGrid, mach: float, k: float, b_ref: float) 
 
 
 def _transfer(mesh: BoxMesh, grid: MachGrid):
-    """(S, T, weight): w/U at the control points -> wing cells (n_w, n), h at the load points ->
-    cells (n_w, n) (zero rows for image cells), and the cell area weights (n_w,)."""
+    """(S, G): S (n_w, n) takes w/U at the control points to the wing cells; G (n, n_w) takes
+    cell pressures to lumped box pressures: each box's force (its cells' pressures, weighted
+    so that they carry exactly the box area) placed at the box centroid, then moved to the
+    strip's load points by the transpose of the linear interpolation, divided by the box area.
+    Image cells (symmetric case) carry no force."""
     cen = grid.centres(grid.wing_i, grid.wing_j)
     s = strip_interpolation(mesh, grid.wing_box, cen[:, 0], "control")
-    t = strip_interpolation(mesh, grid.wing_box, cen[:, 0], "load")
-    t[grid.image] = 0.0
     real = ~grid.image
     counts = np.bincount(grid.wing_box[real], minlength=mesh.n)
     weight = np.where(real, mesh.area[grid.wing_box] / np.maximum(counts[grid.wing_box], 1), 0.0)
     # boxes too small to hold a cell centre: their area to the nearest real cell
     real_idx = np.flatnonzero(real)
+    owner = grid.wing_box.copy()
     for b in np.flatnonzero(counts == 0):
         cb = mesh.corners[b, :, :2].mean(axis=0)
         near = real_idx[np.argmin(np.sum((cen[real_idx] - cb) ** 2, axis=1))]
         weight[near] += mesh.area[b]
-    return s, t, weight
+    agg = np.zeros((mesh.n, grid.wing_i.size))
+    agg[owner, np.arange(owner.size)] = weight
+    _, t = piston_transfer(mesh)                      # load points -> box centroids (n, n)
+    return s, (t.T @ agg) / mesh.area[:, None]
 
 
 def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
@@ -449,9 +463,8 @@ def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
                           stacklevel=2)
     grid = mach_grid(mesh, m, k_max, b, symmetric, cells_per_box, cells_per_wavelength,
                      max_cells)
-    s, t, wgt = _transfer(mesh, grid)
+    s, tw = _transfer(mesh, grid)
     out = np.empty((ks.size, mesh.n, mesh.n), complex)
-    tw = (t * wgt[:, None]).T / mesh.area[:, None]               # (n, n_w)
     for ik, kk in enumerate(ks):
         out[ik] = tw @ _grid_solve(grid, m, float(kk), b, s.T.astype(complex)).T
     if not np.all(np.isfinite(out)):
