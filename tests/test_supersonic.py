@@ -235,3 +235,49 @@ def test_coarse_mesh_warning():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         supersonic_pressure_matrices(mesh, 2.0, [0.0, 0.2], 0.5)
+
+
+# ---- method dispatch and the GAF hook ---------------------------------------------------------
+def test_dispatcher_and_transonic_gap():
+    from asekit.aero.methods import TransonicGapError, TransonicWarning, resolve_method
+    assert resolve_method("auto", 0.6) == "dlm"
+    assert resolve_method("auto", 0.9) == "dlm"
+    assert resolve_method("auto", 1.15) == "supersonic"
+    assert resolve_method("quartic", 0.5) == "dlm"
+    for m in (0.95, 1.0, 1.1):
+        with pytest.raises(TransonicGapError, match="transonic gap.*linear potential theory"):
+            resolve_method("auto", m)
+    with pytest.raises(ValueError, match="mach must be < 1 for the DLM"):
+        resolve_method("dlm", 1.2)
+    with pytest.raises(ValueError, match="mach must be > 1"):
+        resolve_method("supersonic", 0.8)
+    with pytest.raises(ValueError, match="mach must be > 1"):
+        resolve_method("piston", 1.0)
+    with pytest.raises(ValueError, match="method must be one of"):
+        resolve_method("zona51", 2.0)
+    with pytest.warns(TransonicWarning, match="mach=1.1"):
+        resolve_method("supersonic", 1.1)
+
+
+def test_gaf_hook_any_method():
+    """The GAF builder takes method=: 'dlm' equals the default DLM, 'auto' at M 2 equals the
+    supersonic matrices projected by hand, and 'auto' across the gap is refused."""
+    from asekit.aero.gaf import build_gaf_database, gaf_from_box_modes
+    from asekit.aero.methods import TransonicGapError
+    from asekit.aero.spline import analytic_modes
+    mesh = _rect(0.2, 0.3, 6, 4)
+    modes = analytic_modes(mesh, [lambda x, y: (1 + 0 * x, 0 * x),
+                                  lambda x, y: (-(x - 0.05), -1 + 0 * x)])
+    ks, b = [0.01, 0.3], 0.1
+    np.testing.assert_allclose(gaf_from_box_modes(modes, mesh, 0.6, ks, b, method="dlm"),
+                               gaf_from_box_modes(modes, mesh, 0.6, ks, b), rtol=1e-12)
+    q = gaf_from_box_modes(modes, mesh, 2.0, ks, b, method="auto")
+    a = supersonic_pressure_matrices(mesh, 2.0, ks, b)
+    for ik, k in enumerate(ks):
+        cp = a[ik] @ modes.normalwash(k, b)
+        np.testing.assert_allclose(q[ik], modes.h_lp.T @ (mesh.area[:, None] * cp), rtol=1e-12)
+    assert q[0, 1, 1].real < 0          # pitch about the quarter chord: nose-down moment at M 2
+    db = build_gaf_database(modes, mesh, [0.6, 2.0], ks, b, 1, method="auto", progress=False)
+    assert db.Q.shape == (2, 2, 2, 2) and np.all(np.isfinite(db.Q))
+    with pytest.raises(TransonicGapError):
+        build_gaf_database(modes, mesh, [0.6, 1.0], ks, b, 1, method="auto", progress=False)
