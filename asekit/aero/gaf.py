@@ -68,15 +68,13 @@ def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref
     """
     ks = check_k(k)
     if method not in ("quartic", "parabolic"):
-        from .methods import pressure_matrices, resolve_method
+        from .methods import pressures, resolve_method
         if resolve_method(method, mach) != "dlm" or aero_options:
-            a = pressure_matrices(mesh, mach, ks, b_ref, method, symmetric, **(aero_options or {}))
-            out = np.empty((ks.size, box_modes.h_cp.shape[1], box_modes.h_cp.shape[1]), complex)
-            for ik, kk in enumerate(ks):
-                out[ik] = modal_forces(box_modes, a[ik] @ box_modes.normalwash(kk, b_ref), mesh.area)
-                if progress is not None:
-                    progress(1)
-            return out
+            cp = pressures(mesh, mach, ks, b_ref, lambda kk: box_modes.normalwash(kk, b_ref),
+                           method, symmetric, **(aero_options or {}))
+            if progress is not None:
+                progress(ks.size)
+            return np.stack([modal_forces(box_modes, c, mesh.area) for c in cp])
         method = "quartic"
     d = normalwash_matrices(mesh, mach, ks, b_ref, method, symmetric)
     out = np.empty((ks.size, box_modes.h_cp.shape[1], box_modes.h_cp.shape[1]), complex)

@@ -104,3 +104,19 @@ def pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str =
         return supersonic_pressure_matrices(mesh, mach, k, b_ref, symmetric, **options)
     from .piston import piston_pressure_matrices
     return piston_pressure_matrices(mesh, mach, k, b_ref, **options)
+
+
+def pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash, method: str = "auto",
+              symmetric: bool = False, dlm_kernel: str = "quartic", **options) -> np.ndarray:
+    """DeltaCp (n_k, n, m) for the normalwash columns ``normalwash`` (callable k -> (n, m), or
+    an (n_k, n, m) array): ``pressure_matrices(...)[ik] @ normalwash(k)`` without forming the
+    supersonic matrices (:func:`asekit.aero.supersonic.supersonic_pressures`)."""
+    name = resolve_method(method, mach)
+    if name == "supersonic":
+        from .supersonic import supersonic_pressures
+        return supersonic_pressures(mesh, mach, k, b_ref, normalwash, symmetric, **options)
+    ks = np.atleast_1d(np.asarray(k, float))
+    a = pressure_matrices(mesh, mach, ks, b_ref, method, symmetric, dlm_kernel, **options)
+    ws = [np.asarray(normalwash(float(kk)) if callable(normalwash) else normalwash[ik])
+          for ik, kk in enumerate(ks)]
+    return np.stack([a[ik] @ w for ik, w in enumerate(ws)])

@@ -428,6 +428,28 @@ def _transfer(mesh: BoxMesh, grid: MachGrid):
     return s, (t.T @ agg) / mesh.area[:, None]
 
 
+def _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box, cells_per_wavelength, max_cells,
+             bpw_min, warn):
+    m = check_supersonic_mach(mach)
+    ks = _check_k(k)
+    b = float(b_ref)
+    if not (math.isfinite(b) and b > 0):
+        raise ValueError(f"b_ref must be a finite reference semi-chord > 0 m, got {b_ref!r}")
+    k_max = float(ks.max())
+    if warn and k_max > 0:
+        bpw = kernel_wavelength(m, k_max, b) / float(mesh.chord.max())
+        if bpw < bpw_min:
+            warnings.warn(f"mesh too coarse for the supersonic kernel at mach={m:g}, "
+                          f"k={k_max:g}: {bpw:.2g} boxes per wavelength 2 pi b (M - 1)/(k M) < "
+                          f"bpw_min={bpw_min:g}; use box chords below "
+                          f"{kernel_wavelength(m, k_max, b) / bpw_min:.3g} m", MeshRuleWarning,
+                          stacklevel=3)
+    grid = mach_grid(mesh, m, k_max, b, symmetric, cells_per_box, cells_per_wavelength,
+                     max_cells)
+    s, tw = _transfer(mesh, grid)
+    return m, ks, b, grid, s, tw
+
+
 def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
                                  symmetric: bool = False, cells_per_box: float = 2.5,
                                  cells_per_wavelength: float = 8.0, max_cells: int = 6000,
@@ -446,29 +468,38 @@ def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
     cells_per_box, cells_per_wavelength, max_cells : grid resolution (:func:`mach_grid`); one
         grid, built for the highest k, serves every k.
     bpw_min : boxes of the mesh per kernel wavelength below which a MeshRuleWarning is given.
+    warn : give that warning.
     """
-    m = check_supersonic_mach(mach)
-    ks = _check_k(k)
-    b = float(b_ref)
-    if not (math.isfinite(b) and b > 0):
-        raise ValueError(f"b_ref must be a finite reference semi-chord > 0 m, got {b_ref!r}")
-    k_max = float(ks.max())
-    if warn and k_max > 0:
-        bpw = kernel_wavelength(m, k_max, b) / float(mesh.chord.max())
-        if bpw < bpw_min:
-            warnings.warn(f"mesh too coarse for the supersonic kernel at mach={m:g}, "
-                          f"k={k_max:g}: {bpw:.2g} boxes per wavelength 2 pi b (M - 1)/(k M) < "
-                          f"bpw_min={bpw_min:g}; use box chords below "
-                          f"{kernel_wavelength(m, k_max, b) / bpw_min:.3g} m", MeshRuleWarning,
-                          stacklevel=2)
-    grid = mach_grid(mesh, m, k_max, b, symmetric, cells_per_box, cells_per_wavelength,
-                     max_cells)
-    s, tw = _transfer(mesh, grid)
-    out = np.empty((ks.size, mesh.n, mesh.n), complex)
+    eye = np.eye(mesh.n)
+    return supersonic_pressures(mesh, mach, k, b_ref, lambda _k: eye, symmetric, cells_per_box,
+                                cells_per_wavelength, max_cells, bpw_min, warn)
+
+
+def supersonic_pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash,
+                         symmetric: bool = False, cells_per_box: float = 2.5,
+                         cells_per_wavelength: float = 8.0, max_cells: int = 6000,
+                         bpw_min: float = 6.0, warn: bool = True) -> np.ndarray:
+    """DeltaCp (n_k, n, m) for given normalwash columns without forming the matrices (one grid
+    solve per column instead of one per box: the cheap path for a few modes).
+
+    ``normalwash`` is a callable ``k -> (n, m)`` array of w/U at the control points, or an
+    (n_k, n, m) array; the other arguments as :func:`supersonic_pressure_matrices` (the result
+    equals ``A[ik] @ normalwash[ik]`` to rounding)."""
+    m, ks, b, grid, s, tw = _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box,
+                                     cells_per_wavelength, max_cells, bpw_min, warn)
+    out = None
     for ik, kk in enumerate(ks):
-        out[ik] = tw @ _grid_solve(grid, m, float(kk), b, s.T.astype(complex)).T
+        w = np.asarray(normalwash(float(kk)) if callable(normalwash) else normalwash[ik])
+        w = w.reshape(w.shape[0], -1)
+        if w.shape[0] != mesh.n or not np.all(np.isfinite(w)):
+            raise ValueError(f"normalwash must be finite with first dimension {mesh.n}, "
+                             f"got {w.shape}")
+        cp = tw @ _grid_solve(grid, m, float(kk), b, (s @ w).T.astype(complex)).T
+        if out is None:
+            out = np.empty((ks.size, mesh.n, w.shape[1]), complex)
+        out[ik] = cp
     if not np.all(np.isfinite(out)):
-        raise FloatingPointError("supersonic pressure matrix is not finite")
+        raise FloatingPointError("supersonic pressures are not finite")
     return out
 
 
