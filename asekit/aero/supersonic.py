@@ -343,19 +343,25 @@ def _offset_tables(grid: MachGrid, lam: float, kap: float):
 
 class _Convolver:
     """Causal 2-D convolution on the full nx x ny grid by FFT: out[i, j] = sum K[i - i', |j - j'|]
-    f[i', j'] over i' <= i, for a kernel table K[di >= 0, dj >= 0]."""
+    f[i', j'] over i' <= i, for kernel tables K[di >= 0, dj >= 0] (zero-padded to fast FFT
+    lengths >= 2 nx, 2 ny). ``spectrum`` transforms fields once; ``apply`` multiplies by one
+    kernel's spectrum and transforms back, so several kernels share one forward transform."""
 
-    def __init__(self, table: np.ndarray, nx: int, ny: int):
-        full = np.zeros((2 * nx, 2 * ny), complex)
-        full[:nx, :ny] = table
-        full[:nx, ny + 1:] = table[:, 1:][:, ::-1]          # negative dj: mirror
+    def __init__(self, tables, nx: int, ny: int):
         self.nx, self.ny = nx, ny
-        self.kf = sfft.fft2(full, workers=1)
+        self.shape = (sfft.next_fast_len(2 * nx), sfft.next_fast_len(2 * ny))
+        self.kf = []
+        for table in tables:
+            full = np.zeros(self.shape, complex)
+            full[:nx, :ny] = table
+            full[:nx, self.shape[1] - ny + 1:] = table[:, 1:][:, ::-1]     # negative dj: mirror
+            self.kf.append(sfft.fft2(full, workers=1))
 
-    def __call__(self, fields: np.ndarray) -> np.ndarray:
-        """fields (m, nx, ny) -> (m, nx, ny)."""
-        f = sfft.fft2(fields, s=(2 * self.nx, 2 * self.ny), workers=1)
-        return sfft.ifft2(f * self.kf, workers=1)[:, :self.nx, :self.ny]
+    def spectrum(self, fields: np.ndarray) -> np.ndarray:
+        return sfft.fft2(fields, s=self.shape, workers=1)
+
+    def apply(self, spec: np.ndarray, which: int) -> np.ndarray:
+        return sfft.ifft2(spec * self.kf[which], workers=1)[:, :self.nx, :self.ny]
 
 
 def _kernels(grid: MachGrid, mach: float, k: float, b_ref: float):
@@ -379,10 +385,12 @@ def _grid_solve(grid: MachGrid, mach: float, k: float, b_ref: float,
     kphi, kp = _kernels(grid, mach, k, b_ref)
     nx, ny = grid.nx, grid.ny
     m = w_wing.shape[0]
+    conv = _Convolver((kphi, kp), nx, ny)
     field = np.zeros((m, nx, ny), complex)
     field[:, grid.wing_i, grid.wing_j] = w_wing
+    spec = conv.spectrum(field)
     if grid.dia_i.size:
-        phi_w = _Convolver(kphi, nx, ny)(field)[:, grid.dia_i, grid.dia_j]   # (m, n_d)
+        phi_w = conv.apply(spec, 0)[:, grid.dia_i, grid.dia_j]              # (m, n_d)
         order = np.lexsort((grid.dia_j, grid.dia_i))
         di, dj = grid.dia_i[order], grid.dia_j[order]
         d_i = di[:, None] - di[None, :]
@@ -394,8 +402,10 @@ def _grid_solve(grid: MachGrid, mach: float, k: float, b_ref: float,
             wd = sla.solve_triangular(mat, rhs, lower=True, check_finite=False)
         else:
             wd = sla.lu_solve(sla.lu_factor(mat, check_finite=False), rhs, check_finite=False)
-        field[:, di, dj] = wd.T
-    return _Convolver(kp, nx, ny)(field)[:, grid.wing_i, grid.wing_j]
+        dfield = np.zeros((m, nx, ny), complex)
+        dfield[:, di, dj] = wd.T
+        spec = spec + conv.spectrum(dfield)
+    return conv.apply(spec, 1)[:, grid.wing_i, grid.wing_j]
 
 
 def grid_pressure_operator(grid: MachGrid, mach: float, k: float, b_ref: float) -> np.ndarray:
