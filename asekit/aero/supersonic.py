@@ -82,8 +82,8 @@ _GAUSS_F = np.polynomial.legendre.leggauss(32)
 #: Largest share of the mesh area allowed in boxes too small to hold a cell centre (the
 #: slivers at a delta wing's tip); their area goes to the nearest cell of the grid.
 EMPTY_AREA_FRACTION = 0.02
-#: dx / (beta dy) of the grid when the strips do not fix dy (see :func:`mach_grid`).
-MACH_BOX_RATIO = 0.75
+#: dx / (beta dy) of the grid cells: 1, Mach boxes (see :func:`mach_grid`).
+MACH_BOX_RATIO = 1.0
 
 
 # ---------------------------------------------------------------------------------------------
@@ -224,13 +224,12 @@ def kernel_wavelength(mach: float, k: float, b_ref: float) -> float:
 
 
 def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric: bool = False,
-              cells_per_box: float = 2.5, cells_per_wavelength: float = 8.0,
+              cells_per_box: float = 1.5, cells_per_wavelength: float = 8.0,
               max_cells: int = 6000) -> MachGrid:
     """Build the cell grid (:class:`MachGrid`) for ``mesh`` at ``mach`` and the highest reduced
     frequency ``k_max``: dx from ``cells_per_box`` cells across the area-weighted mean box chord and
-    ``cells_per_wavelength`` cells per :func:`kernel_wavelength`; dy in Mach-box proportion,
-    1/2 <= dx / (beta dy) <= 1, with cell boundaries on the strip edges when the strips are
-    equally wide.
+    ``cells_per_wavelength`` cells per :func:`kernel_wavelength` (upper bounds); dy = dx / beta
+    (Mach boxes), with cell boundaries on the strip edges when the strips are equally wide.
     The grid extends (x_max - x_min) / (2 beta) beyond the spanwise extremes of the mesh: no
     off-wing point farther out both feels the wing and influences it.
 
@@ -256,24 +255,23 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     x_min, x_max = float(all_c[:, :, 0].min()), float(all_c[:, :, 0].max())
     dx = float(np.sum(mesh.chord * mesh.area) / np.sum(mesh.area)) / cells_per_box
     dx = min(dx, kernel_wavelength(m, k_max, b_ref) / cells_per_wavelength)
-    # spanwise: Mach-box proportions, 1/2 <= dx / (beta dy) <= 1. At most 1 keeps cells of one
-    # row out of each other's Mach cones (the diaphragm is solved by forward substitution);
-    # at least 1/2 keeps the diaphragm march stable (asekit's tests: narrower cells, ratio
-    # about 0.3-0.45, let it oscillate and grow). Cell boundaries fall on the strip edges
-    # when the strips are equally wide.
+    # Mach boxes: dx = beta dy, the cell diagonals on Mach lines (the classic choice of
+    # [ZH55]). Then cells of one row lie outside each other's Mach cones (the diaphragm is
+    # solved by forward substitution), and the diaphragm march is stable: asekit's tests found
+    # it growing without bound on fine grids for dx / (beta dy) = 0.5, and slower but similar
+    # trouble below that. dy divides the strip width when the strips are equally wide.
     ylo = np.minimum(all_c[:, 0, 1], all_c[:, 3, 1])
     yhi = np.maximum(all_c[:, 0, 1], all_c[:, 3, 1])
     edges = np.unique(np.round(np.concatenate([ylo, yhi]), 12))
     y_wmin, y_wmax = float(edges[0]), float(edges[-1])
     widths = np.diff(edges)
-    width = float(widths[0]) if (widths.size and np.allclose(widths, widths[0], rtol=1e-6)) \
-        else dx / (MACH_BOX_RATIO * beta)
-    a = beta * width / dx
-    n_per = max(1, math.ceil(a / 2.0 - 1e-9))
-    dy = width / n_per
-    dx = min(dx, beta * dy)
+    if widths.size and np.allclose(widths, widths[0], rtol=1e-6):
+        width = float(widths[0])
+        dy = width / max(1, math.ceil(beta * width / (MACH_BOX_RATIO * dx) - 1e-9))
+    else:
+        dy = MACH_BOX_RATIO * dx / beta
+    dx = MACH_BOX_RATIO * beta * dy
     nx = max(1, math.ceil((x_max - x_min) / dx - 1e-9))
-    dx = (x_max - x_min) / nx
     margin = (x_max - x_min) / (2.0 * beta) + dy
     n_lo = math.ceil(margin / dy)
     ny_w = max(1, round((y_wmax - y_wmin) / dy))
@@ -461,7 +459,7 @@ def _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box, cells_per_wavelengt
 
 
 def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
-                                 symmetric: bool = False, cells_per_box: float = 2.5,
+                                 symmetric: bool = False, cells_per_box: float = 1.5,
                                  cells_per_wavelength: float = 8.0, max_cells: int = 6000,
                                  bpw_min: float = 6.0, warn: bool = True) -> np.ndarray:
     """Supersonic pressure-per-normalwash matrices A (n_k, n, n) complex, DeltaCp = A (w/U)
@@ -486,7 +484,7 @@ def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
 
 
 def supersonic_pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash,
-                         symmetric: bool = False, cells_per_box: float = 2.5,
+                         symmetric: bool = False, cells_per_box: float = 1.5,
                          cells_per_wavelength: float = 8.0, max_cells: int = 6000,
                          bpw_min: float = 6.0, warn: bool = True) -> np.ndarray:
     """DeltaCp (n_k, n, m) for given normalwash columns without forming the matrices (one grid

@@ -44,7 +44,7 @@ MACHS = (0.4, 0.5, 0.6, 0.75, 0.9, 1.15, 1.2, 1.5, 2.0, 2.5, 3.0)
 ALTITUDES = (0.0, 2500.0, 5000.0)
 VELOCITIES = np.arange(100.0, 1600.0 + 1e-9, 10.0)     # m/s
 KEY_MACHS = {"M12": 1.2, "M20": 2.0, "M30": 3.0}
-CACHE_FORMAT = 2
+CACHE_FORMAT = 3
 
 
 def cache_dir() -> Path:
