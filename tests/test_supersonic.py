@@ -158,6 +158,21 @@ def test_delta_wing_supersonic_leading_edges():
     assert _lift(mesh, a @ -np.ones(mesh.n)).real == pytest.approx(4 / math.sqrt(3), rel=0.02)
 
 
+def test_delta_wing_subsonic_leading_edges_known_error():
+    """Diaphragm ahead of a subsonic leading edge (m = beta cot Lambda = 0.56): the lift slope
+    against Stewart's conical-flow result 2 pi tan(eps) / E(sqrt(1 - m^2)) (Stewart 1946,
+    Q. Appl. Math. 4; E the complete elliptic integral of the second kind). The Mach-box method
+    is known to be least accurate at subsonic leading edges; asekit measures +4 % here, and the
+    test holds it below 6 % (documented limitation, not the 2 % of supersonic edges)."""
+    from scipy.special import ellipe
+    mach, semispan = 1.5, 0.5
+    m = math.sqrt(mach**2 - 1) * semispan
+    mesh = _half_delta(1.0, semispan, 12)
+    cp = supersonic_pressures(mesh, mach, [0.0], 0.5, -np.ones((1, mesh.n, 1)), symmetric=True)
+    exact = 2 * math.pi * semispan / ellipe(1 - m * m)      # scipy's ellipe takes k^2
+    assert abs(_lift(mesh, cp[0, :, 0]).real / exact - 1) < 0.06
+
+
 def test_symmetric_equals_explicit_image():
     """A wall at y = 0 (symmetric=True) equals meshing the image explicitly."""
     s = TrapezoidSurface((0, 0), 1.0, (0.3, 1.0), 0.6, 6, 5)

@@ -56,7 +56,11 @@ pressure-per-normalwash matrix DeltaCp = A (w/U) with DeltaCp lumped at the load
 same kind of matrix as the DLM's AIC, so :mod:`asekit.aero.gaf` uses either.
 
 Limits. Planar meshes in z = 0 only; trailing edges must be supersonic (|tan Lambda_TE| < beta),
-else ValueError. Leading and side edges may be subsonic or supersonic. The box mesh must resolve
+else ValueError. Leading and side edges may be subsonic or supersonic; at subsonic leading edges
+the staircase of cells and the square-root pressure singularity cost accuracy (delta wings with
+beta cot Lambda = 0.33-0.56: lift slope 4-7 % above Stewart's conical-flow value, against
+0.1-0.3 % with supersonic leading edges; tests/test_supersonic.py). The reference fin's leading
+edge is supersonic from M 1.13. The box mesh must resolve
 the shortest kernel wavelength 2 pi b (M - 1) / (k M) with at least ``bpw_min`` boxes (a
 :class:`~asekit.aero.boxes.MeshRuleWarning` otherwise); the cell grid resolves it with
 ``cells_per_wavelength`` cells and every box with about ``cells_per_box`` cells chordwise.
@@ -143,6 +147,10 @@ def edge_line_integral(x, t1, t2, beta: float, lam: float, kap: float) -> np.nda
     theta = mid[..., None] + rad[..., None] * g
     val = np.sum(np.cos(kap * xs[..., None] * np.cos(theta)) * wg, axis=-1) * rad
     return np.where(pos, np.exp(-1j * lam * xs) * val / beta, 0.0)
+
+
+class GridTooCoarseError(ValueError):
+    """Too much of the mesh area lies in boxes that hold no cell centre of the grid."""
 
 
 # ---------------------------------------------------------------------------------------------
@@ -314,7 +322,7 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     empty = np.flatnonzero(counts == 0)
     area = np.concatenate([mesh.area, mesh.area]) if symmetric else mesh.area
     if empty.size and area[empty].sum() > EMPTY_AREA_FRACTION * area.sum():
-        raise ValueError(f"boxes {owner[empty][:10].tolist()} hold no cell centre of the "
+        raise GridTooCoarseError(f"boxes {owner[empty][:10].tolist()} hold no cell centre of the "
                          f"supersonic grid (dx {dx:.3g} m, dy {dy:.3g} m; "
                          f"{100 * area[empty].sum() / area.sum():.2g} % of the area): raise "
                          "cells_per_box")
@@ -452,8 +460,14 @@ def _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box, cells_per_wavelengt
                           f"bpw_min={bpw_min:g}; use box chords below "
                           f"{kernel_wavelength(m, k_max, b) / bpw_min:.3g} m", MeshRuleWarning,
                           stacklevel=3)
-    grid = mach_grid(mesh, m, k_max, b, symmetric, cells_per_box, cells_per_wavelength,
-                     max_cells)
+    for attempt in range(4):        # small boxes (fine meshes, slivers): refine the grid
+        try:
+            grid = mach_grid(mesh, m, k_max, b, symmetric, cells_per_box * 1.5**attempt,
+                             cells_per_wavelength, max_cells)
+            break
+        except GridTooCoarseError:
+            if attempt == 3:
+                raise
     s, tw = _transfer(mesh, grid)
     return m, ks, b, grid, s, tw
 
