@@ -14,23 +14,24 @@ Times (best of ``--repeat``) at one reduced frequency on the fin's default box m
   (:func:`asekit.aero.supersonic.supersonic_pressures`, one grid solve per mode);
 - piston theory: its matrix (a banded transfer, no solve).
 
-Measured on the 2-core project machine (shared with other jobs), k 0.5, best of 3:
+Measured on the 2-core project machine (shared with other jobs, loaded), k 0.5, best of 3,
+default grid (1.5 cells per mean box chord, Mach boxes dx = beta dy):
 
     case                                              s      x DLM AIC
-    DLM D (M 0.75)                                  0.033      0.96
-    DLM AIC (M 0.75)                                0.035      1.00
-    supersonic matrix M 1.2 (690 + 523 cells)       0.32       9.2
-    supersonic matrix M 2 (1380 + 404 cells)        0.46      13.2
-    supersonic matrix M 3 (2415 + 421 cells)        0.67      19.3
-    supersonic 6 mode columns M 2 (GAF path)        0.135      3.9
-    piston matrix M 3                               0.0006     0.02
+    DLM D (M 0.75)                                  0.054      1.19
+    DLM AIC (M 0.75)                                0.045      1.00
+    supersonic matrix M 1.2 (463 + 368 cells)       0.28       6.2
+    supersonic matrix M 2 (1125 + 302 cells)        0.49      10.8
+    supersonic matrix M 3 (1732 + 293 cells)        0.71      15.8
+    supersonic 6 mode columns M 2 (GAF path)        0.17       3.7
+    piston matrix M 3                               0.0008     0.02
 
-(run of 2026-12-01 20:10 UTC under load from other jobs; an earlier, quieter run gave 0.26,
-0.30, 0.41 s for the three matrices against a 0.037 s AIC). The issue's target, the supersonic
-AIC within 3x the DLM's time for the same boxes, is NOT met: the full 140 x 140 matrix takes
-9-19x, and even the GAF path (6 modal columns, which includes building the grid, about 0.1 s)
-takes about 4x. The full matrix costs one grid solve per box: the Mach-box grid has about 10-25 cells per box (1400-2400 wing cells for the fin at M 2-3)
-and each solve is two 2-D FFTs over it plus the diaphragm's forward substitution.
+(run of 2026-12-01 20:27 UTC; wing + diaphragm cells in brackets). The issue's target, the
+supersonic AIC within 3x the DLM's time for the same boxes, is NOT met: the full 140 x 140
+matrix takes 6-16x, and the GAF path (6 modal columns, including about 0.1 s to build the grid,
+which a k sweep builds once) about 4x. The full matrix costs one grid solve per box: the
+Mach-box grid has 6-12 wing cells per box for the fin at M 1.2-3 (more at high M, where
+dy = dx / beta narrows the cells), and each solve is two 2-D FFTs over it plus the diaphragm's forward substitution.
 """
 
 from __future__ import annotations
