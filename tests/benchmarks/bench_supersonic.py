@@ -31,7 +31,8 @@ supersonic AIC within 3x the DLM's time for the same boxes, is NOT met: the full
 matrix takes 6-16x, and the GAF path (6 modal columns, including about 0.1 s to build the grid,
 which a k sweep builds once) about 4x. The full matrix costs one grid solve per box: the
 Mach-box grid has 6-12 wing cells per box for the fin at M 1.2-3 (more at high M, where
-dy = dx / beta narrows the cells), and each solve is two 2-D FFTs over it plus the diaphragm's forward substitution.
+dy = dx / beta narrows the cells), and each solve is two 2-D FFTs over it plus the
+diaphragm's forward substitution.
 """
 
 from __future__ import annotations
