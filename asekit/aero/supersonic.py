@@ -28,7 +28,8 @@ potential, DeltaCp = Cp_lower - Cp_upper = (4 / U^2) (i omega phi + U phi_x): De
 along +z, the DLM convention. Off the wing the plane carries no load, so phi = 0 there (the
 diaphragm of [PDN55]); behind a supersonic trailing edge the wake cannot reach the wing.
 
-Discretisation (asekit's). The plane is cut into a uniform grid of rectangular cells (dx, dy);
+Discretisation (asekit's). The plane is cut into a uniform grid of rectangular cells, Mach boxes
+with dx = beta dy as in [ZH55] (the diaphragm march is unstable on finer grids otherwise);
 w is constant on each cell. With beta t = X sin(theta) the inner integral over a cell's span
 becomes dt / R = d theta / beta, so the potential influence of a cell is
 
@@ -51,7 +52,8 @@ weighted so that they carry exactly its area) is placed at the box centroid and 
 the strip's load points (1/4 chord) by the transpose of the linear interpolation from the load
 points, which keeps the virtual work of rigid plunge and pitch exact up to the midpoint rule
 (as in :mod:`asekit.aero.piston`). A uniform load gives equal lumped pressures on interior
-boxes; the first and last box of a strip carry the redistribution (0.75 and 1.25 times). The result is a
+boxes; the first and last box of a strip carry the redistribution (0.75 and 1.25 times).
+The result is a
 pressure-per-normalwash matrix DeltaCp = A (w/U) with DeltaCp lumped at the load points, the
 same kind of matrix as the DLM's AIC, so :mod:`asekit.aero.gaf` uses either.
 

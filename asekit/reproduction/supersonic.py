@@ -176,7 +176,8 @@ def torque_at_worst_supersonic(env: dict) -> dict:
             if best is None or hm > best[0]:
                 best = (hm, float(mach), float(h), float(env["Qcc"][im]), atm)
     _, mach, h, qcc, atm = best
-    tr = required_stall_torque(float(env["peak_acceleration"]), fin_inertia=THESIS_FIN_INERTIA, q_cc=qcc,
+    tr = required_stall_torque(float(env["peak_acceleration"]), fin_inertia=THESIS_FIN_INERTIA,
+                               q_cc=qcc,
                                mach=mach, density=float(atm.density),
                                speed_of_sound=float(atm.speed_of_sound))
     return {"mach": mach, "altitude": h, "q_cc": qcc, "torque": tr}
@@ -201,7 +202,8 @@ def run(figures: bool = False) -> ChapterResult:
         fl = env["flutter"][im, 0]
         first = env["first"][im, 0]
         kind = kinds[int(env["first_kind"][im, 0])]
-        note = (f"sea level, sweep {VELOCITIES[0]:.0f}-{VELOCITIES[-1]:.0f} m/s, GAFs at M {mach:g} "
+        note = (f"sea level, sweep {VELOCITIES[0]:.0f}-{VELOCITIES[-1]:.0f} m/s, "
+                f"GAFs at M {mach:g} "
                 f"(flight speed M a = {env['flight_speed'][im, 0]:.0f} m/s); first instability "
                 f"{kind}" + (f" at {first:.0f} m/s" if np.isfinite(first) else ""))
         if not np.isfinite(fl[0]):
