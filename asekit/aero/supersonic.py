@@ -306,14 +306,16 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     wake = (~wing) & (ii > last_wing_row[jj]) & (last_wing_row[jj] >= 0)
     cand = np.flatnonzero((~wing) & (~wake))
     wi, wj = ii[wing], jj[wing]
-    keep = np.zeros(cand.size, bool)
-    for c0 in range(0, cand.size, 1024):
-        c = cand[c0:c0 + 1024]
-        ddx = (ii[c][:, None] - wi[None]) * dx
-        ddy = np.abs(jj[c][:, None] - wj[None]) * dy
-        down = (ddx > 0) & (beta * (ddy - dy) < ddx + dx)       # in a wing cell's downstream cone
-        up = (ddx < 0) & (beta * (ddy - dy) < -ddx + dx)        # ahead of a wing cell's cone
-        keep[c0:c0 + 1024] = down.any(axis=1) & up.any(axis=1)
+    # keep the off-wing cells inside the downstream Mach cone of some wing cell and ahead of
+    # another's: per column, the most upstream / downstream wing cell decides (the cone test
+    # is monotone in the streamwise distance)
+    cols = np.flatnonzero(last_wing_row >= 0)
+    ddy = np.abs(jj[cand][:, None] - cols[None, :]) * dy
+    down_dx = (ii[cand][:, None] - first_wing_row[cols][None, :]) * dx
+    up_dx = (last_wing_row[cols][None, :] - ii[cand][:, None]) * dx
+    down = (down_dx > 0) & (beta * (ddy - dy) < down_dx + dx)
+    up = (up_dx > 0) & (beta * (ddy - dy) < up_dx + dx)
+    keep = down.any(axis=1) & up.any(axis=1)
     dia = cand[keep]
     n_rel = int(wing.sum()) + dia.size
     if n_rel > max_cells:
@@ -337,15 +339,18 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
 # ---------------------------------------------------------------------------------------------
 def _offset_tables(grid: MachGrid, lam: float, kap: float):
     """Influence tables over offsets (di >= 0, dj >= 0): potential I[di, dj] at a cell centre
-    and edge integrals F[m, dj] at X = (m + 1/2) dx."""
-    di = np.arange(grid.nx)[:, None]
-    dj = np.arange(grid.ny)[None, :]
-    xa = (di - 0.5) * grid.dx
+    and edge integrals F[m, dj] at X = (m + 1/2) dx; evaluated only where the Mach cone of the
+    receiving point reaches the cell (beta (dj - 1/2) dy < (di + 1/2) dx), zero elsewhere."""
+    di, dj = np.meshgrid(np.arange(grid.nx), np.arange(grid.ny), indexing="ij")
+    inside = grid.beta * (dj - 0.5) * grid.dy < (di + 0.5) * grid.dx * (1.0 + 1e-9)
+    di, dj = di[inside], dj[inside]
     xb = (di + 0.5) * grid.dx
     t1 = (dj - 0.5) * grid.dy
     t2 = (dj + 0.5) * grid.dy
-    pot = cell_potential_integral(xa, xb, t1, t2, grid.beta, lam, kap)
-    edge = edge_line_integral(xb, t1, t2, grid.beta, lam, kap)
+    pot = np.zeros((grid.nx, grid.ny), complex)
+    edge = np.zeros((grid.nx, grid.ny), complex)
+    pot[di, dj] = cell_potential_integral(xb - grid.dx, xb, t1, t2, grid.beta, lam, kap)
+    edge[di, dj] = edge_line_integral(xb, t1, t2, grid.beta, lam, kap)
     return pot, edge
 
 
