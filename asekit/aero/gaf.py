@@ -62,13 +62,25 @@ class GafDatabase:
 
 def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref: float,
                        symmetric: bool = False, method: str = "quartic",
-                       progress=None) -> np.ndarray:
+                       progress=None, aero_options: dict | None = None) -> np.ndarray:
     """Q(M, k) (n_k, n_modes, n_modes) for mode shapes already interpolated to the boxes.
 
     One LU factorisation of D(M, k) per k solves for all modes at once; the kernel geometry
-    is shared by all k (:func:`asekit.aero.dlm.normalwash_matrices`).
+    is shared by all k (:func:`asekit.aero.dlm.normalwash_matrices`). ``method`` "auto",
+    "dlm", "supersonic" or "piston" chooses the aerodynamics per Mach
+    (:mod:`asekit.aero.methods`; ``aero_options`` go to its pressure matrices); "quartic" and
+    "parabolic" are the DLM kernels.
     """
     ks = check_k(k)
+    if method not in ("quartic", "parabolic"):
+        from .methods import pressures, resolve_method
+        if resolve_method(method, mach) != "dlm" or aero_options:
+            cp = pressures(mesh, mach, ks, b_ref, lambda kk: box_modes.normalwash(kk, b_ref),
+                           method, symmetric, **(aero_options or {}))
+            if progress is not None:
+                progress(ks.size)
+            return np.stack([modal_forces(box_modes, c, mesh.area) for c in cp])
+        method = "quartic"
     d = normalwash_matrices(mesh, mach, ks, b_ref, method, symmetric)
     out = np.empty((ks.size, box_modes.h_cp.shape[1], box_modes.h_cp.shape[1]), complex)
     for ik, kk in enumerate(ks):
@@ -149,9 +161,16 @@ def _blas_threads_for(n_boxes: int):
 
 def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: float, n_rigid: int,
                        symmetric: bool = False, method: str = "quartic", progress: bool = True,
-                       metadata: dict | None = None) -> GafDatabase:
-    """Compute Q over ``machs`` x ``ks`` (tqdm bar over Mach x k when ``progress``)."""
-    machs = np.array([check_mach(m) for m in np.atleast_1d(machs)])
+                       metadata: dict | None = None,
+                       aero_options: dict | None = None) -> GafDatabase:
+    """Compute Q over ``machs`` x ``ks`` (tqdm bar over Mach x k when ``progress``); ``method``
+    and ``aero_options`` as in :func:`gaf_from_box_modes` (e.g. "auto" over subsonic and
+    supersonic Mach numbers, refusing the transonic gap)."""
+    if method in ("quartic", "parabolic"):
+        machs = np.array([check_mach(m) for m in np.atleast_1d(machs)])
+    else:
+        from .methods import resolve_method
+        machs = np.array([float(m) for m in np.atleast_1d(machs) if resolve_method(method, m)])
     ks = check_k(ks)
     if np.any(np.diff(ks) <= 0):
         raise ValueError("ks must be strictly ascending")
@@ -165,7 +184,8 @@ def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: flo
         with _blas_threads_for(mesh.n):
             for im, mach in enumerate(machs):
                 q[im] = gaf_from_box_modes(box_modes, mesh, mach, ks, b_ref, symmetric, method,
-                                           progress=None if bar is None else bar.update)
+                                           progress=None if bar is None else bar.update,
+                                           aero_options=aero_options)
     finally:
         if bar is not None:
             bar.close()
