@@ -1,0 +1,701 @@
+"""A concentrated structural nonlinearity -- freeplay, preload, bilinear stiffness -- in an
+otherwise linear aeroelastic or aeroservoelastic state-space model, analysed in the frequency
+domain (describing function + harmonic balance) and in the time domain (event-located
+piecewise-linear integration).
+
+Formulation
+-----------
+Every model handled here is a linear state-space system with one scalar nonlinear element, the
+connection moment ``f(d)`` acting across a relative rotation ``d``:
+
+    x' = A0 x + b f(d) + B_u u(t),        d = c . x,                                     (1)
+
+where ``A0`` is the system *without* the connection spring (zero stiffness across the
+connection), ``b`` maps the connection moment into the state derivatives and ``c`` picks the
+relative rotation. A linear spring of stiffness k gives ``A(k) = A0 + k b c^T``.
+
+How a modal model carries a connection whose stiffness changes is the fictitious-mass argument
+of Karpel & Wieseman (M. Karpel, C. D. Wieseman, "Modal coordinates for aeroelastic analysis
+with large local structural variations", J. Aircraft 31(2), 1994, 396-403; Karpel, Moulin &
+Love, "Modal-based structural optimization with static aeroelastic and stress constraints",
+J. Aircraft 34(3), 1997): normal modes computed with a large fictitious mass at the connection
+contain the local connection motion, so one modal basis represents the structure for any
+connection stiffness. asekit's FN2 model (:func:`asekit.structure.modes.fin_modal_model`) is
+exactly that basis: the rigid pitch mode (a unit rotation of the whole fin about the shaft) and
+the elastic modes computed with the shaft spring k_s present. Used as Ritz vectors for the *fin
+alone* -- fin coordinates xi = [theta_f, zeta_s], fin displacement phi_R theta_f + Phi_s zeta_s
+-- the structure's stiffness splits exactly into the plate's own and the connection's:
+
+    K_plate = blockdiag(0, K_ss - k_s r r^T),     connection: f(d),  d = theta_f + r . zeta_s - theta_t,
+
+with r the elastic modes' rotation of the shaft node (the FN1 modes satisfy
+K_ss = Phi_s^T (K_plate + k_s e e^T) Phi_s, e^T Phi_s = r) and theta_t the transmission angle.
+The nonlinear spring therefore acts through the rigid pitch coordinate, which here is the fin's
+own rotation, not the actuator's. With a linear k_s and theta_f = theta_t this is the thesis's
+FN2 model (Eq. 2.46); with theta_f free it is a Ritz model with one coordinate more, which is
+what lets the fin rotate freely inside the freeplay band (the elastic modes alone cannot: without
+the spring, K_ss - k_s r r^T of the fin has its lowest frequency at 41 Hz instead of 0). The
+builders for the fin (alone or in the AEM1/AEM2 loop) live in :mod:`asekit.reproduction.freeplay`;
+this module only needs (A0, b, c).
+
+Connection law (frozen :class:`Connection`): stiffness k outside a band of half-width delta
+centred on ``preload`` (rad; the band is [preload - delta, preload + delta]), stiffness k1
+(``inner_stiffness``, 0 for pure freeplay) inside it, continuous:
+
+    f(d) = k1 (d - p)                                 |d - p| <= delta
+    f(d) = k1 delta sgn + k (d - p - delta sgn)        otherwise, sgn = sign(d - p).       (2)
+
+Describing function (sinusoidal input d = A sin(omega t), p = 0; Gelb & Vander Velde,
+*Multiple-Input Describing Functions and Nonlinear System Design*, 1968, ch. 2, dead zone):
+
+    N(A) = k1,                                                    A <= delta
+    N(A) = k1 + (k - k1) [1 - (2/pi)(asin(delta/A) + (delta/A) sqrt(1 - (delta/A)^2))],  A > delta.  (3)
+
+N is real (no hysteresis) and increases monotonically from k1 to k, so its inverse is unique.
+Harmonic balance: an LCO of amplitude A exists where A(N(A)) = A0 + N(A) b c^T has a root on the
+imaginary axis (Tang & Dowell's "equivalent linearisation"; e.g. Tang, Conner & Dowell, J.
+Aircraft 35(2) 1998). :func:`harmonic_balance` sweeps the stiffness ratio kappa = N / k on
+[k1/k, 1], brackets the sign changes of the growth rate sigma(kappa) (largest real part of the
+oscillatory roots), refines each with Brent's method and classifies it with the Krylov-Bogoliubov
+criterion: a perturbation that increases A increases kappa, so the LCO is stable when
+d sigma / d kappa < 0 there and unstable when > 0 (N. Krylov, N. Bogoliubov, *Introduction to
+Non-Linear Mechanics*, 1943; Gelb & Vander Velde Sec. 2.7 limit-cycle stability). The freeplay
+problem is scale-invariant: with k1 = 0 the LCO amplitudes are proportional to delta.
+
+Time domain (:func:`simulate`): within each region of (2) the system is linear and affine,
+x' = (A0 + k_r b c^T) x + f0_r b + B_u u. The region switches d = p +- delta are located as
+``solve_ivp`` events (root of the dense-output interpolant, Brent's method to ~4 eps in time),
+not smoothed; the integration restarts in the new region from the event state. The switching
+error is the dense-output interpolation error of the step that contains the event (of order the
+local error tolerance ``rtol``), and the state is continuous across the switch because f is.
+Conner, Tang, Dowell & Virgin (J. Fluids Struct. 11, 1997) located the same switching points
+with Henon's method; both are exact to the integrator's tolerance.
+
+Units: SI (rad, N m/rad, s); degrees and Hz only where a name says so (``frequency_hz``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from .validate import finite, in_range, positive
+
+# ---------------------------------------------------------------------------------------------
+# the connection law and its describing function
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Connection:
+    """A piecewise-linear connection moment f(d) (N m) across a relative rotation d (rad),
+    Eq. (2) of the module docstring.
+
+    Parameters
+    ----------
+    stiffness : k outside the band (N m/rad), > 0.
+    freeplay : delta, half-width of the band (rad), >= 0 (total freeplay 2 delta).
+    inner_stiffness : k1 inside the band (N m/rad), 0 <= k1 <= k (0: freeplay; between:
+        bilinear stiffness; k1 = k: linear).
+    preload : p, centre of the band relative to the unloaded position (rad); |p| <= delta (a
+        band that does not contain the unloaded position is a preloaded spring, not freeplay
+        about it, and is refused).
+    """
+
+    stiffness: float
+    freeplay: float = 0.0
+    inner_stiffness: float = 0.0
+    preload: float = 0.0
+
+    def __post_init__(self):
+        k = positive("stiffness", self.stiffness)
+        delta = in_range("freeplay", self.freeplay, 0.0, inclusive=True)
+        in_range("inner_stiffness", self.inner_stiffness, 0.0, inclusive=True, high=k)
+        p = finite("preload", self.preload)
+        if abs(p) > delta * (1 + 1e-12):
+            raise ValueError(f"preload must lie within the freeplay band [-{delta:g}, {delta:g}] "
+                             f"rad, got {p!r}")
+
+    @property
+    def is_linear(self) -> bool:
+        """True when f is linear (no band or k1 = k)."""
+        return self.freeplay == 0.0 or self.inner_stiffness == self.stiffness
+
+    @property
+    def breakpoints(self) -> tuple[float, float]:
+        """The band edges (p - delta, p + delta) (rad)."""
+        return (self.preload - self.freeplay, self.preload + self.freeplay)
+
+    def region_of(self, d: float) -> int:
+        """-1 below the band, 0 inside, +1 above."""
+        lo, hi = self.breakpoints
+        return -1 if d < lo else (1 if d > hi else 0)
+
+    def region_law(self, region: int) -> tuple[float, float]:
+        """(slope k_r, intercept f0_r) with f(d) = k_r d + f0_r in ``region`` (-1, 0, +1)."""
+        k, k1, p, dl = self.stiffness, self.inner_stiffness, self.preload, self.freeplay
+        if region == 0:
+            return k1, -k1 * p
+        s = float(np.sign(region))
+        return k, k1 * dl * s - k * (p + dl * s)
+
+    def moment(self, d):
+        """f(d) (N m) of Eq. (2), elementwise."""
+        d = np.asarray(d, dtype=float)
+        k, k1, p, dl = self.stiffness, self.inner_stiffness, self.preload, self.freeplay
+        e = d - p
+        out = k1 * e
+        over = np.abs(e) > dl
+        s = np.sign(e)
+        return np.where(over, k1 * dl * s + k * (e - dl * s), out)
+
+    def describing_function(self, amplitude):
+        """N(A) (N m/rad) of Eq. (3) for d = A sin(omega t), elementwise; needs preload 0
+        (a band off-centre needs a bias-plus-sinusoid describing function, not provided).
+        ``amplitude`` (rad) must be >= 0."""
+        _require_centred(self)
+        a = np.asarray(amplitude, dtype=float)
+        if np.any(~np.isfinite(a)) or np.any(a < 0):
+            raise ValueError(f"amplitude must be finite and >= 0, got {amplitude}")
+        k, k1, dl = self.stiffness, self.inner_stiffness, self.freeplay
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = np.where(a > dl, dl / np.where(a > 0, a, 1.0), 1.0)
+        return k1 + (k - k1) * deadzone_gain(s)
+
+    def amplitude_for(self, equivalent_stiffness: float) -> float:
+        """The amplitude A (rad) with N(A) = ``equivalent_stiffness``, inverse of Eq. (3).
+
+        Valid for k1 <= N < k (N = k1 returns delta: any amplitude inside the band has that
+        stiffness; N = k is reached only as A -> inf and raises). Scales with delta."""
+        _require_centred(self)
+        k, k1, dl = self.stiffness, self.inner_stiffness, self.freeplay
+        if self.is_linear:
+            raise ValueError("a linear connection has no amplitude-dependent stiffness")
+        ne = float(equivalent_stiffness)
+        if not (k1 <= ne < k) or not math.isfinite(ne):
+            raise ValueError(f"equivalent_stiffness must lie in [{k1:g}, {k:g}) N m/rad, got "
+                             f"{equivalent_stiffness!r}")
+        target = (ne - k1) / (k - k1)
+        if target <= 0.0:
+            return dl
+        s = brentq(lambda s_: deadzone_gain(s_) - target, 0.0, 1.0, xtol=1e-15, rtol=1e-14)
+        return dl / s if s > 0 else math.inf
+
+
+def deadzone_gain(s):
+    """g(s) = 1 - (2/pi)(asin s + s sqrt(1 - s^2)), s = delta / A in [0, 1]: the describing
+    function of a unit-slope dead zone of half-width delta (Gelb & Vander Velde 1968). g(0) = 1
+    (A -> inf), g(1) = 0 (A = delta); monotonically decreasing."""
+    s = np.clip(np.asarray(s, dtype=float), 0.0, 1.0)
+    return 1.0 - (2.0 / math.pi) * (np.arcsin(s) + s * np.sqrt(1.0 - s * s))
+
+
+def _require_centred(conn: Connection):
+    if conn.preload != 0.0:
+        raise ValueError("the describing-function analysis needs a centred band (preload = 0); "
+                         f"got preload = {conn.preload!r} rad -- use the time-domain simulate()")
+
+
+# ---------------------------------------------------------------------------------------------
+# the linear system around the connection
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ConnectedSystem:
+    """The linear system of Eq. (1) around one scalar connection.
+
+    A0 : (n, n) state matrix with zero stiffness across the connection.
+    b : (n,) state derivative per unit connection moment (1/(N m) s units of x').
+    c : (n,) the relative rotation d = c . x (rad).
+    B_u : (n, m) input matrix of the external inputs u (e.g. a command), or (n, 0).
+    outputs : ``{name: (row (n,), feed (m,))}`` linear outputs y = row . x + feed . u.
+    velocity : airspeed (m/s) the matrices belong to (informational).
+    state_names : optional names.
+    """
+
+    A0: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    B_u: np.ndarray | None = None
+    outputs: dict = field(default_factory=dict)
+    velocity: float | None = None
+    state_names: tuple = ()
+
+    def __post_init__(self):
+        A0 = np.asarray(self.A0, float)
+        n = A0.shape[0]
+        if A0.shape != (n, n) or not np.all(np.isfinite(A0)):
+            raise ValueError(f"A0 must be a finite square matrix, got shape {A0.shape}")
+        for name in ("b", "c"):
+            v = np.asarray(getattr(self, name), float).ravel()
+            if v.size != n or not np.all(np.isfinite(v)):
+                raise ValueError(f"{name} must be a finite vector of length {n}")
+            object.__setattr__(self, name, v)
+        object.__setattr__(self, "A0", A0)
+        B = np.zeros((n, 0)) if self.B_u is None else np.asarray(self.B_u, float).reshape(n, -1)
+        object.__setattr__(self, "B_u", B)
+
+    @property
+    def n_states(self) -> int:
+        return self.A0.shape[0]
+
+    def state_matrix(self, stiffness: float) -> np.ndarray:
+        """A(k) = A0 + k b c^T: the linear system with a connection spring k (N m/rad)."""
+        return self.A0 + float(stiffness) * np.outer(self.b, self.c)
+
+    def eigenvalues(self, stiffness: float) -> np.ndarray:
+        """Roots (1/s) of A(k)."""
+        return np.linalg.eigvals(self.state_matrix(stiffness))
+
+
+def growth_rate(system: ConnectedSystem, stiffness: float, min_frequency_hz: float = 0.05):
+    """(sigma, omega, sigma_real): the largest real part (1/s) of the oscillatory roots of A(k)
+    (|Im| >= 2 pi ``min_frequency_hz``), that root's frequency (rad/s), and the largest real
+    part of the real (non-oscillatory) roots (-inf if none)."""
+    ev = system.eigenvalues(stiffness)
+    osc = np.abs(ev.imag) >= 2 * math.pi * min_frequency_hz
+    if not osc.any():
+        return -math.inf, 0.0, float(np.max(ev.real))
+    i = np.argmax(np.where(osc, ev.real, -np.inf))
+    real = ev.real[~osc]
+    return float(ev.real[i]), float(abs(ev.imag[i])), (float(real.max()) if real.size
+                                                       else -math.inf)
+
+
+def flutter_stiffness_band(system: ConnectedSystem, k_max: float, n: int = 60):
+    """Stiffness values on [0, k_max] (N m/rad, n points) and their growth rates sigma (1/s),
+    for plotting where the linear system with a spring k is unstable."""
+    ks = np.linspace(0.0, positive("k_max", k_max), int(n))
+    return ks, np.array([growth_rate(system, k)[0] for k in ks])
+
+
+# ---------------------------------------------------------------------------------------------
+# harmonic balance
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Lco:
+    """One harmonic-balance limit cycle: ``amplitude`` of d (rad), ``frequency_hz``,
+    ``stiffness_ratio`` kappa = N(A) / k, ``stable`` (Krylov-Bogoliubov), ``slope``
+    d sigma / d kappa (1/s), ``output_amplitudes`` {name: amplitude} of the system's named
+    outputs on the neutral eigenvector (same unit as the output)."""
+
+    amplitude: float
+    frequency_hz: float
+    stiffness_ratio: float
+    stable: bool
+    slope: float
+    output_amplitudes: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class HarmonicBalance:
+    """Harmonic-balance result at one airspeed.
+
+    lcos : the LCOs found, ascending amplitude. unbounded : the system with the full stiffness
+    k (A -> inf) is unstable, so oscillations larger than the largest LCO grow without bound
+    (above the linear flutter speed). inside_band_unstable : the system with k1 (|d| <= delta)
+    is unstable, so the rest position is unstable. static_instability : a real root is unstable
+    somewhere in [k1, k] (divergence; the describing function's harmonic assumption does not
+    hold there). amplitude_range : the amplitudes searched (rad). message : a sentence.
+    """
+
+    velocity: float | None
+    lcos: tuple
+    unbounded: bool
+    inside_band_unstable: bool
+    static_instability: bool
+    amplitude_range: tuple
+    message: str
+
+    @property
+    def stable_lcos(self) -> tuple:
+        return tuple(lc for lc in self.lcos if lc.stable)
+
+    def largest_stable(self) -> Lco | None:
+        s = self.stable_lcos
+        return s[-1] if s else None
+
+
+def harmonic_balance(system: ConnectedSystem, connection: Connection, n_grid: int = 48,
+                     amplitude_range: tuple[float, float] | None = None,
+                     min_frequency_hz: float = 0.05) -> HarmonicBalance:
+    """Harmonic-balance LCO search at one airspeed (module docstring, Eq. 3).
+
+    Parameters
+    ----------
+    system : the linear system around the connection (:class:`ConnectedSystem`).
+    connection : a centred freeplay or bilinear :class:`Connection` (k1 < k, delta > 0).
+    n_grid : stiffness-ratio samples on [k1/k, 1] (clustered towards 1, where large amplitudes
+        live); every sign change of sigma between neighbours is refined by Brent's method.
+    amplitude_range : (A_min, A_max) in rad, delta <= A_min < A_max <= inf, to restrict the
+        search; default (delta, inf), i.e. every equivalent stiffness.
+    min_frequency_hz : roots below this frequency count as real (static).
+
+    Returns
+    -------
+    :class:`HarmonicBalance`; when no LCO exists in the range, ``lcos`` is empty and
+    ``message`` says "no LCO found in [A_min, A_max] rad".
+    """
+    if not isinstance(connection, Connection):
+        raise TypeError(f"connection must be a Connection, got {type(connection).__name__}")
+    _require_centred(connection)
+    if connection.freeplay <= 0 or connection.is_linear:
+        raise ValueError("harmonic balance needs a nonlinear connection: freeplay > 0 and "
+                         "inner_stiffness < stiffness")
+    n_grid = int(n_grid)
+    if n_grid < 4:
+        raise ValueError(f"n_grid must be >= 4, got {n_grid}")
+    k, k1, dl = connection.stiffness, connection.inner_stiffness, connection.freeplay
+    if amplitude_range is None:
+        a_lo, a_hi = dl, math.inf
+    else:
+        a_lo, a_hi = (float(v) for v in amplitude_range)
+        if not (a_lo >= dl * (1 - 1e-12) and a_hi > a_lo) or math.isnan(a_hi):
+            raise ValueError(f"amplitude_range must satisfy delta = {dl:g} <= A_min < A_max, "
+                             f"got {amplitude_range!r} rad")
+    kap_lo = float((connection.describing_function(a_lo) if a_lo > dl else k1) / k)
+    kap_hi = 1.0 if math.isinf(a_hi) else float(connection.describing_function(a_hi) / k)
+    # grid clustered towards kappa = 1 (amplitude ~ delta / (1 - kappa) there)
+    u = np.linspace(0.0, 1.0, n_grid)
+    kap = kap_lo + (kap_hi - kap_lo) * (1.0 - (1.0 - u) ** 2)
+
+    def sig(kp):
+        return growth_rate(system, kp * k, min_frequency_hz)
+
+    vals = [sig(kp) for kp in kap]
+    s = np.array([v[0] for v in vals])
+    s_real = np.array([v[2] for v in vals])
+    sig_k1 = s[0] if kap_lo == k1 / k else sig(k1 / k)[0]
+    sig_full = s[-1] if kap_hi == 1.0 else sig(1.0)[0]
+    lcos = []
+    for i in np.nonzero(np.sign(s[:-1]) * np.sign(s[1:]) < 0)[0]:
+        if not (np.isfinite(s[i]) and np.isfinite(s[i + 1])):
+            continue
+        ks = brentq(lambda kp: sig(kp)[0], kap[i], kap[i + 1], xtol=1e-13, rtol=1e-12)
+        if ks >= 1.0 - 1e-12:
+            continue
+        slope = (s[i + 1] - s[i]) / (kap[i + 1] - kap[i])
+        amp = connection.amplitude_for(ks * k)
+        _, om, _ = sig(ks)
+        lcos.append(Lco(amplitude=amp, frequency_hz=om / (2 * math.pi), stiffness_ratio=ks,
+                        stable=bool(slope < 0), slope=float(slope),
+                        output_amplitudes=_output_amplitudes(system, ks * k, om, amp)))
+    lcos.sort(key=lambda lc: lc.amplitude)
+    unbounded = bool(sig_full > 0)
+    band_unstable = bool(sig_k1 > 0)
+    static = bool(np.any(s_real > 0))
+    rng = f"[{a_lo:.4g}, {a_hi:.4g}] rad"
+    if lcos:
+        msg = (f"{len(lcos)} LCO(s) in {rng}: "
+               + ", ".join(f"{lc.amplitude:.4g} rad at {lc.frequency_hz:.4g} Hz "
+                           f"({'stable' if lc.stable else 'unstable'})" for lc in lcos))
+    else:
+        msg = f"no LCO found in {rng}"
+    if unbounded:
+        msg += "; unstable with the full stiffness: large oscillations grow without bound"
+    if static:
+        msg += "; a real root is unstable in the band of equivalent stiffness (static)"
+    return HarmonicBalance(velocity=system.velocity, lcos=tuple(lcos), unbounded=unbounded,
+                           inside_band_unstable=band_unstable, static_instability=static,
+                           amplitude_range=(a_lo, a_hi), message=msg)
+
+
+def _output_amplitudes(system: ConnectedSystem, stiffness: float, omega: float,
+                       amplitude: float) -> dict:
+    """Amplitudes of the named outputs on the neutral eigenvector, scaled so |c . v| = A."""
+    if not system.outputs:
+        return {}
+    w, v = np.linalg.eig(system.state_matrix(stiffness))
+    j = np.argmin(np.abs(w - 1j * omega))
+    vec = v[:, j]
+    dv = abs(system.c @ vec)
+    if dv == 0:
+        return {}
+    return {name: float(abs(np.asarray(row) @ vec) / dv * amplitude)
+            for name, (row, _feed) in system.outputs.items()}
+
+
+@dataclass(frozen=True)
+class LcoCurve:
+    """Harmonic balance over airspeeds: ``velocities`` (m/s), ``results``
+    (HarmonicBalance per speed), the connection, and convenience arrays of the largest stable
+    LCO per speed (NaN where there is none -- use ``has_stable`` to mask)."""
+
+    velocities: np.ndarray
+    results: tuple
+    connection: Connection
+
+    @property
+    def has_stable(self) -> np.ndarray:
+        return np.array([r.largest_stable() is not None for r in self.results])
+
+    def stable_amplitude(self) -> np.ndarray:
+        """Largest stable LCO amplitude of d (rad) per speed, NaN where none (masked by
+        ``has_stable``)."""
+        return np.array([r.largest_stable().amplitude if r.largest_stable() else math.nan
+                         for r in self.results])
+
+    def stable_frequency_hz(self) -> np.ndarray:
+        return np.array([r.largest_stable().frequency_hz if r.largest_stable() else math.nan
+                         for r in self.results])
+
+    def onset_speed(self) -> float | None:
+        """Lowest speed of the sweep with any LCO (stable or unstable) or an unstable rest
+        position; None if none."""
+        for u, r in zip(self.velocities, self.results):
+            if r.lcos or r.inside_band_unstable:
+                return float(u)
+        return None
+
+
+def lco_curve(system_at, velocities, connection: Connection, **kwargs) -> LcoCurve:
+    """:func:`harmonic_balance` at each airspeed. ``system_at(U)`` returns the
+    :class:`ConnectedSystem` at airspeed U (m/s); extra keyword arguments go to
+    :func:`harmonic_balance`."""
+    v = np.atleast_1d(np.asarray(velocities, float))
+    if v.size == 0 or not np.all(np.isfinite(v)) or np.any(v <= 0):
+        raise ValueError(f"velocities must be finite and > 0, got {velocities}")
+    res = tuple(harmonic_balance(system_at(float(u)), connection, **kwargs) for u in v)
+    return LcoCurve(velocities=v, results=res, connection=connection)
+
+
+def refine_onset(system_at, connection: Connection, u_lo: float, u_hi: float,
+                 xtol: float = 0.01, **kwargs) -> float:
+    """Lowest airspeed in [u_lo, u_hi] (m/s) at which a harmonic-balance LCO exists, by
+    bisection to ``xtol`` m/s. Needs no LCO at u_lo and one at u_hi (ValueError otherwise)."""
+    def has(u):
+        r = harmonic_balance(system_at(u), connection, **kwargs)
+        return bool(r.lcos) or r.inside_band_unstable
+    if has(u_lo) or not has(u_hi):
+        raise ValueError(f"[{u_lo:g}, {u_hi:g}] m/s does not bracket the LCO onset")
+    a, b = float(u_lo), float(u_hi)
+    while b - a > xtol:
+        m = 0.5 * (a + b)
+        a, b = (a, m) if has(m) else (m, b)
+    return b
+
+
+# ---------------------------------------------------------------------------------------------
+# time domain
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PiecewiseSimulation:
+    """Time history of :func:`simulate`: ``t`` (s), ``x`` (n_states, n_t), ``d`` (rad),
+    ``moment`` f(d) (N m), ``outputs`` {name: history}, ``switch_times`` (s, the located region
+    switches) and ``switch_d`` (d there, rad: equal to a band edge to the event tolerance),
+    ``diverged`` (|d| passed ``divergence_limit`` and the run stopped there)."""
+
+    t: np.ndarray
+    x: np.ndarray
+    d: np.ndarray
+    moment: np.ndarray
+    outputs: dict
+    switch_times: np.ndarray
+    switch_d: np.ndarray
+    diverged: bool
+
+
+def simulate(system: ConnectedSystem, connection: Connection, x0, t_final: float,
+             u=None, n_out: int = 20001, rtol: float = 1e-8, atol: float = 1e-11,
+             method: str = "RK45", max_step: float = math.inf, max_switches: int = 200000,
+             divergence_limit: float | None = None) -> PiecewiseSimulation:
+    """Integrate Eq. (1) with the piecewise-linear connection, region switches located as
+    events (module docstring).
+
+    Parameters
+    ----------
+    system, connection : the linear system and its connection law.
+    x0 : initial state (n_states,).
+    t_final : end time (s), > 0. n_out : uniform output samples on [0, t_final].
+    u : external input: None (zero), a constant vector (m,), or a callable t -> (m,).
+    rtol, atol, method, max_step : passed to :func:`scipy.integrate.solve_ivp`.
+    max_switches : refuse to go on after this many switches (a chattering or grazing motion
+        would otherwise loop for ever): RuntimeError.
+    divergence_limit : stop (``diverged=True``) when |d| exceeds it (rad); default
+        1e3 max(delta, |d(0)|) so an unbounded flutter does not overflow.
+    """
+    if not isinstance(connection, Connection):
+        raise TypeError(f"connection must be a Connection, got {type(connection).__name__}")
+    n = system.n_states
+    x = np.asarray(x0, float).ravel()
+    if x.size != n or not np.all(np.isfinite(x)):
+        raise ValueError(f"x0 must be a finite vector of length {n}")
+    t_final = positive("t_final", t_final)
+    m = system.B_u.shape[1]
+    if u is None:
+        u_fun = None
+    elif callable(u):
+        u_fun = u
+    else:
+        uc = np.asarray(u, float).ravel()
+        if uc.size != m:
+            raise ValueError(f"u must have {m} entries, got {uc.size}")
+        u_fun = (lambda t, _u=uc: _u)
+    if divergence_limit is None:
+        scale = max(connection.freeplay, abs(float(system.c @ x)))
+        lim = 1e3 * scale if scale > 0 else math.inf
+    else:
+        lim = positive("divergence_limit", divergence_limit)
+    lo, hi = connection.breakpoints
+    c, b, A0, Bu = system.c, system.b, system.A0, system.B_u
+    mats = {}
+    for r in (-1, 0, 1):
+        kr, f0 = connection.region_law(r)
+        mats[r] = (A0 + kr * np.outer(b, c), f0 * b)
+    nonlinear = not connection.is_linear and connection.freeplay > 0
+
+    def rhs_factory(r):
+        Ar, fr = mats[r]
+        if u_fun is None:
+            return lambda t, y: Ar @ y + fr
+        return lambda t, y: Ar @ y + fr + Bu @ u_fun(t)
+
+    def pick_region(t, y):
+        if not nonlinear:
+            return 1          # linear: the law above the band is k d - k p everywhere
+        d = c @ y
+        r = connection.region_of(d)
+        scale = max(connection.freeplay, 1e-300)
+        if abs(d - lo) <= 1e-9 * scale or abs(d - hi) <= 1e-9 * scale:
+            # on a switch: the side the motion goes to (d' is continuous across it)
+            dd = c @ rhs_factory(0)(t, y)
+            edge_hi = abs(d - hi) <= abs(d - lo)
+            if edge_hi:
+                r = 1 if dd > 0 else 0
+            else:
+                r = -1 if dd < 0 else 0
+        return r
+
+    def events_for(r):
+        evs = []
+        if nonlinear:
+            if r >= 0:                       # leaving downwards through the lower edge
+                e = (lambda t, y, e0=(lo if r == 0 else hi): c @ y - e0)
+                e.terminal, e.direction = True, -1.0
+                evs.append(e)
+            if r <= 0:                       # leaving upwards through the upper edge
+                e = (lambda t, y, e0=(hi if r == 0 else lo): c @ y - e0)
+                e.terminal, e.direction = True, 1.0
+                evs.append(e)
+        big = lambda t, y: abs(c @ y) - lim  # noqa: E731
+        big.terminal, big.direction = True, 1.0
+        evs.append(big)
+        return evs
+
+    t_out = np.linspace(0.0, t_final, int(n_out))
+    X = np.full((n, t_out.size), np.nan)
+    switches, switch_d = [], []
+    t0 = 0.0
+    diverged = False
+    n_sw = 0
+    stalls = 0
+    while t0 < t_final:
+        r = pick_region(t0, x)
+        extra = {"jac": mats[r][0]} if method in ("Radau", "BDF", "LSODA") else {}
+        sol = solve_ivp(rhs_factory(r), (t0, t_final), x, method=method, rtol=rtol, atol=atol,
+                        max_step=max_step, events=events_for(r), dense_output=True, **extra)
+        if sol.status < 0:
+            raise RuntimeError(f"integration failed at t = {t0:.6g} s: {sol.message}")
+        t1 = float(sol.t[-1])
+        sel = (t_out >= t0) & (t_out <= t1)
+        if sel.any():
+            X[:, sel] = sol.sol(t_out[sel])
+        x = sol.y[:, -1].copy()
+        if sol.status == 1:                 # an event
+            hit_big = sol.t_events[-1].size > 0
+            if hit_big:
+                diverged = True
+                break
+            switches.append(t1)
+            switch_d.append(float(c @ x))
+            n_sw += 1
+            stalls = stalls + 1 if t1 - t0 <= 1e-12 * max(t_final, 1.0) else 0
+            if n_sw > max_switches or stalls > 100:
+                raise RuntimeError(f"more than {max_switches} region switches (or a grazing "
+                                   f"motion chattering on a band edge) by t = {t1:.6g} s; "
+                                   "no settled response")
+        t0 = t1
+    if diverged:
+        keep = ~np.isnan(X[0])
+        t_o, X = t_out[keep], X[:, keep]
+    else:
+        t_o = t_out
+    d = c @ X
+    outs = {}
+    for name, (row, feed) in system.outputs.items():
+        y = np.asarray(row) @ X
+        if u_fun is not None and np.any(np.asarray(feed) != 0):
+            y = y + np.array([np.asarray(feed) @ u_fun(tt) for tt in t_o])
+        outs[name] = y
+    return PiecewiseSimulation(t=t_o, x=X, d=d, moment=connection.moment(d), outputs=outs,
+                               switch_times=np.array(switches), switch_d=np.array(switch_d),
+                               diverged=diverged)
+
+
+@dataclass(frozen=True)
+class TimeDomainLco:
+    """Steady oscillation read from a simulation: ``amplitude`` (half peak-to-peak of the
+    signal over the last cycles, rad), ``frequency_hz`` (from the mean period of those cycles),
+    ``settled`` (successive peaks agree within the tolerance), ``kind`` ("lco", "decayed",
+    "diverged", "not settled"), ``message``."""
+
+    amplitude: float
+    frequency_hz: float
+    settled: bool
+    kind: str
+    message: str
+
+
+def steady_oscillation(t: np.ndarray, y: np.ndarray, n_cycles: int = 6,
+                       rel_tol: float = 0.005, floor: float = 0.0,
+                       diverged: bool = False) -> TimeDomainLco:
+    """Amplitude and frequency of the steady oscillation at the end of a history.
+
+    The last ``n_cycles`` maxima and minima (parabola-refined) give the amplitude
+    (mean of half peak-to-peak) and the period (mean spacing of the maxima). ``settled`` when
+    the half peak-to-peak of those cycles varies by less than ``rel_tol`` relative. An
+    amplitude below ``floor`` is "decayed" (e.g. the motion stuck inside the freeplay band).
+    Never NaN: a history without enough cycles is "not settled" with amplitude and frequency 0.
+    """
+    t = np.asarray(t, float)
+    y = np.asarray(y, float)
+    if diverged:
+        return TimeDomainLco(0.0, 0.0, False, "diverged", "the response grew without bound")
+    ymid = y - 0.5 * (np.max(y[t >= t[-1] * 0.5]) + np.min(y[t >= t[-1] * 0.5]))
+    i_max = np.nonzero((ymid[1:-1] > ymid[:-2]) & (ymid[1:-1] >= ymid[2:]))[0] + 1
+    i_min = np.nonzero((ymid[1:-1] < ymid[:-2]) & (ymid[1:-1] <= ymid[2:]))[0] + 1
+    amp_all = 0.5 * (np.max(y[-max(len(y) // 10, 3):]) - np.min(y[-max(len(y) // 10, 3):]))
+    if amp_all <= floor:
+        return TimeDomainLco(float(amp_all), 0.0, True, "decayed",
+                             f"oscillation below {floor:.3g} at the end (decayed)")
+    if i_max.size < n_cycles + 1 or i_min.size < n_cycles + 1:
+        return TimeDomainLco(0.0, 0.0, False, "not settled",
+                             f"fewer than {n_cycles + 1} cycles in the history")
+
+    def refine(idx):
+        ya, yb, yc = y[idx - 1], y[idx], y[idx + 1]
+        den = ya - 2 * yb + yc
+        off = np.where(den != 0, 0.5 * (ya - yc) / np.where(den != 0, den, 1.0), 0.0)
+        dt = t[idx + 1] - t[idx]
+        return t[idx] + off * dt, yb - 0.25 * (ya - yc) * off
+
+    tmx, ymx = refine(i_max[-(n_cycles + 1):])
+    _, ymn = refine(i_min[-(n_cycles + 1):])
+    half = 0.5 * (ymx[1:] - ymn[1:])
+    amp = float(np.mean(half))
+    period = float(np.mean(np.diff(tmx)))
+    spread = float((half.max() - half.min()) / max(abs(amp), 1e-300))
+    settled = spread < rel_tol
+    kind = "lco" if settled else "not settled"
+    msg = (f"amplitude {amp:.5g}, frequency {1 / period:.5g} Hz, peak spread {spread:.2%}"
+           + ("" if settled else f" > {rel_tol:.2%}: not settled"))
+    return TimeDomainLco(amp, 1.0 / period, settled, kind, msg)
