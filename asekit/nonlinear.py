@@ -643,59 +643,77 @@ def simulate(system: ConnectedSystem, connection: Connection, x0, t_final: float
 
 @dataclass(frozen=True)
 class TimeDomainLco:
-    """Steady oscillation read from a simulation: ``amplitude`` (half peak-to-peak of the
-    signal over the last cycles, rad), ``frequency_hz`` (from the mean period of those cycles),
-    ``settled`` (successive peaks agree within the tolerance), ``kind`` ("lco", "decayed",
-    "diverged", "not settled"), ``message``."""
+    """Steady oscillation read from a simulation (same unit as the signal).
+
+    amplitude : first-harmonic amplitude at the fundamental frequency (what a describing
+    function predicts); peak : half peak-to-peak; bias : mean; frequency_hz : fundamental;
+    settled : the last two windows of ``n_cycles`` periods agree within the tolerance;
+    kind : "lco", "decayed", "diverged" or "not settled"; message : a sentence.
+    """
 
     amplitude: float
     frequency_hz: float
     settled: bool
     kind: str
     message: str
+    peak: float = 0.0
+    bias: float = 0.0
 
 
-def steady_oscillation(t: np.ndarray, y: np.ndarray, n_cycles: int = 6,
-                       rel_tol: float = 0.005, floor: float = 0.0,
+def steady_oscillation(t: np.ndarray, y: np.ndarray, n_cycles: int = 8,
+                       rel_tol: float = 0.01, floor: float = 0.0,
                        diverged: bool = False) -> TimeDomainLco:
-    """Amplitude and frequency of the steady oscillation at the end of a history.
+    """Amplitude and frequency of the steady oscillation at the end of a uniformly sampled
+    history.
 
-    The last ``n_cycles`` maxima and minima (parabola-refined) give the amplitude
-    (mean of half peak-to-peak) and the period (mean spacing of the maxima). ``settled`` when
-    the half peak-to-peak of those cycles varies by less than ``rel_tol`` relative. An
-    amplitude below ``floor`` is "decayed" (e.g. the motion stuck inside the freeplay band).
-    Never NaN: a history without enough cycles is "not settled" with amplitude and frequency 0.
+    The fundamental frequency is the largest peak of the Hann-windowed, zero-padded spectrum of
+    the second half of the record (parabola-refined). Over each of the last two windows of
+    ``n_cycles`` fundamental periods, y is fitted by least squares with
+    B + a cos(omega t) + b sin(omega t): the first-harmonic amplitude sqrt(a^2 + b^2) and the
+    half peak-to-peak are compared between the two windows; ``settled`` when both agree within
+    ``rel_tol`` (a period-doubled, quasi-periodic or chaotic motion does not). An end amplitude
+    (half peak-to-peak of the last tenth) at or below ``floor`` is "decayed". Never NaN: a
+    record with fewer than 2 ``n_cycles`` periods in its second half is "not settled" with
+    zero amplitude and frequency.
     """
     t = np.asarray(t, float)
     y = np.asarray(y, float)
     if diverged:
         return TimeDomainLco(0.0, 0.0, False, "diverged", "the response grew without bound")
-    ymid = y - 0.5 * (np.max(y[t >= t[-1] * 0.5]) + np.min(y[t >= t[-1] * 0.5]))
-    i_max = np.nonzero((ymid[1:-1] > ymid[:-2]) & (ymid[1:-1] >= ymid[2:]))[0] + 1
-    i_min = np.nonzero((ymid[1:-1] < ymid[:-2]) & (ymid[1:-1] <= ymid[2:]))[0] + 1
-    amp_all = 0.5 * (np.max(y[-max(len(y) // 10, 3):]) - np.min(y[-max(len(y) // 10, 3):]))
-    if amp_all <= floor:
-        return TimeDomainLco(float(amp_all), 0.0, True, "decayed",
-                             f"oscillation below {floor:.3g} at the end (decayed)")
-    if i_max.size < n_cycles + 1 or i_min.size < n_cycles + 1:
+    if t.size < 16 or t.shape != y.shape:
+        raise ValueError("t and y must be equal-length histories of at least 16 samples")
+    tail = y[-max(y.size // 10, 3):]
+    end_amp = 0.5 * float(np.max(tail) - np.min(tail))
+    if end_amp <= floor:
+        return TimeDomainLco(end_amp, 0.0, True, "decayed",
+                             f"oscillation {end_amp:.3g} <= {floor:.3g} at the end (decayed)",
+                             peak=end_amp, bias=float(np.mean(tail)))
+    half = t >= t[0] + 0.5 * (t[-1] - t[0])
+    th, yh = t[half], y[half] - np.mean(y[half])
+    dt = float(th[1] - th[0])
+    n_fft = int(2 ** math.ceil(math.log2(8 * yh.size)))
+    spec = np.abs(np.fft.rfft(yh * np.hanning(yh.size), n_fft))
+    i = int(np.argmax(spec[1:-1])) + 1
+    a_, b_, c_ = np.log(spec[i - 1:i + 2] + 1e-300)
+    off = 0.5 * (a_ - c_) / (a_ - 2 * b_ + c_) if (a_ - 2 * b_ + c_) != 0 else 0.0
+    f = (i + off) / (n_fft * dt)
+    if not f > 0 or (th[-1] - th[0]) * f < 2 * n_cycles:
         return TimeDomainLco(0.0, 0.0, False, "not settled",
-                             f"fewer than {n_cycles + 1} cycles in the history")
-
-    def refine(idx):
-        ya, yb, yc = y[idx - 1], y[idx], y[idx + 1]
-        den = ya - 2 * yb + yc
-        off = np.where(den != 0, 0.5 * (ya - yc) / np.where(den != 0, den, 1.0), 0.0)
-        dt = t[idx + 1] - t[idx]
-        return t[idx] + off * dt, yb - 0.25 * (ya - yc) * off
-
-    tmx, ymx = refine(i_max[-(n_cycles + 1):])
-    _, ymn = refine(i_min[-(n_cycles + 1):])
-    half = 0.5 * (ymx[1:] - ymn[1:])
-    amp = float(np.mean(half))
-    period = float(np.mean(np.diff(tmx)))
-    spread = float((half.max() - half.min()) / max(abs(amp), 1e-300))
+                             f"fewer than {2 * n_cycles} periods in the second half of the record")
+    w = 2 * math.pi * f
+    win = n_cycles / f
+    fits = []
+    for t_lo, t_hi in ((t[-1] - 2 * win, t[-1] - win), (t[-1] - win, t[-1] + dt)):
+        sel = (t >= t_lo) & (t < t_hi)
+        G = np.column_stack([np.ones(sel.sum()), np.cos(w * t[sel]), np.sin(w * t[sel])])
+        coef = np.linalg.lstsq(G, y[sel], rcond=None)[0]
+        fits.append((float(np.hypot(coef[1], coef[2])), 0.5 * float(np.ptp(y[sel])),
+                     float(coef[0])))
+    (a1, p1, _), (a2, p2, bias) = fits
+    spread = max(abs(a2 - a1) / max(a2, 1e-300), abs(p2 - p1) / max(p2, 1e-300))
     settled = spread < rel_tol
     kind = "lco" if settled else "not settled"
-    msg = (f"amplitude {amp:.5g}, frequency {1 / period:.5g} Hz, peak spread {spread:.2%}"
+    msg = (f"first harmonic {a2:.5g}, half peak-to-peak {p2:.5g}, bias {bias:.3g}, "
+           f"{f:.5g} Hz; window-to-window change {spread:.2%}"
            + ("" if settled else f" > {rel_tol:.2%}: not settled"))
-    return TimeDomainLco(amp, 1.0 / period, settled, kind, msg)
+    return TimeDomainLco(a2, f, settled, kind, msg, peak=p2, bias=bias)
