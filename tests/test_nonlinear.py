@@ -254,3 +254,35 @@ def test_never_settling_and_chattering_runs_are_reported():
         simulate(sysm, conn, np.zeros(3), 1.0)
     with pytest.raises(ValueError, match="t_final"):
         simulate(sysm, conn, x0, -1.0)
+
+
+def test_exact_propagation_equals_event_located_solve_ivp():
+    """simulate_exact (matrix exponential per region, Brent on the exact d(tau)) and simulate
+    (solve_ivp events) agree on the same switches and history."""
+    from asekit.nonlinear import simulate_exact
+    sysm = toy(1.0)
+    conn = Connection(K_CONN, freeplay=0.01, inner_stiffness=50.0)
+    x0 = np.array([0.01, 0.04, 0.0, 0.0])
+    a = simulate(sysm, conn, x0, 3.0, n_out=3001, rtol=1e-10, atol=1e-13)
+    b = simulate_exact(sysm, conn, x0, 3.0, step=1e-3)
+    assert a.switch_times.size == b.switch_times.size > 20
+    np.testing.assert_allclose(b.switch_times, a.switch_times, atol=1e-8)
+    np.testing.assert_allclose(b.d, a.d, atol=1e-7 * conn.freeplay)
+    with pytest.raises(ValueError, match="constant input"):
+        simulate_exact(sysm, conn, x0, 1.0, u=lambda t: np.zeros(0))
+
+
+def test_equilibria_of_a_destabilising_band():
+    """A connection coordinate with a negative (de-centring) stiffness of its own: the rest
+    position is unstable inside a freeplay band and two offset equilibria against the stops
+    exist, d_e = k delta / (k - k_a), proportional to delta."""
+    from asekit.nonlinear import equilibria
+    ka = 400.0                                     # de-centring stiffness, < k
+    A0 = np.array([[0.0, 1.0], [ka, -2.0]])        # theta'' = ka theta - 2 theta' - f
+    sysm = ConnectedSystem(A0, [0.0, -1.0], [1.0, 0.0])
+    for dl in (0.01, 0.02):
+        eq = equilibria(sysm, Connection(K_CONN, freeplay=dl))
+        assert [e.region for e in eq] == [-1, 0, 1]
+        assert not eq[1].stable and eq[0].stable and eq[2].stable
+        assert eq[2].d == pytest.approx(K_CONN * dl / (K_CONN - ka), rel=1e-12)
+        assert eq[0].d == pytest.approx(-eq[2].d, rel=1e-12)
