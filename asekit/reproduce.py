@@ -27,6 +27,7 @@ CHAPTERS: tuple[tuple[str, str], ...] = (
     ("aero", "Ch. 3.2 aerodynamics"),
     ("flutter", "Ch. 3.2.2-3.3 RFA and flutter"),
     ("ase", "Ch. 5 aeroservoelasticity"),
+    ("freeplay", "Sec. 6.2 freeplay in the actuator-fin connection (issue 14)"),
 )
 
 
