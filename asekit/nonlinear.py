@@ -867,6 +867,14 @@ def simulate_exact(system: ConnectedSystem, connection: Connection, x0, t_final:
         aug[r] = At
         phi[r] = expm(At * h)
     ct = np.append(c, 0.0)
+    # eigen-decomposition of each region's augmented matrix for a cheap exact d(tau) during
+    # the event search: d(tau) = sum_i (ct V)_i exp(lambda_i tau) (V^-1 y)_i; skipped (expm
+    # used instead) when the eigenvectors are ill-conditioned (e.g. a Jordan block)
+    modal = {}
+    for r, At in aug.items():
+        lam, V = np.linalg.eig(At)
+        if np.linalg.cond(V) < 1e8:
+            modal[r] = (lam, ct @ V, np.linalg.inv(V))
 
     def region_for(y):
         if not nonlinear:
@@ -912,8 +920,15 @@ def simulate_exact(system: ConnectedSystem, connection: Connection, x0, t_final:
                 break
             A_r = aug[r]
             g0 = ct @ y - edge
-            tau = brentq(lambda s_: ct @ (expm(A_r * s_) @ y) - edge, 0.0, rem, xtol=1e-15,
-                         rtol=1e-14) if g0 != 0 else 0.0
+            if r in modal:
+                lam, cv, vinv = modal[r]
+                alpha = cv * (vinv @ y)
+                d_of = (lambda s_: float(np.real(alpha @ np.exp(lam * s_))) - edge)
+                if np.sign(d_of(0.0)) == np.sign(d_of(rem)):   # ill-resolved: exact fallback
+                    d_of = (lambda s_: ct @ (expm(A_r * s_) @ y) - edge)
+            else:
+                d_of = (lambda s_: ct @ (expm(A_r * s_) @ y) - edge)
+            tau = brentq(d_of, 0.0, rem, xtol=1e-15, rtol=1e-14) if g0 != 0 else 0.0
             y = expm(A_r * tau) @ y
             rem -= tau
             switches.append(tk + (dt - rem))

@@ -286,3 +286,141 @@ def test_equilibria_of_a_destabilising_band():
         assert not eq[1].stable and eq[0].stable and eq[2].stable
         assert eq[2].d == pytest.approx(K_CONN * dl / (K_CONN - ka), rel=1e-12)
         assert eq[0].d == pytest.approx(-eq[2].d, rel=1e-12)
+
+
+def test_dual_input_df_reduces_to_the_single_input_one_and_to_the_law():
+    from asekit.nonlinear import dual_input_df
+    conn = Connection(100.0, freeplay=0.01, inner_stiffness=10.0)
+    for a in (0.005, 0.02, 0.3):
+        f0, n1 = dual_input_df(conn, 0.0, a)
+        assert f0 == pytest.approx(0.0, abs=1e-12)
+        assert n1 == pytest.approx(conn.describing_function(a), rel=1e-12)
+    # whole cycle on one linear piece: F0 = f(B), N1 = k
+    f0, n1 = dual_input_df(conn, 0.05, 0.01)
+    assert f0 == pytest.approx(float(conn.moment(0.05)), rel=1e-12) and n1 == pytest.approx(100.0)
+    # against quadrature with a bias and a preload
+    cp = Connection(100.0, freeplay=0.01, preload=0.004)
+    B, A = 0.006, 0.015
+    t0 = [math.asin(max(-1, min(1, (e - B) / A))) for e in cp.breakpoints]
+    pts = sorted({x % (2 * math.pi) for t in t0 for x in (t, math.pi - t)})
+    m0 = quad(lambda t: cp.moment(B + A * math.sin(t)), 0, 2 * math.pi, points=pts)[0]
+    m1 = quad(lambda t: cp.moment(B + A * math.sin(t)) * math.sin(t), 0, 2 * math.pi,
+              points=pts)[0]
+    f0, n1 = dual_input_df(cp, B, A)
+    assert f0 == pytest.approx(m0 / (2 * math.pi), rel=1e-9)
+    assert n1 == pytest.approx(m1 / (math.pi * A), rel=1e-9)
+
+
+# --------------------------------------------------------------------------------------------
+# the reference fin (asekit.reproduction.freeplay): FN2 Ritz basis, Mach 0.5, sea level
+# --------------------------------------------------------------------------------------------
+RHO0 = 1.225
+
+
+@pytest.fixture(scope="module")
+def fin_model():
+    from asekit.reproduction.flutter import load_fin_gafs
+    from asekit.reproduction.freeplay import fin_freeplay_model
+    data, reason = load_fin_gafs()
+    if data is None:
+        pytest.skip(reason)
+    return fin_freeplay_model(0.5, data)
+
+
+def test_fin_ritz_model_reproduces_the_linear_fin(fin_model):
+    """With the linear 120 N m/rad spring, the fin-alone Ritz model (rigid pitch + FN1 modes,
+    theta_f free) has the FN1 frequencies (plus one local connection mode above 3 kHz) and the
+    growth rates of the thesis's clamped-actuator model (FN2 s-set, Eq. 3.12)."""
+    from asekit.aeroelastic import aeroelastic_matrices
+    m = fin_model
+    Kt = m.K_plate + m.k_s * np.outer(m.c, m.c)
+    f = np.sort(np.sqrt(np.abs(np.linalg.eigvals(np.linalg.solve(m.M, Kt))))) / (2 * math.pi)
+    np.testing.assert_allclose(f[:-1], m.modal.frequencies_hz[1:], rtol=1e-6)
+    assert f[-1] > 3000.0
+    for u in (150.0, 250.0):
+        ref = np.max(np.linalg.eigvals(aeroelastic_matrices(m.modal, m.rfa, RHO0, u).A).real)
+        new = growth_rate(m.fin_alone(RHO0, u), m.k_s)[0]
+        assert new == pytest.approx(ref, rel=5e-3, abs=0.01)
+
+
+def test_fin_aem1_loop_matches_the_ase_model(fin_model):
+    """The AEM1 loop built through the connection has the aeroelastic roots of
+    asekit.ase.closed_loop (thesis FN2 formulation) near the 140 Hz flutter mode."""
+    import control as ct
+    from asekit import ase
+    from asekit.servo import SYSTEM_3
+    m = fin_model
+    rows = {"fin_root_pitch": m.outputs["fin_root_pitch"]}
+    for u in (180.0, 240.0):
+        model = ase.build_model(m.modal, m.rfa, RHO0, u, rows)
+        ref = ct.poles(ase.closed_loop(model, SYSTEM_3, "AEM1"))
+        new = m.aem1(RHO0, u).eigenvalues(m.k_s)
+        pick = lambda ev: ev[np.argmin(np.abs(np.abs(ev.imag) / (2 * math.pi) - 140.0))]  # noqa
+        a, b = pick(ref), pick(new)
+        assert abs(b.imag) == pytest.approx(abs(a.imag), rel=0.01)
+        assert b.real == pytest.approx(a.real, abs=0.05 * abs(a.imag) * 0.02 + 1.0)
+
+
+def test_fin_band_is_statically_unstable_and_the_fin_rests_on_a_stop(fin_model):
+    """The fin's aerodynamic hinge moment is de-centring (pressure centre ahead of the shaft):
+    with zero stiffness in the band the rest position diverges statically, and below the
+    linear flutter speed the stable states are the two offsets d = +-d_e against the stops,
+    proportional to delta. The time domain settles there."""
+    from asekit.nonlinear import equilibria, simulate_exact
+    m = fin_model
+    s = m.fin_alone(RHO0, 200.0)
+    assert growth_rate(s, 0.0)[2] > 0                       # a real root: static
+    dl = math.radians(0.1)
+    eq = equilibria(s, Connection(m.k_s, freeplay=dl))
+    assert [e.region for e in eq] == [-1, 0, 1]
+    assert eq[0].stable and eq[2].stable and not eq[1].stable
+    eq2 = equilibria(s, Connection(m.k_s, freeplay=2 * dl))
+    assert eq2[2].d == pytest.approx(2 * eq[2].d, rel=1e-10)
+    x0 = np.zeros(s.n_states)
+    x0[0] = 0.5 * dl
+    sim = simulate_exact(s, Connection(m.k_s, freeplay=dl), x0, 3.0, step=1e-4)
+    assert sim.d[-1] == pytest.approx(eq[2].d, rel=2e-3)
+
+
+def test_fin_has_no_lco_below_linear_flutter_and_a_biased_one_above(fin_model):
+    """Harmonic balance, symmetric and biased: no stable LCO at 150 and 200 m/s (below the
+    linear flutter speed, where no equivalent stiffness in [0, k] flutters); just above it a
+    stable LCO about the offset is born at zero amplitude (a Hopf bifurcation of the offset
+    state), so the LCO onset is the linear flutter speed. The zero-stiffness fin does not
+    flutter at all below 900 m/s."""
+    from asekit.nonlinear import biased_harmonic_balance
+    from asekit.reproduction.freeplay import lco_onset, linear_flutter
+    m = fin_model
+    unit = Connection(m.k_s, freeplay=1.0)
+    at = lambda u: m.fin_alone(RHO0, u)  # noqa: E731
+    for u in (150.0, 200.0):
+        s = at(u)
+        assert max(growth_rate(s, kp * m.k_s)[0] for kp in np.linspace(0, 1, 41)) < 0
+        assert harmonic_balance(s, unit).lcos == ()
+        assert biased_harmonic_balance(s, unit) == ()
+    uf, ff = linear_flutter(at, m.k_s, 50.0, 900.0)
+    assert linear_flutter(at, 0.0, 20.0, 900.0) == (None, None)
+    onset = lco_onset(m, "alone", RHO0, uf - 12.0, uf + 17.0)
+    assert onset == pytest.approx(uf, abs=0.5)
+    lc = biased_harmonic_balance(at(uf + 4.0), unit)
+    assert len(lc) == 1 and lc[0].stable and lc[0].amplitude < 0.3 * lc[0].bias
+    assert lc[0].frequency_hz == pytest.approx(ff, rel=0.02)
+
+
+def test_fin_biased_df_against_time_domain(fin_model):
+    """At 210 m/s (4 m/s above linear flutter) the event-located time domain settles on the
+    biased LCO: bias and first-harmonic amplitude within 5 %, frequency within 2 % of the
+    dual-input describing function."""
+    from asekit.nonlinear import biased_harmonic_balance
+    from asekit.reproduction.freeplay import time_domain
+    m = fin_model
+    dl = math.radians(0.1)
+    lc = biased_harmonic_balance(m.fin_alone(RHO0, 210.0), Connection(m.k_s, freeplay=dl))[0]
+    sim = time_domain(m, "alone", RHO0, 210.0, delta_deg=0.1, t_final=4.0,
+                      start=(lc.bias + lc.amplitude) / dl)
+    # near the Hopf point the LCO attracts slowly: 2 % change per 30 cycles at 4 s
+    td = steady_oscillation(sim.t, sim.d, n_cycles=30, rel_tol=0.02)
+    assert td.settled, td.message
+    assert td.bias == pytest.approx(lc.bias, rel=0.05)
+    assert td.amplitude == pytest.approx(lc.amplitude, rel=0.05)
+    assert td.frequency_hz == pytest.approx(lc.frequency_hz, rel=0.02)
