@@ -591,12 +591,27 @@ def biased_harmonic_balance(system: ConnectedSystem, connection: Connection,
     vals = [sig(A) for A in amps]
     out = []
     for i in range(len(amps) - 1):
+        a1, a2 = amps[i], amps[i + 1]
         v1, v2 = vals[i], vals[i + 1]
+        if (v1 is None) != (v2 is None):
+            # the biased branch starts or ends inside this interval (it meets the symmetric
+            # one): bisect for its end and use that as the interval's other point
+            has, hasnt = (a1, a2) if v1 is not None else (a2, a1)
+            for _ in range(40):
+                mid = 0.5 * (has + hasnt)
+                if sig(mid) is not None:
+                    has = mid
+                else:
+                    hasnt = mid
+            if v1 is not None:
+                a2, v2 = has, sig(has)
+            else:
+                a1, v1 = has, sig(has)
         if v1 is None or v2 is None or not (np.isfinite(v1[0]) and np.isfinite(v2[0])):
             continue
         if np.sign(v1[0]) * np.sign(v2[0]) < 0:
-            As = brentq(lambda A: sig(A)[0] if sig(A) is not None else math.nan, amps[i],
-                        amps[i + 1], xtol=1e-12 * dl)
+            As = brentq(lambda A: sig(A)[0] if sig(A) is not None else math.nan, a1, a2,
+                        xtol=1e-12 * dl)
             s_, om, B, n1 = sig(As)
             out.append(BiasedLco(bias=B, amplitude=As, frequency_hz=om / (2 * math.pi),
                                  gain=n1, stable=bool(v2[0] < v1[0]),
