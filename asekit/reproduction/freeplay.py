@@ -397,3 +397,149 @@ def fig_excursion(results: dict, label: str):
     a2.set_xlabel("airspeed (m/s)")
     a2.set_ylabel("static offset on the stop (deg)")
     return fig
+
+
+def fig_fin_lco(results: dict, freeplays_deg=FREEPLAYS_DEG):
+    """Biased-LCO fin-root amplitude (deg, top) and frequency (Hz, bottom) vs airspeed for
+    ``{(label, config): ConfigResult}``, one line per freeplay (amplitude proportional to
+    delta), with each configuration's linear flutter speed (vertical line)."""
+    from ..plotting import new_figure
+    fig, (a1, a2) = new_figure("Freeplay LCO of the fin (dual-input DF), sea-level density",
+                               None, nrows=2, figsize=(7.0, 7.0))
+    styles = ["-", "--", ":", "-."]
+    for j, ((label, cfg), res) in enumerate(results.items()):
+        ls = styles[j % 4]
+        amp = res.biased_amplitude()
+        ok = amp > 0
+        for i, dd in enumerate(freeplays_deg):
+            a1.plot(res.velocities[ok], dd * amp[ok], ls, color=f"C{i}",
+                    label=f"{label} {'fin alone' if cfg == 'alone' else 'AEM1'}, "
+                          f"delta {dd} deg" if j == 0 or i == 0 else None)
+        a2.plot(res.velocities[ok], res.biased_frequency_hz()[ok], ls, color="k",
+                label=f"{label} {'fin alone' if cfg == 'alone' else 'AEM1'}")
+        if res.flutter[0] is not None:
+            a1.axvline(res.flutter[0], color="0.5", ls=ls, lw=0.8)
+    a1.set_yscale("log")
+    a1.set_ylabel("fin-root LCO amplitude (deg)")
+    a1.legend(fontsize=6, ncol=2)
+    a2.set_xlabel("airspeed (m/s)")
+    a2.set_ylabel("LCO frequency (Hz)")
+    a2.legend(fontsize=7)
+    return fig
+
+
+def fig_history(sim, delta: float, title: str, t_window: float | None = None):
+    """d / delta vs time of a :class:`asekit.nonlinear.PiecewiseSimulation` (last
+    ``t_window`` s, default all), band edges dashed."""
+    from ..plotting import new_figure
+    fig, ax = new_figure(title, None, figsize=(7.0, 3.0))
+    sel = sim.t >= (sim.t[-1] - t_window if t_window else 0.0)
+    ax.plot(sim.t[sel], sim.d[sel] / delta, lw=0.6)
+    for e in (-1, 1):
+        ax.axhline(e, color="k", ls="--", lw=0.8)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("connection rotation d / delta (-)")
+    return fig
+
+
+def fig_growth_map(system_at, k: float, velocities, kappas=np.linspace(0.0, 1.0, 41),
+                   title: str = "growth rate of the quasi-linear system"):
+    """Largest real part of the oscillatory roots (1/s) over (airspeed, equivalent stiffness
+    ratio N/k): the harmonic-balance LCOs lie on its zero contour."""
+    from ..plotting import new_figure
+    fig, ax = new_figure(title, None, figsize=(6.4, 4.2))
+    v = np.asarray(velocities, float)
+    sig = np.array([[growth_rate(system_at(u), kp * k)[0] for u in v] for kp in kappas])
+    lim = np.nanmax(np.abs(sig[np.isfinite(sig)]))
+    cs = ax.contourf(v, kappas, sig, levels=np.linspace(-lim, lim, 21), cmap="RdBu_r")
+    ax.contour(v, kappas, sig, levels=[0.0], colors="k")
+    fig.colorbar(cs, ax=ax, label="max Re of oscillatory roots (1/s)")
+    ax.set_xlabel("airspeed (m/s)")
+    ax.set_ylabel("equivalent stiffness N / k (-)")
+    return fig
+
+
+# --------------------------------------------------------------------------------------------
+# the Conner, Tang, Dowell & Virgin (1997) typical section
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ConnerStudy:
+    """Describing function against time domain on the Conner et al. section.
+
+    delta (rad, half-width); velocities and hb (HarmonicBalance per speed); td_velocities and
+    td (TimeDomainLco of the flap angle per speed); flutter (U, Hz) with Jones' and the exact
+    C(k); flutter_zero (U) of the section with zero flap stiffness (flap damping kept)."""
+
+    delta: float
+    velocities: np.ndarray
+    hb: tuple
+    td_velocities: np.ndarray
+    td: tuple
+    flutter_jones: tuple
+    flutter_exact: tuple
+    flutter_zero: float
+
+
+def conner_study(delta_total_deg: float = 2.12, velocities=np.arange(5.0, 24.01, 0.5),
+                 td_velocities=(10.0, 12.0, 15.0, 18.0, 20.0, 21.0, 22.0, 23.0),
+                 t_final: float = 20.0, step: float = 1e-3) -> ConnerStudy:
+    """Harmonic balance over ``velocities`` and exact piecewise time integration at
+    ``td_velocities`` (from beta = 1.5 x the DF amplitude, ``t_final`` s, output every
+    ``step`` s; :func:`asekit.nonlinear.simulate_exact`) of the Conner
+    section with a total flap freeplay of ``delta_total_deg`` (Conner et al.: 2.12 deg)."""
+    from scipy.optimize import brentq
+
+    from ..nonlinear import steady_oscillation
+    from ..typical_section import (conner_1997, connected_system, flutter_speed,
+                                   flutter_speed_exact)
+    sec = conner_1997()
+    dl = math.radians(delta_total_deg) / 2
+    conn = Connection(sec.stiffness_beta, freeplay=dl)
+    v = np.asarray(velocities, float)
+    hb = tuple(harmonic_balance(connected_system(sec, u), conn) for u in v)
+    td = []
+    for u in td_velocities:
+        s = connected_system(sec, u)
+        st = harmonic_balance(s, conn).largest_stable()
+        x0 = np.zeros(8)
+        x0[2] = 1.5 * (st.amplitude if st is not None else 3 * dl)
+        sim = simulate_exact(s, conn, x0, t_final, step=step)
+        td.append(steady_oscillation(sim.t, sim.d, floor=1e-3 * dl, diverged=sim.diverged))
+    fj = flutter_speed(sec, 1.0, 60.0, 120)
+    fe = flutter_speed_exact(sec, *fj)
+    u0 = brentq(lambda u: growth_rate(connected_system(sec, u), 0.0)[0], 2.0, 23.0)
+    return ConnerStudy(delta=dl, velocities=v, hb=hb,
+                       td_velocities=np.asarray(td_velocities, float), td=tuple(td),
+                       flutter_jones=fj, flutter_exact=fe, flutter_zero=float(u0))
+
+
+def fig_conner(cs: ConnerStudy):
+    """Flap LCO amplitude / delta (DF; time domain first harmonic and half peak-to-peak) and
+    frequency vs airspeed for the Conner et al. section."""
+    from ..plotting import new_figure
+    fig, (a1, a2) = new_figure("Conner et al. (1997) section with flap freeplay", None,
+                               nrows=2, figsize=(6.4, 6.5))
+    for branch, mk in ((True, "-"), (False, ":")):
+        u = [v for v, r in zip(cs.velocities, cs.hb) for lc in r.lcos if lc.stable == branch]
+        a = [lc.amplitude / cs.delta for r in cs.hb for lc in r.lcos if lc.stable == branch]
+        f = [lc.frequency_hz for r in cs.hb for lc in r.lcos if lc.stable == branch]
+        lab = "DF, stable" if branch else "DF, unstable"
+        a1.plot(u, a, mk, color="C0", label=lab)
+        a2.plot(u, f, mk, color="C0", label=lab)
+    ok = [i for i, t in enumerate(cs.td) if t.kind == "lco"]
+    a1.plot(cs.td_velocities[ok], [cs.td[i].amplitude / cs.delta for i in ok], "o", color="C1",
+            label="time domain, first harmonic")
+    a1.plot(cs.td_velocities[ok], [cs.td[i].peak / cs.delta for i in ok], "s", mfc="none",
+            color="C1", label="time domain, half peak-to-peak")
+    a2.plot(cs.td_velocities[ok], [cs.td[i].frequency_hz for i in ok], "o", color="C1",
+            label="time domain")
+    for a in (a1, a2):
+        a.axvline(cs.flutter_exact[0], color="k", lw=0.8, ls="--")
+        a.axvline(cs.flutter_zero, color="0.5", lw=0.8, ls="--")
+    a1.set_yscale("log")
+    a1.set_ylabel("flap LCO amplitude / delta (-)")
+    a1.legend(fontsize=7)
+    a2.set_xlabel("airspeed (m/s)")
+    a2.set_ylabel("LCO frequency (Hz)")
+    a2.legend(fontsize=7)
+    return fig
