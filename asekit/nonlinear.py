@@ -71,6 +71,15 @@ local error tolerance ``rtol``), and the state is continuous across the switch b
 Conner, Tang, Dowell & Virgin (J. Fluids Struct. 11, 1997) located the same switching points
 with Henon's method; both are exact to the integrator's tolerance.
 
+A connection whose band is statically unstable (a de-centring aerodynamic moment, as on the
+reference fin) does not oscillate about d = 0: it rests against a stop (:func:`equilibria`)
+and its LCOs are biased. :func:`dual_input_df` gives the bias-plus-sinusoid describing function
+of Eq. (2) in closed form and :func:`biased_harmonic_balance` solves the mean and first-harmonic
+balance together (Gelb & Vander Velde ch. 5). For stiff models (a local connection mode of
+several kHz) :func:`simulate_exact` propagates each linear region with its matrix exponential
+and finds the switches by Brent's method on the exact solution; it agrees with the
+``solve_ivp`` event integration to 1e-8 of delta (tests) at a fraction of the cost.
+
 Units: SI (rad, N m/rad, s); degrees and Hz only where a name says so (``frequency_hz``).
 """
 

@@ -15,7 +15,7 @@ import pytest
 from scipy.optimize import brentq
 
 from asekit.nonlinear import (Connection, growth_rate, harmonic_balance, simulate,
-                              steady_oscillation)
+                              simulate_exact, steady_oscillation)
 from asekit.typical_section import (CONNER_SPAN, conner_1997, connected_system,
                                     flutter_speed, flutter_speed_exact,
                                     frequency_domain_matrix, jones_function, section_matrices,
@@ -142,14 +142,15 @@ def test_conner_lco_amplitude_scales_with_freeplay():
 def test_conner_df_against_time_domain_near_flutter(u):
     """Near the linear flutter speed the LCO is nearly harmonic and the describing function
     agrees with the event-located time domain within the issue's 5 % (amplitude, first
-    harmonic) and 2 % (frequency). Lower speeds: see the next test."""
+    harmonic) and 2 % (frequency). Lower speeds: see the next test. (simulate_exact; it
+    equals the solve_ivp-event integration, see test_nonlinear and the check below.)"""
     sec = conner_1997()
     conn = Connection(sec.stiffness_beta, freeplay=DELTA)
     s = connected_system(sec, u)
     st = harmonic_balance(s, conn).largest_stable()
     x0 = np.zeros(8)
     x0[2] = 1.5 * st.amplitude
-    sim = simulate(s, conn, x0, 30.0, n_out=60001)
+    sim = simulate_exact(s, conn, x0, 30.0, step=1e-3)
     td = steady_oscillation(sim.t, sim.d)
     assert td.settled
     assert td.amplitude == pytest.approx(st.amplitude, rel=0.05)
@@ -168,7 +169,7 @@ def test_conner_df_overestimates_at_mid_speeds():
     st = harmonic_balance(s, conn).largest_stable()
     x0 = np.zeros(8)
     x0[2] = 1.5 * st.amplitude
-    sim = simulate(s, conn, x0, 30.0, n_out=60001)
+    sim = simulate_exact(s, conn, x0, 30.0, step=1e-3)
     td = steady_oscillation(sim.t, sim.d)
     assert td.settled
     assert abs(td.bias) > 0.1 * DELTA
@@ -183,3 +184,15 @@ def test_bad_section_input():
         conner_1997().__class__(**{**conner_1997().__dict__, "c": -0.9})
     with pytest.raises(ValueError, match="unstable at u_lo"):
         flutter_speed(conner_1997(), 30.0, 40.0)
+
+
+def test_conner_exact_and_solve_ivp_integrations_agree():
+    sec = conner_1997()
+    conn = Connection(sec.stiffness_beta, freeplay=DELTA)
+    s = connected_system(sec, 20.0)
+    x0 = np.zeros(8)
+    x0[2] = 3 * DELTA
+    a = simulate(s, conn, x0, 3.0, n_out=3001, rtol=1e-10, atol=1e-13)
+    b = simulate_exact(s, conn, x0, 3.0, step=1e-3)
+    np.testing.assert_allclose(b.d, a.d, atol=1e-6 * DELTA)
+    np.testing.assert_allclose(b.switch_times, a.switch_times, atol=1e-8)

@@ -22,6 +22,16 @@ spring this reproduces the thesis's clamped-actuator flutter model (checked in t
 Airspeed sweeps are at fixed Mach (the RFA of that Mach) and sea-level density, as the thesis's
 p-k tables (unmatched). Reported amplitudes are the fin-root pitch amplitude (deg) of the
 describing-function LCO, freeplay half-width delta (total freeplay 2 delta).
+
+What the analysis finds (tests/test_nonlinear.py, notebooks/freeplay.ipynb): a softer connection
+raises the fin's flutter speed (zero stiffness: no flutter below 900 m/s at Mach 0.5), but makes
+the fin statically unstable inside the band (pressure centre ahead of the shaft). So below the
+linear flutter speed the fin rests against a stop, offset by d_e ~ delta k / (k - k_aero), and
+does not oscillate; the LCO is born at the linear flutter speed as an oscillation about that
+offset (dual-input describing function; confirmed by the time domain just above onset).
+
+Also here: the Conner, Tang, Dowell & Virgin (1997) typical-section study of the notebook
+(:func:`conner_study`) and the figure helpers.
 """
 
 from __future__ import annotations
