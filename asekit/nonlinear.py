@@ -26,7 +26,8 @@ the elastic modes computed with the shaft spring k_s present. Used as Ritz vecto
 alone* -- fin coordinates xi = [theta_f, zeta_s], fin displacement phi_R theta_f + Phi_s zeta_s
 -- the structure's stiffness splits exactly into the plate's own and the connection's:
 
-    K_plate = blockdiag(0, K_ss - k_s r r^T),     connection: f(d),  d = theta_f + r . zeta_s - theta_t,
+    K_plate = blockdiag(0, K_ss - k_s r r^T),    connection f(d),
+    d = theta_f + r . zeta_s - theta_t,
 
 with r the elastic modes' rotation of the shaft node (the FN1 modes satisfy
 K_ss = Phi_s^T (K_plate + k_s e e^T) Phi_s, e^T Phi_s = r) and theta_t the transmission angle.
@@ -49,7 +50,8 @@ Describing function (sinusoidal input d = A sin(omega t), p = 0; Gelb & Vander V
 *Multiple-Input Describing Functions and Nonlinear System Design*, 1968, ch. 2, dead zone):
 
     N(A) = k1,                                                    A <= delta
-    N(A) = k1 + (k - k1) [1 - (2/pi)(asin(delta/A) + (delta/A) sqrt(1 - (delta/A)^2))],  A > delta.  (3)
+    N(A) = k1 + (k - k1) [1 - (2/pi)(asin(delta/A) + (delta/A) sqrt(1 - (delta/A)^2))],
+                                                                        A > delta.     (3)
 
 N is real (no hysteresis) and increases monotonically from k1 to k, so its inverse is unique.
 Harmonic balance: an LCO of amplitude A exists where A(N(A)) = A0 + N(A) b c^T has a root on the
@@ -792,7 +794,8 @@ def simulate(system: ConnectedSystem, connection: Connection, x0, t_final: float
     stalls = 0
     while t0 < t_final:
         r = pick_region(t0, x)
-        extra = {"jac": (lambda t, y, _J=mats[r][0]: _J)} if method in ("Radau", "BDF", "LSODA") else {}
+        implicit = method in ("Radau", "BDF", "LSODA")
+        extra = {"jac": (lambda t, y, _J=mats[r][0]: _J)} if implicit else {}
         sol = solve_ivp(rhs_factory(r), (t0, t_final), x, method=method, rtol=rtol, atol=atol,
                         max_step=max_step, events=events_for(r), dense_output=True, **extra)
         if sol.status < 0:

@@ -45,7 +45,7 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.special import hankel2
 
-from .nonlinear import ConnectedSystem, growth_rate
+from .nonlinear import ConnectedSystem
 from .validate import in_range, positive
 
 JONES_A = (0.165, 0.335)
@@ -164,12 +164,15 @@ def section_matrices(sec: TypicalSection, velocity: float) -> SectionMatrices:
     zeta = np.array([sec.zeta_h, sec.zeta_alpha, sec.zeta_beta])
     D_s = np.diag(2 * zeta * np.sqrt(np.diag(K_s) * np.diag(M_s)))
     r = rho * b * b
+    bb = b * b
     M_nc = r * np.array([[pi, -pi * b * a, -T[1] * b],
-                         [-a * pi * b, pi * b * b * (1 / 8 + a * a), -(T[7] + (c - a) * T[1]) * b * b],
-                         [-T[1] * b, 2 * T[13] * b * b, -T[3] * b * b / pi]])
+                         [-a * pi * b, pi * bb * (1 / 8 + a * a), -(T[7] + (c - a) * T[1]) * bb],
+                         [-T[1] * b, 2 * T[13] * bb, -T[3] * bb / pi]])
+    b_ab = (T[1] - T[8] - (c - a) * T[4] + 0.5 * T[11]) * b          # M_a per beta'
+    b_ba = (-2 * T[9] - T[1] + T[4] * (a - 0.5)) * b                  # M_b per alpha'
     B_nc = r * U * np.array([[0.0, pi, -T[4]],
-                             [0.0, pi * (0.5 - a) * b, (T[1] - T[8] - (c - a) * T[4] + 0.5 * T[11]) * b],
-                             [0.0, (-2 * T[9] - T[1] + T[4] * (a - 0.5)) * b, -T[4] * T[11] * b / (2 * pi)]])
+                             [0.0, pi * (0.5 - a) * b, b_ab],
+                             [0.0, b_ba, -T[4] * T[11] * b / (2 * pi)]])
     K_nc = r * U * U * np.array([[0.0, 0.0, 0.0],
                                  [0.0, 0.0, T[4] + T[10]],
                                  [0.0, 0.0, (T[5] - T[4] * T[10]) / pi]])
@@ -316,4 +319,4 @@ def conner_1997(heave_mass_total: float | None = None) -> TypicalSection:
 
 __all__ = ["TypicalSection", "theodorsen_t", "theodorsen_function", "jones_function",
            "section_matrices", "state_matrix", "frequency_domain_matrix", "connected_system",
-           "flutter_speed", "flutter_speed_exact", "conner_1997", "growth_rate"]
+           "flutter_speed", "flutter_speed_exact", "conner_1997"]

@@ -57,7 +57,8 @@ def test_describing_function_is_the_first_harmonic(k1, ratio):
 
 def test_describing_function_limits_and_inverse():
     conn = Connection(stiffness=120.0, freeplay=0.002, inner_stiffness=10.0)
-    # inside the band the stiffness is k1; far outside it tends to k like k - (k-k1) 4 delta / (pi A)
+    # inside the band the stiffness is k1; far outside it tends to k as
+    # k - (k - k1) 4 delta / (pi A)
     assert conn.describing_function(0.001) == pytest.approx(10.0)
     a = 1e4 * conn.freeplay
     assert conn.describing_function(a) == pytest.approx(120 - 110 * 4 / (math.pi * 1e4), rel=1e-6)
@@ -424,3 +425,25 @@ def test_fin_biased_df_against_time_domain(fin_model):
     assert td.bias == pytest.approx(lc.bias, rel=0.05)
     assert td.amplitude == pytest.approx(lc.amplitude, rel=0.05)
     assert td.frequency_hz == pytest.approx(lc.frequency_hz, rel=0.02)
+
+
+def test_fin_aem1_command_step_with_freeplay(fin_model):
+    """AEM1 with the connection freeplay: a 1 deg command step (u = theta_cmd). The
+    transmission settles at the command less the droop of the PD under the hinge moment, and
+    the fin settles at the transmission angle plus the connection offset of a static equilibrium
+    (the fin leans on one stop)."""
+    from asekit.nonlinear import equilibria, simulate_exact
+    m = fin_model
+    s = m.aem1(RHO0, 150.0)
+    conn = Connection(m.k_s, freeplay=math.radians(0.1))
+    cmd = np.array([math.radians(1.0)])
+    x0 = np.zeros(s.n_states)
+    a = simulate_exact(s, conn, x0, 1.5, u=cmd, step=5e-5)
+    eq = [e for e in equilibria(s, conn, u=cmd) if e.stable]
+    assert eq, "a stable equilibrium under the command"
+    end = a.x[:, -1]
+    best = min(eq, key=lambda e: np.max(np.abs(e.x - end)))
+    assert a.outputs["theta"][-1] == pytest.approx(best.x[0], rel=1e-3)
+    assert a.d[-1] == pytest.approx(best.d, rel=3e-3)
+    assert abs(a.outputs["theta"][-1] - cmd[0]) < 0.05 * cmd[0]
+    assert abs(best.d) > conn.freeplay                    # on a stop
