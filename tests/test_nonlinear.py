@@ -362,6 +362,28 @@ def test_fin_aem1_loop_matches_the_ase_model(fin_model):
         assert b.real == pytest.approx(a.real, abs=0.05 * abs(a.imag) * 0.02 + 1.0)
 
 
+def test_fin_aem2_loop_matches_the_ase_model(fin_model):
+    """AEM2 (PD on the fin-root pitch) through the connection: the same stability verdict
+    and the same least-damped roots as asekit.ase.closed_loop (the thesis finds the linear
+    AEM2 loop unstable, Fig 79)."""
+    import control as ct
+    from asekit import ase
+    from asekit.servo import SYSTEM_3
+    m = fin_model
+    rows = {"fin_root_pitch": m.outputs["fin_root_pitch"]}
+    u = 0.5 * 340.294
+    ref = ct.poles(ase.closed_loop(ase.build_model(m.modal, m.rfa, RHO0, u, rows), SYSTEM_3,
+                                   "AEM2"))
+    new = m.loop(RHO0, u, "AEM2").eigenvalues(m.k_s)
+    r_ref = ref[np.argmax(ref.real)]
+    r_new = new[np.argmax(new.real)]
+    assert (r_ref.real > 0) == (r_new.real > 0)
+    assert abs(r_new) == pytest.approx(abs(r_ref), rel=0.02)
+    assert r_new.real == pytest.approx(r_ref.real, rel=0.05, abs=1.0)
+    with pytest.raises(ValueError, match="topology"):
+        m.loop(RHO0, u, "AEM3")
+
+
 def test_fin_band_is_statically_unstable_and_the_fin_rests_on_a_stop(fin_model):
     """The fin's aerodynamic hinge moment is de-centring (pressure centre ahead of the shaft):
     with zero stiffness in the band the rest position diverges statically, and below the

@@ -106,21 +106,38 @@ class FinFreeplayModel:
 
     def aem1(self, density: float, velocity: float, controller: PDController = SYSTEM_3,
              actuator: ActuatorParameters | None = None) -> ConnectedSystem:
-        """The AEM1 loop (PD on the transmission angle) with the connection between the
-        transmission and the fin: states [theta_t, omega_t, current, fin states], input
-        theta_cmd (rad); d = fin-root pitch - theta_t; outputs ``theta`` (transmission),
-        ``fin_root_pitch`` and the fin outputs."""
+        """The AEM1 loop (PD on the transmission angle): :meth:`loop` with "AEM1"."""
+        return self.loop(density, velocity, "AEM1", controller, actuator)
+
+    def loop(self, density: float, velocity: float, topology: str = "AEM1",
+             controller: PDController = SYSTEM_3,
+             actuator: ActuatorParameters | None = None) -> ConnectedSystem:
+        """The closed ASE loop with the connection between the transmission and the fin:
+        states [theta_t, omega_t, current, fin states], input theta_cmd (rad); d = fin-root
+        pitch - theta_t; outputs ``theta`` (transmission), ``fin_root_pitch`` and the fin
+        outputs. The PD (thesis Sec. 5.1) acts on the transmission angle and rate (AEM1) or on
+        the fin-root pitch and its rate (AEM2, potentiometer at the fin shaft):
+        voltage = K_c (K_P (theta_cmd - y) - K_D y'). Linear actuator (no power limits), its
+        own inertia only (the fin is reached through the connection)."""
+        if topology not in ("AEM1", "AEM2"):
+            raise ValueError(f"topology must be 'AEM1' or 'AEM2', got {topology!r}")
         act = ActuatorParameters(fin_inertia=0.0) if actuator is None else actuator
         ss = actuator_state_space(act)
         Aa, Ba = np.array(ss.A), np.array(ss.B)          # inputs: voltage, hinge_moment
         A_f, b_f, c_f, rows = self._fin(density, velocity)
-        na, nz = 3, A_f.shape[0]
+        na, nz, n = 3, A_f.shape[0], self.n_modes
         kc, kp, kd = controller.gain, controller.kp, controller.kd
+        y_row = np.zeros(na + nz)
+        yd_row = np.zeros(na + nz)
+        if topology == "AEM1":
+            y_row[0], yd_row[1] = 1.0, 1.0
+        else:
+            y_row[na:na + n] = self.c                     # fin-root pitch c . xi
+            yd_row[na + n:na + 2 * n] = self.c            # its rate c . xi'
         A = np.zeros((na + nz, na + nz))
         A[:na, :na] = Aa
-        A[:na, 0] += -Ba[:, 0] * kc * kp                 # voltage = Kc (Kp (cmd - th) - Kd om)
-        A[:na, 1] += -Ba[:, 0] * kc * kd
         A[na:, na:] = A_f
+        A[:na, :] -= np.outer(Ba[:, 0], kc * (kp * y_row + kd * yd_row))
         b = np.concatenate([Ba[:, 1], b_f])              # +f on the transmission, -c f on the fin
         c = np.concatenate([[-1.0, 0.0, 0.0], c_f])
         B_u = np.concatenate([Ba[:, 0] * kc * kp, np.zeros(nz)]).reshape(-1, 1)
