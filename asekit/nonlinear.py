@@ -521,7 +521,7 @@ def dual_input_df(connection: Connection, bias, amplitude) -> tuple[float, float
         if -1 < s_ < 1:
             t1 = math.asin(s_)
             cuts += [t1 % (2 * math.pi), (math.pi - t1) % (2 * math.pi)]
-    cuts = np.unique(np.array(cuts))
+    cuts = sorted(set(cuts))
     f0_int = 0.0
     f1_int = 0.0
     for t1, t2 in zip(cuts[:-1], cuts[1:]):
@@ -621,8 +621,10 @@ def biased_harmonic_balance(system: ConnectedSystem, connection: Connection,
         if v1 is None or v2 is None or not (np.isfinite(v1[0]) and np.isfinite(v2[0])):
             continue
         if np.sign(v1[0]) * np.sign(v2[0]) < 0:
-            As = brentq(lambda A: sig(A)[0] if sig(A) is not None else math.nan, a1, a2,
-                        xtol=1e-12 * dl)
+            def sig0(A):
+                v = sig(A)
+                return v[0] if v is not None else math.nan
+            As = brentq(sig0, a1, a2, xtol=1e-12 * dl)
             s_, om, B, n1 = sig(As)
             out.append(BiasedLco(bias=B, amplitude=As, frequency_hz=om / (2 * math.pi),
                                  gain=n1, stable=bool(v2[0] < v1[0]),
