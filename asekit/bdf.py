@@ -250,7 +250,8 @@ def _element_angle(elem, xyz_of, g1, g2, model) -> float:
     return edge + math.radians(float(tm or 0.0))
 
 
-def read_bdf(path, units: str = "SI", tol: float | None = None) -> BdfModel:
+def read_bdf(path, units: str = "SI", tol: float | None = None,
+             thickness_rule: str = "gauss") -> BdfModel:
     """Read a flat plate-wing BDF with pyNastran and build the asekit model.
 
     Parameters
@@ -259,6 +260,9 @@ def read_bdf(path, units: str = "SI", tol: float | None = None) -> BdfModel:
     units : the deck's unit system, a key of :data:`UNITS` (``"SI"``, ``"mm-t-s"``,
         ``"in-lbf-s"``); everything is converted to SI.
     tol : flatness tolerance in deck length units (default 1e-6 x the model size).
+    thickness_rule : ``"gauss"`` (default: the corner thicknesses T1-T4 interpolated
+        bilinearly to every integration point) or ``"centroid"`` (each element at its mean
+        corner thickness, constant over the element).
 
     Returns
     -------
@@ -363,8 +367,8 @@ def read_bdf(path, units: str = "SI", tol: float | None = None) -> BdfModel:
         idx = np.asarray(idx)
         sub = PlateMesh(nodes=nodes, elements=conn[idx], thickness_root=1.0, thickness_tip=1.0,
                         y_root=float(nodes[:, 1].min()), span=span, corner_thickness=th[idx])
-        K = K + _scatter(sub, mitc4_stiffness(sub, material), n)
-        M = M + _scatter(sub, consistent_mass(sub, material), n)
+        K = K + _scatter(sub, mitc4_stiffness(sub, material, thickness_rule), n)
+        M = M + _scatter(sub, consistent_mass(sub, material, thickness_rule), n)
         nsm = float(p.nsm or 0.0) * wtmass * Mu / L**2
         if nsm:
             # non-structural mass per area: translational only (Nastran's NSM)
