@@ -218,6 +218,10 @@ def _material(mat, wtmass: float, L: float, Mu: float, T: float, angle: float, p
             raise BdfError(f"MAT1 {mat.mid} (PSHELL {pid}): E must be > 0, got {E}")
         if nu is None:
             nu = E / (2 * G) - 1.0
+        elif G is not None and abs(G - E / (2 * (1 + nu))) > 1e-3 * G:
+            raise BdfError(f"MAT1 {mat.mid}: E, G and NU all given and G = {G:g} differs from "
+                           f"E / (2 (1 + NU)) = {E / (2 * (1 + nu)):g}: asekit's isotropic "
+                           f"material takes E and NU (give two of the three)")
         return Material(E * stress, nu, mat.rho * wtmass * dens, name=f"MAT1 {mat.mid}")
     if mat.type == "MAT8":
         g1z = mat.g1z if mat.g1z else mat.g12
@@ -296,6 +300,10 @@ def read_bdf(path, units: str = "SI", tol: float | None = None,
     if not quads:
         raise BdfError(f"{path.name}: no CQUAD4 element: nothing asekit can model")
     nids = np.array(sorted(model.nodes), dtype=np.int64)
+    bad_cd = [int(n) for n in nids if model.nodes[n].cd not in (0, None)]
+    if bad_cd:
+        raise BdfError(f"GRIDs {bad_cd[:10]} have a displacement coordinate system CD != 0: "
+                       f"asekit needs T3, R1, R2 along the basic z, x, y axes")
     xyz = np.array([model.nodes[n].get_position() for n in nids], float)
     index = {int(n): i for i, n in enumerate(nids)}
     size = float(np.ptp(xyz[:, :2], axis=0).max())
@@ -859,12 +867,12 @@ def case_bdf(case, sol: int = 145, n_modes: int | None = None):
         a = case.aero
         boxes = pl.box_mesh(case)
         start = 100001
+        model.add_paero1(1)
         for ip, p in enumerate(case.panels):
             sel = boxes.surface == ip
             nc = int(np.sum(boxes.strip[sel] == boxes.strip[sel][0]))
             ns = int(sel.sum() // nc)
             pf = p.planform
-            model.add_paero1(1)
             model.add_caero1(start, 1, 1, [pf.root_le[0], pf.root_le[1], 0.0],
                              pf.root_chord, [pf.tip_le[0], pf.tip_le[1], 0.0], pf.tip_chord,
                              nspan=ns, nchord=nc)
@@ -880,6 +888,23 @@ def case_bdf(case, sol: int = 145, n_modes: int | None = None):
         model.add_flfact(3, list(case.flight.velocities))
         model.add_flutter(20, "PK", 1, 2, 3, imethod="L")
         lines.insert(4, "FMETHOD = 20")
+    d = case.damping
+    if d.modal_damping_ratio is not None or d.structural_g is not None:
+        from .structure.modes import with_damping
+        ref = pl.modal_model(case)
+        f = ref.frequencies_hz[ref.n_rigid:]
+        if d.structural_g is not None:
+            g = np.broadcast_to(np.asarray(d.structural_g, float), f.shape)
+            kind = "G"
+        else:
+            g = np.broadcast_to(np.asarray(d.modal_damping_ratio, float), f.shape)
+            kind = "CRIT"
+        if np.ptp(g) == 0:
+            x, y = [0.0, 1.0e5], [float(g[0])] * 2
+        else:                                          # per mode: a table through each mode
+            x, y = list(map(float, f)), list(map(float, g))
+        model.add_tabdmp1(30, np.array(x), np.array(y), Type=kind)
+        lines.append("SDAMP = 30")
     model.sol = sol
     model.case_control_deck = CaseControlDeck(lines + ["BEGIN BULK"])
     return model
@@ -1018,3 +1043,28 @@ def write_bdf_model(bdf: BdfModel, path) -> Path:
     bdf_model_deck(bdf).write_bdf(str(path), size=16, elements_size=8, is_double=False,
                                     enddata=True)
     return path
+
+
+def read_f06_eigenvalues(path) -> np.ndarray:
+    """Natural frequencies (Hz, the CYCLES column) of the first REAL EIGENVALUES table of a
+    Nastran f06, keeping the modes with a non-zero generalized mass (Nastran prints 0.0 for
+    the modes beyond those it normalised and recovered). Raises ValueError without a table."""
+    lines = Path(path).read_text(errors="replace").splitlines()
+    try:
+        i = next(j for j, line in enumerate(lines) if "R E A L   E I G E N V A L U E S" in line)
+    except StopIteration:
+        raise ValueError(f"{path}: no REAL EIGENVALUES table") from None
+    out = []
+    for line in lines[i + 1:]:
+        f = line.split()
+        if not f or not f[0].isdigit():
+            if out:
+                break
+            continue
+        if len(f) != 7:
+            break
+        if float(f[5]) > 0:
+            out.append(float(f[4]))
+    if not out:
+        raise ValueError(f"{path}: the REAL EIGENVALUES table has no mode with a mass")
+    return np.array(out)

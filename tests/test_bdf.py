@@ -5,7 +5,6 @@ data/benchmarks/ha145e/ (README there): Nastran SOL 103 eigenvalues from ha145e.
 ZAERO flutter summary of the same example (ha145e.out, M 0.45: 5753.150 in/s, 111.7046 Hz).
 """
 
-import re
 import warnings
 
 import numpy as np
@@ -25,20 +24,6 @@ def _read(path, **kw):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", B.UnsupportedCardWarning)
         return B.read_bdf(path, **kw)
-
-
-def _f06_eigen_hz(path):
-    """CYCLES column of the f06 REAL EIGENVALUES table (modes with non-zero generalized mass)."""
-    lines = open(path).read().splitlines()
-    i = next(j for j, l in enumerate(lines) if "R E A L   E I G E N V A L U E S" in l)
-    out = []
-    for l in lines[i + 3:]:
-        f = l.split()
-        if len(f) != 7 or not f[0].isdigit():
-            break
-        if float(f[5]) > 0:
-            out.append(float(f[4]))
-    return np.array(out)
 
 
 @pytest.fixture(scope="module")
@@ -162,7 +147,7 @@ def test_ha145e_modes_against_nastran():
     modes agree within 3 %. With the corner thicknesses interpolated to every Gauss point
     (asekit's default, closer to the bevelled plate) the modes are 3-6.5 % stiffer: the
     bevelled edge elements carry int t^3 = t_max^3 / 4 instead of (t_max / 2)^3."""
-    nastran = _f06_eigen_hz(HA145E / "ha145e.f06")
+    nastran = B.read_f06_eigenvalues(HA145E / "ha145e.f06")
     np.testing.assert_allclose(nastran, [34.34399, 210.0004, 260.4287, 634.7608], rtol=1e-6)
     m = _read(HA145E / "ha145e.bdf", units="in-lbf-s", thickness_rule="centroid")
     f = B.modal_model(m).frequencies_hz
@@ -185,3 +170,40 @@ def test_ha145e_flutter_against_published():
     assert abs(v_in / 5753.150 - 1) < 0.05, v_in
     assert abs(r.frequency_hz / 111.7046 - 1) < 0.05, r.frequency_hz
     assert r.mode == 1                                   # the second mode (0-based index 1)
+
+
+def test_two_panels_cord2r_grids_and_damping(tmp_path):
+    """A cranked two-panel case with modal damping, its grids rewritten in a translated and
+    rotated CORD2R (pyNastran resolves them to basic): the same modes and damping as the
+    case, one CAERO1 per panel."""
+    from pyNastran.bdf.bdf import BDF
+    case = _variant(DATA_DIR / "cases" / "nalci2013_fin.toml",
+                    panel=[{"root_leading_edge": [0.0, 0.0], "root_chord": 0.156,
+                            "tip_leading_edge": [0.04, 0.08], "tip_chord": 0.116,
+                            "n_chord": 4, "n_span": 4},
+                           {"root_leading_edge": [0.04, 0.08], "root_chord": 0.116,
+                            "tip_leading_edge": [0.078, 0.15], "tip_chord": 0.078,
+                            "n_chord": 4, "n_span": 3}],
+                    support={"kind": "clamped_root"},
+                    damping={"modal_damping_ratio": 0.02},
+                    modes={"count": 4, "keep_rigid": False})
+    ref = pl.modal_model(case)
+    p = B.write_case_bdf(case, tmp_path / "a.bdf")
+    m = BDF(debug=None)
+    m.read_bdf(str(p), xref=False)
+    assert m.card_count["CAERO1"] == 2 and m.card_count["PAERO1"] == 1
+    c, s = np.cos(0.3), np.sin(0.3)
+    origin = np.array([1.0, -2.0, 0.5])
+    m.add_cord2r(7, origin, origin + [0, 0, 1], origin + [c, s, 0])
+    R = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])           # basic -> local
+    for g in m.nodes.values():
+        g.xyz = R @ (np.asarray(g.xyz) - origin)
+        g.cp = 7
+    p2 = tmp_path / "cord.bdf"
+    m.write_bdf(str(p2), size=16, elements_size=8)
+    assert "CORD2R" in p2.read_text()
+    a = _read(p2)
+    mm = B.modal_model(a, n_modes=4)
+    np.testing.assert_allclose(mm.frequencies_hz, ref.frequencies_hz, rtol=2e-5)
+    np.testing.assert_allclose(np.diag(mm.C), np.diag(ref.C), rtol=2e-5)
+    assert a.boxes.n == pl.box_mesh(case).n
