@@ -15,8 +15,10 @@ SPC / SPC1, CELAS1 (PELAS) / CELAS2 springs to ground or between grids, RBE2 (a 
 e.g. the shaft), CAERO1 with PAERO1 (NSPAN/NCHORD or AEFACT LSPAN/LCHORD divisions),
 SPLINE1 / SPLINE4 with SET1 / AELIST (checked: every box must be splined), AERO / AEROS (REFC,
 RHOREF, SYMXZ), MKAERO1, FLFACT, FLUTTER (PK, PKNL), EIGR / EIGRL (number of modes or the
-frequency range), TABDMP1 (G or CRIT modal damping), PARAM WTMASS. CTRIA3 is refused (asekit
-has no triangular plate element); solids, beams, bars, rods and other shells are refused with
+frequency range), TABDMP1 (G or CRIT modal damping), PARAM WTMASS. CTRIA3 is modelled as a
+degenerated MITC4 (its third node repeated: a collapsed quadrilateral, Bathe, *Finite Element
+Procedures*, 1996, Ch. 5), stiffer than the quadrilateral on coarse meshes but convergent
+(tests/test_bdf.py: NAFEMS FV16). Solids, beams, bars, rods and other shells are refused with
 the list of what is missing. Every other card (e.g. ASET1, PARAM COUPMASS, plot cards) is
 listed in one :class:`UnsupportedCardWarning` (name, count, first id) and otherwise ignored.
 
@@ -55,13 +57,14 @@ UNITS = {"SI": (1.0, 1.0, 1.0), "mm-t-s": (1e-3, 1e3, 1.0),
          "in-lbf-s": (0.0254, 4.4482216152605 / 0.0254, 1.0)}
 
 #: Cards asekit reads (see the module docstring).
-SUPPORTED_CARDS = ("GRID", "CORD2R", "CORD1R", "CORD2C", "CORD2S", "CQUAD4", "PSHELL", "MAT1",
+SUPPORTED_CARDS = ("GRID", "CORD2R", "CORD1R", "CORD2C", "CORD2S", "CQUAD4", "CTRIA3", "PSHELL",
+                   "MAT1",
                    "MAT8", "CONM2", "SPC", "SPC1", "CELAS1", "CELAS2", "PELAS", "RBE2",
                    "CAERO1", "PAERO1", "AEFACT", "SPLINE1", "SPLINE4", "SET1", "AELIST", "AERO",
                    "AEROS", "MKAERO1", "FLFACT", "FLUTTER", "EIGR", "EIGRL", "TABDMP1",
                    "PARAM", "ENDDATA")
 #: Element cards asekit cannot represent: a deck holding one of them is refused.
-REFUSED_CARDS = ("CTRIA3", "CTRIA6", "CTRIAR", "CQUAD8", "CQUADR", "CQUAD", "CSHEAR", "CTETRA",
+REFUSED_CARDS = ("CTRIA6", "CTRIAR", "CQUAD8", "CQUADR", "CQUAD", "CSHEAR", "CTETRA",
                  "CPENTA", "CHEXA", "CPYRAM", "CBAR", "CBEAM", "CBEAM3", "CROD", "CONROD",
                  "CTUBE", "CBEND", "CBUSH", "CBUSH1D", "CGAP", "CELAS3", "CELAS4", "CDAMP1",
                  "CDAMP2", "CVISC", "CMASS1", "CMASS2", "CMASS3", "CMASS4", "CONM1", "RBE3",
@@ -288,17 +291,18 @@ def read_bdf(path, units: str = "SI", tol: float | None = None,
     refused, ignored = _card_report(model)
     if refused:
         raise BdfError(f"{path.name}: asekit cannot represent these cards: {_fmt(refused)}. "
-                       f"It models a flat plate of CQUAD4 elements (PSHELL, MAT1/MAT8) with "
-                       f"CONM2, CELAS1/2, RBE2 and SPC supports; CTRIA3 is not supported (no "
-                       f"triangular plate element).")
+                       f"It models a flat plate of CQUAD4 / CTRIA3 elements (PSHELL, "
+                       f"MAT1/MAT8) with CONM2, CELAS1/2, RBE2 and SPC supports (CTRIA3 as a "
+                       f"degenerated MITC4).")
     notes = []
     wt = model.params.get("WTMASS")
     wtmass = float(wt.values[0]) if wt is not None else 1.0
 
     # ---- grids -------------------------------------------------------------------------
-    quads = [e for e in model.elements.values() if e.type == "CQUAD4"]
+    quads = [e for e in model.elements.values() if e.type in ("CQUAD4", "CTRIA3")]
     if not quads:
-        raise BdfError(f"{path.name}: no CQUAD4 element: nothing asekit can model")
+        raise BdfError(f"{path.name}: no CQUAD4 or CTRIA3 element: nothing asekit can model")
+    is_tri = np.array([e.type == "CTRIA3" for e in quads])
     nids = np.array(sorted(model.nodes), dtype=np.int64)
     bad_cd = [int(n) for n in nids if model.nodes[n].cd not in (0, None)]
     if bad_cd:
@@ -313,7 +317,9 @@ def read_bdf(path, units: str = "SI", tol: float | None = None,
     nodes = xyz[:, :2] * L
 
     # ---- elements, thickness, materials --------------------------------------------------
-    conn = np.array([[index[n] for n in e.node_ids] for e in quads], dtype=np.int64)
+    # a CTRIA3 is a degenerated MITC4 with its third node repeated (G1 G2 G3 G3)
+    conn = np.array([[index[n] for n in (list(e.node_ids) + [e.node_ids[2]])[:4]]
+                     for e in quads], dtype=np.int64)
     xy = nodes[conn]
     area2 = ((xy[:, 2, 0] - xy[:, 0, 0]) * (xy[:, 3, 1] - xy[:, 1, 1])
              - (xy[:, 3, 0] - xy[:, 1, 0]) * (xy[:, 2, 1] - xy[:, 0, 1]))
@@ -338,17 +344,24 @@ def read_bdf(path, units: str = "SI", tol: float | None = None,
         if (e.zoffset or 0.0) != 0.0:
             raise BdfError(f"CQUAD4 {e.eid}: ZOFFS = {e.zoffset} is not supported")
         props[e.pid] = p
-        t = [e.T1, e.T2, e.T3, e.T4]
+        t = [e.T1, e.T2, e.T3, e.T3] if is_tri[j] else [e.T1, e.T2, e.T3, e.T4]
         if getattr(e, "tflag", 0) == 1:
             t = [(v if v is not None else 1.0) * p.t for v in t]
         th[j] = [p.t if v is None or v < 0 else v for v in t]
         angles[j] = _element_angle(e, lambda g: xyz[index[g]], e.node_ids[0], e.node_ids[1],
                                    model)
-    conn[flip] = conn[flip][:, ::-1]
-    th[flip] = th[flip][:, ::-1]
+    fq, ft = flip & ~is_tri, flip & is_tri
+    conn[fq] = conn[fq][:, ::-1]
+    th[fq] = th[fq][:, ::-1]
+    conn[ft] = conn[ft][:, [0, 2, 1, 1]]
+    th[ft] = th[ft][:, [0, 2, 1, 1]]
     if flip.any():
-        notes.append(f"{int(flip.sum())} CQUAD4 numbered clockwise seen from +z were "
+        notes.append(f"{int(flip.sum())} elements numbered clockwise seen from +z were "
                      f"renumbered (same element)")
+    if is_tri.any():
+        notes.append(f"{int(is_tri.sum())} CTRIA3 modelled as degenerated MITC4 (G3 repeated; "
+                     f"Bathe, Finite Element Procedures, 1996, Ch. 5: collapsed "
+                     f"quadrilaterals; less accurate than the quadrilateral)")
     th = th * L
     mids3 = {p.pid: p.mid3 for p in props.values()}
     if any(m is None for m in mids3.values()):
@@ -989,9 +1002,13 @@ def bdf_model_deck(bdf: BdfModel):
         if mat is not None and not isinstance(mat, Material):
             d = xy[e, 1] - xy[e, 0]
             theta = math.degrees(float(bdf.element_angles[e]) - math.atan2(d[1], d[0]))
-        model.add_cquad4(e + 1, pid, [ids[c] for c in conn], theta_mcid=float(theta),
-                         T1=float(th[e, 0]), T2=float(th[e, 1]), T3=float(th[e, 2]),
-                         T4=float(th[e, 3]))
+        if conn[2] == conn[3]:
+            model.add_ctria3(e + 1, pid, [ids[c] for c in conn[:3]], theta_mcid=float(theta),
+                             T1=float(th[e, 0]), T2=float(th[e, 1]), T3=float(th[e, 2]))
+        else:
+            model.add_cquad4(e + 1, pid, [ids[c] for c in conn], theta_mcid=float(theta),
+                             T1=float(th[e, 0]), T2=float(th[e, 1]), T3=float(th[e, 2]),
+                             T4=float(th[e, 3]))
     eid = bdf.mesh.n_elements + 1
     for i, m, X, I in bdf.masses:
         model.add_conm2(eid, ids[i], float(m), X=[float(v) for v in X],
