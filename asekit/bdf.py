@@ -616,7 +616,7 @@ def _case_value(model, key: str):
         if sc is not None and sc.has_parameter(key):
             try:
                 return int(sc.get_parameter(key)[0])
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, KeyError):
                 return None
     return None
 

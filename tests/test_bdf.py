@@ -259,3 +259,27 @@ def test_ctria3_degenerated_mitc4_converges_to_nafems_fv16(tmp_path):
             np.testing.assert_allclose(B.modal_model(back, n_modes=5).frequencies_hz, f,
                                        rtol=1e-9)
     assert errs[1] < errs[0] / 4                       # converging
+
+
+def test_aefact_box_divisions_round_trip_and_bulk_only_file(tmp_path):
+    """Non-uniform boxes (cosine chordwise, stretched spanwise) are written as CAERO1 with
+    AEFACT LCHORD / LSPAN and read back (8-character AEFACT fields: 1e-6 m); a bulk-data-only
+    file (no executive / case control) reads as well."""
+    import dataclasses
+    from asekit.aero.boxes import BoxMesh
+    s = _read(HA145E / "ha145e_structure.bdf", units="in-lbf-s")
+    assert s.boxes is None and s.n_modes == 4
+    m = _read(HA145E / "ha145e.bdf", units="in-lbf-s")
+    i = 0.0254
+    xi = 0.5 * (1 - np.cos(np.linspace(0, np.pi, 6)))
+    eta = np.linspace(0, 1, 8) ** 1.3
+    r, t, c = np.zeros(3), np.array([1.48044 * i, 5.5251 * i, 0.0]), 2.07055 * i
+    le = r + eta[:, None] * (t - r)
+    g = le[:, None, :] + xi[None, :, None] * c * np.array([1.0, 0.0, 0.0])
+    box = np.stack([g[:-1, :-1], g[:-1, 1:], g[1:, 1:], g[1:, :-1]], axis=2).reshape(-1, 4, 3)
+    bm = BoxMesh(box, np.repeat(np.arange(7), 5), np.zeros(35, int))
+    p = B.write_bdf_model(dataclasses.replace(m, boxes=bm, box_ids=100001 + np.arange(35)),
+                          tmp_path / "nu.bdf")
+    assert p.read_text().count("AEFACT") == 2
+    back = _read(p)
+    np.testing.assert_allclose(back.boxes.corners, bm.corners, atol=1e-6)
