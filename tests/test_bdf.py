@@ -283,3 +283,19 @@ def test_aefact_box_divisions_round_trip_and_bulk_only_file(tmp_path):
     assert p.read_text().count("AEFACT") == 2
     back = _read(p)
     np.testing.assert_allclose(back.boxes.corners, bm.corners, atol=1e-6)
+
+
+def test_fin_flutter_through_the_bdf_equals_the_case(fin, tmp_path):
+    """The fin exported as SOL 145 and analysed from the deck by asekit (boxes, k, density,
+    velocities all read back from CAERO1 / MKAERO1 / FLFACT) flutters where the case's own
+    pipeline says (M 0.5, sea level; the case holds the rigid pitch mode, the deck's FN2
+    ground inertia does the same): measured 210.0457 vs 210.0441 m/s."""
+    import dataclasses
+    m = _read(B.write_case_bdf(fin, tmp_path / "fin.bdf"))
+    req = dataclasses.replace(m.flutter[0], machs=(0.5,), densities=m.flutter[0].densities[:1])
+    res, _, _ = B.flutter(dataclasses.replace(m, machs=(0.5,), flutter=(req,)))
+    cond = pl.flight_conditions(fin)[0]
+    assert cond.altitude == 0.0 and req.densities[0] == pytest.approx(cond.density, rel=1e-7)
+    ref = pl.analyse_condition(fin, pl.gaf_database(fin, progress=False), 0.5, cond)
+    assert res[0].speed == pytest.approx(ref.flutter.speed, rel=1e-4)
+    assert res[0].frequency_hz == pytest.approx(ref.flutter.frequency_hz, rel=1e-4)
