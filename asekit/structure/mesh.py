@@ -31,6 +31,9 @@ class PlateMesh:
     thickness_field : optional h(x, y) (m), e.g. a :class:`~asekit.geometry.ThicknessField`
         with a chordwise profile; when given it replaces the spanwise linear law everywhere
         the element integrates (:meth:`thickness_xy`).
+    corner_thickness : optional (n_elem, 4) thickness (m) at each element's four corners,
+        interpolated bilinearly inside the element with the shape functions (as Nastran's
+        CQUAD4 T1-T4 fields); when given it replaces both laws above in the element matrices.
     """
 
     nodes: np.ndarray
@@ -42,6 +45,7 @@ class PlateMesh:
     n_chord: int = 0
     n_span: int = 0
     thickness_field: object = None
+    corner_thickness: np.ndarray | None = None
 
     @property
     def n_nodes(self) -> int:

@@ -88,6 +88,12 @@ def _check_geometry(det: np.ndarray):
 
 
 def _thickness(mesh: PlateMesh, xy: np.ndarray, N: np.ndarray, rule: str) -> np.ndarray:
+    ct = getattr(mesh, "corner_thickness", None)
+    if ct is not None:                              # per-element corner thicknesses (T1-T4)
+        if rule == "gauss":
+            return np.asarray(ct, float) @ N
+        if rule == "centroid":
+            return np.asarray(ct, float).mean(axis=1)
     if rule == "gauss":
         x = N @ xy[:, :, 0].T                       # N (4,) -> (ne,)
         y = N @ xy[:, :, 1].T
