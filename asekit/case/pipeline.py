@@ -58,6 +58,10 @@ def modal_model(case: Case) -> ModalModel:
     try:
         if s.kind == "clamped_root":
             model = fixed_modal_model(clamped_edge(mesh, K, M), M, md.f_max, md.count)
+        elif s.kind == "edges":
+            from ..structure.supports import planform_edge_supports
+            model = fixed_modal_model(planform_edge_supports(mesh, K, M, **dict(s.edges)), M,
+                                      md.f_max, md.count)
         else:
             region = "single_node" if s.radius is None else "distributed"
             radius = 0.0 if s.radius is None else s.radius
@@ -124,9 +128,11 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True) -> GafDa
     """Q_mm(M, k) over ``aero.machs`` x the reduced frequencies, cached per fingerprint in the
     user cache directory (:func:`asekit.aero.gaf.cached_gaf_database`)."""
     a = case.aero
+    # the database's method: the DLM kernel name, or the aerodynamic method (asekit.aero.methods)
+    method = a.kernel if a.method == "dlm" else a.method
     return cached_gaf_database(modal_model(case), box_mesh(case), a.machs,
                                reduced_frequencies(case), a.reference_semichord,
-                               symmetric=a.symmetry == "wall", method=a.kernel,
+                               symmetric=a.symmetry == "wall", method=method,
                                progress=progress, rebuild=not cache,
                                metadata={"case": case.name})
 

@@ -43,7 +43,9 @@ class PanelSpec:
 class SupportSpec:
     """How the surface is held.
 
-    kind : ``"clamped_root"`` (every DOF of the root-chord nodes fixed) or ``"shaft"`` (the
+    kind : ``"clamped_root"`` (every DOF of the root-chord nodes fixed), ``"edges"`` (``edges``:
+        the condition -- clamped, simply_supported, sliding or free -- of the root, tip, leading
+        and trailing edges, e.g. for panel flutter) or ``"shaft"`` (the
         thesis's pitch shaft: ``axis_point`` (x, y) m on the root chord, ``torsional_stiffness``
         N m/rad of the actuator-fin connection, optional ``bending_stiffness`` N m/rad about the
         chordwise axis, ``model`` "FN2" (fictitious mass: rigid pitch mode + elastic modes) or
@@ -58,6 +60,7 @@ class SupportSpec:
     model: str = "FN2"
     radius: float | None = None
     fictitious_inertia_factor: float = 1.0e6
+    edges: tuple[tuple[str, str], ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -406,10 +409,20 @@ def _material(t: _Table):
 
 
 def _support(t: _Table, panels) -> SupportSpec:
-    kind = t.string("kind", ("clamped_root", "shaft"), required=True)
+    kind = t.string("kind", ("clamped_root", "shaft", "edges"), required=True)
     if kind == "clamped_root":
         t.done()
         return SupportSpec(kind="clamped_root")
+    if kind == "edges":
+        from ..structure.supports import EDGE_TYPES, PLANFORM_EDGES
+        defaults = {"root": "clamped", "tip": "free", "leading_edge": "free",
+                    "trailing_edge": "free"}
+        edges = tuple((e, t.string(e, EDGE_TYPES, default=defaults[e])) for e in PLANFORM_EDGES)
+        t.done()
+        if all(k == "free" for _, k in edges):
+            raise CaseError("support: all four edges free leaves rigid-body modes; hold at "
+                            "least one edge (support.root = \"clamped\", ...)")
+        return SupportSpec(kind="edges", edges=edges)
     axis = t.numbers("axis_point", required=True, length=2, unit="m")
     k = t.number("torsional_stiffness", required=True, low=0.0, high=1e12, unit="N m/rad")
     kb = t.number("bending_stiffness", low=0.0, high=1e12, unit="N m/rad")
@@ -475,9 +488,16 @@ def _modes(t: _Table | None, support: SupportSpec) -> ModesSpec:
 
 
 def _aero(t: _Table, panels) -> AeroSpec:
-    machs = t.numbers("machs", required=True, low=0.0, low_open=False, high=1.0, high_open=True,
-                      ascending=True)
-    method = t.string("method", ("dlm",), default="dlm")
+    method = t.string("method", ("dlm", "auto", "supersonic", "piston"), default="dlm")
+    machs = t.numbers("machs", required=True, low=0.0, low_open=False,
+                      high=1.0 if method == "dlm" else 10.0, high_open=True, ascending=True)
+    from ..aero.methods import resolve_method
+    for i, m in enumerate(machs):
+        try:
+            resolve_method(method, m)
+        except ValueError as exc:
+            raise CaseError(f"aero.machs[{i}] = {m:g} with aero.method = {method!r}: "
+                            f"{exc}") from None
     b = t.number("reference_semichord", required=True, low=0.0, high=1e3, unit="m")
     ks = t.raw("reduced_frequencies", "auto")
     if ks == "auto":

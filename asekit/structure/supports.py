@@ -80,3 +80,63 @@ def edge_supports(mesh: PlateMesh, K, M, x0: str = "simply_supported",
     return SupportedSystem(K=(T.T @ K @ T).tocsr(), M=(T.T @ M @ T).tocsr(), T=T,
                            shaft_index=None, ground_index=None, fictitious_inertia=0.0,
                            shaft_nodes=np.array([], dtype=np.int64), mesh=mesh, label=label)
+
+
+#: Named edges of a structured surface mesh (nodes ``j (n_chord + 1) + i``): the root and tip
+#: stations and the leading and trailing edges of all panels.
+PLANFORM_EDGES = ("root", "tip", "leading_edge", "trailing_edge")
+
+
+def planform_edge_nodes(mesh: PlateMesh, edge: str) -> np.ndarray:
+    """Nodes on a named edge (:data:`PLANFORM_EDGES`) of a structured mesh
+    (:func:`asekit.structure.mesh.structured_mesh` or ``panels_mesh``)."""
+    if edge not in PLANFORM_EDGES:
+        raise ValueError(f"edge must be one of {PLANFORM_EDGES}, got {edge!r}")
+    nc, ns = mesh.n_chord, mesh.n_span
+    if nc < 1 or ns < 1 or mesh.n_nodes != (nc + 1) * (ns + 1):
+        raise ValueError("planform edges need a structured mesh (n_chord x n_span elements)")
+    grid = np.arange(mesh.n_nodes).reshape(ns + 1, nc + 1)
+    return {"root": grid[0], "tip": grid[-1], "leading_edge": grid[:, 0],
+            "trailing_edge": grid[:, -1]}[edge]
+
+
+def planform_edge_supports(mesh: PlateMesh, K, M, root: str = "clamped", tip: str = "free",
+                           leading_edge: str = "free",
+                           trailing_edge: str = "free") -> SupportedSystem:
+    """Edge conditions on the named edges of a structured surface mesh (a plate wing's root and
+    tip stations, its leading and trailing edges; see the module docstring for the kinds).
+
+    Root and tip run along x (y = const). A leading or trailing edge at constant x takes the
+    "hard" simple support as :func:`edge_supports`; on a swept (or tapered) edge the slope along
+    the edge mixes theta_x and theta_y and cannot be removed by eliminating degrees of freedom,
+    so ``"simply_supported"`` there holds w only (the "soft" simple support; Bathe 1996,
+    Sec. 5.4) and ``"sliding"`` is refused.
+    """
+    kinds = {"root": root, "tip": tip, "leading_edge": leading_edge,
+             "trailing_edge": trailing_edge}
+    fixed = set()
+    scale = float(np.ptp(mesh.nodes, axis=0).max())
+    for edge, kind in kinds.items():
+        if kind not in EDGE_TYPES:
+            raise ValueError(f"{edge} must be one of {EDGE_TYPES}, got {kind!r}")
+        nodes = planform_edge_nodes(mesh, edge)
+        if edge in ("root", "tip"):
+            dofs = _FIXED[(kind, "y")]
+        elif np.ptp(mesh.nodes[nodes, 0]) <= 1e-9 * scale:          # an edge x = const
+            dofs = _FIXED[(kind, "x")]
+        elif kind == "sliding":
+            raise ValueError(f"{edge}: a sliding condition needs an edge at constant x "
+                             "(this one is swept or tapered)")
+        else:
+            dofs = (0,) if kind == "simply_supported" else _FIXED[(kind, "x")]
+        for node in nodes:
+            for d in dofs:
+                fixed.add(DOF_PER_NODE * int(node) + d)
+    n = K.shape[0]
+    free = np.setdiff1d(np.arange(n), np.fromiter(fixed, int, len(fixed)))
+    T = sp.csr_matrix((np.ones(free.size), (free, np.arange(free.size))), shape=(n, free.size))
+    K, M = sp.csr_matrix(K), sp.csr_matrix(M)
+    label = "plate " + ", ".join(f"{e} {k}" for e, k in kinds.items())
+    return SupportedSystem(K=(T.T @ K @ T).tocsr(), M=(T.T @ M @ T).tocsr(), T=T,
+                           shaft_index=None, ground_index=None, fictitious_inertia=0.0,
+                           shaft_nodes=np.array([], dtype=np.int64), mesh=mesh, label=label)
