@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
@@ -336,8 +336,9 @@ def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
     from .. import metrics
     from ..aeroelastic import fin_outputs
     from ..rfa import gaf_at_mach, roger_fit
-    from ..servo import ActuatorParameters, DCMotor, PDController, Transmission
-    from ..simulate import PowerLimits
+    from ..servo import SYSTEM_3, ActuatorParameters, DCMotor, Transmission
+    from ..simulate import THESIS_LIMITS
+    from .schema import MOTOR_KEYS, TRANSMISSION_KEYS
 
     a = case.actuator
     model = modal_model(case)
@@ -349,14 +350,17 @@ def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
     corners = corner_points(case)
     rows = fin_outputs(model, np.array(list(corners.values())), names=list(corners),
                        shaft_point=case.support.axis_point)
-    act = ActuatorParameters(
-        DCMotor(a.resistance, a.inductance, a.torque_constant, a.back_emf_constant,
-                a.rotor_inertia, a.viscous_damping),
-        Transmission(a.ratio, a.efficiency, a.transmission_inertia), fin_inertia=0.0)
-    ctl = PDController(a.k_c, a.k_p, a.k_d, name="case controller")
+    def given(pairs):            # {servo field: case value} for the keys the case sets
+        return {dst: getattr(a, src) for src, dst in pairs if getattr(a, src) is not None}
+
+    act = ActuatorParameters(DCMotor(**given(zip(MOTOR_KEYS, MOTOR_KEYS))),
+                             Transmission(**given(TRANSMISSION_KEYS.items())), fin_inertia=0.0)
+    ctl = replace(SYSTEM_3, name="case controller",
+                  **given((("k_c", "gain"), ("k_p", "kp"), ("k_d", "kd"))))
+    lim = replace(THESIS_LIMITS, **given((("supply_voltage", "supply_voltage"),
+                                          ("current_limit", "current_limit"))))
     m = ase_mod.build_model(model, rfa, rho, U, rows, actuator=act, mach=a.mach)
     stable, maxre, sims, settle, err, over = {}, {}, {}, {}, {}, {}
-    lim = PowerLimits(supply_voltage=a.supply_voltage, current_limit=a.current_limit)
     step = math.radians(a.step_deg)
     for topo in ase_mod.TOPOLOGIES:
         loop = ase_mod.closed_loop(m, ctl, topo)

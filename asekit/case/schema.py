@@ -129,26 +129,36 @@ class FlightSpec:
     envelope_altitude: tuple[float, float] | None = None
 
 
+#: The actuator keys of a case file, each None (the default of :class:`asekit.servo.DCMotor`,
+#: :class:`asekit.servo.Transmission`, the thesis's System 3 and power limits) unless given.
+MOTOR_KEYS = ("resistance", "inductance", "torque_constant", "back_emf_constant",
+              "rotor_inertia", "viscous_damping")
+TRANSMISSION_KEYS = {"ratio": "ratio", "efficiency": "efficiency",
+                     "transmission_inertia": "inertia"}
+
+
 @dataclass(frozen=True)
 class ActuatorSpec:
     """The servo-actuator (thesis Ch. 4-5): DC motor, transmission, PD controller
-    K_c (K_P + K_D s), power limits, and the flight condition of the ASE analysis. Defaults are
-    the thesis's System 3 and Faulhaber 2642 drive (Tables 12, 16, 17)."""
+    K_c (K_P + K_D s), power limits, and the flight condition of the ASE analysis. A value left
+    None takes asekit's default: the Faulhaber 2642 drive of :class:`asekit.servo.DCMotor` and
+    :class:`asekit.servo.Transmission` (thesis Table 12), System 3 (Table 17), 24 V / 10 A
+    (Table 16)."""
 
-    resistance: float = 5.78
-    inductance: float = 550e-6
-    torque_constant: float = 34.6e-3
-    back_emf_constant: float = 34.6e-3
-    rotor_inertia: float = 11e-7
-    viscous_damping: float = 0.0
-    ratio: float = 66.0
-    efficiency: float = 0.7
-    transmission_inertia: float = 0.5e-7
-    k_c: float = 10.0
-    k_p: float = 275.0
-    k_d: float = 1.0
-    supply_voltage: float = 24.0
-    current_limit: float = 10.0
+    resistance: float | None = None
+    inductance: float | None = None
+    torque_constant: float | None = None
+    back_emf_constant: float | None = None
+    rotor_inertia: float | None = None
+    viscous_damping: float | None = None
+    ratio: float | None = None
+    efficiency: float | None = None
+    transmission_inertia: float | None = None
+    k_c: float | None = None
+    k_p: float | None = None
+    k_d: float | None = None
+    supply_voltage: float | None = None
+    current_limit: float | None = None
     mach: float = 0.5
     altitude: float = 0.0
     step_deg: float = 1.0
@@ -568,33 +578,26 @@ def _flight(t: _Table) -> FlightSpec:
 def _actuator(t: _Table | None) -> ActuatorSpec | None:
     if t is None:
         return None
-    d = ActuatorSpec()
     vals = {}
-    for name in ("resistance", "inductance", "torque_constant", "back_emf_constant",
-                 "rotor_inertia", "ratio", "transmission_inertia", "supply_voltage",
-                 "current_limit", "step_deg"):
-        lo_open = name != "transmission_inertia"
-        vals[name] = t.number(name, default=getattr(d, name), low=0.0, low_open=lo_open,
-                              high=1e6)
-    vals["viscous_damping"] = t.number("viscous_damping", default=0.0, low=0.0, low_open=False,
-                                       high=1e6)
-    vals["efficiency"] = t.number("efficiency", default=d.efficiency, low=0.0, high=1.0)
+    for name in MOTOR_KEYS + tuple(TRANSMISSION_KEYS) + ("supply_voltage", "current_limit"):
+        zero_ok = name in ("viscous_damping", "transmission_inertia")
+        vals[name] = t.number(name, low=0.0, low_open=not zero_ok,
+                              high=1.0 if name == "efficiency" else 1e6)
+    vals["step_deg"] = t.number("step_deg", default=1.0, low=0.0, high=15.0,
+                                unit="deg (the fin's travel)")
     ctl = t.table("controller")
     if ctl is not None:
         for name in ("k_c", "k_p", "k_d"):
-            vals[name] = ctl.number(name, default=getattr(d, name), low=-1e9, high=1e9)
+            vals[name] = ctl.number(name, low=-1e9, high=1e9)
         ctl.done()
     cond = t.table("condition")
     if cond is not None:
-        vals["mach"] = cond.number("mach", default=d.mach, low=0.0, low_open=False, high=1.0,
+        vals["mach"] = cond.number("mach", default=0.5, low=0.0, low_open=False, high=1.0,
                                    high_open=True)
-        vals["altitude"] = cond.number("altitude", default=d.altitude, low=-1000.0,
-                                       low_open=False, high=80000.0, unit="m")
+        vals["altitude"] = cond.number("altitude", default=0.0, low=-1000.0, low_open=False,
+                                       high=80000.0, unit="m")
         cond.done()
     t.done()
-    if vals["step_deg"] > 15.0:
-        raise CaseError(f"actuator.step_deg must be <= 15 deg (the fin's travel), "
-                        f"got {vals['step_deg']:g}")
     return ActuatorSpec(**vals)
 
 
