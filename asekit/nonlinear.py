@@ -700,6 +700,17 @@ class PiecewiseSimulation:
     diverged: bool
 
 
+def _check_run(connection, system, x0, t_final):
+    """The checked (initial state, final time) of a simulation of ``system`` with ``connection``."""
+    if not isinstance(connection, Connection):
+        raise TypeError(f"connection must be a Connection, got {type(connection).__name__}")
+    n = system.n_states
+    x = np.asarray(x0, float).ravel()
+    if x.size != n or not np.all(np.isfinite(x)):
+        raise ValueError(f"x0 must be a finite vector of length {n}")
+    return x, positive("t_final", t_final)
+
+
 def simulate(system: ConnectedSystem, connection: Connection, x0, t_final: float,
              u=None, n_out: int = 20001, rtol: float = 1e-8, atol: float = 1e-11,
              method: str = "RK45", max_step: float = math.inf, max_switches: int = 200000,
@@ -719,13 +730,8 @@ def simulate(system: ConnectedSystem, connection: Connection, x0, t_final: float
     divergence_limit : stop (``diverged=True``) when |d| exceeds it (rad); default
         1e3 max(delta, |d(0)|) so an unbounded flutter does not overflow.
     """
-    if not isinstance(connection, Connection):
-        raise TypeError(f"connection must be a Connection, got {type(connection).__name__}")
+    x, t_final = _check_run(connection, system, x0, t_final)
     n = system.n_states
-    x = np.asarray(x0, float).ravel()
-    if x.size != n or not np.all(np.isfinite(x)):
-        raise ValueError(f"x0 must be a finite vector of length {n}")
-    t_final = positive("t_final", t_final)
     m = system.B_u.shape[1]
     if u is None:
         u_fun = None
@@ -861,13 +867,8 @@ def simulate_exact(system: ConnectedSystem, connection: Connection, x0, t_final:
     """
     from scipy.linalg import expm
 
-    if not isinstance(connection, Connection):
-        raise TypeError(f"connection must be a Connection, got {type(connection).__name__}")
+    x, t_final = _check_run(connection, system, x0, t_final)
     n = system.n_states
-    x = np.asarray(x0, float).ravel()
-    if x.size != n or not np.all(np.isfinite(x)):
-        raise ValueError(f"x0 must be a finite vector of length {n}")
-    t_final = positive("t_final", t_final)
     h = positive("step", step)
     m = system.B_u.shape[1]
     if u is None:
