@@ -27,6 +27,7 @@ CHAPTERS: tuple[tuple[str, str], ...] = (
     ("aero", "Ch. 3.2 aerodynamics"),
     ("flutter", "Ch. 3.2.2-3.3 RFA and flutter"),
     ("ase", "Ch. 5 aeroservoelasticity"),
+    ("design", "beyond Ch. 5: minimum-state RFA, controllers on the elastic fin"),
 )
 
 

@@ -217,7 +217,7 @@ def step_cost(controller, plants) -> float:
             c += 1000.0 * max(0.0, metrics.overshoot(r.fin_root, cmd) - 0.01)
             c += 100.0 * max(0.0, float(e[-1]) - 0.005)
             st = metrics.settling_time(r.t, r.fin_root, r.fin_root[-1], cmd)
-            c += 0.5 * max(0.0, 1e3 * min(st, 0.12) - 40.0)      # ms past 40 ms
+            c += 2.0 * max(0.0, 1e3 * min(st, 0.12) - 40.0)      # ms past 40 ms
         worst = max(worst, c)
     return worst
 
@@ -240,3 +240,258 @@ def tune_filtered_pid(plants, resonances_hz, x0, max_evaluations: int = 300):
     res = minimize(f, z0, method="Nelder-Mead",
                    options={"maxfev": int(max_evaluations), "xatol": 1e-3, "fatol": 1e-3})
     return unpack(res.x), float(res.fun)
+
+
+#: Design (a) parameters (kp V/rad, ki V/(rad s), kd V s/rad, tau_d s, low-pass Hz, set-point
+#: weight, notch zeta_pole), from :func:`tune_filtered_pid` on the AEM2 plants of
+#: :data:`DESIGN_A_CONDITIONS` (elastic fin, Roger aerodynamics, processor in the loop),
+#: started from a loop-shaping guess (crossover 25 Hz, lead 2.5, integral zero 5 Hz, notches
+#: at the open-loop resonances). Rerun with :func:`redesign_a`.
+DESIGN_A = (522.396, 25195.97, 2.048884, 0.000154585, 306.377, 0.020692, 0.296415)
+DESIGN_A_CONDITIONS = ((0.5, 0.0, "nominal"), (0.6, 0.0, "nominal"), (0.4, 5000.0, "nominal"),
+                       (0.6, 0.0, "shaft +20%"), (0.6, 0.0, "shaft -20%"),
+                       (0.6, 0.0, "f1,f2 +10%"), (0.6, 0.0, "f1,f2 -10%"),
+                       (0.4, 5000.0, "f1,f2 +10%"), (0.4, 5000.0, "shaft -20%"))
+#: Design (b) weights: LQR on the fin-root error 10 x Bryson's 1/(1 deg)^2, on its integral
+#: 1e-3 x 1/(1 deg x 10 ms)^2, on the voltage 1/(24 V)^2; Kalman predictor for 1 V^2 input
+#: noise and (1 mrad)^2 measurement noise; 5 ms reference model; minimum-state aerodynamics
+#: with 6 lag states (design model 19 states) at the envelope's highest dynamic pressure,
+#: Mach 0.6, sea level (designed at Mach 0.5 the loop overshoots 6-7 % at Mach 0.6 and the
+#: +10 % frequency case fails; a scan of design point, weights and noise picked this one).
+DESIGN_B_CONDITION = (0.6, 0.0)
+DESIGN_B = {"weight_error": 10.0 / math.radians(1.0) ** 2,
+            "weight_integral": 1e-3 / (math.radians(1.0) * 0.01) ** 2,
+            "weight_voltage": 1.0 / 24.0 ** 2, "input_noise": 1.0, "measurement_noise": 1e-6,
+            "reference_time_constant": 0.005}
+DESIGN_B_STATES = 6
+
+
+def design_a(data=None, params=None) -> DigitalController:
+    """Design (a), PID + low-pass + notches on AEM2: notches at the two resonances of OPLOOP 3
+    at Mach 0.5, sea level (the controller is fixed over the envelope: no scheduling)."""
+    m0 = fin_model(0.5, 0.0, data=data)
+    return filtered_pid(DESIGN_A if params is None else params,
+                        open_loop_resonances(m0, "AEM2"), name="PID + LP + notches")
+
+
+def redesign_a(data=None, max_evaluations: int = 500, x0=None):
+    """Rerun the tuning of design (a) (a few minutes). Returns (params, cost)."""
+    data = load() if data is None else data
+    m0 = fin_model(0.5, 0.0, data=data)
+    res = open_loop_resonances(m0, "AEM2")
+    plants = [ase.sampled_plant(fin_model(M, h, c, data=data), "AEM2")
+              for M, h, c in DESIGN_A_CONDITIONS]
+    x0 = (205.6, 6459.0, 2.75, 0.00255, 63.9, 0.0, 0.5) if x0 is None else x0
+    return tune_filtered_pid(plants, res, x0, max_evaluations)
+
+
+def design_b(data=None, topology: str = "AEM2", **overrides) -> DigitalController:
+    """Design (b), LQG + integral action on the minimum-state plant (:data:`DESIGN_B`)."""
+    from ..controllers import lqg_integral as _lqg
+
+    m = fin_model(*DESIGN_B_CONDITION, data=data, fit=ms_fit(DESIGN_B_STATES))
+    plant = ase.sampled_plant(m, topology, SAMPLE_TIME)
+    kw = {**DESIGN_B, **overrides}
+    return _lqg(plant, name="LQG + integral (min-state)", **kw)
+
+
+def designs(data=None) -> dict:
+    """The designs compared: ``{key: (controller, topology)}``."""
+    data = load() if data is None else data
+    s3 = system3()
+    return {"system3_aem1": (s3, "AEM1"), "system3_aem2": (s3, "AEM2"),
+            "pid_notch": (design_a(data), "AEM2"), "lqg": (design_b(data), "AEM2")}
+
+
+def envelope_table(data=None, design_set=None, machs=MACHS, altitudes=ALTITUDES,
+                   cases=tuple(ROBUSTNESS)) -> list[Check]:
+    """:func:`check` of every design at every (Mach, altitude, robustness case)."""
+    data = load() if data is None else data
+    design_set = designs(data) if design_set is None else design_set
+    out = []
+    for M in machs:
+        for h in altitudes:
+            for case in cases:
+                model = fin_model(M, h, case, data=data)
+                for key, (ctl, topo) in design_set.items():
+                    c = check(ctl, model, topo, M, h, case)
+                    out.append(replace(c, design=key))
+    return out
+
+
+def best_corner_error(corner_ratios) -> float:
+    """Smallest achievable max_c |g (1 + d_c) - 1| over the fin-root gain g, for corner
+    rotations (1 + d_c) times the root's (one actuator sets only the root angle): with
+    d_max, d_min the extremes, (d_max - d_min) / (2 + d_max + d_min)."""
+    d = np.asarray(corner_ratios, float) - 1.0
+    return float((d.max() - d.min()) / (2.0 + d.max() + d.min()))
+
+
+def static_deflections(data=None, mach=0.6, altitude=0.0, case="nominal") -> dict:
+    """Steady rotations per unit fin-root angle of the transmission and the four corners under
+    the steady aerodynamic load (any controller that holds the root at r gives these, to the
+    extent its steady state is set by the root angle), and the best achievable corner error."""
+    model = fin_model(mach, altitude, case, data=data)
+    plant = ase.sampled_plant(model, "AEM2", SAMPLE_TIME)
+    ctl = design_b(data)
+    names = ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in ase.CORNERS]
+    g = dc_gains(plant, ctl, names)
+    ratios = {n: g[n] / g[ase.FIN_ROOT] for n in names}
+    corners = [ratios[f"theta_{c}"] for c in ase.CORNERS]
+    return {"ratios": ratios, "best_corner_error": best_corner_error(corners)}
+
+
+# ---------------------------------------------------------------------------------------------
+# minimum-state aerodynamics studies
+# ---------------------------------------------------------------------------------------------
+def rfa_state_study(data=None, mach: float = 0.75, roger_lags=range(0, 8),
+                    ms_states=(1, 2, 4, 6, 8, 10, 12, 16), max_iter: int = 2000) -> dict:
+    """Fit error against the number of aerodynamic lag states: Roger (N lags -> N n states)
+    and minimum-state (n_L states), unweighted, at ``mach``."""
+    from ..rfa import gaf_at_mach, minimum_state_fit, roger_fit
+
+    db, _ = load() if data is None else data
+    k, Q = gaf_at_mach(db, mach)
+    n = Q.shape[1]
+    rg = [(N * n, roger_fit(k, Q, db.b_ref, n_lags=N).fit_error) for N in roger_lags]
+    ms = [(s, minimum_state_fit(k, Q, db.b_ref, n_states=s, max_iter=max_iter).fit_error)
+          for s in ms_states]
+    return {"roger": np.array(rg), "minimum_state": np.array(ms), "n_modes": n, "mach": mach}
+
+
+def states_for_error(table: np.ndarray, target: float = 0.01):
+    """Smallest state count in ``table`` ((states, error) rows) with error <= target, or
+    None."""
+    ok = table[table[:, 1] <= target]
+    return None if ok.size == 0 else int(ok[:, 0].min())
+
+
+def elastic_problem(data, mach):
+    """The clamped (rigid mode held) flutter problem: (ModalArrays, k, Q_ss, b_ref)."""
+    from ..aeroelastic import modal_arrays
+    from ..rfa import gaf_at_mach
+
+    db, modal = data
+    m = modal_arrays(modal)
+    s = slice(m.n_rigid, m.n_modes)
+    me = modal_arrays(M=m.M[s, s], K=m.K[s, s], C=m.C[s, s], n_rigid=0)
+    k, Q = gaf_at_mach(db, mach)
+    return me, k, Q[:, s, s], db.b_ref
+
+
+def flutter_comparison(data=None, mach: float = 0.75, altitude: float = 0.0,
+                       roger_lags=(2, 4, 6), ms_states=(2, 4, 5, 6, 8), band: float = 2.0,
+                       order: int = 4, velocities=np.arange(150.0, 461.0, 5.0)) -> dict:
+    """Flutter speed of the fin (rigid mode held) by p-k and by the root locus with Roger fits
+    and minimum-state fits (unweighted and weighted to k <= ``band`` k_f, k_f from p-k)."""
+    from ..atmosphere import standard_atmosphere
+    from ..flutter import (TabulatedGaf, first_of, pk_flutter, pk_instabilities, root_locus,
+                           root_locus_instabilities)
+    from ..rfa import minimum_state_fit, reduced_frequency_weights, roger_fit
+
+    data = load() if data is None else data
+    me, k, Qe, b = elastic_problem(data, mach)
+    rho = float(standard_atmosphere(altitude).density)
+    gaf = TabulatedGaf(k, Qe, b, mach)
+    pk = first_of(pk_instabilities(pk_flutter(me, gaf, rho, velocities), me, gaf), "flutter")
+    kf = 2 * np.pi * pk.frequency_hz * b / pk.speed
+
+    def rl(fit):
+        i = first_of(root_locus_instabilities(root_locus(me, fit, rho, velocities), me, fit),
+                     "flutter")
+        return None if i is None else float(i.speed)
+
+    w = reduced_frequency_weights(k, band * kf, order)
+    rows = []
+    for N in roger_lags:
+        f = roger_fit(k, Qe, b, n_lags=N)
+        rows.append(("Roger", N * Qe.shape[1], f.fit_error, rl(f)))
+    for s in ms_states:
+        f = minimum_state_fit(k, Qe, b, n_states=s)
+        rows.append(("min-state", s, f.fit_error, rl(f)))
+        f = minimum_state_fit(k, Qe, b, n_states=s, weights=w)
+        rows.append((f"min-state, W(k<{band:g} k_f)", s, f.fit_error, rl(f)))
+    return {"pk_speed": float(pk.speed), "pk_frequency_hz": float(pk.frequency_hz),
+            "k_f": float(kf), "rows": rows, "mach": mach, "altitude": altitude}
+
+
+def flutter_weighting_study(data=None, mach: float = 0.75, bands=(2.0, 3.0, 4.0),
+                            orders=(2, 4), ms_states=(4, 5, 6, 8)) -> list:
+    """Root-locus flutter speed error (%) against p-k for minimum-state fits weighted with
+    :func:`asekit.rfa.reduced_frequency_weights` (k_band = band x k_f, order): rows
+    (band, order, [errors per state count])."""
+    out = []
+    for band in bands:
+        for order in orders:
+            fc = flutter_comparison(data, mach, roger_lags=(), ms_states=ms_states, band=band,
+                                    order=order)
+            errs = [None if r[3] is None else 100 * (r[3] / fc["pk_speed"] - 1)
+                    for r in fc["rows"] if r[0].startswith("min-state, W")]
+            out.append((band, order, errs))
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# reproduce chapter: the designs at Mach 0.5, sea level (cheap); the envelope in the notebook
+# ---------------------------------------------------------------------------------------------
+def run(figures: bool = False) -> ChapterResult:
+    data = load()
+    q = []
+    model = fin_model(0.5, 0.0, data=data)
+    for key, (ctl, topo) in designs(data).items():
+        c = check(ctl, model, topo)
+        note = f"{topo}, M 0.5 sea level, 1 kHz + 1 sample delay, power limited, 1 and 15 deg"
+        q.append(Quantity(f"ase.design.{key}.table2_pass", c.table2_pass, "-", note))
+        q.append(Quantity(f"ase.design.{key}.settling_ms", c.settling_ms, "ms",
+                          "fin root, 2 % band, worst of 1 and 15 deg"))
+        q.append(Quantity(f"ase.design.{key}.steady_error_pct", c.steady_error_pct, "%",
+                          "fin root, exact DC gain of the sampled loop"))
+    study = rfa_state_study(data, 0.75, roger_lags=range(0, 8), ms_states=(6, 12, 16))
+    q.append(Quantity("rfa.M075.roger.states_for_1pct", states_for_error(study["roger"]), "-",
+                      "Roger N lags x 6 modes"))
+    q.append(Quantity("rfa.M075.minimum_state.states_for_1pct",
+                      states_for_error(study["minimum_state"]), "-",
+                      "of 6, 12, 16 shared states, unweighted"))
+    fc = flutter_comparison(data, 0.75, roger_lags=(4,), ms_states=(6,))
+    q.append(Quantity("flutter.pk.M075.h0.elastic.speed_ms", fc["pk_speed"], "m/s",
+                      "rigid mode held, 150-460 m/s by 5"))
+    rl_ms = [r for r in fc["rows"] if r[0].startswith("min-state, W")][0][3]
+    q.append(Quantity("flutter.root_locus.minimum_state6.M075.h0.speed_ms", rl_ms, "m/s",
+                      "6 lag states, weighted k < 2 k_f"))
+    return ChapterResult("design", tuple(q), {})
+
+
+def gain_margins(plant, controller, delay=DELAY, lo: float = 1e-3, hi: float = 1e3):
+    """Gain margins from the closed-loop eigenvalues: the factors g_low < 1 < g_high by
+    which the controller's output can be scaled before the sampled loop loses stability
+    (bisection on the spectral radius; Nyquist-correct by construction, the open loop being
+    unstable). Returns (g_low, g_high) in dB (-inf / +inf when none within [lo, hi])."""
+    ss = controller.ss
+
+    def stable(g):
+        c = DigitalController(ct_ss(ss, g), controller.integrator_states, controller.name)
+        Phi, _ = ase.closed_loop_sampled_matrix(plant, c, delay)
+        return bool(np.max(np.abs(np.linalg.eigvals(Phi))) < 1.0)
+
+    if not stable(1.0):
+        raise ValueError("the nominal loop is unstable: no gain margins")
+
+    def edge(a, b):                      # stable at a, unstable at b
+        for _ in range(40):
+            m = math.sqrt(a * b)
+            a, b = (m, b) if stable(m) else (a, m)
+        return math.sqrt(a * b)
+
+    g_hi = math.inf if stable(hi) else edge(1.0, hi)
+    g_lo = 0.0 if stable(lo) else edge(1.0, lo)
+    db = (lambda g: 20 * math.log10(g) if 0 < g < math.inf else (-math.inf if g == 0
+                                                                   else math.inf))
+    return db(g_lo), db(g_hi)
+
+
+def ct_ss(ss, g):
+    """The discrete controller ``ss`` with its output scaled by g (the v_applied input, used
+    by observers, left as is)."""
+    import control as _ct
+    return _ct.ss(ss.A, ss.B, g * np.asarray(ss.C), g * np.asarray(ss.D), ss.dt,
+                  inputs=list(ss.input_labels), outputs=list(ss.output_labels))
