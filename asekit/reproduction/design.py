@@ -150,19 +150,20 @@ def dc_gains(plant, controller, names, delay=DELAY) -> dict:
 
 
 def check(controller: DigitalController, model, topology: str, mach=0.5, altitude=0.0,
-          case="nominal", sensor=None, t_final: float = 0.15) -> Check:
-    """Table 2 at the fin root (module docstring) for ``controller`` on ``model``."""
+          case="nominal", sensor=None, t_final: float = 0.15, delay: int = DELAY) -> Check:
+    """Table 2 at the fin root (module docstring) for ``controller`` on ``model``, with
+    ``delay`` samples of computational delay (default one, the thesis's processor)."""
     plant = ase.sampled_plant(model, topology, SAMPLE_TIME, sensor=sensor)
-    Phi, _ = ase.closed_loop_sampled_matrix(plant, controller, DELAY)
+    Phi, _ = ase.closed_loop_sampled_matrix(plant, controller, delay)
     stable = bool(np.max(np.abs(np.linalg.eigvals(Phi))) < 1.0)
     corners = [f"theta_{c}" for c in ase.CORNERS]
     if not stable:
         return Check(controller.name, topology, mach, altitude, case, False, math.inf,
                      math.inf, math.inf, math.nan, math.nan, math.nan)
-    g = dc_gains(plant, controller, [ase.FIN_ROOT] + corners)
+    g = dc_gains(plant, controller, [ase.FIN_ROOT] + corners, delay)
     st, ov, vm, im = 0.0, 0.0, 0.0, 0.0
     for cmd in STEPS:
-        r = ase.simulate_sampled(plant, controller, cmd, t_final=t_final, delay_samples=DELAY,
+        r = ase.simulate_sampled(plant, controller, cmd, t_final=t_final, delay_samples=delay,
                                  sensor=sensor)
         y = r.fin_root
         st = max(st, metrics.settling_time(r.t, y, y[-1], cmd))
@@ -247,7 +248,7 @@ def tune_filtered_pid(plants, resonances_hz, x0, max_evaluations: int = 300):
 #: :data:`DESIGN_A_CONDITIONS` (elastic fin, Roger aerodynamics, processor in the loop),
 #: started from a loop-shaping guess (crossover 25 Hz, lead 2.5, integral zero 5 Hz, notches
 #: at the open-loop resonances). Rerun with :func:`redesign_a`.
-DESIGN_A = (522.396, 25195.97, 2.048884, 0.000154585, 306.377, 0.020692, 0.296415)
+DESIGN_A = (521.396, 25111.80, 2.052407, 0.000158636, 304.477, 0.020799, 0.307676)
 DESIGN_A_CONDITIONS = ((0.5, 0.0, "nominal"), (0.6, 0.0, "nominal"), (0.4, 5000.0, "nominal"),
                        (0.6, 0.0, "shaft +20%"), (0.6, 0.0, "shaft -20%"),
                        (0.6, 0.0, "f1,f2 +10%"), (0.6, 0.0, "f1,f2 -10%"),
@@ -295,12 +296,38 @@ def design_b(data=None, topology: str = "AEM2", **overrides) -> DigitalControlle
     return _lqg(plant, name="LQG + integral (min-state)", **kw)
 
 
+def design_b_scheduled(data=None, **overrides):
+    """Design (b) scheduled on the flight condition: a factory ``(mach, altitude) ->``
+    LQG + integral designed (:data:`DESIGN_B` weights) on the minimum-state plant of that
+    condition -- the missile's autopilot knows its Mach and altitude. Designs are cached."""
+    from ..controllers import lqg_integral as _lqg
+
+    data = load() if data is None else data
+    cache = {}
+
+    def factory(mach, altitude):
+        key = (float(mach), float(altitude))
+        if key not in cache:
+            m = fin_model(mach, altitude, data=data, fit=ms_fit(DESIGN_B_STATES))
+            plant = ase.sampled_plant(m, "AEM2", SAMPLE_TIME)
+            cache[key] = _lqg(plant, name="LQG scheduled on (M, h)",
+                              **{**DESIGN_B, **overrides})
+        return cache[key]
+    return factory
+
+
 def designs(data=None) -> dict:
     """The designs compared: ``{key: (controller, topology)}``."""
     data = load() if data is None else data
     s3 = system3()
     return {"system3_aem1": (s3, "AEM1"), "system3_aem2": (s3, "AEM2"),
-            "pid_notch": (design_a(data), "AEM2"), "lqg": (design_b(data), "AEM2")}
+            "pid_notch": (design_a(data), "AEM2"), "lqg": (design_b(data), "AEM2"),
+            "lqg_scheduled": (design_b_scheduled(data), "AEM2")}
+
+
+def controller_at(ctl, mach, altitude) -> DigitalController:
+    """A design's controller at a flight condition (a scheduled design is a factory)."""
+    return ctl if isinstance(ctl, DigitalController) else ctl(mach, altitude)
 
 
 def envelope_table(data=None, design_set=None, machs=MACHS, altitudes=ALTITUDES,
@@ -314,7 +341,7 @@ def envelope_table(data=None, design_set=None, machs=MACHS, altitudes=ALTITUDES,
             for case in cases:
                 model = fin_model(M, h, case, data=data)
                 for key, (ctl, topo) in design_set.items():
-                    c = check(ctl, model, topo, M, h, case)
+                    c = check(controller_at(ctl, M, h), model, topo, M, h, case)
                     out.append(replace(c, design=key))
     return out
 
@@ -327,13 +354,16 @@ def best_corner_error(corner_ratios) -> float:
     return float((d.max() - d.min()) / (2.0 + d.max() + d.min()))
 
 
-def static_deflections(data=None, mach=0.6, altitude=0.0, case="nominal") -> dict:
+def static_deflections(data=None, mach=0.6, altitude=0.0, case="nominal",
+                       controller=None) -> dict:
     """Steady rotations per unit fin-root angle of the transmission and the four corners under
-    the steady aerodynamic load (any controller that holds the root at r gives these, to the
-    extent its steady state is set by the root angle), and the best achievable corner error."""
+    the steady aerodynamic load, and the best achievable corner error. In steady state the
+    structure and the steady aerodynamics set every rotation once the root angle is set, so
+    any stable controller with integral action on the root gives the same ratios (default:
+    design (a))."""
     model = fin_model(mach, altitude, case, data=data)
     plant = ase.sampled_plant(model, "AEM2", SAMPLE_TIME)
-    ctl = design_b(data)
+    ctl = design_a(data) if controller is None else controller
     names = ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in ase.CORNERS]
     g = dc_gains(plant, ctl, names)
     ratios = {n: g[n] / g[ase.FIN_ROOT] for n in names}
@@ -439,25 +469,20 @@ def run(figures: bool = False) -> ChapterResult:
     q = []
     model = fin_model(0.5, 0.0, data=data)
     for key, (ctl, topo) in designs(data).items():
-        c = check(ctl, model, topo)
+        c = check(controller_at(ctl, 0.5, 0.0), model, topo)
         note = f"{topo}, M 0.5 sea level, 1 kHz + 1 sample delay, power limited, 1 and 15 deg"
         q.append(Quantity(f"ase.design.{key}.table2_pass", c.table2_pass, "-", note))
         q.append(Quantity(f"ase.design.{key}.settling_ms", c.settling_ms, "ms",
                           "fin root, 2 % band, worst of 1 and 15 deg"))
         q.append(Quantity(f"ase.design.{key}.steady_error_pct", c.steady_error_pct, "%",
                           "fin root, exact DC gain of the sampled loop"))
-    study = rfa_state_study(data, 0.75, roger_lags=range(0, 8), ms_states=(6, 12, 16))
-    q.append(Quantity("rfa.M075.roger.states_for_1pct", states_for_error(study["roger"]), "-",
-                      "Roger N lags x 6 modes"))
-    q.append(Quantity("rfa.M075.minimum_state.states_for_1pct",
-                      states_for_error(study["minimum_state"]), "-",
-                      "of 6, 12, 16 shared states, unweighted"))
-    fc = flutter_comparison(data, 0.75, roger_lags=(4,), ms_states=(6,))
-    q.append(Quantity("flutter.pk.M075.h0.elastic.speed_ms", fc["pk_speed"], "m/s",
-                      "rigid mode held, 150-460 m/s by 5"))
+    fc = flutter_comparison(data, 0.75, roger_lags=(), ms_states=(6,))
     rl_ms = [r for r in fc["rows"] if r[0].startswith("min-state, W")][0][3]
     q.append(Quantity("flutter.root_locus.minimum_state6.M075.h0.speed_ms", rl_ms, "m/s",
-                      "6 lag states, weighted k < 2 k_f"))
+                      "6 shared lag states, weighted k < 2 k_f, rigid mode held"))
+    q.append(Quantity("flutter.root_locus.minimum_state6.M075.h0.error_vs_pk_pct",
+                      None if rl_ms is None else 100 * (rl_ms / fc["pk_speed"] - 1), "%",
+                      f"p-k {fc['pk_speed']:.1f} m/s"))
     return ChapterResult("design", tuple(q), {})
 
 
@@ -495,3 +520,104 @@ def ct_ss(ss, g):
     import control as _ct
     return _ct.ss(ss.A, ss.B, g * np.asarray(ss.C), g * np.asarray(ss.D), ss.dt,
                   inputs=list(ss.input_labels), outputs=list(ss.output_labels))
+
+
+# ---------------------------------------------------------------------------------------------
+# reporting helpers for notebooks/ch5b_controller_design.ipynb
+# ---------------------------------------------------------------------------------------------
+def loop_frequency_response(plant, controller, f_hz, delay=DELAY) -> np.ndarray:
+    """Loop gain L(e^{j w T}) broken at the voltage demand: u -> (delay, ZOH plant) -> y and
+    v_applied -> controller -> -u (so the loop closes as 1 + L). Exact for the sampled loop;
+    f_hz below the Nyquist frequency 1 / (2 T)."""
+    ss = controller.ss
+    Ac, Bc, Cc, Dc = (np.array(x) for x in (ss.A, ss.B, ss.C, ss.D))
+    Ap, Bp = plant.Ad_sample, plant.Bd_sample
+    cm = plant.C[plant.i_meas:plant.i_meas + 1]
+    out = []
+    for f in np.atleast_1d(f_hz):
+        z = np.exp(2j * np.pi * f * plant.sample_time)
+        P = (cm @ np.linalg.solve(z * np.eye(Ap.shape[0]) - Ap, Bp))[0, 0]
+        Kc = Cc @ np.linalg.solve(z * np.eye(Ac.shape[0]) - Ac, Bc) + Dc   # (1, 3)
+        d = z ** (-delay)
+        out.append(-(Kc[0, 1] * P * d + Kc[0, 2] * d))
+    return np.array(out)
+
+
+def format_envelope(checks, designs_order=None) -> str:
+    """Pass/fail text table: a row per (Mach, altitude, case), a column per design; a failed
+    cell names the failed requirements."""
+    keys = designs_order or list(dict.fromkeys(c.design for c in checks))
+    rows = {}
+    for c in checks:
+        rows.setdefault((c.mach, c.altitude, c.case), {})[c.design] = c
+    w = max(len(k) for k in keys) + 2
+    lines = ["M    h (m)  case          " + "".join(k.ljust(max(w, 22)) for k in keys)]
+    for (M, h, case), d in rows.items():
+        cells = []
+        for k in keys:
+            c = d.get(k)
+            if c is None:
+                cells.append("-")
+            elif c.table2_pass:
+                cells.append(f"pass {c.settling_ms:.0f} ms")
+            else:
+                bad = [n for n, ok in c.passes.items() if not ok]
+                cells.append("FAIL " + ",".join(bad)[:17])
+        lines.append(f"{M:<4} {h:<6.0f} {case:<13} " + "".join(s.ljust(max(w, 22))
+                                                               for s in cells))
+    return "\n".join(lines)
+
+
+def fig_fit_error(study):
+    from ..plotting import new_figure
+    fig, ax = new_figure(f"RFA fit error vs aerodynamic lag states (fin, Mach {study['mach']})",
+                         "beyond the thesis")
+    rg, ms = study["roger"], study["minimum_state"]
+    ax.semilogy(rg[:, 0], rg[:, 1], "o-", label=f"Roger (N lags x {study['n_modes']} modes)")
+    ax.semilogy(ms[:, 0], ms[:, 1], "s-", label="minimum-state (shared states)")
+    ax.axhline(0.01, color="k", lw=0.8, ls=":", label="1 %")
+    ax.set_xlabel("aerodynamic lag states")
+    ax.set_ylabel("||Q - Q~||_F / ||Q||_F (-)")
+    ax.legend()
+    return fig
+
+
+def fig_loop_bode(plant, design_set, f_hz=None):
+    from ..plotting import new_figure
+    f = np.logspace(0, np.log10(480.0), 2000) if f_hz is None else f_hz
+    fig, ax = new_figure(f"Loop gain at the voltage demand, {plant.topology}, sampled 1 kHz",
+                         "beyond the thesis", nrows=2, sharex=True, figsize=(7.5, 6.5))
+    for key, ctl in design_set.items():
+        L = loop_frequency_response(plant, ctl, f)
+        ax[0].semilogx(f, 20 * np.log10(np.abs(L)), label=key)
+        ax[1].semilogx(f, np.degrees(np.unwrap(np.angle(L))), label=key)
+    ax[0].axhline(0.0, color="k", lw=0.8)
+    ax[0].set_ylabel("|L| (dB)")
+    ax[1].set_ylabel("phase of L (deg)")
+    ax[1].set_xlabel("frequency (Hz)")
+    ax[0].legend(fontsize=8)
+    return fig
+
+
+def fig_steps(model, design_set, limits=ase.THESIS_LIMITS, t_final=0.1):
+    """Fin-root responses to 1 deg and 15 deg steps (normalised), voltage and current."""
+    from ..plotting import new_figure
+    label = "power limited" if limits is not None else "linear"
+    fig, ax = new_figure(f"Steps at the fin root, AEM2, {label}", "beyond the thesis", nrows=3,
+                         sharex=True, figsize=(7.5, 8.0))
+    for key, ctl in design_set.items():
+        plant = ase.sampled_plant(model, "AEM2", SAMPLE_TIME)
+        for cmd, ls in zip(STEPS, ("-", "--")):
+            r = ase.simulate_sampled(plant, ctl, cmd, limits=limits, t_final=t_final)
+            lab = f"{key}, {math.degrees(cmd):.0f} deg"
+            ax[0].plot(1e3 * r.t, r.fin_root / cmd, ls, label=lab)
+            ax[1].plot(1e3 * r.t, r.voltage, ls, label=lab)
+            ax[2].plot(1e3 * r.t, r.outputs["current"], ls, label=lab)
+    ax[0].axhspan(0.98, 1.02, color="0.9")
+    ax[0].axvline(50.0, color="k", lw=0.8, ls=":")
+    ax[0].set_ylabel("fin root / command (-)")
+    ax[1].set_ylabel("voltage (V)")
+    ax[2].set_ylabel("current (A)")
+    ax[2].set_xlabel("time (ms)")
+    ax[0].legend(fontsize=7)
+    return fig
