@@ -119,11 +119,16 @@ def test_perturbed_modal_model(data):
 
 
 def test_designs_meet_table2_at_the_fin_root(data, model):
-    # design (a) and (b) on AEM2 at M 0.5 sea level, processor and power limits in the loop
-    for ctl in (dz.design_a(data), dz.design_b(data)):
+    # design (a) and the scheduled design (b) on AEM2 at M 0.5 sea level, processor and power
+    # limits in the loop (thesis Table 2: 50 ms, 2 %, no overshoot, 24 V, 10 A)
+    for ctl in (dz.design_a(data), dz.design_b_scheduled(data)(0.5, 0.0)):
         c = dz.check(ctl, model, "AEM2")
         assert c.stable and c.table2_pass, (ctl.name, c)
         assert c.steady_error_pct < 1e-6                # integral action on the fin root
+    # the same LQG designed at M 0.6 and used at M 0.5: stable, exact in steady state, but its
+    # q-dependent feed-forward leaves a slow integral tail (settling fails)
+    fixed = dz.check(dz.design_b(data), model, "AEM2")
+    assert fixed.stable and fixed.steady_error_pct < 1e-6 and fixed.settling_ms > 50.0
     # the thesis's System 3 with the processor: unstable on AEM2
     assert not dz.check(dz.system3(), model, "AEM2").stable
 
