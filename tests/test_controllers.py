@@ -133,6 +133,23 @@ def test_designs_meet_table2_at_the_fin_root(data, model):
     assert not dz.check(dz.system3(), model, "AEM2").stable
 
 
+def test_sensor_filter_and_resolution(data, model):
+    # a 12-bit potentiometer (2 pi / 4096 rad) behind a 500 Hz first-order filter: design (a)
+    # stays stable and holds the fin root within a few quantisation steps of the command
+    sensor = ase.SensorModel(cutoff_hz=500.0, resolution=2 * np.pi / 4096)
+    ctl = dz.design_a(data)
+    plant = ase.sampled_plant(model, "AEM2", 1e-3, sensor=sensor)
+    assert plant.Ad.shape[0] == ase.sampled_plant(model, "AEM2", 1e-3).Ad.shape[0] + 1
+    assert ase.is_stable_sampled(plant, ctl)
+    cmd = math.radians(1.0)
+    r = ase.simulate_sampled(plant, ctl, cmd, t_final=0.15, sensor=sensor)
+    late = r.t > 0.1
+    assert np.max(np.abs(r.fin_root[late] - cmd)) < 3 * sensor.resolution
+    # the measured (filtered, unquantised) angle follows the fin root in steady state
+    assert np.max(np.abs(r.outputs["measured"][late] - r.fin_root[late])) < 1e-3 * cmd + \
+        3 * sensor.resolution
+
+
 def test_bad_input(model):
     with pytest.raises(ValueError, match="cutoff_hz"):
         ase.SensorModel(cutoff_hz=-1.0)
