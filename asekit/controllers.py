@@ -93,7 +93,8 @@ def pd_controller(gain: float, kp: float, kd: float, sample_time: float = 1e-3,
                   name: str = "PD") -> DigitalController:
     """The thesis's PD K_c (K_P e + K_D e') with e' the backward difference of the sampled
     feedback (the derivative acts on the measurement only, as in :mod:`asekit.ase`):
-    u_k = K_c K_P (r_k - y_k) - K_c K_D (y_k - y_{k-1}) / T."""
+    u_k = K_c K_P (r_k - y_k) - K_c K_D (y_k - y_{k-1}) / T. Its ``continuous`` prototype is
+    K_c (K_P + K_D s) made proper by a 1 ns pole (for frequency responses only)."""
     for n, v in (("gain", gain), ("kp", kp), ("kd", kd)):
         finite(n, v)
     ts = positive("sample_time", sample_time)

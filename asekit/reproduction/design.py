@@ -34,7 +34,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .. import ase, metrics
-from ..controllers import DigitalController, lqg_integral, pd_controller, pid_filtered
+from ..controllers import DigitalController, pd_controller, pid_filtered
 from ..reproduce import ChapterResult, Quantity
 
 MACHS = (0.4, 0.5, 0.6)
