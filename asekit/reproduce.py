@@ -29,6 +29,7 @@ CHAPTERS: tuple[tuple[str, str], ...] = (
     ("ase", "Ch. 5 aeroservoelasticity"),
     ("supersonic", "beyond the thesis: the fin from M 0.4 to 3"),
     ("freeplay", "Sec. 6.2 freeplay in the actuator-fin connection (issue 14)"),
+    ("design", "beyond Ch. 5: minimum-state RFA, controllers on the elastic fin"),
 )
 
 
