@@ -3,7 +3,8 @@
 Commands (argparse subcommands; each sets ``func(args) -> exit code``, so more can be added):
 
 * ``reproduce [--json PATH|-] [--figures DIR] [--only CHAPTER ...] [--wide] [--quiet]
-  [--keep-going]``: the thesis reproduction table (see :mod:`asekit.reproduce`).
+  [--keep-going]``: the thesis reproduction table (see :mod:`asekit.reproduce`);
+* ``analyse CASE.toml [--json PATH] [--report DIR]``: a case file (see :mod:`asekit.cli_analyse`).
 
 Exit codes: 0 success, 1 a chapter's inputs failed (without ``--keep-going``), 2 bad arguments
 (argparse), 130 interrupted.
@@ -59,8 +60,8 @@ def _check_outputs(parser: argparse.ArgumentParser, args) -> None:
             parser.error(f"--figures {args.figures}: {reason}")
 
 
-def _reproduce(args, parser) -> int:
-    _check_outputs(parser, args)
+def _reproduce(args) -> int:
+    _check_outputs(args.parser, args)
     import matplotlib
     matplotlib.use("Agg")
     from .reproduce import ChapterFailed, reproduce
@@ -97,14 +98,17 @@ def build_parser() -> argparse.ArgumentParser:
                                                     "standard output; the table goes to "
                                                     "standard error)")
     rep.add_argument("--figures", metavar="DIR", help="write every chapter figure as PNG")
+    from .reproduce import CHAPTERS
     rep.add_argument("--only", nargs="+", metavar="CHAPTER", type=_chapter,
-                     help="run only these chapters (servo, structure, aero, flutter, ase)")
+                     help=f"run only these chapters ({', '.join(n for n, _ in CHAPTERS)})")
     rep.add_argument("--wide", action="store_true",
                      help="one line per row with its note at the end (wider than 100 columns)")
     rep.add_argument("--quiet", action="store_true", help="no progress bar on standard error")
     rep.add_argument("--keep-going", action="store_true",
                      help="run the other chapters when one's inputs fail, and exit 0")
-    rep.set_defaults(func=_reproduce)
+    rep.set_defaults(func=_reproduce, parser=rep)
+    from .cli_analyse import add_parser as add_analyse
+    add_analyse(sub)
     return parser
 
 
@@ -112,7 +116,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return args.func(args, parser)
+        return args.func(args)
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130

@@ -106,6 +106,7 @@ class AeroelasticMatrices:
     n_rigid: int
     velocity: float
     density: float
+    n_lag_states: int = 0
 
     @property
     def n_states(self) -> int:
@@ -122,7 +123,9 @@ def aeroelastic_matrices(modal, rfa, rho: float, velocity: float) -> Aeroelastic
     Parameters
     ----------
     modal : ModalArrays or any object with M, K, C, n_rigid (n_modes x n_modes, rigid first).
-    rfa : :class:`asekit.rfa.RogerFit` over the same n_modes (coefficients A0..A_{N+2}).
+    rfa : :class:`asekit.rfa.RogerFit` (coefficients A0..A_{N+2}) or
+        :class:`asekit.rfa.MinimumStateFit` over the same n_modes (anything with ``A[0:3]``,
+        ``b_ref`` and ``lag_realization(n_rigid)``).
     rho : air density (kg/m^3), > 0.
     velocity : true airspeed U (m/s), > 0.
     """
@@ -134,40 +137,33 @@ def aeroelastic_matrices(modal, rfa, rho: float, velocity: float) -> Aeroelastic
     b = rfa.b_ref
     q = 0.5 * rho * U ** 2
     A = rfa.A
-    N = rfa.n_lags
     Mb = m.M - 0.5 * rho * b ** 2 * A[2]                    # Eq. (2.60) definitions
     Cb = m.C - 0.5 * rho * b * U * A[1]
     Kb = m.K - q * A[0]
     c, s = slice(0, m.n_rigid), slice(m.n_rigid, m.n_modes)
     ns, nc = m.n_elastic, m.n_rigid
+    # lag terms as D (p I + diag(beta))^-1 E p: Roger's (Eqs. 2.61-2.63, D a 0/1 selection) or
+    # the minimum-state fit's (Karpel 1982), x_a' = -(U/b) diag(beta) x_a + E zeta'
+    Dl, El, roots, lag_names = rfa.lag_realization(nc)
+    nL = roots.size
     Mss_inv = np.linalg.inv(Mb[s, s])
-    nz = 2 * ns + N * ns + N * nc
+    nz = 2 * ns + nL
     Asys = np.zeros((nz, nz))
     Bsys = np.zeros((nz, 3))
-    i_q, i_qd, i_sa, i_ca = 0, ns, 2 * ns, 2 * ns + N * ns
+    i_q, i_qd, i_sa = 0, ns, 2 * ns
     Asys[i_q:i_qd, i_qd:i_sa] = np.eye(ns)
-    Ds = np.hstack([np.eye(ns)] * N) if N else np.zeros((ns, 0))
     Asys[i_qd:i_sa, i_q:i_qd] = -Mss_inv @ Kb[s, s]
     Asys[i_qd:i_sa, i_qd:i_sa] = -Mss_inv @ Cb[s, s]
-    Asys[i_qd:i_sa, i_sa:i_ca] = q * Mss_inv @ Ds
-    for n_ in range(N):
-        rate = U / b * rfa.lag_roots[n_]
-        r = slice(i_sa + n_ * ns, i_sa + (n_ + 1) * ns)
-        Asys[r, i_qd:i_sa] = A[3 + n_][s, s]                   # E_ss
-        Asys[r, r] = -rate * np.eye(ns)                        # (U/b) R_ss
-        if nc:
-            rc = slice(i_ca + n_ * nc, i_ca + (n_ + 1) * nc)
-            Asys[rc, i_qd:i_sa] = A[3 + n_][c, s]              # E_cs
-            Asys[rc, rc] = -rate * np.eye(nc)                  # (U/b) R_cs
-            Bsys[r, 1:2] = A[3 + n_][s, c]                     # E_sc
-            Bsys[rc, 1:2] = A[3 + n_][c, c]                    # E_cc
+    Asys[i_qd:i_sa, i_sa:] = q * Mss_inv @ Dl[s]
+    Asys[i_sa:, i_qd:i_sa] = El[:, s]                          # E_s (E_ss, E_cs of Eq. 2.63)
+    Asys[i_sa:, i_sa:] = -np.diag(U / b * roots)               # (U/b) R
     if nc:
+        Bsys[i_sa:, 1:2] = El[:, c]                            # E_c (E_sc, E_cc)
         Bsys[i_qd:i_sa, 0:1] = -Mss_inv @ Kb[s, c]
         Bsys[i_qd:i_sa, 1:2] = -Mss_inv @ Cb[s, c]
         Bsys[i_qd:i_sa, 2:3] = -Mss_inv @ Mb[s, c]
-        Dc = np.ones((1, N))
-        row_state = np.hstack([-Kb[c, s], -Cb[c, s], np.zeros((nc, N * ns)), q * Dc])
-        acc_state = np.hstack([-Kb[s, s], -Cb[s, s], q * Ds, np.zeros((ns, N * nc))])
+        row_state = np.hstack([-Kb[c, s], -Cb[c, s], q * Dl[c]])
+        acc_state = np.hstack([-Kb[s, s], -Cb[s, s], q * Dl[s]])
         C_h = row_state - Mb[c, s] @ Mss_inv @ acc_state                     # Eq. (2.69)
         D_h = (np.hstack([-Kb[c, c], -Cb[c, c], -Mb[c, c]])
                - Mb[c, s] @ Mss_inv @ np.hstack([-Kb[s, c], -Cb[s, c], -Mb[s, c]]))  # (2.70)
@@ -176,11 +172,10 @@ def aeroelastic_matrices(modal, rfa, rho: float, velocity: float) -> Aeroelastic
         C_h = np.zeros((0, nz))
         D_h = np.zeros((0, 0))
     names = ([f"zeta{j + 1}" for j in range(ns)] + [f"zeta{j + 1}_dot" for j in range(ns)]
-             + [f"lag{n_ + 1}_zeta{j + 1}" for n_ in range(N) for j in range(ns)]
-             + [f"lag{n_ + 1}_hinge" for n_ in range(N) for _ in range(nc)])
+             + list(lag_names))
     return AeroelasticMatrices(A=Asys, B=Bsys, C_hinge=C_h, D_hinge=D_h,
-                               state_names=tuple(names), n_elastic=ns, n_lags=N, n_rigid=nc,
-                               velocity=U, density=rho)
+                               state_names=tuple(names), n_elastic=ns, n_lags=rfa.n_lags,
+                               n_rigid=nc, velocity=U, density=rho, n_lag_states=nL)
 
 
 def rotation_rows(dw_dx: np.ndarray, n_rigid: int, sign: float = -1.0) -> np.ndarray:
@@ -209,7 +204,8 @@ def aeroelastic_model(modal, rfa, rho: float, velocity: float, outputs: dict | N
     Parameters
     ----------
     modal : ModalArrays or a ModalModel-like object (M, K, C, n_rigid).
-    rfa : :class:`asekit.rfa.RogerFit` of the same modes.
+    rfa : :class:`asekit.rfa.RogerFit` or :class:`asekit.rfa.MinimumStateFit` of the same
+        modes.
     rho, velocity : density (kg/m^3) and true airspeed (m/s), both > 0.
     outputs : optional ``{name: row}`` where ``row`` (n_modes,) maps the modal coordinates
         (rigid first) to a physical quantity by modal superposition, Eq. (2.64): a displacement

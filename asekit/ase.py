@@ -562,7 +562,7 @@ class FinAse:
 
 def fin_ase(mach: float = 0.5, altitude: float = 0.0, actuator: ActuatorParameters | None = None,
             count_fin_inertia_twice: bool = False, n_lags: int = 4, database=None,
-            modal=None) -> FinAse:
+            modal=None, fit=None) -> FinAse:
     """The reference fin's aeroservoelastic model at (mach, altitude) (thesis Ch. 5).
 
     Uses the cached GAF database (:func:`asekit.aero.gaf.fin_gaf_database`, single-node shaft,
@@ -571,6 +571,8 @@ def fin_ase(mach: float = 0.5, altitude: float = 0.0, actuator: ActuatorParamete
     standard atmosphere at ``altitude`` (m) and U = mach x speed of sound. Outputs: the fin-root
     pitch (AEM2 feedback), the pitch rotations ``theta_<corner>`` and normal displacements
     ``w_<corner>`` at the four planform corners (:data:`CORNERS`), and the modal coordinates.
+    ``fit``: optional callable ``fit(k, Q, b_ref, mach) -> RFA`` replacing the Roger fit (e.g.
+    a :func:`asekit.rfa.minimum_state_fit`).
     """
     from .aero.gaf import fin_gaf_database
     from .aeroelastic import fin_outputs
@@ -587,7 +589,8 @@ def fin_ase(mach: float = 0.5, altitude: float = 0.0, actuator: ActuatorParamete
         raise ValueError(f"mach must lie within the GAF database's range [{lo}, {hi}], "
                          f"got {mach}")
     k, q = gaf_at_mach(database, mach, interpolate=True)
-    rfa = roger_fit(k, q, database.b_ref, n_lags=n_lags, mach=mach)
+    rfa = (roger_fit(k, q, database.b_ref, n_lags=n_lags, mach=mach) if fit is None
+           else fit(k, q, database.b_ref, mach))
     atm = standard_atmosphere(altitude)
     rho, a = float(atm.density), float(atm.speed_of_sound)
     fin = load_fin()
@@ -606,3 +609,266 @@ def static_gains(sys, outputs: list[str]) -> dict:
     g = np.asarray(ct.dcgain(sys)).ravel()
     names = list(sys.output_labels)
     return {o: float(g[names.index(o)]) for o in outputs}
+
+
+# ---------------------------------------------------------------------------------------------
+# general (state-space) controllers, sampled by a processor (issue 15)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class SensorModel:
+    """Measurement chain of the feedback angle: a first-order low-pass filter (the
+    potentiometer's or the encoder interface's anti-aliasing filter) of corner
+    ``cutoff_hz`` (None: no filter) and a quantisation step ``resolution`` (rad; None: ideal),
+    applied when the processor samples. A motor encoder of ``c`` counts per motor revolution
+    seen at the fin through the transmission ratio N has resolution 2 pi / (c N); a 12-bit
+    potentiometer over 2 pi rad, 2 pi / 4096."""
+
+    cutoff_hz: float | None = None
+    resolution: float | None = None
+
+    def __post_init__(self):
+        if self.cutoff_hz is not None:
+            positive("cutoff_hz", self.cutoff_hz)
+        if self.resolution is not None:
+            positive("resolution", self.resolution)
+
+
+@dataclass(frozen=True)
+class SampledPlant:
+    """The actuator + aeroelastic fin + sensor filter, continuous (``sys``: input ``voltage``,
+    outputs every plant output and ``measured`` the filtered feedback angle) and its exact
+    zero-order-hold discretisation over one ``substep`` (``Ad``, ``Bd``) with ``substeps`` per
+    sample period ``sample_time`` (``Ad_sample``, ``Bd_sample`` over a whole sample); ``C``,
+    ``D`` the output rows, ``i_meas`` the measured output's index, ``topology``, the motor
+    ``resistance`` (ohm, for the current limit's voltage clip I_lim R)."""
+
+    sys: ct.StateSpace
+    Ad: np.ndarray
+    Bd: np.ndarray
+    Ad_sample: np.ndarray
+    Bd_sample: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    i_meas: int
+    sample_time: float
+    substeps: int
+    topology: str
+    resistance: float = 5.78
+
+    @property
+    def output_names(self) -> list[str]:
+        return list(self.sys.output_labels)
+
+
+def sampled_plant(model: AeroservoelasticModel, topology: str, sample_time: float = 1e-3,
+                  sensor: SensorModel | None = None, substeps: int = 10) -> SampledPlant:
+    """The plant seen by a digital controller: voltage in (held over each sample, ZOH),
+    the feedback angle of ``topology`` (AEM1: transmission angle, encoder; AEM2: fin-root
+    angle, potentiometer) through the sensor filter out. The discretisation is exact for the
+    linear plant (matrix exponential of the augmented [A B; 0 0] over sample_time / substeps).
+    """
+    from scipy.linalg import expm
+
+    _check_topology(topology)
+    positive("sample_time", sample_time)
+    if int(substeps) < 1:
+        raise ValueError(f"substeps must be >= 1, got {substeps}")
+    sensor = SensorModel() if sensor is None else sensor
+    p = _plant(model)
+    A, B, C, D = (np.array(x) for x in (p.A, p.B, p.C, p.D))
+    names = list(p.output_labels)
+    fb = "theta" if topology == "AEM1" else FIN_ROOT
+    j = names.index(fb)
+    if sensor.cutoff_hz is not None:
+        w = 2 * np.pi * sensor.cutoff_hz
+        n = A.shape[0]
+        A = np.block([[A, np.zeros((n, 1))], [w * C[j:j + 1], -w * np.ones((1, 1))]])
+        B = np.vstack([B, w * D[j:j + 1]])
+        C = np.hstack([C, np.zeros((C.shape[0], 1))])
+        C = np.vstack([C, np.zeros((1, n + 1))])
+        C[-1, -1] = 1.0
+        D = np.vstack([D, np.zeros((1, 1))])
+    else:
+        C = np.vstack([C, C[j:j + 1]])
+        D = np.vstack([D, D[j:j + 1]])
+    names = names + ["measured"]
+    sys = ct.ss(A, B, C, D, inputs=["voltage"], outputs=names, name="sampled_plant")
+    n = A.shape[0]
+
+    def zoh(h):
+        M = np.zeros((n + 1, n + 1))
+        M[:n, :n], M[:n, n:] = A * h, B * h
+        E = expm(M)
+        return E[:n, :n], E[:n, n:]
+
+    Ad, Bd = zoh(sample_time / int(substeps))
+    Ads, Bds = zoh(sample_time)
+    return SampledPlant(sys=sys, Ad=Ad, Bd=Bd, Ad_sample=Ads, Bd_sample=Bds, C=C, D=D,
+                        i_meas=len(names) - 1, sample_time=float(sample_time),
+                        substeps=int(substeps), topology=topology,
+                        resistance=float(model.actuator.motor.resistance))
+
+
+def _check_digital(controller, sample_time):
+    for name in ("ss", "integrator_states"):
+        if not hasattr(controller, name):
+            raise ValueError("controller must be a digital controller with attributes ss "
+                             "(discrete StateSpace, inputs cmd, fb, v_applied; output voltage) "
+                             "and integrator_states (see asekit.controllers.DigitalController)")
+    ss = controller.ss
+    if not ss.isdtime() or abs(float(ss.dt) - sample_time) > 1e-12 * sample_time:
+        raise ValueError(f"controller.ss must be discrete with dt = sample_time = "
+                         f"{sample_time:g} s, got dt = {ss.dt}")
+    if ss.ninputs != 3 or ss.noutputs != 1:
+        raise ValueError("controller.ss must have 3 inputs (cmd, fb, v_applied) and 1 output")
+    return ss
+
+
+def closed_loop_sampled_matrix(plant: SampledPlant, controller, delay_samples: int = 1):
+    """State-transition matrix and command column of the linear sampled loop (no
+    saturation, no quantisation): state [x_plant, x_controller, held voltages (delay)], one
+    step per sample. Its eigenvalues inside the unit circle <=> the sampled loop is stable
+    (the ground truth, whatever the open loop's unstable poles). Returns (Phi, Gamma)."""
+    ss = _check_digital(controller, plant.sample_time)
+    Ap, Bp = plant.Ad_sample, plant.Bd_sample
+    cm = plant.C[plant.i_meas:plant.i_meas + 1]
+    if np.any(plant.D[plant.i_meas] != 0):
+        raise ValueError("the measured output has a direct voltage term; not supported")
+    Ac, Bc, Cc, Dc = (np.array(x) for x in (ss.A, ss.B, ss.C, ss.D))
+    npl, nc, nd = Ap.shape[0], Ac.shape[0], int(delay_samples)
+    if nd < 0:
+        raise ValueError(f"delay_samples must be >= 0, got {delay_samples}")
+    if nd == 0:
+        # u_k = Cc xc + Dc [r, y, u_k] -> u_k (1 - Dc[2]) = Cc xc + Dc0 r + Dc1 y
+        g = 1.0 / (1.0 - Dc[0, 2])
+        Ku_x, Ku_c, Ku_r = g * Dc[0, 1] * cm, g * Cc, g * Dc[0, 0]
+        n = npl + nc
+        Phi = np.zeros((n, n))
+        Gam = np.zeros((n, 1))
+        Phi[:npl, :npl] = Ap + Bp @ Ku_x
+        Phi[:npl, npl:] = Bp @ Ku_c
+        Gam[:npl, 0] = Bp[:, 0] * Ku_r
+        Phi[npl:, :npl] = Bc[:, 1:2] @ cm + Bc[:, 2:3] @ Ku_x
+        Phi[npl:, npl:] = Ac + Bc[:, 2:3] @ Ku_c
+        Gam[npl:, 0] = Bc[:, 0] + Bc[:, 2] * Ku_r
+        return Phi, Gam
+    n = npl + nc + nd
+    Phi = np.zeros((n, n))
+    Gam = np.zeros((n, 1))
+    i_d = npl + nc                          # held voltages: d_1 (applied now) .. d_nd
+    Phi[:npl, :npl] = Ap
+    Phi[:npl, i_d:i_d + 1] = Bp
+    # the controller sees the voltage applied now (d_1) as its v_applied input
+    Phi[npl:i_d, :npl] = Bc[:, 1:2] @ cm
+    Phi[npl:i_d, npl:i_d] = Ac
+    Phi[npl:i_d, i_d:i_d + 1] += Bc[:, 2:3]
+    Gam[npl:i_d, 0] = Bc[:, 0]
+    for q in range(nd - 1):
+        Phi[i_d + q, i_d + q + 1] = 1.0
+    u_row = np.zeros(n)
+    u_row[:npl] = Dc[0, 1] * cm[0]
+    u_row[npl:i_d] = Cc[0]
+    u_row[i_d] += Dc[0, 2]
+    Phi[i_d + nd - 1] = u_row
+    Gam[i_d + nd - 1, 0] = Dc[0, 0]
+    return Phi, Gam
+
+
+def is_stable_sampled(plant: SampledPlant, controller, delay_samples: int = 1) -> bool:
+    """All eigenvalues of :func:`closed_loop_sampled_matrix` strictly inside the unit
+    circle."""
+    Phi, _ = closed_loop_sampled_matrix(plant, controller, delay_samples)
+    return bool(np.max(np.abs(np.linalg.eigvals(Phi))) < 1.0)
+
+
+@dataclass(frozen=True)
+class SampledSimulation:
+    """Histories of a sampled (digital-controller) closed-loop simulation, SI: ``t`` (s, on
+    the substep grid), ``outputs`` {name: history} of every plant output (``theta``,
+    ``omega``, ``alpha``, ``current``, ``fin_root_pitch``, corners, ``hinge_moment`` without
+    the acceleration term, ``measured``), ``voltage`` (applied, V), ``voltage_demand`` (V),
+    ``command`` (rad), ``topology``."""
+
+    t: np.ndarray
+    outputs: dict
+    voltage: np.ndarray
+    voltage_demand: np.ndarray
+    command: float
+    topology: str
+
+    @property
+    def fin_root(self) -> np.ndarray:
+        return self.outputs[FIN_ROOT]
+
+
+def simulate_sampled(plant: SampledPlant, controller, command: float,
+                     limits: PowerLimits | None = THESIS_LIMITS, t_final: float = 0.1,
+                     delay_samples: int = 1, sensor: SensorModel | None = None,
+                     angle_limit: float = math.radians(15.0)) -> SampledSimulation:
+    """Step response of the plant under a digital controller sampled every
+    ``plant.sample_time`` (thesis Table 2: 1 kHz), its voltage applied ``delay_samples``
+    samples later (one sample of computation) and held (ZOH).
+
+    Power limits: with ``limits`` of the ``"voltage_clip"`` kind (thesis Eqs. 4.14-4.15, the
+    default) the applied voltage is the demand clipped to +-min(V_supply, I_lim R); the plant
+    is linear in the voltage, so the response is computed exactly by the discretised plant.
+    The controller's ``integrator_states`` are held while the demand is clipped
+    (conditional-integration anti-windup) and the controller is told the applied voltage
+    (its third input). ``sensor.resolution`` quantises the sample of the measured angle.
+    """
+    ss = _check_digital(controller, plant.sample_time)
+    command = finite("command", command)
+    if abs(command) > angle_limit + 1e-12:
+        raise ValueError(f"command {math.degrees(command):.3g} deg exceeds the angular position "
+                         f"limit of {math.degrees(angle_limit):.3g} deg (thesis Table 2)")
+    positive("t_final", t_final)
+    lim = limits if limits is not None else PowerLimits(supply_voltage=None, current_limit=None)
+    if lim.current_limit_model != "voltage_clip":
+        raise ValueError("simulate_sampled supports the voltage_clip current-limit model only")
+    vmax = math.inf
+    if lim.supply_voltage is not None:
+        vmax = min(vmax, lim.supply_voltage)
+    if lim.current_limit is not None:
+        vmax = min(vmax, lim.current_limit * plant.resistance)        # Eqs. (4.14)-(4.15)
+    res = None if sensor is None else sensor.resolution
+    Ac, Bc, Cc, Dc = (np.array(x) for x in (ss.A, ss.B, ss.C, ss.D))
+    if Dc[0, 2] != 0 and delay_samples == 0:
+        raise ValueError("a controller with a direct v_applied term needs delay_samples >= 1")
+    integ = np.array(sorted(controller.integrator_states), dtype=int)
+    n_s = int(math.ceil(t_final / plant.sample_time - 1e-9))
+    m = plant.substeps
+    x = np.zeros(plant.Ad.shape[0])
+    xc = np.zeros(Ac.shape[0])
+    held = [0.0] * max(int(delay_samples), 0)
+    ts_all, ys, vs, vds = [], [], [], []
+    cm = plant.C[plant.i_meas]
+    v_app = 0.0
+    for k in range(n_s):
+        y = float(cm @ x)
+        if res is not None:
+            y = res * round(y / res)
+        if delay_samples == 0:
+            u = float(Cc[0] @ xc + Dc[0, 0] * command + Dc[0, 1] * y)
+            v_now = float(np.clip(u, -vmax, vmax))
+        else:
+            v_now = held[0]
+            u = float(Cc[0] @ xc + Dc[0, 0] * command + Dc[0, 1] * y + Dc[0, 2] * v_now)
+        sat = abs(u) > vmax
+        xc_new = Ac @ xc + Bc[:, 0] * command + Bc[:, 1] * y + Bc[:, 2] * v_now
+        if sat and integ.size:
+            xc_new[integ] = xc[integ]
+        xc = xc_new
+        if delay_samples:
+            held = held[1:] + [float(np.clip(u, -vmax, vmax))]
+        v_app = v_now
+        for j in range(m):
+            ts_all.append((k * m + j) * plant.sample_time / m)
+            ys.append(plant.C @ x + plant.D[:, 0] * v_app)
+            vs.append(v_app)
+            vds.append(u)
+            x = plant.Ad @ x + plant.Bd[:, 0] * v_app
+    Y = np.array(ys).T
+    outs = {nm: Y[i] for i, nm in enumerate(plant.output_names)}
+    return SampledSimulation(t=np.array(ts_all), outputs=outs, voltage=np.array(vs),
+                             voltage_demand=np.array(vds), command=float(command),
+                             topology=plant.topology)

@@ -3,13 +3,12 @@
 Axes: x chordwise (downstream, the free-stream direction), y spanwise, z normal (up). A positive
 rotation about +y moves the trailing edge down: nose-up, i.e. a positive angle of attack.
 
-The reference fin is defined once, in ``data/fin.toml``; :func:`load_fin` reads it.
+The reference fin is one case file, ``data/cases/nalci2013_fin.toml``; :func:`load_fin` reads it.
 """
 
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -111,20 +110,171 @@ class Planform:
                 & (p[:, 0] >= x_le - tol) & (p[:, 0] <= x_le + c + tol))
 
 
+#: NACA 65A010 basic thickness form: stations x/c and half-thickness y_t/c in per cent of the
+#: chord (Abbott & von Doenhoff, *Theory of Wing Sections*, 1959; the same ordinates are the
+#: "NACA 65A010" thickness form of OpenProp). A 65A00t section scales the ordinates by t / 10;
+#: the full thickness is twice the half-thickness.
+NACA65A010_X = (0.0, 0.5, 0.75, 1.25, 2.5, 5.0, 7.5, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0,
+                45.0, 50.0, 55.0, 60.0, 65.0, 70.0, 75.0, 80.0, 85.0, 90.0, 95.0, 100.0)
+NACA65A010_YT = (0.0, 0.765, 0.928, 1.183, 1.623, 2.182, 2.65, 3.04, 3.658, 4.127, 4.483, 4.742,
+                 4.912, 4.995, 4.983, 4.863, 4.632, 4.304, 3.899, 3.432, 2.912, 2.352, 1.771,
+                 1.188, 0.604, 0.021)
+
+
 @dataclass(frozen=True)
-class LinearThickness:
-    """Plate thickness varying linearly along the span from ``root`` to ``tip`` (m)."""
+class ChordwiseProfile:
+    """Thickness relative to the section's nominal maximum, t / t_max, as a function of the
+    chord fraction x / c in [0, 1], linear between tabulated points.
+
+    Build one with :func:`chordwise_profile` from a name (``"flat"``, ``"biconvex"``,
+    ``"NACA 0012"``, ``"NACA 65A004"``) or a table. ``x_over_c`` must run from 0 to 1, strictly
+    ascending; ``t_over_tmax`` in [0, 1] (zero at an edge allowed) with a positive maximum.
+    For NACA sections the ratio is taken to the nominal thickness (last two digits), so a
+    tabulated maximum slightly below 1 (65A010: 0.999) is kept as published.
+    """
+
+    x_over_c: tuple[float, ...]
+    t_over_tmax: tuple[float, ...]
+    name: str = "table"
+
+    def __post_init__(self):
+        x = np.asarray(self.x_over_c, float)
+        t = np.asarray(self.t_over_tmax, float)
+        if x.ndim != 1 or x.shape != t.shape or x.size < 2:
+            raise ValueError("profile table must hold at least two [x_over_c, t_over_tmax] pairs")
+        if not (np.all(np.isfinite(x)) and np.all(np.isfinite(t))):
+            raise ValueError("profile table must be finite")
+        if abs(x[0]) > 1e-12 or abs(x[-1] - 1.0) > 1e-12 or np.any(np.diff(x) <= 0):
+            raise ValueError("profile x_over_c must run strictly ascending from 0 to 1, "
+                             f"got {x.tolist()}")
+        if np.any(t < 0) or np.any(t > 1 + 1e-9) or t.max() <= 0:
+            raise ValueError("profile t_over_tmax must lie in [0, 1] with a positive maximum, "
+                             f"got {t.tolist()}")
+        object.__setattr__(self, "x_over_c", tuple(float(v) for v in x))
+        object.__setattr__(self, "t_over_tmax", tuple(float(v) for v in t))
+
+    @property
+    def is_flat(self) -> bool:
+        return all(v == 1.0 for v in self.t_over_tmax)
+
+    def at(self, xi) -> np.ndarray:
+        """t / t_max at chord fraction(s) ``xi`` (clipped to [0, 1])."""
+        return np.interp(np.clip(np.asarray(xi, float), 0.0, 1.0), self.x_over_c, self.t_over_tmax)
+
+    def mean(self) -> float:
+        """Chordwise mean of t / t_max (section area over t_max c), trapezoidal rule."""
+        return float(np.trapezoid(self.t_over_tmax, self.x_over_c))
+
+
+FLAT = ChordwiseProfile((0.0, 1.0), (1.0, 1.0), "flat")
+
+
+def chordwise_profile(spec) -> ChordwiseProfile:
+    """A :class:`ChordwiseProfile` from a name or a table.
+
+    Parameters
+    ----------
+    spec : ``"flat"``; ``"biconvex"`` (circular-arc section in the thin-section limit,
+        t / t_max = 4 xi (1 - xi)); ``"NACA 00tt"`` (symmetric 4-digit section,
+        t / t_max = 10 (0.2969 sqrt(xi) - 0.1260 xi - 0.3516 xi^2 + 0.2843 xi^3 - 0.1015 xi^4),
+        Abbott & von Doenhoff 1959, Sec. 6.4, on 201 cosine-spaced points); ``"NACA 65A0tt"``
+        (the 65A010 basic thickness form :data:`NACA65A010_YT`); or a sequence of
+        ``[x_over_c, t_over_tmax]`` pairs.
+
+    The name gives only the *shape*; the thickness in metres comes from :class:`Thickness`
+    (``root``, ``tip`` are the section's nominal maximum thickness). Cambered sections are
+    refused: the plate and the lifting surface are flat.
+    """
+    if isinstance(spec, ChordwiseProfile):
+        return spec
+    if isinstance(spec, str):
+        s = spec.strip().upper().replace("NACA", "").replace("-", "").strip()
+        if s == "FLAT":
+            return FLAT
+        if s == "BICONVEX":
+            xi = np.linspace(0.0, 1.0, 201)
+            return ChordwiseProfile(tuple(xi), tuple(4 * xi * (1 - xi)), "biconvex")
+        if len(s) == 4 and s.isdigit():
+            if s[:2] != "00":
+                raise ValueError(f"profile {spec!r}: only symmetric NACA 4-digit sections "
+                                 "(NACA 00tt) are allowed; camber does not enter a flat plate")
+            xi = 0.5 * (1 - np.cos(np.linspace(0.0, math.pi, 201)))
+            t = 10 * (0.2969 * np.sqrt(xi) - 0.1260 * xi - 0.3516 * xi**2 + 0.2843 * xi**3
+                      - 0.1015 * xi**4)
+            return ChordwiseProfile(tuple(xi), tuple(np.clip(t, 0.0, 1.0)), f"NACA {s}")
+        if len(s) == 6 and s[:3] == "65A" and s[3:].isdigit():
+            if s[3] != "0":
+                raise ValueError(f"profile {spec!r}: only symmetric 65A0tt sections are allowed")
+            return ChordwiseProfile(tuple(v / 100 for v in NACA65A010_X),
+                                    tuple(v / 5.0 for v in NACA65A010_YT), f"NACA {s}")
+        raise ValueError(f"profile {spec!r} is not known: use 'flat', 'biconvex', 'NACA 00tt', "
+                         "'NACA 65A0tt' or a table [[x_over_c, t_over_tmax], ...]")
+    try:
+        table = np.asarray(spec, float)
+    except (TypeError, ValueError):
+        raise ValueError(f"profile must be a name or a table of [x_over_c, t_over_tmax] pairs, "
+                         f"got {spec!r}") from None
+    if table.ndim != 2 or table.shape[1] != 2:
+        raise ValueError(f"profile table must be a list of [x_over_c, t_over_tmax] pairs, "
+                         f"got shape {table.shape}")
+    return ChordwiseProfile(tuple(table[:, 0]), tuple(table[:, 1]), "table")
+
+
+@dataclass(frozen=True)
+class Thickness:
+    """Plate thickness: the section's maximum thickness varies linearly along the span from
+    ``root`` to ``tip`` (m, > 0) and is multiplied by a chordwise ``profile`` (t / t_max of
+    the chord fraction, default flat):
+
+        h(x, y) = [root + eta (tip - root)] * profile((x - x_le(y)) / c(y)),  eta in [0, 1].
+    """
 
     root: float
     tip: float
+    profile: ChordwiseProfile = FLAT
 
     def __post_init__(self):
         positive("thickness root", self.root)
         positive("thickness tip", self.tip)
+        object.__setattr__(self, "profile", chordwise_profile(self.profile))
 
     def at(self, eta: np.ndarray) -> np.ndarray:
-        """Thickness (m) at span fraction ``eta`` in [0, 1]."""
+        """Maximum (section) thickness (m) at span fraction ``eta`` in [0, 1]."""
         return self.root + np.asarray(eta, float) * (self.tip - self.root)
+
+
+#: The reference fin's law (flat, linear along the span) is a :class:`Thickness` with the
+#: default flat profile; the old name is kept.
+LinearThickness = Thickness
+
+
+@dataclass(frozen=True)
+class ThicknessField:
+    """h(x, y) (m) over a surface of one or more trapezoidal ``panels`` joined spanwise: the
+    spanwise law of ``thickness`` runs over the whole span (first root to last tip), the
+    chord fraction is taken in the panel that holds the point."""
+
+    panels: tuple[Planform, ...]
+    thickness: Thickness
+
+    def __call__(self, x, y) -> np.ndarray:
+        x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
+        y0, y1 = self.panels[0].root_le[1], self.panels[-1].tip_le[1]
+        h = self.thickness.at((y - y0) / (y1 - y0))
+        if self.thickness.profile.is_flat:
+            return h
+        xi = np.zeros_like(x)
+        for i, p in enumerate(self.panels):
+            sel = (y >= p.root_le[1] - 1e-12) if i else np.ones(y.shape, bool)
+            xi = np.where(sel, (x - p.leading_edge_at(y)) / p.chord_at(y), xi)
+        return h * self.thickness.profile.at(xi)
+
+
+def _check_material_number(name: str, value) -> float:
+    v = float(value)
+    if not math.isfinite(v) or v <= 0 or v > 1e15:
+        raise ValueError(f"{name} must be > 0 and at most 1e15 (SI units), got {value!r}")
+    return v
 
 
 @dataclass(frozen=True)
@@ -137,11 +287,85 @@ class Material:
     name: str = ""
 
     def __post_init__(self):
-        positive("youngs_modulus", self.youngs_modulus)
-        positive("density", self.density)
+        _check_material_number("youngs_modulus", self.youngs_modulus)
+        _check_material_number("density", self.density)
         nu = float(self.poisson_ratio)
         if not (-1.0 < nu < 0.5):
             raise ValueError(f"poisson_ratio must lie in (-1, 0.5), got {nu!r}")
+
+    def plane_stress_matrix(self) -> np.ndarray:
+        """Plane-stress stiffness Q (3 x 3, Pa) relating [s_xx, s_yy, s_xy] to the engineering
+        strains [e_xx, e_yy, g_xy]: E / (1 - nu^2) [[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu)/2]]."""
+        E, nu = self.youngs_modulus, self.poisson_ratio
+        return E / (1 - nu**2) * np.array([[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu) / 2]])
+
+    def transverse_shear_matrix(self) -> np.ndarray:
+        """Transverse shear moduli (2 x 2, Pa) relating [s_xz, s_yz] to [g_xz, g_yz]: G I."""
+        return self.youngs_modulus / (2 * (1 + self.poisson_ratio)) * np.eye(2)
+
+
+@dataclass(frozen=True)
+class OrthotropicMaterial:
+    """Orthotropic lamina in plane stress (laminated wood, a unidirectional composite).
+
+    e1, e2 : Young's moduli along and across the fibres (Pa); g12 in-plane shear modulus (Pa);
+    nu12 major Poisson ratio (nu21 = nu12 e2 / e1); density (kg/m^3); g13, g23 transverse shear
+    moduli (Pa; default g12 -- the transverse shear of a thin plate hardly matters);
+    fibre_angle : angle of the fibre direction 1 from +x toward +y (rad).
+
+    Q in material axes is [[e1, nu12 e2, 0], [nu12 e2, e2, 0], [0, 0, g12 d]] / d,
+    d = 1 - nu12 nu21; in the x-y axes Q_xy = T^T Q T with the engineering-strain rotation
+    [e_11, e_22, g_12] = T [e_xx, e_yy, g_xy], T = [[c^2, s^2, c s], [s^2, c^2, -c s],
+    [-2 c s, 2 c s, c^2 - s^2]] (c, s of the fibre angle; strain energy is invariant; cf. Jones,
+    *Mechanics of Composite Materials*, 2nd ed., Sec. 2.6). Positive definiteness needs
+    nu12^2 < e1 / e2.
+    """
+
+    e1: float
+    e2: float
+    g12: float
+    nu12: float
+    density: float
+    g13: float | None = None
+    g23: float | None = None
+    fibre_angle: float = 0.0
+    name: str = ""
+
+    def __post_init__(self):
+        for nm in ("e1", "e2", "g12", "density"):
+            _check_material_number(nm, getattr(self, nm))
+        for nm in ("g13", "g23"):
+            if getattr(self, nm) is None:
+                object.__setattr__(self, nm, float(self.g12))
+            _check_material_number(nm, getattr(self, nm))
+        nu = float(self.nu12)
+        lim = math.sqrt(self.e1 / self.e2)
+        if not math.isfinite(nu) or not -lim < nu < lim:
+            raise ValueError(f"nu12 must satisfy nu12^2 < e1/e2 = {self.e1 / self.e2:.4g} "
+                             f"(positive definite), got {self.nu12!r}")
+        if not math.isfinite(float(self.fibre_angle)):
+            raise ValueError(f"fibre_angle must be finite (rad), got {self.fibre_angle!r}")
+
+    def plane_stress_matrix(self) -> np.ndarray:
+        """Q_xy (3 x 3, Pa) for engineering strains [e_xx, e_yy, g_xy] in the x-y axes."""
+        nu21 = self.nu12 * self.e2 / self.e1
+        d = 1 - self.nu12 * nu21
+        Q = np.array([[self.e1 / d, self.nu12 * self.e2 / d, 0.0],
+                      [self.nu12 * self.e2 / d, self.e2 / d, 0.0],
+                      [0.0, 0.0, self.g12]])
+        c, s = math.cos(self.fibre_angle), math.sin(self.fibre_angle)
+        T = np.array([[c * c, s * s, c * s], [s * s, c * c, -c * s],
+                      [-2 * c * s, 2 * c * s, c * c - s * s]])
+        Qxy = T.T @ Q @ T
+        return 0.5 * (Qxy + Qxy.T)                 # exactly symmetric
+
+    def transverse_shear_matrix(self) -> np.ndarray:
+        """Transverse shear moduli in x-y axes (2 x 2, Pa): R^T diag(g13, g23) R with
+        [g_1z, g_2z] = R [g_xz, g_yz], R = [[c, s], [-s, c]]."""
+        c, s = math.cos(self.fibre_angle), math.sin(self.fibre_angle)
+        R = np.array([[c, s], [-s, c]])
+        G = R.T @ np.diag([self.g13, self.g23]) @ R
+        return 0.5 * (G + G.T)
 
 
 @dataclass(frozen=True)
@@ -189,29 +413,40 @@ class FinDefinition:
     (n_chord x n_span elements) and aerodynamic settings."""
 
     planform: Planform
-    thickness: LinearThickness
-    material: Material
+    thickness: Thickness
+    material: Material | OrthotropicMaterial
     shaft: Shaft
     n_chord: int
     n_span: int
     aero: AeroSettings
 
 
-def load_fin(path: str | Path = FIN_FILE) -> FinDefinition:
-    """Read a fin definition from a TOML file (default: the reference fin, ``data/fin.toml``)."""
-    with open(path, "rb") as fh:
-        d = tomllib.load(fh)
-    p, t, m, s, mesh, a = (d["planform"], d["thickness"], d["material"], d["shaft"], d["mesh"],
-                          d["aero"])
+#: Radius (m) of the fin's physical shaft region assumed for the distributed-shaft model when
+#: the case file holds the single-node shaft (the thesis gives no radius).
+DEFAULT_SHAFT_RADIUS = 0.005
+
+
+def fin_definition(case) -> FinDefinition:
+    """The :class:`FinDefinition` of a one-panel shaft-supported case
+    (:class:`asekit.case.Case`): planform, thickness, material, shaft, FE mesh, aero settings."""
+    if len(case.panels) != 1 or case.support.kind != "shaft":
+        raise ValueError(f"case {case.name!r}: a fin definition needs one panel and a shaft "
+                         f"support, got {len(case.panels)} panel(s), support {case.support.kind!r}")
+    s, a, f = case.support, case.aero, case.flight
+    p = case.panels[0]
+    altitudes = tuple(f.altitudes) if f.altitudes is not None else ()
     return FinDefinition(
-        planform=Planform(tuple(p["root_leading_edge"]), p["root_chord"],
-                          tuple(p["tip_leading_edge"]), p["tip_chord"]),
-        thickness=LinearThickness(t["root"], t["tip"]),
-        material=Material(m["youngs_modulus"], m["poisson_ratio"], m["density"], m.get("name", "")),
-        shaft=Shaft(tuple(s["axis_point"]), s["torsional_stiffness"], s["radius"],
-                    s.get("fictitious_inertia_factor", 1.0e6)),
-        n_chord=int(mesh["n_chord"]),
-        n_span=int(mesh["n_span"]),
-        aero=AeroSettings(a["reference_semichord"], tuple(a["machs"]), a["f_max"], a["u_min"],
-                          a["u_max"], tuple(a["altitudes"])),
-    )
+        planform=p.planform, thickness=case.thickness, material=case.material,
+        shaft=Shaft(s.axis_point, s.torsional_stiffness,
+                    DEFAULT_SHAFT_RADIUS if s.radius is None else s.radius,
+                    s.fictitious_inertia_factor),
+        n_chord=p.n_chord, n_span=p.n_span,
+        aero=AeroSettings(a.reference_semichord, tuple(a.machs), a.f_max, a.u_min,
+                          float(f.velocities[-1]), altitudes))
+
+
+def load_fin(path: str | Path = FIN_FILE) -> FinDefinition:
+    """The fin definition of a case file (default: the reference fin,
+    ``data/cases/nalci2013_fin.toml``), see :func:`fin_definition`."""
+    from .case.schema import load_case
+    return fin_definition(load_case(path))

@@ -35,6 +35,9 @@ CHAPTERS: tuple[tuple[str, str], ...] = (
     ("aero", "Ch. 3.2 aerodynamics"),
     ("flutter", "Ch. 3.2.2-3.3 RFA and flutter"),
     ("ase", "Ch. 5 aeroservoelasticity"),
+    ("supersonic", "beyond the thesis: the fin from M 0.4 to 3"),
+    ("freeplay", "Sec. 6.2 freeplay in the actuator-fin connection (issue 14)"),
+    ("design", "beyond Ch. 5: minimum-state RFA, controllers on the elastic fin"),
 )
 
 

@@ -18,21 +18,26 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import warnings
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import scipy.linalg as sla
 
 from .. import __version__
 from ..cache import CacheError, load_npz, save_npz
-from ..paths import DATA_DIR
+from ..paths import DATA_DIR, user_cache_dir
 from .boxes import BoxMesh, fin_boxes
 from .dlm import check_k, normalwash_matrices
 from .spline import BoxModes, fe_spline, modal_forces
 from .vlm import check_mach
 
-#: Where the fin's database lives (committed, so CI does not rebuild it).
+#: The reference fin's database, shipped read-only with the repository (so CI does not rebuild
+#: it). Rebuilt databases go to the user cache directory (:func:`asekit.paths.user_cache_dir`).
 GAF_FILE = DATA_DIR / "gaf_fin.npz"
+#: Databases shipped with asekit: any whose fingerprint matches a request is used as is.
+SHIPPED_DATABASES = (GAF_FILE,)
 #: Format version of the database file; bump when its layout or meaning changes.
 GAF_FORMAT = 1
 
@@ -57,13 +62,25 @@ class GafDatabase:
 
 def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref: float,
                        symmetric: bool = False, method: str = "quartic",
-                       progress=None) -> np.ndarray:
+                       progress=None, aero_options: dict | None = None) -> np.ndarray:
     """Q(M, k) (n_k, n_modes, n_modes) for mode shapes already interpolated to the boxes.
 
     One LU factorisation of D(M, k) per k solves for all modes at once; the kernel geometry
-    is shared by all k (:func:`asekit.aero.dlm.normalwash_matrices`).
+    is shared by all k (:func:`asekit.aero.dlm.normalwash_matrices`). ``method`` "auto",
+    "dlm", "supersonic" or "piston" chooses the aerodynamics per Mach
+    (:mod:`asekit.aero.methods`; ``aero_options`` go to its pressure matrices); "quartic" and
+    "parabolic" are the DLM kernels.
     """
     ks = check_k(k)
+    if method not in ("quartic", "parabolic"):
+        from .methods import pressures, resolve_method
+        if resolve_method(method, mach) != "dlm" or aero_options:
+            cp = pressures(mesh, mach, ks, b_ref, lambda kk: box_modes.normalwash(kk, b_ref),
+                           method, symmetric, **(aero_options or {}))
+            if progress is not None:
+                progress(ks.size)
+            return np.stack([modal_forces(box_modes, c, mesh.area) for c in cp])
+        method = "quartic"
     d = normalwash_matrices(mesh, mach, ks, b_ref, method, symmetric)
     out = np.empty((ks.size, box_modes.h_cp.shape[1], box_modes.h_cp.shape[1]), complex)
     for ik, kk in enumerate(ks):
@@ -93,13 +110,22 @@ def gaf_matrix(model, boxes: BoxMesh, mach: float, k: float, b_ref: float,
                               method)[0]
 
 
-def database_k(fin) -> np.ndarray:
-    """The database's reduced frequencies: 15 values from 0.001 to k_max = 2 pi f_max b / U_min
-    (fin.md; about 2.72 for the reference fin), dense at low k where the GAFs curve most."""
-    k_max = fin.aero.k_max
+def default_reduced_frequencies(k_max: float) -> np.ndarray:
+    """Reduced frequencies for a database up to ``k_max``: the values 0.001, 0.01, 0.025, 0.05,
+    0.075, 0.1, 0.15, 0.2, 0.3, 0.45, 0.65, 0.9, 1.25, 1.75 below 0.95 k_max, then k_max
+    (15 values for the reference fin), dense at low k where the GAFs curve most."""
+    k_max = float(k_max)
+    if not math.isfinite(k_max) or k_max <= 0.001:
+        raise ValueError(f"k_max must be > 0.001, got {k_max!r}")
     base = np.array([0.001, 0.01, 0.025, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.45, 0.65, 0.9,
                      1.25, 1.75])
     return np.concatenate([base[base < 0.95 * k_max], [k_max]])
+
+
+def database_k(fin) -> np.ndarray:
+    """The fin database's reduced frequencies, :func:`default_reduced_frequencies` up to
+    k_max = 2 pi f_max b / U_min (fin.md; about 2.72 for the reference fin)."""
+    return default_reduced_frequencies(fin.aero.k_max)
 
 
 def _fingerprint(arrays: dict, settings: dict) -> str:
@@ -118,11 +144,33 @@ def _fingerprint(arrays: dict, settings: dict) -> str:
     return h.hexdigest()
 
 
+#: Below this many boxes the dense LU solves of a database run on one BLAS thread: on a shared
+#: 2-core machine OpenBLAS's threads stall on small matrices (the fin's 140-box rebuild: 2.4-5.5 s
+#: wall with 2 threads, 0.8-0.9 s with one, measured on the project machine in issue 12).
+SMALL_SOLVE_BOXES = 2000
+
+
+def _blas_threads_for(n_boxes: int):
+    """A context limiting BLAS to one thread for small systems (threadpoolctl), else a no-op."""
+    import contextlib
+    if n_boxes >= SMALL_SOLVE_BOXES:
+        return contextlib.nullcontext()
+    from threadpoolctl import threadpool_limits
+    return threadpool_limits(limits=1, user_api="blas")
+
+
 def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: float, n_rigid: int,
                        symmetric: bool = False, method: str = "quartic", progress: bool = True,
-                       metadata: dict | None = None) -> GafDatabase:
-    """Compute Q over ``machs`` x ``ks`` (tqdm bar over Mach x k when ``progress``)."""
-    machs = np.array([check_mach(m) for m in np.atleast_1d(machs)])
+                       metadata: dict | None = None,
+                       aero_options: dict | None = None) -> GafDatabase:
+    """Compute Q over ``machs`` x ``ks`` (tqdm bar over Mach x k when ``progress``); ``method``
+    and ``aero_options`` as in :func:`gaf_from_box_modes` (e.g. "auto" over subsonic and
+    supersonic Mach numbers, refusing the transonic gap)."""
+    if method in ("quartic", "parabolic"):
+        machs = np.array([check_mach(m) for m in np.atleast_1d(machs)])
+    else:
+        from .methods import resolve_method
+        machs = np.array([float(m) for m in np.atleast_1d(machs) if resolve_method(method, m)])
     ks = check_k(ks)
     if np.any(np.diff(ks) <= 0):
         raise ValueError("ks must be strictly ascending")
@@ -133,34 +181,117 @@ def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: flo
         from tqdm.auto import tqdm
         bar = tqdm(total=machs.size * ks.size, desc="GAF database (Mach x k)", leave=False)
     try:
-        for im, mach in enumerate(machs):
-            q[im] = gaf_from_box_modes(box_modes, mesh, mach, ks, b_ref, symmetric, method,
-                                       progress=None if bar is None else bar.update)
+        with _blas_threads_for(mesh.n):
+            for im, mach in enumerate(machs):
+                q[im] = gaf_from_box_modes(box_modes, mesh, mach, ks, b_ref, symmetric, method,
+                                           progress=None if bar is None else bar.update,
+                                           aero_options=aero_options)
     finally:
         if bar is not None:
             bar.close()
     return GafDatabase(machs, ks, q, float(b_ref), int(n_rigid), dict(metadata or {}))
 
 
-def _fin_settings(fin, boxes: BoxMesh, symmetric: bool, method: str) -> dict:
-    return {"format": GAF_FORMAT, "machs": [float(m) for m in fin.aero.machs],
-            "k": [float(v) for v in database_k(fin)], "b_ref": fin.aero.reference_semichord,
+def database_settings(machs, ks, b_ref: float, boxes: BoxMesh, symmetric: bool,
+                      method: str) -> dict:
+    """What a GAF database depends on besides the mode set (part of its fingerprint)."""
+    return {"format": GAF_FORMAT, "machs": [float(m) for m in machs],
+            "k": [float(v) for v in ks], "b_ref": float(b_ref),
             "symmetric": bool(symmetric), "method": method, "boxes": int(boxes.n),
             "box_corners_sha256": hashlib.sha256(np.round(boxes.corners, 12).tobytes()).hexdigest()}
+
+
+def _fin_settings(fin, boxes: BoxMesh, symmetric: bool, method: str) -> dict:
+    return database_settings(fin.aero.machs, database_k(fin), fin.aero.reference_semichord,
+                             boxes, symmetric, method)
+
+
+def mode_set_fingerprint(model, settings: dict) -> str:
+    """Fingerprint of a database request: the mode set (shapes, nodes, frequencies) of a
+    ``ModalModel`` and the ``settings`` (see :func:`database_settings`)."""
+    return _fingerprint({"shapes": model.shapes, "nodes": model.nodes,
+                         "frequencies_hz": model.frequencies_hz}, settings)
+
+
+def _load_matching(path: Path, fp: str, settings: dict, n_modes: int):
+    """The database at ``path`` if it exists, passes its checksum and matches the fingerprint
+    and the settings it claims (Mach and k arrays, b_ref, shape); else None."""
+    try:
+        arrays, meta = load_npz(path)
+    except (CacheError, FileNotFoundError, OSError, KeyError, ValueError):
+        return None
+    try:
+        if meta.get("fingerprint") != fp:
+            return None
+        machs, k, Q = arrays["machs"], arrays["k"], arrays["Q"]
+        ok = (np.allclose(machs, settings["machs"], rtol=0, atol=1e-12)
+              and np.allclose(k, settings["k"], rtol=1e-12, atol=0)
+              and math.isclose(float(meta["b_ref"]), settings["b_ref"], rel_tol=1e-12)
+              and Q.shape == (machs.size, k.size, n_modes, n_modes)
+              and np.all(np.isfinite(Q)))
+        if not ok:
+            return None
+        return GafDatabase(machs, k, Q, float(meta["b_ref"]), int(meta["n_rigid"]), meta)
+    except (KeyError, TypeError, ValueError, AttributeError):
+        return None
+
+
+def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetric: bool = False,
+                        method: str = "quartic", progress: bool = True, rebuild: bool = False,
+                        cache_dir=None, path=None, metadata: dict | None = None) -> GafDatabase:
+    """The GAF database of a ``ModalModel`` on ``boxes`` over ``machs`` x ``ks``, from a cache
+    when one matches, else computed (tqdm bar) and written atomically.
+
+    Lookup order: ``path`` if given, else the shipped databases (:data:`SHIPPED_DATABASES`,
+    read-only) and ``cache_dir`` / ``gaf_<fingerprint>.npz`` (default
+    :func:`asekit.paths.user_cache_dir`). A file is used only if its checksum passes and its
+    fingerprint (mode set + settings), Mach and k arrays, b_ref and array shape all match.
+    A rebuild that cannot be written (read-only folder) is returned all the same, with a warning.
+    """
+    settings = database_settings(machs, ks, b_ref, boxes, symmetric, method)
+    fp = mode_set_fingerprint(model, settings)
+    n = len(model.frequencies_hz)
+    if path is not None:
+        candidates, target = [Path(path)], Path(path)
+    else:
+        cdir = Path(user_cache_dir() if cache_dir is None else cache_dir)
+        target = cdir / f"gaf_{fp[:32]}.npz"
+        candidates = [*SHIPPED_DATABASES, target]
+    if not rebuild:
+        for c in candidates:
+            db = _load_matching(c, fp, settings, n)
+            if db is not None:
+                return db
+    meta = dict(settings)
+    meta.update({"fingerprint": fp, "asekit_version": __version__, "n_rigid": model.n_rigid,
+                 "mode_set": model.label, "frequencies_hz": [float(f) for f in model.frequencies_hz],
+                 "Q_units": "per unit dynamic pressure; rigid-pitch row/column in m^3 per rad",
+                 "sign": "F_i = q sum_j Q_ij zeta_j; Q_cc > 0 de-centering"})
+    meta.update(metadata or {})
+    db = build_gaf_database(fe_spline(model, boxes), boxes, machs, ks, b_ref, model.n_rigid,
+                            symmetric, method, progress, meta)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        save_npz(target, {"machs": db.machs, "k": db.k, "Q": db.Q}, meta)
+        written = _load_matching(target, fp, settings, n)      # what a later run will read
+        if written is not None:
+            return written
+    except OSError as exc:
+        warnings.warn(f"GAF database computed but not cached ({target}: {exc}); set "
+                      f"ASEKIT_CACHE_DIR to a writable folder to keep it", RuntimeWarning,
+                      stacklevel=2)
+    return db
 
 
 def fin_gaf_database(rebuild: bool = False, progress: bool = True, path=None,
                      symmetric: bool = False, method: str = "quartic"):
     """The reference fin's GAF database and its modal model.
 
-    Loads ``data/gaf_fin.npz`` if it is present, passes its checksum
-    (:func:`asekit.cache.load_npz`) and matches the current mode set and settings fingerprint;
-    otherwise (or with ``rebuild``) computes it -- Mach 0.4, 0.5, 0.6, 0.75 x
-    :func:`database_k`, isolated fin, default structure ``fin_modal_model()`` (FN2, 6 x 7
-    single-node shaft) on :func:`~asekit.aero.boxes.fin_boxes` -- and writes it atomically.
-
-    ``symmetric`` (a wall at the root) or ``method="parabolic"`` select another database, kept in
-    its own file (``data/gaf_fin_wall_quartic.npz`` etc.) unless ``path`` is given.
+    Mach 0.4, 0.5, 0.6, 0.75 x :func:`database_k`, isolated fin (``symmetric``: a wall at the
+    root), DLM ``method`` kernel, default structure ``fin_modal_model()`` (FN2, 6 x 7
+    single-node shaft) on :func:`~asekit.aero.boxes.fin_boxes`; loaded from the shipped
+    ``data/gaf_fin.npz`` or the user cache when one matches, else rebuilt into the user cache
+    (see :func:`cached_gaf_database`; ``path`` overrides the location).
 
     Returns
     -------
@@ -171,34 +302,11 @@ def fin_gaf_database(rebuild: bool = False, progress: bool = True, path=None,
     fin = load_fin()
     model = fin_modal_model(fin)
     boxes = fin_boxes(fin)
-    settings = _fin_settings(fin, boxes, symmetric, method)
-    fp = _fingerprint({"shapes": model.shapes, "nodes": model.nodes,
-                       "frequencies_hz": model.frequencies_hz}, settings)
-    if path is None:      # only the default settings live in the committed file
-        default = not symmetric and method == "quartic"
-        path = GAF_FILE if default else DATA_DIR / (
-            f"gaf_fin_{'wall' if symmetric else 'isolated'}_{method}.npz")
-    if not rebuild:
-        try:
-            arrays, meta = load_npz(path)
-            if meta.get("fingerprint") == fp:
-                return (GafDatabase(arrays["machs"], arrays["k"], arrays["Q"],
-                                    float(meta["b_ref"]), int(meta["n_rigid"]), meta), model)
-        except (CacheError, KeyError):
-            pass
-    meta = dict(settings)
-    meta.update({"fingerprint": fp, "asekit_version": __version__, "n_rigid": model.n_rigid,
-                 "mode_set": model.label, "frequencies_hz": [float(f) for f in model.frequencies_hz],
-                 "reference_semichord": "root semi-chord, fin.aero.reference_semichord (m)",
-                 "Q_units": "per unit dynamic pressure; rigid-pitch row/column in m^3 per rad",
-                 "sign": "F_i = q sum_j Q_ij zeta_j; Q_cc > 0 de-centering"})
-    db = build_gaf_database(fe_spline(model, boxes), boxes, fin.aero.machs, database_k(fin),
-                            fin.aero.reference_semichord, model.n_rigid, symmetric, method,
-                            progress, meta)
-    save_npz(path, {"machs": db.machs, "k": db.k, "Q": db.Q}, meta)
-    arrays, meta = load_npz(path)
-    return GafDatabase(arrays["machs"], arrays["k"], arrays["Q"], float(meta["b_ref"]),
-                       int(meta["n_rigid"]), meta), model
+    db = cached_gaf_database(
+        model, boxes, fin.aero.machs, database_k(fin), fin.aero.reference_semichord,
+        symmetric, method, progress, rebuild, path=path,
+        metadata={"reference_semichord": "root semi-chord, fin.aero.reference_semichord (m)"})
+    return db, model
 
 
 def steady_hinge_coefficient(db: GafDatabase, mach: float) -> float:

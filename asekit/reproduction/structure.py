@@ -30,7 +30,7 @@ from ..structure.modes import (ModalModel, NormalModes, fin_mesh, fin_modal_mode
                                normal_modes, pitch_inertia_exact)
 from ..thesis import thesis_value
 
-#: Mesh used for the distributed-shaft result (the 5 mm shaft radius of data/fin.toml is resolved
+#: Mesh used for the distributed-shaft result (the 5 mm shaft radius of the fin case file is resolved
 #: by 23 nodes here; 192 x 224 changes modes 1-2 by a further +0.3 / +1.0 %).
 CONVERGED_MESH = (96, 112)
 #: Meshes of the convergence study (issue 3: 6x7 up to at least 48x56).
@@ -50,7 +50,7 @@ class StructureChapter:
 
 
 def compute(fin: FinDefinition | None = None) -> StructureChapter:
-    """Run the Ch. 3.1 analyses on the reference fin (default ``data/fin.toml``)."""
+    """Run the Ch. 3.1 analyses on the reference fin (default ``data/cases/nalci2013_fin.toml``)."""
     fin = load_fin() if fin is None else fin
     mesh = fin_mesh(fin)
     K, M = assemble(mesh, fin.material)

@@ -148,7 +148,8 @@ def shaft_region_nodes(mesh: PlateMesh, axis_point, region: str, radius: float) 
 def shaft_support(mesh: PlateMesh, K, M, axis_point, torsional_stiffness: float,
                   model: str = "FN1", region: str = "single_node", radius: float = 0.0,
                   fictitious_inertia: float | None = None,
-                  fictitious_inertia_factor: float = 1.0e6) -> SupportedSystem:
+                  fictitious_inertia_factor: float = 1.0e6,
+                  bending_stiffness: float | None = None) -> SupportedSystem:
     """Support the plate on the pitch shaft (thesis Sec. 3.1.1, Figs 12 and 13).
 
     Parameters
@@ -161,6 +162,11 @@ def shaft_support(mesh: PlateMesh, K, M, axis_point, torsional_stiffness: float,
     region : "single_node" (thesis) or "distributed" (rigid region of ``radius`` m).
     fictitious_inertia : I_f (kg m^2); default ``fictitious_inertia_factor`` x the fin's pitch
         inertia about the axis.
+    bending_stiffness : optional stiffness (N m/rad) of the actuator-fin connection about the
+        chordwise (x) axis through ``axis_point`` (thesis Sec. 6.2). Without it the shaft nodes
+        are held in that rotation (rigid in bending, the thesis's model). With it the shaft
+        region rotates rigidly about x by one more coordinate phi (w_n += (y_n - y_a) phi,
+        theta_x,n = phi), restrained by a spring of this stiffness to the ground.
     """
     if not np.isfinite(torsional_stiffness) or torsional_stiffness <= 0:
         raise ValueError(f"torsional_stiffness must be > 0 (N m/rad), got {torsional_stiffness!r}")
@@ -171,14 +177,25 @@ def shaft_support(mesh: PlateMesh, K, M, axis_point, torsional_stiffness: float,
     n_full = K.shape[0]
     slave = (DOF_PER_NODE * nodes[:, None] + np.arange(DOF_PER_NODE)).ravel()
     free = np.setdiff1d(np.arange(n_full), slave)
-    n_q = free.size + (2 if model == "FN2" else 1)
+    bend = bending_stiffness is not None
+    if bend and (not np.isfinite(bending_stiffness) or bending_stiffness <= 0):
+        raise ValueError(f"bending_stiffness must be > 0 (N m/rad), got {bending_stiffness!r}")
+    n_q = free.size + (2 if model == "FN2" else 1) + (1 if bend else 0)
     s_idx = free.size
     rows = np.concatenate([free, DOF_PER_NODE * nodes, DOF_PER_NODE * nodes + 2])
     cols = np.concatenate([np.arange(free.size), np.full(2 * nodes.size, s_idx)])
     vals = np.concatenate([np.ones(free.size), -(mesh.nodes[nodes, 0] - x_a), np.ones(nodes.size)])
+    if bend:
+        b_idx = n_q - 1
+        y_a = float(np.asarray(axis_point, float)[1])
+        rows = np.concatenate([rows, DOF_PER_NODE * nodes, DOF_PER_NODE * nodes + 1])
+        cols = np.concatenate([cols, np.full(2 * nodes.size, b_idx)])
+        vals = np.concatenate([vals, mesh.nodes[nodes, 1] - y_a, np.ones(nodes.size)])
     T = sp.csr_matrix((vals, (rows, cols)), shape=(n_full, n_q))
     Kr = (T.T @ K @ T).tolil()
     Mr = (T.T @ M @ T).tolil()
+    if bend:
+        Kr[b_idx, b_idx] += float(bending_stiffness)
     k = float(torsional_stiffness)
     kind = "single-node" if region == "single_node" else f"distributed r={radius * 1e3:g} mm"
     label = f"{model} {mesh.n_chord}x{mesh.n_span} {kind} shaft"
@@ -202,3 +219,34 @@ def shaft_support(mesh: PlateMesh, K, M, axis_point, torsional_stiffness: float,
         Mr[g_idx, g_idx] += I_f
     return SupportedSystem(K=Kr.tocsr(), M=Mr.tocsr(), T=T, shaft_index=s_idx, ground_index=g_idx,
                            fictitious_inertia=I_f, shaft_nodes=nodes, mesh=mesh, label=label)
+
+
+def point_mass_matrix(mesh: PlateMesh, masses) -> sp.csr_matrix:
+    """Global mass matrix (3 n_nodes square, sparse) of concentrated masses on the plate.
+
+    ``masses`` is a sequence of ``(position (x, y) m, mass kg, (I_xx, I_yy) kg m^2)``. Each is
+    attached consistently through the bilinear shape functions N of the element holding it
+    (kinetic energy 1/2 m (N w)^2 + 1/2 I_xx (N theta_x)^2 + 1/2 I_yy (N theta_y)^2), so a
+    mass need not sit on a node; at a node this is the usual lumped CONM2-like mass.
+    """
+    from .modes import locate_points
+    from .plate import shape_functions
+    n = DOF_PER_NODE * mesh.n_nodes
+    M = sp.csr_matrix((n, n))
+    masses = list(masses)
+    if not masses:
+        return M
+    pos = np.array([m[0] for m in masses], float).reshape(-1, 2)
+    elem, rs = locate_points(mesh.nodes, mesh.elements, pos)
+    N, _, _ = shape_functions(rs[:, 0], rs[:, 1])
+    rows, cols, vals = [], [], []
+    for i, (_, m, inertia) in enumerate(masses):
+        conn = mesh.elements[elem[i]]
+        NN = np.outer(N[i], N[i])
+        for dof, value in ((0, m), (1, inertia[0]), (2, inertia[1])):
+            d = DOF_PER_NODE * conn + dof
+            rows.append(np.repeat(d, 4))
+            cols.append(np.tile(d, 4))
+            vals.append((value * NN).ravel())
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(n, n))

@@ -258,7 +258,7 @@ def mode_shapes_at(model: ModalModel, points: np.ndarray) -> tuple[np.ndarray, n
 
 
 def fin_mesh(fin: FinDefinition, n_chord: int | None = None, n_span: int | None = None) -> PlateMesh:
-    """The fin's structured mesh (default: the thesis's 6 x 7 from ``data/fin.toml``)."""
+    """The fin's structured mesh (default: the thesis's 6 x 7 from ``data/cases/nalci2013_fin.toml``)."""
     return structured_mesh(fin.planform, fin.thickness,
                            fin.n_chord if n_chord is None else n_chord,
                            fin.n_span if n_span is None else n_span)
@@ -281,30 +281,60 @@ def fin_supported(fin: FinDefinition, mesh: PlateMesh, model: str, shaft: str = 
                          fictitious_inertia_factor=s.fictitious_inertia_factor)
 
 
-def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None,
-                    n_span: int | None = None, shaft: str = "single_node",
-                    f_max_hz: float = 1000.0) -> ModalModel:
-    """The FN2 modal model: rigid pitch mode + elastic modes below ``f_max_hz`` with
-    out-of-plane motion (thesis Sec. 3.1, Table 6, Eqs. (2.45)-(2.46)).
+def _keep_modes(f_hz, share, f_max_hz, n_modes):
+    """Mask of the elastic modes kept: out-of-plane ones below f_max_hz, or the first n_modes."""
+    if n_modes is None:
+        return select_modes(f_hz, share, f_max_hz)
+    oop = np.flatnonzero(select_modes(f_hz, share, 1e300))
+    if oop.size < n_modes:
+        raise ValueError(f"modes.count = {n_modes} elastic out-of-plane modes requested but only "
+                         f"{oop.size} were found: lower the count or refine the mesh")
+    keep = np.zeros(len(f_hz), bool)
+    keep[oop[:n_modes]] = True
+    return keep
+
+
+def _solve_modes(system, M_fin, f_max_hz, n_modes, extra: int = 0) -> NormalModes:
+    if n_modes is None:
+        return modes_up_to(system, f_max_hz, M_fin=M_fin)
+    n = int(n_modes)
+    if n < 1:
+        raise ValueError(f"modes.count must be an integer >= 1, got {n_modes!r}")
+    return normal_modes(system, min(system.K.shape[0], 2 * n + 4 + extra), M_fin=M_fin)
+
+
+def fictitious_mass_modal_model(mesh: PlateMesh, K, M, axis_point, torsional_stiffness: float,
+                                region: str = "single_node", radius: float = 0.0,
+                                fictitious_inertia_factor: float = 1.0e6,
+                                bending_stiffness: float | None = None,
+                                f_max_hz: float = 1000.0, n_modes: int | None = None
+                                ) -> ModalModel:
+    """The FN2 modal model of a plate on a pitch shaft (thesis Sec. 3.1.1, Eqs. (2.45)-(2.46);
+    Karpel's fictitious-mass method): rigid pitch mode + the elastic modes kept.
 
     Parameters
     ----------
-    fin : fin definition (default ``load_fin()``).
-    n_chord, n_span : elements per direction (default the fin's 6 x 7).
-    shaft : "single_node" (thesis) or "distributed" (rigid region of radius fin.shaft.radius).
-    f_max_hz : frequency limit for the elastic modes kept (Hz), > 0.
+    mesh, K, M : plate mesh and its global sparse stiffness and mass (point masses included).
+    axis_point : (x, y) of the pitch axis on the root chord (m).
+    torsional_stiffness : actuator-fin connection about the pitch axis (N m/rad), > 0.
+    region, radius : ``"single_node"`` or ``"distributed"`` shaft of ``radius`` m.
+    fictitious_inertia_factor : I_f / J_fin of the FN2 ground point.
+    bending_stiffness : optional connection stiffness about the chordwise axis (N m/rad).
+    f_max_hz : keep the elastic modes with out-of-plane motion below this (Hz) ...
+    n_modes : ... or, when given, the first ``n_modes`` such modes.
 
     Returns
     -------
     ModalModel with n_rigid = 1: M[0, 0] = J_fin, M_ss = I, K = diag(0, omega_s^2), C = 0.
     """
-    fin = load_fin() if fin is None else fin
     positive("f_max_hz", f_max_hz)
-    mesh = fin_mesh(fin, n_chord, n_span)
-    K, M = assemble(mesh, fin.material)
-    fn2 = fin_supported(fin, mesh, "FN2", shaft, K, M)
-    fn1 = fin_supported(fin, mesh, "FN1", shaft, K, M)
-    modes = modes_up_to(fn2, f_max_hz, M_fin=M)
+    fn2 = shaft_support(mesh, K, M, axis_point, torsional_stiffness, model="FN2",
+                        region=_region(region), radius=radius,
+                        fictitious_inertia_factor=fictitious_inertia_factor,
+                        bending_stiffness=bending_stiffness)
+    fn1 = shaft_support(mesh, K, M, axis_point, torsional_stiffness, model="FN1",
+                        region=region, radius=radius, bending_stiffness=bending_stiffness)
+    modes = _solve_modes(fn2, M, f_max_hz, n_modes, extra=1)
     g, s_i = fn2.ground_index, fn2.shaft_index
     # the rigid mode: almost all of its kinetic energy sits in the fictitious inertia
     energy_g = fn2.fictitious_inertia * modes.q[g] ** 2
@@ -313,7 +343,7 @@ def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None
     phi_c = fn2.T @ q_c
     # elastic: drop the ground coordinate, re-diagonalise with the fin's mass + FN1 stiffness
     elastic = [j for j in range(modes.q.shape[1]) if j != i_rigid]
-    Qs = modes.q[:g, elastic]
+    Qs = np.delete(modes.q[:, elastic], g, axis=0)
     Kt = Qs.T @ (fn1.K @ Qs)
     Mt = Qs.T @ (fn1.M @ Qs)
     lam, V = sla.eigh(0.5 * (Kt + Kt.T), 0.5 * (Mt + Mt.T))
@@ -326,7 +356,7 @@ def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None
             Qs[:, j] *= -1
     f_s = np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi)
     share = _fin_mass_share(phi_s, M)
-    keep = select_modes(f_s, share, f_max_hz)
+    keep = _keep_modes(f_s, share, f_max_hz, n_modes)
     phi_s, Qs, lam_s = phi_s[:, keep], Qs[:, keep], lam[keep]
     Phi = np.column_stack([phi_c, phi_s])
     M_mm = Phi.T @ (M @ Phi)
@@ -347,14 +377,87 @@ def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None
                       elements=mesh.elements.copy(), label=fn2.label)
 
 
+def fixed_modal_model(system: SupportedSystem, M_fin, f_max_hz: float = 1000.0,
+                      n_modes: int | None = None, axis_x: float | None = None) -> ModalModel:
+    """A ModalModel without rigid modes (n_rigid = 0) of a supported system with no free
+    rotation (clamped root, FN1 shaft, edge supports): the out-of-plane modes below
+    ``f_max_hz`` (or the first ``n_modes``), mass-normalised."""
+    positive("f_max_hz", f_max_hz)
+    modes = _solve_modes(system, M_fin, f_max_hz, n_modes)
+    return elastic_modal_model(modes, M_fin, f_max_hz, axis_x=axis_x, n_modes=n_modes)
+
+
+def with_damping(model: ModalModel, modal_damping_ratio=None, structural_g=None) -> ModalModel:
+    """The model with viscous modal damping of its elastic modes.
+
+    C_ii = 2 zeta_i omega_i M_ii for each elastic mode i (``modal_damping_ratio``: one value
+    or one per elastic mode, in [0, 1)); a structural damping coefficient g is applied as its
+    equivalent viscous damping at each mode's natural frequency, zeta = g / 2 (the viscous
+    form of modal structural damping used in p-k flutter, e.g. MSC Nastran's TABDMP1 with
+    the PK method). Rigid modes stay undamped. Default (both None): C unchanged (zero, as in
+    the thesis).
+    """
+    import dataclasses
+    if modal_damping_ratio is not None and structural_g is not None:
+        raise ValueError("give modal_damping_ratio or structural_g, not both")
+    if modal_damping_ratio is None and structural_g is None:
+        return model
+    n_s = len(model.frequencies_hz) - model.n_rigid
+    if structural_g is not None:
+        g = np.broadcast_to(np.asarray(structural_g, float), (n_s,)) if np.ndim(structural_g) == 0 \
+            else np.asarray(structural_g, float)
+        zeta = 0.5 * g
+        name = "structural_g"
+    else:
+        zeta = np.asarray(modal_damping_ratio, float)
+        zeta = np.full(n_s, float(zeta)) if zeta.ndim == 0 else zeta
+        name = "modal_damping_ratio"
+    if zeta.shape != (n_s,):
+        raise ValueError(f"damping.{name} must be one value or one per elastic mode "
+                         f"({n_s}), got {zeta.size} values")
+    if not np.all(np.isfinite(zeta)) or np.any(zeta < 0) or np.any(zeta >= 1):
+        raise ValueError(f"damping.{name} must give damping ratios in [0, 1), got "
+                         f"{np.asarray(modal_damping_ratio if structural_g is None else structural_g).tolist()}")
+    omega = 2 * math.pi * model.frequencies_hz[model.n_rigid:]
+    C = model.C.copy()
+    r = model.n_rigid
+    C[r:, r:] += np.diag(2 * zeta * omega * np.diag(model.M)[r:])
+    return dataclasses.replace(model, C=C)
+
+
+def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None,
+                    n_span: int | None = None, shaft: str = "single_node",
+                    f_max_hz: float = 1000.0) -> ModalModel:
+    """The FN2 modal model of a fin definition: rigid pitch mode + elastic modes below
+    ``f_max_hz`` with out-of-plane motion (thesis Sec. 3.1, Table 6, Eqs. (2.45)-(2.46)); see
+    :func:`fictitious_mass_modal_model`.
+
+    Parameters
+    ----------
+    fin : fin definition (default ``load_fin()``).
+    n_chord, n_span : elements per direction (default the fin's 6 x 7).
+    shaft : "single_node" (thesis) or "distributed" (rigid region of radius fin.shaft.radius).
+    f_max_hz : frequency limit for the elastic modes kept (Hz), > 0.
+    """
+    fin = load_fin() if fin is None else fin
+    positive("f_max_hz", f_max_hz)
+    mesh = fin_mesh(fin, n_chord, n_span)
+    K, M = assemble(mesh, fin.material)
+    s = fin.shaft
+    return fictitious_mass_modal_model(mesh, K, M, s.axis_point, s.torsional_stiffness,
+                                       region=_region(shaft), radius=s.radius,
+                                       fictitious_inertia_factor=s.fictitious_inertia_factor,
+                                       f_max_hz=f_max_hz)
+
+
 def elastic_modal_model(modes: NormalModes, M_fin, f_max_hz: float = 1000.0,
-                        axis_x: float | None = None) -> ModalModel:
+                        axis_x: float | None = None, n_modes: int | None = None) -> ModalModel:
     """A ModalModel without rigid modes (n_rigid = 0) from an FN1 or clamped eigen-solution:
     the modes below ``f_max_hz`` with out-of-plane motion, mass-normalised (M = I,
     K = diag(omega^2), C = 0). ``J_fin`` is the plate's pitch inertia about x = ``axis_x``
     (default: the shaft axis of the support, or NaN when clamped)."""
     sys_ = modes.system
-    keep = select_modes(modes.frequencies_hz, _fin_mass_share(modes.fin, M_fin), f_max_hz)
+    keep = _keep_modes(modes.frequencies_hz, _fin_mass_share(modes.fin, M_fin), f_max_hz, n_modes)
     phi = modes.fin[:, keep]
     n = phi.shape[1]
     M_mm = phi.T @ (M_fin @ phi)

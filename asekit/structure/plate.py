@@ -88,11 +88,18 @@ def _check_geometry(det: np.ndarray):
 
 
 def _thickness(mesh: PlateMesh, xy: np.ndarray, N: np.ndarray, rule: str) -> np.ndarray:
+    ct = getattr(mesh, "corner_thickness", None)
+    if ct is not None:                              # per-element corner thicknesses (T1-T4)
+        if rule == "gauss":
+            return np.asarray(ct, float) @ N
+        if rule == "centroid":
+            return np.asarray(ct, float).mean(axis=1)
     if rule == "gauss":
-        y = N @ xy[:, :, 1].T                       # N (4,) -> (ne,)
-        return mesh.thickness_at(y)
+        x = N @ xy[:, :, 0].T                       # N (4,) -> (ne,)
+        y = N @ xy[:, :, 1].T
+        return mesh.thickness_xy(x, y)
     if rule == "centroid":
-        return mesh.thickness_at(xy[:, :, 1].mean(axis=1))
+        return mesh.thickness_xy(xy[:, :, 0].mean(axis=1), xy[:, :, 1].mean(axis=1))
     raise ValueError(f"thickness_rule must be 'gauss' or 'centroid', got {rule!r}")
 
 
@@ -119,16 +126,18 @@ def mitc4_stiffness(mesh: PlateMesh, material: Material, thickness_rule: str = "
                     n_gauss: int = 2) -> np.ndarray:
     """Element stiffness matrices of all elements, shape (n_elem, 12, 12) (SI: N/m, N, N m).
 
-    K_e = int B_b^T D_b B_b dA + int B_s^T D_s B_s dA with
+    K_e = int B_b^T D_b B_b dA + int B_s^T D_s B_s dA with the general bending and
+    transverse-shear constitutive matrices D_b = h^3 / 12 Q (Q the material's plane-stress
+    matrix in x-y axes, isotropic or orthotropic at any fibre angle) and D_s = k h G_s
+    (G_s its 2 x 2 transverse-shear moduli, k = 5/6); for an isotropic material
     D_b = E h^3 / (12 (1 - nu^2)) [[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu)/2]] and
-    D_s = k G h I (k = 5/6), the shear strains from the MITC4 assumed covariant field
+    D_s = k G h I. The shear strains come from the MITC4 assumed covariant field
     (Bathe & Dvorkin 1985); ``n_gauss`` x ``n_gauss`` Gauss integration (2 is the
-    standard MITC4 rule).
+    standard MITC4 rule); h is evaluated at every integration point.
     """
     xy = mesh.nodes[mesh.elements]                   # (ne, 4, 2)
-    E, nu = material.youngs_modulus, material.poisson_ratio
-    G = E / (2 * (1 + nu))
-    Db0 = E / (12 * (1 - nu**2)) * np.array([[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu) / 2]])
+    Db0 = material.plane_stress_matrix() / 12.0
+    Gs = material.transverse_shear_matrix()
     # covariant shear rows at the tying points A (0,1), C (0,-1) [e_rz] and D (1,0), B (-1,0) [e_sz]
     tie = {}
     for name, (r, s) in {"A": (0, 1), "C": (0, -1), "D": (1, 0), "B": (-1, 0)}.items():
@@ -154,10 +163,10 @@ def mitc4_stiffness(mesh: PlateMesh, material: Material, thickness_rule: str = "
         erz = 0.5 * (1 + s) * tie["A"][0] + 0.5 * (1 - s) * tie["C"][0]
         esz = 0.5 * (1 + r) * tie["D"][1] + 0.5 * (1 - r) * tie["B"][1]
         Bs = np.einsum("eij,ejk->eik", Jinv, np.stack([erz, esz], axis=1))
-        ds = SHEAR_FACTOR * G * h
+        ds = SHEAR_FACTOR * h
         f = wgt * det
         K += f[:, None, None] * (np.einsum("eji,ejk,ekl->eil", Bb, Db, Bb)
-                                 + ds[:, None, None] * np.einsum("eji,ejl->eil", Bs, Bs))
+                                 + ds[:, None, None] * np.einsum("eji,jk,ekl->eil", Bs, Gs, Bs))
     return K
 
 
@@ -190,15 +199,16 @@ def membrane_matrices(mesh: PlateMesh, material: Material, thickness_rule: str =
     """Plane-stress bilinear (Q4) membrane stiffness and consistent mass, (n_elem, 8, 8) each,
     DOFs (u, v) per node.
 
-    K_e = int B^T D B dA, D = E h / (1 - nu^2) [[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu)/2]],
+    K_e = int B^T D B dA, D = h Q (Q the plane-stress matrix; isotropic:
+    E / (1 - nu^2) [[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu)/2]]),
     B = [[N_x, 0], [0, N_y], [N_y, N_x]]; M_e = int rho h N^T N dA (3 x 3 Gauss). Used only to
     examine the in-plane behaviour that the bending model leaves out (the flat plate's membrane
     and bending fields are uncoupled). The element has no drilling stiffness: an in-plane rigid
     rotation costs no energy (cf. the artificial drilling stiffness of shell elements).
     """
     xy = mesh.nodes[mesh.elements]
-    E, nu, rho = material.youngs_modulus, material.poisson_ratio, material.density
-    D0 = E / (1 - nu**2) * np.array([[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu) / 2]])
+    rho = material.density
+    D0 = material.plane_stress_matrix()
     ne = xy.shape[0]
     K = np.zeros((ne, 8, 8))
     M = np.zeros((ne, 8, 8))

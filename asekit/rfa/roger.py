@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .validate import in_range, positive
+from ..validate import in_range, positive
 
 
 def default_lag_roots(k_max: float, n_lags: int = 4) -> np.ndarray:
@@ -77,6 +77,35 @@ class RogerFit:
     def n_modes(self) -> int:
         return self.A.shape[1]
 
+    @property
+    def n_lag_states(self) -> int:
+        """Aerodynamic lag states of the state-space model: one per lag term and mode, N n."""
+        return self.n_lags * self.n_modes
+
+    def lag_realization(self, n_rigid: int = 0):
+        """The lag terms as one realization  sum_n (ik) A_{n+2} / (ik + beta_n) =
+        D (ik I + diag(beta))^-1 E (ik)  (the minimum-state form of Karpel, with D a 0/1
+        selection matrix): returns ``(D (n, N n), E (N n, n), roots (N n,), names)``.
+
+        States are ordered as in thesis Eq. (2.63): for each lag n the rows of the elastic
+        modes (``lag<n>_zeta<j>``), then, for each lag, the rigid rows (``lag<n>_hinge``);
+        ``n_rigid`` (0 or 1) is the number of rigid modes in front.
+        """
+        n, N = self.n_modes, self.n_lags
+        ns = n - n_rigid
+        rows = [(n_, n_rigid + j) for n_ in range(N) for j in range(ns)]
+        rows += [(n_, c) for n_ in range(N) for c in range(n_rigid)]
+        D = np.zeros((n, N * n))
+        E = np.zeros((N * n, n))
+        roots = np.zeros(N * n)
+        for r, (n_, i) in enumerate(rows):
+            D[i, r] = 1.0
+            E[r] = self.A[3 + n_][i]
+            roots[r] = self.lag_roots[n_]
+        names = ([f"lag{n_ + 1}_zeta{j + 1}" for n_ in range(N) for j in range(ns)]
+                 + [f"lag{n_ + 1}_hinge" for n_ in range(N) for _ in range(n_rigid)])
+        return D, E, roots, names
+
     def evaluate(self, k) -> np.ndarray:
         """Q~ at reduced frequencies ``k`` (scalar or array): (n, n) or (len(k), n, n) complex,
         Eq. (2.13)."""
@@ -95,6 +124,34 @@ class RogerFit:
         terms = [np.ones_like(sb), sb, sb ** 2] + [sb / (sb + b) for b in self.lag_roots]
         out = np.einsum("fc,cij->fij", np.stack(terms, axis=1), self.A)
         return out[0] if np.ndim(s) == 0 else out
+
+
+def fit_errors(Q: np.ndarray, Q_fit: np.ndarray) -> tuple[np.ndarray, float]:
+    """Normalised errors of a fit over k: per element ||Q_ij - Q~_ij|| / ||Q_ij|| (an all-zero
+    element: the absolute error divided by the largest element norm), and overall
+    ||Q - Q~||_F / ||Q||_F. Inputs (n_k, n, n) complex; returns ((n, n), float)."""
+    err = Q - Q_fit
+    num = np.sqrt(np.sum(np.abs(err) ** 2, axis=0))
+    den = np.sqrt(np.sum(np.abs(Q) ** 2, axis=0))
+    scale = max(float(den.max()), 1e-300)
+    elem = np.where(den > 1e-12 * scale, num / np.where(den > 0, den, 1.0), num / scale)
+    overall = float(np.linalg.norm(err) / max(np.linalg.norm(Q), 1e-300))
+    return elem, overall
+
+
+def check_gaf_table(k, Q) -> tuple[np.ndarray, np.ndarray]:
+    """Validate a GAF table: k (n_k,) finite, >= 0, strictly ascending; Q (n_k, n, n) finite
+    complex. Returns (k, Q) as float and complex arrays; ValueError otherwise."""
+    k = np.asarray(k, dtype=float)
+    Q = np.asarray(Q, dtype=complex)
+    if k.ndim != 1 or Q.ndim != 3 or Q.shape[0] != k.size or Q.shape[1] != Q.shape[2]:
+        raise ValueError(f"Q must have shape (n_k, n, n) with n_k = len(k) = {k.size}; "
+                         f"got Q {Q.shape}")
+    if not (np.all(np.isfinite(k)) and np.all(np.isfinite(Q))) or np.abs(Q).max(initial=0) > 1e150:
+        raise ValueError("k and Q must be finite (|Q| <= 1e150: its squares must not overflow)")
+    if k.size == 0 or np.any(k < 0) or np.any(np.diff(k) <= 0):
+        raise ValueError(f"k must be >= 0 and strictly ascending, got {k}")
+    return k, Q
 
 
 def design_rows(k: np.ndarray, lag_roots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -136,16 +193,8 @@ def roger_fit(k, Q, b_ref: float, lag_roots=None, n_lags: int = 4, weights=None,
         Non-positive lag roots, negative weights, fewer equations (2 n_k, real and imaginary)
         than coefficients N + 3, shape mismatch, or non-finite data.
     """
-    k = np.asarray(k, dtype=float)
-    Q = np.asarray(Q, dtype=complex)
     positive("b_ref", b_ref)
-    if k.ndim != 1 or Q.ndim != 3 or Q.shape[0] != k.size or Q.shape[1] != Q.shape[2]:
-        raise ValueError(f"Q must have shape (n_k, n, n) with n_k = len(k) = {k.size}; "
-                         f"got Q {Q.shape}")
-    if not (np.all(np.isfinite(k)) and np.all(np.isfinite(Q))) or np.abs(Q).max(initial=0) > 1e150:
-        raise ValueError("k and Q must be finite (|Q| <= 1e150: its squares must not overflow)")
-    if k.size == 0 or np.any(k < 0) or np.any(np.diff(k) <= 0):
-        raise ValueError(f"k must be >= 0 and strictly ascending, got {k}")
+    k, Q = check_gaf_table(k, Q)
     if lag_roots is None:
         lag_roots = default_lag_roots(float(k.max()), n_lags)
     lag_roots = np.atleast_1d(np.asarray(lag_roots, dtype=float))
@@ -181,12 +230,7 @@ def roger_fit(k, Q, b_ref: float, lag_roots=None, n_lags: int = 4, weights=None,
     fit = RogerFit(A=A, lag_roots=lag_roots, b_ref=float(b_ref), k=k, Q=Q,
                    element_error=np.zeros((n, n)), fit_error=0.0,
                    constrained_k0=bool(constrain_k0), mach=mach, weights=w)
-    err = Q - fit.evaluate(k)
-    num = np.sqrt(np.sum(np.abs(err) ** 2, axis=0))
-    den = np.sqrt(np.sum(np.abs(Q) ** 2, axis=0))
-    scale = max(float(den.max()), 1e-300)
-    elem = np.where(den > 1e-12 * scale, num / np.where(den > 0, den, 1.0), num / scale)
-    overall = float(np.linalg.norm(err) / max(np.linalg.norm(Q), 1e-300))
+    elem, overall = fit_errors(Q, fit.evaluate(k))
     return RogerFit(A=A, lag_roots=lag_roots, b_ref=float(b_ref), k=k, Q=Q,
                     element_error=elem, fit_error=overall, constrained_k0=bool(constrain_k0),
                     mach=mach, weights=w)

@@ -1,0 +1,540 @@
+"""Supersonic lifting-surface method for harmonically oscillating planar surfaces: a Mach-box
+(velocity-potential) method with exact box integrals and a diaphragm, for about 1.15 <= M <= 3.
+
+References (equation numbers below refer to these):
+
+- [ZH55] G. Zartarian, P. T. Hsu, "Theoretical studies on the prediction of unsteady
+  supersonic airloads on elastic wings", WADC TR 56-97, 1955 (the Mach box method).
+- [PDN55] S. Pines, J. Dugundji, J. Neuringer, "Aerodynamic flutter derivatives for a flexible
+  wing with supersonic and subsonic edges", J. Aeronaut. Sci. 22(10), 1955, 693-700 (the
+  diaphragm: phi = 0 on the plane off the wing, after Evvard).
+- [BAH55] R. L. Bisplinghoff, H. Ashley, R. L. Halfman, *Aeroelasticity*, Addison-Wesley 1955,
+  Section 5-7 (Eq. 5-302: the planar supersonic velocity potential below) and Section 7-4.
+- [GR46] I. E. Garrick, S. I. Rubinow, "Theoretical study of air forces on an oscillating or
+  steady thin wing in a supersonic main stream", NACA Report 872, 1946 (the 2-D case).
+
+Formulation. With exp(i omega t), the perturbation potential of the linearised equation
+beta^2 phi_xx - phi_yy - phi_zz + 2 i omega M^2 / U phi_x - omega^2 M^2 / U^2 phi = 0
+(beta = sqrt(M^2 - 1)) is phi = psi exp(-i lambda x), lambda = omega M^2 / (U beta^2), with psi
+a Klein-Gordon field of mass mu = omega M / (U beta); its retarded source solution gives the
+potential on the upper side of the plane z = 0 in terms of the normalwash w ([BAH55] Eq. 5-302,
+[ZH55])
+
+    phi(x, y) = -(1/pi) int int_tau w(xi, eta) exp(-i lambda X) cos(kappa R) / R d xi d eta,
+
+X = x - xi, R = sqrt(X^2 - beta^2 (y - eta)^2), kappa = omega M / (U beta^2), tau the part of the
+plane inside the forward Mach cone of (x, y). The pressure jump follows from the (antisymmetric)
+potential, DeltaCp = Cp_lower - Cp_upper = (4 / U^2) (i omega phi + U phi_x): Delta Cp > 0 pushes
+along +z, the DLM convention. Off the wing the plane carries no load, so phi = 0 there (the
+diaphragm of [PDN55]); behind a supersonic trailing edge the wake cannot reach the wing.
+
+Discretisation (asekit's). The plane is cut into a uniform grid of rectangular cells, Mach boxes
+with dx = beta dy as in [ZH55] (the diaphragm march is unstable on finer grids otherwise);
+w is constant on each cell. With beta t = X sin(theta) the inner integral over a cell's span
+becomes dt / R = d theta / beta, so the potential influence of a cell is
+
+    I = (1/beta) int d theta int_L(theta)^H(theta) exp(-i lambda X) cos(kappa X cos theta) dX,
+
+done exactly in X (exponentials) and by Gauss-Legendre quadrature in theta between the kinks of
+L and H; phi_x needs the same integrand at the cell's two chordwise edges only,
+F(X) = (1/beta) exp(-i lambda X) int cos(kappa X cos theta) d theta, so no numerical
+differentiation of phi is needed. In steady flow I reduces to the exact area integral of 1/R and
+F(X) to (theta_2 - theta_1) / beta, and in 2-D (far from edges) DeltaCp = -4 (w/U) / beta:
+Ackeret's 4 alpha / beta. The influences depend on the cell offset only. Cells whose centre lies
+in a box are wing cells; off-wing cells ahead of the trailing edge within the Mach cones of the
+wing (beyond side edges, ahead of subsonic leading edges) are diaphragm cells whose w follows
+from phi = 0 at their centres; the pressure is evaluated at the wing-cell centres.
+
+Transfer to the box mesh. The input is the normalwash w/U at the DLM control points (3/4 chord
+of each box, w/U = dh/dx + i k h / b); it is interpolated linearly in x along each chordwise
+strip to the cell centres. Each box's force (the pressures of the cells whose centres it holds,
+weighted so that they carry exactly its area) is placed at the box centroid and goes back to
+the strip's load points (1/4 chord) by the transpose of the linear interpolation from the load
+points, which keeps the virtual work of rigid plunge and pitch exact up to the midpoint rule
+(as in :mod:`asekit.aero.piston`). A uniform load gives equal lumped pressures on interior
+boxes; the first and last box of a strip carry the redistribution (0.75 and 1.25 times).
+The result is a
+pressure-per-normalwash matrix DeltaCp = A (w/U) with DeltaCp lumped at the load points, the
+same kind of matrix as the DLM's AIC, so :mod:`asekit.aero.gaf` uses either.
+
+Limits. Planar meshes in z = 0 only; trailing edges must be supersonic (|tan Lambda_TE| < beta),
+else ValueError. Leading and side edges may be subsonic or supersonic; at subsonic leading edges
+the staircase of cells and the square-root pressure singularity cost accuracy (delta wings with
+beta cot Lambda = 0.33-0.56: lift slope 4-7 % above Stewart's conical-flow value, against
+0.1-0.3 % with supersonic leading edges; tests/test_supersonic.py). The reference fin's leading
+edge is supersonic from M 1.13. The box mesh must resolve
+the shortest kernel wavelength 2 pi b (M - 1) / (k M) with at least ``bpw_min`` boxes (a
+:class:`~asekit.aero.boxes.MeshRuleWarning` otherwise); the cell grid resolves it with
+``cells_per_wavelength`` cells and every box with about ``cells_per_box`` cells chordwise.
+Near M = 1 this wavelength shrinks to zero and the linear theory itself fails: the dispatcher
+(:mod:`asekit.aero.methods`) refuses 0.9 < M < 1.15.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.fft as sfft
+import scipy.linalg as sla
+
+from .boxes import BoxMesh, MeshRuleWarning
+from .piston import _check_k, check_supersonic_mach, piston_transfer, strip_interpolation
+
+_GAUSS_PHI = np.polynomial.legendre.leggauss(12)
+_GAUSS_F = np.polynomial.legendre.leggauss(32)
+#: Largest share of the mesh area allowed in boxes too small to hold a cell centre (the
+#: slivers at a delta wing's tip); their area goes to the nearest cell of the grid.
+EMPTY_AREA_FRACTION = 0.02
+#: dx / (beta dy) of the grid cells: 1, Mach boxes (see :func:`mach_grid`).
+MACH_BOX_RATIO = 1.0
+
+
+# ---------------------------------------------------------------------------------------------
+# influence coefficients of one constant-w cell
+# ---------------------------------------------------------------------------------------------
+def cell_potential_integral(xa, xb, t1, t2, beta: float, lam: float, kap: float) -> np.ndarray:
+    """I = int_{X in [xa, xb]} int_{t in [t1, t2]} exp(-i lam X) cos(kap R) / R dt dX over the
+    part inside the Mach cone X > beta |t| (module docstring), broadcast over the arrays.
+
+    ``xa < xb`` the range of X = x - xi and ``t1 < t2`` that of t = y - eta of the source cell
+    seen from the field point (m); lam, kap in 1/m (0, 0 steady)."""
+    xa, xb, t1, t2 = np.broadcast_arrays(*(np.asarray(v, float) for v in (xa, xb, t1, t2)))
+    xa = np.maximum(xa, 0.0)
+    a1, a2 = beta * t1, beta * t2
+    half = 0.5 * np.pi
+    kinks = [np.full(xa.shape, -half), np.full(xa.shape, half)]
+    for a in (a1, a2):
+        for x in (xa, xb):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                r = np.where(x > 0, a / np.where(x > 0, x, 1.0), -2.0)
+            kinks.append(np.arcsin(np.clip(r, -1.0, 1.0)))
+    th = np.sort(np.stack(kinks, axis=-1), axis=-1)            # (..., 6)
+    lo, hi = th[..., :-1], th[..., 1:]                          # 5 segments
+    g, wg = _GAUSS_PHI
+    mid, rad = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    theta = mid[..., None] + rad[..., None] * g                 # (..., 5, ng)
+    s, c = np.sin(theta), np.cos(theta)
+    s = np.where(s == 0.0, 1e-300, s)
+    e = (Ellipsis, None, None)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        low = np.where(s > 0, a1[e] / s, a2[e] / s)
+        upp = np.where(s > 0, a2[e] / s, a1[e] / s)
+    L = np.maximum(xa[e], low)
+    H = np.minimum(xb[e], upp)
+    ln = np.maximum(H - L, 0.0)
+    m = 0.5 * (H + L)
+    m = np.where(ln > 0, m, 0.0)
+    if lam == 0.0 and kap == 0.0:
+        inner = ln.astype(complex)
+    else:
+        def ex(nu):
+            return ln * np.exp(1j * nu * m) * np.sinc(nu * ln / (2.0 * np.pi))
+        inner = 0.5 * (ex(kap * c - lam) + ex(-kap * c - lam))
+    return np.sum(inner * (rad[..., None] * wg), axis=(-1, -2)) / beta
+
+
+def edge_line_integral(x, t1, t2, beta: float, lam: float, kap: float) -> np.ndarray:
+    """F(X) = int_{t1}^{t2} exp(-i lam X) cos(kap R) / R dt inside the Mach cone
+    = (1/beta) exp(-i lam X) int_{theta1}^{theta2} cos(kap X cos theta) d theta, 0 for X <= 0."""
+    x, t1, t2 = np.broadcast_arrays(*(np.asarray(v, float) for v in (x, t1, t2)))
+    pos = x > 0
+    xs = np.where(pos, x, 1.0)
+    th1 = np.arcsin(np.clip(beta * t1 / xs, -1.0, 1.0))
+    th2 = np.arcsin(np.clip(beta * t2 / xs, -1.0, 1.0))
+    g, wg = _GAUSS_F
+    mid, rad = 0.5 * (th1 + th2), 0.5 * (th2 - th1)
+    theta = mid[..., None] + rad[..., None] * g
+    val = np.sum(np.cos(kap * xs[..., None] * np.cos(theta)) * wg, axis=-1) * rad
+    return np.where(pos, np.exp(-1j * lam * xs) * val / beta, 0.0)
+
+
+class GridTooCoarseError(ValueError):
+    """Too much of the mesh area lies in boxes that hold no cell centre of the grid."""
+
+
+# ---------------------------------------------------------------------------------------------
+# the cell grid
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class MachGrid:
+    """Cells of the supersonic method for one mesh and Mach number.
+
+    ``x0, y0`` grid origin (m), ``dx, dy`` cell size (m), ``nx, ny`` cells per direction;
+    ``wing_i, wing_j`` (n_w,) indices of the wing cells and ``wing_box`` the box (index into the
+    mesh) each lies in, ``image`` (n_w,) True for cells of the mirror image (symmetric case);
+    ``dia_i, dia_j`` (n_d,) the diaphragm cells.
+    """
+
+    x0: float
+    y0: float
+    dx: float
+    dy: float
+    nx: int
+    ny: int
+    beta: float
+    wing_i: np.ndarray
+    wing_j: np.ndarray
+    wing_box: np.ndarray
+    image: np.ndarray
+    dia_i: np.ndarray
+    dia_j: np.ndarray
+
+    @property
+    def n_cells(self) -> int:
+        return self.wing_i.size + self.dia_i.size
+
+    def centres(self, i, j) -> np.ndarray:
+        return np.column_stack([self.x0 + (np.asarray(i) + 0.5) * self.dx,
+                                self.y0 + (np.asarray(j) + 0.5) * self.dy])
+
+
+def _check_planar(mesh: BoxMesh) -> None:
+    scale = float(np.ptp(mesh.corners[:, :, 0])) + float(np.ptp(mesh.corners[:, :, 1]))
+    if np.any(np.abs(mesh.corners[:, :, 2]) > 1e-9 * scale) or np.any(np.abs(mesh.dihedral) > 1e-9):
+        raise ValueError("mesh must be planar in z = 0 (horizontal boxes) for the supersonic "
+                         "method; nonplanar meshes are not supported")
+
+
+def _locate(corners: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """Index of the box containing each point (-1 if none); boxes with streamwise sides."""
+    y1, y2 = corners[:, 0, 1], corners[:, 3, 1]
+    ylo, yhi = np.minimum(y1, y2), np.maximum(y1, y2)
+    out = np.full(pts.shape[0], -1)
+    for i0 in range(0, pts.shape[0], 2048):
+        p = pts[i0:i0 + 2048]
+        f = (p[:, None, 1] - y1[None]) / (y2 - y1)[None]
+        xle = corners[None, :, 0, 0] + f * (corners[None, :, 3, 0] - corners[None, :, 0, 0])
+        xte = corners[None, :, 1, 0] + f * (corners[None, :, 2, 0] - corners[None, :, 1, 0])
+        inside = ((p[:, None, 1] >= ylo[None]) & (p[:, None, 1] < yhi[None])
+                  & (p[:, None, 0] >= xle) & (p[:, None, 0] < xte))
+        hit = inside.any(axis=1)
+        out[i0:i0 + 2048] = np.where(hit, inside.argmax(axis=1), -1)
+    return out
+
+
+def _check_trailing_edges(mesh: BoxMesh, beta: float, mach: float) -> None:
+    for s in np.unique(mesh.strip):
+        members = np.flatnonzero(mesh.strip == s)
+        last = members[np.argmax(mesh.corners[members, 1, 0])]
+        c = mesh.corners[last]
+        tan_te = (c[2, 0] - c[1, 0]) / (c[2, 1] - c[1, 1])
+        if abs(tan_te) >= beta:
+            raise ValueError(f"mach={mach:g}: the trailing edge of strip {s} is subsonic "
+                             f"(|tan sweep| {abs(tan_te):.3g} >= sqrt(M^2 - 1) = {beta:.3g}); the "
+                             "supersonic method needs supersonic trailing edges")
+
+
+def kernel_wavelength(mach: float, k: float, b_ref: float) -> float:
+    """Shortest streamwise wavelength of the kernel, 2 pi / (lambda + kappa) =
+    2 pi b (M - 1) / (k M) (m); inf for k = 0."""
+    return math.inf if k <= 0 else 2.0 * math.pi * b_ref * (mach - 1.0) / (k * mach)
+
+
+def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric: bool = False,
+              cells_per_box: float = 1.5, cells_per_wavelength: float = 8.0,
+              max_cells: int = 6000) -> MachGrid:
+    """Build the cell grid (:class:`MachGrid`) for ``mesh`` at ``mach`` and the highest reduced
+    frequency ``k_max``: dx from ``cells_per_box`` cells across the area-weighted mean box chord and
+    ``cells_per_wavelength`` cells per :func:`kernel_wavelength` (upper bounds); dy = dx / beta
+    (Mach boxes), with cell boundaries on the strip edges when the strips are equally wide.
+    The grid extends (x_max - x_min) / (2 beta) beyond the spanwise extremes of the mesh: no
+    off-wing point farther out both feels the wing and influences it.
+
+    Raises ValueError when more than ``max_cells`` cells would be needed.
+    """
+    m = check_supersonic_mach(mach)
+    beta = math.sqrt(m * m - 1.0)
+    _check_planar(mesh)
+    _check_trailing_edges(mesh, beta, m)
+    cells_per_box = float(cells_per_box)
+    if not (math.isfinite(cells_per_box) and cells_per_box >= 1.0):
+        raise ValueError(f"cells_per_box must be >= 1, got {cells_per_box!r}")
+    if not (math.isfinite(cells_per_wavelength) and cells_per_wavelength >= 2.0):
+        raise ValueError(f"cells_per_wavelength must be >= 2, got {cells_per_wavelength!r}")
+    corners = mesh.corners
+    if symmetric:
+        img = mesh.mirrored().corners
+        all_c = np.concatenate([corners, img])
+        owner = np.concatenate([np.arange(mesh.n), np.arange(mesh.n)])
+        is_img = np.concatenate([np.zeros(mesh.n, bool), np.ones(mesh.n, bool)])
+    else:
+        all_c, owner, is_img = corners, np.arange(mesh.n), np.zeros(mesh.n, bool)
+    x_min, x_max = float(all_c[:, :, 0].min()), float(all_c[:, :, 0].max())
+    dx = float(np.sum(mesh.chord * mesh.area) / np.sum(mesh.area)) / cells_per_box
+    dx = min(dx, kernel_wavelength(m, k_max, b_ref) / cells_per_wavelength)
+    # Mach boxes: dx = beta dy, the cell diagonals on Mach lines (the classic choice of
+    # [ZH55]). Then cells of one row lie outside each other's Mach cones (the diaphragm is
+    # solved by forward substitution), and the diaphragm march is stable: asekit's tests found
+    # it growing without bound on fine grids for dx / (beta dy) = 0.5, and slower but similar
+    # trouble below that. dy divides the strip width when the strips are equally wide.
+    ylo = np.minimum(all_c[:, 0, 1], all_c[:, 3, 1])
+    yhi = np.maximum(all_c[:, 0, 1], all_c[:, 3, 1])
+    edges = np.unique(np.round(np.concatenate([ylo, yhi]), 12))
+    y_wmin, y_wmax = float(edges[0]), float(edges[-1])
+    widths = np.diff(edges)
+    if widths.size and np.allclose(widths, widths[0], rtol=1e-6):
+        width = float(widths[0])
+        dy = width / max(1, math.ceil(beta * width / (MACH_BOX_RATIO * dx) - 1e-9))
+    else:
+        dy = MACH_BOX_RATIO * dx / beta
+    dx = MACH_BOX_RATIO * beta * dy
+    nx = max(1, math.ceil((x_max - x_min) / dx - 1e-9))
+    margin = (x_max - x_min) / (2.0 * beta) + dy
+    n_lo = math.ceil(margin / dy)
+    ny_w = max(1, round((y_wmax - y_wmin) / dy))
+    y0 = y_wmin - n_lo * dy
+    ny = ny_w + 2 * n_lo
+    if nx * ny > 4 * max_cells:
+        raise ValueError(f"the supersonic grid would need about {nx * ny} cells (> {max_cells} "
+                         f"relevant cells, max_cells) at mach={m:g}, k={k_max:g}: coarsen with "
+                         "cells_per_box / cells_per_wavelength or lower k")
+    ii, jj = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
+    ii, jj = ii.ravel(), jj.ravel()
+    cen = np.column_stack([x_min + (ii + 0.5) * dx, y0 + (jj + 0.5) * dy])
+    box = _locate(all_c, cen)
+    wing = box >= 0
+    if not wing.any():
+        raise ValueError("no grid cell centre lies on the mesh: the mesh is degenerate")
+    # wake: off-wing cells behind a wing cell of the same column
+    first_wing_row = np.full(ny, nx)
+    np.minimum.at(first_wing_row, jj[wing], ii[wing])
+    last_wing_row = np.full(ny, -1)
+    np.maximum.at(last_wing_row, jj[wing], ii[wing])
+    wake = (~wing) & (ii > last_wing_row[jj]) & (last_wing_row[jj] >= 0)
+    cand = np.flatnonzero((~wing) & (~wake))
+    wi, wj = ii[wing], jj[wing]
+    # keep the off-wing cells inside the downstream Mach cone of some wing cell and ahead of
+    # another's: per column, the most upstream / downstream wing cell decides (the cone test
+    # is monotone in the streamwise distance)
+    cols = np.flatnonzero(last_wing_row >= 0)
+    ddy = np.abs(jj[cand][:, None] - cols[None, :]) * dy
+    down_dx = (ii[cand][:, None] - first_wing_row[cols][None, :]) * dx
+    up_dx = (last_wing_row[cols][None, :] - ii[cand][:, None]) * dx
+    down = (down_dx > 0) & (beta * (ddy - dy) < down_dx + dx)
+    up = (up_dx > 0) & (beta * (ddy - dy) < up_dx + dx)
+    keep = down.any(axis=1) & up.any(axis=1)
+    dia = cand[keep]
+    n_rel = int(wing.sum()) + dia.size
+    if n_rel > max_cells:
+        raise ValueError(f"the supersonic grid needs {n_rel} cells (> max_cells={max_cells}) at "
+                         f"mach={m:g}, k={k_max:g}: coarsen with cells_per_box / "
+                         "cells_per_wavelength, or raise max_cells")
+    counts = np.bincount(box[wing], minlength=all_c.shape[0])
+    empty = np.flatnonzero(counts == 0)
+    area = np.concatenate([mesh.area, mesh.area]) if symmetric else mesh.area
+    if empty.size and area[empty].sum() > EMPTY_AREA_FRACTION * area.sum():
+        raise GridTooCoarseError(f"boxes {owner[empty][:10].tolist()} hold no cell centre of the "
+                         f"supersonic grid (dx {dx:.3g} m, dy {dy:.3g} m; "
+                         f"{100 * area[empty].sum() / area.sum():.2g} % of the area): raise "
+                         "cells_per_box")
+    return MachGrid(x_min, y0, dx, dy, nx, ny, beta, wi, wj, owner[box[wing]], is_img[box[wing]],
+                    ii[dia], jj[dia])
+
+
+# ---------------------------------------------------------------------------------------------
+# solution on the grid
+# ---------------------------------------------------------------------------------------------
+def _offset_tables(grid: MachGrid, lam: float, kap: float):
+    """Influence tables over offsets (di >= 0, dj >= 0): potential I[di, dj] at a cell centre
+    and edge integrals F[m, dj] at X = (m + 1/2) dx; evaluated only where the Mach cone of the
+    receiving point reaches the cell (beta (dj - 1/2) dy < (di + 1/2) dx), zero elsewhere."""
+    di, dj = np.meshgrid(np.arange(grid.nx), np.arange(grid.ny), indexing="ij")
+    inside = grid.beta * (dj - 0.5) * grid.dy < (di + 0.5) * grid.dx * (1.0 + 1e-9)
+    di, dj = di[inside], dj[inside]
+    xb = (di + 0.5) * grid.dx
+    t1 = (dj - 0.5) * grid.dy
+    t2 = (dj + 0.5) * grid.dy
+    pot = np.zeros((grid.nx, grid.ny), complex)
+    edge = np.zeros((grid.nx, grid.ny), complex)
+    pot[di, dj] = cell_potential_integral(xb - grid.dx, xb, t1, t2, grid.beta, lam, kap)
+    edge[di, dj] = edge_line_integral(xb, t1, t2, grid.beta, lam, kap)
+    return pot, edge
+
+
+class _Convolver:
+    """Causal 2-D convolution on the full nx x ny grid by FFT: out[i, j] = sum K[i - i', |j - j'|]
+    f[i', j'] over i' <= i, for kernel tables K[di >= 0, dj >= 0] (zero-padded to fast FFT
+    lengths >= 2 nx, 2 ny). ``spectrum`` transforms fields once; ``apply`` multiplies by one
+    kernel's spectrum and transforms back, so several kernels share one forward transform."""
+
+    def __init__(self, tables, nx: int, ny: int):
+        self.nx, self.ny = nx, ny
+        self.shape = (sfft.next_fast_len(2 * nx), sfft.next_fast_len(2 * ny))
+        self.kf = []
+        for table in tables:
+            full = np.zeros(self.shape, complex)
+            full[:nx, :ny] = table
+            full[:nx, self.shape[1] - ny + 1:] = table[:, 1:][:, ::-1]     # negative dj: mirror
+            self.kf.append(sfft.fft2(full, workers=1))
+
+    def spectrum(self, fields: np.ndarray) -> np.ndarray:
+        return sfft.fft2(fields, s=self.shape, workers=1)
+
+    def apply(self, spec: np.ndarray, which: int) -> np.ndarray:
+        return sfft.ifft2(spec * self.kf[which], workers=1)[:, :self.nx, :self.ny]
+
+
+def _kernels(grid: MachGrid, mach: float, k: float, b_ref: float):
+    """(potential table, pressure table) over offsets, per unit w/U: phi/U = sum Kphi w/U and
+    DeltaCp = sum Kp w/U with Kp = -(4/pi) [(i k/b) I + F(X_b) - F(X_a)]."""
+    beta = grid.beta
+    kb = k / b_ref
+    lam, kap = kb * mach**2 / beta**2, kb * mach / beta**2
+    pot, edge = _offset_tables(grid, lam, kap)
+    f_a = np.zeros_like(edge)
+    f_a[1:] = edge[:-1]
+    kp = (-4.0 / np.pi) * (1j * kb * pot + edge - f_a)
+    return (-1.0 / np.pi) * pot, kp
+
+
+def _grid_solve(grid: MachGrid, mach: float, k: float, b_ref: float,
+                w_wing: np.ndarray) -> np.ndarray:
+    """DeltaCp at the wing-cell centres (m, n_w) for wing-cell normalwash w/U (m, n_w): the
+    diaphragm w from phi = 0 at its centres (forward substitution row by row when the grid
+    keeps same-row cells apart, dx <= beta dy; LU otherwise), then the pressure by FFT."""
+    kphi, kp = _kernels(grid, mach, k, b_ref)
+    nx, ny = grid.nx, grid.ny
+    m = w_wing.shape[0]
+    conv = _Convolver((kphi, kp), nx, ny)
+    field = np.zeros((m, nx, ny), complex)
+    field[:, grid.wing_i, grid.wing_j] = w_wing
+    spec = conv.spectrum(field)
+    if grid.dia_i.size:
+        phi_w = conv.apply(spec, 0)[:, grid.dia_i, grid.dia_j]              # (m, n_d)
+        order = np.lexsort((grid.dia_j, grid.dia_i))
+        di, dj = grid.dia_i[order], grid.dia_j[order]
+        d_i = di[:, None] - di[None, :]
+        d_j = np.abs(dj[:, None] - dj[None, :])
+        ok = d_i >= 0
+        mat = np.where(ok, kphi[np.where(ok, d_i, 0), d_j], 0.0)
+        rhs = -phi_w[:, order].T
+        if grid.dx <= grid.beta * grid.dy * (1 + 1e-12):
+            wd = sla.solve_triangular(mat, rhs, lower=True, check_finite=False)
+        else:
+            wd = sla.lu_solve(sla.lu_factor(mat, check_finite=False), rhs, check_finite=False)
+        dfield = np.zeros((m, nx, ny), complex)
+        dfield[:, di, dj] = wd.T
+        spec = spec + conv.spectrum(dfield)
+    return conv.apply(spec, 1)[:, grid.wing_i, grid.wing_j]
+
+
+def grid_pressure_operator(grid: MachGrid, mach: float, k: float, b_ref: float) -> np.ndarray:
+    """A_grid (n_w, n_w) complex: DeltaCp at the wing-cell centres per unit w/U on each wing
+    cell, the diaphragm eliminated (for tests and small grids: one solve per wing cell)."""
+    return _grid_solve(grid, mach, k, b_ref, np.eye(grid.wing_i.size, dtype=complex)).T
+
+
+def _transfer(mesh: BoxMesh, grid: MachGrid):
+    """(S, G): S (n_w, n) takes w/U at the control points to the wing cells; G (n, n_w) takes
+    cell pressures to lumped box pressures: each box's force (its cells' pressures, weighted
+    so that they carry exactly the box area) placed at the box centroid, then moved to the
+    strip's load points by the transpose of the linear interpolation, divided by the box area.
+    Image cells (symmetric case) carry no force."""
+    cen = grid.centres(grid.wing_i, grid.wing_j)
+    s = strip_interpolation(mesh, grid.wing_box, cen[:, 0], "control")
+    real = ~grid.image
+    counts = np.bincount(grid.wing_box[real], minlength=mesh.n)
+    weight = np.where(real, mesh.area[grid.wing_box] / np.maximum(counts[grid.wing_box], 1), 0.0)
+    # boxes too small to hold a cell centre: their area to the nearest real cell
+    real_idx = np.flatnonzero(real)
+    owner = grid.wing_box.copy()
+    for b in np.flatnonzero(counts == 0):
+        cb = mesh.corners[b, :, :2].mean(axis=0)
+        near = real_idx[np.argmin(np.sum((cen[real_idx] - cb) ** 2, axis=1))]
+        weight[near] += mesh.area[b]
+    agg = np.zeros((mesh.n, grid.wing_i.size))
+    agg[owner, np.arange(owner.size)] = weight
+    _, t = piston_transfer(mesh)                      # load points -> box centroids (n, n)
+    return s, (t.T @ agg) / mesh.area[:, None]
+
+
+def _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box, cells_per_wavelength, max_cells,
+             bpw_min, warn):
+    m = check_supersonic_mach(mach)
+    ks = _check_k(k)
+    b = float(b_ref)
+    if not (math.isfinite(b) and b > 0):
+        raise ValueError(f"b_ref must be a finite reference semi-chord > 0 m, got {b_ref!r}")
+    k_max = float(ks.max())
+    if warn and k_max > 0:
+        bpw = kernel_wavelength(m, k_max, b) / float(mesh.chord.max())
+        if bpw < bpw_min:
+            warnings.warn(f"mesh too coarse for the supersonic kernel at mach={m:g}, "
+                          f"k={k_max:g}: {bpw:.2g} boxes per wavelength 2 pi b (M - 1)/(k M) < "
+                          f"bpw_min={bpw_min:g}; use box chords below "
+                          f"{kernel_wavelength(m, k_max, b) / bpw_min:.3g} m", MeshRuleWarning,
+                          stacklevel=3)
+    for attempt in range(4):        # small boxes (fine meshes, slivers): refine the grid
+        try:
+            grid = mach_grid(mesh, m, k_max, b, symmetric, cells_per_box * 1.5**attempt,
+                             cells_per_wavelength, max_cells)
+            break
+        except GridTooCoarseError:
+            if attempt == 3:
+                raise
+    s, tw = _transfer(mesh, grid)
+    return m, ks, b, grid, s, tw
+
+
+def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
+                                 symmetric: bool = False, cells_per_box: float = 1.5,
+                                 cells_per_wavelength: float = 8.0, max_cells: int = 6000,
+                                 bpw_min: float = 6.0, warn: bool = True) -> np.ndarray:
+    """Supersonic pressure-per-normalwash matrices A (n_k, n, n) complex, DeltaCp = A (w/U)
+    with w/U at the DLM control points and DeltaCp lumped at the load points (module
+    docstring), the counterpart of the DLM's AIC.
+
+    Parameters
+    ----------
+    mesh : planar :class:`~asekit.aero.boxes.BoxMesh` in z = 0, supersonic trailing edges.
+    mach : M > 1 (intended range about 1.15 to 3).
+    k : reduced frequencies omega b_ref / U >= 0, scalar or 1-D.
+    b_ref : reference semi-chord (m) of k.
+    symmetric : mirror image in y = 0 (wall at the root).
+    cells_per_box, cells_per_wavelength, max_cells : grid resolution (:func:`mach_grid`); one
+        grid, built for the highest k, serves every k.
+    bpw_min : boxes of the mesh per kernel wavelength below which a MeshRuleWarning is given.
+    warn : give that warning.
+    """
+    eye = np.eye(mesh.n)
+    return supersonic_pressures(mesh, mach, k, b_ref, lambda _k: eye, symmetric, cells_per_box,
+                                cells_per_wavelength, max_cells, bpw_min, warn)
+
+
+def supersonic_pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash,
+                         symmetric: bool = False, cells_per_box: float = 1.5,
+                         cells_per_wavelength: float = 8.0, max_cells: int = 6000,
+                         bpw_min: float = 6.0, warn: bool = True) -> np.ndarray:
+    """DeltaCp (n_k, n, m) for given normalwash columns without forming the matrices (one grid
+    solve per column instead of one per box: the cheap path for a few modes).
+
+    ``normalwash`` is a callable ``k -> (n, m)`` array of w/U at the control points, or an
+    (n_k, n, m) array; the other arguments as :func:`supersonic_pressure_matrices` (the result
+    equals ``A[ik] @ normalwash[ik]`` to rounding)."""
+    m, ks, b, grid, s, tw = _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box,
+                                     cells_per_wavelength, max_cells, bpw_min, warn)
+    out = None
+    for ik, kk in enumerate(ks):
+        w = np.asarray(normalwash(float(kk)) if callable(normalwash) else normalwash[ik])
+        w = w.reshape(w.shape[0], -1)
+        if w.shape[0] != mesh.n or not np.all(np.isfinite(w)):
+            raise ValueError(f"normalwash must be finite with first dimension {mesh.n}, "
+                             f"got {w.shape}")
+        cp = tw @ _grid_solve(grid, m, float(kk), b, (s @ w).T.astype(complex)).T
+        if out is None:
+            out = np.empty((ks.size, mesh.n, w.shape[1]), complex)
+        out[ik] = cp
+    if not np.all(np.isfinite(out)):
+        raise FloatingPointError("supersonic pressures are not finite")
+    return out
+
+
+def supersonic_pressure_matrix(mesh: BoxMesh, mach: float, k: float, b_ref: float,
+                               symmetric: bool = False, **options) -> np.ndarray:
+    """A (n, n) at one reduced frequency; see :func:`supersonic_pressure_matrices`."""
+    if np.ndim(k) != 0:
+        raise ValueError(f"k must be a scalar reduced frequency, got shape {np.shape(k)}")
+    return supersonic_pressure_matrices(mesh, mach, [k], b_ref, symmetric, **options)[0]

@@ -1,0 +1,330 @@
+"""What ``python -m asekit analyse`` prints and writes: the summary (a dict that is the JSON
+output), a plain-text table of it, and an HTML report with the figures a user expects
+(planform with FE and aero meshes, mode shapes, V-g and V-f with the flutter point marked,
+root locus; with an actuator also the FWTF Bode with its margins and the step responses).
+
+Units: SI in the JSON (m/s, Hz, kg/m^3, m); the same in the table.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import math
+import textwrap
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .schema import Case
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """Everything one ``analyse`` run computed: the case, its modal model, GAF database,
+    flutter analysis, ASE result (None without an actuator) and step timings (s)."""
+
+    case: Case
+    modal: object
+    database: object
+    flutter: object
+    ase: object
+    seconds: dict
+
+
+def run_analysis(case: Case, progress: bool = False) -> Analysis:
+    """Run the whole pipeline of ``case`` and time each step."""
+    from . import pipeline as P
+    sec = {}
+    t = time.perf_counter()
+    modal = P.modal_model(case)
+    sec["modes"] = time.perf_counter() - t
+    t = time.perf_counter()
+    db = P.gaf_database(case, progress=progress)
+    sec["gaf_database"] = time.perf_counter() - t
+    t = time.perf_counter()
+    fa = P.flutter(case, db=db)
+    sec["flutter"] = time.perf_counter() - t
+    t = time.perf_counter()
+    ase = P.ase(case, db=db)
+    if ase is not None:
+        sec["ase"] = time.perf_counter() - t
+    return Analysis(case, modal, db, fa, ase, sec)
+
+
+def _f(v):
+    return None if v is None or (isinstance(v, float) and not math.isfinite(v)) else float(v)
+
+
+def summary(a: Analysis) -> dict:
+    """The JSON document of an analysis (schema in docs/case-format.md)."""
+    c = a.case
+    fl = []
+    for r in a.flutter.results:
+        f = r.flutter
+        row = {"mach": r.mach, "altitude_m": r.condition.altitude, "density": r.condition.density,
+               "speed_ms": None if f is None else float(f.speed),
+               "frequency_hz": None if f is None else float(f.frequency_hz),
+               "mode": None if f is None else int(f.mode),
+               "unstable_at_first_point": bool(r.unstable_at_start)}
+        if r.unstable_at_start:
+            row["note"] = (f"unstable at the first point of the sweep "
+                           f"({c.flight.velocities[0]:g} m/s): flutter at or below it")
+        if c.flutter_index is not None and f is not None:
+            fs = c.flutter_index
+            w_a = 2 * math.pi * fs.f_alpha
+            row["flutter_speed_index"] = float(f.speed / (fs.semichord * w_a * math.sqrt(fs.mass_ratio)))
+            row["frequency_ratio"] = float(f.frequency_hz / fs.f_alpha)
+        fl.append(row)
+    out = {"case": c.name, "reference": c.reference,
+           "modes": {"frequencies_hz": [float(v) for v in a.modal.frequencies_hz],
+                     "n_rigid": int(a.modal.n_rigid)},
+           "boxes": int(a.database.metadata.get("boxes", 0)) or None,
+           "flutter": fl,
+           "divergence": [{"mach": d["mach"], "altitude_m": d["altitude_m"],
+                           "speed_ms": _f(d["speed_ms"])} for d in a.flutter.divergence],
+           "match_points": [dict(m) for m in a.flutter.match_points],
+           "flutter_margins": [dict(m) for m in a.flutter.margins],
+           "notes": list(a.flutter.notes),
+           "seconds": {k: float(v) for k, v in a.seconds.items()}}
+    if a.ase is not None:
+        s = a.ase
+        out["ase"] = {"mach": s.mach, "altitude_m": s.altitude, "velocity_ms": s.velocity,
+                      "stable": dict(s.stable), "max_real_pole": dict(s.max_real_pole),
+                      "settling_ms": {k: _f(v * 1e3) for k, v in s.settling_s.items()},
+                      "steady_error_pct": {k: _f(v * 100) for k, v in s.steady_error.items()},
+                      "corner_overshoot_pct": {k: {c: _f(x * 100) for c, x in v.items()}
+                                               for k, v in s.corner_overshoot.items()},
+                      "fwtf_phase_margin_deg": {str(i): _f(x.phase_margin_deg)
+                                                for i, x in s.crossovers.items()}}
+    return out
+
+
+def _cell(v, fmt="{:.4g}"):
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return fmt.format(v)
+    return str(v)
+
+
+def format_summary(s: dict, width: int = 100) -> str:
+    """A plain-text summary of :func:`summary` that fits ``width`` columns."""
+    lines = textwrap.wrap(f"case {s['case']}" + (f"  ({s['reference']})" if s.get("reference")
+                                                  else ""), width, subsequent_indent="  ")
+    f = s["modes"]["frequencies_hz"]
+    r = s["modes"]["n_rigid"]
+    lines.append("modes (Hz): " + ", ".join(f"{v:.4g}" for v in f[r:])
+                 + (f"  (+ {r} rigid)" if r else ""))
+    has_fsi = any("flutter_speed_index" in row for row in s["flutter"])
+    head = f"{'Mach':>6} {'altitude m':>10} {'rho kg/m3':>10} {'U_f m/s':>9} {'f_f Hz':>8} {'mode':>4}"
+    if has_fsi:
+        head += f" {'FSI':>7} {'w_f/w_a':>7}"
+    head += "  note"
+    lines += ["", "flutter (p-k, rigid modes held)", head]
+    for row in s["flutter"]:
+        ln = (f"{row['mach']:>6.3g} {_cell(row['altitude_m'], '{:.0f}'):>10} "
+              f"{row['density']:>10.4g} {_cell(row['speed_ms'], '{:.2f}'):>9} "
+              f"{_cell(row['frequency_hz'], '{:.2f}'):>8} {_cell(row['mode']):>4}")
+        if has_fsi:
+            ln += (f" {_cell(row.get('flutter_speed_index'), '{:.4f}'):>7}"
+                   f" {_cell(row.get('frequency_ratio'), '{:.4f}'):>7}")
+        if row["unstable_at_first_point"]:
+            ln += "  UNSTABLE AT FIRST POINT"
+        elif row["speed_ms"] is None:
+            ln += "  none in sweep"
+        lines.append(ln[:width])
+    div = [d for d in s["divergence"] if d["speed_ms"] is not None]
+    if div:
+        lines += [""] + textwrap.wrap("static divergence (m/s): " + ", ".join(
+            f"M {d['mach']:g} {_cell(d['altitude_m'], '{:.0f} m')} {d['speed_ms']:.1f}"
+            for d in div), width, subsequent_indent="  ")
+    for m in s["match_points"]:
+        lines.append(f"match point at {_cell(m['altitude_m'], '{:.0f}')} m: "
+                     + (f"none ({m['no_match']})" if m["matched_mach"] is None else
+                        f"M {m['matched_mach']:.3f} ({m['matched_speed_ms']:.1f} m/s)"))
+    for m in s["flutter_margins"]:
+        lines.append(f"flutter margin at {_cell(m['altitude_m'], '{:.0f}')} m, envelope top "
+                     f"M {m['envelope_mach']:g}: "
+                     + ("-" if m["margin"] is None else f"{100 * m['margin']:+.1f} % "
+                        f"(U_f {m['flutter_speed_ms']:.1f} vs {m['envelope_speed_ms']:.1f} m/s)"))
+    if "ase" in s:
+        a = s["ase"]
+        lines += ["", f"ASE loop at M {a['mach']:g}, {a['altitude_m']:g} m:"]
+        for t in a["stable"]:
+            ov = a["corner_overshoot_pct"][t]
+            st = a["settling_ms"][t]
+            lines += textwrap.wrap(
+                f"{t}: {'stable' if a['stable'][t] else 'UNSTABLE'} (max Re pole "
+                f"{a['max_real_pole'][t]:.3g} 1/s); fin root "
+                + ("never inside the 2 % band" if st is None else f"settles in {st:.1f} ms")
+                + f", final error {_cell(a['steady_error_pct'][t], '{:.2f}')} %; corner "
+                f"overshoot {min(ov.values()):.0f}-{max(ov.values()):.0f} %", width,
+                initial_indent="  ", subsequent_indent="    ")
+    for n in s["notes"]:
+        lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
+    lines.append("")
+    lines.append("times (s): " + ", ".join(f"{k} {v:.2f}" for k, v in s["seconds"].items()))
+    out = []
+    for ln in lines:
+        out += textwrap.wrap(ln, width, subsequent_indent="    ") if len(ln) > width else [ln]
+    return "\n".join(out)
+
+
+# ---------------------------------------------------------------------------------------------
+# figures and the HTML report
+# ---------------------------------------------------------------------------------------------
+def fig_planform(a: Analysis):
+    from ..plotting import new_figure
+    from . import pipeline as P
+    fig, ax = new_figure(f"{a.case.name}: planform, FE mesh (black) and aerodynamic boxes (blue)")
+    mesh = P.structural_mesh(a.case)
+    for e in mesh.elements:
+        xy = mesh.nodes[np.r_[e, e[0]]]
+        ax.plot(xy[:, 1], xy[:, 0], "k-", lw=0.6)
+    for c in P.box_mesh(a.case).corners:
+        xy = c[[0, 1, 2, 3, 0]]
+        ax.plot(xy[:, 1], xy[:, 0], "C0-", lw=0.4, alpha=0.7)
+    s = a.case.support
+    if s.kind == "shaft":
+        ax.plot(s.axis_point[1], s.axis_point[0], "rs", label="pitch axis")
+        ax.legend()
+    ax.set_xlabel("y (m, span)")
+    ax.set_ylabel("x (m, downstream)")
+    ax.invert_yaxis()
+    ax.set_aspect("equal")
+    return fig
+
+
+def fig_modes(a: Analysis, n: int = 4):
+    from ..plotting import new_figure
+    m = a.modal
+    idx = list(range(m.n_rigid, min(len(m.frequencies_hz), m.n_rigid + n)))
+    fig, axes = new_figure(f"{a.case.name}: mode shapes (w, contours)", ncols=len(idx),
+                           figsize=(3.2 * len(idx), 3.6))
+    axes = np.atleast_1d(axes)
+    tri = np.concatenate([m.elements[:, [0, 1, 2]], m.elements[:, [0, 2, 3]]])
+    for ax, j in zip(axes, idx):
+        w = m.shapes[:, 0, j]
+        ax.tricontourf(m.nodes[:, 1], m.nodes[:, 0], tri, w / np.abs(w).max(), levels=15,
+                       cmap="RdBu_r")
+        ax.set_title(f"mode {j - m.n_rigid + 1}: {m.frequencies_hz[j]:.4g} Hz")
+        ax.set_xlabel("y (m)")
+        ax.set_ylabel("x (m)")
+        ax.invert_yaxis()
+        ax.set_aspect("equal")
+    return fig
+
+
+def fig_vg(a: Analysis, result):
+    from ..plotting import new_figure
+    pk = result.pk
+    alt = result.condition.altitude
+    where = f"{alt:g} m" if alt is not None else f"rho {result.condition.density:.4g} kg/m^3"
+    fig, (ax1, ax2) = new_figure(f"{a.case.name}: V-g and V-f, M {result.mach:g}, {where}",
+                                 nrows=2, figsize=(6.4, 6.4), sharex=True)
+    for j in range(pk.p.shape[1]):
+        ax1.plot(pk.velocities, pk.damping_g[:, j], label=f"mode {j + 1}")
+        ax2.plot(pk.velocities, pk.frequency_hz[:, j])
+    f = result.flutter
+    if f is not None:
+        ax1.plot(f.speed, 0.0, "r*", ms=12, label=f"flutter {f.speed:.1f} m/s")
+        ax2.plot(f.speed, f.frequency_hz, "r*", ms=12)
+    ax1.axhline(0.0, color="k", lw=0.8)
+    ax1.set_ylabel("damping g = 2 Re p / |Im p| (-)")
+    ax1.set_ylim(-0.5, 0.3)
+    ax1.legend(ncol=2)
+    ax2.set_xlabel("airspeed U (m/s)")
+    ax2.set_ylabel("frequency (Hz)")
+    return fig
+
+
+def fig_root_locus(a: Analysis, result):
+    from ..plotting import new_figure
+    pk = result.pk
+    fig, ax = new_figure(f"{a.case.name}: root locus of the p-k roots, M {result.mach:g}")
+    for j in range(pk.p.shape[1]):
+        ax.plot(pk.p[:, j].real, pk.p[:, j].imag / (2 * math.pi), ".-", ms=2)
+    f = result.flutter
+    if f is not None:
+        ax.plot(0.0, f.frequency_hz, "r*", ms=12, label=f"flutter {f.speed:.1f} m/s")
+        ax.legend()
+    ax.axvline(0.0, color="k", lw=0.8)
+    ax.set_xlabel("Re p (1/s)")
+    ax.set_ylabel("Im p / 2 pi (Hz)")
+    return fig
+
+
+def fig_ase_bode(a: Analysis):
+    from .. import ase as ase_mod
+    from ..plotting import new_figure
+    s = a.ase
+    f = np.logspace(0, 3.5, 800)
+    fig, (ax1, ax2) = new_figure(f"{a.case.name}: forward paths FWTF 1-3, M {s.mach:g}",
+                                 nrows=2, figsize=(6.4, 6.4), sharex=True)
+    for i in (1, 2, 3):
+        h = ase_mod.frequency_response(ase_mod.forward_path(s.model, s.controller, i), f)
+        ax1.semilogx(f, 20 * np.log10(np.abs(h)), label=f"FWTF {i}")
+        ax2.semilogx(f, np.degrees(np.unwrap(np.angle(h))))
+        c = s.crossovers[i]
+        if c.gain_crossovers_hz.size:
+            ax1.plot(c.gain_crossovers_hz[0], 0.0, "k|", ms=12)
+    ax1.axhline(0.0, color="k", lw=0.8)
+    ax2.axhline(-180.0, color="k", lw=0.8)
+    ax1.set_ylabel("gain (dB)")
+    ax2.set_ylabel("phase (deg)")
+    ax2.set_xlabel("frequency (Hz)")
+    ax1.legend()
+    return fig
+
+
+def fig_ase_steps(a: Analysis):
+    from ..plotting import new_figure
+    s = a.ase
+    fig, ax = new_figure(f"{a.case.name}: power-limited step, fin-root pitch")
+    for t, sim in s.simulations.items():
+        ax.plot(sim.t * 1e3, np.degrees(sim.fin_root), label=t)
+    ax.axhline(a.case.actuator.step_deg, color="k", lw=0.8, ls="--", label="command")
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("fin-root pitch (deg)")
+    ax.set_ylim(-0.5 * a.case.actuator.step_deg, 2.5 * a.case.actuator.step_deg)
+    ax.legend()
+    return fig
+
+
+def figures(a: Analysis) -> dict:
+    """{name: figure} of the report (V-g / V-f and root locus for the first Mach at each flight
+    condition, plus the ASE figures with an actuator)."""
+    figs = {"planform": fig_planform(a), "modes": fig_modes(a)}
+    first_mach = a.case.aero.machs[-1]
+    for i, r in enumerate(x for x in a.flutter.results if x.mach == first_mach):
+        figs[f"vg_{i}"] = fig_vg(a, r)
+        if i == 0:
+            figs["root_locus"] = fig_root_locus(a, r)
+    if a.ase is not None:
+        figs["ase_bode"] = fig_ase_bode(a)
+        figs["ase_steps"] = fig_ase_steps(a)
+    return figs
+
+
+def write_report(a: Analysis, directory) -> Path:
+    """Write ``directory/index.html`` (summary table and figures) with the PNGs beside it and
+    ``summary.json``; returns the index path."""
+    from ..plotting import save_figure
+    d = Path(directory)
+    d.mkdir(parents=True, exist_ok=True)
+    s = summary(a)
+    (d / "summary.json").write_text(json.dumps(s, indent=2))
+    names = [save_figure(f, d, n).name for n, f in figures(a).items()]
+    body = "\n".join(f'<figure><img src="{html.escape(n)}" alt="{html.escape(n)}"></figure>'
+                     for n in names)
+    page = (f"<!doctype html><html><head><meta charset='utf-8'><title>asekit: "
+            f"{html.escape(s['case'])}</title><style>body{{font-family:sans-serif;max-width:70em;"
+            f"margin:auto}} img{{max-width:100%}} pre{{background:#f4f4f4;padding:1em}}</style>"
+            f"</head><body><h1>{html.escape(s['case'])}</h1><pre>"
+            f"{html.escape(format_summary(s, width=120))}</pre>{body}</body></html>")
+    index = d / "index.html"
+    index.write_text(page)
+    return index

@@ -1,0 +1,654 @@
+"""The case file: a declarative model of one flat all-movable surface or plate wing (TOML).
+
+A case is a frozen :class:`Case` of small frozen specs. :func:`load_case` reads a TOML file (or
+:func:`case_from_dict` a dict) and checks every key: unknown keys are errors, and every error
+names the key path and the valid range, e.g. ``panel[1].tip_chord must be > 0 m, got -0.1``.
+The format is documented in ``docs/case-format.md``; ``data/cases/`` holds worked examples.
+
+SI units throughout the file, except keys whose name says otherwise (``fibre_angle_deg``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import tomllib
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
+
+
+class CaseError(ValueError):
+    """A case file or case definition that cannot be analysed; the message names the key."""
+
+
+# ---------------------------------------------------------------------------------------------
+# the specs
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PanelSpec:
+    """One flat trapezoidal panel: its planform (m) and its structural mesh (elements chordwise
+    ``n_chord`` and spanwise ``n_span``). Panels are joined spanwise in order."""
+
+    planform: Planform
+    n_chord: int
+    n_span: int
+
+
+@dataclass(frozen=True)
+class SupportSpec:
+    """How the surface is held.
+
+    kind : ``"clamped_root"`` (every DOF of the root-chord nodes fixed), ``"edges"`` (``edges``:
+        the condition -- clamped, simply_supported, sliding or free -- of the root, tip, leading
+        and trailing edges, e.g. for panel flutter) or ``"shaft"`` (the
+        thesis's pitch shaft: ``axis_point`` (x, y) m on the root chord, ``torsional_stiffness``
+        N m/rad of the actuator-fin connection, optional ``bending_stiffness`` N m/rad about the
+        chordwise axis, ``model`` "FN2" (fictitious mass: rigid pitch mode + elastic modes) or
+        "FN1" (spring to ground), ``radius`` None for the single-node shaft or the radius (m) of
+        a rigid shaft region, ``fictitious_inertia_factor``).
+    """
+
+    kind: str = "clamped_root"
+    axis_point: tuple[float, float] | None = None
+    torsional_stiffness: float | None = None
+    bending_stiffness: float | None = None
+    model: str = "FN2"
+    radius: float | None = None
+    fictitious_inertia_factor: float = 1.0e6
+    edges: tuple[tuple[str, str], ...] | None = None
+
+
+@dataclass(frozen=True)
+class PointMass:
+    """A concentrated mass at ``position`` (x, y) m: ``mass`` kg, ``inertia`` (I_xx, I_yy) kg m^2."""
+
+    position: tuple[float, float]
+    mass: float
+    inertia: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class DampingSpec:
+    """Modal damping of the elastic modes: ``modal_damping_ratio`` (one value or one per
+    elastic mode) or ``structural_g``; both None = undamped (the thesis)."""
+
+    modal_damping_ratio: float | tuple[float, ...] | None = None
+    structural_g: float | tuple[float, ...] | None = None
+
+
+@dataclass(frozen=True)
+class ModesSpec:
+    """Elastic modes kept: the first ``count`` with out-of-plane motion, or all below ``f_max``
+    (Hz); ``keep_rigid`` keeps the rigid pitch mode of an FN2 shaft (needed for the ASE loop)."""
+
+    count: int | None = None
+    f_max: float = 1000.0
+    keep_rigid: bool = True
+
+
+@dataclass(frozen=True)
+class AeroSpec:
+    """Unsteady aerodynamics.
+
+    machs : GAF database Mach numbers; reduced_frequencies : k = omega b / U (None: automatic,
+    15 values from 0.001 to 2 pi f_max b / u_min); reference_semichord b (m); f_max (Hz) and
+    u_min (m/s) for the automatic k and the mesh rules (15 boxes per wavelength, 4 boxes per
+    chord, aspect ratio < 3); boxes : per panel (n_chord, n_span), or None for automatic from
+    the mesh rules; kernel "quartic" | "parabolic"; symmetry "none" | "wall" (a reflection plane
+    at the root); method "dlm" (doublet lattice, M < 1).
+    """
+
+    machs: tuple[float, ...]
+    reference_semichord: float
+    reduced_frequencies: tuple[float, ...] | None = None
+    f_max: float = 1000.0
+    u_min: float = 100.0
+    boxes: tuple[tuple[int, int], ...] | None = None
+    kernel: str = "quartic"
+    symmetry: str = "none"
+    method: str = "dlm"
+
+
+@dataclass(frozen=True)
+class FlightSpec:
+    """Flight conditions: ``altitudes`` (m, 1976 standard atmosphere) or explicit
+    ``densities`` (kg/m^3; then ``speeds_of_sound`` m/s may be given for match points);
+    the p-k velocity sweep ``velocities`` (m/s, ascending); the envelope ``envelope_mach``
+    (min, max) and ``envelope_altitude`` (min, max) m for match points and flutter margins."""
+
+    velocities: tuple[float, ...]
+    altitudes: tuple[float, ...] | None = None
+    densities: tuple[float, ...] | None = None
+    speeds_of_sound: tuple[float, ...] | None = None
+    envelope_mach: tuple[float, float] | None = None
+    envelope_altitude: tuple[float, float] | None = None
+
+
+#: The actuator keys of a case file, each None (the default of :class:`asekit.servo.DCMotor`,
+#: :class:`asekit.servo.Transmission`, the thesis's System 3 and power limits) unless given.
+MOTOR_KEYS = ("resistance", "inductance", "torque_constant", "back_emf_constant",
+              "rotor_inertia", "viscous_damping")
+TRANSMISSION_KEYS = {"ratio": "ratio", "efficiency": "efficiency",
+                     "transmission_inertia": "inertia"}
+
+
+@dataclass(frozen=True)
+class ActuatorSpec:
+    """The servo-actuator (thesis Ch. 4-5): DC motor, transmission, PD controller
+    K_c (K_P + K_D s), power limits, and the flight condition of the ASE analysis. A value left
+    None takes asekit's default: the Faulhaber 2642 drive of :class:`asekit.servo.DCMotor` and
+    :class:`asekit.servo.Transmission` (thesis Table 12), System 3 (Table 17), 24 V / 10 A
+    (Table 16)."""
+
+    resistance: float | None = None
+    inductance: float | None = None
+    torque_constant: float | None = None
+    back_emf_constant: float | None = None
+    rotor_inertia: float | None = None
+    viscous_damping: float | None = None
+    ratio: float | None = None
+    efficiency: float | None = None
+    transmission_inertia: float | None = None
+    k_c: float | None = None
+    k_p: float | None = None
+    k_d: float | None = None
+    supply_voltage: float | None = None
+    current_limit: float | None = None
+    mach: float = 0.5
+    altitude: float = 0.0
+    step_deg: float = 1.0
+
+
+@dataclass(frozen=True)
+class FlutterIndexSpec:
+    """Normalisation of the flutter speed as a flutter speed index
+    FSI = U_f / (b_s omega_alpha sqrt(mu)) (Yates 1987): ``semichord`` b_s (m), ``f_alpha``
+    omega_alpha / 2 pi (Hz), ``mass_ratio`` mu; the frequency ratio is omega_f / omega_alpha."""
+
+    semichord: float
+    f_alpha: float
+    mass_ratio: float
+
+
+@dataclass(frozen=True)
+class Case:
+    """A complete case: what the surface is, how it is held and analysed."""
+
+    name: str
+    panels: tuple[PanelSpec, ...]
+    thickness: Thickness
+    material: Material | OrthotropicMaterial
+    support: SupportSpec
+    aero: AeroSpec
+    flight: FlightSpec
+    modes: ModesSpec = ModesSpec()
+    damping: DampingSpec = DampingSpec()
+    point_masses: tuple[PointMass, ...] = ()
+    actuator: ActuatorSpec | None = None
+    flutter_index: FlutterIndexSpec | None = None
+    reference: str = ""
+    source: str = field(default="", compare=False)
+
+    @classmethod
+    def from_toml(cls, path) -> "Case":
+        """Read and check a case file (see :func:`load_case`)."""
+        return load_case(path)
+
+    @property
+    def span(self) -> float:
+        return self.panels[-1].planform.tip_le[1] - self.panels[0].planform.root_le[1]
+
+    def fingerprint(self) -> str:
+        """SHA-256 of everything that defines the case (not its name or file location)."""
+        d = asdict(self)
+        for k in ("name", "reference", "source"):
+            d.pop(k)
+        return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
+
+    # the pipeline (asekit.case.pipeline) -- thin methods so a case reads naturally
+    def modal_model(self):
+        from .pipeline import modal_model
+        return modal_model(self)
+
+    def gaf_database(self, progress: bool = True, cache: bool = True):
+        from .pipeline import gaf_database
+        return gaf_database(self, progress=progress, cache=cache)
+
+    def flutter(self, progress: bool = False):
+        from .pipeline import flutter
+        return flutter(self, progress=progress)
+
+    def ase(self):
+        from .pipeline import ase
+        return ase(self)
+
+
+# ---------------------------------------------------------------------------------------------
+# reading and checking
+# ---------------------------------------------------------------------------------------------
+class _Table:
+    """A TOML table being read: typed getters that name the key path, then :meth:`done` refuses
+    the keys nobody asked for."""
+
+    def __init__(self, data, path: str):
+        if not isinstance(data, dict):
+            raise CaseError(f"{path} must be a table, got {type(data).__name__}")
+        self.d = data
+        self.path = path
+        self.used = set()
+
+    def key(self, k):
+        return f"{self.path}.{k}" if self.path else k
+
+    def has(self, k) -> bool:
+        return k in self.d
+
+    def raw(self, k, default=None, required=False):
+        self.used.add(k)
+        if k not in self.d:
+            if required:
+                raise CaseError(f"{self.key(k)} is missing")
+            return default
+        return self.d[k]
+
+    def number(self, k, default=None, required=False, low=None, high=None, low_open=True,
+               high_open=False, unit=""):
+        v = self.raw(k, default, required)
+        if v is None:
+            return None
+        return _number(self.key(k), v, low, high, low_open, high_open, unit)
+
+    def integer(self, k, default=None, required=False, low=1, high=100000):
+        v = self.raw(k, default, required)
+        if v is None:
+            return None
+        if isinstance(v, bool) or not isinstance(v, int):
+            raise CaseError(f"{self.key(k)} must be an integer in [{low}, {high}], got {v!r}")
+        if not low <= v <= high:
+            raise CaseError(f"{self.key(k)} must be an integer in [{low}, {high}], got {v}")
+        return v
+
+    def string(self, k, choices, default=None, required=False):
+        v = self.raw(k, default, required)
+        if v is None:
+            return None
+        if v not in choices:
+            raise CaseError(f"{self.key(k)} must be one of {', '.join(map(repr, choices))}, "
+                            f"got {v!r}")
+        return v
+
+    def text(self, k, default=""):
+        v = self.raw(k, default)
+        if not isinstance(v, str):
+            raise CaseError(f"{self.key(k)} must be a string, got {v!r}")
+        return v
+
+    def boolean(self, k, default):
+        v = self.raw(k, default)
+        if not isinstance(v, bool):
+            raise CaseError(f"{self.key(k)} must be true or false, got {v!r}")
+        return v
+
+    def numbers(self, k, default=None, required=False, length=None, min_length=1, low=None,
+                high=None, low_open=True, high_open=False, unit="", ascending=False):
+        v = self.raw(k, default, required)
+        if v is None:
+            return None
+        if isinstance(v, (int, float)) and not isinstance(v, bool) and length is None:
+            v = [v]
+        if not isinstance(v, (list, tuple)):
+            raise CaseError(f"{self.key(k)} must be a list of numbers, got {v!r}")
+        if length is not None and len(v) != length:
+            raise CaseError(f"{self.key(k)} must hold {length} numbers, got {len(v)}")
+        if len(v) < min_length:
+            raise CaseError(f"{self.key(k)} must hold at least {min_length} number(s), got {len(v)}")
+        out = tuple(_number(f"{self.key(k)}[{i}]", x, low, high, low_open, high_open, unit)
+                    for i, x in enumerate(v))
+        if ascending and any(b <= a for a, b in zip(out, out[1:])):
+            raise CaseError(f"{self.key(k)} must be strictly ascending, got {list(out)}")
+        return out
+
+    def table(self, k, required=False):
+        v = self.raw(k, None, required)
+        return None if v is None else _Table(v, self.key(k))
+
+    def done(self):
+        extra = sorted(set(self.d) - self.used)
+        if extra:
+            raise CaseError(f"{self.key(extra[0])} is not a known key"
+                            + (f" (also {', '.join(extra[1:])})" if len(extra) > 1 else ""))
+
+
+def _number(path, v, low, high, low_open, high_open, unit):
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise CaseError(f"{path} must be a finite number{_range(low, high, low_open, high_open, unit)}"
+                        f", got {v!r}")
+    u = f" {unit}" if unit else ""
+    if low is not None and (v <= low if low_open else v < low):
+        raise CaseError(f"{path} must be {'>' if low_open else '>='} {low:g}{u}, got {v:g}")
+    if high is not None and (v >= high if high_open else v > high):
+        raise CaseError(f"{path} must be {'<' if high_open else '<='} {high:g}{u}, got {v:g}")
+    return float(v)
+
+
+def _range(low, high, low_open, high_open, unit):
+    parts = []
+    if low is not None:
+        parts.append(f"{'>' if low_open else '>='} {low:g}")
+    if high is not None:
+        parts.append(f"{'<' if high_open else '<='} {high:g}")
+    return (" " + " and ".join(parts) + (f" {unit}" if unit else "")) if parts else ""
+
+
+def _wrap(path, fn, *args, **kw):
+    """Call a physics constructor and re-raise its ValueError under the case key path."""
+    try:
+        return fn(*args, **kw)
+    except CaseError:
+        raise
+    except ValueError as exc:
+        raise CaseError(f"{path}: {exc}") from None
+
+
+def _panels(raw) -> tuple[PanelSpec, ...]:
+    if raw is None:
+        raise CaseError("panel is missing: give at least one [[panel]] table")
+    if not isinstance(raw, list) or not raw:
+        raise CaseError("panel must be an array of tables ([[panel]]) with at least one panel")
+    panels = []
+    for i, d in enumerate(raw):
+        t = _Table(d, f"panel[{i}]")
+        rle = t.numbers("root_leading_edge", required=True, length=2, unit="m")
+        tle = t.numbers("tip_leading_edge", required=True, length=2, unit="m")
+        rc = t.number("root_chord", required=True, low=0.0, high=1e4, unit="m")
+        tc = t.number("tip_chord", required=True, low=0.0, high=1e4, unit="m")
+        nc = t.integer("n_chord", required=True, high=2000)
+        ns = t.integer("n_span", required=True, high=2000)
+        t.done()
+        if tle[1] <= rle[1]:
+            raise CaseError(f"panel[{i}].tip_leading_edge y ({tle[1]:g} m) must exceed "
+                            f"root_leading_edge y ({rle[1]:g} m): the planform is crossed or "
+                            f"has zero span")
+        if i:
+            prev = panels[-1].planform
+            if not (np.allclose(prev.tip_le, rle, atol=1e-9) and math.isclose(prev.tip_chord, rc,
+                                                                              rel_tol=1e-9)):
+                raise CaseError(f"panel[{i}] root (leading edge {list(rle)}, chord {rc:g} m) must "
+                                f"coincide with panel[{i - 1}] tip (leading edge "
+                                f"{list(prev.tip_le)}, chord {prev.tip_chord:g} m)")
+            if nc != panels[0].n_chord:
+                raise CaseError(f"panel[{i}].n_chord must equal panel[0].n_chord = "
+                                f"{panels[0].n_chord} (a conforming structural mesh), got {nc}")
+        panels.append(PanelSpec(_wrap(f"panel[{i}]", Planform, rle, rc, tle, tc), nc, ns))
+    return tuple(panels)
+
+
+def _thickness(t: _Table) -> Thickness:
+    root = t.number("root", required=True, low=0.0, high=100.0, unit="m")
+    tip = t.number("tip", required=True, low=0.0, high=100.0, unit="m")
+    prof = t.raw("profile", "flat")
+    t.done()
+    return Thickness(root, tip, _wrap("thickness.profile", chordwise_profile, prof))
+
+
+def _material(t: _Table):
+    kind = t.string("kind", ("isotropic", "orthotropic"), default="isotropic")
+    name = t.text("name", "")
+    big = 1e15
+    if kind == "isotropic":
+        e = t.number("youngs_modulus", required=True, low=0.0, high=big, unit="Pa")
+        nu = t.number("poisson_ratio", required=True, low=-1.0, high=0.5, high_open=True)
+        rho = t.number("density", required=True, low=0.0, high=1e6, unit="kg/m^3")
+        t.done()
+        return _wrap("material", Material, e, nu, rho, name)
+    vals = {k: t.number(k, required=True, low=0.0, high=big, unit="Pa") for k in ("e1", "e2", "g12")}
+    nu12 = t.number("nu12", required=True, low=-10.0, high=10.0)
+    rho = t.number("density", required=True, low=0.0, high=1e6, unit="kg/m^3")
+    g13 = t.number("g13", low=0.0, high=big, unit="Pa")
+    g23 = t.number("g23", low=0.0, high=big, unit="Pa")
+    angle = t.number("fibre_angle_deg", default=0.0, low=-360.0, high=360.0, low_open=False,
+                     unit="deg")
+    t.done()
+    return _wrap("material", OrthotropicMaterial, vals["e1"], vals["e2"], vals["g12"], nu12, rho,
+                 g13, g23, math.radians(angle), name)
+
+
+def _support(t: _Table, panels) -> SupportSpec:
+    kind = t.string("kind", ("clamped_root", "shaft", "edges"), required=True)
+    if kind == "clamped_root":
+        t.done()
+        return SupportSpec(kind="clamped_root")
+    if kind == "edges":
+        from ..structure.supports import EDGE_TYPES, PLANFORM_EDGES
+        defaults = {"root": "clamped", "tip": "free", "leading_edge": "free",
+                    "trailing_edge": "free"}
+        edges = tuple((e, t.string(e, EDGE_TYPES, default=defaults[e])) for e in PLANFORM_EDGES)
+        t.done()
+        if all(k == "free" for _, k in edges):
+            raise CaseError("support: all four edges free leaves rigid-body modes; hold at "
+                            "least one edge (support.root = \"clamped\", ...)")
+        return SupportSpec(kind="edges", edges=edges)
+    axis = t.numbers("axis_point", required=True, length=2, unit="m")
+    k = t.number("torsional_stiffness", required=True, low=0.0, high=1e12, unit="N m/rad")
+    kb = t.number("bending_stiffness", low=0.0, high=1e12, unit="N m/rad")
+    model = t.string("model", ("FN1", "FN2"), default="FN2")
+    region = t.raw("region", "single_node")
+    fif = t.number("fictitious_inertia_factor", default=1.0e6, low=1.0, high=1e12)
+    t.done()
+    if region == "single_node":
+        radius = None
+    elif isinstance(region, (int, float)) and not isinstance(region, bool):
+        radius = _number("support.region", region, 0.0, 1e3, True, False, "m")
+    else:
+        raise CaseError(f"support.region must be \"single_node\" or a shaft radius > 0 m, "
+                        f"got {region!r}")
+    root = panels[0].planform
+    if abs(axis[1] - root.root_le[1]) > 1e-9 * max(root.span, 1.0) or not (
+            root.root_le[0] <= axis[0] <= root.root_le[0] + root.root_chord):
+        raise CaseError(f"support.axis_point {list(axis)} must lie on the root chord "
+                        f"(y = {root.root_le[1]:g} m, x in [{root.root_le[0]:g}, "
+                        f"{root.root_le[0] + root.root_chord:g}] m)")
+    return SupportSpec("shaft", axis, k, kb, model, radius, fif)
+
+
+def _point_masses(raw) -> tuple[PointMass, ...]:
+    if raw is None:
+        return ()
+    if not isinstance(raw, list):
+        raise CaseError("point_mass must be an array of tables ([[point_mass]])")
+    out = []
+    for i, d in enumerate(raw):
+        t = _Table(d, f"point_mass[{i}]")
+        pos = t.numbers("position", required=True, length=2, unit="m")
+        m = t.number("mass", required=True, low=0.0, high=1e9, low_open=False, unit="kg")
+        inertia = t.numbers("inertia", default=[0.0, 0.0], length=2, low=0.0, low_open=False,
+                            high=1e9, unit="kg m^2")
+        t.done()
+        out.append(PointMass(pos, m, inertia))
+    return tuple(out)
+
+
+def _damping(t: _Table | None) -> DampingSpec:
+    if t is None:
+        return DampingSpec()
+    z = t.numbers("modal_damping_ratio", low=0.0, low_open=False, high=1.0, high_open=True)
+    g = t.numbers("structural_g", low=0.0, low_open=False, high=2.0, high_open=True)
+    t.done()
+    if z is not None and g is not None:
+        raise CaseError("damping: give modal_damping_ratio or structural_g, not both")
+    one = (lambda v: None if v is None else (v[0] if len(v) == 1 else v))
+    return DampingSpec(one(z), one(g))
+
+
+def _modes(t: _Table | None, support: SupportSpec) -> ModesSpec:
+    if t is None:
+        return ModesSpec()
+    count = t.integer("count", high=500)
+    f_max = t.number("f_max", default=1000.0, low=0.0, high=1e7, unit="Hz")
+    keep = t.boolean("keep_rigid", True)
+    t.done()
+    if keep and not (support.kind == "shaft" and support.model == "FN2"):
+        keep = False         # only the FN2 shaft has a rigid pitch mode
+    return ModesSpec(count, f_max, keep)
+
+
+def _aero(t: _Table, panels) -> AeroSpec:
+    method = t.string("method", ("dlm", "auto", "supersonic", "piston"), default="dlm")
+    machs = t.numbers("machs", required=True, low=0.0, low_open=False,
+                      high=1.0 if method == "dlm" else 10.0, high_open=True, ascending=True)
+    from ..aero.methods import resolve_method
+    for i, m in enumerate(machs):
+        try:
+            resolve_method(method, m)
+        except ValueError as exc:
+            raise CaseError(f"aero.machs[{i}] = {m:g} with aero.method = {method!r}: "
+                            f"{exc}") from None
+    b = t.number("reference_semichord", required=True, low=0.0, high=1e3, unit="m")
+    ks = t.raw("reduced_frequencies", "auto")
+    if ks == "auto":
+        ks = None
+    else:
+        t.used.discard("reduced_frequencies")
+        ks = t.numbers("reduced_frequencies", low=0.0, low_open=False, high=100.0,
+                       ascending=True, min_length=2)
+    f_max = t.number("f_max", default=1000.0, low=0.0, high=1e7, unit="Hz")
+    u_min = t.number("u_min", default=100.0, low=0.0, high=1e5, unit="m/s")
+    kernel = t.string("kernel", ("quartic", "parabolic"), default="quartic")
+    symmetry = t.string("symmetry", ("none", "wall"), default="none")
+    boxes = t.raw("boxes", "auto")
+    t.done()
+    if boxes == "auto":
+        boxes = None
+    else:
+        if not isinstance(boxes, list) or len(boxes) != len(panels):
+            raise CaseError(f"aero.boxes must be \"auto\" or one table {{n_chord, n_span}} per "
+                            f"panel ({len(panels)}), got {boxes!r}")
+        out = []
+        for i, d in enumerate(boxes):
+            bt = _Table(d, f"aero.boxes[{i}]")
+            out.append((bt.integer("n_chord", required=True, high=1000),
+                        bt.integer("n_span", required=True, high=1000)))
+            bt.done()
+        boxes = tuple(out)
+    if symmetry == "wall" and abs(panels[0].planform.root_le[1]) > 1e-12:
+        raise CaseError(f"aero.symmetry = \"wall\" puts the reflection plane at y = 0, but the "
+                        f"root is at y = {panels[0].planform.root_le[1]:g} m")
+    return AeroSpec(machs, b, ks, f_max, u_min, boxes, kernel, symmetry, method)
+
+
+def _flight(t: _Table) -> FlightSpec:
+    alts = t.numbers("altitudes", low=-1000.0, high=80000.0, low_open=False, unit="m")
+    dens = t.numbers("densities", low=0.0, high=100.0, unit="kg/m^3")
+    sos = t.numbers("speeds_of_sound", low=0.0, high=1e4, unit="m/s")
+    vt = t.table("velocities", required=True)
+    v0 = vt.number("min", required=True, low=0.0, high=1e5, unit="m/s")
+    v1 = vt.number("max", required=True, low=0.0, high=1e5, unit="m/s")
+    dv = vt.number("step", required=True, low=0.0, high=1e5, unit="m/s")
+    vt.done()
+    env = t.table("envelope")
+    em = ea = None
+    if env is not None:
+        em = env.numbers("mach", length=2, low=0.0, low_open=False, high=10.0)
+        ea = env.numbers("altitude", length=2, low=-1000.0, low_open=False, high=80000.0, unit="m")
+        env.done()
+        for nm, r in (("mach", em), ("altitude", ea)):
+            if r is not None and r[1] < r[0]:
+                raise CaseError(f"flight.envelope.{nm} must be [min, max] with min <= max, "
+                                f"got {list(r)}")
+    t.done()
+    if (alts is None) == (dens is None):
+        raise CaseError("flight: give exactly one of altitudes (m, standard atmosphere) or "
+                        "densities (kg/m^3)")
+    if sos is not None and (dens is None or len(sos) != len(dens)):
+        raise CaseError("flight.speeds_of_sound needs densities and one value per density")
+    if v1 <= v0:
+        raise CaseError(f"flight.velocities.max must be > min ({v0:g} m/s), got {v1:g}")
+    n = int(math.floor((v1 - v0) / dv + 1e-9)) + 1
+    if n < 2 or n > 20000:
+        raise CaseError(f"flight.velocities must give 2 to 20000 points, got {n} "
+                        f"(min {v0:g}, max {v1:g}, step {dv:g} m/s)")
+    return FlightSpec(tuple(float(v) for v in v0 + dv * np.arange(n)), alts, dens, sos, em, ea)
+
+
+def _actuator(t: _Table | None) -> ActuatorSpec | None:
+    if t is None:
+        return None
+    vals = {}
+    for name in MOTOR_KEYS + tuple(TRANSMISSION_KEYS) + ("supply_voltage", "current_limit"):
+        zero_ok = name in ("viscous_damping", "transmission_inertia")
+        vals[name] = t.number(name, low=0.0, low_open=not zero_ok,
+                              high=1.0 if name == "efficiency" else 1e6)
+    vals["step_deg"] = t.number("step_deg", default=1.0, low=0.0, high=15.0,
+                                unit="deg (the fin's travel)")
+    ctl = t.table("controller")
+    if ctl is not None:
+        for name in ("k_c", "k_p", "k_d"):
+            vals[name] = ctl.number(name, low=-1e9, high=1e9)
+        ctl.done()
+    cond = t.table("condition")
+    if cond is not None:
+        vals["mach"] = cond.number("mach", default=0.5, low=0.0, low_open=False, high=1.0,
+                                   high_open=True)
+        vals["altitude"] = cond.number("altitude", default=0.0, low=-1000.0, low_open=False,
+                                       high=80000.0, unit="m")
+        cond.done()
+    t.done()
+    return ActuatorSpec(**vals)
+
+
+def case_from_dict(d: dict, source: str = "") -> Case:
+    """Build and check a :class:`Case` from the parsed TOML dictionary ``d``."""
+    top = _Table(d, "")
+    info = top.table("case", required=True)
+    name = info.text("name", "")
+    if not name:
+        raise CaseError("case.name is missing or empty")
+    reference = info.text("reference", "")
+    info.done()
+    panels = _panels(top.raw("panel", None, required=False))
+    thickness = _thickness(top.table("thickness", required=True))
+    material = _material(top.table("material", required=True))
+    support = _support(top.table("support", required=True), panels)
+    masses = _point_masses(top.raw("point_mass"))
+    damping = _damping(top.table("damping"))
+    modes = _modes(top.table("modes"), support)
+    aero = _aero(top.table("aero", required=True), panels)
+    flight = _flight(top.table("flight", required=True))
+    actuator = _actuator(top.table("actuator"))
+    fsi = top.table("flutter_speed_index")
+    if fsi is not None:
+        fsi_spec = FlutterIndexSpec(fsi.number("semichord", required=True, low=0.0, unit="m"),
+                                    fsi.number("f_alpha", required=True, low=0.0, unit="Hz"),
+                                    fsi.number("mass_ratio", required=True, low=0.0))
+        fsi.done()
+    else:
+        fsi_spec = None
+    top.done()
+    if actuator is not None and not (support.kind == "shaft" and support.model == "FN2"
+                                     and modes.keep_rigid):
+        raise CaseError("actuator needs support.kind = \"shaft\" with model \"FN2\" and "
+                        "modes.keep_rigid = true (the actuator drives the rigid pitch mode)")
+    if actuator is not None and not aero.machs[0] <= actuator.mach <= aero.machs[-1]:
+        raise CaseError(f"actuator.condition.mach must lie within aero.machs "
+                        f"[{aero.machs[0]:g}, {aero.machs[-1]:g}], got {actuator.mach:g}")
+    return Case(name=name, panels=panels, thickness=thickness, material=material,
+                support=support, aero=aero, flight=flight, modes=modes, damping=damping,
+                point_masses=masses, actuator=actuator, flutter_index=fsi_spec,
+                reference=reference, source=source)
+
+
+def load_case(path) -> Case:
+    """Read and check a case file (TOML). Raises :class:`CaseError` (a ValueError) naming the
+    offending key and its valid range, or FileNotFoundError."""
+    path = Path(path)
+    with open(path, "rb") as fh:
+        try:
+            d = tomllib.load(fh)
+        except tomllib.TOMLDecodeError as exc:
+            raise CaseError(f"{path.name} is not valid TOML: {exc}") from None
+    return case_from_dict(d, source=str(path))

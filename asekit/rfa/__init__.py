@@ -1,0 +1,22 @@
+"""Rational function approximations of tabulated generalized aerodynamic forces.
+
+Two fits behind one interface (``evaluate(k)``, ``evaluate_laplace(s, U)``, ``A`` holding
+A0, A1, A2 in front, ``lag_realization()``, ``fit_error``, ``b_ref``):
+
+* :mod:`asekit.rfa.roger` -- Roger's fit (thesis Sec. 2.2.1.4, Eqs. 2.13-2.24), N lag terms
+  per element, N n aerodynamic states for n modes;
+* :mod:`asekit.rfa.minimum_state` -- the minimum-state fit of Karpel (1982) by the iterative
+  least squares of Tiffany & Adams (1988), n_L lag states shared by all elements.
+
+The aeroelastic state space (:mod:`asekit.aeroelastic`), the root locus and the ASE loop take
+either.
+"""
+
+from .minimum_state import (MinimumStateFit, default_ms_roots, minimum_state_fit,
+                            minimum_state_fit_database, reduced_frequency_weights)
+from .roger import (RogerFit, default_lag_roots, design_rows, gaf_at_mach, roger_fit,
+                    roger_fit_database)
+
+__all__ = ["RogerFit", "MinimumStateFit", "default_lag_roots", "default_ms_roots",
+           "design_rows", "gaf_at_mach", "roger_fit", "roger_fit_database",
+           "minimum_state_fit", "minimum_state_fit_database", "reduced_frequency_weights"]

@@ -1,0 +1,142 @@
+"""Edge supports of plate meshes: clamped, simply supported, sliding or free edges (for panel
+flutter and other plate problems), by the same transformation u = T q as
+:mod:`asekit.structure.assembly`.
+
+Degrees of freedom per node are (w, theta_x, theta_y) with the Kirchhoff limits
+theta_x = dw/dy, theta_y = -dw/dx (:mod:`asekit.structure.plate`). On an edge of the mesh's
+bounding rectangle:
+
+- ``"clamped"``: w = theta_x = theta_y = 0;
+- ``"simply_supported"``: w = 0 and the rotation about the edge normal (the slope along the
+  edge) = 0, the "hard" simple support of Reissner-Mindlin plates (e.g. Bathe, *Finite Element
+  Procedures*, 1996, Section 5.4): theta_x = 0 on an edge x = const, theta_y = 0 on y = const;
+- ``"sliding"``: the slope normal to the edge = 0, w free (a symmetry line; two sliding side
+  edges make a plate strip bend cylindrically, the 2-D panel): theta_y = 0 on x = const,
+  theta_x = 0 on y = const;
+- ``"free"``: nothing.
+
+Edges are named ``x0`` (x = x_min, the leading edge for flow along +x), ``x1`` (x = x_max),
+``y0`` (y = y_min) and ``y1`` (y = y_max).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from .assembly import SupportedSystem
+from .mesh import PlateMesh
+from .plate import DOF_PER_NODE
+
+EDGE_TYPES = ("free", "simply_supported", "clamped", "sliding")
+EDGES = ("x0", "x1", "y0", "y1")
+
+# fixed local DOFs (0 w, 1 theta_x, 2 theta_y) per edge type and edge orientation
+_FIXED = {
+    ("clamped", "x"): (0, 1, 2), ("clamped", "y"): (0, 1, 2),
+    ("simply_supported", "x"): (0, 1), ("simply_supported", "y"): (0, 2),
+    ("sliding", "x"): (2,), ("sliding", "y"): (1,),
+    ("free", "x"): (), ("free", "y"): (),
+}
+
+
+def edge_nodes(mesh: PlateMesh, edge: str, tol: float = 1e-9) -> np.ndarray:
+    """Nodes on one edge of the mesh's bounding rectangle (``x0``, ``x1``, ``y0``, ``y1``)."""
+    if edge not in EDGES:
+        raise ValueError(f"edge must be one of {EDGES}, got {edge!r}")
+    axis = 0 if edge[0] == "x" else 1
+    c = mesh.nodes[:, axis]
+    target = c.min() if edge[1] == "0" else c.max()
+    scale = float(np.ptp(mesh.nodes, axis=0).max())
+    return np.flatnonzero(np.abs(c - target) <= tol * scale)
+
+
+def edge_supports(mesh: PlateMesh, K, M, x0: str = "simply_supported",
+                  x1: str = "simply_supported", y0: str = "simply_supported",
+                  y1: str = "simply_supported") -> SupportedSystem:
+    """Apply edge conditions (module docstring) to the assembled plate ``K``, ``M`` (3 n_nodes
+    square, :func:`asekit.structure.assembly.assemble`) and return the reduced system.
+
+    Corners shared by two edges get the union of both edges' conditions. Raises ValueError for
+    an unknown edge type. Rigid-body freedom is not checked (an all-free plate keeps its
+    zero-frequency modes)."""
+    kinds = {"x0": x0, "x1": x1, "y0": y0, "y1": y1}
+    fixed = set()
+    for edge, kind in kinds.items():
+        if kind not in EDGE_TYPES:
+            raise ValueError(f"{edge} must be one of {EDGE_TYPES}, got {kind!r}")
+        for node in edge_nodes(mesh, edge):
+            for d in _FIXED[(kind, edge[0])]:
+                fixed.add(DOF_PER_NODE * int(node) + d)
+    n = K.shape[0]
+    if n != DOF_PER_NODE * mesh.n_nodes or M.shape != K.shape:
+        raise ValueError(f"K and M must be {DOF_PER_NODE * mesh.n_nodes} square, got {K.shape}, "
+                         f"{M.shape}")
+    free = np.setdiff1d(np.arange(n), np.fromiter(fixed, int, len(fixed)))
+    T = sp.csr_matrix((np.ones(free.size), (free, np.arange(free.size))), shape=(n, free.size))
+    K = sp.csr_matrix(K)
+    M = sp.csr_matrix(M)
+    label = "plate " + ", ".join(f"{e} {k}" for e, k in kinds.items())
+    return SupportedSystem(K=(T.T @ K @ T).tocsr(), M=(T.T @ M @ T).tocsr(), T=T,
+                           shaft_index=None, ground_index=None, fictitious_inertia=0.0,
+                           shaft_nodes=np.array([], dtype=np.int64), mesh=mesh, label=label)
+
+
+#: Named edges of a structured surface mesh (nodes ``j (n_chord + 1) + i``): the root and tip
+#: stations and the leading and trailing edges of all panels.
+PLANFORM_EDGES = ("root", "tip", "leading_edge", "trailing_edge")
+
+
+def planform_edge_nodes(mesh: PlateMesh, edge: str) -> np.ndarray:
+    """Nodes on a named edge (:data:`PLANFORM_EDGES`) of a structured mesh
+    (:func:`asekit.structure.mesh.structured_mesh` or ``panels_mesh``)."""
+    if edge not in PLANFORM_EDGES:
+        raise ValueError(f"edge must be one of {PLANFORM_EDGES}, got {edge!r}")
+    nc, ns = mesh.n_chord, mesh.n_span
+    if nc < 1 or ns < 1 or mesh.n_nodes != (nc + 1) * (ns + 1):
+        raise ValueError("planform edges need a structured mesh (n_chord x n_span elements)")
+    grid = np.arange(mesh.n_nodes).reshape(ns + 1, nc + 1)
+    return {"root": grid[0], "tip": grid[-1], "leading_edge": grid[:, 0],
+            "trailing_edge": grid[:, -1]}[edge]
+
+
+def planform_edge_supports(mesh: PlateMesh, K, M, root: str = "clamped", tip: str = "free",
+                           leading_edge: str = "free",
+                           trailing_edge: str = "free") -> SupportedSystem:
+    """Edge conditions on the named edges of a structured surface mesh (a plate wing's root and
+    tip stations, its leading and trailing edges; see the module docstring for the kinds).
+
+    Root and tip run along x (y = const). A leading or trailing edge at constant x takes the
+    "hard" simple support as :func:`edge_supports`; on a swept (or tapered) edge the slope along
+    the edge mixes theta_x and theta_y and cannot be removed by eliminating degrees of freedom,
+    so ``"simply_supported"`` there holds w only (the "soft" simple support; Bathe 1996,
+    Sec. 5.4) and ``"sliding"`` is refused.
+    """
+    kinds = {"root": root, "tip": tip, "leading_edge": leading_edge,
+             "trailing_edge": trailing_edge}
+    fixed = set()
+    scale = float(np.ptp(mesh.nodes, axis=0).max())
+    for edge, kind in kinds.items():
+        if kind not in EDGE_TYPES:
+            raise ValueError(f"{edge} must be one of {EDGE_TYPES}, got {kind!r}")
+        nodes = planform_edge_nodes(mesh, edge)
+        if edge in ("root", "tip"):
+            dofs = _FIXED[(kind, "y")]
+        elif np.ptp(mesh.nodes[nodes, 0]) <= 1e-9 * scale:          # an edge x = const
+            dofs = _FIXED[(kind, "x")]
+        elif kind == "sliding":
+            raise ValueError(f"{edge}: a sliding condition needs an edge at constant x "
+                             "(this one is swept or tapered)")
+        else:
+            dofs = (0,) if kind == "simply_supported" else _FIXED[(kind, "x")]
+        for node in nodes:
+            for d in dofs:
+                fixed.add(DOF_PER_NODE * int(node) + d)
+    n = K.shape[0]
+    free = np.setdiff1d(np.arange(n), np.fromiter(fixed, int, len(fixed)))
+    T = sp.csr_matrix((np.ones(free.size), (free, np.arange(free.size))), shape=(n, free.size))
+    K, M = sp.csr_matrix(K), sp.csr_matrix(M)
+    label = "plate " + ", ".join(f"{e} {k}" for e, k in kinds.items())
+    return SupportedSystem(K=(T.T @ K @ T).tocsr(), M=(T.T @ M @ T).tocsr(), T=T,
+                           shaft_index=None, ground_index=None, fictitious_inertia=0.0,
+                           shaft_nodes=np.array([], dtype=np.int64), mesh=mesh, label=label)

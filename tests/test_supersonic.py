@@ -1,0 +1,324 @@
+"""Supersonic lifting-surface method (asekit.aero.supersonic).
+
+Sources of the reference values:
+- Ackeret's 2-D lift slope 4 / sqrt(M^2 - 1) (J. Ackeret, "Luftkraefte auf Fluegel, die mit
+  groesserer als Schallgeschwindigkeit bewegt werden", ZFM 16, 1925); the region of a wing
+  outside the Mach cones of its tips is exactly two-dimensional in linear theory.
+- Rectangular wing, both tips free: C_L,alpha = (4/beta) (1 - 1 / (2 beta A)) for beta A >= 1
+  (each tip Mach cone carries half the 2-D loading on average; e.g. Jones & Cohen, *High Speed
+  Wing Theory*, Princeton 1960, rectangular wings; Bisplinghoff, Ashley & Halfman,
+  *Aeroelasticity*, 1955, Section 7-4).
+- Delta wing with supersonic leading edges (beta cot Lambda >= 1): C_L,alpha = 4 / beta
+  (Puckett 1946, J. Aeronaut. Sci. 13(9); Jones & Cohen 1960).
+- Unsteady 2-D: the exact solution of the oscillating supersonic airfoil in the integral form
+  of Garrick & Rubinow (NACA Report 872, 1946), phi(x) = -(1/beta) int_0^x w(xi)
+  exp(-i lambda (x - xi)) J0(kappa (x - xi)) d xi, evaluated here independently of the 3-D grid
+  by Gauss-Legendre quadrature (the published tables were not at hand: this is the "exact 2-D
+  solution computed independently" alternative).
+- Piston theory as the high-Mach / high-frequency limit: Lighthill 1953; Ashley & Zartarian 1956.
+"""
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+from scipy.special import j0
+
+from asekit.aero.boxes import MeshRuleWarning, TrapezoidSurface, fin_boxes, mesh_surfaces
+from asekit.aero.piston import piston_pressure_matrices
+from asekit.aero.supersonic import (cell_potential_integral, supersonic_pressure_matrices,
+                                    supersonic_pressure_matrix, supersonic_pressures)
+
+
+def _rect(chord, span, n_chord, n_span):
+    return mesh_surfaces([TrapezoidSurface((0, 0), chord, (0, span), chord, n_chord, n_span)])
+
+
+def _lift(mesh, cp, rows=None):
+    rows = np.ones(mesh.n, bool) if rows is None else rows
+    return np.sum(cp[rows] * mesh.area[rows]) / np.sum(mesh.area[rows])
+
+
+# ---- the exact steady cell integral -----------------------------------------------------------
+def _g(x, a):
+    """Antiderivative in X of asin(clip(a / X)) (the steady integral of 1/R over t, times beta),
+    continuous at X = |a| (derived by hand: d/dX [X asin(a/X) + a ln(X + sqrt(X^2 - a^2))])."""
+    if a == 0:
+        return 0.0
+    if x <= abs(a):
+        return math.copysign(math.pi / 2, a) * x
+    return x * math.asin(a / x) + a * math.log((x + math.sqrt(x * x - a * a)) / abs(a))
+
+
+@pytest.mark.parametrize("xa, xb, t1, t2", [(0.1, 0.3, -0.05, 0.02), (-0.1, 0.2, 0.05, 0.1),
+                                            (0.2, 0.5, -0.3, -0.1), (0.0, 0.05, -1.0, 1.0)])
+def test_steady_cell_integral_closed_form(xa, xb, t1, t2):
+    beta = 1.3
+    x0 = max(xa, 0.0)
+    exact = (_g(xb, beta * t2) - _g(x0, beta * t2) - _g(xb, beta * t1) + _g(x0, beta * t1)) / beta
+    assert cell_potential_integral(xa, xb, t1, t2, beta, 0.0, 0.0).real == pytest.approx(
+        exact, rel=1e-10, abs=1e-14)
+
+
+# ---- 2-D limits -----------------------------------------------------------------------------
+@pytest.mark.parametrize("mach", [1.3, 2.0, 3.0])
+def test_ackeret_two_dimensional_region(mach):
+    """Boxes of a wide rectangular wing outside the tip Mach cones: DeltaCp = 4 alpha / beta
+    (to rounding, except the first and the last two boxes, where the force transfer to the
+    quarter-chord load points redistributes but conserves the load), and the strip
+    lift slope equals 4/beta."""
+    beta = math.sqrt(mach**2 - 1)
+    chord = 1.0
+    span = 2 * chord / beta + 0.8
+    n_span = int(round(span / 0.2))
+    mesh = _rect(chord, span, 10, n_span)
+    cp = supersonic_pressure_matrix(mesh, mach, 0.0, 0.5) @ -np.ones(mesh.n)
+    mid = mesh.strip == n_span // 2
+    np.testing.assert_allclose(cp[mid][1:-2].real, 4 / beta, rtol=1e-9)
+    assert _lift(mesh, cp, mid).real == pytest.approx(4 / beta, rel=1e-9)
+    assert np.max(np.abs(cp.imag)) < 1e-12
+
+
+def _exact_2d(mach, k, b, x_axis):
+    """Lift / (q c) and nose-up moment about x_axis / (q c^2) of plunge (h = 1 m) and pitch
+    (1 rad) of a 2-D flat plate of chord 2b in supersonic flow, from the Garrick-Rubinow
+    integral (module docstring) by nested 200-point Gauss-Legendre quadrature."""
+    beta = math.sqrt(mach**2 - 1)
+    kb = k / b
+    lam, kap = kb * mach**2 / beta**2, kb * mach / beta**2
+    c = 2 * b
+    g, w = np.polynomial.legendre.leggauss(200)
+    x, wx = 0.5 * c * (g + 1), 0.5 * c * w
+    xx = x[:, None] * 0.5 * (g[None] + 1)
+    ww = x[:, None] * 0.5 * w[None]
+    kern = np.exp(-1j * lam * xx) * j0(kap * xx)
+    g0, g1 = (kern * ww).sum(1), (kern * xx * ww).sum(1)
+    gx = np.exp(-1j * lam * x) * j0(kap * x)
+    out = {}
+    for name, (w0, w1) in {"h": (1j * kb, 0.0), "a": (-1.0 + 1j * kb * x_axis, -1j * kb)}.items():
+        phi = -(w0 * g0 + w1 * (x * g0 - g1)) / beta
+        phi_x = -(w0 * gx + w1 * g0) / beta
+        cp = 4 * (1j * kb * phi + phi_x)
+        out["L" + name] = np.sum(cp * wx) / c
+        out["M" + name] = np.sum(cp * -(x - x_axis) * wx) / c**2
+    return out
+
+
+@pytest.mark.parametrize("mach", [1.5, 2.0])
+def test_unsteady_two_dimensional_strip(mach):
+    """Mid-span strip of a wide wing (outside the tip Mach cones, hence exactly 2-D) against the
+    exact 2-D solution: lift and moment of plunge and pitch about the quarter chord at
+    k = 0.1, 0.5, 1.0 within 2 % of the largest coefficient of each kind."""
+    beta = math.sqrt(mach**2 - 1)
+    chord, b = 1.0, 0.5
+    span = 2 * chord / beta + 0.4
+    n_span = int(round(span / 0.2))
+    mesh = _rect(chord, span, 12, n_span)
+    ks = [0.1, 0.5, 1.0]
+    a = supersonic_pressure_matrices(mesh, mach, ks, b)
+    mid = mesh.strip == n_span // 2
+    xa = 0.25 * chord
+    xc, xl = mesh.control_point[:, 0], mesh.load_point[:, 0]
+    ar = mesh.area[mid]
+    for ik, k in enumerate(ks):
+        kb = k / b
+        ex = _exact_2d(mach, k, b, xa)
+        got = {}
+        for name, w in {"h": 1j * kb * np.ones(mesh.n), "a": -1 - 1j * kb * (xc - xa)}.items():
+            cp = a[ik] @ w
+            got["L" + name] = np.sum(cp[mid] * ar) / ar.sum()
+            got["M" + name] = np.sum(cp[mid] * ar * -(xl[mid] - xa)) / ar.sum() / chord
+        for key in ex:
+            scale = max(abs(ex["L" + key[1]]), abs(ex["M" + key[1]]))
+            assert abs(got[key] - ex[key]) < 0.02 * scale, (mach, k, key, got[key], ex[key])
+
+
+# ---- 3-D steady -----------------------------------------------------------------------------
+@pytest.mark.parametrize("mach, aspect", [(1.5, 3.0), (2.0, 2.0), (3.0, 1.0)])
+def test_rectangular_wing_tip_mach_cones(mach, aspect):
+    beta = math.sqrt(mach**2 - 1)
+    assert beta * aspect >= 1
+    mesh = _rect(1.0, aspect, 10, int(round(aspect / 0.125)))
+    cla = _lift(mesh, supersonic_pressure_matrix(mesh, mach, 0.0, 0.5) @ -np.ones(mesh.n)).real
+    exact = 4 / beta * (1 - 1 / (2 * beta * aspect))
+    assert cla == pytest.approx(exact, rel=0.02)
+
+
+def _half_delta(chord, semispan, n):
+    # tip chord 1e-3 c: a delta with a sliver tip (its boxes hold less than 2 % of the area)
+    return mesh_surfaces([TrapezoidSurface((0, 0), chord, (chord * (1 - 1e-3), semispan),
+                                           chord * 1e-3, n, n)])
+
+
+def test_delta_wing_supersonic_leading_edges():
+    mach, semispan = 2.0, 1.0                 # beta cot(Lambda) = 1.73 >= 1
+    mesh = _half_delta(1.0, semispan, 12)
+    a = supersonic_pressure_matrix(mesh, mach, 0.0, 0.5, symmetric=True)
+    assert _lift(mesh, a @ -np.ones(mesh.n)).real == pytest.approx(4 / math.sqrt(3), rel=0.02)
+
+
+def test_delta_wing_subsonic_leading_edges_known_error():
+    """Diaphragm ahead of a subsonic leading edge (m = beta cot Lambda = 0.56): the lift slope
+    against Stewart's conical-flow result 2 pi tan(eps) / E(sqrt(1 - m^2)) (Stewart 1946,
+    Q. Appl. Math. 4; E the complete elliptic integral of the second kind). The Mach-box method
+    is known to be least accurate at subsonic leading edges; asekit measures +4 % here, and the
+    test holds it below 6 % (documented limitation, not the 2 % of supersonic edges)."""
+    from scipy.special import ellipe
+    mach, semispan = 1.5, 0.5
+    m = math.sqrt(mach**2 - 1) * semispan
+    mesh = _half_delta(1.0, semispan, 12)
+    cp = supersonic_pressures(mesh, mach, [0.0], 0.5, -np.ones((1, mesh.n, 1)), symmetric=True)
+    exact = 2 * math.pi * semispan / ellipe(1 - m * m)      # scipy's ellipe takes k^2
+    assert abs(_lift(mesh, cp[0, :, 0]).real / exact - 1) < 0.06
+
+
+def test_symmetric_equals_explicit_image():
+    """A wall at y = 0 (symmetric=True) equals meshing the image explicitly."""
+    s = TrapezoidSurface((0, 0), 1.0, (0.3, 1.0), 0.6, 6, 5)
+    mesh = mesh_surfaces([s])
+    img = mesh.mirrored()
+    both = mesh_surfaces([s, TrapezoidSurface((0.3, -1.0), 0.6, (0, 0), 1.0, 6, 5)])
+    a_sym = supersonic_pressure_matrix(mesh, 2.0, 0.3, 0.5, symmetric=True)
+    a_both = supersonic_pressure_matrix(both, 2.0, 0.3, 0.5)
+    w = -1 - 0.3j * mesh.control_point[:, 0] / 0.5
+    wb = -1 - 0.3j * both.control_point[:, 0] / 0.5
+    cp_sym = a_sym @ w
+    cp_both = (a_both @ wb)[: mesh.n]
+    assert img.n == mesh.n
+    np.testing.assert_allclose(_lift(mesh, cp_sym), _lift(mesh, cp_both), rtol=0.02)
+
+
+# ---- the fin: stability over Mach and the piston limit ------------------------------------------
+def test_fin_smooth_over_mach_and_tends_to_piston():
+    """On the fin: lift of the rigid pitch mode finite and smooth over M 1.15-5 (the diaphragm
+    march stays stable), and the ratio to first-order piston theory tends to 1 as M grows at
+    M 2, 3, 5 (steady and k = 0.5): |ratio - 1| falls monotonically, below 8 % at M 5."""
+    mesh = fin_boxes()
+    b, xa = 0.078, 0.078
+    x = mesh.control_point[:, 0]
+
+    def pitch(k):
+        return (-1 - 1j * k * (x - xa) / b)[:, None]
+
+    err = {0.0: [], 0.5: []}
+    for mach in (2.0, 3.0, 5.0):
+        ks = [0.0, 0.5]
+        cp = supersonic_pressures(mesh, mach, ks, b, pitch)
+        p = piston_pressure_matrices(mesh, mach, ks, b, warn=False)
+        for ik, k in enumerate(ks):
+            ratio = np.sum(cp[ik, :, 0] * mesh.area) / np.sum((p[ik] @ pitch(k))[:, 0] * mesh.area)
+            err[k].append(abs(ratio - 1))
+    for k, e in err.items():
+        assert e[0] > e[1] > e[2], (k, e)
+        assert e[2] < 0.08
+    lifts = []
+    for mach in (1.15, 1.3, 1.6, 2.2, 3.0, 4.0):
+        cp = supersonic_pressures(mesh, mach, [0.3], b, pitch)[0, :, 0]
+        assert np.all(np.isfinite(cp))
+        lifts.append(abs(_lift(mesh, cp)))
+    assert np.all(np.diff(lifts) < 0)               # lift slope falls with M above M 1.15
+    assert max(lifts) < 4 / math.sqrt(1.15**2 - 1)  # below the 2-D value
+
+
+def test_matrix_and_column_paths_agree():
+    mesh = _rect(1.0, 0.8, 6, 4)
+    w = np.random.default_rng(1).standard_normal((mesh.n, 2))
+    a = supersonic_pressure_matrices(mesh, 1.8, [0.0, 0.7], 0.5)
+    cp = supersonic_pressures(mesh, 1.8, [0.0, 0.7], 0.5, lambda k: w)
+    for ik in range(2):
+        np.testing.assert_allclose(cp[ik], a[ik] @ w, rtol=1e-10, atol=1e-12)
+
+
+def test_grid_converges_on_the_fin():
+    """Re Q_cc of the fin's rigid pitch at M 2 (steady): default grid within 2 % of a grid with
+    twice as many cells per box chord (diaphragm march stable as the grid is refined)."""
+    mesh = fin_boxes()
+    b = xa = 0.078
+    x, xl = mesh.control_point[:, 0], mesh.load_point[:, 0]
+    qcc = []
+    for cpb in (1.5, 3.0):
+        cp = supersonic_pressures(mesh, 2.0, [0.0], b, -np.ones((1, mesh.n, 1)),
+                                  cells_per_box=cpb, max_cells=20000)[0, :, 0]
+        qcc.append(float(np.sum(-(xl - xa) * cp * mesh.area).real))
+    assert qcc[0] < 0 and qcc[0] == pytest.approx(qcc[1], rel=0.02)
+
+
+# ---- bad input --------------------------------------------------------------------------------
+@pytest.mark.parametrize("kwargs, match", [
+    ({"mach": 1.0}, "mach"), ({"mach": 0.7}, "mach"), ({"mach": float("inf")}, "mach"),
+    ({"k": -0.5}, "k must"), ({"k": float("nan")}, "k must"), ({"b_ref": -1.0}, "b_ref"),
+])
+def test_bad_arguments(kwargs, match):
+    args = {"mach": 2.0, "k": 0.1, "b_ref": 0.5}
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=match):
+        supersonic_pressure_matrices(_rect(1.0, 1.0, 4, 4), **args)
+
+
+def test_bad_meshes():
+    swept_te = mesh_surfaces([TrapezoidSurface((0, 0), 1.0, (0.0, 1.0), 2.0, 4, 4)])
+    with pytest.raises(ValueError, match="trailing edge"):
+        supersonic_pressure_matrix(swept_te, 1.2, 0.0, 0.5)       # tan 45 deg > beta 0.66
+    tilted = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, 1.0, 0.5), 1.0, 4, 4)])
+    with pytest.raises(ValueError, match="planar"):
+        supersonic_pressure_matrix(tilted, 2.0, 0.0, 0.5)
+    with pytest.raises(ValueError, match="max_cells"):
+        supersonic_pressure_matrix(_rect(1.0, 1.0, 4, 4), 2.0, 0.0, 0.5, cells_per_box=40,
+                                   max_cells=500)
+
+
+def test_coarse_mesh_warning():
+    """Boxes per kernel wavelength 2 pi b (M-1)/(k M): warn naming Mach and k."""
+    mesh = _rect(1.0, 1.0, 4, 4)
+    with pytest.warns(MeshRuleWarning, match=r"mach=1\.2, k=2"):
+        supersonic_pressure_matrices(mesh, 1.2, [0.0, 2.0], 0.5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        supersonic_pressure_matrices(mesh, 2.0, [0.0, 0.2], 0.5)
+
+
+# ---- method dispatch and the GAF hook ---------------------------------------------------------
+def test_dispatcher_and_transonic_gap():
+    from asekit.aero.methods import TransonicGapError, TransonicWarning, resolve_method
+    assert resolve_method("auto", 0.6) == "dlm"
+    assert resolve_method("auto", 0.9) == "dlm"
+    assert resolve_method("auto", 1.15) == "supersonic"
+    assert resolve_method("quartic", 0.5) == "dlm"
+    for m in (0.95, 1.0, 1.1):
+        with pytest.raises(TransonicGapError, match="transonic gap.*linear potential theory"):
+            resolve_method("auto", m)
+    with pytest.raises(ValueError, match="mach must be < 1 for the DLM"):
+        resolve_method("dlm", 1.2)
+    with pytest.raises(ValueError, match="mach must be > 1"):
+        resolve_method("supersonic", 0.8)
+    with pytest.raises(ValueError, match="mach must be > 1"):
+        resolve_method("piston", 1.0)
+    with pytest.raises(ValueError, match="method must be one of"):
+        resolve_method("zona51", 2.0)
+    with pytest.warns(TransonicWarning, match="mach=1.1"):
+        resolve_method("supersonic", 1.1)
+
+
+def test_gaf_hook_any_method():
+    """The GAF builder takes method=: 'dlm' equals the default DLM, 'auto' at M 2 equals the
+    supersonic matrices projected by hand, and 'auto' across the gap is refused."""
+    from asekit.aero.gaf import build_gaf_database, gaf_from_box_modes
+    from asekit.aero.methods import TransonicGapError
+    from asekit.aero.spline import analytic_modes
+    mesh = _rect(0.2, 0.3, 6, 4)
+    modes = analytic_modes(mesh, [lambda x, y: (1 + 0 * x, 0 * x),
+                                  lambda x, y: (-(x - 0.05), -1 + 0 * x)])
+    ks, b = [0.01, 0.3], 0.1
+    np.testing.assert_allclose(gaf_from_box_modes(modes, mesh, 0.6, ks, b, method="dlm"),
+                               gaf_from_box_modes(modes, mesh, 0.6, ks, b), rtol=1e-12)
+    q = gaf_from_box_modes(modes, mesh, 2.0, ks, b, method="auto")
+    a = supersonic_pressure_matrices(mesh, 2.0, ks, b)
+    for ik, k in enumerate(ks):
+        cp = a[ik] @ modes.normalwash(k, b)
+        np.testing.assert_allclose(q[ik], modes.h_lp.T @ (mesh.area[:, None] * cp), rtol=1e-12)
+    assert q[0, 1, 1].real < 0          # pitch about the quarter chord: nose-down moment at M 2
+    db = build_gaf_database(modes, mesh, [0.6, 2.0], ks, b, 1, method="auto", progress=False)
+    assert db.Q.shape == (2, 2, 2, 2) and np.all(np.isfinite(db.Q))
+    with pytest.raises(TransonicGapError):
+        build_gaf_database(modes, mesh, [0.6, 1.0], ks, b, 1, method="auto", progress=False)
