@@ -18,7 +18,7 @@ settings.register_profile("asekit-default", max_examples=12, deadline=None, data
                           derandomize=True,
                           suppress_health_check=[HealthCheck.too_slow,
                                                  HealthCheck.filter_too_much])
-settings.register_profile("thorough", max_examples=400, deadline=None,
+settings.register_profile("thorough", max_examples=400, deadline=None, database=None,
                           suppress_health_check=[HealthCheck.too_slow,
                                                  HealthCheck.filter_too_much])
 settings.load_profile(os.environ.get("ASEKIT_HYPOTHESIS_PROFILE", "asekit-default"))
