@@ -165,12 +165,7 @@ def case_state_spaces(case, mach: float | None = None, altitude: float | None = 
                        shaft_point=shaft)
     out = {"aeroelastic": aeroelastic_model(model, rfa, rho, U, outputs=rows)}
     if a is not None:
-        from .servo import ActuatorParameters, DCMotor, PDController, Transmission
-        act = ActuatorParameters(
-            DCMotor(a.resistance, a.inductance, a.torque_constant, a.back_emf_constant,
-                    a.rotor_inertia, a.viscous_damping),
-            Transmission(a.ratio, a.efficiency, a.transmission_inertia), fin_inertia=0.0)
-        ctl = PDController(a.k_c, a.k_p, a.k_d, name="case controller")
+        act, ctl, _ = pl.actuator_setup(case)
         m = ase_mod.build_model(model, rfa, rho, U, rows, actuator=act, mach=mach)
         for topo in ase_mod.TOPOLOGIES:
             out[topo] = ase_mod.closed_loop(m, ctl, topo)

@@ -205,14 +205,6 @@ class FlutterAnalysis:
     notes: tuple[str, ...] = field(default_factory=tuple)
 
 
-def _start_instability(pk: PkResult) -> int | None:
-    """Index of a tracked root with Re p > 0 at the first velocity of the sweep (tolerance
-    1e-9 of |p| so round-off on an undamped system is not an instability)."""
-    p0 = pk.p[0]
-    bad = np.flatnonzero(p0.real > 1e-9 * np.maximum(np.abs(p0), 1.0))
-    return int(bad[0]) if bad.size else None
-
-
 def analyse_condition(case: Case, db: GafDatabase, mach: float, cond: FlightCondition,
                       model: ModalModel | None = None) -> ConditionResult:
     model = modal_model(case) if model is None else model
@@ -220,9 +212,11 @@ def analyse_condition(case: Case, db: GafDatabase, mach: float, cond: FlightCond
     U = np.asarray(case.flight.velocities, float)
     pk = pk_flutter(model, gaf, cond.density, U)
     inst = tuple(pk_instabilities(pk, model, gaf))
-    j0 = _start_instability(pk)
-    return ConditionResult(float(mach), cond, pk, inst, first_of(list(inst), "flutter"),
-                           first_of(list(inst), "divergence"), j0 is not None, j0)
+    start = [i for i in inst if i.at_first_point]          # unstable at U0 (asekit.flutter)
+    crossings = [i for i in inst if not i.at_first_point]
+    return ConditionResult(float(mach), cond, pk, inst, first_of(crossings, "flutter"),
+                           first_of(crossings, "divergence"), bool(start),
+                           start[0].mode if start else None)
 
 
 def _interp_speed(points: list[tuple[float, float]], mach: float,
@@ -328,6 +322,29 @@ def corner_points(case: Case) -> dict:
             "tip_le": t.tip_le, "tip_te": (t.tip_le[0] + t.tip_chord, t.tip_le[1])}
 
 
+def actuator_setup(case: Case):
+    """(ActuatorParameters, PDController, PowerLimits) of the case's ``[actuator]``: the keys
+    it sets, asekit's defaults (thesis Tables 12, 16, 17) for the rest. The actuator's load
+    inertia is 0: the fin's inertia enters through its modal model (:func:`asekit.ase.build_model`)."""
+    from ..servo import SYSTEM_3, ActuatorParameters, DCMotor, Transmission
+    from ..simulate import THESIS_LIMITS
+    from .schema import MOTOR_KEYS, TRANSMISSION_KEYS
+    a = case.actuator
+    if a is None:
+        raise CaseError("the case has no [actuator]")
+
+    def given(pairs):            # {servo field: case value} for the keys the case sets
+        return {dst: getattr(a, src) for src, dst in pairs if getattr(a, src) is not None}
+
+    act = ActuatorParameters(DCMotor(**given(zip(MOTOR_KEYS, MOTOR_KEYS))),
+                             Transmission(**given(TRANSMISSION_KEYS.items())), fin_inertia=0.0)
+    ctl = replace(SYSTEM_3, name="case controller",
+                  **given((("k_c", "gain"), ("k_p", "kp"), ("k_d", "kd"))))
+    lim = replace(THESIS_LIMITS, **given((("supply_voltage", "supply_voltage"),
+                                          ("current_limit", "current_limit"))))
+    return act, ctl, lim
+
+
 def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
     """The Ch. 5 analysis of the case's actuator (None without ``[actuator]``)."""
     if case.actuator is None:
@@ -336,9 +353,6 @@ def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
     from .. import metrics
     from ..aeroelastic import fin_outputs
     from ..rfa import gaf_at_mach, roger_fit
-    from ..servo import SYSTEM_3, ActuatorParameters, DCMotor, Transmission
-    from ..simulate import THESIS_LIMITS
-    from .schema import MOTOR_KEYS, TRANSMISSION_KEYS
 
     a = case.actuator
     model = modal_model(case)
@@ -350,15 +364,7 @@ def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
     corners = corner_points(case)
     rows = fin_outputs(model, np.array(list(corners.values())), names=list(corners),
                        shaft_point=case.support.axis_point)
-    def given(pairs):            # {servo field: case value} for the keys the case sets
-        return {dst: getattr(a, src) for src, dst in pairs if getattr(a, src) is not None}
-
-    act = ActuatorParameters(DCMotor(**given(zip(MOTOR_KEYS, MOTOR_KEYS))),
-                             Transmission(**given(TRANSMISSION_KEYS.items())), fin_inertia=0.0)
-    ctl = replace(SYSTEM_3, name="case controller",
-                  **given((("k_c", "gain"), ("k_p", "kp"), ("k_d", "kd"))))
-    lim = replace(THESIS_LIMITS, **given((("supply_voltage", "supply_voltage"),
-                                          ("current_limit", "current_limit"))))
+    act, ctl, lim = actuator_setup(case)
     m = ase_mod.build_model(model, rfa, rho, U, rows, actuator=act, mach=a.mach)
     stable, maxre, sims, settle, err, over = {}, {}, {}, {}, {}, {}
     step = math.radians(a.step_deg)

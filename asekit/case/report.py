@@ -63,7 +63,7 @@ def summary(a: Analysis) -> dict:
     c = a.case
     fl = []
     for r in a.flutter.results:
-        f = r.flutter
+        f = None if r.unstable_at_start else r.flutter     # "at or below U0" has no speed
         row = {"mach": r.mach, "altitude_m": r.condition.altitude, "density": r.condition.density,
                "speed_ms": None if f is None else float(f.speed),
                "frequency_hz": None if f is None else float(f.frequency_hz),
