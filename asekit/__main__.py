@@ -19,6 +19,8 @@ def main(argv: list[str] | None = None) -> int:
                      help="run only these chapters (servo, structure, aero, flutter, ase)")
     from .cli_analyse import add_parser as add_analyse
     add_analyse(sub)
+    from .cli_sweep import add_parser as add_sweep
+    add_sweep(sub)
     args = parser.parse_args(argv)
     if hasattr(args, "func"):
         try:

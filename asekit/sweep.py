@@ -810,9 +810,9 @@ def connect(scheduler: str | None, workers: int | None, timeout: float = 5.0):
     if scheduler:
         try:
             return Client(scheduler, timeout=f"{timeout}s"), None
-        except (OSError, TimeoutError) as exc:
+        except Exception as exc:      # refused, timed out, or not a Dask scheduler at all
             raise SweepError(f"cannot reach the Dask scheduler at {scheduler} within "
-                             f"{timeout:g} s ({type(exc).__name__})") from None
+                             f"{timeout:g} s ({type(exc).__name__}: {str(exc)[:120]})") from None
     cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
                            dashboard_address=None)
     return Client(cluster), cluster
@@ -849,49 +849,49 @@ def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | N
     todo = [(i, v) for i, v in enumerate(design) if i not in done]
     rows_mem = dict(done)
     fh = None
-    if path is not None:
-        if not path.exists():
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(",".join(cols) + "\n")
-        fh = open(path, "a")
+    cl = cluster = None
+    if todo and executor == "dask":
+        cl, cluster = (client, None) if client is not None else connect(scheduler, workers)
     bar = None
-    if progress:
-        from tqdm.auto import tqdm
-        bar = tqdm(total=len(design), initial=len(done), desc=f"sweep {sweep.name}",
-                   unit="sample")
-
-    def record(row):
-        line = format_row(row, cols)
-        rows_mem[row["sample"]] = line
-        if fh is not None:
-            fh.write(line)
-            fh.flush()
-        if bar is not None:
-            bar.update(1)
-
     try:
         if todo:
             factors = base_factors(sweep) if factors is None else factors
+        if progress:
+            from tqdm.auto import tqdm
+            bar = tqdm(total=len(design), initial=len(done), desc=f"sweep {sweep.name}",
+                       unit="sample")
+        if path is not None:
+            if not path.exists():
+                path.parent.mkdir(parents=True, exist_ok=True)
+                path.write_text(",".join(cols) + "\n")
+            fh = open(path, "a")
+
+        def record(row):
+            line = format_row(row, cols)
+            rows_mem[row["sample"]] = line
+            if fh is not None:
+                fh.write(line)
+                fh.flush()
+            if bar is not None:
+                bar.update(1)
+
+        if todo:
             if executor == "serial":
                 for i, v in todo:
                     record(evaluate(sweep, factors, i, v))
             elif executor == "processes":
                 _run_processes(sweep, factors, todo, workers or 2, record)
             else:
-                own = client is None
-                cl, cluster = connect(scheduler, workers) if own else (client, None)
-                try:
-                    _run_dask(cl, sweep, factors, todo, record)
-                finally:
-                    if own:
-                        cl.close()
-                        if cluster is not None:
-                            cluster.close()
+                _run_dask(cl, sweep, factors, todo, record)
     finally:
         if fh is not None:
             fh.close()
         if bar is not None:
             bar.close()
+        if cl is not None and client is None:
+            cl.close()
+            if cluster is not None:
+                cluster.close()
     text = ",".join(cols) + "\n" + "".join(rows_mem[i] for i in sorted(rows_mem))
     if path is not None:
         _atomic_write(path, text)

@@ -432,3 +432,51 @@ def _toml(d) -> str:
     for p in d["parameter"]:
         out += ["[[parameter]]"] + [f"{k} = {val(v)}" for k, v in p.items()]
     return "\n".join(out) + "\n"
+
+
+# ------------------------------------------------------------------------------------------
+# command line
+# ------------------------------------------------------------------------------------------
+def _cli(args, tmp_path, timeout=120):
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    return subprocess.run([sys.executable, "-m", "asekit", "sweep", *args], env=env,
+                          cwd=tmp_path, capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda d: d["parameter"][0].update(path="material.youngs_modulos"),
+     "'material.youngs_modulos' is not a case-file key"),
+    (lambda d: d["parameter"][0].update(sigma=-0.1), "sigma must be a finite number > 0"),
+    (lambda d: d["parameter"][0].update(distribution="uniform", low=130.0, high=110.0),
+     None),
+    (lambda d: d["sweep"].update(outputs=["flutter_speed", "q_dyn"]), "'q_dyn' is not an output"),
+])
+def test_cli_bad_input_is_one_line_and_exit_2(tmp_path, edit, message):
+    d = sweep_dict([copy.deepcopy(MC[1])], samples=2)
+    edit(d)
+    if d["parameter"][0]["distribution"] == "uniform":
+        del d["parameter"][0]["median"], d["parameter"][0]["sigma"]
+        message = r"low \(130\) must be < high \(110\)"
+    f = tmp_path / "bad.toml"
+    f.write_text(_toml(d))
+    r = _cli([str(f), "--out", "o.csv", "--quiet"], tmp_path)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: bad.toml: ")
+    import re
+    assert re.search(message, lines[0]), lines[0]
+    assert not (tmp_path / "o.csv").exists()
+
+
+def test_cli_unreachable_scheduler_fails_fast(tmp_path):
+    pytest.importorskip("dask.distributed")
+    f = tmp_path / "s.toml"
+    f.write_text(_toml(sweep_dict([MC[1]], samples=2)))
+    t0 = time.perf_counter()
+    r = _cli([str(f), "--out", "o.csv", "--executor", "dask", "--scheduler",
+              "tcp://127.0.0.1:9", "--quiet"], tmp_path)
+    assert time.perf_counter() - t0 < 30
+    assert r.returncode == 2
+    assert r.stderr.strip().splitlines()[-1].startswith(
+        "error: cannot reach the Dask scheduler at tcp://127.0.0.1:9 within 5 s")
