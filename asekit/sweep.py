@@ -1058,3 +1058,32 @@ def describe(table, column: str = "flutter_speed") -> dict:
             "std": float(v.std(ddof=1)) if v.size > 1 else 0.0, "p05": float(q[0]),
             "median": float(q[1]), "p95": float(q[2]), "min": float(v.min()),
             "max": float(v.max())}
+
+
+def match_points(table) -> list[dict]:
+    """Match points of an envelope table (columns flight.mach, flight.altitude, flutter_speed,
+    flight_speed): per altitude, the Mach at which the flutter Mach U_f(M) / a equals M, by
+    linear interpolation of d(M) = U_f / a - M between the grid Machs (the rule of
+    :func:`asekit.case.pipeline.flutter`). ``matched_mach`` None where d keeps one sign (no
+    match inside the grid: flutter-free if d > 0 throughout)."""
+    ok = _ok(table)
+    for c in ("flight.mach", "flight.altitude", "flutter_speed", "flight_speed"):
+        if c not in ok:
+            raise ValueError(f"the table has no column {c!r}")
+    out = []
+    for h, g in ok.groupby("flight.altitude", sort=True):
+        g = g.dropna(subset=["flutter_speed"]).sort_values("flight.mach")
+        if "unstable_at_start" in g:
+            g = g[~g["unstable_at_start"].astype(bool)]
+        m = g["flight.mach"].to_numpy(float)
+        a = g["flight_speed"].to_numpy(float) / m
+        d = g["flutter_speed"].to_numpy(float) / a - m
+        mm = None
+        for i in range(len(m) - 1):
+            if d[i] == 0 or d[i] * d[i + 1] < 0:
+                mm = float(m[i] + (m[i + 1] - m[i]) * d[i] / (d[i] - d[i + 1]))
+                break
+        speed = None if mm is None else float(mm * np.interp(mm, m, a))
+        out.append({"altitude_m": float(h), "matched_mach": mm, "matched_speed_ms": speed,
+                    "all_above": bool(mm is None and len(d) and np.all(d > 0))})
+    return out
