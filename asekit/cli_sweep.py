@@ -23,6 +23,8 @@ def add_parser(sub) -> None:
                    help="local processes or LocalCluster workers (default 2)")
     p.add_argument("--samples", type=int, metavar="N",
                    help="override sweep.samples (the Monte Carlo sample count)")
+    p.add_argument("--retry-failed", action="store_true",
+                   help="on resume, run the failed rows of --out again instead of keeping them")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
@@ -69,7 +71,8 @@ def run(args) -> int:
     journal = out.with_name(out.name + ".partial.csv") if parquet else out
     try:
         df = S.run_sweep(sw, out=journal, executor=args.executor, workers=args.workers,
-                         scheduler=args.scheduler, progress=not args.quiet)
+                         scheduler=args.scheduler, progress=not args.quiet,
+                         retry_failed=args.retry_failed)
     except S.SweepError as exc:
         return _error(str(exc))
     if parquet:

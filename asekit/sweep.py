@@ -820,7 +820,7 @@ def connect(scheduler: str | None, workers: int | None, timeout: float = 5.0):
 
 def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | None = None,
               scheduler: str | None = None, client=None, progress: bool = False,
-              factors: AicFactors | None = None):
+              factors: AicFactors | None = None, retry_failed: bool = False):
     """Run every sample not yet in ``out`` and return the whole table (pandas DataFrame,
     sorted by sample).
 
@@ -833,6 +833,12 @@ def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | N
         (``client`` if given, else ``scheduler`` address, else a LocalCluster of ``workers``).
     progress : tqdm bar.
     factors : precomputed :func:`base_factors` (else computed here, once).
+    retry_failed : on resume, run the failed rows of ``out`` again (e.g. after a lost worker)
+        instead of keeping them.
+
+    The "processes" executor starts its workers with the ``spawn`` method: a script that calls
+    it must guard its entry point with ``if __name__ == "__main__":`` (Python's multiprocessing
+    rule); notebooks and ``python -m asekit sweep`` need nothing.
     """
     if executor not in EXECUTORS:
         raise SweepError(f"executor must be one of {', '.join(EXECUTORS)}, got {executor!r}")
@@ -845,6 +851,10 @@ def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | N
     done: dict[int, str] = {}
     if path is not None and path.exists():
         done = read_journal(path, sweep)
+        if retry_failed:
+            i_st = cols.index("status")
+            done = {i: ln for i, ln in done.items()
+                    if next(csv.reader([ln]))[i_st] == "ok"}
         _rewrite(path, cols, done)                    # drops a cut-off last line
     todo = [(i, v) for i, v in enumerate(design) if i not in done]
     rows_mem = dict(done)

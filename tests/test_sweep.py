@@ -290,6 +290,23 @@ def test_resume_from_a_partial_file(tmp_path):
         S.run_sweep(other, out=out)
 
 
+def test_resume_keeps_or_retries_failed_rows(tmp_path):
+    sw = S.sweep_from_dict(sweep_dict([{"path": "support.torsional_stiffness",
+                                        "values": [100.0, 120.0]}], outputs=["f1_hz"]))
+    out = tmp_path / "r.csv"
+    full = S.run_sweep(sw, out=out)
+    lines = out.read_text().splitlines(keepends=True)
+    cols = next(csv.reader([lines[0]]))
+    cells = next(csv.reader([lines[2]]))
+    cells[cols.index("status")], cells[cols.index("error")] = "failed", "KilledWorker: lost"
+    cells[cols.index("f1_hz")] = ""
+    out.write_text(lines[0] + lines[1] + ",".join(cells) + "\n")
+    kept = S.run_sweep(sw, out=out)
+    assert kept["status"].tolist() == ["ok", "failed"]           # a finished row is kept
+    again = S.run_sweep(sw, out=out, retry_failed=True)
+    assert_identical(full, again)
+
+
 # ------------------------------------------------------------------------------------------
 # statistics
 # ------------------------------------------------------------------------------------------
