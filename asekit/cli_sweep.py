@@ -75,6 +75,8 @@ def run(args) -> int:
                          retry_failed=args.retry_failed)
     except S.SweepError as exc:
         return _error(str(exc))
+    except ValueError as exc:            # a base case the pipeline refuses (e.g. its DLM)
+        return _error(f"{Path(args.sweep).name}: {type(exc).__name__}: {exc}")
     if parquet:
         df.to_parquet(out, index=False)
         journal.unlink()

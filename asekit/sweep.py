@@ -465,6 +465,8 @@ def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
     mach0, alt0 = _base_condition(base, base_case)
     mach = _num("sweep.mach", s["mach"]) if "mach" in s else mach0
     alt = _num("sweep.altitude", s["altitude"]) if "altitude" in s else alt0
+    _check_condition("sweep.mach", "flight.mach", mach)
+    _check_condition("sweep.altitude", "flight.altitude", alt)
     samples = s.get("samples", 1)
     if isinstance(samples, bool) or not isinstance(samples, int) or not 1 <= samples <= 10 ** 7:
         raise SweepError(f"sweep.samples must be an integer in [1, 10000000], got {samples!r}")
@@ -489,6 +491,11 @@ def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
     if not isinstance(raw, list):
         raise SweepError("parameter must be an array of tables ([[parameter]])")
     params = tuple(_parameter(i, t, base) for i, t in enumerate(raw))
+    for i, q in enumerate(params):
+        if q.path in CONDITION_PATHS and q.is_grid:
+            for j, v in enumerate(q.values):
+                _check_condition(f"parameter[{i}] ({q.path}).values[{j}]", q.path,
+                                 _num(f"parameter[{i}] ({q.path}).values[{j}]", v))
     paths = [q.path for q in params]
     if len(set(paths)) != len(paths):
         dup = next(x for x in paths if paths.count(x) > 1)
@@ -511,6 +518,15 @@ def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
                 raise SweepError(f"parameter[{i}].path {q.path!r} is not a case-file key: "
                                  f"{msg}") from None
     return sweep
+
+
+def _check_condition(where: str, path: str, v: float) -> None:
+    """The analysed Mach must suit the doublet lattice (0 <= M < 1), the altitude the 1976
+    standard atmosphere (-1000 to 80000 m)."""
+    if path == "flight.mach" and not 0.0 <= v < 1.0:
+        raise SweepError(f"{where} must be a Mach number in [0, 1) (doublet lattice), got {v:g}")
+    if path == "flight.altitude" and not -1000.0 <= v <= 80000.0:
+        raise SweepError(f"{where} must be an altitude in [-1000, 80000] m, got {v:g}")
 
 
 def load_sweep(path) -> Sweep:
@@ -657,6 +673,8 @@ def _analyse(sweep: Sweep, factors: AicFactors, values: dict):
     from .case import pipeline as P
     from .flutter import divergence_speeds
     d, mach, alt = sweep.case_dict(values)
+    _check_condition("flight.mach", "flight.mach", mach)
+    _check_condition("flight.altitude", "flight.altitude", alt)
     case = case_from_dict(d)
     model = P.modal_model(case)
     if aero_key(case) == factors.key:

@@ -116,6 +116,13 @@ def test_invalid_distribution_parameters(param, message):
         S.sweep_from_dict(d)
 
 
+def test_condition_out_of_range_is_a_sweep_error():
+    with pytest.raises(S.SweepError, match=r"values\[1\] must be a Mach number in \[0, 1\)"):
+        S.sweep_from_dict(sweep_dict([{"path": "flight.mach", "values": [0.5, 1.2]}]))
+    with pytest.raises(S.SweepError, match="sweep.altitude must be an altitude"):
+        S.sweep_from_dict(sweep_dict([], altitude=1e6))
+
+
 def test_unknown_output_and_sweep_keys():
     with pytest.raises(S.SweepError, match="'flutter_sped' is not an output"):
         S.sweep_from_dict(sweep_dict([], outputs=["flutter_sped"]))
@@ -254,6 +261,32 @@ def test_a_sample_is_the_pipeline_on_the_edited_case():
     assert row["flutter_margin"] == r.flutter.speed / (0.5 * cond.speed_of_sound) - 1
     assert row["flutter_inside"] == (r.flutter.speed <= 0.5 * cond.speed_of_sound)
     assert row["f1_hz"] == model.frequencies_hz[1]
+
+
+def test_envelope_and_ase_outputs_are_the_pipeline():
+    """min_flutter_speed / envelope_margin / matched_mach = asekit.case.pipeline.flutter and
+    the aem outputs = pipeline.ase on the edited case (two Machs, two altitudes)."""
+    outs = list(S.ENVELOPE_OUTPUTS) + list(S.ASE_OUTPUTS)
+    d = sweep_dict([{"path": "actuator.controller.k_p", "values": [250.0]}], outputs=outs)
+    d["case"].update({"aero.machs": [0.5, 0.6], "flight.altitudes": [0.0, 5000.0],
+                      "actuator.condition.mach": 0.55})
+    sw = S.sweep_from_dict(d)
+    row = S.run_sweep(sw).iloc[0]
+    assert row["status"] == "ok", row["error"]
+    case = case_from_dict(sw.case_dict({"actuator.controller.k_p": 250.0})[0])
+    db = P.gaf_database(case, progress=False)
+    fa = P.flutter(case, db=db)
+    assert row["min_flutter_speed"] == min(r.flutter.speed for r in fa.results)
+    assert row["envelope_margin"] == min(m["margin"] for m in fa.margins)
+    mm = [m["matched_mach"] for m in fa.match_points if m["matched_mach"] is not None]
+    assert (math.isnan(row["matched_mach"]) and not mm) or row["matched_mach"] == min(mm)
+    a = P.ase(case, db=db)
+    for t in ("AEM1", "AEM2"):
+        p = t.lower()
+        assert row[f"{p}_stable"] == a.stable[t]
+        assert row[f"{p}_max_real_pole"] == a.max_real_pole[t]
+        assert row[f"{p}_settling_s"] == a.settling_s[t]
+        assert row[f"{p}_corner_overshoot"] == max(a.corner_overshoot[t].values())
 
 
 def test_failed_sample_is_a_row_with_its_error():

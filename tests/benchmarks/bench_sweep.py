@@ -84,9 +84,18 @@ def main(argv=None) -> int:
     ap.add_argument("--samples", type=int, default=1000)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--skip-serial", action="store_true")
+    ap.add_argument("--velocities", metavar="MIN:MAX:STEP",
+                    help="override the p-k velocity sweep (m/s), e.g. 150:350:10")
     args = ap.parse_args(argv)
     sw = dataclasses.replace(S.load_sweep(ROOT / "data/sweeps/fin_monte_carlo.toml"),
                              samples=args.samples)
+    if args.velocities:
+        lo, hi, st = (float(x) for x in args.velocities.split(":"))
+        base = dict(sw.base)
+        base["flight"] = {**base["flight"], "velocities": {"min": lo, "max": hi, "step": st}}
+        sw = dataclasses.replace(sw, base=base)
+    v = sw.base["flight"]["velocities"]
+    print(f"p-k velocities {v['min']:g}-{v['max']:g} m/s every {v['step']:g} m/s")
     print(f"sweep {sw.name}: {sw.n_samples} samples, outputs {', '.join(sw.outputs)}; "
           f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}")
     t = time.perf_counter()
@@ -97,11 +106,14 @@ def main(argv=None) -> int:
 
     serial = None
     if not args.skip_serial:
-        t = time.perf_counter()
+        t, c = time.perf_counter(), time.process_time()
         serial = S.run_sweep(sw, factors=fac)
-        t_serial = time.perf_counter() - t
-        print(f"serial: {t_serial:.1f} s ({t_serial / len(serial) * 1e3:.0f} ms/sample; "
+        t_serial, c_serial = time.perf_counter() - t, time.process_time() - c
+        print(f"serial: {t_serial:.1f} s wall, {c_serial:.1f} s CPU "
+              f"({t_serial / len(serial) * 1e3:.0f} ms/sample; "
               f"{int((serial.status != 'ok').sum())} failed); peak RSS {_peak_rss_mb():.0f} MB")
+        print(f"  -> on {args.workers} idle cores the sweep would take about "
+              f"{c_serial / args.workers:.0f} s (serial CPU time / workers; an estimate)")
 
     from dask.distributed import Client, LocalCluster
     t = time.perf_counter()
@@ -117,6 +129,10 @@ def main(argv=None) -> int:
     finally:
         client.close()
         cluster.close()
+    print(f"per-sample compute (mean wall_s): serial "
+          f"{'-' if serial is None else f'{serial.wall_s.mean() * 1e3:.0f} ms'}, dask workers "
+          f"{dask_df.wall_s.mean() * 1e3:.0f} ms (a larger value = the workers did not get "
+          f"their cores)")
     print(f"dask LocalCluster ({args.workers} workers x 1 thread): {t_dask:.1f} s "
           f"(+ {t_start:.1f} s cluster start); peak RSS per worker "
           + ", ".join(f"{v:.0f} MB" for v in peaks.values()))
