@@ -430,6 +430,7 @@ def test_worker_killed_mid_sweep_loses_no_rows(client, tmp_path):
     df = S.run_sweep(sw, out=out, executor="dask", client=client)
     th.join()
     assert "rows" in seen, "the worker was never killed"
+    assert pids[0] not in client.run(os.getpid).values()         # it died (and was replaced)
     final = out.read_text().splitlines()
     assert all(r in final for r in seen["rows"])                 # no finished row lost
     assert len(df) == 8
