@@ -181,7 +181,8 @@ def _parameter(i: int, d, base: dict) -> Parameter:
              "low", "high"}
     extra = sorted(set(d) - known)
     if extra:
-        raise SweepError(f"{where}.{extra[0]} is not a known key (known: {', '.join(sorted(known))})")
+        raise SweepError(f"{where}.{extra[0]} is not a known key "
+                         f"(known: {', '.join(sorted(known))})")
     path = d.get("path")
     if not isinstance(path, str):
         raise SweepError(f"{where}.path is missing (a case-file key path, e.g. "

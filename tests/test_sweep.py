@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from asekit import sweep as S
-from asekit.case import CaseError, case_from_dict, load_case
+from asekit.case import case_from_dict
 from asekit.case import pipeline as P
 from asekit.paths import FIN_FILE
 
