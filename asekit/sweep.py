@@ -562,6 +562,15 @@ class AicFactors:
         return sum(a.nbytes + p.nbytes for a, p in self.lu.values())
 
 
+def _one_blas_thread():
+    """A context in which BLAS / LAPACK run on one thread (threadpoolctl). Multithreaded BLAS
+    may sum in another order, so the same sample would differ in its last bits between a
+    serial run (the user's thread settings) and Dask workers (one thread each); pinning one
+    thread everywhere makes the executors bit-identical whatever OMP_NUM_THREADS says."""
+    from threadpoolctl import threadpool_limits
+    return threadpool_limits(limits=1)
+
+
 def aero_key(case) -> str:
     """SHA-256 of what the AIC factors of ``case`` depend on besides Mach: its boxes (corners),
     reduced frequencies, reference semichord, kernel and symmetry."""
@@ -576,12 +585,17 @@ def aero_key(case) -> str:
 
 def aic_factors(case, machs) -> AicFactors:
     """LU factors of D(M, k) (:func:`asekit.aero.dlm.normalwash_matrices`) for the case's
-    boxes at every Mach of ``machs`` and the case's reduced frequencies."""
-    from .aero.dlm import normalwash_matrices
+    boxes at every Mach of ``machs`` and the case's reduced frequencies (BLAS on one thread)."""
     from .case import pipeline as P
-    a = case.aero
     boxes = P.box_mesh(case)
     ks = P.reduced_frequencies(case)
+    with _one_blas_thread():
+        return _factors(case, boxes, ks, machs)
+
+
+def _factors(case, boxes, ks, machs) -> AicFactors:
+    from .aero.dlm import normalwash_matrices
+    a = case.aero
     lu = {}
     for m in sorted({float(x) for x in machs}):
         d = normalwash_matrices(boxes, m, ks, a.reference_semichord, a.kernel,
@@ -647,7 +661,8 @@ def evaluate(sweep: Sweep, factors: AicFactors, index: int, values: dict) -> dic
     for k, v in values.items():
         row[k] = v
     try:
-        out, reused, mach, alt = _analyse(sweep, factors, values)
+        with _one_blas_thread():
+            out, reused, mach, alt = _analyse(sweep, factors, values)
         row.update(out)
         row["aic_reused"] = reused
         row["status"] = "ok"

@@ -30,6 +30,14 @@ def _cache(tmp_path, monkeypatch):
     monkeypatch.setenv("ASEKIT_CACHE_DIR", str(tmp_path / "cache"))
 
 
+@pytest.fixture
+def one_blas_thread():
+    """The pipeline computations a test compares with run on one BLAS thread, as the sweep's
+    samples do (multithreaded BLAS may differ in the last bits)."""
+    with S._one_blas_thread():
+        yield
+
+
 def sweep_dict(parameters, samples=None, outputs=None, seed=7, **sweep):
     s = {"name": "t", "case": str(FIN_FILE), "seed": seed, "mach": 0.6, "altitude": 0.0}
     if samples is not None:
@@ -194,7 +202,7 @@ def test_grid_times_monte_carlo_design():
 # ------------------------------------------------------------------------------------------
 # AIC reuse and one sample
 # ------------------------------------------------------------------------------------------
-def test_projected_gafs_equal_a_rebuilt_database_bit_for_bit(tmp_path):
+def test_projected_gafs_equal_a_rebuilt_database_bit_for_bit(tmp_path, one_blas_thread):
     """The factored D(M, k) projected on a varied structure's modes gives the GAFs the
     pipeline builds from scratch (same operations, Eqs. 2.10-2.12)."""
     from asekit.aero.gaf import cached_gaf_database
@@ -230,7 +238,7 @@ def test_structural_sweep_builds_the_dlm_once_per_mach(monkeypatch):
     assert df["aic_reused"].tolist() == [True, False]
 
 
-def test_a_sample_is_the_pipeline_on_the_edited_case():
+def test_a_sample_is_the_pipeline_on_the_edited_case(one_blas_thread):
     """Row = asekit.case.pipeline on the case file edited by hand (same flutter speed,
     frequency, divergence speed and flags); flight.mach / flight.altitude pick the condition."""
     from asekit.atmosphere import standard_atmosphere
@@ -263,7 +271,7 @@ def test_a_sample_is_the_pipeline_on_the_edited_case():
     assert row["f1_hz"] == model.frequencies_hz[1]
 
 
-def test_envelope_and_ase_outputs_are_the_pipeline():
+def test_envelope_and_ase_outputs_are_the_pipeline(one_blas_thread):
     """min_flutter_speed / envelope_margin / matched_mach = asekit.case.pipeline.flutter and
     the aem outputs = pipeline.ase on the edited case (two Machs, two altitudes)."""
     outs = list(S.ENVELOPE_OUTPUTS) + list(S.ASE_OUTPUTS)
@@ -396,6 +404,21 @@ def test_serial_processes_and_dask_give_identical_tables(client):
     assert (serial["status"] == "ok").all() and serial["flutter_speed"].notna().all()
     assert_identical(serial, S.run_sweep(sw, executor="processes", workers=2))
     assert_identical(serial, S.run_sweep(sw, executor="dask", client=client))
+
+
+def test_blas_threads_do_not_change_the_table(tmp_path):
+    """A serial run with two BLAS threads (OMP/OPENBLAS_NUM_THREADS=2) equals the in-process
+    table bit for bit: samples and factors run on one BLAS thread whatever the environment."""
+    d = sweep_dict(MC, samples=3, outputs=["flutter_speed", "divergence_speed", "f1_hz"])
+    f = tmp_path / "s.toml"
+    f.write_text(_toml(d))
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "2",
+           "OPENBLAS_NUM_THREADS": "2"}
+    r = subprocess.run([sys.executable, "-m", "asekit", "sweep", str(f), "--out", "o.csv",
+                        "--quiet"], env=env, cwd=tmp_path, capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert_identical(S.read_table(tmp_path / "o.csv"), S.run_sweep(S.sweep_from_dict(d)))
 
 
 def test_failing_task_on_dask_is_a_failed_row(client):
