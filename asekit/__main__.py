@@ -108,7 +108,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="run the other chapters when one's inputs fail, and exit 0")
     rep.set_defaults(func=_reproduce, parser=rep)
     from .cli_analyse import add_parser as add_analyse
+    from .cli_sweep import add_parser as add_sweep
     add_analyse(sub)
+    add_sweep(sub)
     return parser
 
 

@@ -1,0 +1,1133 @@
+"""Flight-envelope and uncertainty sweeps of a case file, serial, in local processes or on a
+Dask cluster, with identical results.
+
+A sweep (TOML, ``data/sweeps/``) names a base case file and varies its keys by key path
+(``material.youngs_modulus``, ``support.torsional_stiffness``, ``thickness.root``,
+``damping.modal_damping_ratio``, ``actuator.controller.k_p``, ``panel[0].tip_chord``...) plus
+the analysed flight condition ``flight.mach`` / ``flight.altitude``. Each parameter is a grid
+(``values`` or a ``range``) or a distribution (normal, uniform, lognormal, truncated normal) for
+Monte Carlo with a seed. The samples are the Cartesian product of the grids times the Monte
+Carlo draws (the same draws at every grid point: common random numbers).
+
+Every sample edits the parsed TOML dict of the base case at its key paths and rebuilds the
+case with :func:`asekit.case.case_from_dict`, so it is validated with the same key-path errors
+as a case file; a sample whose case is invalid (or whose analysis raises) becomes a failed row
+with its error message, never a dropped row.
+
+AIC reuse. The doublet-lattice normalwash matrices D(M, k) depend on the boxes, Mach and k only
+(:func:`asekit.aero.dlm.normalwash_matrices`). The sweep factors them once per (M, k) for the
+base box mesh (:func:`aic_factors`) and projects each sample's mode shapes:
+Q_ij(M, k) = h_i(lp)^T A D(M, k)^-1 (dh_j/dx + i k h_j / b) (thesis Eqs. 2.10-2.12, the same
+operations as :func:`asekit.aero.gaf.gaf_from_box_modes`, so the projected GAFs are bit-identical
+to a rebuilt database). A sample whose boxes, reduced frequencies or kernel settings differ from
+the base (a planform or ``aero`` key varied) gets its own factors (column ``aic_reused`` false).
+On Dask the factors are scattered to the workers once, on local processes they are passed once
+per process (pool initializer).
+
+Determinism: the samples are drawn up front from ``numpy.random.SeedSequence(seed)`` (one
+child stream per parameter, inverse-CDF transforms, no rejection), every sample is evaluated by
+the same pure function, and the table is sorted by sample index: the same sweep file gives
+bit-identical tables serially, with processes and on Dask (except the timing column
+``wall_s``) on machines with the same floating-point behaviour.
+
+Results: one row per sample (:data:`BASE_COLUMNS`, every parameter value, every output), journaled
+row by row to the output CSV as samples finish, so an interrupted sweep resumes from its partial
+output file (rows of another sweep are refused by their ``sweep_id``).
+"""
+
+from __future__ import annotations
+
+import copy
+import csv
+import hashlib
+import io
+import itertools
+import json
+import math
+import os
+import re
+import time
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import scipy.linalg as sla
+
+
+class SweepError(ValueError):
+    """A sweep file or sweep definition that cannot be run; the message names the key."""
+
+
+# ---------------------------------------------------------------------------------------------
+# key paths into the parsed TOML dict
+# ---------------------------------------------------------------------------------------------
+_TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)")
+#: Parameters that are not case-file keys: the analysed flight condition of each sample.
+CONDITION_PATHS = ("flight.mach", "flight.altitude")
+
+
+def parse_key_path(path: str) -> tuple:
+    """``"panel[0].tip_chord"`` -> ``("panel", 0, "tip_chord")``; SweepError if malformed."""
+    if not isinstance(path, str) or not path:
+        raise SweepError(f"a key path must be a non-empty string, got {path!r}")
+    out = []
+    for part in path.split("."):
+        m = _TOKEN.fullmatch(part)
+        if m is None:
+            raise SweepError(f"key path {path!r} is malformed at {part!r} (expected names "
+                             f"joined by dots, with optional [index], e.g. panel[0].tip_chord)")
+        out.append(m.group(1))
+        out.extend(int(i) for i in re.findall(r"\[(\d+)\]", m.group(2)))
+    return tuple(out)
+
+
+def get_key(d: dict, path: str):
+    """The value at ``path`` in the nested dict ``d`` (KeyError / IndexError if absent)."""
+    cur = d
+    for t in parse_key_path(path):
+        cur = cur[t]
+    return cur
+
+
+def set_key(d: dict, path: str, value) -> None:
+    """Set ``path`` in the nested dict ``d`` in place, creating missing tables (a table the
+    case schema does not know is then refused by :func:`~asekit.case.case_from_dict`)."""
+    toks = parse_key_path(path)
+    cur = d
+    for i, t in enumerate(toks[:-1]):
+        nxt = toks[i + 1]
+        if isinstance(t, int):
+            if not isinstance(cur, list) or t >= len(cur):
+                raise SweepError(f"key path {path!r}: index [{t}] does not exist in the base case")
+            cur = cur[t]
+            continue
+        if not isinstance(cur, dict):
+            raise SweepError(f"key path {path!r}: {t!r} is not inside a table")
+        if t not in cur:
+            if isinstance(nxt, int):
+                raise SweepError(f"key path {path!r}: {t} is not in the base case")
+            cur[t] = {}
+        cur = cur[t]
+    last = toks[-1]
+    if isinstance(last, int):
+        if not isinstance(cur, list) or last >= len(cur):
+            raise SweepError(f"key path {path!r}: index [{last}] does not exist in the base case")
+        cur[last] = value
+    else:
+        if not isinstance(cur, dict):
+            raise SweepError(f"key path {path!r}: the parent of {last!r} is not a table")
+        cur[last] = value
+
+
+# ---------------------------------------------------------------------------------------------
+# parameters and samplers
+# ---------------------------------------------------------------------------------------------
+DISTRIBUTIONS = ("normal", "uniform", "lognormal", "truncated_normal")
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One varied key.
+
+    path : the case-file key path (or ``flight.mach`` / ``flight.altitude``).
+    kind : ``"grid"`` (``values``) or a distribution: ``"normal"`` (``a`` = mean,
+        ``b`` = standard deviation), ``"uniform"`` (``low``, ``high``), ``"lognormal"``
+        (``a`` = median, ``b`` = sigma of ln X), ``"truncated_normal"`` (mean ``a``, standard
+        deviation ``b`` of the parent normal, truncated to [``low``, ``high``]).
+    """
+
+    path: str
+    kind: str
+    values: tuple = ()
+    a: float | None = None
+    b: float | None = None
+    low: float | None = None
+    high: float | None = None
+
+    @property
+    def is_grid(self) -> bool:
+        return self.kind == "grid"
+
+    def draw(self, u: np.ndarray) -> np.ndarray:
+        """Values from uniforms ``u`` in (0, 1) by the inverse CDF (deterministic)."""
+        from scipy.special import ndtr, ndtri
+        if self.kind == "normal":
+            return self.a + self.b * ndtri(u)
+        if self.kind == "uniform":
+            return self.low + (self.high - self.low) * u
+        if self.kind == "lognormal":
+            return self.a * np.exp(self.b * ndtri(u))
+        if self.kind == "truncated_normal":
+            lo, hi = ndtr((self.low - self.a) / self.b), ndtr((self.high - self.a) / self.b)
+            x = self.a + self.b * ndtri(lo + u * (hi - lo))
+            return np.clip(x, self.low, self.high)
+        raise SweepError(f"{self.path}: not a distribution ({self.kind})")
+
+
+def _num(where, v, positive=False):
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise SweepError(f"{where} must be a finite number, got {v!r}")
+    if positive and v <= 0:
+        raise SweepError(f"{where} must be > 0, got {v:g}")
+    return float(v)
+
+
+def _parameter(i: int, d, base: dict) -> Parameter:
+    where = f"parameter[{i}]"
+    if not isinstance(d, dict):
+        raise SweepError(f"{where} must be a table ([[parameter]]), got {d!r}")
+    known = {"path", "values", "range", "distribution", "mean", "std", "median", "sigma",
+             "low", "high"}
+    extra = sorted(set(d) - known)
+    if extra:
+        raise SweepError(f"{where}.{extra[0]} is not a known key "
+                         f"(known: {', '.join(sorted(known))})")
+    path = d.get("path")
+    if not isinstance(path, str):
+        raise SweepError(f"{where}.path is missing (a case-file key path, e.g. "
+                         f"material.youngs_modulus)")
+    parse_key_path(path)
+    where = f"parameter[{i}] ({path})"
+    grid = "values" in d or "range" in d
+    dist = d.get("distribution")
+    if grid and dist is not None:
+        raise SweepError(f"{where}: give values/range (a grid) or a distribution, not both")
+    if grid:
+        if "values" in d and "range" in d:
+            raise SweepError(f"{where}: give values or range, not both")
+        if "values" in d:
+            vals = d["values"]
+            if not isinstance(vals, list) or not vals:
+                raise SweepError(f"{where}.values must be a non-empty list, got {vals!r}")
+            vals = tuple(vals)
+        else:
+            r = d["range"]
+            if not isinstance(r, dict) or set(r) - {"min", "max", "num", "step"} \
+                    or "min" not in r or "max" not in r or (("num" in r) == ("step" in r)):
+                raise SweepError(f"{where}.range must be {{min, max, num}} or {{min, max, step}}, "
+                                 f"got {r!r}")
+            lo, hi = _num(f"{where}.range.min", r["min"]), _num(f"{where}.range.max", r["max"])
+            if hi < lo:
+                raise SweepError(f"{where}.range: min ({lo:g}) must be <= max ({hi:g})")
+            if "num" in r:
+                n = r["num"]
+                if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 100000:
+                    raise SweepError(f"{where}.range.num must be an integer in [1, 100000], "
+                                     f"got {n!r}")
+                vals = tuple(float(v) for v in np.linspace(lo, hi, n))
+            else:
+                st = _num(f"{where}.range.step", r["step"], positive=True)
+                n = int(math.floor((hi - lo) / st + 1e-9)) + 1
+                if n > 100000:
+                    raise SweepError(f"{where}.range gives {n} values (> 100000)")
+                vals = tuple(float(v) for v in lo + st * np.arange(n))
+        return Parameter(path, "grid", values=vals)
+    if dist is None:
+        raise SweepError(f"{where}: give values, range or distribution "
+                         f"({', '.join(DISTRIBUTIONS)})")
+    if dist not in DISTRIBUTIONS:
+        raise SweepError(f"{where}.distribution must be one of {', '.join(DISTRIBUTIONS)}, "
+                         f"got {dist!r}")
+    allowed = {"normal": {"mean", "std"}, "uniform": {"low", "high"},
+               "lognormal": {"median", "sigma"},
+               "truncated_normal": {"mean", "std", "low", "high"}}[dist]
+    bad = sorted(set(d) - allowed - {"path", "distribution"})
+    if bad:
+        raise SweepError(f"{where}: {bad[0]} is not a parameter of the {dist} distribution "
+                         f"(give {', '.join(sorted(allowed))})")
+
+    def centre(key):
+        if key in d:
+            return _num(f"{where}.{key}", d[key])
+        if path in CONDITION_PATHS:
+            raise SweepError(f"{where}.{key} is missing")
+        try:
+            v = get_key(base, path)
+        except (KeyError, IndexError, TypeError):
+            raise SweepError(f"{where}.{key} is missing and the base case has no value at "
+                             f"{path}") from None
+        return _num(f"{where}.{key} (the base case's {path})", v)
+
+    def bounds():
+        for k in ("low", "high"):
+            if k not in d:
+                raise SweepError(f"{where}.{k} is missing ({dist})")
+        lo, hi = _num(f"{where}.low", d["low"]), _num(f"{where}.high", d["high"])
+        if not lo < hi:
+            raise SweepError(f"{where}: low ({lo:g}) must be < high ({hi:g})")
+        return lo, hi
+
+    if dist == "normal":
+        return Parameter(path, dist, a=centre("mean"), b=_pos(where, d, "std"))
+    if dist == "uniform":
+        lo, hi = bounds()
+        return Parameter(path, dist, low=lo, high=hi)
+    if dist == "lognormal":
+        med = centre("median")
+        if med <= 0:
+            raise SweepError(f"{where}.median must be > 0, got {med:g}")
+        return Parameter(path, dist, a=med, b=_pos(where, d, "sigma"))
+    mean, std = centre("mean"), _pos(where, d, "std")
+    lo, hi = bounds()
+    from scipy.special import ndtr
+    if ndtr((hi - mean) / std) - ndtr((lo - mean) / std) < 1e-12:
+        raise SweepError(f"{where}: [low, high] = [{lo:g}, {hi:g}] holds no probability of "
+                         f"the normal(mean {mean:g}, std {std:g})")
+    return Parameter(path, dist, a=mean, b=std, low=lo, high=hi)
+
+
+def _pos(where, d, key):
+    if key not in d:
+        raise SweepError(f"{where}.{key} is missing")
+    v = d[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
+        raise SweepError(f"{where}.{key} must be a finite number > 0, got {v!r}")
+    return float(v)
+
+
+# ---------------------------------------------------------------------------------------------
+# outputs
+# ---------------------------------------------------------------------------------------------
+#: Outputs at the analysed condition (flight.mach, flight.altitude) of each sample.
+POINT_OUTPUTS = {
+    "flutter_speed": "m/s, first p-k flutter crossing (empty: none in the velocity sweep)",
+    "flutter_frequency": "Hz, at the flutter speed",
+    "flutter_mode": "index of the fluttering elastic mode",
+    "divergence_speed": "m/s, static divergence (steady GAF eigenproblem; empty: none)",
+    "unstable_at_start": "the first speed of the velocity sweep is already unstable",
+    "flight_speed": "m/s, M a at the analysed condition",
+    "flutter_margin": "U_f / (M a) - 1 at the analysed condition",
+    "flutter_inside": "flutter at or below the flight speed M a (unstable at the condition)",
+    "f1_hz": "Hz, first elastic natural frequency",
+    "f2_hz": "Hz, second elastic natural frequency",
+}
+#: Outputs over the whole case (every aero.machs x flight altitude; the analyse pipeline).
+ENVELOPE_OUTPUTS = {
+    "min_flutter_speed": "m/s, lowest flutter speed over aero.machs x flight conditions",
+    "envelope_margin": "smallest flutter margin U_f / U_envelope - 1 over the altitudes "
+                       "(needs [flight.envelope])",
+    "matched_mach": "lowest match-point Mach over the altitudes (empty: no match)",
+}
+#: Outputs of the ASE loop (needs [actuator]): thesis Ch. 5 / Table 2 metrics.
+ASE_OUTPUTS = {f"{t}_{m}": d for t in ("aem1", "aem2") for m, d in (
+    ("stable", "closed loop stable"), ("max_real_pole", "1/s, largest closed-loop Re(pole)"),
+    ("settling_s", "s, 2 % settling time of the power-limited step"),
+    ("steady_error", "fraction of the command at the end of the step"),
+    ("corner_overshoot", "largest corner overshoot, fraction of the command"))}
+OUTPUTS = {**POINT_OUTPUTS, **ENVELOPE_OUTPUTS, **ASE_OUTPUTS}
+#: Columns of every table, before the parameters and outputs.
+BASE_COLUMNS = ("sample", "sweep_id", "seed", "status", "error", "aic_reused", "wall_s")
+DEFAULT_OUTPUTS = ("flutter_speed", "flutter_frequency", "divergence_speed", "unstable_at_start",
+                   "flutter_margin", "flutter_inside")
+
+
+# ---------------------------------------------------------------------------------------------
+# the sweep
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Sweep:
+    """A checked sweep: ``base`` the parsed TOML dict of the base case (after the sweep's
+    ``[case]`` overrides), ``parameters``, Monte Carlo ``samples`` and ``seed``, the analysed
+    condition defaults ``mach`` / ``altitude``, the ``outputs`` and the file it came from."""
+
+    name: str
+    base: dict = field(compare=False, hash=False)
+    parameters: tuple[Parameter, ...]
+    outputs: tuple[str, ...]
+    mach: float
+    altitude: float
+    samples: int = 1
+    seed: int = 0
+    source: str = field(default="", compare=False)
+
+    @property
+    def grid(self) -> tuple[Parameter, ...]:
+        return tuple(p for p in self.parameters if p.is_grid)
+
+    @property
+    def random(self) -> tuple[Parameter, ...]:
+        return tuple(p for p in self.parameters if not p.is_grid)
+
+    @property
+    def n_samples(self) -> int:
+        n = self.samples if self.random else 1
+        for p in self.grid:
+            n *= len(p.values)
+        return n
+
+    def sweep_id(self) -> str:
+        """Short SHA-256 of everything that defines the rows (base case, parameters, outputs,
+        condition, samples, seed): the rows of a partial output file must carry it."""
+        d = {"base": self.base, "parameters": [p.__dict__ for p in self.parameters],
+             "outputs": list(self.outputs), "mach": self.mach, "altitude": self.altitude,
+             "samples": self.samples if self.random else 1, "seed": self.seed}
+        return hashlib.sha256(json.dumps(d, sort_keys=True, default=repr).encode()).hexdigest()[:16]
+
+    def columns(self) -> tuple[str, ...]:
+        params = [p.path for p in self.parameters if p.path not in CONDITION_PATHS]
+        return BASE_COLUMNS + ("flight.mach", "flight.altitude") + tuple(params) + self.outputs
+
+    def design(self) -> list[dict]:
+        """The samples in order: one dict {key path: value} per row (grid-major, then the Monte
+        Carlo draws, the same draws at every grid point)."""
+        rnd = self.random
+        if rnd:
+            children = np.random.SeedSequence(self.seed).spawn(len(rnd))
+            draws = []
+            for p, ss in zip(rnd, children):
+                g = np.random.Generator(np.random.PCG64(ss))
+                u = (g.integers(0, 2 ** 53, self.samples, dtype=np.int64) + 0.5) / 2.0 ** 53
+                draws.append(p.draw(u))
+            mc = [{p.path: float(x[i]) for p, x in zip(rnd, draws)} for i in range(self.samples)]
+        else:
+            mc = [{}]
+        grid = self.grid
+        out = []
+        for combo in itertools.product(*(p.values for p in grid)):
+            g = {p.path: v for p, v in zip(grid, combo)}
+            out.extend({**g, **m} for m in mc)
+        return out
+
+    def case_dict(self, values: dict) -> tuple[dict, float, float]:
+        """The sample's case dict (base edited at the key paths) and its analysed Mach and
+        altitude."""
+        d = copy.deepcopy(self.base)
+        mach, alt = self.mach, self.altitude
+        for path, v in values.items():
+            if path == "flight.mach":
+                mach = float(v)
+            elif path == "flight.altitude":
+                alt = float(v)
+            else:
+                set_key(d, path, v)
+        return d, mach, alt
+
+
+def _base_condition(case_dict: dict, case) -> tuple[float, float]:
+    """Default analysed condition: the envelope's top Mach at its lowest altitude (the
+    critical corner: highest flight speed at the highest density), else the case's highest
+    Mach at its first altitude."""
+    f = case.flight
+    mach = f.envelope_mach[1] if f.envelope_mach is not None else case.aero.machs[-1]
+    if f.envelope_altitude is not None:
+        alt = f.envelope_altitude[0]
+    elif f.altitudes is not None:
+        alt = f.altitudes[0]
+    else:
+        alt = 0.0
+    return float(mach), float(alt)
+
+
+def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
+    """Build and check a :class:`Sweep` from a parsed sweep file (see ``data/sweeps/``)."""
+    from .case import CaseError, case_from_dict
+    if not isinstance(d, dict):
+        raise SweepError("a sweep must be a table")
+    extra = sorted(set(d) - {"sweep", "case", "parameter"})
+    if extra:
+        raise SweepError(f"{extra[0]} is not a known key (known: sweep, case, parameter)")
+    s = d.get("sweep")
+    if not isinstance(s, dict):
+        raise SweepError("sweep is missing: a [sweep] table with case = \"path/to/case.toml\"")
+    known = {"name", "case", "samples", "seed", "outputs", "mach", "altitude"}
+    extra = sorted(set(s) - known)
+    if extra:
+        raise SweepError(f"sweep.{extra[0]} is not a known key (known: {', '.join(sorted(known))})")
+    name = s.get("name", "sweep")
+    if not isinstance(name, str) or not name:
+        raise SweepError(f"sweep.name must be a non-empty string, got {name!r}")
+    cpath = s.get("case")
+    if not isinstance(cpath, str) or not cpath:
+        raise SweepError("sweep.case is missing: the base case file (relative to the sweep file)")
+    p = Path(cpath)
+    if not p.is_absolute():
+        p = Path(base_dir) / p
+        if not p.exists():
+            from .paths import CASES_DIR
+            if (CASES_DIR / cpath).exists():          # a shipped case by name
+                p = CASES_DIR / cpath
+    try:
+        with open(p, "rb") as fh:
+            base = tomllib.load(fh)
+    except FileNotFoundError:
+        raise SweepError(f"sweep.case: case file {p} not found") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SweepError(f"sweep.case: {p.name} is not valid TOML: {exc}") from None
+    over = d.get("case", {})
+    if not isinstance(over, dict):
+        raise SweepError("case must be a table of overrides {key path = value}")
+    for k, v in over.items():
+        set_key(base, k, copy.deepcopy(v))
+    try:
+        base_case = case_from_dict(copy.deepcopy(base), source=str(p))
+    except CaseError as exc:
+        raise SweepError(f"base case ({p.name} with the sweep's [case] overrides): {exc}") from None
+    mach0, alt0 = _base_condition(base, base_case)
+    mach = _num("sweep.mach", s["mach"]) if "mach" in s else mach0
+    alt = _num("sweep.altitude", s["altitude"]) if "altitude" in s else alt0
+    _check_condition("sweep.mach", "flight.mach", mach)
+    _check_condition("sweep.altitude", "flight.altitude", alt)
+    samples = s.get("samples", 1)
+    if isinstance(samples, bool) or not isinstance(samples, int) or not 1 <= samples <= 10 ** 7:
+        raise SweepError(f"sweep.samples must be an integer in [1, 10000000], got {samples!r}")
+    seed = s.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise SweepError(f"sweep.seed must be an integer >= 0, got {seed!r}")
+    outs = s.get("outputs", list(DEFAULT_OUTPUTS))
+    if not isinstance(outs, list) or not outs or not all(isinstance(o, str) for o in outs):
+        raise SweepError(f"sweep.outputs must be a non-empty list of names, got {outs!r}")
+    for o in outs:
+        if o not in OUTPUTS:
+            raise SweepError(f"sweep.outputs: {o!r} is not an output (known: "
+                             f"{', '.join(OUTPUTS)})")
+    if len(set(outs)) != len(outs):
+        raise SweepError("sweep.outputs lists a name twice")
+    if any(o in ASE_OUTPUTS for o in outs) and base_case.actuator is None:
+        raise SweepError("sweep.outputs: the aem1_* / aem2_* outputs need an [actuator] in the "
+                         "base case")
+    if "envelope_margin" in outs and base_case.flight.envelope_mach is None:
+        raise SweepError("sweep.outputs: envelope_margin needs [flight.envelope] in the base case")
+    raw = d.get("parameter", [])
+    if not isinstance(raw, list):
+        raise SweepError("parameter must be an array of tables ([[parameter]])")
+    params = tuple(_parameter(i, t, base) for i, t in enumerate(raw))
+    for i, q in enumerate(params):
+        if q.path in CONDITION_PATHS and q.is_grid:
+            for j, v in enumerate(q.values):
+                _check_condition(f"parameter[{i}] ({q.path}).values[{j}]", q.path,
+                                 _num(f"parameter[{i}] ({q.path}).values[{j}]", v))
+    paths = [q.path for q in params]
+    if len(set(paths)) != len(paths):
+        dup = next(x for x in paths if paths.count(x) > 1)
+        raise SweepError(f"parameter path {dup!r} is given twice")
+    if "samples" in s and not any(not q.is_grid for q in params):
+        raise SweepError("sweep.samples needs at least one parameter with a distribution")
+    sweep = Sweep(name, base, params, tuple(outs), mach, alt, samples, seed, source)
+    # every parameter, alone at its first value, must give a case the schema accepts: an
+    # unknown key path is an error of the sweep file, not of each sample
+    first = sweep.design()[0] if sweep.n_samples else {}
+    for i, q in enumerate(params):
+        if q.path in CONDITION_PATHS:
+            continue
+        dd, _, _ = sweep.case_dict({q.path: first[q.path]})
+        try:
+            case_from_dict(dd)
+        except CaseError as exc:
+            msg = str(exc)
+            if "is not a known key" in msg:
+                raise SweepError(f"parameter[{i}].path {q.path!r} is not a case-file key: "
+                                 f"{msg}") from None
+    return sweep
+
+
+def _check_condition(where: str, path: str, v: float) -> None:
+    """The analysed Mach must suit the doublet lattice (0 <= M < 1), the altitude the 1976
+    standard atmosphere (-1000 to 80000 m)."""
+    if path == "flight.mach" and not 0.0 <= v < 1.0:
+        raise SweepError(f"{where} must be a Mach number in [0, 1) (doublet lattice), got {v:g}")
+    if path == "flight.altitude" and not -1000.0 <= v <= 80000.0:
+        raise SweepError(f"{where} must be an altitude in [-1000, 80000] m, got {v:g}")
+
+
+def load_sweep(path) -> Sweep:
+    """Read and check a sweep file (TOML); SweepError naming the key, or FileNotFoundError."""
+    path = Path(path)
+    with open(path, "rb") as fh:
+        try:
+            d = tomllib.load(fh)
+        except tomllib.TOMLDecodeError as exc:
+            raise SweepError(f"{path.name} is not valid TOML: {exc}") from None
+    return sweep_from_dict(d, base_dir=path.parent, source=str(path))
+
+
+# ---------------------------------------------------------------------------------------------
+# AIC reuse
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class AicFactors:
+    """LU factors of the DLM normalwash matrices D(M, k) of one box mesh.
+
+    key : what the factors depend on (box corners, k, b_ref, kernel, symmetry);
+    k : (n_k,) reduced frequencies; b_ref : m; lu : {mach: ((n_k, n, n) LU, (n_k, n) pivots)}.
+    """
+
+    key: str
+    k: np.ndarray
+    b_ref: float
+    lu: dict
+
+    @property
+    def nbytes(self) -> int:
+        return sum(a.nbytes + p.nbytes for a, p in self.lu.values())
+
+
+def _one_blas_thread():
+    """A context in which BLAS / LAPACK run on one thread (threadpoolctl). Multithreaded BLAS
+    may sum in another order, so the same sample would differ in its last bits between a
+    serial run (the user's thread settings) and Dask workers (one thread each); pinning one
+    thread everywhere makes the executors bit-identical whatever OMP_NUM_THREADS says."""
+    from threadpoolctl import threadpool_limits
+    return threadpool_limits(limits=1)
+
+
+def aero_key(case) -> str:
+    """SHA-256 of what the AIC factors of ``case`` depend on besides Mach: its boxes (corners),
+    reduced frequencies, reference semichord, kernel and symmetry."""
+    from .case import pipeline as P
+    a = case.aero
+    boxes = P.box_mesh(case)
+    h = hashlib.sha256(np.ascontiguousarray(boxes.corners).tobytes())
+    h.update(np.ascontiguousarray(P.reduced_frequencies(case)).tobytes())
+    h.update(json.dumps([a.reference_semichord, a.kernel, a.symmetry]).encode())
+    return h.hexdigest()
+
+
+def aic_factors(case, machs) -> AicFactors:
+    """LU factors of D(M, k) (:func:`asekit.aero.dlm.normalwash_matrices`) for the case's
+    boxes at every Mach of ``machs`` and the case's reduced frequencies (BLAS on one thread)."""
+    from .case import pipeline as P
+    boxes = P.box_mesh(case)
+    ks = P.reduced_frequencies(case)
+    with _one_blas_thread():
+        return _factors(case, boxes, ks, machs)
+
+
+def _factors(case, boxes, ks, machs) -> AicFactors:
+    from .aero.dlm import normalwash_matrices
+    a = case.aero
+    lu = {}
+    for m in sorted({float(x) for x in machs}):
+        d = normalwash_matrices(boxes, m, ks, a.reference_semichord, a.kernel,
+                                a.symmetry == "wall")
+        fac = [sla.lu_factor(d[i], check_finite=False) for i in range(ks.size)]
+        lu[m] = (np.stack([f[0] for f in fac]), np.stack([f[1] for f in fac]))
+    return AicFactors(aero_key(case), ks, float(a.reference_semichord), lu)
+
+
+def projected_gaf(model, case, factors: AicFactors, mach: float) -> np.ndarray:
+    """Q(M, k) (n_k, n_modes, n_modes) of ``model`` from the factored D(M, k):
+    Q = H_lp^T diag(A) D^-1 (dH/dx + i k H / b) per k (Eqs. 2.10-2.12), the operations of
+    :func:`asekit.aero.gaf.gaf_from_box_modes` on precomputed factors."""
+    from .aero.spline import fe_spline, modal_forces
+    from .case import pipeline as P
+    boxes = P.box_mesh(case)
+    bm = fe_spline(model, boxes)
+    lu, piv = factors.lu[float(mach)]
+    n = bm.h_cp.shape[1]
+    out = np.empty((factors.k.size, n, n), complex)
+    for ik, kk in enumerate(factors.k):
+        cp = sla.lu_solve((lu[ik], piv[ik]), bm.normalwash(kk, factors.b_ref))
+        out[ik] = modal_forces(bm, cp, boxes.area)
+    return out
+
+
+def needed_machs(sweep: Sweep) -> set:
+    """The Mach numbers the samples need factors at: their analysed Machs, and every
+    ``aero.machs`` when envelope or ASE outputs are asked for."""
+    machs = {sweep.mach}
+    for p in sweep.parameters:
+        if p.path == "flight.mach":
+            machs = set(float(v) for v in p.values) if p.is_grid else set()
+    if any(o in ENVELOPE_OUTPUTS or o in ASE_OUTPUTS for o in sweep.outputs):
+        machs |= {float(m) for m in sweep.base["aero"]["machs"]}
+    return machs
+
+
+def base_factors(sweep: Sweep) -> AicFactors:
+    """The factors of the base case at :func:`needed_machs` (computed once per sweep)."""
+    from .case import case_from_dict
+    return aic_factors(case_from_dict(copy.deepcopy(sweep.base)), needed_machs(sweep))
+
+
+# ---------------------------------------------------------------------------------------------
+# one sample
+# ---------------------------------------------------------------------------------------------
+def _database(model, case, factors: AicFactors, machs):
+    from .aero.gaf import GafDatabase
+    ms = np.array(sorted({float(m) for m in machs}))
+    Q = np.stack([projected_gaf(model, case, factors, m) for m in ms])
+    return GafDatabase(ms, factors.k, Q, factors.b_ref, model.n_rigid, {})
+
+
+def evaluate(sweep: Sweep, factors: AicFactors, index: int, values: dict) -> dict:
+    """The row of sample ``index`` with parameter ``values`` (key path -> value): the case is
+    rebuilt from the edited dict (:func:`~asekit.case.case_from_dict`), its modes projected on
+    the factored AICs, p-k at the analysed condition (and over the case for envelope outputs,
+    the ASE loop for aem outputs). Any exception gives ``status = "failed"`` and its message."""
+    t0 = time.perf_counter()
+    row = {c: None for c in sweep.columns()}
+    row.update({"sample": int(index), "sweep_id": sweep.sweep_id(), "seed": sweep.seed})
+    for k, v in values.items():
+        row[k] = v
+    try:
+        with _one_blas_thread():
+            out, reused, mach, alt = _analyse(sweep, factors, values)
+        row.update(out)
+        row["aic_reused"] = reused
+        row["status"] = "ok"
+    except Exception as exc:                 # recorded in the row, never dropped
+        row["status"] = "failed"
+        row["error"] = f"{type(exc).__name__}: {exc}".replace("\n", " ")
+        mach, alt = sweep.case_dict(values)[1:] if _safe(sweep, values) else (None, None)
+    row["flight.mach"], row["flight.altitude"] = mach, alt
+    row["wall_s"] = time.perf_counter() - t0
+    return row
+
+
+def _safe(sweep, values):
+    try:
+        sweep.case_dict(values)
+        return True
+    except Exception:
+        return False
+
+
+def _analyse(sweep: Sweep, factors: AicFactors, values: dict):
+    from .atmosphere import standard_atmosphere
+    from .case import case_from_dict
+    from .case import pipeline as P
+    from .flutter import divergence_speeds
+    d, mach, alt = sweep.case_dict(values)
+    _check_condition("flight.mach", "flight.mach", mach)
+    _check_condition("flight.altitude", "flight.altitude", alt)
+    case = case_from_dict(d)
+    model = P.modal_model(case)
+    if aero_key(case) == factors.key:
+        fac, reused = factors, True
+    else:
+        fac, reused = aic_factors(case, needed_machs(sweep) | {mach}), False
+    if float(mach) not in fac.lu:
+        fac = AicFactors(fac.key, fac.k, fac.b_ref,
+                         {**fac.lu, **aic_factors(case, [mach]).lu})
+    out = {}
+    want = set(sweep.outputs)
+    f_el = model.frequencies_hz[model.n_rigid:]
+    if "f1_hz" in want:
+        out["f1_hz"] = float(f_el[0])
+    if "f2_hz" in want:
+        out["f2_hz"] = float(f_el[1]) if f_el.size > 1 else None
+    if want & set(POINT_OUTPUTS) - {"f1_hz", "f2_hz"}:
+        atm = standard_atmosphere(alt)
+        cond = P.FlightCondition(float(alt), float(atm.density), float(atm.speed_of_sound))
+        db = _database(model, case, fac, [mach])
+        r = P.analyse_condition(case, db, mach, cond, model)
+        f = r.flutter
+        u_f = None if (f is None or r.unstable_at_start) else float(f.speed)
+        u_fl = float(mach) * cond.speed_of_sound
+        div = divergence_speeds(model, db.Q[0, 0].real, cond.density)
+        out.update({"flutter_speed": u_f,
+                    "flutter_frequency": None if u_f is None else float(f.frequency_hz),
+                    "flutter_mode": None if u_f is None else int(f.mode),
+                    "divergence_speed": float(div[0]) if div.size else None,
+                    "unstable_at_start": bool(r.unstable_at_start), "flight_speed": u_fl})
+        if "flutter_margin" in want or "flutter_inside" in want:
+            u_max = case.flight.velocities[-1]
+            if r.unstable_at_start:
+                inside, margin = True, None
+            elif u_f is not None:
+                inside, margin = u_f <= u_fl, u_f / u_fl - 1.0
+            elif u_max >= u_fl:
+                inside, margin = False, None
+            else:
+                raise ValueError(f"flutter_inside: no flutter up to {u_max:g} m/s, the end of "
+                                 f"flight.velocities, below the flight speed M a = {u_fl:g} "
+                                 f"m/s: extend the velocity sweep")
+            out["flutter_margin"], out["flutter_inside"] = margin, bool(inside)
+    if want & set(ENVELOPE_OUTPUTS) or want & set(ASE_OUTPUTS):
+        db = _database(model, case, fac, case.aero.machs)
+        if want & set(ENVELOPE_OUTPUTS):
+            fa = P.flutter(case, db=db)
+            speeds = [r.flutter.speed for r in fa.results
+                      if r.flutter is not None and not r.unstable_at_start]
+            if any(r.unstable_at_start for r in fa.results):
+                speeds.append(case.flight.velocities[0])
+            out["min_flutter_speed"] = float(min(speeds)) if speeds else None
+            ms = [m["margin"] for m in fa.margins if m["margin"] is not None]
+            out["envelope_margin"] = float(min(ms)) if ms else None
+            mm = [m["matched_mach"] for m in fa.match_points if m["matched_mach"] is not None]
+            out["matched_mach"] = float(min(mm)) if mm else None
+        if want & set(ASE_OUTPUTS):
+            a = P.ase(case, db=db)
+            for t in ("AEM1", "AEM2"):
+                p = t.lower()
+                out[f"{p}_stable"] = bool(a.stable[t])
+                out[f"{p}_max_real_pole"] = a.max_real_pole[t]
+                out[f"{p}_settling_s"] = a.settling_s[t]
+                out[f"{p}_steady_error"] = a.steady_error[t]
+                out[f"{p}_corner_overshoot"] = max(a.corner_overshoot[t].values())
+    return {k: v for k, v in out.items() if k in want}, reused, float(mach), float(alt)
+
+
+# ---------------------------------------------------------------------------------------------
+# the output file (journal)
+# ---------------------------------------------------------------------------------------------
+def _cell(v) -> str:
+    if v is None:
+        return ""
+    if isinstance(v, (bool, np.bool_)):
+        return "True" if v else "False"
+    if isinstance(v, (float, np.floating)):
+        if not math.isfinite(v):
+            return "inf" if v > 0 else ("-inf" if v < 0 else "nan")
+        return repr(float(v))                      # shortest round-trip repr: bit-exact
+    return str(v)
+
+
+def format_row(row: dict, columns) -> str:
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerow([_cell(row.get(c)) for c in columns])
+    return buf.getvalue()
+
+
+def read_journal(path: Path, sweep: Sweep) -> dict[int, str]:
+    """The finished rows of a partial output file, {sample: CSV line}. A last line cut off by
+    an interruption is dropped (that sample runs again); SweepError if the file belongs to
+    another sweep or has other columns."""
+    cols = list(sweep.columns())
+    text = path.read_text()
+    if not text.strip():
+        return {}
+    lines = text.splitlines(keepends=True)
+    header = next(csv.reader([lines[0]]))
+    if header != cols:
+        raise SweepError(f"{path}: its columns are not this sweep's; give another --out or "
+                         f"delete the file")
+    done = {}
+    sid = sweep.sweep_id()
+    i_s, i_id = cols.index("sample"), cols.index("sweep_id")
+    for ln in lines[1:]:
+        if not ln.endswith("\n"):
+            continue                                  # cut off mid-write
+        cells = next(csv.reader([ln]))
+        if len(cells) != len(cols):
+            continue
+        if cells[i_id] != sid:
+            raise SweepError(f"{path}: holds rows of another sweep (sweep_id {cells[i_id]}, "
+                             f"this one {sid}); give another --out or delete the file")
+        done[int(cells[i_s])] = ln
+    return done
+
+
+def read_table(path):
+    """The output CSV as a pandas DataFrame (floats read back bit-exactly)."""
+    import pandas as pd
+    df = pd.read_csv(path)
+    return df
+
+
+# ---------------------------------------------------------------------------------------------
+# executors
+# ---------------------------------------------------------------------------------------------
+EXECUTORS = ("serial", "processes", "dask")
+_WORKER: dict = {}        # per worker process of the "processes" executor: (sweep, factors)
+
+
+def _init_worker(sweep, factors):
+    _WORKER["job"] = (sweep, factors)
+
+
+def _worker_evaluate(index, values):
+    sweep, factors = _WORKER["job"]
+    return evaluate(sweep, factors, index, values)
+
+
+def connect(scheduler: str | None, workers: int | None, timeout: float = 5.0):
+    """A dask.distributed Client: to ``scheduler`` (SweepError if it is not reachable within
+    ``timeout`` s), else to a new LocalCluster of ``workers`` single-threaded worker processes.
+    Returns (client, cluster or None)."""
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        raise SweepError("--executor dask needs dask[distributed]: pip install "
+                         "'asekit[sweep]'") from None
+    if scheduler:
+        try:
+            return Client(scheduler, timeout=f"{timeout}s"), None
+        except Exception as exc:      # refused, timed out, or not a Dask scheduler at all
+            raise SweepError(f"cannot reach the Dask scheduler at {scheduler} within "
+                             f"{timeout:g} s ({type(exc).__name__}: {str(exc)[:120]})") from None
+    cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
+                           dashboard_address=None)
+    return Client(cluster), cluster
+
+
+def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | None = None,
+              scheduler: str | None = None, client=None, progress: bool = False,
+              factors: AicFactors | None = None, retry_failed: bool = False):
+    """Run every sample not yet in ``out`` and return the whole table (pandas DataFrame,
+    sorted by sample).
+
+    Parameters
+    ----------
+    sweep : the :class:`Sweep`.
+    out : output CSV path: finished rows are appended as they arrive (an interrupted sweep
+        resumes from it); at the end it is rewritten sorted by sample. None: in memory.
+    executor : "serial", "processes" (``workers`` local processes, default 2) or "dask"
+        (``client`` if given, else ``scheduler`` address, else a LocalCluster of ``workers``).
+    progress : tqdm bar.
+    factors : precomputed :func:`base_factors` (else computed here, once).
+    retry_failed : on resume, run the failed rows of ``out`` again (e.g. after a lost worker)
+        instead of keeping them.
+
+    The "processes" executor starts its workers with the ``spawn`` method: a script that calls
+    it must guard its entry point with ``if __name__ == "__main__":`` (Python's multiprocessing
+    rule); notebooks and ``python -m asekit sweep`` need nothing.
+    """
+    if executor not in EXECUTORS:
+        raise SweepError(f"executor must be one of {', '.join(EXECUTORS)}, got {executor!r}")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
+        raise SweepError(f"workers must be an integer >= 1, got {workers!r}")
+    cols = sweep.columns()
+    design = sweep.design()
+    path = None if out is None else Path(out)
+    done: dict[int, str] = {}
+    if path is not None and path.exists():
+        done = read_journal(path, sweep)
+        if retry_failed:
+            i_st = cols.index("status")
+            done = {i: ln for i, ln in done.items()
+                    if next(csv.reader([ln]))[i_st] == "ok"}
+        _rewrite(path, cols, done)                    # drops a cut-off last line
+    todo = [(i, v) for i, v in enumerate(design) if i not in done]
+    rows_mem = dict(done)
+    fh = None
+    cl = cluster = None
+    if todo and executor == "dask":
+        cl, cluster = (client, None) if client is not None else connect(scheduler, workers)
+    bar = None
+    try:
+        if todo:
+            factors = base_factors(sweep) if factors is None else factors
+        if progress:
+            from tqdm.auto import tqdm
+            bar = tqdm(total=len(design), initial=len(done), desc=f"sweep {sweep.name}",
+                       unit="sample")
+        if path is not None:
+            if not path.exists():
+                path.parent.mkdir(parents=True, exist_ok=True)
+                path.write_text(",".join(cols) + "\n")
+            fh = open(path, "a")
+
+        def record(row):
+            line = format_row(row, cols)
+            rows_mem[row["sample"]] = line
+            if fh is not None:
+                fh.write(line)
+                fh.flush()
+            if bar is not None:
+                bar.update(1)
+
+        if todo:
+            if executor == "serial":
+                for i, v in todo:
+                    record(evaluate(sweep, factors, i, v))
+            elif executor == "processes":
+                _run_processes(sweep, factors, todo, workers or 2, record)
+            else:
+                _run_dask(cl, sweep, factors, todo, record)
+    finally:
+        if fh is not None:
+            fh.close()
+        if bar is not None:
+            bar.close()
+        if cl is not None and client is None:
+            cl.close()
+            if cluster is not None:
+                cluster.close()
+    text = ",".join(cols) + "\n" + "".join(rows_mem[i] for i in sorted(rows_mem))
+    if path is not None:
+        _atomic_write(path, text)
+    import pandas as pd
+    return pd.read_csv(io.StringIO(text))
+
+
+def _rewrite(path: Path, cols, done: dict):
+    _atomic_write(path, ",".join(cols) + "\n" + "".join(done[i] for i in sorted(done)))
+
+
+def _atomic_write(path: Path, text: str):
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def _failed_row(sweep: Sweep, index: int, values: dict, exc: BaseException) -> dict:
+    row = {c: None for c in sweep.columns()}
+    row.update(values)
+    row.update({"sample": index, "sweep_id": sweep.sweep_id(), "seed": sweep.seed,
+                "status": "failed", "error": f"{type(exc).__name__}: {exc}".replace("\n", " ")})
+    return row
+
+
+def _run_processes(sweep, factors, todo, workers, record):
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    ctx = mp.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
+                             initargs=(sweep, factors)) as pool:
+        futs = {pool.submit(_worker_evaluate, i, v): (i, v) for i, v in todo}
+        for f in as_completed(futs):
+            i, v = futs[f]
+            try:
+                record(f.result())
+            except Exception as exc:          # a worker that died: recorded, not dropped
+                record(_failed_row(sweep, i, v, exc))
+
+
+def _run_dask(client, sweep, factors, todo, record):
+    from dask.distributed import as_completed
+    # the factors and the sweep go to every worker once; tasks carry their index and values
+    fac_f = client.scatter(factors, broadcast=True, hash=False)
+    sw_f = client.scatter(sweep, broadcast=True, hash=False)
+    futs = [client.submit(evaluate, sw_f, fac_f, i, v, key=f"sample-{sweep.sweep_id()}-{i}",
+                          pure=False) for i, v in todo]
+    meta = {f.key: (i, v) for f, (i, v) in zip(futs, todo)}
+    for f in as_completed(futs):
+        i, v = meta[f.key]
+        try:
+            record(f.result())
+        except Exception as exc:              # KilledWorker etc.: a failed row, not a hole
+            record(_failed_row(sweep, i, v, exc))
+        f.release()
+
+
+# ---------------------------------------------------------------------------------------------
+# statistics
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Proportion:
+    """An estimated probability ``p`` = k / n with its two-sided confidence interval
+    [``low``, ``high``] at ``confidence``."""
+
+    k: int
+    n: int
+    p: float
+    low: float
+    high: float
+    confidence: float
+
+
+def clopper_pearson(k: int, n: int, confidence: float = 0.95) -> Proportion:
+    """Exact (Clopper-Pearson) binomial confidence interval of k successes in n trials:
+    low = B^-1(alpha/2; k, n - k + 1), high = B^-1(1 - alpha/2; k + 1, n - k), with B^-1 the
+    beta quantile (Clopper & Pearson, Biometrika 26(4), 1934, 404-413; low = 0 for k = 0,
+    high = 1 for k = n). Coverage is at least ``confidence`` for every p."""
+    from scipy.stats import beta
+    if isinstance(n, bool) or int(n) != n or n < 1:
+        raise ValueError(f"n must be an integer >= 1, got {n!r}")
+    if isinstance(k, bool) or int(k) != k or not 0 <= k <= n:
+        raise ValueError(f"k must be an integer in [0, n = {n}], got {k!r}")
+    if not 0 < confidence < 1:
+        raise ValueError(f"confidence must be in (0, 1), got {confidence!r}")
+    k, n = int(k), int(n)
+    a = 1.0 - confidence
+    lo = 0.0 if k == 0 else float(beta.ppf(a / 2, k, n - k + 1))
+    hi = 1.0 if k == n else float(beta.ppf(1 - a / 2, k + 1, n - k))
+    return Proportion(k, n, k / n, lo, hi, confidence)
+
+
+def _ok(table):
+    if "status" not in table:
+        raise ValueError("table must be a sweep table (column 'status')")
+    return table[table["status"] == "ok"]
+
+
+def flutter_probability(table, column: str = "flutter_inside",
+                        confidence: float = 0.95) -> Proportion:
+    """P(flutter inside the envelope) from the successful rows of a sweep table (``column``
+    true = flutter at or below the flight speed), with its Clopper-Pearson interval. Failed
+    rows are not counted (their number is ``len(table) - n``)."""
+    ok = _ok(table)
+    if column not in ok:
+        raise ValueError(f"the table has no column {column!r} (add it to sweep.outputs)")
+    vals = ok[column]
+    if vals.isna().any():
+        raise ValueError(f"{column} is empty in {int(vals.isna().sum())} successful rows")
+    v = vals.astype(str).str.lower().map({"true": True, "false": False, "1": True, "0": False,
+                                          "1.0": True, "0.0": False})
+    return clopper_pearson(int(v.sum()), int(v.size), confidence)
+
+
+@dataclass(frozen=True)
+class Sensitivity:
+    """Standardised regression coefficients of ``output`` on the inputs, ranked by |SRC|
+    (``ranking``: (input, SRC) pairs), the regression's ``r2`` and the ``n`` rows used."""
+
+    output: str
+    ranking: tuple[tuple[str, float], ...]
+    r2: float
+    n: int
+
+
+def standardised_regression_coefficients(table, inputs, output: str) -> Sensitivity:
+    """SRC_j = b_j s_j / s_y of the least-squares fit y = b_0 + sum_j b_j x_j over the
+    successful rows with a value of ``output`` (Saltelli et al., *Global Sensitivity Analysis:
+    The Primer*, Wiley 2008, Sec. 1.2.5, Eqs. 1.6-1.8). For a linear model sum_j SRC_j^2 = R^2;
+    the ranking is meaningful when R^2 is close to 1 (it is returned)."""
+    ok = _ok(table)
+    inputs = list(inputs)
+    for c in inputs + [output]:
+        if c not in ok:
+            raise ValueError(f"the table has no column {c!r}")
+    sub = ok[inputs + [output]].dropna()
+    n = len(sub)
+    if n < len(inputs) + 2:
+        raise ValueError(f"need at least {len(inputs) + 2} rows with {output}, got {n}")
+    X = sub[inputs].to_numpy(float)
+    y = sub[output].to_numpy(float)
+    sx, sy = X.std(axis=0, ddof=1), y.std(ddof=1)
+    if np.any(sx == 0) or sy == 0:
+        raise ValueError("an input or the output does not vary")
+    Z = (X - X.mean(0)) / sx
+    zy = (y - y.mean()) / sy
+    src, *_ = np.linalg.lstsq(np.column_stack([np.ones(n), Z]), zy, rcond=None)
+    src = src[1:]
+    resid = zy - Z @ src
+    r2 = float(1.0 - resid @ resid / (zy @ zy))
+    order = np.argsort(-np.abs(src), kind="stable")
+    return Sensitivity(output, tuple((inputs[j], float(src[j])) for j in order), r2, n)
+
+
+def describe(table, column: str = "flutter_speed") -> dict:
+    """Mean, standard deviation, 5 / 50 / 95 % quantiles, min, max and count of ``column``
+    over the successful rows that have a value, and how many rows had none."""
+    ok = _ok(table)
+    v = ok[column].dropna().to_numpy(float)
+    if v.size == 0:
+        raise ValueError(f"no successful row has a {column}")
+    q = np.quantile(v, [0.05, 0.5, 0.95])
+    return {"n": int(v.size), "missing": int(len(ok) - v.size), "mean": float(v.mean()),
+            "std": float(v.std(ddof=1)) if v.size > 1 else 0.0, "p05": float(q[0]),
+            "median": float(q[1]), "p95": float(q[2]), "min": float(v.min()),
+            "max": float(v.max())}
+
+
+def match_points(table) -> list[dict]:
+    """Match points of an envelope table (columns flight.mach, flight.altitude, flutter_speed,
+    flight_speed): per altitude, the Mach at which the flutter Mach U_f(M) / a equals M, by
+    linear interpolation of d(M) = U_f / a - M between the grid Machs (the rule of
+    :func:`asekit.case.pipeline.flutter`). ``matched_mach`` None where d keeps one sign (no
+    match inside the grid: flutter-free if d > 0 throughout)."""
+    ok = _ok(table)
+    for c in ("flight.mach", "flight.altitude", "flutter_speed", "flight_speed"):
+        if c not in ok:
+            raise ValueError(f"the table has no column {c!r}")
+    out = []
+    for h, g in ok.groupby("flight.altitude", sort=True):
+        g = g.dropna(subset=["flutter_speed"]).sort_values("flight.mach")
+        if "unstable_at_start" in g:
+            g = g[~g["unstable_at_start"].astype(bool)]
+        m = g["flight.mach"].to_numpy(float)
+        a = g["flight_speed"].to_numpy(float) / m
+        d = g["flutter_speed"].to_numpy(float) / a - m
+        mm = None
+        for i in range(len(m) - 1):
+            if d[i] == 0 or d[i] * d[i + 1] < 0:
+                mm = float(m[i] + (m[i + 1] - m[i]) * d[i] / (d[i] - d[i + 1]))
+                break
+        speed = None if mm is None else float(mm * np.interp(mm, m, a))
+        out.append({"altitude_m": float(h), "matched_mach": mm, "matched_speed_ms": speed,
+                    "all_above": bool(mm is None and len(d) and np.all(d > 0))})
+    return out

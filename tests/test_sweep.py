@@ -1,0 +1,556 @@
+"""Sweeps (asekit.sweep): key-path editing, samplers, AIC reuse, the sample against the case
+pipeline, failed rows, resume, statistics; serial = processes = a real dask LocalCluster bit for
+bit, a failing task and a worker killed by PID mid-sweep."""
+
+import copy
+import csv
+import math
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from asekit import sweep as S
+from asekit.case import case_from_dict
+from asekit.case import pipeline as P
+from asekit.paths import FIN_FILE
+
+ROOT = Path(__file__).resolve().parent.parent
+FAST_V = {"min": 150.0, "max": 350.0, "step": 10.0}
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("ASEKIT_CACHE_DIR", str(tmp_path / "cache"))
+
+
+@pytest.fixture
+def one_blas_thread():
+    """The pipeline computations a test compares with run on one BLAS thread, as the sweep's
+    samples do (multithreaded BLAS may differ in the last bits)."""
+    with S._one_blas_thread():
+        yield
+
+
+def sweep_dict(parameters, samples=None, outputs=None, seed=7, **sweep):
+    s = {"name": "t", "case": str(FIN_FILE), "seed": seed, "mach": 0.6, "altitude": 0.0}
+    if samples is not None:
+        s["samples"] = samples
+    if outputs is not None:
+        s["outputs"] = outputs
+    s.update(sweep)
+    return {"sweep": s, "case": {"flight.velocities": dict(FAST_V)}, "parameter": parameters}
+
+
+MC = [{"path": "material.youngs_modulus", "distribution": "truncated_normal", "mean": 70e9,
+       "std": 1.75e9, "low": 66.5e9, "high": 73.5e9},
+      {"path": "support.torsional_stiffness", "distribution": "lognormal", "median": 120.0,
+       "sigma": 0.0912},
+      {"path": "damping.modal_damping_ratio", "distribution": "uniform", "low": 0.0,
+       "high": 0.01}]
+
+
+def strip(df):
+    return df.drop(columns=["wall_s"]).reset_index(drop=True)
+
+
+def assert_identical(a, b):
+    """Same columns, same cells, bit for bit (NaN == NaN), except the timing column."""
+    a, b = strip(a), strip(b)
+    assert list(a.columns) == list(b.columns)
+    assert len(a) == len(b)
+    for c in a.columns:
+        x, y = a[c].to_numpy(), b[c].to_numpy()
+        if x.dtype.kind == "f" and y.dtype.kind == "f":
+            nan = np.isnan(x)
+            assert np.array_equal(nan, np.isnan(y)), c
+            assert np.array_equal(x[~nan].view(np.uint64), y[~nan].view(np.uint64)), c
+        else:
+            assert list(map(str, x)) == list(map(str, y)), c
+
+
+# ------------------------------------------------------------------------------------------
+# key paths
+# ------------------------------------------------------------------------------------------
+def test_key_paths_edit_the_parsed_case():
+    d = {"a": {"b": 1}, "panel": [{"tip_chord": 0.1}]}
+    assert S.parse_key_path("panel[0].tip_chord") == ("panel", 0, "tip_chord")
+    S.set_key(d, "panel[0].tip_chord", 0.2)
+    S.set_key(d, "damping.modal_damping_ratio", 0.01)           # a missing table is created
+    S.set_key(d, "a.b", 3)
+    assert d == {"a": {"b": 3}, "panel": [{"tip_chord": 0.2}],
+                 "damping": {"modal_damping_ratio": 0.01}}
+    assert S.get_key(d, "panel[0].tip_chord") == 0.2
+    for bad in ("", "a..b", "a.[0]", "1a.b"):
+        with pytest.raises(S.SweepError, match="key path"):
+            S.parse_key_path(bad)
+    with pytest.raises(S.SweepError, match=r"index \[3\]"):
+        S.set_key(d, "panel[3].tip_chord", 1.0)
+
+
+def test_unknown_key_path_is_a_sweep_error_naming_it():
+    d = sweep_dict([{"path": "material.youngs_modulu", "values": [70e9]}])
+    with pytest.raises(S.SweepError, match=r"parameter\[0\].path 'material.youngs_modulu' is "
+                                           r"not a case-file key: material.youngs_modulu is "
+                                           r"not a known key"):
+        S.sweep_from_dict(d)
+    d = sweep_dict([{"path": "materal.density", "values": [2700.0]}])
+    with pytest.raises(S.SweepError, match="materal is not a known key"):
+        S.sweep_from_dict(d)
+
+
+@pytest.mark.parametrize("param, message", [
+    ({"distribution": "normal", "mean": 1.0, "std": -0.1}, r"std must be a finite number > 0"),
+    ({"distribution": "uniform", "low": 2.0, "high": 1.0}, r"low \(2\) must be < high \(1\)"),
+    ({"distribution": "lognormal", "median": 120.0, "sigma": 0.0}, r"sigma must be"),
+    ({"distribution": "truncated_normal", "mean": 0.0, "std": 1.0, "low": 1.0, "high": 0.5},
+     r"low \(1\) must be < high \(0.5\)"),
+    ({"distribution": "truncated_normal", "mean": 0.0, "std": 1.0, "low": 50.0, "high": 60.0},
+     "holds no probability"),
+    ({"distribution": "gamma", "mean": 1.0}, "distribution must be one of"),
+    ({"distribution": "normal", "mean": 1.0, "std": 1.0, "low": 0.0}, "low is not a parameter"),
+    ({"values": [1.0], "distribution": "normal"}, "not both"),
+    ({"range": {"min": 2.0, "max": 1.0, "num": 3}}, r"min \(2\) must be <= max \(1\)"),
+])
+def test_invalid_distribution_parameters(param, message):
+    d = sweep_dict([{"path": "support.torsional_stiffness", **param}], samples=3)
+    with pytest.raises(S.SweepError, match=message):
+        S.sweep_from_dict(d)
+
+
+def test_condition_out_of_range_is_a_sweep_error():
+    with pytest.raises(S.SweepError, match=r"values\[1\] must be a Mach number in \[0, 1\)"):
+        S.sweep_from_dict(sweep_dict([{"path": "flight.mach", "values": [0.5, 1.2]}]))
+    with pytest.raises(S.SweepError, match="sweep.altitude must be an altitude"):
+        S.sweep_from_dict(sweep_dict([], altitude=1e6))
+
+
+def test_unknown_output_and_sweep_keys():
+    with pytest.raises(S.SweepError, match="'flutter_sped' is not an output"):
+        S.sweep_from_dict(sweep_dict([], outputs=["flutter_sped"]))
+    with pytest.raises(S.SweepError, match="sweep.sample is not a known key"):
+        S.sweep_from_dict(sweep_dict([], sample=3))
+
+
+# ------------------------------------------------------------------------------------------
+# samplers
+# ------------------------------------------------------------------------------------------
+def test_samplers_match_their_distributions_and_the_seed():
+    """Moments of 40000 draws against the analytic values: normal mean/std; uniform mean
+    (a+b)/2, std (b-a)/sqrt(12); lognormal median and mean m exp(s^2/2); truncated normal mean
+    mu + s (phi(a) - phi(b)) / (Phi(b) - Phi(a)) (Johnson, Kotz & Balakrishnan, Continuous
+    Univariate Distributions 1, 2nd ed., Eq. 13.134) and its bounds. Tolerances: 5 standard
+    errors."""
+    from scipy.stats import norm
+    n = 40000
+    ps = [{"path": "material.youngs_modulus", "distribution": "normal", "mean": 70e9, "std": 2e9},
+          {"path": "material.density", "distribution": "uniform", "low": 2600.0, "high": 2800.0},
+          {"path": "support.torsional_stiffness", "distribution": "lognormal", "median": 120.0,
+           "sigma": 0.2},
+          {"path": "thickness.root", "distribution": "truncated_normal", "mean": 0.004,
+           "std": 0.0002, "low": 0.0039, "high": 0.0045}]
+    sw = S.sweep_from_dict(sweep_dict(ps, samples=n))
+    rows = sw.design()
+    assert len(rows) == n == sw.n_samples
+    x = {p["path"]: np.array([r[p["path"]] for r in rows]) for p in ps}
+    e = x["material.youngs_modulus"]
+    assert abs(e.mean() - 70e9) < 5 * 2e9 / math.sqrt(n)
+    assert abs(e.std() / 2e9 - 1) < 5 / math.sqrt(2 * n)
+    r = x["material.density"]
+    assert r.min() >= 2600 and r.max() <= 2800
+    assert abs(r.mean() - 2700) < 5 * (200 / math.sqrt(12)) / math.sqrt(n)
+    k = x["support.torsional_stiffness"]
+    assert abs(np.log(k).mean() - math.log(120.0)) < 5 * 0.2 / math.sqrt(n)
+    assert abs(np.log(k).std() - 0.2) < 5 * 0.2 / math.sqrt(2 * n)
+    t = x["thickness.root"]
+    a, b = (0.0039 - 0.004) / 0.0002, (0.0045 - 0.004) / 0.0002
+    mean = 0.004 + 0.0002 * (norm.pdf(a) - norm.pdf(b)) / (norm.cdf(b) - norm.cdf(a))
+    assert t.min() >= 0.0039 and t.max() <= 0.0045
+    assert abs(t.mean() - mean) < 5 * 0.0002 / math.sqrt(n)
+    # the same seed draws the same samples; another seed others
+    again = S.sweep_from_dict(sweep_dict(ps, samples=n)).design()
+    assert again == rows
+    other = S.sweep_from_dict(sweep_dict(ps, samples=n, seed=8)).design()
+    assert other[0] != rows[0]
+    # a parameter added at the end leaves the draws of the others as they were
+    more = S.sweep_from_dict(sweep_dict(ps + [{"path": "material.poisson_ratio",
+                                               "distribution": "uniform", "low": 0.29,
+                                               "high": 0.31}], samples=n)).design()
+    assert all(m[p["path"]] == r0[p["path"]] for m, r0 in zip(more[:50], rows[:50]) for p in ps)
+
+
+def test_grid_times_monte_carlo_design():
+    ps = [{"path": "flight.mach", "values": [0.4, 0.6]},
+          {"path": "flight.altitude", "range": {"min": 0.0, "max": 5000.0, "num": 3}},
+          MC[2]]
+    sw = S.sweep_from_dict(sweep_dict(ps, samples=4))
+    rows = sw.design()
+    assert sw.n_samples == len(rows) == 2 * 3 * 4
+    assert [r["flight.altitude"] for r in rows[:12:4]] == [0.0, 2500.0, 5000.0]
+    assert rows[0]["flight.mach"] == 0.4 and rows[12]["flight.mach"] == 0.6
+    # common random numbers: the same draws at every grid point
+    z = [r["damping.modal_damping_ratio"] for r in rows]
+    assert z[:4] == z[4:8] == z[20:24]
+
+
+# ------------------------------------------------------------------------------------------
+# AIC reuse and one sample
+# ------------------------------------------------------------------------------------------
+def test_projected_gafs_equal_a_rebuilt_database_bit_for_bit(tmp_path, one_blas_thread):
+    """The factored D(M, k) projected on a varied structure's modes gives the GAFs the
+    pipeline builds from scratch (same operations, Eqs. 2.10-2.12)."""
+    from asekit.aero.gaf import cached_gaf_database
+    sw = S.sweep_from_dict(sweep_dict([]))
+    fac = S.base_factors(sw)
+    d, _, _ = sw.case_dict({"material.youngs_modulus": 66e9, "thickness.root": 0.0041})
+    case = case_from_dict(d)
+    model = P.modal_model(case)
+    q = S.projected_gaf(model, case, fac, 0.6)
+    db = cached_gaf_database(model, P.box_mesh(case), [0.6], P.reduced_frequencies(case),
+                             case.aero.reference_semichord, progress=False, rebuild=True,
+                             cache_dir=tmp_path)
+    assert np.array_equal(q, db.Q[0])
+    assert S.aero_key(case) == fac.key
+
+
+def test_structural_sweep_builds_the_dlm_once_per_mach(monkeypatch):
+    import asekit.aero.dlm as dlm
+    calls = []
+    real = dlm.normalwash_matrices
+    monkeypatch.setattr(dlm, "normalwash_matrices",
+                        lambda *a, **k: calls.append(a[1]) or real(*a, **k))
+    sw = S.sweep_from_dict(sweep_dict(MC, samples=3, outputs=["f1_hz"]))
+    df = S.run_sweep(sw)
+    assert calls == [0.6]
+    assert df["aic_reused"].all() and (df["status"] == "ok").all()
+    # a planform change is not the base mesh: that sample gets its own factors
+    calls.clear()
+    sw = S.sweep_from_dict(sweep_dict([{"path": "panel[0].tip_chord", "values": [0.078, 0.07]}],
+                                      outputs=["flutter_speed"]))
+    df = S.run_sweep(sw)
+    assert calls == [0.6, 0.6]
+    assert df["aic_reused"].tolist() == [True, False]
+
+
+def test_a_sample_is_the_pipeline_on_the_edited_case(one_blas_thread):
+    """Row = asekit.case.pipeline on the case file edited by hand (same flutter speed,
+    frequency, divergence speed and flags); flight.mach / flight.altitude pick the condition."""
+    from asekit.atmosphere import standard_atmosphere
+    from asekit.flutter import divergence_speeds
+    ps = [{"path": "support.torsional_stiffness", "values": [100.0]},
+          {"path": "damping.modal_damping_ratio", "values": [0.005]},
+          {"path": "flight.mach", "values": [0.5]}, {"path": "flight.altitude", "values": [2500.0]}]
+    sw = S.sweep_from_dict(sweep_dict(ps, outputs=list(S.POINT_OUTPUTS)))
+    row = S.run_sweep(sw).iloc[0]
+    import tomllib
+    d = tomllib.loads(FIN_FILE.read_text())
+    d["support"]["torsional_stiffness"] = 100.0
+    d["damping"] = {"modal_damping_ratio": 0.005}
+    d["flight"]["velocities"] = dict(FAST_V)
+    case = case_from_dict(d)
+    db = P.gaf_database(case, progress=False)
+    atm = standard_atmosphere(2500.0)
+    cond = P.FlightCondition(2500.0, float(atm.density), float(atm.speed_of_sound))
+    r = P.analyse_condition(case, db, 0.5, cond)
+    assert row["status"] == "ok" and row["flight.mach"] == 0.5
+    assert row["flutter_speed"] == r.flutter.speed
+    assert row["flutter_frequency"] == r.flutter.frequency_hz
+    assert row["flutter_mode"] == r.flutter.mode
+    model = P.modal_model(case)
+    div = divergence_speeds(model, P.gaf_at(db, 0.5).Q[0].real, cond.density)
+    assert row["divergence_speed"] == div[0]
+    assert row["flight_speed"] == 0.5 * cond.speed_of_sound
+    assert row["flutter_margin"] == r.flutter.speed / (0.5 * cond.speed_of_sound) - 1
+    assert row["flutter_inside"] == (r.flutter.speed <= 0.5 * cond.speed_of_sound)
+    assert row["f1_hz"] == model.frequencies_hz[1]
+
+
+def test_envelope_and_ase_outputs_are_the_pipeline(one_blas_thread):
+    """min_flutter_speed / envelope_margin / matched_mach = asekit.case.pipeline.flutter and
+    the aem outputs = pipeline.ase on the edited case (two Machs, two altitudes)."""
+    outs = list(S.ENVELOPE_OUTPUTS) + list(S.ASE_OUTPUTS)
+    d = sweep_dict([{"path": "actuator.controller.k_p", "values": [250.0]}], outputs=outs)
+    d["case"].update({"aero.machs": [0.5, 0.6], "flight.altitudes": [0.0, 5000.0],
+                      "actuator.condition.mach": 0.55})
+    sw = S.sweep_from_dict(d)
+    row = S.run_sweep(sw).iloc[0]
+    assert row["status"] == "ok", row["error"]
+    case = case_from_dict(sw.case_dict({"actuator.controller.k_p": 250.0})[0])
+    db = P.gaf_database(case, progress=False)
+    fa = P.flutter(case, db=db)
+    assert row["min_flutter_speed"] == min(r.flutter.speed for r in fa.results)
+    assert row["envelope_margin"] == min(m["margin"] for m in fa.margins)
+    mm = [m["matched_mach"] for m in fa.match_points if m["matched_mach"] is not None]
+    assert (math.isnan(row["matched_mach"]) and not mm) or row["matched_mach"] == min(mm)
+    a = P.ase(case, db=db)
+    for t in ("AEM1", "AEM2"):
+        p = t.lower()
+        assert row[f"{p}_stable"] == a.stable[t]
+        assert row[f"{p}_max_real_pole"] == a.max_real_pole[t]
+        assert row[f"{p}_settling_s"] == a.settling_s[t]
+        assert row[f"{p}_corner_overshoot"] == max(a.corner_overshoot[t].values())
+
+
+def test_failed_sample_is_a_row_with_its_error():
+    sw = S.sweep_from_dict(sweep_dict([{"path": "material.youngs_modulus",
+                                        "values": [70e9, -1.0]}], outputs=["f1_hz"]))
+    df = S.run_sweep(sw)
+    assert len(df) == 2
+    assert df["status"].tolist() == ["ok", "failed"]
+    assert "CaseError: material.youngs_modulus must be > 0 Pa, got -1" in df["error"][1]
+    assert df["material.youngs_modulus"][1] == -1.0 and math.isnan(df["f1_hz"][1])
+
+
+def test_undecidable_flutter_inside_is_a_failed_row_not_false():
+    d = sweep_dict([{"path": "support.torsional_stiffness", "values": [120.0]}],
+                   outputs=["flutter_inside"])
+    d["case"]["flight.velocities"] = {"min": 100.0, "max": 180.0, "step": 10.0}
+    df = S.run_sweep(S.sweep_from_dict(d))
+    assert df["status"][0] == "failed" and "extend the velocity sweep" in df["error"][0]
+
+
+def test_resume_from_a_partial_file(tmp_path):
+    sw = S.sweep_from_dict(sweep_dict([MC[1]], samples=3, outputs=["f1_hz", "flutter_speed"]))
+    out = tmp_path / "r.csv"
+    full = S.run_sweep(sw, out=out)
+    lines = out.read_text().splitlines(keepends=True)
+    assert len(lines) == 4
+    out.write_text(lines[0] + lines[2] + lines[3][:20])          # one row, one cut-off row
+    again = S.run_sweep(sw, out=out)
+    assert_identical(full, again)
+    assert again["wall_s"][1] == full["wall_s"][1]                 # the kept row was not rerun
+    other = S.sweep_from_dict(sweep_dict([MC[1]], samples=3, seed=99,
+                                         outputs=["f1_hz", "flutter_speed"]))
+    with pytest.raises(S.SweepError, match="rows of another sweep"):
+        S.run_sweep(other, out=out)
+
+
+def test_resume_keeps_or_retries_failed_rows(tmp_path):
+    sw = S.sweep_from_dict(sweep_dict([{"path": "support.torsional_stiffness",
+                                        "values": [100.0, 120.0]}], outputs=["f1_hz"]))
+    out = tmp_path / "r.csv"
+    full = S.run_sweep(sw, out=out)
+    lines = out.read_text().splitlines(keepends=True)
+    cols = next(csv.reader([lines[0]]))
+    cells = next(csv.reader([lines[2]]))
+    cells[cols.index("status")], cells[cols.index("error")] = "failed", "KilledWorker: lost"
+    cells[cols.index("f1_hz")] = ""
+    out.write_text(lines[0] + lines[1] + ",".join(cells) + "\n")
+    kept = S.run_sweep(sw, out=out)
+    assert kept["status"].tolist() == ["ok", "failed"]           # a finished row is kept
+    again = S.run_sweep(sw, out=out, retry_failed=True)
+    assert_identical(full, again)
+
+
+# ------------------------------------------------------------------------------------------
+# statistics
+# ------------------------------------------------------------------------------------------
+def test_clopper_pearson_interval():
+    """k = 0: high = 1 - (alpha/2)^(1/n) exactly; k = 5 of 10: [0.187086, 0.812914] (R
+    binom.test(5, 10)); and the defining tail equations P(X >= k | low) = P(X <= k | high) =
+    alpha / 2 (Clopper & Pearson 1934)."""
+    from scipy.stats import binom
+    r = S.clopper_pearson(0, 10)
+    assert r.low == 0.0 and math.isclose(r.high, 1 - 0.025 ** 0.1, rel_tol=1e-12)
+    r = S.clopper_pearson(5, 10)
+    assert abs(r.low - 0.187086) < 1e-6 and abs(r.high - 0.812914) < 1e-6
+    r = S.clopper_pearson(7, 40, 0.9)
+    assert math.isclose(binom.sf(6, 40, r.low), 0.05, rel_tol=1e-9)
+    assert math.isclose(binom.cdf(7, 40, r.high), 0.05, rel_tol=1e-9)
+    for bad in ((11, 10), (-1, 10), (1, 0)):
+        with pytest.raises(ValueError):
+            S.clopper_pearson(*bad)
+
+
+def test_standardised_regression_coefficients_of_a_linear_model():
+    """y = 2 x1 - 0.5 x2 + 0 x3 with sd(x) = 1, 4, 3: SRC = b_j sd_j / sd_y = 2/sqrt(8),
+    -2/sqrt(8), 0 (Saltelli et al. 2008, Eq. 1.8), R^2 = 1."""
+    import pandas as pd
+    g = np.random.default_rng(1)
+    x = g.standard_normal((5000, 3)) * [1.0, 4.0, 3.0]
+    y = 2 * x[:, 0] - 0.5 * x[:, 1]
+    t = pd.DataFrame({"a": x[:, 0], "b": x[:, 1], "c": x[:, 2], "y": y, "status": "ok"})
+    s = S.standardised_regression_coefficients(t, ["c", "b", "a"], "y")
+    names = [n for n, _ in s.ranking]
+    assert names[2] == "c" and abs(s.ranking[2][1]) < 0.01
+    src = dict(s.ranking)
+    assert abs(src["a"] - 2 / math.sqrt(8)) < 0.02 and abs(src["b"] + 2 / math.sqrt(8)) < 0.02
+    assert s.r2 > 1 - 1e-12
+
+
+# ------------------------------------------------------------------------------------------
+# processes and a real dask.distributed LocalCluster (2 worker processes)
+# ------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def client():
+    distributed = pytest.importorskip("dask.distributed")
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                       dashboard_address=None)
+    cl = distributed.Client(cluster)
+    yield cl
+    cl.close()
+    cluster.close()
+
+
+def test_serial_processes_and_dask_give_identical_tables(client):
+    sw = S.sweep_from_dict(sweep_dict(MC, samples=4))
+    serial = S.run_sweep(sw)
+    assert (serial["status"] == "ok").all() and serial["flutter_speed"].notna().all()
+    assert_identical(serial, S.run_sweep(sw, executor="processes", workers=2))
+    assert_identical(serial, S.run_sweep(sw, executor="dask", client=client))
+
+
+def test_blas_threads_do_not_change_the_table(tmp_path):
+    """A serial run with two BLAS threads (OMP/OPENBLAS_NUM_THREADS=2) equals the in-process
+    table bit for bit: samples and factors run on one BLAS thread whatever the environment."""
+    d = sweep_dict(MC, samples=3, outputs=["flutter_speed", "divergence_speed", "f1_hz"])
+    f = tmp_path / "s.toml"
+    f.write_text(_toml(d))
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "2",
+           "OPENBLAS_NUM_THREADS": "2"}
+    r = subprocess.run([sys.executable, "-m", "asekit", "sweep", str(f), "--out", "o.csv",
+                        "--quiet"], env=env, cwd=tmp_path, capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert_identical(S.read_table(tmp_path / "o.csv"), S.run_sweep(S.sweep_from_dict(d)))
+
+
+def test_failing_task_on_dask_is_a_failed_row(client):
+    sw = S.sweep_from_dict(sweep_dict([{"path": "damping.modal_damping_ratio",
+                                        "values": [0.0, 1.5]}], outputs=["flutter_speed"]))
+    df = S.run_sweep(sw, executor="dask", client=client)
+    assert df["status"].tolist() == ["ok", "failed"]
+    assert "damping.modal_damping_ratio[0] must be < 1" in df["error"][1]
+    assert_identical(df, S.run_sweep(sw))
+
+
+def test_worker_killed_mid_sweep_loses_no_rows(client, tmp_path):
+    """SIGKILL one worker process by PID once the first rows are in the file: the finished
+    rows stay, dask reruns the lost tasks on the restarted worker, and the table equals the
+    serial one."""
+    sw = S.sweep_from_dict(sweep_dict(MC, samples=8, outputs=["flutter_speed", "f1_hz"]))
+    out = tmp_path / "killed.csv"
+    pids = list(client.run(os.getpid).values())
+    seen = {}
+
+    def killer():
+        t0 = time.time()
+        while time.time() - t0 < 120:
+            if out.exists() and len(out.read_text().splitlines()) >= 3:
+                seen["rows"] = out.read_text().splitlines()[1:]
+                os.kill(pids[0], signal.SIGKILL)
+                return
+            time.sleep(0.02)
+
+    th = threading.Thread(target=killer)
+    th.start()
+    df = S.run_sweep(sw, out=out, executor="dask", client=client)
+    th.join()
+    assert "rows" in seen, "the worker was never killed"
+    assert pids[0] not in client.run(os.getpid).values()         # it died (and was replaced)
+    final = out.read_text().splitlines()
+    assert all(r in final for r in seen["rows"])                 # no finished row lost
+    assert len(df) == 8
+    assert_identical(df, S.run_sweep(sw))
+
+
+def test_interrupted_sweep_resumes_on_dask(tmp_path):
+    """The CLI killed (SIGKILL) mid-sweep leaves its finished rows; rerunning it with
+    --executor dask (a LocalCluster it starts) completes the table, identical to serial."""
+    pytest.importorskip("dask.distributed")
+    d = sweep_dict(MC, samples=6, outputs=["flutter_speed", "f1_hz"])
+    sw_file = tmp_path / "s.toml"
+    sw_file.write_text(_toml(d))
+    out = tmp_path / "out.csv"
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    cmd = [sys.executable, "-m", "asekit", "sweep", str(sw_file), "--out", str(out), "--quiet"]
+    proc = subprocess.Popen(cmd, env=env, cwd=tmp_path)
+    t0 = time.time()
+    while time.time() - t0 < 120 and proc.poll() is None:
+        if out.exists() and len(out.read_text().splitlines()) >= 3:
+            break
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    kept = out.read_text().splitlines()[1:]
+    assert 2 <= len(kept) < 6
+    r = subprocess.run(cmd + ["--executor", "dask", "--workers", "2"], env=env, cwd=tmp_path,
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    final = out.read_text().splitlines()
+    assert set(kept) <= set(final)
+    assert_identical(S.read_table(out), S.run_sweep(S.sweep_from_dict(d)))
+
+
+def _toml(d) -> str:
+    """A minimal TOML writer for the test sweeps (tables of scalars, lists, inline tables)."""
+    def val(v):
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, str):
+            return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        if isinstance(v, dict):
+            return "{ " + ", ".join(f"{k} = {val(x)}" for k, x in v.items()) + " }"
+        if isinstance(v, list):
+            return "[" + ", ".join(val(x) for x in v) + "]"
+        return repr(v)
+    out = ["[sweep]"] + [f"{k} = {val(v)}" for k, v in d["sweep"].items()]
+    out += ["[case]"] + [f'"{k}" = {val(v)}' for k, v in d["case"].items()]
+    for p in d["parameter"]:
+        out += ["[[parameter]]"] + [f"{k} = {val(v)}" for k, v in p.items()]
+    return "\n".join(out) + "\n"
+
+
+# ------------------------------------------------------------------------------------------
+# command line
+# ------------------------------------------------------------------------------------------
+def _cli(args, tmp_path, timeout=120):
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    return subprocess.run([sys.executable, "-m", "asekit", "sweep", *args], env=env,
+                          cwd=tmp_path, capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda d: d["parameter"][0].update(path="material.youngs_modulos"),
+     "'material.youngs_modulos' is not a case-file key"),
+    (lambda d: d["parameter"][0].update(sigma=-0.1), "sigma must be a finite number > 0"),
+    (lambda d: d["parameter"][0].update(distribution="uniform", low=130.0, high=110.0),
+     None),
+    (lambda d: d["sweep"].update(outputs=["flutter_speed", "q_dyn"]), "'q_dyn' is not an output"),
+])
+def test_cli_bad_input_is_one_line_and_exit_2(tmp_path, edit, message):
+    d = sweep_dict([copy.deepcopy(MC[1])], samples=2)
+    edit(d)
+    if d["parameter"][0]["distribution"] == "uniform":
+        del d["parameter"][0]["median"], d["parameter"][0]["sigma"]
+        message = r"low \(130\) must be < high \(110\)"
+    f = tmp_path / "bad.toml"
+    f.write_text(_toml(d))
+    r = _cli([str(f), "--out", "o.csv", "--quiet"], tmp_path)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: bad.toml: ")
+    import re
+    assert re.search(message, lines[0]), lines[0]
+    assert not (tmp_path / "o.csv").exists()
+
+
+def test_cli_unreachable_scheduler_fails_fast(tmp_path):
+    pytest.importorskip("dask.distributed")
+    f = tmp_path / "s.toml"
+    f.write_text(_toml(sweep_dict([MC[1]], samples=2)))
+    t0 = time.perf_counter()
+    r = _cli([str(f), "--out", "o.csv", "--executor", "dask", "--scheduler",
+              "tcp://127.0.0.1:9", "--quiet"], tmp_path)
+    assert time.perf_counter() - t0 < 30
+    assert r.returncode == 2
+    assert r.stderr.strip().splitlines()[-1].startswith(
+        "error: cannot reach the Dask scheduler at tcp://127.0.0.1:9 within 5 s")
