@@ -198,6 +198,7 @@ def all_figures(ch: AseChapter) -> dict:
         "fig69_fwtf_bode": fig_bode(ch, "fwtf"),
         "fig70_aem1_transmission": fig_aem1_transmission(ch),
         "fig71_aem1_corners": fig_corners(ch),
+        "fig72_corner_locations": fig_corner_locations(ch),
         "fig73_aem1_spectrum": fig_spectrum(ch, "AEM1"),
         "fig74_aem1_modal": fig_modal(ch, "AEM1"),
         "fig75_aem1_hinge_moment": fig_hinge_moment(ch),
@@ -364,15 +365,42 @@ def fig_corners(ch: AseChapter):
     return fig
 
 
+def fig_corner_locations(ch: AseChapter):
+    """Fig 72: where the fin-corner rotations of Fig 71 are taken (planform corners), the fin
+    root and the pitch axis."""
+    from ..geometry import load_fin
+    fin = load_fin()
+    p = fin.planform
+    fig, ax = new_figure("Fin positions of Fig 71", "Fig 72", figsize=(5.5, 5))
+    c = np.asarray(p.corners) * 1e3
+    ax.fill(c[:, 0], c[:, 1], color="0.9", edgecolor="k")
+    for name, (xi, eta) in ase.CORNERS.items():
+        pt = np.asarray(p.point(np.array([xi]), np.array([eta])))[0] * 1e3
+        ax.plot(pt[0], pt[1], "o", color="C3")
+        ax.annotate(name.replace("_", " "), pt[:2], textcoords="offset points",
+                    xytext=(6 if xi > 0.5 else -6, 6), ha="left" if xi > 0.5 else "right",
+                    fontsize=8, color="C3")
+    xa = fin.shaft.axis_point[0] * 1e3
+    ax.axvline(xa, color="C0", ls="--", lw=1, label=f"pitch axis x = {xa:g} mm")
+    ax.plot(xa, 0.0, "s", color="C0", label="fin root (shaft)")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_aspect("equal")
+    ax.legend(fontsize=8, loc="upper left")
+    return fig
+
+
 def fig_spectrum(ch: AseChapter, topology: str):
     f, amp = ch.aem1_spectrum if topology == "AEM1" else ch.aem2_spectrum
     fig, ax = new_figure(f"{topology}: fin-root spectrum after 95 % rise, mean removed",
                          "Fig 73" if topology == "AEM1" else "Fig 81")
     sel = f <= 1000
     ax.plot(f[sel], np.degrees(amp[sel]))
-    for p in metrics.spectrum_peaks(f, amp, n=2):
-        ax.axvline(p, color=THESIS_COLOR, ls="--", lw=0.8)
-        ax.annotate(f"{p:.1f} Hz", (p, ax.get_ylim()[1]), va="top", fontsize=8)
+    for n, p in enumerate(metrics.spectrum_peaks(f, amp, n=2)):
+        a_p = float(np.degrees(np.interp(p, f, amp)))
+        ax.plot(p, a_p, "v", color="C3", ms=6)
+        ax.annotate(f"{p:.1f} Hz", (p, a_p), textcoords="offset points",
+                    xytext=(8, 2 - 12 * n), fontsize=8, color="C3")
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("amplitude (deg)")
     return fig
@@ -402,11 +430,15 @@ def fig_hinge_moment(ch: AseChapter):
 
 
 def fig_full_step(ch: AseChapter):
+    """Fig 76: +15 deg step; the rigid-fin curve is drawn first (wide, light) so that the
+    elastic transmission output on top of it stays visible where they coincide."""
     fig, ax = new_figure("AEM1 +15 deg step: transmission output", "Fig 76")
-    ax.plot(1e3 * ch.aem1_full.t, np.degrees(ch.aem1_full.theta), label="power limited, elastic")
-    ax.plot(1e3 * ch.aem1_full.t, np.degrees(ch.aem1_full.fin_root), label="fin root")
-    ax.plot(1e3 * ch.rigid_full.t, np.degrees(ch.rigid_full.theta), color="g",
+    ax.plot(1e3 * ch.rigid_full.t, np.degrees(ch.rigid_full.theta), color="g", lw=4, alpha=0.4,
             label="rigid fin (Ch. 4 model)")
+    ax.plot(1e3 * ch.aem1_full.t, np.degrees(ch.aem1_full.theta), color="C0",
+            label="transmission, elastic fin, power limited")
+    ax.plot(1e3 * ch.aem1_full.t, np.degrees(ch.aem1_full.fin_root), color="C1", ls="--",
+            label="fin root, elastic fin")
     ax.set_xlabel("time (ms)")
     ax.set_ylabel("angle (deg)")
     ax.legend()
