@@ -144,8 +144,8 @@ def nyquist_margins(loop, points_per_decade: int = 400) -> NyquistMargins:
 
     Raises
     ------
-    TypeError if ``loop`` is not a continuous-time SISO LTI system; ValueError if it has poles
-    on the imaginary axis away from the origin (undamped modes: the margins are then not
+    TypeError if ``loop`` is not a continuous-time SISO LTI system; ValueError if it has no
+    state, or poles on the imaginary axis away from the origin (undamped modes: the margins are then not
     defined) or ``points_per_decade`` < 10; RuntimeError if the Nyquist count disagrees with the
     closed-loop eigenvalues.
     """
@@ -159,6 +159,9 @@ def nyquist_margins(loop, points_per_decade: int = 400) -> NyquistMargins:
     if points_per_decade < 10:
         raise ValueError(f"points_per_decade must be >= 10, got {points_per_decade}")
     ss = ct.ss(loop)
+    if ss.nstates == 0:
+        raise ValueError("loop must have at least one state (a static gain has no Nyquist "
+                         "margins)")
     A, B, C = np.asarray(ss.A), np.asarray(ss.B), np.asarray(ss.C)
     D = float(np.asarray(ss.D).real.ravel()[0])
     poles = np.linalg.eigvals(A) if A.size else np.zeros(0)

@@ -105,6 +105,8 @@ def test_bad_input():
         nyquist_margins(ct.rss(2, 2, 2))
     with pytest.raises(ValueError, match="imaginary axis"):
         nyquist_margins(ct.tf([1.0], [1, 0, 4.0]))           # undamped poles at +-2j
+    with pytest.raises(ValueError, match="at least one state"):
+        nyquist_margins(ct.ss([], [], [], [[-2.0]]))
     with pytest.raises(ValueError, match="points_per_decade"):
         nyquist_margins(ct.tf([1.0], [1, 1]), points_per_decade=2)
     m = nyquist_margins(ct.tf([1.0], [1, 1]))

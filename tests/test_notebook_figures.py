@@ -11,8 +11,10 @@ after the inline backend has displayed (and closed) the cell's figures. It check
 * every figure a cell displays was created by that cell: no figure is open when a cell starts;
 * the import cell (the first code cell) displays no figure.
 
-Slow (all six chapter notebooks, about 3 min on one core): marked ``slow``; it runs in the default
-``pytest`` (and CI), deselect with ``-m "not slow"``.
+Slow (all six chapter notebooks: about 100 s on an idle two-core machine, 4 min on a loaded
+one; the first run after a change to the physics also recomputes the cached converged-flutter
+study of ch3_flutter, several minutes): marked ``slow``; it runs in the default ``pytest`` (and
+CI), deselect with ``-m "not slow"``.
 """
 
 from __future__ import annotations

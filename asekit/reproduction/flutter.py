@@ -461,7 +461,7 @@ def fig_flutter_mode(modal, flutter, thesis_figure="Fig 29"):
     w = w / w[np.argmax(np.abs(w))]
     fig, (a1, a2) = new_figure(f"Flutter mode shape, {flutter.speed:.1f} m/s, "
                                f"{flutter.frequency_hz:.1f} Hz", thesis_figure, ncols=2,
-                               figsize=(11, 4.5))
+                               figsize=(12.5, 4.5))
     x, y = modal.nodes[:, 0] * 1e3, modal.nodes[:, 1] * 1e3
     c1 = a1.tricontourf(x, y, np.abs(w), 20, cmap="viridis")
     fig.colorbar(c1, ax=a1, label="|w| (normalised)")
