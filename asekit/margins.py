@@ -145,9 +145,9 @@ def nyquist_margins(loop, points_per_decade: int = 400) -> NyquistMargins:
     Raises
     ------
     TypeError if ``loop`` is not a continuous-time SISO LTI system; ValueError if it has no
-    state, or poles on the imaginary axis away from the origin (undamped modes: the margins are then not
-    defined) or ``points_per_decade`` < 10; RuntimeError if the Nyquist count disagrees with the
-    closed-loop eigenvalues.
+    state, poles on the imaginary axis away from the origin (undamped modes: the margins are
+    then not defined) or ``points_per_decade`` < 10; RuntimeError if the Nyquist count
+    disagrees with the closed-loop eigenvalues.
     """
     if not isinstance(loop, (ct.StateSpace, ct.TransferFunction)):
         raise TypeError(f"loop must be a control.StateSpace or TransferFunction, got "

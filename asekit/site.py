@@ -3,8 +3,9 @@
 Each chapter notebook (``notebooks/ch*.ipynb``, in reading order) is executed in a fresh kernel
 with the inline matplotlib backend, as JupyterLab runs it, and converted to HTML with nbconvert
 (figures embedded), so a reader can browse every figure without running anything.
-The executed notebooks are written beside the pages. ``OUTDIR/index.html`` links the chapters and lists how many figures each one displays; links
-between notebooks (``chX.ipynb``) are rewritten to the HTML pages. Widgets (the live panels) are
+The executed notebooks are written beside the pages. ``OUTDIR/index.html`` links the chapters
+and lists how many figures each one displays; links between notebooks (``chX.ipynb``) are
+rewritten to the HTML pages. Widgets (the live panels) are
 shown as their static last state at most.
 
 Options: ``--only ch4_servo_actuator ...`` builds selected notebooks; ``--timeout`` per cell (s).
@@ -46,7 +47,9 @@ def execute_notebook(path: Path, timeout: float = 900.0):
 
     nb = nbformat.read(path, as_version=4)
     env = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}
-    client = nbclient.NotebookClient(nb, timeout=timeout, kernel_name="python3",
+    # startup_timeout: on a loaded machine the kernel can take more than the default 60 s
+    client = nbclient.NotebookClient(nb, timeout=timeout, startup_timeout=300,
+                                     kernel_name="python3",
                                      resources={"metadata": {"path": str(path.parent)}})
     client.execute(env=env)
     return nb
@@ -103,7 +106,8 @@ def build_site(outdir, only=None, timeout: float = 900.0, echo=print) -> list[di
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>asekit chapter notebooks"
         "</title></head>\n<body style=\"font-family: sans-serif; max-width: 50em; margin: 2em "
         "auto\">\n<h1>asekit: the thesis reproduction, chapter by chapter</h1>\n<p>Executed "
-        f"notebooks of <code>notebooks/</code> (built {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}"
+        "notebooks of <code>notebooks/</code> (built "
+        f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}"
         ") with every figure displayed where it is drawn.</p>\n<ol>\n" + items
         + "\n</ol>\n</body></html>\n", encoding="utf-8")
     return records

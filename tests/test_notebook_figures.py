@@ -59,7 +59,9 @@ def _execute(path: Path):
     env = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}
     env.setdefault("OMP_NUM_THREADS", "1")
     env.setdefault("OPENBLAS_NUM_THREADS", "1")
-    client = nbclient.NotebookClient(nb, timeout=900, kernel_name="python3",
+    # startup_timeout: on a loaded machine the kernel can take more than the default 60 s
+    client = nbclient.NotebookClient(nb, timeout=900, startup_timeout=300,
+                                     kernel_name="python3",
                                      resources={"metadata": {"path": str(path.parent)}})
     client.execute(env=env)
     text = "".join(o.get("text", "") for o in nb.cells[-1].outputs if o.get("name") == "stdout")
