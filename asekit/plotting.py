@@ -41,15 +41,22 @@ def new_figure(title: str, thesis_figure: str | None = None, nrows: int = 1, nco
     -------
     (fig, axes) as from :func:`matplotlib.pyplot.subplots`.
     """
+    if figsize is None:
+        figsize = (6.4 * ncols if ncols > 1 else 6.4, 3.6 * nrows + 0.6)
+    # The first figure of a Jupyter session loads the inline backend, which switches interactive
+    # mode on (that is what makes the kernel show figures at the end of a cell). Done inside
+    # ``rc_context`` that switch would be undone on exit (rc_context restores every rcParam but
+    # the backend, ``interactive`` included) and no later figure would be shown; so the style
+    # stays local to the figure's creation and the interactive state is carried out of it.
     with matplotlib.rc_context(STYLE):
-        if figsize is None:
-            figsize = (6.4 * ncols if ncols > 1 else 6.4, 3.6 * nrows + 0.6)
         fig, axes = plt.subplots(nrows, ncols, figsize=figsize, squeeze=True, **subplot_kw)
         full = f"{thesis_figure}: {title}" if thesis_figure else title
         fig.suptitle(full)
         for ax in (axes.flat if hasattr(axes, "flat") else [axes]):
             if hasattr(ax, "grid"):
                 ax.grid(True, alpha=STYLE["grid.alpha"])
+        interactive = matplotlib.is_interactive()
+    matplotlib.interactive(interactive)
     return fig, axes
 
 

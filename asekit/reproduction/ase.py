@@ -9,7 +9,11 @@ Definitions used for the reported numbers:
 
 * resonances of OPLOOP 3: the first two local maxima of |OPLOOP 3| above 10 Hz;
 * FWTF phase margins and crossovers: at the first (lowest) gain crossover; FWTF 3's gain margin:
-  at its first phase crossover (it has several);
+  at its first phase crossover (it has several), the thesis's reading of Fig 68;
+* Nyquist margins (:func:`asekit.margins.nyquist_margins`): the open-loop right-half-plane poles
+  are counted (OPLOOP 2/3 and FWTF 2/3 have one, about +15.5 rad/s, from the de-centering hinge
+  moment), so FWTF 2's lower gain margin (at zero frequency, where L(0) < 0) is found; the
+  upper and lower gain margins bound the range of loop gain with a stable closed loop;
 * AEM1 settling time: the transmission angle's 2 % band around its final value, power-limited
   unit (1 deg) step; corner overshoot: peak pitch rotation at the four planform corners past the
   command, as a fraction of the command (min and max over the corners); static elastic
@@ -29,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import ase, metrics
+from ..margins import NyquistMargins, nyquist_margins
 from ..plotting import THESIS_COLOR, new_figure
 from ..reproduce import ChapterResult, Quantity
 from ..servo import SYSTEM_3, PDController
@@ -50,6 +55,7 @@ class AseChapter:
     oploops: dict                 # 1, 2, 3 -> StateSpace
     fwtfs: dict                   # 1, 2, 3 -> StateSpace
     crossovers: dict              # 1, 2, 3 -> Crossovers
+    nyquist: dict                 # 1, 2, 3 -> NyquistMargins of FWTF i
     oploop3_resonances_hz: np.ndarray
     closed_loops: dict            # "AEM1", "AEM2" -> StateSpace
     aem1_linear: ase.AseSimulation
@@ -73,6 +79,7 @@ def compute(mach: float = 0.5, altitude: float = 0.0,
     oploops = {i: ase.open_loop(m, i) for i in (1, 2, 3)}
     fwtfs = {i: ase.forward_path(m, controller, i) for i in (1, 2, 3)}
     cross = {i: ase.crossovers(fwtfs[i]) for i in (1, 2, 3)}
+    nyq = {i: nyquist_margins(fwtfs[i]) for i in (1, 2, 3)}
     loops = {t: ase.closed_loop(m, controller, t) for t in ase.TOPOLOGIES}
     sim = ase.simulate_closed_loop
     aem1_lin = sim(m, controller, UNIT_STEP, "AEM1", limits=None, t_final=0.2)
@@ -92,6 +99,7 @@ def compute(mach: float = 0.5, altitude: float = 0.0,
     spec2 = metrics.spectrum_after_rise(aem2_nl.t, aem2_nl.fin_root, UNIT_STEP)
     return AseChapter(
         fin=fin, controller=controller, oploops=oploops, fwtfs=fwtfs, crossovers=cross,
+        nyquist=nyq,
         oploop3_resonances_hz=ase.resonances(oploops[3]), closed_loops=loops,
         aem1_linear=aem1_lin, aem1_nonlinear=aem1_nl, aem1_full=aem1_full,
         aem2_linear=aem2_lin, aem2_nonlinear=aem2_nl, rigid_unit=rigid_unit,
@@ -150,6 +158,15 @@ def quantities(ch: AseChapter) -> tuple[Quantity, ...]:
         Quantity("ase.fwtf2.crossover_hz", float(c2.gain_crossovers_hz[0]), "Hz"),
         Quantity("ase.fwtf3.gain_margin_db", float(c3.gain_margin_db), "dB",
                  "first phase crossover"),
+        Quantity("ase.fwtf2.open_loop_unstable_poles", ch.nyquist[2].open_loop_unstable_poles,
+                 "-", "pole at +%.1f rad/s (de-centering hinge moment)"
+                 % float(ch.nyquist[2].open_loop_rhp_poles.real.max())),
+        Quantity("ase.fwtf2.lower_gain_margin_db", ch.nyquist[2].lower_gain_margin_db, "dB",
+                 "Nyquist, at 0 Hz (L(0) < 0)"),
+        Quantity("ase.fwtf2.upper_gain_margin_db", ch.nyquist[2].upper_gain_margin_db, "dB",
+                 "Nyquist"),
+        Quantity("ase.fwtf3.closed_loop_unstable_poles",
+                 ch.nyquist[3].closed_loop_unstable_poles, "-", "AEM2 linear loop, Nyquist"),
         Quantity("ase.aem1.settling_ms",
                  1e3 * metrics.settling_time(r.t, r.theta, r.theta[-1], UNIT_STEP), "ms",
                  "transmission output, power-limited 1 deg step"),
@@ -174,9 +191,14 @@ def all_figures(ch: AseChapter) -> dict:
     return {
         "fig63_oploop_bode": fig_bode(ch, "oploop"),
         "fig64_oploop3_resonances": fig_oploop3_zoom(ch),
+        "fig65_fwtf1_bode": fig_fwtf(ch, 1),
+        "fig66_fwtf2_outputs": fig_fwtf2_outputs(ch),
+        "fig67_fwtf2_bode": fig_fwtf(ch, 2),
+        "fig68_fwtf3_bode": fig_fwtf(ch, 3),
         "fig69_fwtf_bode": fig_bode(ch, "fwtf"),
         "fig70_aem1_transmission": fig_aem1_transmission(ch),
         "fig71_aem1_corners": fig_corners(ch),
+        "fig72_corner_locations": fig_corner_locations(ch),
         "fig73_aem1_spectrum": fig_spectrum(ch, "AEM1"),
         "fig74_aem1_modal": fig_modal(ch, "AEM1"),
         "fig75_aem1_hinge_moment": fig_hinge_moment(ch),
@@ -207,7 +229,7 @@ def fig_bode(ch: AseChapter, which: str):
     systems = ch.oploops if which == "oploop" else ch.fwtfs
     name = "OPLOOP" if which == "oploop" else "FWTF"
     fig, ax = new_figure(f"{name} 1/2/3, M {ch.fin.mach:g}, h {ch.fin.altitude:g} m",
-                         "Fig 63" if which == "oploop" else "Figs 65-69", nrows=2,
+                         "Fig 63" if which == "oploop" else "Fig 69", nrows=2,
                          figsize=(7.5, 6.5), sharex=True)
     for i, sys in systems.items():
         _bode_axes(ax, sys, f"{name} {i}", lw=1.2)
@@ -222,6 +244,86 @@ def fig_bode(ch: AseChapter, which: str):
                         f"{c[2].phase_margins_deg[0]:.1f} deg at {c[2].gain_crossovers_hz[0]:.0f}"
                         f" Hz; FWTF3 GM {c[3].gain_margin_db:.1f} dB", fontsize=9)
     ax[0].legend()
+    return fig
+
+
+_FWTF_FIGURE = {1: "Fig 65", 2: "Fig 67", 3: "Fig 68"}
+
+
+def _margin_text(m: NyquistMargins) -> str:
+    """One line: open-loop RHP poles, closed-loop stability and the Nyquist gain margins."""
+    head = (f"P = {m.open_loop_unstable_poles} open-loop RHP pole(s); closed loop "
+            + ("stable" if m.closed_loop_stable else
+               f"UNSTABLE ({m.closed_loop_unstable_poles} RHP poles)"))
+    if not m.closed_loop_stable:
+        ranges = [(lo, hi) for lo, hi, z in zip(np.r_[0.0, m.boundary_gains],
+                                                 np.r_[m.boundary_gains, np.inf],
+                                                 m.unstable_counts) if z == 0]
+        txt = ", ".join(f"{20 * np.log10(lo):.1f} to {20 * np.log10(hi):.1f} dB"
+                        for lo, hi in ranges if lo > 0 and np.isfinite(hi))
+        return head + (f"; stable for gains {txt}" if txt else "")
+    return (head + f"; GM {m.lower_gain_margin_db:.1f} / +{m.upper_gain_margin_db:.1f} dB, "
+            f"PM {m.phase_margin_deg:.1f} deg")
+
+
+def fig_fwtf(ch: AseChapter, which: int):
+    """Figs 65, 67, 68: Bode plot of FWTF ``which`` with its gain crossovers (phase margins),
+    its phase crossovers (gain margins), the -180 deg lines and the Nyquist margins."""
+    names = {1: "actuator + PD (Ch. 4 loop)", 2: "AEM1, transmission feedback",
+             3: "AEM2, fin-root feedback"}
+    fig, ax = new_figure(f"FWTF {which} ({names[which]}), M {ch.fin.mach:g}, "
+                         f"h {ch.fin.altitude:g} m", _FWTF_FIGURE[which], nrows=2,
+                         figsize=(7.5, 6.5), sharex=True)
+    h = ase.frequency_response(ch.fwtfs[which], _F)
+    mag = 20 * np.log10(np.abs(h))
+    ph = np.degrees(np.unwrap(np.angle(h)))
+    ax[0].semilogx(_F, mag, color=f"C{which - 1}")
+    ax[1].semilogx(_F, ph, color=f"C{which - 1}")
+    ax[0].axhline(0.0, color="k", lw=0.8)
+    for n in range(int(np.floor((ph.min() + 180) / 360)), int(np.ceil((ph.max() + 180) / 360)) + 1):
+        ax[1].axhline(-180.0 + 360.0 * n, color="k", lw=0.8, ls="--")
+    m = ch.nyquist[which]
+    for n_gc, (fc, pm) in enumerate(zip(m.gain_crossovers_hz, m.phase_margins_deg)):
+        ax[0].plot(fc, 0.0, "o", color="C3", ms=5)
+        p = np.interp(np.log(fc), np.log(_F), ph)
+        ax[1].plot(fc, p, "o", color="C3", ms=5)
+        if n_gc < 3:                 # the first three labelled; the rest marked only
+            ax[1].annotate(f"PM {pm:.1f}$^\\circ$\n{fc:.0f} Hz", (fc, p),
+                           textcoords="offset points", xytext=(4, 4 - 14 * n_gc), fontsize=7,
+                           color="C3")
+    inside = [(fc, gm) for fc, gm in zip(m.phase_crossovers_hz, m.gain_margins_db)
+              if _F[0] <= fc <= _F[-1]]       # at 0 Hz or infinity: in the title
+    for n_pc, (fc, gm) in enumerate(inside):
+        g = np.interp(np.log(fc), np.log(_F), mag)
+        ax[0].plot([fc, fc], [0.0, g], color="C2", lw=1.2)
+        if n_pc < 3:
+            ax[0].annotate(f"GM {gm:.1f} dB", (fc, g), textcoords="offset points",
+                           xytext=(3, -9 if gm > 0 else 3), fontsize=7, color="C2")
+    ax[0].set_ylabel("magnitude (dB)")
+    ax[1].set_ylabel("phase (deg)")
+    ax[1].set_xlabel("frequency (Hz)")
+    ax[0].set_title(_margin_text(m), fontsize=8)
+    return fig
+
+
+def fig_fwtf2_outputs(ch: AseChapter):
+    """Fig 66: FWTF 2 to the transmission's angle, rate and acceleration (the three outputs fed
+    to the aeroelastic fin): PD x OPLOOP 2 times 1, j w, (j w)^2 (omega = theta', alpha =
+    theta'' exactly in the actuator's state space)."""
+    fig, ax = new_figure(f"FWTF 2 to the transmission angle, rate and acceleration, M "
+                         f"{ch.fin.mach:g}, h {ch.fin.altitude:g} m", "Fig 66", nrows=2,
+                         figsize=(7.5, 6.5), sharex=True)
+    h = ase.frequency_response(ch.fwtfs[2], _F)
+    jw = 2j * np.pi * _F
+    for factor, lab in ((1.0, "angle (rad/rad)"), (jw, "rate (rad/s per rad)"),
+                        (jw ** 2, "acceleration (rad/s$^2$ per rad)")):
+        hh = h * factor
+        ax[0].semilogx(_F, 20 * np.log10(np.abs(hh)), label=lab)
+        ax[1].semilogx(_F, np.degrees(np.unwrap(np.angle(hh))), label=lab)
+    ax[0].set_ylabel("magnitude (dB)")
+    ax[1].set_ylabel("phase (deg)")
+    ax[1].set_xlabel("frequency (Hz)")
+    ax[0].legend(fontsize=8)
     return fig
 
 
@@ -263,15 +365,42 @@ def fig_corners(ch: AseChapter):
     return fig
 
 
+def fig_corner_locations(ch: AseChapter):
+    """Fig 72: where the fin-corner rotations of Fig 71 are taken (planform corners), the fin
+    root and the pitch axis."""
+    from ..geometry import load_fin
+    fin = load_fin()
+    p = fin.planform
+    fig, ax = new_figure("Fin positions of Fig 71", "Fig 72", figsize=(5.5, 5))
+    c = np.asarray(p.corners) * 1e3
+    ax.fill(c[:, 0], c[:, 1], color="0.9", edgecolor="k")
+    for name, (xi, eta) in ase.CORNERS.items():
+        pt = np.asarray(p.point(np.array([xi]), np.array([eta])))[0] * 1e3
+        ax.plot(pt[0], pt[1], "o", color="C3")
+        ax.annotate(name.replace("_", " "), pt[:2], textcoords="offset points",
+                    xytext=(6 if xi > 0.5 else -6, 6), ha="left" if xi > 0.5 else "right",
+                    fontsize=8, color="C3")
+    xa = fin.shaft.axis_point[0] * 1e3
+    ax.axvline(xa, color="C0", ls="--", lw=1, label=f"pitch axis x = {xa:g} mm")
+    ax.plot(xa, 0.0, "s", color="C0", label="fin root (shaft)")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_aspect("equal")
+    ax.legend(fontsize=8, loc="upper left")
+    return fig
+
+
 def fig_spectrum(ch: AseChapter, topology: str):
     f, amp = ch.aem1_spectrum if topology == "AEM1" else ch.aem2_spectrum
     fig, ax = new_figure(f"{topology}: fin-root spectrum after 95 % rise, mean removed",
                          "Fig 73" if topology == "AEM1" else "Fig 81")
     sel = f <= 1000
     ax.plot(f[sel], np.degrees(amp[sel]))
-    for p in metrics.spectrum_peaks(f, amp, n=2):
-        ax.axvline(p, color=THESIS_COLOR, ls="--", lw=0.8)
-        ax.annotate(f"{p:.1f} Hz", (p, ax.get_ylim()[1]), va="top", fontsize=8)
+    for n, p in enumerate(metrics.spectrum_peaks(f, amp, n=2)):
+        a_p = float(np.degrees(np.interp(p, f, amp)))
+        ax.plot(p, a_p, "v", color="C3", ms=6)
+        ax.annotate(f"{p:.1f} Hz", (p, a_p), textcoords="offset points",
+                    xytext=(8, 2 - 12 * n), fontsize=8, color="C3")
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("amplitude (deg)")
     return fig
@@ -301,11 +430,15 @@ def fig_hinge_moment(ch: AseChapter):
 
 
 def fig_full_step(ch: AseChapter):
+    """Fig 76: +15 deg step; the rigid-fin curve is drawn first (wide, light) so that the
+    elastic transmission output on top of it stays visible where they coincide."""
     fig, ax = new_figure("AEM1 +15 deg step: transmission output", "Fig 76")
-    ax.plot(1e3 * ch.aem1_full.t, np.degrees(ch.aem1_full.theta), label="power limited, elastic")
-    ax.plot(1e3 * ch.aem1_full.t, np.degrees(ch.aem1_full.fin_root), label="fin root")
-    ax.plot(1e3 * ch.rigid_full.t, np.degrees(ch.rigid_full.theta), color="g",
+    ax.plot(1e3 * ch.rigid_full.t, np.degrees(ch.rigid_full.theta), color="g", lw=4, alpha=0.4,
             label="rigid fin (Ch. 4 model)")
+    ax.plot(1e3 * ch.aem1_full.t, np.degrees(ch.aem1_full.theta), color="C0",
+            label="transmission, elastic fin, power limited")
+    ax.plot(1e3 * ch.aem1_full.t, np.degrees(ch.aem1_full.fin_root), color="C1", ls="--",
+            label="fin root, elastic fin")
     ax.set_xlabel("time (ms)")
     ax.set_ylabel("angle (deg)")
     ax.legend()

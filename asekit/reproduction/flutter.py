@@ -179,6 +179,24 @@ def run(figures: bool = False) -> ChapterResult:
                       rl_first.kind if rl_first else "none up to 460 m/s"))
     q.append(Quantity("flutter.first_instability.time_domain.M075.h0.speed_ms",
                       td.onset_speed, "m/s", td_kind or "none up to 460 m/s"))
+    conv = converged_flutter_study(db)
+    (sc, ss), (ac, asp) = conv["structure"], conv["aero"]
+    cs, ca = conv["change_structure"], conv["change_aero"]
+    conv_note = (f"distributed shaft, FE {sc}x{ss}, boxes {ac}x{asp}; last refinements "
+                 f"{'-' if cs is None else f'{100 * cs:.2f}'} % (FE), "
+                 f"{'-' if ca is None else f'{100 * ca:.2f}'} % (boxes)"
+                 + ("" if conv["converged"] else "; NOT converged to 1 %"))
+    q.append(Quantity("flutter.converged.pk.M075.h0.speed_ms", conv["speed"], "m/s", conv_note))
+    q.append(Quantity("flutter.converged.pk.M075.h0.freq_hz", conv["freq"], "Hz", conv_note))
+    damp = damping_study(modal, db, velocities=DAMPING_VELOCITIES)
+    q.append(Quantity("flutter.damping.pk.M075.h0.speed_ms",
+                      [r["speed"] for r in damp if r["kind"] == "zeta"], "m/s",
+                      "6x7 model; modal damping ratio "
+                      + ", ".join(f"{100 * z:g}" for z in DAMPING_RATIOS) + " %"))
+    q.append(Quantity("flutter.structural_g.pk.M075.h0.speed_ms",
+                      [r["speed"] for r in damp if r["kind"] == "g"], "m/s",
+                      "6x7 model; g = " + ", ".join(f"{g:g}" for g in STRUCTURAL_G)
+                      + " (equivalent viscous at the flutter frequency)"))
     if figures:
         figs.update(fin_figures(modal, db, fit, conds, rl, td))
         if ha is not None:
@@ -201,72 +219,213 @@ def fig_rfa_element(fit, i: int, j: int, thesis_figure: str = "Fig 23"):
     ax.plot(qd.real, qd.imag, "x", color="C1", label="fit at the data k")
     for a, b in zip(fit.Q[:, i, j], qd):
         ax.plot([a.real, b.real], [a.imag, b.imag], color="0.6", lw=0.6)
+    for n, (kk_, a) in enumerate(zip(fit.k, fit.Q[:, i, j])):
+        if n % 2 == 0 or n == fit.k.size - 1:        # every other k labelled: no overprint
+            ax.annotate(f"k={kk_:.3g}", (a.real, a.imag), textcoords="offset points",
+                        xytext=(4, 4 if n % 4 == 0 else -10), fontsize=6, color="C0")
+    err = getattr(fit, "element_error", None)
+    if err is not None:
+        ax.set_title(f"element fit error {float(np.asarray(err)[i, j]):.3f}", fontsize=9)
     ax.set_xlabel("Re Q (per unit q)")
     ax.set_ylabel("Im Q (per unit q)")
     ax.legend()
     return fig
 
 
+#: The thesis's flight envelope (Table 3): Mach 0.4-0.6, altitude 0-5000 m.
+FLIGHT_MACH = (0.4, 0.6)
+FLIGHT_ALTITUDE = (0.0, 5000.0)
+#: The customary flutter margin: flutter-free up to 1.15 x the envelope's limit speed
+#: (e.g. 14 CFR 25.629(b)(1), 1.15 V_D), applied here to the Mach limit at each altitude.
+FLUTTER_MARGIN = 0.15
+
+
+def _envelope():
+    """(u_min, u_max, h_max) of the analysis envelope in data/fin.toml (m/s, m/s, m)."""
+    from ..geometry import load_fin
+    a = load_fin().aero
+    return float(a.u_min), float(a.u_max), float(max(a.altitudes))
+
+
 def fig_mach_airspeed_altitude(points=(), thesis_figure: str = "Fig 25"):
-    """Mach lines in the airspeed-altitude plane (Fig 25), optional (U, h, label) points."""
+    """Mach lines in the airspeed-altitude plane (Fig 25) with the analysis envelope of
+    data/fin.toml shaded; optional (U, h, label) points, one marker style per label."""
     from ..plotting import new_figure
     fig, ax = new_figure("Mach - airspeed - altitude (1976 standard atmosphere)", thesis_figure)
     h = np.linspace(0, 12000, 100)
     a = standard_atmosphere(h).speed_of_sound
     for m in (0.4, 0.5, 0.6, 0.7, 0.75, 0.8, 0.9, 1.0):
-        ax.plot(m * a, h / 1000, lw=1, label=f"M {m}")
-    for u, hh, lab in points:
-        ax.plot(u, hh / 1000, "k*", ms=10)
-        ax.annotate(lab, (u, hh / 1000))
+        ax.plot(m * a, h / 1000, lw=1, color="0.55")
+        ax.annotate(f"M {m}", (m * a[-1], h[-1] / 1000), textcoords="offset points",
+                    xytext=(0, 3), ha="center", fontsize=7, color="0.35")
+    u0, u1, hmax = _envelope()
+    ax.fill_between([u0, u1], 0, hmax / 1000, color="C0", alpha=0.10,
+                    label=f"analysis envelope {u0:.0f}-{u1:.0f} m/s, 0-{hmax / 1000:g} km")
+    hf = np.linspace(*FLIGHT_ALTITUDE, 30)
+    af = standard_atmosphere(hf).speed_of_sound
+    ax.fill_betweenx(hf / 1000, FLIGHT_MACH[0] * af, FLIGHT_MACH[1] * af, color="C2", alpha=0.3,
+                     label=f"flight envelope (Table 3): M {FLIGHT_MACH[0]}-{FLIGHT_MACH[1]}, "
+                           f"0-{FLIGHT_ALTITUDE[1] / 1000:g} km")
+    labels = sorted({lab for _, _, lab in points})
+    for n, lab in enumerate(labels):
+        pts = [(u, hh) for u, hh, lb in points if lb == lab]
+        ax.plot([u for u, _ in pts], [hh / 1000 for _, hh in pts], "*^sD"[n % 4], ms=9,
+                color=f"C{n + 1}", label=f"p-k flutter, {lab}")
     ax.set_xlabel("true airspeed (m/s)")
     ax.set_ylabel("altitude (km)")
-    ax.legend(ncol=2, fontsize=8)
+    ax.set_ylim(0, 12.8)
+    ax.legend(fontsize=8, loc="upper left")
     return fig
 
 
-def fig_pk(res, title="p-k damping and frequency", thesis_figure="Figs 30-31", unit="m/s"):
-    """Damping g and frequency vs airspeed of every tracked mode (Figs 30-31)."""
+def fig_match_points(table, thesis_figure: str = "Figs 26-28"):
+    """The match-point check (Sec. 3.3.1.1), one panel per altitude: the flight Mach M = U/a(h)
+    of the standard atmosphere and the p-k flutter speed at each analysis Mach (rows of
+    :func:`asekit.flutter.match_point_table`); where the two meet is the matched flutter point.
+    The flight envelope's Mach band (Table 3) and the customary +15 % margin are drawn."""
     from ..plotting import new_figure
-    fig, (a1, a2) = new_figure(title, thesis_figure, nrows=2, figsize=(6.4, 6.5))
+    alts = sorted({r.altitude for r in table})
+    fig, axes = new_figure("Match point: flutter speed per analysis Mach vs flight Mach",
+                           thesis_figure, ncols=len(alts), figsize=(4.2 * len(alts), 4.2),
+                           sharey=True)
+    axes = np.atleast_1d(axes)
+    for ax, h in zip(axes, alts):
+        a = float(standard_atmosphere(h).speed_of_sound)
+        u = np.linspace(100, 460, 50)
+        ax.plot(u, u / a, color="k", lw=1, label="flight Mach U/a(h)")
+        ax.axhspan(*FLIGHT_MACH, color="C2", alpha=0.25, label="flight envelope (Table 3)")
+        ax.axhline(FLIGHT_MACH[1] * (1 + FLUTTER_MARGIN), color="C2", ls="--", lw=0.8,
+                   label=f"+{100 * FLUTTER_MARGIN:.0f} % margin")
+        rows = sorted((r for r in table if r.altitude == h and r.speed is not None),
+                      key=lambda r: r.mach)
+        ax.plot([r.speed for r in rows], [r.mach for r in rows], "o-", color="C3",
+                label="p-k flutter speed")
+        for r in rows:
+            ax.annotate(f"{r.speed:.0f}", (r.speed, r.mach), textcoords="offset points",
+                        xytext=(5, -3), fontsize=7, color="C3")
+        from ..flutter import matched_mach
+        mm = matched_mach(table, h)
+        if mm is not None:
+            ax.plot(mm * a, mm, "*", color="C2", ms=12, label=f"matched M {mm:.3f}")
+        ax.set_title(f"h = {h:g} m", fontsize=9)
+        ax.set_xlim(120, 380)
+        ax.set_ylim(0.3, 1.05)
+        ax.set_xlabel("true airspeed (m/s)")
+        ax.legend(fontsize=7, loc="upper left")
+    axes[0].set_ylabel("Mach")
+    return fig
+
+
+#: The thesis's p-k flutter point at Mach 0.75, sea level (Table 10) and its root-locus point
+#: (Table 11), drawn beside asekit's for comparison only.
+THESIS_PK_POINT = (251.12, 143.55)
+THESIS_RL_POINT = (253.11, 144.1)
+
+
+def _low_modes_ylim(freq_hz, n: int = 2):
+    """Frequency-axis limits showing the first ``n`` tracked modes (the flutter coupling)."""
+    f = np.asarray(freq_hz)[:, :n]
+    f = f[np.isfinite(f)]
+    return (0.0, 1.15 * float(f.max())) if f.size else None
+
+
+def fig_pk(res, title="p-k damping and frequency", thesis_figure="Figs 30-31", unit="m/s",
+           flutter=None, thesis_point=None):
+    """Damping ratio xi = -Re p / |p| (Eq. 3.13, the sign used throughout: xi < 0 unstable) and
+    frequency vs airspeed of every tracked mode (Figs 30-31). ``flutter``: an
+    :class:`asekit.flutter.Instability` to mark; ``thesis_point``: (speed, Hz) drawn beside it.
+    The frequency axis shows the first two modes, whose coalescence is the flutter."""
+    from ..plotting import THESIS_COLOR, new_figure
+    fig, (a1, a2) = new_figure(title, thesis_figure, nrows=2, figsize=(6.4, 6.5), sharex=True)
     for j in range(res.p.shape[1]):
-        a1.plot(res.velocities, res.damping_g[:, j], label=f"mode {j + 1}")
+        a1.plot(res.velocities, res.damping_ratio[:, j], label=f"mode {j + 1}")
         a2.plot(res.velocities, res.frequency_hz[:, j])
     a1.axhline(0, color="k", lw=0.8)
-    a1.set_ylabel("damping g = 2 Re p / |p|")
-    a1.set_ylim(max(a1.get_ylim()[0], -1.0), min(a1.get_ylim()[1], 0.5))
-    a1.legend(fontsize=8)
+    a1.set_ylabel("damping ratio xi = -Re p/|p|\n(< 0: unstable)")
+    a1.set_ylim(max(a1.get_ylim()[0], -0.25), min(a1.get_ylim()[1], 0.5))
+    lim = _low_modes_ylim(res.frequency_hz)
+    if lim:
+        a2.set_ylim(*lim)
+    _mark_flutter(a1, a2, flutter, thesis_point, unit)
+    a1.legend(fontsize=8, ncol=2)
     a2.set_xlabel(f"airspeed ({unit})")
     a2.set_ylabel("frequency (Hz)")
     return fig
 
 
-def fig_root_locus(rl, thesis_figure="Figs 32, 35"):
-    """Aeroelastic roots over airspeed in the complex plane (Figs 32, 35)."""
+def _mark_flutter(a1, a2, flutter, thesis_point, unit):
+    from ..plotting import THESIS_COLOR
+    if flutter is not None:
+        a1.plot(flutter.speed, 0.0, "*", color="C3", ms=12, zorder=5,
+                label=f"asekit {flutter.speed:.1f} {unit}")
+        a2.plot(flutter.speed, flutter.frequency_hz, "*", color="C3", ms=12, zorder=5)
+        a2.annotate(f"asekit {flutter.speed:.1f} {unit}, {flutter.frequency_hz:.1f} Hz",
+                    (flutter.speed, flutter.frequency_hz), textcoords="offset points",
+                    xytext=(-10, -16), ha="right", fontsize=8, color="C3")
+    if thesis_point is not None:
+        u, f = thesis_point
+        a1.plot(u, 0.0, "D", color=THESIS_COLOR, ms=7, zorder=5, label=f"thesis {u:g} {unit}")
+        a2.plot(u, f, "D", color=THESIS_COLOR, ms=7, zorder=5)
+        a2.annotate(f"thesis {u:g} {unit}, {f:g} Hz", (u, f), textcoords="offset points",
+                    xytext=(8, 6), fontsize=8, color=THESIS_COLOR)
+
+
+def fig_root_locus(rl, thesis_figure="Figs 32, 35", flutter=None):
+    """Aeroelastic roots over airspeed in the complex plane (Figs 32, 35); the flutter root
+    marked when ``flutter`` is given."""
     from ..plotting import new_figure
     fig, ax = new_figure("Root locus of A_sys (aeroelastic roots)", thesis_figure)
     for j in range(rl.elastic.shape[1]):
         ax.plot(rl.elastic[:, j].real, rl.elastic[:, j].imag / (2 * np.pi), ".-", ms=3,
                 label=f"mode {j + 1}")
     ax.axvline(0, color="k", lw=0.8)
+    if flutter is not None:
+        ax.plot(0.0, flutter.frequency_hz, "*", color="C3", ms=12,
+                label=f"flutter {flutter.speed:.1f} m/s, {flutter.frequency_hz:.1f} Hz")
     ax.set_xlabel("Re lambda (1/s)")
     ax.set_ylabel("Im lambda / 2 pi (Hz)")
     ax.legend(fontsize=8)
     return fig
 
 
-def fig_root_locus_damping(rl, thesis_figure="Figs 33-34", unit="m/s"):
-    """Damping ratio and natural frequency of the aeroelastic roots vs airspeed (Eq. 3.13)."""
+def fig_root_locus_damping(rl, thesis_figure="Figs 33-34", unit="m/s", flutter=None,
+                           thesis_point=None):
+    """Damping ratio (Eq. 3.13, xi < 0 unstable) and natural frequency of the aeroelastic roots
+    vs airspeed, flutter point marked (asekit's and the thesis's)."""
     from ..plotting import new_figure
     fig, (a1, a2) = new_figure("Root locus: damping ratio and frequency", thesis_figure,
-                               nrows=2, figsize=(6.4, 6.5))
+                               nrows=2, figsize=(6.4, 6.5), sharex=True)
     for j in range(rl.elastic.shape[1]):
         a1.plot(rl.velocities, rl.damping_ratio[:, j], label=f"mode {j + 1}")
         a2.plot(rl.velocities, rl.frequency_hz[:, j])
     a1.axhline(0, color="k", lw=0.8)
-    a1.set_ylabel("damping ratio xi")
-    a1.legend(fontsize=8)
+    a1.set_ylabel("damping ratio xi = -Re lambda/|lambda|\n(< 0: unstable)")
+    a1.set_ylim(max(a1.get_ylim()[0], -0.25), min(a1.get_ylim()[1], 0.5))
+    lim = _low_modes_ylim(rl.frequency_hz)
+    if lim:
+        a2.set_ylim(*lim)
+    _mark_flutter(a1, a2, flutter, thesis_point, unit)
+    a1.legend(fontsize=8, ncol=2)
     a2.set_xlabel(f"airspeed ({unit})")
     a2.set_ylabel("frequency (Hz)")
+    return fig
+
+
+def fig_time_responses(responses, coordinate=1, thesis_figure="Figs 36-38"):
+    """Free responses of one elastic coordinate, one panel per (label, speed, response), filled
+    column by column (Figs 36-38: the thesis's speeds left, asekit's onset speeds right)."""
+    from ..plotting import new_figure
+    n = len(responses)
+    fig, axes = new_figure(f"Free response of zeta_{coordinate + 1} (Eq. 3.15)", thesis_figure,
+                           nrows=(n + 1) // 2, ncols=2, figsize=(11, 2.6 * ((n + 1) // 2) + 0.8),
+                           sharex=True)
+    axes = np.atleast_2d(axes)
+    for ax, (label, speed, resp) in zip(np.ravel(axes, order="F"), responses):   # by column
+        ax.plot(resp.t, resp.z[:, coordinate], lw=0.7)
+        ax.set_title(f"{label}: {speed:.1f} m/s", fontsize=9)
+        ax.set_ylabel(f"zeta_{coordinate + 1}")
+    for ax in axes[-1]:
+        ax.set_xlabel("time (s)")
     return fig
 
 
@@ -278,6 +437,42 @@ def fig_time_response(resp, coordinate=1, speed=None, thesis_figure="Figs 36-38"
     ax.plot(resp.t, resp.z[:, coordinate], lw=0.8)
     ax.set_xlabel("time (s)")
     ax.set_ylabel(f"zeta_{coordinate + 1}")
+    return fig
+
+
+def fig_step_sizes(resp, speed: float, thesis_figure="Fig 39"):
+    """RK45 step sizes of one free-response run (Fig 39), as 1/step on a log axis."""
+    from ..plotting import new_figure
+    fig, ax = new_figure(f"RK45 step sizes of the free response at {speed:.1f} m/s",
+                         thesis_figure)
+    ax.semilogy(np.cumsum(resp.steps), 1.0 / resp.steps, ".", ms=2)
+    ax.axhline(1e4, color="k", lw=0.8, ls="--", label="1e4 Hz cap (thesis: step <= 1e-4 s)")
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("1 / step (Hz)")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def fig_flutter_mode(modal, flutter, thesis_figure="Fig 29"):
+    """Flutter mode shape (Fig 29): magnitude and phase of the out-of-plane displacement of the
+    flutter eigenvector expanded on the elastic mode shapes (normalised to its largest value)."""
+    from ..plotting import new_figure
+    v = flutter.vector / flutter.vector[np.argmax(np.abs(flutter.vector))]
+    w = modal.shapes[:, 0, modal.n_rigid:] @ v
+    w = w / w[np.argmax(np.abs(w))]
+    fig, (a1, a2) = new_figure(f"Flutter mode shape, {flutter.speed:.1f} m/s, "
+                               f"{flutter.frequency_hz:.1f} Hz", thesis_figure, ncols=2,
+                               figsize=(12.5, 4.5))
+    x, y = modal.nodes[:, 0] * 1e3, modal.nodes[:, 1] * 1e3
+    c1 = a1.tricontourf(x, y, np.abs(w), 20, cmap="viridis")
+    fig.colorbar(c1, ax=a1, label="|w| (normalised)")
+    c2 = a2.tricontourf(x, y, np.degrees(np.angle(w)), 20, cmap="twilight")
+    fig.colorbar(c2, ax=a2, label="phase of w (deg)")
+    for ax, t in ((a1, "magnitude"), (a2, "phase")):
+        ax.set_xlabel("x (mm)")
+        ax.set_ylabel("y (mm)")
+        ax.set_aspect("equal")
+        ax.set_title(t, fontsize=9)
     return fig
 
 
@@ -295,23 +490,62 @@ def fig_growth(td, thesis_figure="Table 11", unit="m/s"):
     return fig
 
 
-def fin_figures(modal, db, fit, conds, rl, td) -> dict:
+def fig_damping_study(rows, thesis_speed: float | None = None):
+    """Flutter speed vs modal damping ratio and vs structural g (equivalent at g = 2 zeta)."""
+    from ..plotting import THESIS_COLOR, new_figure
+    fig, ax = new_figure("Flutter speed vs structural damping, Mach 0.75, sea level, 6x7 model")
+    z = [(r["value"], r["speed"]) for r in rows if r["kind"] == "zeta" and r["speed"]]
+    g = [(r["value"], r["speed"]) for r in rows if r["kind"] == "g" and r["speed"]]
+    ax.plot([100 * a for a, _ in z], [b for _, b in z], "o-", label="modal damping ratio zeta")
+    ax.plot([50 * a for a, _ in g], [b for _, b in g], "s--", label="structural g (plotted at g/2)")
+    if thesis_speed:
+        ax.axhline(thesis_speed, color=THESIS_COLOR, ls=":", label=f"thesis {thesis_speed} m/s")
+    ax.set_xlabel("damping ratio zeta = g/2 (%)")
+    ax.set_ylabel("p-k flutter speed (m/s)")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def free_responses(modal, fit, rho: float, onset: float | None, t_end: float = 0.25):
+    """Free responses (Eq. 3.15, unit initial zeta_2, RK45 with steps <= 1e-4 s) at the thesis's
+    248 / 254 / 260 m/s (Figs 36-38) and at asekit's onset -6 / 0 / +6 m/s: a list of
+    (label, speed, FreeResponse)."""
     from ..aeroelastic import aeroelastic_matrices
     from ..flutter import initial_state, simulate_free_response
-    figs = {"fig23_rfa_q45": fig_rfa_element(fit, min(3, fit.n_modes - 1),
-                                             min(4, fit.n_modes - 1), "Fig 23"),
-            "fig24_rfa_q12": fig_rfa_element(fit, 0, 1, "Fig 24")}
-    pts = [(c["flutter"].speed, h, f"{mk}") for (mk, h), c in conds.items()
+    cases = [("thesis Fig 36", 248.0), ("thesis Fig 37", 254.0), ("thesis Fig 38", 260.0)]
+    if onset:
+        cases += [("asekit onset - 6", onset - 6.0), ("asekit onset", onset),
+                  ("asekit onset + 6", onset + 6.0)]
+    out = []
+    for label, u in cases:
+        A = aeroelastic_matrices(modal, fit, rho, u).A
+        out.append((label, u, simulate_free_response(A, initial_state(A.shape[0], 1), t_end,
+                                                      1e-4, "RK45")))
+    return out
+
+
+def fin_figures(modal, db, fit, conds, rl, td) -> dict:
+    c0 = conds[("M075", 0.0)]
+    fit06 = fin_rfa(db, 0.6)
+    figs = {"fig23_rfa_q45": fig_rfa_element(fit06, min(3, fit06.n_modes - 1),
+                                             min(4, fit06.n_modes - 1), "Fig 23"),
+            "fig24_rfa_q12": fig_rfa_element(fit06, 0, 1, "Fig 24")}
+    pts = [(c["flutter"].speed, h, f"M {mk[1]}.{mk[2:]}") for (mk, h), c in conds.items()
            if c["flutter"] is not None]
     figs["fig25_mach_airspeed_altitude"] = fig_mach_airspeed_altitude(pts)
-    figs["fig30_31_pk"] = fig_pk(conds[("M075", 0.0)]["pk"], "p-k, Mach 0.75, sea level")
-    figs["fig32_35_root_locus"] = fig_root_locus(rl)
-    figs["fig33_34_root_locus_damping"] = fig_root_locus_damping(rl)
+    figs["fig30_31_pk"] = fig_pk(c0["pk"], "p-k, Mach 0.75, sea level", flutter=c0["flutter"],
+                                 thesis_point=THESIS_PK_POINT)
+    rl_fl = first_of(root_locus_instabilities(rl, modal, fit), "flutter")
+    figs["fig32_35_root_locus"] = fig_root_locus(rl, flutter=rl_fl)
+    figs["fig33_34_root_locus_damping"] = fig_root_locus_damping(
+        rl, flutter=rl_fl, thesis_point=THESIS_RL_POINT)
+    if c0["flutter"] is not None:
+        figs["fig29_flutter_mode"] = fig_flutter_mode(modal, c0["flutter"])
     figs["fig_growth"] = fig_growth(td)
-    u = td.onset_speed or 300.0
-    mats = aeroelastic_matrices(modal, fit, conds[("M075", 0.0)]["density"], u)
-    resp = simulate_free_response(mats.A, initial_state(mats.n_states, 1), 0.25, 1e-4, "RK45")
-    figs["fig37_time_response"] = fig_time_response(resp, 1, u, "Fig 37")
+    resp = free_responses(modal, fit, c0["density"], td.onset_speed)
+    figs["fig36_38_time_response"] = fig_time_responses(resp)
+    label, u, r = resp[4] if len(resp) > 4 else resp[1]
+    figs["fig39_step_sizes"] = fig_step_sizes(r, u)
     return figs
 
 
@@ -501,3 +735,235 @@ def model_sensitivity(db, mach: float = 0.75, altitude: float = 0.0, velocities=
                      "first_kind": None if first is None else first.kind,
                      "Q_cc": float(g.Q[0, 0, 0].real)})
     return rows
+
+
+# --------------------------------------------------------------------------------------------
+# damping: how the flutter speed moves with structural damping (issue 10)
+# --------------------------------------------------------------------------------------------
+#: Modal (viscous) damping ratios of the damping study, fractions of critical.
+DAMPING_RATIOS = (0.0, 0.0025, 0.005, 0.01, 0.02)
+#: Structural (hysteretic) damping coefficients g of the damping study.
+STRUCTURAL_G = (0.0, 0.005, 0.01, 0.02, 0.04)
+#: Airspeeds of the damping study (m/s): coarser than VELOCITIES (each crossing is refined by
+#: Brent's method, so the step sets only the bracketing), covering 150-340 m/s.
+DAMPING_VELOCITIES = np.arange(150.0, 342.0 + 1e-9, 4.0)
+
+
+def damped_modal(modal, zeta: float = 0.0, g: float = 0.0, omega_ref: float | None = None):
+    """The modal model with damping on its elastic modes (as :class:`ModalArrays`).
+
+    ``zeta``: viscous modal damping ratio, C_ss,ii = 2 zeta omega_i M_ss,ii (M_ss, K_ss diagonal
+    in the modal basis). ``g``: hysteretic (structural) damping i g K_ss, represented by its
+    equivalent viscous damping (g / omega_ref) K_ss, exact for harmonic motion at omega_ref
+    (rad/s) — at the flutter point when omega_ref is the flutter frequency (p = i omega_f:
+    p (g/omega_f) K = i g K). The rigid mode stays undamped. ``zeta`` in [0, 1), ``g`` >= 0.
+    """
+    from ..aeroelastic import ModalArrays, modal_arrays
+    if not (0.0 <= zeta < 1.0):
+        raise ValueError(f"zeta must be in [0, 1), got {zeta!r}")
+    if not (g >= 0.0 and np.isfinite(g)):
+        raise ValueError(f"g must be >= 0, got {g!r}")
+    if g > 0 and not (omega_ref is not None and omega_ref > 0):
+        raise ValueError(f"omega_ref must be > 0 (rad/s) when g > 0, got {omega_ref!r}")
+    m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
+    s = slice(m.n_rigid, m.n_modes)
+    C = m.C.copy()
+    Mss, Kss = np.diag(m.M[s, s]), np.diag(m.K[s, s])
+    C[s, s] += np.diag(2.0 * zeta * np.sqrt(Kss / Mss) * Mss)
+    if g > 0:
+        C[s, s] += (g / omega_ref) * m.K[s, s]
+    return ModalArrays(M=m.M, K=m.K, C=C, n_rigid=m.n_rigid)
+
+
+def damping_study(modal, db, mach: float = 0.75, altitude: float = 0.0,
+                  ratios=DAMPING_RATIOS, gs=STRUCTURAL_G, velocities=VELOCITIES) -> list[dict]:
+    """p-k flutter speed and frequency versus modal damping ratio and structural g.
+
+    Rows {kind: "zeta" | "g", value, speed (m/s), freq (Hz)}; speed None when no flutter in the
+    sweep. For g the equivalent viscous damping is evaluated at the flutter frequency, iterated
+    until it changes by < 0.1 % (at most 6 passes; starts from the undamped flutter frequency).
+    """
+    rho = float(standard_atmosphere(altitude).density)
+    gaf = fin_gaf(db, mach)
+
+    def flutter(mod):
+        res = pk_flutter(mod, gaf, rho, velocities)
+        return first_of(pk_instabilities(res, mod, gaf), "flutter")
+
+    rows = []
+    for z in ratios:
+        fl = flutter(damped_modal(modal, zeta=z))
+        rows.append({"kind": "zeta", "value": float(z), "speed": _val(fl, "speed"),
+                     "freq": _val(fl, "frequency_hz")})
+    f_ref = next((r["freq"] for r in rows if r["value"] == 0.0 and r["freq"]), None)
+    for g in gs:
+        if g == 0:
+            fl = flutter(damped_modal(modal))
+        else:
+            fl, f = None, f_ref
+            for _ in range(6):
+                if f is None:
+                    break
+                fl = flutter(damped_modal(modal, g=g, omega_ref=2 * np.pi * f))
+                if fl is None or abs(fl.frequency_hz / f - 1) < 1e-3:
+                    break
+                f = fl.frequency_hz
+        rows.append({"kind": "g", "value": float(g), "speed": _val(fl, "speed"),
+                     "freq": _val(fl, "frequency_hz")})
+    return rows
+
+
+# --------------------------------------------------------------------------------------------
+# converged flutter: distributed shaft, structural and aerodynamic meshes refined (issue 10)
+# --------------------------------------------------------------------------------------------
+#: Structural meshes (elements chordwise x spanwise) of the convergence study, distributed shaft.
+CONVERGENCE_STRUCTURE = ((24, 28), (48, 56), (96, 112), (192, 224), (384, 448))
+#: Aerodynamic box meshes (chordwise x spanwise); the first is the mesh-rule default.
+CONVERGENCE_AERO = ((14, 10), (28, 20), (56, 40))
+#: Convergence criterion: relative change of the flutter speed on the last refinement.
+CONVERGENCE_TOL = 0.01
+_STUDY_VERSION = 1
+
+
+def user_cache_dir():
+    """Directory for expensive results computed once per machine: ``$ASEKIT_CACHE_DIR``, else
+    ``$XDG_CACHE_HOME/asekit``, else ``~/.cache/asekit`` (outside the repository)."""
+    import os
+    from pathlib import Path
+    if os.environ.get("ASEKIT_CACHE_DIR"):
+        return Path(os.environ["ASEKIT_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "asekit"
+
+
+def _study_fingerprint(db, mach, altitude, velocities, structure, aero) -> str:
+    """SHA-256 over everything the converged study depends on: the fin definition, the GAF
+    database's k and b_ref, the condition, the sweep, the meshes and the source of the modules
+    that compute it (so an edit to the physics invalidates the cached result)."""
+    import hashlib
+    from pathlib import Path
+
+    from ..paths import FIN_FILE
+    h = hashlib.sha256()
+    h.update(f"v{_STUDY_VERSION} {mach!r} {altitude!r} {structure!r} {aero!r}".encode())
+    h.update(np.ascontiguousarray(np.asarray(velocities, float)).tobytes())
+    h.update(np.ascontiguousarray(np.asarray(db.k, float)).tobytes())
+    h.update(repr(float(db.b_ref)).encode())
+    h.update(Path(FIN_FILE).read_bytes())
+    pkg = Path(__file__).resolve().parent.parent
+    for rel in sorted(["flutter.py", "aeroelastic.py", "atmosphere.py", "geometry.py"]
+                      + [f"structure/{p.name}" for p in (pkg / "structure").glob("*.py")]
+                      + [f"aero/{p.name}" for p in (pkg / "aero").glob("*.py")]):
+        h.update(rel.encode())
+        h.update((pkg / rel).read_bytes())
+    return h.hexdigest()
+
+
+def _distributed_model(structure):
+    """The FN2 modal model with the distributed shaft region on a ``structure`` mesh."""
+    import warnings
+
+    from ..structure.modes import fin_modal_model
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")          # unresolved shaft region on the coarse meshes
+        return fin_modal_model(n_chord=structure[0], n_span=structure[1], shaft="distributed")
+
+
+def _mesh_flutter(model, db, mach, rho, velocities, aero):
+    """(elastic Hz (first 3), speed, freq) of ``model`` with GAFs on the ``aero`` box mesh."""
+    from ..aeroelastic import modal_arrays
+    g = aero_variant_gafs(model, db, mach, n_chord=aero[0], n_span=aero[1])
+    m = modal_arrays(model)
+    fl = first_of(pk_instabilities(pk_flutter(m, g, rho, velocities), m, g), "flutter")
+    f = model.frequencies_hz[model.n_rigid:model.n_rigid + 3]
+    return (list(map(float, f)) + [np.nan] * (3 - len(f)), _val(fl, "speed"),
+            _val(fl, "frequency_hz"))
+
+
+def converged_flutter_study(db, mach: float = 0.75, altitude: float = 0.0,
+                            velocities=np.arange(140.0, 340.0 + 1e-9, 2.0),
+                            structure=CONVERGENCE_STRUCTURE, aero=CONVERGENCE_AERO,
+                            tol: float = CONVERGENCE_TOL, cache: bool = True) -> dict:
+    """p-k flutter of the fin with the distributed shaft region (rigid disc of the shaft radius)
+    on successively refined structural meshes (at the default box mesh), then on refined box
+    meshes at the finest structure; each refinement stops once the flutter speed moves by less
+    than ``tol``.
+
+    Returns ``{"rows": [(structure, aero, elastic_hz, speed, freq), ...], "speed", "freq",
+    "structure", "aero", "change_structure", "change_aero", "converged"}`` where speed/freq
+    (m/s, Hz) belong to the finest mesh pair and change_* are the relative speed changes of its
+    last structural and aerodynamic refinement.
+
+    The finest meshes take minutes, so with ``cache`` the result is stored (atomically, with a
+    checksum, :mod:`asekit.cache`) in :func:`user_cache_dir` under a fingerprint of all its
+    inputs and the physics source, and reused while the fingerprint matches.
+    """
+    from ..cache import CacheError, load_npz, save_npz
+    key = _study_fingerprint(db, mach, altitude, velocities, structure, aero)
+    path = user_cache_dir() / f"flutter_convergence_{key[:16]}.npz"
+    if cache:
+        try:
+            arrays, meta = load_npz(path)
+            if meta.get("fingerprint") == key:
+                return _study_from_arrays(arrays, meta)
+        except CacheError:
+            pass                                    # missing or corrupt: recompute
+    rho = float(standard_atmosphere(altitude).density)
+    rows = []
+
+    def run(model, s, a):
+        f, u, fr = _mesh_flutter(model, db, mach, rho, velocities, a)
+        rows.append((tuple(s), tuple(a), f, u, fr))
+        return u
+
+    def rel(u_new, u_old):
+        return None if (u_new is None or u_old is None) else abs(u_new / u_old - 1)
+
+    a0 = aero[0]
+    prev = change_s = model = None
+    s_final = structure[0]
+    for s in structure:
+        model = _distributed_model(s)
+        u = run(model, s, a0)
+        s_final = s
+        change_s = rel(u, prev) if prev is not None else None
+        if change_s is not None and change_s < tol:
+            break
+        prev = u
+    prev, change_a, a_final = rows[-1][3], None, a0
+    for a in aero[1:]:                       # the box mesh refined on the finest structure
+        u = run(model, s_final, a)
+        a_final = a
+        change_a = rel(u, prev)
+        if change_a is not None and change_a < tol:
+            break
+        prev = u
+    out = {"rows": rows, "speed": rows[-1][3], "freq": rows[-1][4], "structure": s_final,
+           "aero": a_final, "change_structure": change_s, "change_aero": change_a,
+           "converged": bool(change_s is not None and change_s < tol
+                             and (change_a is None or change_a < tol))}
+    if cache:
+        arr = {"structure": np.array([r[0] for r in rows], float),
+               "aero": np.array([r[1] for r in rows], float),
+               "elastic_hz": np.array([r[2] for r in rows], float),
+               "speed": np.array([np.nan if r[3] is None else r[3] for r in rows], float),
+               "freq": np.array([np.nan if r[4] is None else r[4] for r in rows], float)}
+        meta = {"fingerprint": key, "mach": mach, "altitude": altitude, "tol": tol,
+                "final_structure": list(s_final), "final_aero": list(a_final),
+                "change_structure": change_s, "change_aero": change_a,
+                "converged": out["converged"]}
+        save_npz(path, arr, meta)
+    return out
+
+
+def _study_from_arrays(arrays, meta) -> dict:
+    def opt(x):
+        return None if np.isnan(x) else float(x)
+    rows = [(tuple(int(v) for v in s), tuple(int(v) for v in a), list(map(float, f)), opt(u),
+             opt(fr)) for s, a, f, u, fr in zip(arrays["structure"], arrays["aero"],
+                                                  arrays["elastic_hz"], arrays["speed"],
+                                                  arrays["freq"])]
+    return {"rows": rows, "speed": rows[-1][3], "freq": rows[-1][4],
+            "structure": tuple(meta["final_structure"]), "aero": tuple(meta["final_aero"]),
+            "change_structure": meta["change_structure"], "change_aero": meta["change_aero"],
+            "converged": meta["converged"]}

@@ -175,24 +175,37 @@ def run(figures: bool = False) -> ChapterResult:
 
 # ---- figures ---------------------------------------------------------------------------------
 
+def _registry() -> dict:
+    """Figure name -> function of a :class:`ServoChapter` drawing it."""
+    return {
+        "fig40_41_profile_position": fig_profile_position,
+        "fig42_profile_rate": fig_profile_rate,
+        "fig43_profile_acceleration": fig_profile_acceleration,
+        "fig47_root_locus_open_loop": lambda ch: fig_root_locus_open_loop(ch, dominant=False),
+        "fig48_root_locus_dominant": lambda ch: fig_root_locus_open_loop(ch, dominant=True),
+        "fig49_step_no_controller": fig_step_no_controller,
+        "fig50_root_locus_pd": fig_root_locus_pd,
+        "fig51_step_systems12": fig_step_systems12,
+        "fig52_step14_system2": lambda ch: fig_step14(ch, SYSTEM_2),
+        "fig53_step14_system3": lambda ch: fig_step14(ch, SYSTEM_3),
+        "fig54_bode_system3": fig_bode,
+        "fig55_reversal_position": lambda ch: fig_reversal(ch, "position"),
+        "fig56_reversal_rate": lambda ch: fig_reversal(ch, "rate"),
+        "fig57_reversal_torque": lambda ch: fig_reversal(ch, "torque"),
+    }
+
+
+def figure(ch: ServoChapter, name: str):
+    """Draw the Ch. 4 figure ``name`` (a key of :func:`all_figures`) and return it."""
+    reg = _registry()
+    if name not in reg:
+        raise ValueError(f"name must be one of {sorted(reg)}, got {name!r}")
+    return reg[name](ch)
+
+
 def all_figures(ch: ServoChapter) -> dict:
     """Every Ch. 4 figure, keyed by a stable name."""
-    return {
-        "fig40_41_profile_position": fig_profile_position(ch),
-        "fig42_profile_rate": fig_profile_rate(ch),
-        "fig43_profile_acceleration": fig_profile_acceleration(ch),
-        "fig47_root_locus_open_loop": fig_root_locus_open_loop(ch, dominant=False),
-        "fig48_root_locus_dominant": fig_root_locus_open_loop(ch, dominant=True),
-        "fig49_step_no_controller": fig_step_no_controller(ch),
-        "fig50_root_locus_pd": fig_root_locus_pd(ch),
-        "fig51_step_systems12": fig_step_systems12(ch),
-        "fig52_step14_system2": fig_step14(ch, SYSTEM_2),
-        "fig53_step14_system3": fig_step14(ch, SYSTEM_3),
-        "fig54_bode_system3": fig_bode(ch),
-        "fig55_reversal_position": fig_reversal(ch, "position"),
-        "fig56_reversal_rate": fig_reversal(ch, "rate"),
-        "fig57_reversal_torque": fig_reversal(ch, "torque"),
-    }
+    return {name: draw(ch) for name, draw in _registry().items()}
 
 
 def _linear_profile(ch: ServoChapter) -> ProfileResponse:

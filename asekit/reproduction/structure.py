@@ -198,7 +198,9 @@ def _triangles(elements: np.ndarray) -> np.ndarray:
 
 def fig_mode_shapes(model: ModalModel, title: str = "FN2 mode shapes (w, contours)",
                     thesis_figure: str = "Fig 17"):
-    """Fig 17 (and Fig 18's rigid mode): contour plots of w of every mode of the modal model."""
+    """Fig 17 (and Fig 18's rigid mode): contour plots of w of every mode of the modal model:
+    the rigid mode per radian of pitch (m/rad), the elastic modes mass-normalised (w per unit
+    modal coordinate, kg^-1/2), numbered as asekit's and as the thesis's Table 6."""
     n = model.frequencies_hz.size
     ncols = 3
     nrows = math.ceil(n / ncols)
@@ -215,12 +217,17 @@ def fig_mode_shapes(model: ModalModel, title: str = "FN2 mode shapes (w, contour
                             levels=np.linspace(-lim, lim, 17), cmap="RdBu_r")
         ax.tricontour(model.nodes[:, 0] * 1e3, model.nodes[:, 1] * 1e3, tri, w, levels=[0.0],
                       colors="k", linewidths=0.8)
-        kind = "rigid pitch, unit rad" if j < model.n_rigid else f"elastic mode {j - model.n_rigid + 1}"
+        rigid = j < model.n_rigid
+        # the thesis numbers its in-plane mode "elastic mode 1", so its out-of-plane modes used
+        # (Table 6) are its elastic modes 2-6
+        kind = ("rigid pitch, 1 rad" if rigid else
+                f"elastic mode {j - model.n_rigid + 1} (thesis {j - model.n_rigid + 2})")
         ax.set_title(f"{kind}: {model.frequencies_hz[j]:.1f} Hz", fontsize=9)
         ax.set_aspect("equal")
         ax.set_xlabel("x (mm)")
         ax.set_ylabel("y (mm)")
-        fig.colorbar(cs, ax=ax, shrink=0.8, label="w (m)")
+        fig.colorbar(cs, ax=ax, shrink=0.8,
+                     label="w (m/rad)" if rigid else "w (kg$^{-1/2}$, mass-normalised)")
     return fig
 
 
