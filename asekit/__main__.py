@@ -62,6 +62,8 @@ def _check_outputs(parser: argparse.ArgumentParser, args) -> None:
 
 def _reproduce(args) -> int:
     _check_outputs(args.parser, args)
+    if args.converged:             # read by asekit.reproduction.flutter.converged_study_requested
+        os.environ["ASEKIT_CONVERGED_STUDY"] = "1"
     import matplotlib
     matplotlib.use("Agg")
     from .reproduce import ChapterFailed, reproduce
@@ -106,6 +108,9 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--quiet", action="store_true", help="no progress bar on standard error")
     rep.add_argument("--keep-going", action="store_true",
                      help="run the other chapters when one's inputs fail, and exit 0")
+    rep.add_argument("--converged", action="store_true",
+                     help="also compute the fin's mesh-converged flutter study if it is not "
+                          "cached (about 8 min and 7 GB of memory the first time)")
     rep.set_defaults(func=_reproduce, parser=rep)
     from .cli_analyse import add_parser as add_analyse
     from .cli_sweep import add_parser as add_sweep

@@ -6,6 +6,7 @@ the p-k roots of every elastic mode must show the damping ratio zeta put in; hys
 i g K equals the viscous c = g k / omega at the frequency omega.
 """
 
+from asekit.paths import user_cache_dir
 import numpy as np
 import pytest
 
@@ -64,10 +65,10 @@ def test_damping_raises_the_flutter_speed_monotonically():
 
 def test_user_cache_dir_override(monkeypatch, tmp_path):
     monkeypatch.setenv("ASEKIT_CACHE_DIR", str(tmp_path / "c"))
-    assert rf.user_cache_dir() == tmp_path / "c"
+    assert user_cache_dir() == tmp_path / "c"
     monkeypatch.delenv("ASEKIT_CACHE_DIR")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "x"))
-    assert rf.user_cache_dir() == tmp_path / "x" / "asekit"
+    assert user_cache_dir() == tmp_path / "x" / "asekit"
 
 
 @needs_db

@@ -179,15 +179,20 @@ def run(figures: bool = False) -> ChapterResult:
                       rl_first.kind if rl_first else "none up to 460 m/s"))
     q.append(Quantity("flutter.first_instability.time_domain.M075.h0.speed_ms",
                       td.onset_speed, "m/s", td_kind or "none up to 460 m/s"))
-    conv = converged_flutter_study(db)
-    (sc, ss), (ac, asp) = conv["structure"], conv["aero"]
-    cs, ca = conv["change_structure"], conv["change_aero"]
-    conv_note = (f"distributed shaft, FE {sc}x{ss}, boxes {ac}x{asp}; last refinements "
-                 f"{'-' if cs is None else f'{100 * cs:.2f}'} % (FE), "
-                 f"{'-' if ca is None else f'{100 * ca:.2f}'} % (boxes)"
-                 + ("" if conv["converged"] else "; NOT converged to 1 %"))
-    q.append(Quantity("flutter.converged.pk.M075.h0.speed_ms", conv["speed"], "m/s", conv_note))
-    q.append(Quantity("flutter.converged.pk.M075.h0.freq_hz", conv["freq"], "Hz", conv_note))
+    conv = converged_flutter_study(db, compute=converged_study_requested())
+    if conv is None:
+        conv_note = (f"not computed (about 8 min, 7 GB the first time): {CONVERGED_HINT}")
+        speed = freq = None
+    else:
+        (sc, ss), (ac, asp) = conv["structure"], conv["aero"]
+        cs, ca = conv["change_structure"], conv["change_aero"]
+        conv_note = (f"distributed shaft, FE {sc}x{ss}, boxes {ac}x{asp}; last refinements "
+                     f"{'-' if cs is None else f'{100 * cs:.2f}'} % (FE), "
+                     f"{'-' if ca is None else f'{100 * ca:.2f}'} % (boxes)"
+                     + ("" if conv["converged"] else "; NOT converged to 1 %"))
+        speed, freq = conv["speed"], conv["freq"]
+    q.append(Quantity("flutter.converged.pk.M075.h0.speed_ms", speed, "m/s", conv_note))
+    q.append(Quantity("flutter.converged.pk.M075.h0.freq_hz", freq, "Hz", conv_note))
     damp = damping_study(modal, db, velocities=DAMPING_VELOCITIES)
     q.append(Quantity("flutter.damping.pk.M075.h0.speed_ms",
                       [r["speed"] for r in damp if r["kind"] == "zeta"], "m/s",
@@ -825,15 +830,17 @@ CONVERGENCE_TOL = 0.01
 _STUDY_VERSION = 1
 
 
-def user_cache_dir():
-    """Directory for expensive results computed once per machine: ``$ASEKIT_CACHE_DIR``, else
-    ``$XDG_CACHE_HOME/asekit``, else ``~/.cache/asekit`` (outside the repository)."""
+#: How to ask for the converged study when it is not cached.
+CONVERGED_HINT = ("python -m asekit reproduce --converged, or ASEKIT_CONVERGED_STUDY=1 for the "
+                  "notebooks and tests")
+
+
+def converged_study_requested() -> bool:
+    """Whether the (minutes-long, 7 GB) converged study may be computed in this run:
+    ``ASEKIT_CONVERGED_STUDY=1`` (set by ``python -m asekit reproduce --converged``). Without
+    it a cached result is still used."""
     import os
-    from pathlib import Path
-    if os.environ.get("ASEKIT_CACHE_DIR"):
-        return Path(os.environ["ASEKIT_CACHE_DIR"])
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "asekit"
+    return os.environ.get("ASEKIT_CONVERGED_STUDY", "") == "1"
 
 
 def _study_fingerprint(db, mach, altitude, velocities, structure, aero) -> str:
@@ -883,7 +890,8 @@ def _mesh_flutter(model, db, mach, rho, velocities, aero):
 def converged_flutter_study(db, mach: float = 0.75, altitude: float = 0.0,
                             velocities=np.arange(140.0, 340.0 + 1e-9, 2.0),
                             structure=CONVERGENCE_STRUCTURE, aero=CONVERGENCE_AERO,
-                            tol: float = CONVERGENCE_TOL, cache: bool = True) -> dict:
+                            tol: float = CONVERGENCE_TOL, cache: bool = True,
+                            compute: bool = True) -> dict | None:
     """p-k flutter of the fin with the distributed shaft region (rigid disc of the shaft radius)
     on successively refined structural meshes (at the default box mesh), then on refined box
     meshes at the finest structure; each refinement stops once the flutter speed moves by less
@@ -894,10 +902,13 @@ def converged_flutter_study(db, mach: float = 0.75, altitude: float = 0.0,
     (m/s, Hz) belong to the finest mesh pair and change_* are the relative speed changes of its
     last structural and aerodynamic refinement.
 
-    The finest meshes take minutes, so with ``cache`` the result is stored (atomically, with a
-    checksum, :mod:`asekit.cache`) in :func:`user_cache_dir` under a fingerprint of all its
-    inputs and the physics source, and reused while the fingerprint matches.
+    The finest meshes take minutes (about 8 min and 7 GB for 384 x 448), so with ``cache`` the
+    result is stored (atomically, with a checksum, :mod:`asekit.cache`) in the user cache
+    directory (:func:`asekit.paths.user_cache_dir`) under a fingerprint of all its inputs and
+    the physics source, and reused while the fingerprint matches. With ``compute=False`` a
+    missing or stale cache returns None instead of computing.
     """
+    from ..paths import user_cache_dir
     from ..cache import CacheError, load_npz, save_npz
     key = _study_fingerprint(db, mach, altitude, velocities, structure, aero)
     path = user_cache_dir() / f"flutter_convergence_{key[:16]}.npz"
@@ -908,6 +919,8 @@ def converged_flutter_study(db, mach: float = 0.75, altitude: float = 0.0,
                 return _study_from_arrays(arrays, meta)
         except CacheError:
             pass                                    # missing or corrupt: recompute
+    if not compute:
+        return None
     rho = float(standard_atmosphere(altitude).density)
     rows = []
 
