@@ -6,13 +6,13 @@ the p-k roots of every elastic mode must show the damping ratio zeta put in; hys
 i g K equals the viscous c = g k / omega at the frequency omega.
 """
 
-from asekit.paths import user_cache_dir
 import numpy as np
 import pytest
 
 import asekit.reproduction.flutter as rf
 from asekit.aeroelastic import modal_arrays
 from asekit.flutter import pk_flutter
+from asekit.paths import user_cache_dir
 
 DATA, REASON = rf.load_fin_gafs()
 needs_db = pytest.mark.skipif(DATA is None, reason=REASON or "no GAF database")
