@@ -532,13 +532,9 @@ def _check_condition(where: str, path: str, v: float) -> None:
 
 def load_sweep(path) -> Sweep:
     """Read and check a sweep file (TOML); SweepError naming the key, or FileNotFoundError."""
+    from .validate import read_toml
     path = Path(path)
-    with open(path, "rb") as fh:
-        try:
-            d = tomllib.load(fh)
-        except tomllib.TOMLDecodeError as exc:
-            raise SweepError(f"{path.name} is not valid TOML: {exc}") from None
-    return sweep_from_dict(d, base_dir=path.parent, source=str(path))
+    return sweep_from_dict(read_toml(path, SweepError), base_dir=path.parent, source=str(path))
 
 
 # ---------------------------------------------------------------------------------------------

@@ -61,3 +61,16 @@ def positive_array(name: str, values) -> np.ndarray:
     if a.size == 0 or not np.all(np.isfinite(a)) or np.any(a <= 0):
         raise ValueError(f"{name} must be finite and > 0, got {values}")
     return a
+
+
+def read_toml(path, error: type[Exception] = ValueError) -> dict:
+    """Parse the TOML file ``path``; a syntax error becomes ``error`` naming the file (a missing
+    file raises FileNotFoundError)."""
+    import tomllib
+    from pathlib import Path
+    path = Path(path)
+    with open(path, "rb") as fh:
+        try:
+            return tomllib.load(fh)
+        except tomllib.TOMLDecodeError as exc:
+            raise error(f"{path.name} is not valid TOML: {exc}") from None

@@ -13,9 +13,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import tomllib
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -645,10 +643,5 @@ def case_from_dict(d: dict, source: str = "") -> Case:
 def load_case(path) -> Case:
     """Read and check a case file (TOML). Raises :class:`CaseError` (a ValueError) naming the
     offending key and its valid range, or FileNotFoundError."""
-    path = Path(path)
-    with open(path, "rb") as fh:
-        try:
-            d = tomllib.load(fh)
-        except tomllib.TOMLDecodeError as exc:
-            raise CaseError(f"{path.name} is not valid TOML: {exc}") from None
-    return case_from_dict(d, source=str(path))
+    from ..validate import read_toml
+    return case_from_dict(read_toml(path, CaseError), source=str(path))
