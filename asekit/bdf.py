@@ -903,7 +903,6 @@ def case_bdf(case, sol: int = 145, n_modes: int | None = None):
         lines.insert(4, "FMETHOD = 20")
     d = case.damping
     if d.modal_damping_ratio is not None or d.structural_g is not None:
-        from .structure.modes import with_damping
         ref = pl.modal_model(case)
         f = ref.frequencies_hz[ref.n_rigid:]
         if d.structural_g is not None:

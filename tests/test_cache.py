@@ -4,9 +4,7 @@ rebuild signal), never a crash; orphaned temporary files are cleaned."""
 
 import json
 import os
-import shutil
 import time
-import zipfile
 
 import numpy as np
 import pytest

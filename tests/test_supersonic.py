@@ -235,7 +235,7 @@ def test_grid_converges_on_the_fin():
     twice as many cells per box chord (diaphragm march stable as the grid is refined)."""
     mesh = fin_boxes()
     b = xa = 0.078
-    x, xl = mesh.control_point[:, 0], mesh.load_point[:, 0]
+    xl = mesh.load_point[:, 0]
     qcc = []
     for cpb in (1.5, 3.0):
         cp = supersonic_pressures(mesh, 2.0, [0.0], b, -np.ones((1, mesh.n, 1)),

@@ -340,7 +340,7 @@ def fig_pk(res, title="p-k damping and frequency", thesis_figure="Figs 30-31", u
     frequency vs airspeed of every tracked mode (Figs 30-31). ``flutter``: an
     :class:`asekit.flutter.Instability` to mark; ``thesis_point``: (speed, Hz) drawn beside it.
     The frequency axis shows the first two modes, whose coalescence is the flutter."""
-    from ..plotting import THESIS_COLOR, new_figure
+    from ..plotting import new_figure
     fig, (a1, a2) = new_figure(title, thesis_figure, nrows=2, figsize=(6.4, 6.5), sharex=True)
     for j in range(res.p.shape[1]):
         a1.plot(res.velocities, res.damping_ratio[:, j], label=f"mode {j + 1}")
