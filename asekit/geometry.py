@@ -1,20 +1,19 @@
-"""Trapezoidal lifting surfaces and the reference fin definition.
+"""Trapezoidal lifting surfaces, thickness laws and materials.
 
 Axes: x chordwise (downstream, the free-stream direction), y spanwise, z normal (up). A positive
 rotation about +y moves the trailing edge down: nose-up, i.e. a positive angle of attack.
 
-The reference fin is one case file, ``data/cases/nalci2013_fin.toml``; :func:`load_fin` reads it.
+The reference fin is one case file, ``data/cases/nalci2013_fin.toml``, read by
+:func:`asekit.reproduction.fin.load_fin`; nothing here knows it.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from .paths import FIN_FILE
 from .validate import positive
 
 
@@ -368,85 +367,3 @@ class OrthotropicMaterial:
         return 0.5 * (G + G.T)
 
 
-@dataclass(frozen=True)
-class Shaft:
-    """The fin's pitch shaft: a spanwise axis through ``axis_point`` (x, y) in m.
-
-    torsional_stiffness (N m/rad) is the FN1 spring; radius (m) the physical shaft region used by
-    the distributed (rigid multi-point) shaft model; fictitious_inertia_factor the FN2 multiplier.
-    """
-
-    axis_point: tuple[float, float]
-    torsional_stiffness: float
-    radius: float
-    fictitious_inertia_factor: float = 1.0e6
-
-    def __post_init__(self):
-        object.__setattr__(self, "axis_point", tuple(float(v) for v in self.axis_point))
-        positive("torsional_stiffness", self.torsional_stiffness)
-        positive("radius", self.radius)
-        positive("fictitious_inertia_factor", self.fictitious_inertia_factor)
-
-
-@dataclass(frozen=True)
-class AeroSettings:
-    """Aerodynamic analysis settings of a fin (SI): reference semi-chord b for k = omega b / U,
-    Mach numbers of the GAF database, the highest structural frequency of interest (Hz), the
-    analysis speed range (m/s) and altitudes (m)."""
-
-    reference_semichord: float
-    machs: tuple[float, ...]
-    f_max: float
-    u_min: float
-    u_max: float
-    altitudes: tuple[float, ...]
-
-    @property
-    def k_max(self) -> float:
-        """Highest reduced frequency needed: 2 pi f_max b / U_min."""
-        return 2.0 * math.pi * self.f_max * self.reference_semichord / self.u_min
-
-
-@dataclass(frozen=True)
-class FinDefinition:
-    """Everything that defines a fin: planform, thickness law, material, shaft, default FE mesh
-    (n_chord x n_span elements) and aerodynamic settings."""
-
-    planform: Planform
-    thickness: Thickness
-    material: Material | OrthotropicMaterial
-    shaft: Shaft
-    n_chord: int
-    n_span: int
-    aero: AeroSettings
-
-
-#: Radius (m) of the fin's physical shaft region assumed for the distributed-shaft model when
-#: the case file holds the single-node shaft (the thesis gives no radius).
-DEFAULT_SHAFT_RADIUS = 0.005
-
-
-def fin_definition(case) -> FinDefinition:
-    """The :class:`FinDefinition` of a one-panel shaft-supported case
-    (:class:`asekit.case.Case`): planform, thickness, material, shaft, FE mesh, aero settings."""
-    if len(case.panels) != 1 or case.support.kind != "shaft":
-        raise ValueError(f"case {case.name!r}: a fin definition needs one panel and a shaft "
-                         f"support, got {len(case.panels)} panel(s), support {case.support.kind!r}")
-    s, a, f = case.support, case.aero, case.flight
-    p = case.panels[0]
-    altitudes = tuple(f.altitudes) if f.altitudes is not None else ()
-    return FinDefinition(
-        planform=p.planform, thickness=case.thickness, material=case.material,
-        shaft=Shaft(s.axis_point, s.torsional_stiffness,
-                    DEFAULT_SHAFT_RADIUS if s.radius is None else s.radius,
-                    s.fictitious_inertia_factor),
-        n_chord=p.n_chord, n_span=p.n_span,
-        aero=AeroSettings(a.reference_semichord, tuple(a.machs), a.f_max, a.u_min,
-                          float(f.velocities[-1]), altitudes))
-
-
-def load_fin(path: str | Path = FIN_FILE) -> FinDefinition:
-    """The fin definition of a case file (default: the reference fin,
-    ``data/cases/nalci2013_fin.toml``), see :func:`fin_definition`."""
-    from .case.schema import load_case
-    return fin_definition(load_case(path))

@@ -155,7 +155,7 @@ def test_fin_outputs_root_pitch_and_corners():
     the shaft node, with the rigid mode contributing exactly theta; corner outputs exist."""
     pytest.importorskip("asekit.structure.modes")
     from asekit.aeroelastic import fin_outputs
-    from asekit.structure.modes import fin_modal_model
+    from asekit.reproduction.fin import fin_modal_model
     modal = fin_modal_model()
     corners = np.array([[0.0, 0.0], [0.156, 0.0], [0.078, 0.15], [0.156, 0.15]])
     out = fin_outputs(modal, corners, names=["rle", "rte", "tle", "tte"],

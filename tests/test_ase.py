@@ -10,11 +10,12 @@ import pytest
 from asekit import ase, metrics
 from asekit.servo import SYSTEM_3, ActuatorParameters, PDController, actuator_transfer_function
 from asekit.servo import margins as servo_margins
+from asekit.reproduction import fin as reffin
 
 
 @pytest.fixture(scope="module")
 def fin():
-    return ase.fin_ase(mach=0.5, altitude=0.0)
+    return reffin.fin_ase(mach=0.5, altitude=0.0)
 
 
 def test_oploop1_is_eq_2_41(fin):
@@ -40,7 +41,7 @@ def test_oploop2_low_frequency_sees_the_whole_fin_inertia(fin):
 
 def _rows(f):
     from asekit.aeroelastic import fin_outputs
-    from asekit.geometry import load_fin
+    from asekit.reproduction.fin import load_fin
 
     return fin_outputs(f.modal, np.array([[0.156, 0.15]]), names=["tip_te"],
                        shaft_point=load_fin().shaft.axis_point)
@@ -132,7 +133,7 @@ def test_bad_input(fin):
     with pytest.raises(ValueError, match="angular position limit"):
         ase.simulate_closed_loop(fin.model, SYSTEM_3, math.radians(20.0), "AEM1")
     with pytest.raises(ValueError, match="mach"):
-        ase.fin_ase(mach=0.9)
+        reffin.fin_ase(mach=0.9)
     with pytest.raises(ValueError, match="which"):
         ase.open_loop(fin.model, 4)
     with pytest.raises(ValueError, match="finite"):

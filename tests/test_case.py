@@ -36,8 +36,8 @@ def _fin_dict() -> dict:
 # ---------------------------------------------------------------------------------------------
 def test_fin_case_equals_fin_definition_path():
     from asekit.reproduction.flutter import analyse_condition
-    from asekit.aero.gaf import fin_gaf_database
-    from asekit.structure.modes import fin_modal_model
+    from asekit.reproduction.fin import fin_gaf_database
+    from asekit.reproduction.fin import fin_modal_model
     case = load_case(FIN)
     m = P.modal_model(case)
     ref = fin_modal_model()

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from asekit.cache import CacheError, load_npz, save_npz
-from asekit.geometry import LinearThickness, Material, Planform, load_fin
+from asekit.geometry import LinearThickness, Material, Planform
+from asekit.reproduction.fin import load_fin
 from asekit.reproduce import CHAPTERS, difference
 from asekit.thesis import all_keys, thesis_value
 

@@ -7,7 +7,8 @@ import pytest
 from scipy.special import hankel2
 
 from asekit.aero import dlm
-from asekit.aero.boxes import BoxMesh, TrapezoidSurface, fin_boxes, mesh_surfaces
+from asekit.aero.boxes import BoxMesh, TrapezoidSurface, mesh_surfaces
+from asekit.reproduction.fin import fin_boxes
 from asekit.aero.dlm import aic_matrix, normalwash_matrices, normalwash_matrix, pressure_jump
 from asekit.aero.vlm import vlm_normalwash_matrix
 from panelaero_grid import panelaero_grid

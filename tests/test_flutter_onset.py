@@ -26,7 +26,7 @@ HA145B_FLUTTER_SPEED = 12672.0      # in/s, Nastran HA145B (see module docstring
 
 @pytest.fixture(scope="module")
 def fin():
-    from asekit.aero.gaf import fin_gaf_database
+    from asekit.reproduction.fin import fin_gaf_database
     from asekit.reproduction.flutter import fin_gaf, fin_rfa
     db, modal = fin_gaf_database(rebuild=False, progress=False)
     return modal, fin_gaf(db, 0.75), fin_rfa(db, 0.75)

@@ -5,11 +5,12 @@ import shutil
 import numpy as np
 import pytest
 
-from asekit.aero.boxes import TrapezoidSurface, fin_boxes, mesh_surfaces
-from asekit.aero.gaf import (GAF_FILE, database_k, fin_gaf_database, gaf_from_box_modes,
-                             gaf_matrix, steady_hinge_coefficient)
+from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
+from asekit.reproduction.fin import fin_boxes
+from asekit.aero.gaf import GAF_FILE, gaf_from_box_modes, gaf_matrix, steady_hinge_coefficient
+from asekit.reproduction.fin import database_k, fin_gaf_database
 from asekit.aero.spline import InfinitePlateSpline, analytic_modes, fe_spline, normalwash
-from asekit.geometry import load_fin
+from asekit.reproduction.fin import load_fin
 from asekit.thesis import thesis_value
 
 B = 0.078          # reference semi-chord of the fin (root semi-chord), m

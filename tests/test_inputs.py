@@ -8,7 +8,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from asekit.aero.boxes import BoxMesh, TrapezoidSurface, fin_boxes, fin_surface, mesh_surfaces
+from asekit.aero.boxes import BoxMesh, TrapezoidSurface, mesh_surfaces
+from asekit.reproduction.fin import fin_boxes, fin_surface
 from asekit.aero.dlm import normalwash_matrix
 from asekit.aero.vlm import lift_curve_slope, steady_pressure
 from asekit.nastran import read_op4, write_op4
@@ -73,7 +74,7 @@ def test_lift_curve_slope_reference_area():
 
 
 def test_box_count_and_matrix_memory_bounds():
-    from asekit.geometry import load_fin
+    from asekit.reproduction.fin import load_fin
     fin = load_fin()
     big = dataclasses.replace(fin, aero=dataclasses.replace(fin.aero, f_max=1e6))
     with pytest.raises(ValueError, match=r"GiB.*f_max"):

@@ -28,7 +28,7 @@ def _ms_data(n=3, roots=(0.1, 0.4, 1.2), seed=2):
 
 @pytest.fixture(scope="module")
 def fin():
-    from asekit.aero.gaf import fin_gaf_database
+    from asekit.reproduction.fin import fin_gaf_database
     return fin_gaf_database(rebuild=False, progress=False)
 
 

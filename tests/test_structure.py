@@ -6,13 +6,15 @@ import math
 import numpy as np
 import pytest
 
-from asekit.geometry import LinearThickness, Material, Planform, load_fin
-from asekit.structure import ModalModel, fin_modal_model, mode_shapes_at
+from asekit.geometry import LinearThickness, Material, Planform
+from asekit.reproduction.fin import load_fin
+from asekit.structure import ModalModel, mode_shapes_at
+from asekit.reproduction.fin import fin_modal_model
 from asekit.structure.assembly import (assemble, clamped_edge, pitch_inertia, rigid_pitch_vector,
                                        shaft_support)
 from asekit.structure.mesh import rectangular_mesh, structured_mesh
-from asekit.structure.modes import (fin_mesh, fin_supported, normal_modes, pitch_inertia_exact,
-                                    select_modes)
+from asekit.structure.modes import normal_modes, select_modes
+from asekit.reproduction.fin import fin_mesh, fin_supported, pitch_inertia_exact
 from asekit.structure.plate import consistent_mass, mitc4_stiffness
 
 ALU = Material(70e9, 0.3, 2700.0)
@@ -264,7 +266,8 @@ def test_eigen_solution_reproducible_bit_for_bit(fin):
 
 
 def test_fn1_and_clamped_modal_models(fin, fn2):
-    from asekit.structure.modes import elastic_modal_model, fin_fn1_modal_model
+    from asekit.structure.modes import elastic_modal_model
+    from asekit.reproduction.fin import fin_fn1_modal_model
     m1 = fin_fn1_modal_model(fin)
     assert m1.n_rigid == 0 and m1.label.startswith("FN1 6x7")
     np.testing.assert_allclose(m1.frequencies_hz, fn2.frequencies_hz[1:], rtol=1e-6)
@@ -283,7 +286,7 @@ def test_inplane_mode_of_single_node_shaft_is_a_mechanism(fin):
     # Membrane check behind the thesis's discarded 16.57 Hz in-plane mode (Fig 16): pinned at one
     # node, a fin of bilinear membrane elements turns in its plane at zero frequency (no drilling
     # stiffness); the first genuine in-plane mode lies far above the 1000 Hz limit.
-    from asekit.structure.modes import fin_inplane_modes
+    from asekit.reproduction.fin import fin_inplane_modes
     ip = fin_inplane_modes(fin)
     assert ip.frequencies_hz[0] < 0.1
     assert ip.frequencies_hz[1] > 3000.0

@@ -25,7 +25,8 @@ import numpy as np
 import pytest
 from scipy.special import j0
 
-from asekit.aero.boxes import MeshRuleWarning, TrapezoidSurface, fin_boxes, mesh_surfaces
+from asekit.aero.boxes import MeshRuleWarning, TrapezoidSurface, mesh_surfaces
+from asekit.reproduction.fin import fin_boxes
 from asekit.aero.piston import piston_pressure_matrices
 from asekit.aero.supersonic import (cell_potential_integral, supersonic_pressure_matrices,
                                     supersonic_pressure_matrix, supersonic_pressures)

@@ -7,8 +7,8 @@ import warnings
 import numpy as np
 import pytest
 
-from asekit.aero.boxes import (BoxMesh, MeshRuleWarning, TrapezoidSurface, check_mesh_rules,
-                               fin_boxes, mesh_surfaces)
+from asekit.aero.boxes import BoxMesh, MeshRuleWarning, TrapezoidSurface, check_mesh_rules, mesh_surfaces
+from asekit.reproduction.fin import fin_boxes
 from asekit.aero.vlm import lift_curve_slope, steady_pressure, vlm_normalwash_matrix
 from panelaero_grid import panelaero_grid
 

@@ -11,12 +11,11 @@ semi-chord b stated by the caller (the fin: root semi-chord 0.078 m); Delta Cp >
 along its normal (+z); normalwash w/U = dh/dx + i k h / b.
 """
 
-from .boxes import (BoxMesh, MeshRuleReport, MeshRuleWarning, TrapezoidSurface,
-                    check_mesh_rules, fin_boxes, fin_surface, mesh_surfaces)
+from .boxes import BoxMesh, MeshRuleReport, MeshRuleWarning, TrapezoidSurface, check_mesh_rules, mesh_surfaces
 from .dlm import aic_matrix, normalwash_matrices, normalwash_matrix, pressure_jump
 from .vlm import lift_curve_slope, steady_pressure, vlm_normalwash_matrix
 
 __all__ = ["BoxMesh", "MeshRuleReport", "MeshRuleWarning", "TrapezoidSurface", "check_mesh_rules",
-           "fin_boxes", "fin_surface", "mesh_surfaces", "aic_matrix", "normalwash_matrices",
+           "mesh_surfaces", "aic_matrix", "normalwash_matrices",
            "normalwash_matrix", "pressure_jump", "lift_curve_slope", "steady_pressure",
            "vlm_normalwash_matrix"]

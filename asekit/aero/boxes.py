@@ -333,43 +333,6 @@ def mesh_surfaces(surfaces) -> BoxMesh:
     return BoxMesh(np.concatenate(corners), np.concatenate(strip), np.concatenate(surf), names)
 
 
-def fin_surface(fin, n_chord: int | None = None, n_span: int | None = None,
-                bpw_min: float = 15.0, ar_max: float = 3.0) -> TrapezoidSurface:
-    """The reference fin's planform as a :class:`TrapezoidSurface` (z = 0).
-
-    Without ``n_chord``/``n_span`` the box counts follow the mesh rules with a margin: the
-    smallest ``n_chord >= 4`` giving ``BPW > bpw_min`` (strictly) on the root strip (Eq. 3.5
-    with the fin's U_min and f_max; 14 for the reference fin: BPW 16.6 on the root strip
-    with its mid-span box chord), and the smallest ``n_span`` keeping every box aspect ratio below
-    ``ar_max`` with a 10 % margin.
-    """
-    p = fin.planform
-    bpw_min, ar_max = positive("bpw_min", bpw_min), positive("ar_max", ar_max)
-    if n_chord is None:
-        dx_max = positive("fin.aero.u_min", fin.aero.u_min) / (
-            bpw_min * positive("fin.aero.f_max", fin.aero.f_max))
-        n_chord = max(4, math.floor(p.root_chord / dx_max) + 1)
-    if n_span is None:
-        dx_tip = p.tip_chord / n_chord
-        n_span = max(1, math.ceil(p.span / (0.9 * ar_max * dx_tip)))
-    n_boxes = int(n_chord) * int(n_span)
-    check_matrix_memory(n_boxes, 1, 16, f"one DLM matrix of the fin ({n_chord} x {n_span} boxes "
-                        f"from f_max = {fin.aero.f_max:g} Hz, u_min = {fin.aero.u_min:g} m/s, "
-                        f"bpw_min = {bpw_min:g})", "lower f_max, raise u_min or pass n_chord / "
-                        "n_span")
-    return TrapezoidSurface(p.root_le + (0.0,), p.root_chord, p.tip_le + (0.0,), p.tip_chord,
-                            n_chord, n_span, name="fin")
-
-
-def fin_boxes(fin=None, n_chord: int | None = None, n_span: int | None = None) -> BoxMesh:
-    """Box mesh of the reference fin (default: ``asekit.geometry.load_fin()``), see
-    :func:`fin_surface` for the default box counts."""
-    if fin is None:
-        from ..geometry import load_fin
-        fin = load_fin()
-    return mesh_surfaces([fin_surface(fin, n_chord, n_span)])
-
-
 @dataclass(frozen=True)
 class MeshRuleReport:
     """Mesh-rule numbers of a box mesh (thesis Section 3.2.1).

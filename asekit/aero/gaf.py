@@ -1,4 +1,4 @@
-"""Generalised aerodynamic force matrices Q_mm(M, k) and the fin's cached GAF database
+"""Generalised aerodynamic force matrices Q_mm(M, k) and their cached databases
 (thesis Section 2.2.1.3, Eqs. 2.10-2.12; Section 3.2).
 
 For modes phi_j with normal displacement h_j on the boxes, the doublet-lattice pressure jumps
@@ -7,10 +7,10 @@ DeltaCp_j = D(M, k)^-1 (dh_j/dx + i k h_j / b) (see :mod:`asekit.aero.dlm`) give
     Q_ij(M, k) = sum_boxes h_i(load point) DeltaCp_j A_box         (Eqs. 2.10-2.11)
 
 so that the modal aerodynamic force is F_i = q sum_j Q_ij zeta_j (Eq. 2.12), per unit dynamic
-pressure and unit modal coordinate. For the fin's rigid pitch mode (a unit nose-up rotation,
+pressure and unit modal coordinate. For a rigid pitch mode (a unit nose-up rotation,
 h = -(x - x_axis)) Q_cc is in m^3 and is positive (de-centering) when the centre of pressure
-lies ahead of the shaft. k = omega b / U with b = ``fin.aero.reference_semichord`` = 0.078 m,
-the fin's root semi-chord.
+lies ahead of the shaft. k = omega b / U with the database's reference semi-chord b
+(``GafDatabase.b_ref``, stated by the caller).
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ import scipy.linalg as sla
 from .. import __version__
 from ..cache import CacheError, load_npz, save_npz
 from ..paths import DATA_DIR, user_cache_dir
-from .boxes import BoxMesh, fin_boxes
+from .boxes import BoxMesh
 from .dlm import check_k, normalwash_matrices
 from .spline import BoxModes, fe_spline, modal_forces
 from .vlm import check_mach
@@ -122,12 +122,6 @@ def default_reduced_frequencies(k_max: float) -> np.ndarray:
     return np.concatenate([base[base < 0.95 * k_max], [k_max]])
 
 
-def database_k(fin) -> np.ndarray:
-    """The fin database's reduced frequencies, :func:`default_reduced_frequencies` up to
-    k_max = 2 pi f_max b / U_min (fin.md; about 2.72 for the reference fin)."""
-    return default_reduced_frequencies(fin.aero.k_max)
-
-
 def _fingerprint(arrays: dict, settings: dict) -> str:
     """SHA-256 over the mode set and the settings. Each array is scaled by its largest magnitude
     and rounded to 8 decimals first, so round-off differences between machines (including the
@@ -199,11 +193,6 @@ def database_settings(machs, ks, b_ref: float, boxes: BoxMesh, symmetric: bool,
             "k": [float(v) for v in ks], "b_ref": float(b_ref),
             "symmetric": bool(symmetric), "method": method, "boxes": int(boxes.n),
             "box_corners_sha256": hashlib.sha256(np.round(boxes.corners, 12).tobytes()).hexdigest()}
-
-
-def _fin_settings(fin, boxes: BoxMesh, symmetric: bool, method: str) -> dict:
-    return database_settings(fin.aero.machs, database_k(fin), fin.aero.reference_semichord,
-                             boxes, symmetric, method)
 
 
 def mode_set_fingerprint(model, settings: dict) -> str:
@@ -281,32 +270,6 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
                       f"ASEKIT_CACHE_DIR to a writable folder to keep it", RuntimeWarning,
                       stacklevel=2)
     return db
-
-
-def fin_gaf_database(rebuild: bool = False, progress: bool = True, path=None,
-                     symmetric: bool = False, method: str = "quartic"):
-    """The reference fin's GAF database and its modal model.
-
-    Mach 0.4, 0.5, 0.6, 0.75 x :func:`database_k`, isolated fin (``symmetric``: a wall at the
-    root), DLM ``method`` kernel, default structure ``fin_modal_model()`` (FN2, 6 x 7
-    single-node shaft) on :func:`~asekit.aero.boxes.fin_boxes`; loaded from the shipped
-    ``data/gaf_fin.npz`` or the user cache when one matches, else rebuilt into the user cache
-    (see :func:`cached_gaf_database`; ``path`` overrides the location).
-
-    Returns
-    -------
-    (GafDatabase, ModalModel)
-    """
-    from ..geometry import load_fin
-    from ..structure.modes import fin_modal_model
-    fin = load_fin()
-    model = fin_modal_model(fin)
-    boxes = fin_boxes(fin)
-    db = cached_gaf_database(
-        model, boxes, fin.aero.machs, database_k(fin), fin.aero.reference_semichord,
-        symmetric, method, progress, rebuild, path=path,
-        metadata={"reference_semichord": "root semi-chord, fin.aero.reference_semichord (m)"})
-    return db, model
 
 
 def steady_hinge_coefficient(db: GafDatabase, mach: float) -> float:

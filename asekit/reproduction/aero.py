@@ -15,11 +15,13 @@ from __future__ import annotations
 import numpy as np
 from scipy.special import hankel2
 
-from ..aero.boxes import TrapezoidSurface, check_mesh_rules, fin_boxes, mesh_surfaces
+from ..aero.boxes import TrapezoidSurface, check_mesh_rules, mesh_surfaces
+from asekit.reproduction.fin import fin_boxes
 from ..aero.dlm import normalwash_matrices, pressure_jump
-from ..aero.gaf import fin_gaf_database, steady_hinge_coefficient
+from ..aero.gaf import steady_hinge_coefficient
+from asekit.reproduction.fin import fin_gaf_database
 from ..aero.vlm import lift_curve_slope, steady_pressure
-from ..geometry import load_fin
+from asekit.reproduction.fin import load_fin
 from ..plotting import THESIS_COLOR, new_figure
 from ..reproduce import ChapterResult, Quantity
 from ..thesis import thesis_value

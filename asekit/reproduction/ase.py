@@ -38,6 +38,7 @@ from ..plotting import THESIS_COLOR, new_figure
 from ..reproduce import ChapterResult, Quantity
 from ..servo import SYSTEM_3, PDController
 from ..simulate import THESIS_LIMITS, SimulationResult, simulate
+from . import fin as reffin
 
 #: Thesis Table 2 requirements checked on the elastic fin.
 SETTLING_REQUIREMENT = 0.05      # s
@@ -50,7 +51,7 @@ FULL_STEP = math.radians(15.0)
 class AseChapter:
     """Every computed Ch. 5 result (SI units)."""
 
-    fin: ase.FinAse
+    fin: reffin.FinAse
     controller: PDController
     oploops: dict                 # 1, 2, 3 -> StateSpace
     fwtfs: dict                   # 1, 2, 3 -> StateSpace
@@ -74,7 +75,7 @@ class AseChapter:
 def compute(mach: float = 0.5, altitude: float = 0.0,
             controller: PDController = SYSTEM_3) -> AseChapter:
     """Run the Ch. 5 analyses (a few seconds)."""
-    fin = ase.fin_ase(mach=mach, altitude=altitude)
+    fin = reffin.fin_ase(mach=mach, altitude=altitude)
     m = fin.model
     oploops = {i: ase.open_loop(m, i) for i in (1, 2, 3)}
     fwtfs = {i: ase.forward_path(m, controller, i) for i in (1, 2, 3)}
@@ -93,7 +94,7 @@ def compute(mach: float = 0.5, altitude: float = 0.0,
                           hinge_moment=hm)
     rigid_full = simulate(rigid, controller, FULL_STEP, t_final=0.2, limits=THESIS_LIMITS,
                           hinge_moment=hm)
-    corner_names = [f"theta_{c}" for c in ase.CORNERS]
+    corner_names = [f"theta_{c}" for c in reffin.CORNERS]
     gains = ase.static_gains(loops["AEM1"], ["theta", ase.FIN_ROOT] + corner_names)
     spec1 = metrics.spectrum_after_rise(aem1_nl.t, aem1_nl.fin_root, UNIT_STEP)
     spec2 = metrics.spectrum_after_rise(aem2_nl.t, aem2_nl.fin_root, UNIT_STEP)
@@ -110,7 +111,7 @@ def compute(mach: float = 0.5, altitude: float = 0.0,
 def corner_overshoots(ch: AseChapter) -> dict:
     """Overshoot (fraction) of each corner rotation in the power-limited AEM1 unit step."""
     r = ch.aem1_nonlinear
-    return {c: metrics.overshoot(r.outputs[f"theta_{c}"], UNIT_STEP) for c in ase.CORNERS}
+    return {c: metrics.overshoot(r.outputs[f"theta_{c}"], UNIT_STEP) for c in reffin.CORNERS}
 
 
 def requirement_table(ch: AseChapter) -> list[tuple[str, str, str, bool]]:
@@ -124,7 +125,7 @@ def requirement_table(ch: AseChapter) -> list[tuple[str, str, str, bool]]:
     st_root = metrics.settling_time(r.t, r.fin_root, r.fin_root[-1], UNIT_STEP)
     rows.append(("settling time, fin root", "< 50 ms", f"{st_root * 1e3:.1f} ms",
                  st_root < SETTLING_REQUIREMENT))
-    for name in ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in ase.CORNERS]:
+    for name in ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in reffin.CORNERS]:
         err = abs(ch.static_gains[name] - 1.0)
         rows.append((f"steady error, {name}", "< 2 %", f"{100 * err:.2f} %",
                      err < ERROR_REQUIREMENT))
@@ -143,7 +144,7 @@ def quantities(ch: AseChapter) -> tuple[Quantity, ...]:
     c1, c2, c3 = ch.crossovers[1], ch.crossovers[2], ch.crossovers[3]
     r = ch.aem1_nonlinear
     ov = corner_overshoots(ch)
-    corner_gain = [ch.static_gains[f"theta_{c}"] for c in ase.CORNERS]
+    corner_gain = [ch.static_gains[f"theta_{c}"] for c in reffin.CORNERS]
     peaks1 = metrics.spectrum_peaks(*ch.aem1_spectrum, n=2)
     amp, freq = ch.aem2_limit_cycle
     note_struct = "asekit 6x7 MITC4 modes + own DLM, M 0.5 sea level"
@@ -354,7 +355,7 @@ def fig_aem1_transmission(ch: AseChapter):
 def fig_corners(ch: AseChapter):
     fig, ax = new_figure("AEM1 unit step (power limited): fin corners vs rigid fin", "Fig 71")
     r = ch.aem1_nonlinear
-    for c in ase.CORNERS:
+    for c in reffin.CORNERS:
         ax.plot(1e3 * r.t, np.degrees(r.outputs[f"theta_{c}"]), lw=1.0, label=c.replace("_", " "))
     ax.plot(1e3 * r.t, np.degrees(r.fin_root), "k", lw=1.0, label="fin root")
     ax.plot(1e3 * ch.rigid_unit.t, np.degrees(ch.rigid_unit.theta), color="g", lw=2,
@@ -368,13 +369,13 @@ def fig_corners(ch: AseChapter):
 def fig_corner_locations(ch: AseChapter):
     """Fig 72: where the fin-corner rotations of Fig 71 are taken (planform corners), the fin
     root and the pitch axis."""
-    from ..geometry import load_fin
+    from asekit.reproduction.fin import load_fin
     fin = load_fin()
     p = fin.planform
     fig, ax = new_figure("Fin positions of Fig 71", "Fig 72", figsize=(5.5, 5))
     c = np.asarray(p.corners) * 1e3
     ax.fill(c[:, 0], c[:, 1], color="0.9", edgecolor="k")
-    for name, (xi, eta) in ase.CORNERS.items():
+    for name, (xi, eta) in reffin.CORNERS.items():
         pt = np.asarray(p.point(np.array([xi]), np.array([eta])))[0] * 1e3
         ax.plot(pt[0], pt[1], "o", color="C3")
         ax.annotate(name.replace("_", " "), pt[:2], textcoords="offset points",

@@ -36,6 +36,7 @@ import numpy as np
 from .. import ase, metrics
 from ..controllers import DigitalController, pd_controller, pid_filtered
 from ..reproduce import ChapterResult, Quantity
+from . import fin as reffin
 
 MACHS = (0.4, 0.5, 0.6)
 ALTITUDES = (0.0, 2500.0, 5000.0)
@@ -57,7 +58,7 @@ DELAY = 1
 # ---------------------------------------------------------------------------------------------
 def load():
     """(database, modal) of the fin (cached GAFs)."""
-    from ..aero.gaf import fin_gaf_database
+    from asekit.reproduction.fin import fin_gaf_database
     return fin_gaf_database(rebuild=False, progress=False)
 
 
@@ -71,7 +72,7 @@ def perturbed_modal(modal, shaft_scale: float = 1.0, freq_scales=(1.0, 1.0)):
     s2, 1, ...).
     """
     from ..aeroelastic import fin_outputs
-    from ..geometry import load_fin
+    from asekit.reproduction.fin import load_fin
 
     if shaft_scale <= 0 or min(freq_scales) <= 0:
         raise ValueError("shaft_scale and freq_scales must be > 0")
@@ -89,7 +90,7 @@ def perturbed_modal(modal, shaft_scale: float = 1.0, freq_scales=(1.0, 1.0)):
 
 
 def ms_fit(n_states: int = 6):
-    """A minimum-state fit factory for :func:`asekit.ase.fin_ase` (``n_states`` shared lag
+    """A minimum-state fit factory for :func:`asekit.reproduction.fin.fin_ase` (``n_states`` shared lag
     states, steady constraint)."""
     from ..rfa import minimum_state_fit
 
@@ -104,7 +105,7 @@ def fin_model(mach=0.5, altitude=0.0, case="nominal", data=None, fit=None):
     ks, f1, f2 = ROBUSTNESS[case]
     if (ks, f1, f2) != (1.0, 1.0, 1.0):
         modal = perturbed_modal(modal, ks, (f1, f2))
-    return ase.fin_ase(mach, altitude, database=db, modal=modal, fit=fit).model
+    return reffin.fin_ase(mach, altitude, database=db, modal=modal, fit=fit).model
 
 
 # ---------------------------------------------------------------------------------------------
@@ -156,7 +157,7 @@ def check(controller: DigitalController, model, topology: str, mach=0.5, altitud
     plant = ase.sampled_plant(model, topology, SAMPLE_TIME, sensor=sensor)
     Phi, _ = ase.closed_loop_sampled_matrix(plant, controller, delay)
     stable = bool(np.max(np.abs(np.linalg.eigvals(Phi))) < 1.0)
-    corners = [f"theta_{c}" for c in ase.CORNERS]
+    corners = [f"theta_{c}" for c in reffin.CORNERS]
     if not stable:
         return Check(controller.name, topology, mach, altitude, case, False, math.inf,
                      math.inf, math.inf, math.nan, math.nan, math.nan)
@@ -366,10 +367,10 @@ def static_deflections(data=None, mach=0.6, altitude=0.0, case="nominal",
     model = fin_model(mach, altitude, case, data=data)
     plant = ase.sampled_plant(model, "AEM2", SAMPLE_TIME)
     ctl = design_a(data) if controller is None else controller
-    names = ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in ase.CORNERS]
+    names = ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in reffin.CORNERS]
     g = dc_gains(plant, ctl, names)
     ratios = {n: g[n] / g[ase.FIN_ROOT] for n in names}
-    corners = [ratios[f"theta_{c}"] for c in ase.CORNERS]
+    corners = [ratios[f"theta_{c}"] for c in reffin.CORNERS]
     return {"ratios": ratios, "best_corner_error": best_corner_error(corners)}
 
 

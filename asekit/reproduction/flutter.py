@@ -1,7 +1,7 @@
 """Chapter 3.2.2-3.3 reproduction: RFA fit, p-k (Tables 9-10), root locus, time domain
 (Table 11) and divergence for the reference fin, plus the HA145B cross-check.
 
-The fin's GAF database comes from :func:`asekit.aero.gaf.fin_gaf_database` (rigid pitch mode
+The fin's GAF database comes from :func:`asekit.reproduction.fin.fin_gaf_database` (rigid pitch mode
 first). When that module or its cache is not available the fin quantities are reported as None
 with a note, and only the Nastran HA145B validation is computed.
 
@@ -30,7 +30,7 @@ N_LAGS = 4
 def load_fin_gafs():
     """(GafDatabase, ModalModel) of the fin, or (None, reason) when not available."""
     try:
-        from ..aero.gaf import fin_gaf_database
+        from asekit.reproduction.fin import fin_gaf_database
     except ImportError as exc:           # the aerodynamics module is not there yet
         return None, f"asekit.aero.gaf not available ({exc.__class__.__name__})"
     try:
@@ -247,7 +247,7 @@ FLUTTER_MARGIN = 0.15
 
 def _envelope():
     """(u_min, u_max, h_max) of the analysis envelope in data/fin.toml (m/s, m/s, m)."""
-    from ..geometry import load_fin
+    from asekit.reproduction.fin import load_fin
     a = load_fin().aero
     return float(a.u_min), float(a.u_max), float(max(a.altitudes))
 
@@ -693,10 +693,10 @@ def aero_variant_gafs(modal, db, mach: float = 0.75, symmetric: bool = False,
     nodes instead of the finite-element shape functions, on the database's k and b_ref (uses
     asekit.aero; a few seconds per variant). ``modal`` is the ModalModel whose shapes are used.
     """
-    from ..aero.boxes import fin_boxes
+    from asekit.reproduction.fin import fin_boxes
     from ..aero.gaf import gaf_from_box_modes
     from ..aero.spline import InfinitePlateSpline, fe_spline
-    from ..geometry import load_fin
+    from asekit.reproduction.fin import load_fin
     boxes = fin_boxes(load_fin(), n_chord, n_span)
     if spline == "fe":
         bm = fe_spline(modal, boxes)
@@ -724,7 +724,7 @@ def model_sensitivity(db, mach: float = 0.75, altitude: float = 0.0, velocities=
     model, structural mesh, spline, symmetry plane, aerodynamic mesh) at one Mach and altitude.
     Rows: label, elastic frequencies (Hz), Q_cc(k_min), speed, freq, first, first_kind."""
     from ..aeroelastic import modal_arrays
-    from ..structure.modes import fin_modal_model
+    from asekit.reproduction.fin import fin_modal_model
     rho = float(standard_atmosphere(altitude).density)
     rows = []
     for label, skw, akw in variants:
@@ -870,7 +870,7 @@ def _distributed_model(structure):
     """The FN2 modal model with the distributed shaft region on a ``structure`` mesh."""
     import warnings
 
-    from ..structure.modes import fin_modal_model
+    from asekit.reproduction.fin import fin_modal_model
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")          # unresolved shaft region on the coarse meshes
         return fin_modal_model(n_chord=structure[0], n_span=structure[1], shaft="distributed")

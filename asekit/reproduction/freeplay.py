@@ -150,7 +150,7 @@ class FinFreeplayModel:
 def fin_freeplay_model(mach: float, data=None, n_lags: int = N_LAGS) -> FinFreeplayModel:
     """Build :class:`FinFreeplayModel` from the cached GAF database (``data`` = (db, modal) as
     :func:`asekit.reproduction.flutter.load_fin_gafs` returns; loaded when None)."""
-    from ..geometry import load_fin
+    from asekit.reproduction.fin import load_fin
     from .flutter import fin_rfa, load_fin_gafs
 
     if data is None:
@@ -162,7 +162,7 @@ def fin_freeplay_model(mach: float, data=None, n_lags: int = N_LAGS) -> FinFreep
         raise ValueError("the fin model needs the FN2 modal model (one rigid pitch mode first)")
     fin = load_fin()
     rows = fin_outputs(modal, np.zeros((0, 2)), names=[], shaft_point=fin.shaft.axis_point)
-    from ..ase import CORNERS
+    from asekit.reproduction.fin import CORNERS
     pts = fin.planform.point(np.array([v[0] for v in CORNERS.values()]),
                              np.array([v[1] for v in CORNERS.values()]))
     rows.update(fin_outputs(modal, pts, names=list(CORNERS)))

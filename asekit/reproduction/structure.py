@@ -22,12 +22,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import FinDefinition, load_fin
+from asekit.reproduction.fin import FinDefinition, load_fin
 from ..plotting import THESIS_COLOR, new_figure
 from ..reproduce import ChapterResult, Quantity
 from ..structure.assembly import assemble, rigid_pitch_vector
-from ..structure.modes import (ModalModel, NormalModes, fin_mesh, fin_modal_model, fin_supported,
-                               normal_modes, pitch_inertia_exact)
+from ..structure.modes import ModalModel, NormalModes, normal_modes
+from asekit.reproduction.fin import fin_mesh, fin_modal_model, fin_supported, pitch_inertia_exact
 from ..thesis import thesis_value
 
 #: Mesh used for the distributed-shaft result (the 5 mm shaft radius of the fin case file is resolved
@@ -290,7 +290,7 @@ def fig_inplane(fin: FinDefinition, n_chord: int | None = None, n_span: int | No
     """Fig 16 (the thesis's discarded in-plane mode): asekit's membrane check. In-plane modes of
     the fin held only at the shaft node: the first is a rigid in-plane rotation about that node
     (0 Hz without artificial drilling stiffness), the next a genuine in-plane mode (kHz)."""
-    from ..structure.modes import fin_inplane_modes
+    from asekit.reproduction.fin import fin_inplane_modes
     ip = fin_inplane_modes(fin, n_chord, n_span)
     mesh = fin_mesh(fin, n_chord, n_span)
     fig, axes = new_figure("In-plane modes with the single-node shaft (membrane check)", "Fig 16",

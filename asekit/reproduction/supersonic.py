@@ -6,7 +6,7 @@ Section 4.1.1 torque requirement at the worst supersonic condition.
 Aerodynamics per Mach by :mod:`asekit.aero.methods` ``method="auto"``: the DLM up to M 0.9
 (the cached database for M 0.4-0.75), the supersonic Mach-box method from M 1.15; nothing in
 the gap between (linear theory is not trusted there). Structure: ``fin_modal_model()`` (FN2,
-rigid pitch + elastic modes), GAFs over :func:`asekit.aero.gaf.database_k`.
+rigid pitch + elastic modes), GAFs over :func:`asekit.reproduction.fin.database_k`.
 
 Reproduce keys: ``aero.Qcc_steady_m3.M12/.M20/.M30`` (Re Q_cc at k 0.001, m^3/rad, positive
 de-centering), ``flutter.pk.M12.h0.speed_ms`` (and ``.M20.``, ``.M30.``; None when no flutter is
@@ -29,14 +29,16 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..aero.boxes import MeshRuleWarning, fin_boxes
-from ..aero.gaf import database_k, fin_gaf_database, gaf_from_box_modes
+from ..aero.boxes import MeshRuleWarning
+from asekit.reproduction.fin import fin_boxes
+from ..aero.gaf import gaf_from_box_modes
+from asekit.reproduction.fin import database_k, fin_gaf_database
 from ..aero.methods import DLM_MACH_MAX, SUPERSONIC_MACH_MIN, pressures
 from ..aero.spline import fe_spline
 from ..atmosphere import standard_atmosphere
 from ..cache import CacheError, load_npz, save_npz
 from ..flutter import TabulatedGaf, divergence_speeds, first_of, pk_flutter, pk_instabilities
-from ..geometry import load_fin
+from asekit.reproduction.fin import load_fin
 from ..reproduce import ChapterResult, Quantity
 
 MACHS = (0.4, 0.5, 0.6, 0.75, 0.9, 1.15, 1.2, 1.5, 2.0, 2.5, 3.0)
@@ -129,7 +131,7 @@ def envelope(rebuild: bool = False) -> dict:
     ``divergence`` (m/s, NaN none), ``peak_acceleration`` (rad/s^2, the Section 4.1.1
     profile's), ``flight_speed`` (M a(h), m/s), ``x_axis`` (m), ``model``.
     """
-    from ..structure.modes import fin_modal_model
+    from asekit.reproduction.fin import fin_modal_model
     fin = load_fin()
     model = fin_modal_model(fin)
     boxes = fin_boxes(fin)

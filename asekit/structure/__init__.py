@@ -4,6 +4,6 @@ mesh (structured quadrilateral meshes) -> plate (MITC4 element) -> assembly (spa
 supports) -> modes (eigen-analysis, mode selection, the modal model).
 """
 
-from .modes import ModalModel, fin_fn1_modal_model, fin_modal_model, mode_shapes_at
+from .modes import ModalModel, mode_shapes_at
 
-__all__ = ["ModalModel", "fin_fn1_modal_model", "fin_modal_model", "mode_shapes_at"]
+__all__ = ["ModalModel", "mode_shapes_at"]

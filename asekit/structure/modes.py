@@ -5,8 +5,8 @@ The eigenproblem K phi = omega^2 M phi (Eq. (2.4)) is solved for the lowest mode
 sparse Lanczos solver of ARPACK in shift-invert mode (:func:`scipy.sparse.linalg.eigsh`), the
 same family of method as MSC Nastran SOL 103's default.
 
-:func:`fin_modal_model` builds the thesis's model FN2 (fictitious-mass method, Sec. 3.1.1): one
-eigen-analysis gives the rigid pitch mode and the elastic modes. The fictitious inertia is then
+:func:`fictitious_mass_modal_model` builds the thesis's model FN2 (fictitious-mass method,
+Sec. 3.1.1): one eigen-analysis gives the rigid pitch mode and the elastic modes. The fictitious inertia is then
 removed: the rigid mode is scaled to a unit (1 rad) pitch rotation and the elastic modes are
 re-diagonalised by a Rayleigh-Ritz step with the fin's own mass matrix and the FN1 stiffness
 (the shaft spring to ground) in the span of the FN2 elastic modes. Because those modes differ
@@ -24,10 +24,9 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
-from ..geometry import FinDefinition, load_fin
 from ..validate import positive
-from .assembly import SupportedSystem, assemble, rigid_pitch_vector, shaft_support
-from .mesh import PlateMesh, structured_mesh
+from .assembly import SupportedSystem, rigid_pitch_vector, shaft_support
+from .mesh import PlateMesh
 from .plate import shape_functions
 
 #: Modes whose share of kinetic energy in the out-of-plane translation w is below this are
@@ -257,30 +256,6 @@ def mode_shapes_at(model: ModalModel, points: np.ndarray) -> tuple[np.ndarray, n
     return w, dwdx
 
 
-def fin_mesh(fin: FinDefinition, n_chord: int | None = None, n_span: int | None = None) -> PlateMesh:
-    """The fin's structured mesh (default: the thesis's 6 x 7 from ``data/cases/nalci2013_fin.toml``)."""
-    return structured_mesh(fin.planform, fin.thickness,
-                           fin.n_chord if n_chord is None else n_chord,
-                           fin.n_span if n_span is None else n_span)
-
-
-def _region(shaft: str) -> str:
-    if shaft not in ("single_node", "distributed"):
-        raise ValueError(f"shaft must be 'single_node' or 'distributed', got {shaft!r}")
-    return shaft
-
-
-def fin_supported(fin: FinDefinition, mesh: PlateMesh, model: str, shaft: str = "single_node",
-                  K=None, M=None) -> SupportedSystem:
-    """The fin on its shaft: model "FN1" or "FN2" with the single-node or distributed shaft."""
-    if K is None or M is None:
-        K, M = assemble(mesh, fin.material)
-    s = fin.shaft
-    return shaft_support(mesh, K, M, s.axis_point, s.torsional_stiffness, model=model,
-                         region=_region(shaft), radius=s.radius,
-                         fictitious_inertia_factor=s.fictitious_inertia_factor)
-
-
 def _keep_modes(f_hz, share, f_max_hz, n_modes):
     """Mask of the elastic modes kept: out-of-plane ones below f_max_hz, or the first n_modes."""
     if n_modes is None:
@@ -329,7 +304,7 @@ def fictitious_mass_modal_model(mesh: PlateMesh, K, M, axis_point, torsional_sti
     """
     positive("f_max_hz", f_max_hz)
     fn2 = shaft_support(mesh, K, M, axis_point, torsional_stiffness, model="FN2",
-                        region=_region(region), radius=radius,
+                        region=region, radius=radius,
                         fictitious_inertia_factor=fictitious_inertia_factor,
                         bending_stiffness=bending_stiffness)
     fn1 = shaft_support(mesh, K, M, axis_point, torsional_stiffness, model="FN1",
@@ -425,31 +400,6 @@ def with_damping(model: ModalModel, modal_damping_ratio=None, structural_g=None)
     return dataclasses.replace(model, C=C)
 
 
-def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None,
-                    n_span: int | None = None, shaft: str = "single_node",
-                    f_max_hz: float = 1000.0) -> ModalModel:
-    """The FN2 modal model of a fin definition: rigid pitch mode + elastic modes below
-    ``f_max_hz`` with out-of-plane motion (thesis Sec. 3.1, Table 6, Eqs. (2.45)-(2.46)); see
-    :func:`fictitious_mass_modal_model`.
-
-    Parameters
-    ----------
-    fin : fin definition (default ``load_fin()``).
-    n_chord, n_span : elements per direction (default the fin's 6 x 7).
-    shaft : "single_node" (thesis) or "distributed" (rigid region of radius fin.shaft.radius).
-    f_max_hz : frequency limit for the elastic modes kept (Hz), > 0.
-    """
-    fin = load_fin() if fin is None else fin
-    positive("f_max_hz", f_max_hz)
-    mesh = fin_mesh(fin, n_chord, n_span)
-    K, M = assemble(mesh, fin.material)
-    s = fin.shaft
-    return fictitious_mass_modal_model(mesh, K, M, s.axis_point, s.torsional_stiffness,
-                                       region=_region(shaft), radius=s.radius,
-                                       fictitious_inertia_factor=s.fictitious_inertia_factor,
-                                       f_max_hz=f_max_hz)
-
-
 def elastic_modal_model(modes: NormalModes, M_fin, f_max_hz: float = 1000.0,
                         axis_x: float | None = None, n_modes: int | None = None) -> ModalModel:
     """A ModalModel without rigid modes (n_rigid = 0) from an FN1 or clamped eigen-solution:
@@ -475,84 +425,3 @@ def elastic_modal_model(modes: NormalModes, M_fin, f_max_hz: float = 1000.0,
                       elements=sys_.mesh.elements.copy(), label=sys_.label)
 
 
-def fin_fn1_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None,
-                        n_span: int | None = None, shaft: str = "single_node",
-                        f_max_hz: float = 1000.0) -> ModalModel:
-    """The thesis's model FN1 (shaft spring to ground, no rigid mode; thesis Sec. 3.1.1, Fig 12)
-    as a ModalModel with n_rigid = 0; arguments as :func:`fin_modal_model`."""
-    fin = load_fin() if fin is None else fin
-    positive("f_max_hz", f_max_hz)
-    mesh = fin_mesh(fin, n_chord, n_span)
-    K, M = assemble(mesh, fin.material)
-    fn1 = fin_supported(fin, mesh, "FN1", shaft, K, M)
-    return elastic_modal_model(modes_up_to(fn1, f_max_hz, M_fin=M), M, f_max_hz,
-                               axis_x=fin.shaft.axis_point[0])
-
-
-@dataclass(frozen=True)
-class InPlaneModes:
-    """In-plane (membrane) modes of the fin pinned at one node (u = v = 0), the situation of the
-    thesis's discarded mode (Fig. 16).
-
-    frequencies_hz : (n,) ascending; the first is the in-plane rigid rotation about the pinned
-        node (0 Hz up to round-off: nothing but an artificial drilling stiffness restrains it).
-    shapes : (n_nodes, 2, n) u, v per node (mass-normalised).
-    J_z : in-plane rotational inertia of the fin about the pinned node (kg m^2).
-    """
-
-    frequencies_hz: np.ndarray
-    shapes: np.ndarray
-    J_z: float
-
-
-def fin_inplane_modes(fin: FinDefinition | None = None, n_chord: int | None = None,
-                      n_span: int | None = None, n_modes: int = 4) -> InPlaneModes:
-    """In-plane modes of the fin held only at the shaft node (plane-stress Q4 membrane, see
-    :func:`asekit.structure.plate.membrane_matrices`). Not part of the modal model: a flat fin's
-    in-plane motion does not couple with bending or with the aerodynamics."""
-    import scipy.sparse as sp
-
-    from .plate import membrane_matrices
-    fin = load_fin() if fin is None else fin
-    mesh = fin_mesh(fin, n_chord, n_span)
-    Ke, Me = membrane_matrices(mesh, fin.material)
-    dofs = (2 * mesh.elements[:, :, None] + np.arange(2)).reshape(-1, 8)
-    rows, cols = np.repeat(dofs, 8, axis=1).ravel(), np.tile(dofs, (1, 8)).ravel()
-    n = 2 * mesh.n_nodes
-    K = sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(n, n))
-    M = sp.csr_matrix((Me.ravel(), (rows, cols)), shape=(n, n))
-    node = mesh.node_at(fin.shaft.axis_point, name="shaft axis_point")
-    free = np.setdiff1d(np.arange(n), [2 * node, 2 * node + 1])
-    Kf = K[free][:, free]
-    Mf = M[free][:, free]
-    if free.size <= 2000:
-        lam, q = sla.eigh(Kf.toarray(), Mf.toarray(), subset_by_index=(0, n_modes - 1))
-    else:
-        lam, q = spla.eigsh(Kf.tocsc(), k=n_modes, M=Mf.tocsc(), sigma=-(2 * math.pi) ** 2,
-                            which="LM", v0=np.ones(free.size) / math.sqrt(free.size))
-        order = np.argsort(lam)
-        lam, q = lam[order], q[:, order]
-    phi = np.zeros((n, n_modes))
-    phi[free] = q
-    xa, ya = mesh.nodes[node]
-    rz = np.zeros(n)
-    rz[0::2] = -(mesh.nodes[:, 1] - ya)
-    rz[1::2] = mesh.nodes[:, 0] - xa
-    return InPlaneModes(frequencies_hz=np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi),
-                        shapes=phi.reshape(mesh.n_nodes, 2, n_modes), J_z=float(rz @ (M @ rz)))
-
-
-def pitch_inertia_exact(fin: FinDefinition) -> float:
-    """Pitch inertia (kg m^2) of the flat trapezoidal plate about the shaft axis, by exact
-    integration: J = int_y rho h(y) int_x [(x - x_a)^2 + h^2 / 12] dx dy (the second term is the
-    plate's own rotary inertia). Gauss-Legendre in y is exact for this polynomial integrand."""
-    p, t, rho = fin.planform, fin.thickness, fin.material.density
-    x_a = fin.shaft.axis_point[0]
-    g, wg = np.polynomial.legendre.leggauss(8)
-    eta = 0.5 * (g + 1)
-    h = t.at(eta)
-    x0 = p.root_le[0] + eta * (p.tip_le[0] - p.root_le[0]) - x_a
-    c = p.root_chord + eta * (p.tip_chord - p.root_chord)
-    x1 = x0 + c
-    inner = (x1**3 - x0**3) / 3 + h**2 / 12 * c
-    return float(0.5 * p.span * np.sum(wg * rho * h * inner))

@@ -12,6 +12,7 @@ import numpy as np
 
 from asekit import ase
 from asekit.servo import SYSTEM_3
+from asekit.reproduction import fin as reffin
 
 
 def best_of(fn, n=3):
@@ -25,7 +26,7 @@ def best_of(fn, n=3):
 
 def main():
     t0 = time.perf_counter()
-    fin = ase.fin_ase(mach=0.5, altitude=0.0)
+    fin = reffin.fin_ase(mach=0.5, altitude=0.0)
     print(f"model build (GAF cache load, RFA, interconnect data): {time.perf_counter() - t0:.3f} s")
     cmd = math.radians(1.0)
     t_nl = best_of(lambda: ase.simulate_closed_loop(fin.model, SYSTEM_3, cmd, "AEM1",

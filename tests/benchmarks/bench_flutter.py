@@ -42,7 +42,7 @@ def timed(label, fn, repeat=3):
 
 def main():
     try:
-        from asekit.aero.gaf import fin_gaf_database
+        from asekit.reproduction.fin import fin_gaf_database
         db, modal = fin_gaf_database(rebuild=False, progress=False)
         i = int(np.argmin(np.abs(np.asarray(db.machs) - 0.75)))
         gaf = TabulatedGaf(db.k, db.Q[i], db.b_ref, db.machs[i])

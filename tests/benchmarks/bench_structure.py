@@ -9,8 +9,8 @@ import sys
 import time
 import warnings
 
-from asekit.geometry import load_fin
-from asekit.structure import fin_modal_model
+from asekit.reproduction.fin import load_fin
+from asekit.reproduction.fin import fin_modal_model
 
 TARGET_S = 10.0
 

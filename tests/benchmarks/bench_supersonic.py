@@ -71,7 +71,7 @@ def main(argv=None) -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--k", type=float, default=0.5)
     args = ap.parse_args(argv)
-    from asekit.structure.modes import fin_modal_model
+    from asekit.reproduction.fin import fin_modal_model
     mesh = fin_boxes()
     b, k, r = 0.078, args.k, args.repeat
     bm = fe_spline(fin_modal_model(), mesh)
