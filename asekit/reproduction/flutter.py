@@ -334,21 +334,19 @@ def _low_modes_ylim(freq_hz, n: int = 2):
     return (0.0, 1.15 * float(f.max())) if f.size else None
 
 
-def fig_pk(res, title="p-k damping and frequency", thesis_figure="Figs 30-31", unit="m/s",
-           flutter=None, thesis_point=None):
-    """Damping ratio xi = -Re p / |p| (Eq. 3.13, the sign used throughout: xi < 0 unstable) and
-    frequency vs airspeed of every tracked mode (Figs 30-31). ``flutter``: an
-    :class:`asekit.flutter.Instability` to mark; ``thesis_point``: (speed, Hz) drawn beside it.
-    The frequency axis shows the first two modes, whose coalescence is the flutter."""
+def _damping_frequency_figure(title, thesis_figure, velocities, damping_ratio, frequency_hz,
+                              root: str, flutter, thesis_point, unit):
+    """Damping ratio and frequency of every tracked root vs airspeed (two panels), the flutter
+    point marked beside the thesis's; ``root`` names the eigenvalue in the axis label."""
     from ..plotting import new_figure
     fig, (a1, a2) = new_figure(title, thesis_figure, nrows=2, figsize=(6.4, 6.5), sharex=True)
-    for j in range(res.p.shape[1]):
-        a1.plot(res.velocities, res.damping_ratio[:, j], label=f"mode {j + 1}")
-        a2.plot(res.velocities, res.frequency_hz[:, j])
+    for j in range(damping_ratio.shape[1]):
+        a1.plot(velocities, damping_ratio[:, j], label=f"mode {j + 1}")
+        a2.plot(velocities, frequency_hz[:, j])
     a1.axhline(0, color="k", lw=0.8)
-    a1.set_ylabel("damping ratio xi = -Re p/|p|\n(< 0: unstable)")
+    a1.set_ylabel(f"damping ratio xi = -Re {root}/|{root}|\n(< 0: unstable)")
     a1.set_ylim(max(a1.get_ylim()[0], -0.25), min(a1.get_ylim()[1], 0.5))
-    lim = _low_modes_ylim(res.frequency_hz)
+    lim = _low_modes_ylim(frequency_hz)
     if lim:
         a2.set_ylim(*lim)
     _mark_flutter(a1, a2, flutter, thesis_point, unit)
@@ -356,6 +354,16 @@ def fig_pk(res, title="p-k damping and frequency", thesis_figure="Figs 30-31", u
     a2.set_xlabel(f"airspeed ({unit})")
     a2.set_ylabel("frequency (Hz)")
     return fig
+
+
+def fig_pk(res, title="p-k damping and frequency", thesis_figure="Figs 30-31", unit="m/s",
+           flutter=None, thesis_point=None):
+    """Damping ratio xi = -Re p / |p| (Eq. 3.13, the sign used throughout: xi < 0 unstable) and
+    frequency vs airspeed of every tracked mode (Figs 30-31). ``flutter``: an
+    :class:`asekit.flutter.Instability` to mark; ``thesis_point``: (speed, Hz) drawn beside it.
+    The frequency axis shows the first two modes, whose coalescence is the flutter."""
+    return _damping_frequency_figure(title, thesis_figure, res.velocities, res.damping_ratio,
+                                     res.frequency_hz, "p", flutter, thesis_point, unit)
 
 
 def _mark_flutter(a1, a2, flutter, thesis_point, unit):
@@ -397,23 +405,9 @@ def fig_root_locus_damping(rl, thesis_figure="Figs 33-34", unit="m/s", flutter=N
                            thesis_point=None):
     """Damping ratio (Eq. 3.13, xi < 0 unstable) and natural frequency of the aeroelastic roots
     vs airspeed, flutter point marked (asekit's and the thesis's)."""
-    from ..plotting import new_figure
-    fig, (a1, a2) = new_figure("Root locus: damping ratio and frequency", thesis_figure,
-                               nrows=2, figsize=(6.4, 6.5), sharex=True)
-    for j in range(rl.elastic.shape[1]):
-        a1.plot(rl.velocities, rl.damping_ratio[:, j], label=f"mode {j + 1}")
-        a2.plot(rl.velocities, rl.frequency_hz[:, j])
-    a1.axhline(0, color="k", lw=0.8)
-    a1.set_ylabel("damping ratio xi = -Re lambda/|lambda|\n(< 0: unstable)")
-    a1.set_ylim(max(a1.get_ylim()[0], -0.25), min(a1.get_ylim()[1], 0.5))
-    lim = _low_modes_ylim(rl.frequency_hz)
-    if lim:
-        a2.set_ylim(*lim)
-    _mark_flutter(a1, a2, flutter, thesis_point, unit)
-    a1.legend(fontsize=8, ncol=2)
-    a2.set_xlabel(f"airspeed ({unit})")
-    a2.set_ylabel("frequency (Hz)")
-    return fig
+    return _damping_frequency_figure("Root locus: damping ratio and frequency", thesis_figure,
+                                     rl.velocities, rl.damping_ratio, rl.frequency_hz, "lambda",
+                                     flutter, thesis_point, unit)
 
 
 def fig_time_responses(responses, coordinate=1, thesis_figure="Figs 36-38"):
