@@ -5,12 +5,17 @@ data/benchmarks/ha145e/ (README there): Nastran SOL 103 eigenvalues from ha145e.
 ZAERO flutter summary of the same example (ha145e.out, M 0.45: 5753.150 in/s, 111.7046 Hz).
 """
 
+import os
 import warnings
 
 import numpy as np
 import pytest
 
-pytest.importorskip("pyNastran")
+if os.environ.get("ASEKIT_REQUIRE_PYNASTRAN"):
+    # .ci/run's Nastran environment (environment-nastran.txt): there a missing reader fails
+    import pyNastran                                            # noqa: F401
+else:
+    pytest.importorskip("pyNastran")
 
 from asekit import bdf as B                                     # noqa: E402
 from asekit.case import case_from_dict, load_case               # noqa: E402
