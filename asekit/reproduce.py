@@ -273,7 +273,9 @@ def format_table(rows, wide: bool = False, notes: bool = True) -> str:
                  "  ".join("-" * w for w in widths)]
         for c, r in zip(cells, rows):
             line = "  ".join(x.ljust(w) for x, w in zip(c, widths))
-            lines.append((line + (f"  # {r[5]}" if notes and r[5] else "")).rstrip())
+            why = _explanation(r[0], r[6]) if notes else ""
+            lines.append((line + (f"  # {r[5]}" if notes and r[5] else "")
+                          + (f"  why: {why}" if why else "")).rstrip())
         return "\n".join(lines)
     widths = _WIDTHS
     lines = ["  ".join(h.ljust(w) for h, w in zip(_HEAD, widths)).rstrip(),
@@ -286,7 +288,19 @@ def format_table(rows, wide: bool = False, notes: bool = True) -> str:
         if notes and r[5]:
             lines += textwrap.wrap(r[5], 100, initial_indent="    # ",
                                    subsequent_indent="      ", break_on_hyphens=False)
+        why = _explanation(r[0], r[6]) if notes else ""
+        if why:
+            lines += textwrap.wrap(why, 100, initial_indent="    why: ",
+                                   subsequent_indent="      ", break_on_hyphens=False)
     return "\n".join(lines)
+
+
+def _explanation(key: str, verdict_text: str) -> str:
+    """The ``explained`` text of data/thesis.toml for a row whose verdict is "explained
+    difference" (shown under the row), else ""."""
+    if verdict_text != "explained difference":
+        return ""
+    return str(_load(Path(THESIS_FILE)).get(key, {}).get("explained", ""))
 
 
 def comparison_table(quantities, wide: bool = False) -> str:

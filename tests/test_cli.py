@@ -40,7 +40,9 @@ def test_verdicts():
     assert verdict("ase.aem1.corner_overshoot_pct", [20.0, 40.0], [10.0, 16.0]) == \
         "outside range"
     assert verdict("flutter.pk.M075.h0.speed_ms", 251.12, 250.0) == "within tolerance"
-    assert verdict("flutter.pk.M075.h0.speed_ms", 251.12, 218.1) == "differs"
+    assert verdict("flutter.pk.M075.h0.freq_hz", 143.55, 120.0) == "differs"
+    # outside tolerance with an `explained` text in data/thesis.toml
+    assert verdict("flutter.pk.M075.h0.speed_ms", 251.12, 218.1) == "explained difference"
     assert verdict("flutter.pk.M075.h0.speed_ms", 251.12, None) == "not computed"
     assert verdict("aero.boxes", None, 140) == "not reported"
     assert verdict("servo.system3.gain_margin_db", float("inf"), float("inf")) == \
@@ -56,14 +58,29 @@ def test_table_fits_100_columns_and_wide_keeps_one_line_per_row():
                    "a long note " * 20),
           Quantity("servo.system1.closed_loop_poles", [-214.38, -666.56, -9628.15], "rad/s",
                    "x"),
-          Quantity("flutter.pk.M075.h0.speed_ms", 218.1, "m/s", "note")]
+          Quantity("flutter.pk.M075.h0.speed_ms", 218.1, "m/s", "note"),
+          Quantity("flutter.pk.M075.h0.freq_hz", 120.0, "Hz", "")]
     rows = rp.comparison_rows(qs)
     text = format_table(rows)
     assert max(len(line) for line in text.splitlines()) <= 100
     assert "verdict" in text.splitlines()[0] and "differs" in text
     assert text.count("long") == 20                          # folded, not cut
+    # an explained difference carries its reason from data/thesis.toml under the row
+    assert "explained difference" in text and "    why: the 6x7 single-node model" in text
     wide = format_table(rows, wide=True)
     assert len(wide.splitlines()) == 2 + len(rows)
+    assert "why: the 6x7" in wide
+
+
+def test_every_explanation_names_a_known_quantity_with_a_thesis_value():
+    entries = rp._load(rp.Path(rp.THESIS_FILE))
+    explained = {k: v for k, v in entries.items() if "explained" in v}
+    assert explained
+    from asekit.thesis import all_keys
+    known = set(all_keys())
+    for key, entry in explained.items():
+        assert key in known and entry.get("value") is not None, key
+        assert isinstance(entry["explained"], str) and len(entry["explained"]) > 20, key
 
 
 # ---- arguments -------------------------------------------------------------------------------
