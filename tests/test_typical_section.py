@@ -265,3 +265,26 @@ def test_conner_exact_and_solve_ivp_integrations_agree():
     b = simulate_exact(s, conn, x0, 3.0, step=1e-3)
     np.testing.assert_allclose(b.d, a.d, atol=1e-6 * DELTA)
     np.testing.assert_allclose(b.switch_times, a.switch_times, atol=1e-8)
+
+
+@pytest.mark.parametrize("p", [0.5, 1.0])
+def test_conner_preloaded_lco_multi_harmonic_balance_against_time_domain(p):
+    """A preloaded band (centre p delta off the unloaded position; p = 1: the unloaded flap
+    rests on a stop): the LCO is biased. At 18 m/s the multi-harmonic balance (bias + 11
+    harmonics) gives bias, first harmonic and frequency within 0.1 % of the time domain
+    (measured 0.003 %, bias 0.41 and 0.82 delta)."""
+    sec = conner_1997()
+    s = connected_system(sec, 18.0)
+    st = harmonic_balance(s, Connection(sec.stiffness_beta, freeplay=DELTA)).largest_stable()
+    conn = Connection(sec.stiffness_beta, freeplay=DELTA, preload=p * DELTA)
+    m = multi_harmonic_balance(s, conn, st.amplitude, st.frequency_hz, bias=p * DELTA,
+                               n_harmonics=11)
+    assert m.converged and m.stable
+    x0 = np.zeros(8)
+    x0[2] = p * DELTA + 1.5 * st.amplitude
+    sim = simulate_exact(s, conn, x0, 40.0, step=1e-3)
+    td = steady_oscillation(sim.t, sim.d, floor=1e-3 * DELTA)
+    assert td.kind == "lco" and td.bias > 0.3 * p * DELTA
+    assert td.bias == pytest.approx(m.bias, rel=1e-3)
+    assert td.amplitude == pytest.approx(m.amplitude, rel=1e-3)
+    assert td.frequency_hz == pytest.approx(m.frequency_hz, rel=1e-4)
