@@ -705,7 +705,8 @@ def _transfer(system: ConnectedSystem, s: complex) -> complex:
 
 def multi_harmonic_balance(system: ConnectedSystem, connection: Connection, amplitude: float,
                            frequency_hz: float, bias: float = 0.0, n_harmonics: int = 7,
-                           n_samples: int = 1024, tol: float = 1e-10) -> MultiHarmonicLco:
+                           n_samples: int = 1024, tol: float = 1e-10,
+                           harmonics_guess=None) -> MultiHarmonicLco:
     """Periodic solution of Eq. (1) (no external input) by harmonic balance with a bias and
     ``n_harmonics`` harmonics, the nonlinear moment evaluated in the time domain
     (alternating frequency-time method: Cameron & Griffin, J. Appl. Mech. 56, 1989, 149-154;
@@ -728,6 +729,11 @@ def multi_harmonic_balance(system: ConnectedSystem, connection: Connection, ampl
     the region durations tau_r of the balanced orbit (switch angles from the harmonic series,
     Brent). One multiplier is 1 (autonomous system; its distance from 1 measures how well N
     harmonics resolve the orbit); the LCO is stable when the others lie inside the unit circle.
+
+    ``harmonics_guess`` (complex, N + 1, rad; optional): a full starting series D_0..D_N
+    (e.g. a neighbouring solution with a symmetry-breaking bias and even harmonics added, to
+    reach an asymmetric branch); Newton then starts at N harmonics directly (D_1 is rotated to
+    real) and ``amplitude`` and ``bias`` are not used.
 
     Returns :class:`MultiHarmonicLco`; ``converged`` False with "no LCO found near ..." when
     Newton fails or ends on an orbit that never leaves the band (the rest position).
@@ -778,6 +784,16 @@ def multi_harmonic_balance(system: ConnectedSystem, connection: Connection, ampl
     steps = list(range(1, N + 1, 2))
     if steps[-1] != N:
         steps.append(N)
+    if harmonics_guess is not None:
+        Dg = np.asarray(harmonics_guess, complex).ravel()
+        if Dg.size != N + 1 or not np.all(np.isfinite(Dg)) or abs(Dg[1]) == 0:
+            raise ValueError(f"harmonics_guess must be N + 1 = {N + 1} finite complex "
+                             "coefficients with D_1 != 0")
+        Dg = Dg * np.exp(-1j * np.angle(Dg[1]) * np.arange(N + 1))   # D_1 real
+        z = np.concatenate([[Dg[0].real / dl, abs(Dg[1]) / dl],
+                            np.column_stack([Dg[2:].real, Dg[2:].imag]).ravel() / dl, [1.0]])
+        nh = N
+        steps = [N]
     sol = None
     for nh_new in steps:
         if nh_new > nh:                       # pad the new harmonics with zeros

@@ -510,6 +510,8 @@ def test_multi_harmonic_balance_bad_input_and_no_lco():
             multi_harmonic_balance(sysm, conn, **args)
     with pytest.raises(ValueError, match="freeplay > 0"):
         multi_harmonic_balance(sysm, Connection(K_CONN), 0.02, 6.0)
+    with pytest.raises(ValueError, match="harmonics_guess"):
+        multi_harmonic_balance(sysm, conn, 0.02, 6.0, n_harmonics=3, harmonics_guess=[0, 0.02])
     with pytest.raises(TypeError, match="Connection"):
         multi_harmonic_balance(sysm, 1.0, 0.02, 6.0)
     # q = 0.3: no stiffness flutters, no LCO; a guess inside the band stays at rest

@@ -230,20 +230,42 @@ def test_conner_lco_below_the_zero_stiffness_flutter_speed():
     assert _td(3.5, None, t_final=30.0, x0=x0).kind == "decayed"
 
 
-def test_conner_symmetric_lco_loses_stability_at_mid_speeds():
-    """Between the two branches (about 9.5-12 m/s) the symmetric LCO of the multi-harmonic
-    balance is unstable (a Floquet multiplier leaves the unit circle: 1.51 at 10 m/s) and the
-    time domain settles instead on an asymmetric LCO (bias about 0.33 delta at 10 m/s, one of a
-    mirror pair) -- outside what a symmetric (zero-bias) balance started from the DF can
-    represent; the asymmetric branch is not computed here."""
+def test_conner_period_one_lcos_lose_stability_at_mid_speeds():
+    """Between the two branches (about 9.5-12 m/s) no period-one LCO is stable. At 10 m/s the
+    symmetric LCO of the multi-harmonic balance has a Floquet multiplier of 1.51; the time domain
+    settles on an asymmetric motion (bias 0.33 delta, one of a mirror pair) whose successive
+    flap maxima repeat only every 4 cycles (1.157, 1.175, 1.181, 1.161 delta): not period-one.
+    The asymmetric period-one orbit exists (the balance converges on it from the time-domain
+    harmonics: bias and first harmonic within 0.5 % of the time domain's) but is unstable
+    (|multiplier| 1.11), so no period-one balance can represent the attractor there."""
+    from scipy.signal import find_peaks
     sec = conner_1997()
     conn = Connection(sec.stiffness_beta, freeplay=DELTA)
     s = connected_system(sec, 10.0)
     st = harmonic_balance(s, conn).largest_stable()
     m = multi_harmonic_balance(s, conn, st.amplitude, st.frequency_hz, n_harmonics=11)
     assert m.converged and not m.stable
-    td = _td(10.0, st.amplitude)
-    assert td.kind == "lco" and abs(td.bias) > 0.2 * DELTA
+    x0 = np.zeros(8)
+    x0[2] = 1.5 * st.amplitude
+    sim = simulate_exact(s, conn, x0, 30.0, step=1e-3)
+    td = steady_oscillation(sim.t, sim.d)
+    assert abs(td.bias) > 0.2 * DELTA
+    tail = sim.t > 25.0
+    pk = sim.d[tail][find_peaks(sim.d[tail])[0]]
+    assert np.ptp(pk[:4]) > 0.01 * DELTA                  # not period-one ...
+    np.testing.assert_allclose(pk[4:8], pk[:4], atol=2e-3 * DELTA)    # ... but period-four
+    # the asymmetric period-one orbit, from the time-domain harmonics of the last 10 periods
+    w = 2 * math.pi * td.frequency_hz
+    sel = sim.t >= sim.t[-1] - 10 / td.frequency_hz
+    t = sim.t[sel]
+    cols = [np.ones_like(t)] + [f(n * w * t) for n in range(1, 12) for f in (np.cos, np.sin)]
+    cf = np.linalg.lstsq(np.column_stack(cols), sim.d[sel], rcond=None)[0]
+    guess = np.concatenate([[cf[0]], cf[1::2] - 1j * cf[2::2]])
+    ma = multi_harmonic_balance(s, conn, 1.0, td.frequency_hz, n_harmonics=11,
+                                harmonics_guess=guess)
+    assert ma.converged and not ma.stable
+    assert ma.bias == pytest.approx(td.bias, rel=5e-3)
+    assert ma.amplitude == pytest.approx(td.amplitude, rel=5e-3)
 
 
 def test_bad_section_input():
