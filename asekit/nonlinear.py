@@ -82,6 +82,19 @@ several kHz) :func:`simulate_exact` propagates each linear region with its matri
 and finds the switches by Brent's method on the exact solution; it agrees with the
 ``solve_ivp`` event integration to 1e-8 of delta (tests) at a fraction of the cost.
 
+Beyond one harmonic (:func:`multi_harmonic_balance`): the describing function assumes a
+sinusoidal d(t); where the contact makes the waveform strongly non-harmonic (the Conner et al.
+section's 4.8 Hz branch: half peak-to-peak 1.21 x the first harmonic) its amplitude is off by
+12 %. The multi-harmonic balance solves d = Re sum D_n e^{i n omega t} (bias and N harmonics,
+any preload) against the exact linear part, Eq. (4), with the moment evaluated in time (AFT),
+and classifies the orbit by its Floquet multipliers instead of the Krylov-Bogoliubov slope;
+with 9-11 harmonics it matches the event-located time domain to 0.01 % (tests). A hysteresis-free
+friction option is not provided: dry (Coulomb) friction depends on the sign of the relative
+velocity d', so it is neither a function of d alone (Eq. 1 would need f(d, d')) nor free of
+sticking phases (a set-valued law, whose time domain needs stick-slip event handling and whose
+describing function is a hysteresis, i.e. complex); viscous damping across the connection is
+already linear and belongs in A0.
+
 Units: SI (rad, N m/rad, s); degrees and Hz only where a name says so (``frequency_hz``).
 """
 
@@ -208,7 +221,8 @@ def deadzone_gain(s):
 def _require_centred(conn: Connection):
     if conn.preload != 0.0:
         raise ValueError("the describing-function analysis needs a centred band (preload = 0); "
-                         f"got preload = {conn.preload!r} rad -- use the time-domain simulate()")
+                         f"got preload = {conn.preload!r} rad -- use multi_harmonic_balance() (any "
+                         "preload) or the time-domain simulate()")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -630,6 +644,221 @@ def biased_harmonic_balance(system: ConnectedSystem, connection: Connection,
                                  gain=n1, stable=bool(v2[0] < v1[0]),
                                  output_amplitudes=_output_amplitudes(system, n1, om, As)))
     return tuple(out)
+
+
+# ---------------------------------------------------------------------------------------------
+# multi-harmonic balance (bias + N harmonics, alternating frequency-time, Newton)
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class MultiHarmonicLco:
+    """A periodic solution of Eq. (1) by multi-harmonic balance.
+
+    ``harmonics`` (complex, N + 1): d(t) = Re sum_n D_n exp(i n omega t), D_0 = ``bias`` (rad),
+    |D_1| = ``amplitude`` (rad, the first harmonic, phase fixed so D_1 is real); ``peak`` half
+    peak-to-peak of the reconstructed d(t) (rad); ``frequency_hz``; ``n_harmonics`` N;
+    ``residual`` the relative residual norm at the end; ``converged``; ``multipliers`` the
+    Floquet multipliers of the orbit (the trivial one, ~1, removed), ``trivial_multiplier``;
+    ``stable`` (all |multipliers| < 1); ``message`` a sentence ("no LCO found near ..." when
+    Newton fails or falls back to the rest position inside the band); ``state`` the state x at
+    phase 0 of the orbit, x = Re sum_n (i n omega I - A0)^-1 b F_n (to start a simulation on
+    the orbit).
+    """
+
+    harmonics: np.ndarray
+    frequency_hz: float
+    n_harmonics: int
+    residual: float
+    converged: bool
+    stable: bool
+    multipliers: np.ndarray
+    trivial_multiplier: complex
+    message: str
+    state: np.ndarray | None = None
+
+    @property
+    def bias(self) -> float:
+        return float(self.harmonics[0].real)
+
+    @property
+    def amplitude(self) -> float:
+        return float(abs(self.harmonics[1]))
+
+    def waveform(self, n: int = 512):
+        """(theta (rad, one period), d(theta) (rad)) of the harmonic series."""
+        th = np.linspace(0.0, 2 * math.pi, int(n), endpoint=False)
+        k = np.arange(self.harmonics.size)
+        return th, np.real(np.exp(1j * np.outer(th, k)) @ self.harmonics)
+
+    @property
+    def peak(self) -> float:
+        _, d = self.waveform(2048)
+        return 0.5 * float(np.ptp(d))
+
+
+def _transfer(system: ConnectedSystem, s: complex) -> complex:
+    """G(s) = c (s I - A0)^-1 b: relative rotation per unit connection moment (rad/(N m))."""
+    n = system.n_states
+    return complex(system.c @ np.linalg.solve(s * np.eye(n) - system.A0, system.b))
+
+
+def multi_harmonic_balance(system: ConnectedSystem, connection: Connection, amplitude: float,
+                           frequency_hz: float, bias: float = 0.0, n_harmonics: int = 7,
+                           n_samples: int = 1024, tol: float = 1e-10,
+                           harmonics_guess=None) -> MultiHarmonicLco:
+    """Periodic solution of Eq. (1) (no external input) by harmonic balance with a bias and
+    ``n_harmonics`` harmonics, the nonlinear moment evaluated in the time domain
+    (alternating frequency-time method: Cameron & Griffin, J. Appl. Mech. 56, 1989, 149-154;
+    for freeplay aeroelasticity e.g. Liu & Dowell, Nonlinear Dyn. 37, 2004, 31-49).
+
+    With d(t) = Re sum_{n=0}^{N} D_n e^{i n omega t} and the Fourier coefficients F_n of
+    f(d(t)) (FFT of ``n_samples`` samples per period), Eq. (1) is exactly
+
+        D_n = G(i n omega) F_n,   G(s) = c (s I - A0)^-1 b,   n = 0 .. N,           (4)
+
+    2N + 1 real equations for the unknowns D_0, D_1 (real: the phase is free), Re/Im D_n
+    (n >= 2) and omega. Solved by Newton's method (MINPACK hybrd with a finite-difference
+    Jacobian, on d / delta and omega / omega_guess) from (``bias``, ``amplitude`` (rad),
+    ``frequency_hz``), in steps of the harmonic count 1, 3, 5, ..., N, each from the previous
+    solution; N = 1 is the dual-input (bias + sinusoid) describing function.
+
+    Stability: the connection moment is continuous, so the saltation matrices at the switches
+    are the identity (Leine & Nijmeijer, *Dynamics and Bifurcations of Non-Smooth Mechanical
+    Systems*, 2004, Sec. 7.3) and the monodromy matrix is the product of expm(A_r tau_r) over
+    the region durations tau_r of the balanced orbit (switch angles from the harmonic series,
+    Brent). One multiplier is 1 (autonomous system; its distance from 1 measures how well N
+    harmonics resolve the orbit); the LCO is stable when the others lie inside the unit circle.
+
+    ``harmonics_guess`` (complex, N + 1, rad; optional): a full starting series D_0..D_N
+    (e.g. a neighbouring solution with a symmetry-breaking bias and even harmonics added, to
+    reach an asymmetric branch); Newton then starts at N harmonics directly (D_1 is rotated to
+    real) and ``amplitude`` and ``bias`` are not used.
+
+    Returns :class:`MultiHarmonicLco`; ``converged`` False with "no LCO found near ..." when
+    Newton fails or ends on an orbit that never leaves the band (the rest position).
+    """
+    from scipy.linalg import expm
+    from scipy.optimize import root
+
+    if not isinstance(connection, Connection):
+        raise TypeError(f"connection must be a Connection, got {type(connection).__name__}")
+    dl = connection.freeplay
+    if dl <= 0 or connection.is_linear:
+        raise ValueError("multi-harmonic balance needs freeplay > 0 and inner_stiffness < "
+                         "stiffness")
+    a0 = positive("amplitude", amplitude)
+    w0 = 2 * math.pi * positive("frequency_hz", frequency_hz)
+    b0 = finite("bias", bias)
+    N = int(n_harmonics)
+    if N < 1:
+        raise ValueError(f"n_harmonics must be >= 1, got {n_harmonics}")
+    M = int(n_samples)
+    if M < 8 * N:
+        raise ValueError(f"n_samples must be >= 8 n_harmonics = {8 * N}, got {n_samples}")
+    th = 2 * math.pi * np.arange(M) / M
+    G0 = _transfer(system, 0.0).real
+
+    def unpack(z, nh):
+        D = np.zeros(nh + 1, complex)
+        D[0] = z[0] * dl
+        D[1] = z[1] * dl
+        for n in range(2, nh + 1):
+            D[n] = (z[2 * n - 2] + 1j * z[2 * n - 1]) * dl
+        return D, z[-1] * w0
+
+    def resid(z, nh):
+        D, w = unpack(z, nh)
+        d = np.real(np.exp(1j * np.outer(th, np.arange(nh + 1))) @ D)
+        F = np.fft.rfft(connection.moment(d)) / M
+        F = F[:nh + 1].copy()
+        F[1:] *= 2.0
+        r = [(D[0].real - G0 * F[0].real) / dl]
+        for n in range(1, nh + 1):
+            e = (D[n] - _transfer(system, 1j * n * w) * F[n]) / dl
+            r += [e.real, e.imag]
+        return np.array(r)
+
+    z = np.array([b0 / dl, a0 / dl, 1.0])
+    nh = 1
+    steps = list(range(1, N + 1, 2))
+    if steps[-1] != N:
+        steps.append(N)
+    if harmonics_guess is not None:
+        Dg = np.asarray(harmonics_guess, complex).ravel()
+        if Dg.size != N + 1 or not np.all(np.isfinite(Dg)) or abs(Dg[1]) == 0:
+            raise ValueError(f"harmonics_guess must be N + 1 = {N + 1} finite complex "
+                             "coefficients with D_1 != 0")
+        Dg = Dg * np.exp(-1j * np.angle(Dg[1]) * np.arange(N + 1))   # D_1 real
+        z = np.concatenate([[Dg[0].real / dl, abs(Dg[1]) / dl],
+                            np.column_stack([Dg[2:].real, Dg[2:].imag]).ravel() / dl, [1.0]])
+        nh = N
+        steps = [N]
+    sol = None
+    for nh_new in steps:
+        if nh_new > nh:                       # pad the new harmonics with zeros
+            z = np.concatenate([z[:-1], np.zeros(2 * (nh_new - nh)), z[-1:]])
+            nh = nh_new
+        sol = root(resid, z, args=(nh,), method="hybr", tol=tol)
+        z = sol.x
+        if not np.all(np.isfinite(z)):
+            break
+    D, w = unpack(z, nh)
+    res = float(np.linalg.norm(resid(z, nh)) / max(np.linalg.norm(z[:-1]), 1e-300))
+    lco = MultiHarmonicLco(harmonics=D, frequency_hz=w / (2 * math.pi), n_harmonics=N,
+                           residual=res, converged=False, stable=False,
+                           multipliers=np.zeros(0), trivial_multiplier=complex("nan"),
+                           message="")
+    _, dd = lco.waveform(2048)
+    lo, hi = connection.breakpoints
+    guess = f"(A = {a0:.4g} rad, {frequency_hz:.4g} Hz, bias {b0:.3g} rad)"
+    if not (np.all(np.isfinite(z)) and res < 1e-6 and w > 0):
+        return _replace_lco(lco, message=f"no LCO found near {guess}: Newton did not converge "
+                                         f"(relative residual {res:.2g})")
+    if np.all((dd >= lo) & (dd <= hi)):
+        return _replace_lco(lco, message=f"no LCO found near {guess}: Newton fell back to the "
+                                         "rest position inside the band")
+    # Floquet multipliers: region durations of the balanced orbit over one period
+    T = 2 * math.pi / w
+    k = np.arange(nh + 1)
+    dth = lambda t_: float(np.real(np.exp(1j * k * t_) @ D))  # noqa: E731
+    thf = np.linspace(0.0, 2 * math.pi, 4097)
+    dv = np.real(np.exp(1j * np.outer(thf, k)) @ D)
+    cuts = [0.0, 2 * math.pi]
+    for e in (lo, hi):
+        g = dv - e
+        for i in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
+            cuts.append(brentq(lambda t_: dth(t_) - e, thf[i], thf[i + 1], xtol=1e-14))
+    cuts = np.sort(cuts)
+    mono = np.eye(system.n_states)
+    for t1, t2 in zip(cuts[:-1], cuts[1:]):
+        if t2 <= t1:
+            continue
+        kr, _ = connection.region_law(connection.region_of(dth(0.5 * (t1 + t2))))
+        mono = expm(system.state_matrix(kr) * (t2 - t1) / w) @ mono
+    mu = np.linalg.eigvals(mono)
+    dfull = np.real(np.exp(1j * np.outer(th, np.arange(nh + 1))) @ D)
+    Ff = np.fft.rfft(connection.moment(dfull)) / M
+    Ff = Ff[:nh + 1].copy()
+    Ff[1:] *= 2.0
+    ns = system.n_states
+    x_0 = sum(np.real(np.linalg.solve(1j * n * w * np.eye(ns) - system.A0, system.b) * Ff[n])
+              for n in range(nh + 1))
+    j = int(np.argmin(np.abs(mu - 1.0)))
+    triv = complex(mu[j])
+    others = np.delete(mu, j)
+    stable = bool(np.all(np.abs(others) < 1.0))
+    msg = (f"LCO: first harmonic {abs(D[1]):.5g} rad, bias {D[0].real:.3g} rad, "
+           f"{w / (2 * math.pi):.5g} Hz ({N} harmonics, residual {res:.1e}); "
+           f"{'stable' if stable else 'unstable'} (largest |Floquet multiplier| "
+           f"{np.max(np.abs(others)):.4f}, trivial multiplier {abs(triv):.4f}, period {T:.4g} s)")
+    return _replace_lco(lco, converged=True, stable=stable, multipliers=others,
+                        trivial_multiplier=triv, message=msg, state=np.asarray(x_0, float))
+
+
+def _replace_lco(lco: MultiHarmonicLco, **kw) -> MultiHarmonicLco:
+    from dataclasses import replace
+    return replace(lco, **kw)
 
 
 @dataclass(frozen=True)

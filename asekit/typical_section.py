@@ -285,38 +285,53 @@ def flutter_speed_exact(sec: TypicalSection, u_guess: float, f_guess_hz: float,
 # ---------------------------------------------------------------------------------------------
 # the published case
 # ---------------------------------------------------------------------------------------------
-#: Span of the Duke wind-tunnel model (m); the published masses are for this span.
+#: Span of the Duke wind-tunnel model (m). Informational only: the parameters of
+#: :func:`conner_1997` are per unit span as published and are not divided by it.
 CONNER_SPAN = 0.52
 
+#: Conner et al. (1997) freeplay: the flap moves freely over 4.24 deg, from -2.12 to +2.12 deg
+#: (delta = 4.24 deg, alpha_f = -2.12 deg in their notation), i.e. a half-width of 2.12 deg.
+CONNER_FREEPLAY_HALF_WIDTH_DEG = 2.12
 
-def conner_1997(heave_mass_total: float | None = None) -> TypicalSection:
+
+def conner_1997(heave_mass: float = 3.39298, wing_mass: float = 1.5666) -> TypicalSection:
     """The typical section of Conner, Tang, Dowell & Virgin (J. Fluids Struct. 11, 1997, 89-109,
-    Table 1), per unit span (the published whole-model values divided by the 0.52 m span).
+    Table 1), per unit span.
 
-    Values used (whole model): semichord b = 0.127 m, a = -0.5, c = 0.5; wing mass
-    m_W = 1.558 kg, S_alpha = 0.08587 kg m, S_beta = 0.00395 kg m, I_alpha = 0.01347 kg m^2,
-    I_beta = 0.0003264 kg m^2; K_h = 2818.8 N/m, K_alpha = 37.3 N m/rad, K_beta = 3.9 N m/rad;
-    zeta_h = 0.0113, zeta_alpha = 0.01626, zeta_beta = 0.0115; rho = 1.225 kg/m^3. They give
-    the nondimensional x_alpha = S_a / (m b) = 0.434, x_beta = 0.01996, r_alpha = 0.7321,
-    r_beta = 0.11397 quoted with the paper (checked in tests/test_typical_section.py).
-    ``heave_mass_total`` (kg): the mass in plunge, default m_W (the nondimensional form of the
-    paper's equations uses one mass m); pass the wing-plus-support mass to include the support.
+    Values (per unit span, SI): semichord b = 0.127 m, a = -0.5, c = 0.5; mass of wing and
+    aileron m_W = 1.5666 kg/m, mass of wing, aileron and supports m_T = 3.39298 kg/m (the mass
+    that moves in plunge); S_alpha = 0.08587 kg m/m, S_beta = 0.00395 kg m/m,
+    I_alpha = 0.01347 kg m^2/m, I_beta = 0.0003264 kg m^2/m; K_h = 2818.8 N/m/m,
+    K_alpha = 37.34 N m/rad/m, K_beta = 3.9 N m/rad/m; zeta_h = 0.0113, zeta_alpha = 0.01626,
+    zeta_beta = 0.0115; rho = 1.225 kg/m^3. The nondimensional set quoted with them is
+    x_alpha = 0.434, x_beta = 0.02, r_alpha = 0.7321, r_beta = 0.1140, omega_h = 42.5352,
+    omega_alpha = 52.6506, omega_beta = 109.3093 rad/s (with m = 1.558 kg/m; tests check the
+    consistency).
 
-    Provenance caveat: these numbers were taken from the parameter table as quoted in the
-    follow-up literature (Tang, Conner & Dowell, J. Aircraft 35(2), 1998, Table 1), not read
-    from a copy of the 1997 paper in this session.
+    Provenance: the paper itself was not available to this session (only its first page, on
+    vdocuments.mx). The numbers are those of a public Python implementation of the Conner
+    et al. section (a UVLM-coupling project on GitHub, found through the code index; its
+    parameter block is labelled "Conner", with a second block "Darabseh 2022": m = 1.558,
+    m_T = 3.3843 kg/m, same stiffnesses, inertias and static moments). The evidence that they
+    are the published ones: with them the Theodorsen flutter point is 24.2 m/s at 6.09 Hz (exact
+    C(k)) and 24.0 m/s at 6.10 Hz (Jones), against the 23.9 m/s and 6.1 Hz that issue 14
+    quotes for the paper; the earlier reading (whole-model values divided by a 0.52 m span,
+    m_W in plunge) gave 23.6 m/s at 8.2 Hz, a different flutter mode.
+
+    ``heave_mass`` (kg/m): the plunging mass, default m_T; ``wing_mass`` is informational (the
+    nondimensional form of the equations uses it for mu, x_alpha, r_alpha; here the dimensional
+    S and I are used directly).
     """
-    s = CONNER_SPAN
-    m_w = 1.558
-    mh = m_w if heave_mass_total is None else positive("heave_mass_total", heave_mass_total)
-    return TypicalSection(semichord=0.127, a=-0.5, c=0.5, heave_mass=mh / s,
-                          static_moment_alpha=0.08587 / s, static_moment_beta=0.00395 / s,
-                          inertia_alpha=0.01347 / s, inertia_beta=0.0003264 / s,
-                          stiffness_h=2818.8 / s, stiffness_alpha=37.3 / s,
-                          stiffness_beta=3.9 / s, zeta_h=0.0113, zeta_alpha=0.01626,
-                          zeta_beta=0.0115, density=1.225)
+    positive("wing_mass", wing_mass)
+    return TypicalSection(semichord=0.127, a=-0.5, c=0.5,
+                          heave_mass=positive("heave_mass", heave_mass),
+                          static_moment_alpha=0.08587, static_moment_beta=0.00395,
+                          inertia_alpha=0.01347, inertia_beta=0.0003264,
+                          stiffness_h=2818.8, stiffness_alpha=37.34, stiffness_beta=3.9,
+                          zeta_h=0.0113, zeta_alpha=0.01626, zeta_beta=0.0115, density=1.225)
 
 
 __all__ = ["TypicalSection", "theodorsen_t", "theodorsen_function", "jones_function",
            "section_matrices", "state_matrix", "frequency_domain_matrix", "connected_system",
-           "flutter_speed", "flutter_speed_exact", "conner_1997"]
+           "flutter_speed", "flutter_speed_exact", "conner_1997", "CONNER_SPAN",
+           "CONNER_FREEPLAY_HALF_WIDTH_DEG"]

@@ -469,3 +469,52 @@ def test_fin_aem1_command_step_with_freeplay(fin_model):
     assert a.d[-1] == pytest.approx(best.d, rel=3e-3)
     assert abs(a.outputs["theta"][-1] - cmd[0]) < 0.05 * cmd[0]
     assert abs(best.d) > conn.freeplay                    # on a stop
+
+
+# --------------------------------------------------------------------------------------------
+# multi-harmonic balance
+# --------------------------------------------------------------------------------------------
+def test_multi_harmonic_balance_with_one_harmonic_is_the_describing_function():
+    """With one harmonic and no bias, Eq. (4) is the describing-function balance
+    D_1 = G(i omega) N(A) D_1: same amplitude and frequency as harmonic_balance (to the FFT
+    sampling of the moment); more harmonics move the toy's stable LCO by under 1 % (its
+    waveform is nearly harmonic) and agree with the time domain of the DF test above."""
+    from asekit.nonlinear import multi_harmonic_balance
+    sysm = toy(1.0)
+    conn = Connection(K_CONN, freeplay=0.01)
+    st = harmonic_balance(sysm, conn).largest_stable()
+    m1 = multi_harmonic_balance(sysm, conn, 1.1 * st.amplitude, 0.98 * st.frequency_hz,
+                                n_harmonics=1, n_samples=4096)
+    assert m1.converged
+    assert m1.amplitude == pytest.approx(st.amplitude, rel=1e-5)
+    assert m1.frequency_hz == pytest.approx(st.frequency_hz, rel=1e-6)
+    assert abs(m1.bias) < 1e-9
+    m9 = multi_harmonic_balance(sysm, conn, st.amplitude, st.frequency_hz, n_harmonics=9)
+    assert m9.converged and m9.stable and abs(m9.trivial_multiplier - 1) < 0.01
+    assert m9.amplitude == pytest.approx(st.amplitude, rel=0.01)
+    # the unstable (lower) DF branch is unstable for the multi-harmonic balance too
+    un = harmonic_balance(sysm, conn).lcos[0]
+    mu = multi_harmonic_balance(sysm, conn, un.amplitude, un.frequency_hz, n_harmonics=9)
+    assert mu.converged and not mu.stable
+
+
+def test_multi_harmonic_balance_bad_input_and_no_lco():
+    from asekit.nonlinear import multi_harmonic_balance
+    sysm = toy(1.0)
+    conn = Connection(K_CONN, freeplay=0.01)
+    for kw, name in (({"amplitude": -0.01}, "amplitude"), ({"frequency_hz": 0.0}, "frequency_hz"),
+                     ({"n_harmonics": 0}, "n_harmonics"), ({"n_samples": 16}, "n_samples"),
+                     ({"bias": math.nan}, "bias")):
+        args = {"amplitude": 0.02, "frequency_hz": 6.0, **kw}
+        with pytest.raises(ValueError, match=name):
+            multi_harmonic_balance(sysm, conn, **args)
+    with pytest.raises(ValueError, match="freeplay > 0"):
+        multi_harmonic_balance(sysm, Connection(K_CONN), 0.02, 6.0)
+    with pytest.raises(ValueError, match="harmonics_guess"):
+        multi_harmonic_balance(sysm, conn, 0.02, 6.0, n_harmonics=3, harmonics_guess=[0, 0.02])
+    with pytest.raises(TypeError, match="Connection"):
+        multi_harmonic_balance(sysm, 1.0, 0.02, 6.0)
+    # q = 0.3: no stiffness flutters, no LCO; a guess inside the band stays at rest
+    quiet = multi_harmonic_balance(toy(0.3), conn, 0.005, 6.0, n_harmonics=3)
+    assert not quiet.converged and quiet.message.startswith("no LCO found near")
+    assert np.isfinite(quiet.amplitude)

@@ -491,40 +491,59 @@ def fig_growth_map(system_at, k: float, velocities, kappas=np.linspace(0.0, 1.0,
 # --------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class ConnerStudy:
-    """Describing function against time domain on the Conner et al. section.
+    """Describing function, multi-harmonic balance and time domain on the Conner et al. section.
 
-    delta (rad, half-width); velocities and hb (HarmonicBalance per speed); td_velocities and
-    td (TimeDomainLco of the flap angle per speed); flutter (U, Hz) with Jones' and the exact
-    C(k); flutter_zero (U) of the section with zero flap stiffness (flap damping kept)."""
+    delta (rad, half-width); velocities and hb (HarmonicBalance per speed); mhb (per speed, the
+    MultiHarmonicLco started from the largest stable DF LCO, None where there is none);
+    td_velocities and td (TimeDomainLco of the flap angle per speed, from beta = 1.5 x the DF
+    amplitude); td_mhb (the same, started on the balanced orbit); flutter (U, Hz) with Jones'
+    and the exact C(k); flutter_zero (U) of the section with zero flap stiffness (flap damping
+    kept)."""
 
     delta: float
     velocities: np.ndarray
     hb: tuple
+    mhb: tuple
     td_velocities: np.ndarray
     td: tuple
+    td_mhb: tuple
     flutter_jones: tuple
     flutter_exact: tuple
     flutter_zero: float
 
+    def mhb_at(self, u: float):
+        """The multi-harmonic LCO of the sweep speed nearest ``u`` (m/s)."""
+        return self.mhb[int(np.argmin(np.abs(self.velocities - u)))]
 
-def conner_study(delta_total_deg: float = 2.12, velocities=np.arange(5.0, 24.01, 0.5),
-                 td_velocities=(10.0, 12.0, 15.0, 18.0, 20.0, 21.0, 22.0, 23.0),
-                 t_final: float = 20.0, step: float = 1e-3) -> ConnerStudy:
-    """Harmonic balance over ``velocities`` and exact piecewise time integration at
-    ``td_velocities`` (from beta = 1.5 x the DF amplitude, ``t_final`` s, output every
-    ``step`` s; :func:`asekit.nonlinear.simulate_exact`) of the Conner
-    section with a total flap freeplay of ``delta_total_deg`` (Conner et al.: 2.12 deg)."""
+    def df_at(self, u: float):
+        return self.hb[int(np.argmin(np.abs(self.velocities - u)))].largest_stable()
+
+
+def conner_study(delta_half_deg: float | None = None, velocities=np.arange(3.0, 24.01, 0.5),
+                 td_velocities=(5.0, 6.0, 7.0, 8.0, 10.0, 14.0, 18.0, 22.0, 23.0),
+                 t_final: float = 30.0, step: float = 1e-3, n_harmonics: int = 11) -> ConnerStudy:
+    """Harmonic balance (describing function and ``n_harmonics`` multi-harmonic balance) over
+    ``velocities`` and exact piecewise time integration at ``td_velocities`` (``t_final`` s,
+    output every ``step`` s; :func:`asekit.nonlinear.simulate_exact`) of the Conner section with
+    a flap freeplay of half-width ``delta_half_deg`` (default: Conner et al., +-2.12 deg)."""
     from scipy.optimize import brentq
 
-    from ..nonlinear import steady_oscillation
-    from ..typical_section import (conner_1997, connected_system, flutter_speed,
-                                   flutter_speed_exact)
+    from ..nonlinear import multi_harmonic_balance, steady_oscillation
+    from ..typical_section import (CONNER_FREEPLAY_HALF_WIDTH_DEG, conner_1997,
+                                   connected_system, flutter_speed, flutter_speed_exact)
     sec = conner_1997()
-    dl = math.radians(delta_total_deg) / 2
+    dl = math.radians(CONNER_FREEPLAY_HALF_WIDTH_DEG if delta_half_deg is None
+                      else delta_half_deg)
     conn = Connection(sec.stiffness_beta, freeplay=dl)
     v = np.asarray(velocities, float)
     hb = tuple(harmonic_balance(connected_system(sec, u), conn) for u in v)
-    td = []
+    mhb = []
+    for u, r in zip(v, hb):
+        st = r.largest_stable()
+        mhb.append(None if st is None else
+                   multi_harmonic_balance(connected_system(sec, u), conn, st.amplitude,
+                                          st.frequency_hz, n_harmonics=n_harmonics))
+    td, td_m = [], []
     for u in td_velocities:
         s = connected_system(sec, u)
         st = harmonic_balance(s, conn).largest_stable()
@@ -532,12 +551,20 @@ def conner_study(delta_total_deg: float = 2.12, velocities=np.arange(5.0, 24.01,
         x0[2] = 1.5 * (st.amplitude if st is not None else 3 * dl)
         sim = simulate_exact(s, conn, x0, t_final, step=step)
         td.append(steady_oscillation(sim.t, sim.d, floor=1e-3 * dl, diverged=sim.diverged))
+        m = mhb[int(np.argmin(np.abs(v - u)))]
+        if m is not None and m.converged and abs(v[int(np.argmin(np.abs(v - u)))] - u) < 1e-9:
+            sim = simulate_exact(s, conn, m.state, t_final, step=step)
+            td_m.append(steady_oscillation(sim.t, sim.d, floor=1e-3 * dl,
+                                           diverged=sim.diverged))
+        else:
+            td_m.append(None)
     fj = flutter_speed(sec, 1.0, 60.0, 120)
     fe = flutter_speed_exact(sec, *fj)
     u0 = brentq(lambda u: growth_rate(connected_system(sec, u), 0.0)[0], 2.0, 23.0)
-    return ConnerStudy(delta=dl, velocities=v, hb=hb,
+    return ConnerStudy(delta=dl, velocities=v, hb=hb, mhb=tuple(mhb),
                        td_velocities=np.asarray(td_velocities, float), td=tuple(td),
-                       flutter_jones=fj, flutter_exact=fe, flutter_zero=float(u0))
+                       td_mhb=tuple(td_m), flutter_jones=fj, flutter_exact=fe,
+                       flutter_zero=float(u0))
 
 
 def fig_conner(cs: ConnerStudy):
@@ -553,6 +580,15 @@ def fig_conner(cs: ConnerStudy):
         lab = "DF, stable" if branch else "DF, unstable"
         a1.plot(u, a, mk, color="C0", label=lab)
         a2.plot(u, f, mk, color="C0", label=lab)
+    for stab, mk in ((True, "^"), (False, "v")):
+        sel = [(u, m) for u, m in zip(cs.velocities, cs.mhb)
+               if m is not None and m.converged and m.stable == stab]
+        if sel:
+            lab = f"multi-harmonic balance, {'stable' if stab else 'unstable'}"
+            a1.plot([u for u, _ in sel], [m.amplitude / cs.delta for _, m in sel], mk,
+                    color="C2", ms=4, mfc="C2" if stab else "none", label=lab)
+            a2.plot([u for u, _ in sel], [m.frequency_hz for _, m in sel], mk, color="C2",
+                    ms=4, mfc="C2" if stab else "none", label=lab)
     ok = [i for i, t in enumerate(cs.td) if t.kind == "lco"]
     a1.plot(cs.td_velocities[ok], [cs.td[i].amplitude / cs.delta for i in ok], "o", color="C1",
             label="time domain, first harmonic")
@@ -560,6 +596,11 @@ def fig_conner(cs: ConnerStudy):
             color="C1", label="time domain, half peak-to-peak")
     a2.plot(cs.td_velocities[ok], [cs.td[i].frequency_hz for i in ok], "o", color="C1",
             label="time domain")
+    okm = [i for i, t in enumerate(cs.td_mhb) if t is not None and t.kind == "lco"]
+    a1.plot(cs.td_velocities[okm], [cs.td_mhb[i].amplitude / cs.delta for i in okm], "x",
+            color="C3", label="time domain from the balanced orbit")
+    a2.plot(cs.td_velocities[okm], [cs.td_mhb[i].frequency_hz for i in okm], "x", color="C3",
+            label="time domain from the balanced orbit")
     for a in (a1, a2):
         a.axvline(cs.flutter_exact[0], color="k", lw=0.8, ls="--")
         a.axvline(cs.flutter_zero, color="0.5", lw=0.8, ls="--")
