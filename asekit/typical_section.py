@@ -285,41 +285,57 @@ def flutter_speed_exact(sec: TypicalSection, u_guess: float, f_guess_hz: float,
 # ---------------------------------------------------------------------------------------------
 # the published case
 # ---------------------------------------------------------------------------------------------
-#: Span of the Duke wind-tunnel model (m). Informational only: the parameters of
-#: :func:`conner_1997` are per unit span as published and are not divided by it.
+#: Span of the Duke wind-tunnel model (m; Conner et al. 1997, Table A.1). Informational only: the
+#: parameters of :func:`conner_1997` are per unit span as published and are not divided by it.
 CONNER_SPAN = 0.52
 
-#: Conner et al. (1997) freeplay: the flap moves freely over 4.24 deg, from -2.12 to +2.12 deg
-#: (delta = 4.24 deg, alpha_f = -2.12 deg in their notation), i.e. a half-width of 2.12 deg.
+#: Conner et al. (1997) freeplay "Gap 3" (Sec. 11.2, p. 101: freeplay regions of +-1.15, +-1.83 and
+#: +-2.12 deg), the case of Tang, Dowell & Virgin (1998, Sec. 4.2: "a nominal angular gap of 4.24
+#: deg, i.e. delta = +-2.12 deg"): the flap moves freely from -2.12 to +2.12 deg, a half-width of
+#: 2.12 deg.
 CONNER_FREEPLAY_HALF_WIDTH_DEG = 2.12
 
 
 def conner_1997(heave_mass: float = 3.39298, wing_mass: float = 1.5666) -> TypicalSection:
-    """The typical section of Conner, Tang, Dowell & Virgin (J. Fluids Struct. 11, 1997, 89-109,
-    Table 1), per unit span.
+    """The typical section of Conner, Tang, Dowell & Virgin, "Nonlinear behavior of a typical
+    airfoil section with control surface freeplay: a numerical and experimental study",
+    J. Fluids Struct. 11 (1997) 89-109, Appendix A, Table A.1 (p. 108), per unit span.
 
-    Values (per unit span, SI): semichord b = 0.127 m, a = -0.5, c = 0.5; mass of wing and
-    aileron m_W = 1.5666 kg/m, mass of wing, aileron and supports m_T = 3.39298 kg/m (the mass
-    that moves in plunge); S_alpha = 0.08587 kg m/m, S_beta = 0.00395 kg m/m,
-    I_alpha = 0.01347 kg m^2/m, I_beta = 0.0003264 kg m^2/m; K_h = 2818.8 N/m/m,
-    K_alpha = 37.34 N m/rad/m, K_beta = 3.9 N m/rad/m; zeta_h = 0.0113, zeta_alpha = 0.01626,
-    zeta_beta = 0.0115; rho = 1.225 kg/m^3. The nondimensional set quoted with them is
-    x_alpha = 0.434, x_beta = 0.02, r_alpha = 0.7321, r_beta = 0.1140, omega_h = 42.5352,
-    omega_alpha = 52.6506, omega_beta = 109.3093 rad/s (with m = 1.558 kg/m; tests check the
-    consistency).
+    Values (per unit span, SI): semichord b = 0.127 m (chord 0.254 m, span 0.52 m), elastic
+    axis a = -0.5, hinge c = 0.5; S_alpha = 0.08587 kg m/m, S_beta = 0.00395 kg m/m,
+    I_alpha = 0.01347 kg m^2/m, I_beta = 0.0003264 kg m^2/m; damping ratios zeta_alpha =
+    0.01626, zeta_beta = 0.0115, zeta_h = 0.0113 (log-decrement); rho = 1.225 kg/m^3.
 
-    Provenance: the paper itself was not available to this session (only its first page, on
-    vdocuments.mx). The numbers are those of a public Python implementation of the Conner
-    et al. section (a UVLM-coupling project on GitHub, found through the code index; its
-    parameter block is labelled "Conner", with a second block "Darabseh 2022": m = 1.558,
-    m_T = 3.3843 kg/m, same stiffnesses, inertias and static moments). The evidence that they
-    are the published ones: with them the Theodorsen flutter point is 24.2 m/s at 6.09 Hz (exact
-    C(k)) and 24.0 m/s at 6.10 Hz (Jones), against the 23.9 m/s and 6.1 Hz that issue 14
-    quotes for the paper; the earlier reading (whole-model values divided by a 0.52 m span,
-    m_W in plunge) gave 23.6 m/s at 8.2 Hz, a different flutter mode.
+    Masses: Table A.1 lists the wing 0.62868 kg, the aileron 0.18597 kg and the support blocks
+    2 x 0.47485 kg (the two blocks move only in plunge, Sec. 7), so the plunging mass per span is
+    m_T = (0.62868 + 0.18597 + 2 x 0.47485) / 0.52 = 3.39298 kg/m (``heave_mass``) and the
+    wing-aileron mass is (0.62868 + 0.18597) / 0.52 = 1.5666 kg/m (``wing_mass``); the table's
+    "mass/length of wing-aileron" M = 1.558 kg/m is the one its nondimensional values use.
+
+    Stiffnesses: Table A.1 gives them reduced as in Theodorsen (1935): K_alpha = C_alpha / (M b^2)
+    = 1486 1/s^2, K_beta = C_beta / (M b^2) = 155 1/s^2, K_h = C_h / M = 1809 1/s^2 (M = 1.558);
+    the dimensional values used here, C_alpha = 37.34 N m/rad/m, C_beta = 3.9 N m/rad/m,
+    C_h = 2818.8 N/m/m, are those of Tang, Dowell & Virgin, J. Fluids Struct. 12 (1998) 839-858,
+    Table 1 (p. 841: 37.3, 3.9 and 2818.8 "per span"), and reproduce Table A.1's reduced values
+    to its three to four digits (tests). Nondimensional set of Table A.1: x_alpha = 0.434,
+    x_beta = 0.01996, r_alpha = 0.7321, r_beta = 0.11397, kappa = pi rho b^2 / M = 0.03984.
+
+    Checks against the paper (tests/test_typical_section.py): the in-vacuo coupled natural
+    frequencies 4.444, 9.209, 19.442 Hz against Conner et al. Table 1 (p. 98, "numerical")
+    4.455, 9.218, 19.442 Hz (Tang et al. 1998 Table 1: 4.45, 9.21, 19.44 Hz), which also
+    confirms that m_T (not M) moves in plunge (with M the plunge frequency would be 5.8 Hz);
+    linear flutter 24.03 m/s, 6.10 Hz with Jones' C(k) against Table 1's 23.9 m/s, 6.112 Hz.
+
+    Differences from the paper's model: Conner et al. (Sec. 3, Eq. 6) treat the measured
+    damping ratios as *modal* ratios of the coupled in-vacuo modes and transform that damping
+    back to [alpha, beta, h] (a full matrix); here the damping is uncoupled,
+    diag(2 zeta_i sqrt(K_i M_s,ii)). The flutter speed moves by 0.1 % between the two (tests).
+    Freeplay: Conner et al. test +-1.15, +-1.83 and +-2.12 deg (Gaps 1-3, Sec. 11.2, p. 101);
+    Tang et al. (1998, Sec. 4.2) use delta = +-2.12 deg, a 4.24 deg total gap
+    (:data:`CONNER_FREEPLAY_HALF_WIDTH_DEG` is the half-width).
 
     ``heave_mass`` (kg/m): the plunging mass, default m_T; ``wing_mass`` is informational (the
-    nondimensional form of the equations uses it for mu, x_alpha, r_alpha; here the dimensional
+    nondimensional form of the equations uses M for mu, x_alpha, r_alpha; here the dimensional
     S and I are used directly).
     """
     positive("wing_mass", wing_mass)
