@@ -567,6 +567,91 @@ def conner_study(delta_half_deg: float | None = None, velocities=np.arange(3.0, 
                        flutter_zero=float(u0))
 
 
+def repeat_period(t: np.ndarray, y: np.ndarray, frequency_hz: float, window: float,
+                  max_period: int = 8, rel_tol: float = 0.02) -> int | None:
+    """The smallest p in 1..``max_period`` for which the end of a uniformly sampled history
+    repeats after p fundamental periods: max |y(t + p T) - y(t)| <= ``rel_tol`` max |y| over the
+    last ``window`` s before the final p T (T = 1 / ``frequency_hz``). p = 1 is a period-one
+    motion, 2 a period-doubled one; None: no repetition up to ``max_period`` (quasi-periodic,
+    chaotic or not settled)."""
+    if frequency_hz <= 0 or window <= 0:
+        raise ValueError(f"frequency_hz and window must be > 0, got {frequency_hz}, {window}")
+    period = 1.0 / frequency_hz
+    scale = float(np.max(np.abs(y[t >= t[-1] - window - max_period * period]))) or 1.0
+    for p in range(1, int(max_period) + 1):
+        t1 = t[-1] - p * period
+        sel = (t >= t1 - window) & (t <= t1)
+        if not np.any(sel):
+            raise ValueError("the history is shorter than window + max_period periods")
+        err = np.max(np.abs(np.interp(t[sel] + p * period, t, y) - y[sel]))
+        if err <= rel_tol * scale:
+            return p
+    return None
+
+
+@dataclass(frozen=True)
+class PathPoint:
+    """One airspeed of :func:`conner_path_following`: ``flap`` the steady oscillation of the
+    flap angle (rad; :func:`asekit.nonlinear.steady_oscillation`), r.m.s. of flap, pitch (rad)
+    and plunge (m) over the last ``tail`` s (Conner et al. 1997, Eq. 7), ``period`` from
+    :func:`repeat_period` (None when not periodic or not an LCO), ``maxima_per_cycle``: flap
+    maxima (prominence > 0.05 delta) per fundamental period over the last ``tail`` s (1 for a
+    simple oscillation, 2 for a flap motion with two maxima a cycle), ``restarted``: the run
+    started from the disturbance rather than from the previous speed's end state."""
+
+    velocity: float
+    flap: object
+    flap_rms: float
+    pitch_rms: float
+    plunge_rms: float
+    period: int | None
+    maxima_per_cycle: float
+    restarted: bool
+
+
+def conner_path_following(velocities, delta_half_deg: float | None = None,
+                          t_final: float = 20.0, tail: float = 5.0,
+                          plunge_kick: float = 1.0, step: float = 1e-3) -> tuple:
+    """Path following in airspeed on the Conner et al. section, as Conner et al. (1997,
+    Sec. 11.2) ran their model and experiment: at each airspeed of the increasing sequence
+    ``velocities`` (m/s) the exact piecewise integration (:func:`asekit.nonlinear.
+    simulate_exact`, ``t_final`` s) starts from the end state of the previous speed; at the
+    first speed, and after a run that decayed to rest, it starts from the disturbance "flap
+    resting on a band edge" (beta = delta, as in the experiment) plus a plunge displacement of
+    ``plunge_kick`` delta b (Tang et al. 1998: plunge is the degree of freedom that most easily
+    starts the LCO). Returns a tuple of :class:`PathPoint`."""
+    from scipy.signal import find_peaks
+
+    from ..nonlinear import steady_oscillation
+    from ..typical_section import CONNER_FREEPLAY_HALF_WIDTH_DEG, conner_1997, connected_system
+    v = np.asarray(velocities, float)
+    if v.size == 0 or np.any(np.diff(v) <= 0):
+        raise ValueError("velocities must be a non-empty increasing sequence")
+    sec = conner_1997()
+    dl = math.radians(CONNER_FREEPLAY_HALF_WIDTH_DEG if delta_half_deg is None
+                      else delta_half_deg)
+    conn = Connection(sec.stiffness_beta, freeplay=dl)
+    kick = np.zeros(8)
+    kick[0], kick[2] = plunge_kick * dl * sec.semichord, dl
+    x, out = None, []
+    for u in v:
+        restarted = x is None
+        sim = simulate_exact(connected_system(sec, u), conn, kick if restarted else x,
+                             t_final, step=step)
+        td = steady_oscillation(sim.t, sim.d, floor=1e-3 * dl, diverged=sim.diverged)
+        last = sim.t >= sim.t[-1] - tail
+        rms = np.sqrt(np.mean(sim.x[:3, last] ** 2, axis=1))
+        osc = td.kind in ("lco", "not settled") and td.frequency_hz > 0
+        per = repeat_period(sim.t, sim.d, td.frequency_hz, window=1.0) if osc else None
+        n_max = (len(find_peaks(sim.d[last], prominence=0.05 * dl)[0])
+                 / (tail * td.frequency_hz) if osc else 0.0)
+        out.append(PathPoint(velocity=float(u), flap=td, flap_rms=float(rms[2]),
+                             pitch_rms=float(rms[1]), plunge_rms=float(rms[0]), period=per,
+                             maxima_per_cycle=float(n_max), restarted=restarted))
+        x = None if td.kind in ("decayed", "diverged") else sim.x[:, -1].copy()
+    return tuple(out)
+
+
 def fig_conner(cs: ConnerStudy):
     """Flap LCO amplitude / delta (DF; time domain first harmonic and half peak-to-peak) and
     frequency vs airspeed for the Conner et al. section."""
