@@ -184,7 +184,11 @@ def test_conner_lco_structure(conner_hb):
     (6.80 m/s); (iii) above the linear flutter speed (24.0 m/s) the motion is unbounded and no
     stable LCO remains; (iv) the DF LCO onset (4.0 m/s) lies BELOW the zero-stiffness flutter
     speed: the issue's "no LCO below the flutter speed of the system with zero connection
-    stiffness" does not hold here (the time domain confirms it, next tests)."""
+    stiffness" does not hold here (the time domain confirms it, next tests). This is what
+    [T98] Sec. 4.2.1 and Sec. 5 state for the same section: between U_F,min and U_F0 "a finite
+    disturbance is required to excite the LCO", and the minimum velocity of an LCO "corresponds
+    to the minimum flutter velocity for the linear system ... with w_beta / w_alpha allowed to
+    assume the value that minimizes the flutter velocity"."""
     sec, conn, us, res = conner_hb
     u0 = brentq(lambda u: growth_rate(connected_system(sec, u), 0.0)[0], 2.0, 20.0)
     uf, _ = flutter_speed(sec, 1.0, 60.0, 120)
