@@ -506,12 +506,11 @@ def test_conner_flap_stiffness_flutter_against_tang_1998():
 
     Evidence on the difference: it is not the C(k) approximation nor the damping model. U_F0
     with the exact C(k) and with Jones' C(k), flap damping kept or removed, and with the
-    paper's modal damping, all lie within 6.4-7.1 m/s (>= 17 % below 8.6), and the published
-    LCO bifurcation speeds in m/s agree with asekit (onset 4.44 m/s vs 4.0-4.5; high-frequency
-    LCO at U / U_F0 ~ 1.5, i.e. ~12.9 m/s, vs 12.5 m/s, test above), so U_F0 = 8.6 m/s is not
-    consistent with them either under the same parameters: unresolved from the published
-    text (Peters' M = 4 model is not given in full; [T98] defers to Tang, Conner & Dowell,
-    J. Aircraft 35, 1998)."""
+    paper's modal damping, all lie within 6.4-7.1 m/s (>= 17 % below 8.6), while the published
+    LCO speeds in m/s agree with asekit's (onset 4.44 m/s vs the multi-harmonic fold in
+    (4.0, 4.5]; high-frequency LCO from U / U_F0 ~ 1.5, i.e. ~12.9 m/s, vs 12.5 m/s): left
+    open, as Peters' M = 4 model is not given in full in [T98] (it defers to Tang, Conner &
+    Dowell, J. Aircraft 35, 1998)."""
     sec = conner_1997()
     wa = math.sqrt(sec.stiffness_alpha / sec.inertia_alpha)
     kw = np.arange(0.06, 0.161, 0.01)
