@@ -535,3 +535,21 @@ def test_conner_flap_stiffness_flutter_against_tang_1998():
     assert u_zero[0] == pytest.approx(6.80, abs=0.02)
     assert all(6.4 < u < 7.1 for u in u_zero), u_zero
     assert max(u_zero) < 0.83 * 8.6
+
+
+def test_path_following_helpers():
+    """repeat_period finds the period of a period-doubled signal (a 5 Hz sine plus a 2.5 Hz
+    subharmonic repeats after 2 periods of 5 Hz, a pure sine after 1, an incommensurate sum
+    never within 8); bad input is refused."""
+    from asekit.reproduction.freeplay import conner_path_following, repeat_period
+    t = np.arange(0.0, 10.0, 1e-3)
+    assert repeat_period(t, np.sin(2 * math.pi * 5 * t), 5.0, 1.0) == 1
+    assert repeat_period(t, np.sin(2 * math.pi * 5 * t) + 0.3 * np.sin(math.pi * 5 * t),
+                         5.0, 1.0) == 2
+    assert repeat_period(t, np.sin(2 * math.pi * 5 * t) + 0.3 * np.sin(2 * math.pi * 5 * t
+                                                                        / math.sqrt(5)),
+                         5.0, 1.0) is None
+    with pytest.raises(ValueError, match="frequency_hz"):
+        repeat_period(t, t, 0.0, 1.0)
+    with pytest.raises(ValueError, match="velocities"):
+        conner_path_following([5.0, 4.0])
