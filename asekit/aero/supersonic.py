@@ -57,6 +57,14 @@ The result is a
 pressure-per-normalwash matrix DeltaCp = A (w/U) with DeltaCp lumped at the load points, the
 same kind of matrix as the DLM's AIC, so :mod:`asekit.aero.gaf` uses either.
 
+Two evaluations of the same sums. Columns (a few modes, :func:`supersonic_pressures`): each
+normalwash field is convolved with the offset tables by 2-D FFT. The full matrix
+(:func:`supersonic_pressure_matrices`): the influence coefficients depend only on the cell
+offset (di, |dj|) and k, so one nx x ny table per k is evaluated and gathered into sparse
+influence matrices holding only the cell pairs inside each other's Mach cone (10-30 % of them);
+their index pattern is built once per grid and reused for every k, and the strip-local
+transfers are sparse too. The two agree to rounding (tests/test_supersonic.py, 1e-12).
+
 Limits. Planar meshes in z = 0 only; trailing edges must be supersonic (|tan Lambda_TE| < beta),
 else ValueError. Leading and side edges may be subsonic or supersonic; at subsonic leading edges
 the staircase of cells and the square-root pressure singularity cost accuracy (delta wings with
@@ -79,6 +87,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft as sfft
 import scipy.linalg as sla
+import scipy.sparse as sp
 
 from .boxes import BoxMesh, MeshRuleWarning
 from .piston import _check_k, check_supersonic_mach, piston_transfer, strip_interpolation
@@ -215,6 +224,37 @@ def _locate(corners: np.ndarray, pts: np.ndarray) -> np.ndarray:
     return out
 
 
+def _locate_grid(corners: np.ndarray, x0: float, y0: float, dx: float, dy: float, nx: int,
+                 ny: int) -> np.ndarray:
+    """:func:`_locate` for the centres of an nx x ny cell grid (origin x0, y0, cells dx x dy),
+    raveled row-major (index i ny + j): only the cells in each box's bounding rectangle (plus
+    one cell around it) are tested, with the same containment test, and a centre in two boxes
+    goes to the lower box index, as in :func:`_locate`."""
+    y1, y2 = corners[:, 0, 1], corners[:, 3, 1]
+    ylo, yhi = np.minimum(y1, y2), np.maximum(y1, y2)
+    xs = corners[:, :, 0]
+    j0 = np.clip(np.floor((ylo - y0) / dy - 0.5).astype(int) - 1, 0, ny)
+    j1 = np.clip(np.ceil((yhi - y0) / dy - 0.5).astype(int) + 1, 0, ny)
+    i0 = np.clip(np.floor((xs.min(axis=1) - x0) / dx - 0.5).astype(int) - 1, 0, nx)
+    i1 = np.clip(np.ceil((xs.max(axis=1) - x0) / dx - 0.5).astype(int) + 1, 0, nx)
+    ni, nj = i1 - i0, j1 - j0
+    count = ni * nj
+    box = np.repeat(np.arange(corners.shape[0]), count)
+    local = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+    ii = i0[box] + local // nj[box]
+    jj = j0[box] + local % nj[box]
+    px, py = x0 + (ii + 0.5) * dx, y0 + (jj + 0.5) * dy
+    c = corners[box]
+    f = (py - c[:, 0, 1]) / (c[:, 3, 1] - c[:, 0, 1])
+    xle = c[:, 0, 0] + f * (c[:, 3, 0] - c[:, 0, 0])
+    xte = c[:, 1, 0] + f * (c[:, 2, 0] - c[:, 1, 0])
+    inside = (py >= ylo[box]) & (py < yhi[box]) & (px >= xle) & (px < xte)
+    out = np.full(nx * ny, corners.shape[0])
+    np.minimum.at(out, (ii * ny + jj)[inside], box[inside])
+    out[out == corners.shape[0]] = -1
+    return out
+
+
 def _check_trailing_edges(mesh: BoxMesh, beta: float, mach: float) -> None:
     for s in np.unique(mesh.strip):
         members = np.flatnonzero(mesh.strip == s)
@@ -293,8 +333,7 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
                          "cells_per_box / cells_per_wavelength or lower k")
     ii, jj = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     ii, jj = ii.ravel(), jj.ravel()
-    cen = np.column_stack([x_min + (ii + 0.5) * dx, y0 + (jj + 0.5) * dy])
-    box = _locate(all_c, cen)
+    box = _locate_grid(all_c, x_min, y0, dx, dy, nx, ny)
     wing = box >= 0
     if not wing.any():
         raise ValueError("no grid cell centre lies on the mesh: the mesh is degenerate")
@@ -337,13 +376,19 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
 # ---------------------------------------------------------------------------------------------
 # solution on the grid
 # ---------------------------------------------------------------------------------------------
+def _cone_mask(grid: MachGrid) -> np.ndarray:
+    """(nx, ny) bool over offsets (di, dj >= 0): the Mach cone of a receiving cell centre
+    reaches the cell, beta (dj - 1/2) dy < (di + 1/2) dx; the influence tables are zero
+    elsewhere (both, since the cone grows with di)."""
+    di, dj = np.meshgrid(np.arange(grid.nx), np.arange(grid.ny), indexing="ij")
+    return grid.beta * (dj - 0.5) * grid.dy < (di + 0.5) * grid.dx * (1.0 + 1e-9)
+
+
 def _offset_tables(grid: MachGrid, lam: float, kap: float):
     """Influence tables over offsets (di >= 0, dj >= 0): potential I[di, dj] at a cell centre
     and edge integrals F[m, dj] at X = (m + 1/2) dx; evaluated only where the Mach cone of the
     receiving point reaches the cell (beta (dj - 1/2) dy < (di + 1/2) dx), zero elsewhere."""
-    di, dj = np.meshgrid(np.arange(grid.nx), np.arange(grid.ny), indexing="ij")
-    inside = grid.beta * (dj - 0.5) * grid.dy < (di + 0.5) * grid.dx * (1.0 + 1e-9)
-    di, dj = di[inside], dj[inside]
+    di, dj = np.nonzero(_cone_mask(grid))
     xb = (di + 0.5) * grid.dx
     t1 = (dj - 0.5) * grid.dy
     t2 = (dj + 0.5) * grid.dy
@@ -421,6 +466,120 @@ def _grid_solve(grid: MachGrid, mach: float, k: float, b_ref: float,
     return conv.apply(spec, 1)[:, grid.wing_i, grid.wing_j]
 
 
+def _signed_table(table: np.ndarray) -> np.ndarray:
+    """An (nx, ny) offset table K[di >= 0, dj >= 0] spread to signed offsets and raveled:
+    T[(di + nx) 2 ny + (dj + ny)] = K[di, |dj|] for di >= 0 and 0 for di < 0 (upstream cells
+    feel nothing), so that the influence of cell (i', j') on cell (i, j) is
+    T[(i 2 ny + j) - (i' 2 ny + j') + nx 2 ny + ny] (see :class:`_GridGather`)."""
+    nx, ny = table.shape
+    t = np.zeros((2 * nx, 2 * ny), table.dtype)
+    t[nx:, ny:] = table
+    t[nx:, 1:ny] = table[:, :0:-1]
+    return t.ravel()
+
+
+@dataclass(frozen=True)
+class _Pattern:
+    """Sparsity pattern of one influence matrix (receiving cells x source cells) in CSR form:
+    ``indptr``, ``indices`` and, per stored entry, ``table`` its index into a signed table
+    (:func:`_signed_table`); ``shape``."""
+
+    indptr: np.ndarray
+    indices: np.ndarray
+    table: np.ndarray
+    shape: tuple
+
+    def matrix(self, signed: np.ndarray) -> sp.csr_matrix:
+        return sp.csr_matrix((signed[self.table], self.indices, self.indptr), shape=self.shape)
+
+
+def _pattern(rkey: np.ndarray, ckey: np.ndarray, n2: int, off: int,
+             reach: np.ndarray) -> _Pattern:
+    """The pairs (receiving cell, source cell) inside the Mach cone: for every receiving cell
+    (key i n2 + j) and every row offset di >= 0, the source cells of row i - di with
+    |j' - j| <= reach[di] (:func:`_cone_mask`), one contiguous run of the sorted source keys
+    ``ckey`` (found by bisection). Entries of a row of the pattern come in ascending source
+    order."""
+    nr, nx = rkey.size, reach.size
+    ip = rkey[:, None] // n2 - np.arange(nx, dtype=rkey.dtype)[::-1][None, :]   # ascending
+    base = ip * n2 + (rkey % n2)[:, None]
+    rr = reach[::-1][None, :]
+    lo = np.searchsorted(ckey, base - rr, "left")
+    cnt = np.where(ip >= 0, np.searchsorted(ckey, base + rr, "right") - lo, 0).ravel()
+    per_row = cnt.reshape(nr, nx).sum(axis=1)
+    indptr = np.zeros(nr + 1, np.int64)
+    np.cumsum(per_row, out=indptr[1:])
+    total = int(indptr[-1])
+    ends = np.cumsum(cnt)
+    cols = np.repeat((lo.ravel() - ends + cnt).astype(rkey.dtype), cnt)
+    cols += np.arange(total, dtype=rkey.dtype)
+    table = np.repeat(rkey + off, per_row)
+    table -= ckey[cols]
+    return _Pattern(indptr, cols, table, (nr, ckey.size))
+
+
+@dataclass(frozen=True)
+class _GridGather:
+    """Index sets of the direct-summation grid operator, built once per (mesh, Mach) grid and
+    reused for every k. The influence of one cell on another depends only on their offset
+    (di, |dj|) and on k (module docstring), so every influence matrix is a gather from the
+    nx x ny coefficient tables of :func:`_kernels` (a Toeplitz reuse: nx ny coefficients per k
+    instead of one per pair of cells). With the cell key c = i 2 ny + j, the table index of the
+    influence of cell b on cell a is c_a - c_b + off (:func:`_signed_table`), and only the pairs
+    inside each other's Mach cone (:func:`_cone_mask`: 10-30 % of them on the fin) are kept, as
+    sparse matrices.
+
+    ``ww`` wing <- wing, ``dw`` diaphragm <- wing, ``wd`` wing <- diaphragm (:class:`_Pattern`),
+    ``dd`` (n_d, n_d) dense table indices diaphragm <- diaphragm, the diaphragm cells sorted by
+    row, then column; ``triangular`` when cells of one row lie outside each other's Mach cones
+    (dx <= beta dy), which makes dd lower triangular."""
+
+    ww: _Pattern
+    dw: _Pattern
+    wd: _Pattern
+    dd: np.ndarray
+    triangular: bool
+
+
+def _grid_gather(grid: MachGrid) -> _GridGather:
+    n2 = 2 * grid.ny
+    off = grid.nx * n2 + grid.ny
+    reach = _cone_mask(grid).sum(axis=1) - 1          # largest |dj| in the cone, per di
+    it = np.int32 if 2 * grid.nx * n2 < 2**31 else np.int64
+    cw = (grid.wing_i * n2 + grid.wing_j).astype(it)
+    if np.any(np.diff(cw) <= 0):
+        raise AssertionError("wing cells must be sorted by row, then column")
+    order = np.lexsort((grid.dia_j, grid.dia_i))
+    cd = (grid.dia_i[order] * n2 + grid.dia_j[order]).astype(it)
+    reach = reach.astype(it)
+    return _GridGather(_pattern(cw, cw, n2, off, reach), _pattern(cd, cw, n2, off, reach),
+                       _pattern(cw, cd, n2, off, reach), cd[:, None] - cd[None, :] + off,
+                       grid.dx <= grid.beta * grid.dy * (1 + 1e-12))
+
+
+def _grid_matrix(grid: MachGrid, gather: _GridGather, mach: float, k: float, b_ref: float,
+                 s: sp.csr_matrix, tw: sp.csr_matrix) -> np.ndarray:
+    """The pressure-per-normalwash matrix A (n, n) = T_w DeltaCp_grid S by direct summation
+    over the gathered kernel tables K (:class:`_GridGather`): with the diaphragm normalwash
+    w_d = -(K^phi_dd)^-1 K^phi_dw S (phi = 0 on the diaphragm; forward substitution),
+    A = T_w K^p_ww S + (T_w K^p_wd) w_d. ``s`` is S (n_w, n) and ``tw`` T_w (n, n_w), both
+    sparse (two entries per row of S, strip-local T_w). The same sums as :func:`_grid_solve`
+    applied to the columns of S, without the FFT (equal to rounding)."""
+    kphi, kp = _kernels(grid, mach, k, b_ref)
+    tp = _signed_table(kp)
+    out = (tw @ (gather.ww.matrix(tp) @ s)).toarray()
+    if gather.dd.size:
+        tphi = _signed_table(kphi)
+        rhs = -(gather.dw.matrix(tphi) @ s).toarray()          # (n_d, n): -K^phi_dw S
+        mat = tphi[gather.dd]
+        if gather.triangular:
+            wd = sla.solve_triangular(mat, rhs, lower=True, check_finite=False)
+        else:
+            wd = sla.lu_solve(sla.lu_factor(mat, check_finite=False), rhs, check_finite=False)
+        out += (tw @ gather.wd.matrix(tp)).toarray() @ wd
+    return out
+
+
 def grid_pressure_operator(grid: MachGrid, mach: float, k: float, b_ref: float) -> np.ndarray:
     """A_grid (n_w, n_w) complex: DeltaCp at the wing-cell centres per unit w/U on each wing
     cell, the diaphragm eliminated (for tests and small grids: one solve per wing cell)."""
@@ -445,10 +604,9 @@ def _transfer(mesh: BoxMesh, grid: MachGrid):
         cb = mesh.corners[b, :, :2].mean(axis=0)
         near = real_idx[np.argmin(np.sum((cen[real_idx] - cb) ** 2, axis=1))]
         weight[near] += mesh.area[b]
-    agg = np.zeros((mesh.n, grid.wing_i.size))
-    agg[owner, np.arange(owner.size)] = weight
     _, t = piston_transfer(mesh)                      # load points -> box centroids (n, n)
-    return s, (t.T @ agg) / mesh.area[:, None]
+    # T^T @ Agg with Agg (n, n_w) holding each cell's weight in its owner's row
+    return s, (t.T[:, owner] * weight[None, :]) / mesh.area[:, None]
 
 
 def _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box, cells_per_wavelength, max_cells,
@@ -499,9 +657,16 @@ def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
     bpw_min : boxes of the mesh per kernel wavelength below which a MeshRuleWarning is given.
     warn : give that warning.
     """
-    eye = np.eye(mesh.n)
-    return supersonic_pressures(mesh, mach, k, b_ref, lambda _k: eye, symmetric, cells_per_box,
-                                cells_per_wavelength, max_cells, bpw_min, warn)
+    m, ks, b, grid, s, tw = _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box,
+                                     cells_per_wavelength, max_cells, bpw_min, warn)
+    gather = _grid_gather(grid)                   # one index set for every k
+    s_sp, tw_sp = sp.csr_matrix(s), sp.csr_matrix(tw)
+    out = np.empty((ks.size, mesh.n, mesh.n), complex)
+    for ik, kk in enumerate(ks):
+        out[ik] = _grid_matrix(grid, gather, m, float(kk), b, s_sp, tw_sp)
+    if not np.all(np.isfinite(out)):
+        raise FloatingPointError("supersonic pressures are not finite")
+    return out
 
 
 def supersonic_pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash,
