@@ -27,6 +27,9 @@ plane inside the forward Mach cone of (x, y). The pressure jump follows from the
 potential, DeltaCp = Cp_lower - Cp_upper = (4 / U^2) (i omega phi + U phi_x): Delta Cp > 0 pushes
 along +z, the DLM convention. Off the wing the plane carries no load, so phi = 0 there (the
 diaphragm of [PDN55]); behind a supersonic trailing edge the wake cannot reach the wing.
+Behind a subsonic trailing edge (|tan Lambda_TE| >= beta) it can: the wake carries a potential
+jump but no load, so there DeltaCp = 0 (the linearised wake condition, with phi = 0 off the
+wing and the wake the boundary conditions of [PDN55] for wings with subsonic edges).
 
 Discretisation (asekit's). The plane is cut into a uniform grid of rectangular cells, Mach boxes
 with dx = beta dy as in [ZH55] (the diaphragm march is unstable on finer grids otherwise);
@@ -43,7 +46,9 @@ F(X) to (theta_2 - theta_1) / beta, and in 2-D (far from edges) DeltaCp = -4 (w/
 Ackeret's 4 alpha / beta. The influences depend on the cell offset only. Cells whose centre lies
 in a box are wing cells; off-wing cells ahead of the trailing edge within the Mach cones of the
 wing (beyond side edges, ahead of subsonic leading edges) are diaphragm cells whose w follows
-from phi = 0 at their centres; the pressure is evaluated at the wing-cell centres.
+from phi = 0 at their centres, and off-wing cells behind a subsonic trailing edge are wake
+cells whose w follows from DeltaCp = 0 at their centres (all solved together, row by row);
+the pressure is evaluated at the wing-cell centres.
 
 Transfer to the box mesh. The input is the normalwash w/U at the DLM control points (3/4 chord
 of each box, w/U = dh/dx + i k h / b); it is interpolated linearly in x along each chordwise
@@ -65,8 +70,9 @@ influence matrices holding only the cell pairs inside each other's Mach cone (10
 their index pattern is built once per grid and reused for every k, and the strip-local
 transfers are sparse too. The two agree to rounding (tests/test_supersonic.py, 1e-12).
 
-Limits. Planar meshes in z = 0 only; trailing edges must be supersonic (|tan Lambda_TE| < beta),
-else ValueError. Leading and side edges may be subsonic or supersonic; at subsonic leading edges
+Limits. Planar meshes in z = 0 only. Leading, side and trailing edges may be subsonic or
+supersonic (a subsonic trailing edge checked by the flow-reversal theorem, 1-3 %,
+tests/test_supersonic.py); at subsonic leading edges
 the staircase of cells and the square-root pressure singularity cost accuracy (delta wings with
 beta cot Lambda = 0.33-0.56: lift slope 4-7 % above Stewart's conical-flow value, against
 0.1-0.3 % with supersonic leading edges; tests/test_supersonic.py). The reference fin's leading
@@ -174,7 +180,9 @@ class MachGrid:
     ``x0, y0`` grid origin (m), ``dx, dy`` cell size (m), ``nx, ny`` cells per direction;
     ``wing_i, wing_j`` (n_w,) indices of the wing cells and ``wing_box`` the box (index into the
     mesh) each lies in, ``image`` (n_w,) True for cells of the mirror image (symmetric case);
-    ``dia_i, dia_j`` (n_d,) the diaphragm cells.
+    ``dia_i, dia_j`` (n_d,) the off-wing cells solved for (diaphragm and wake) and
+    ``dia_wake`` (n_d,) True for the wake cells among them (behind a subsonic trailing edge:
+    DeltaCp = 0 there instead of phi = 0; None: no wake cells).
     """
 
     x0: float
@@ -190,6 +198,11 @@ class MachGrid:
     image: np.ndarray
     dia_i: np.ndarray
     dia_j: np.ndarray
+    dia_wake: np.ndarray | None = None
+
+    def wake_mask(self) -> np.ndarray:
+        """(n_d,) bool: which solved off-wing cells are wake cells."""
+        return np.zeros(self.dia_i.size, bool) if self.dia_wake is None else self.dia_wake
 
     @property
     def n_cells(self) -> int:
@@ -255,16 +268,22 @@ def _locate_grid(corners: np.ndarray, x0: float, y0: float, dx: float, dy: float
     return out
 
 
-def _check_trailing_edges(mesh: BoxMesh, beta: float, mach: float) -> None:
+def trailing_edge_tangents(mesh: BoxMesh) -> np.ndarray:
+    """|tan Lambda_TE| (n_strips,) of the trailing edge of every chordwise strip."""
+    out = []
     for s in np.unique(mesh.strip):
         members = np.flatnonzero(mesh.strip == s)
         last = members[np.argmax(mesh.corners[members, 1, 0])]
         c = mesh.corners[last]
-        tan_te = (c[2, 0] - c[1, 0]) / (c[2, 1] - c[1, 1])
-        if abs(tan_te) >= beta:
-            raise ValueError(f"mach={mach:g}: the trailing edge of strip {s} is subsonic "
-                             f"(|tan sweep| {abs(tan_te):.3g} >= sqrt(M^2 - 1) = {beta:.3g}); the "
-                             "supersonic method needs supersonic trailing edges")
+        out.append(abs((c[2, 0] - c[1, 0]) / (c[2, 1] - c[1, 1])))
+    return np.array(out)
+
+
+def has_subsonic_trailing_edge(mesh: BoxMesh, mach: float) -> bool:
+    """True when some trailing edge is subsonic, |tan Lambda_TE| >= sqrt(M^2 - 1): its wake
+    then lies inside the forward Mach cones of wing points (module docstring)."""
+    m = check_supersonic_mach(mach)
+    return bool(np.any(trailing_edge_tangents(mesh) >= math.sqrt(m * m - 1.0)))
 
 
 def kernel_wavelength(mach: float, k: float, b_ref: float) -> float:
@@ -288,7 +307,7 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     m = check_supersonic_mach(mach)
     beta = math.sqrt(m * m - 1.0)
     _check_planar(mesh)
-    _check_trailing_edges(mesh, beta, m)
+    subsonic_te = has_subsonic_trailing_edge(mesh, m)
     cells_per_box = float(cells_per_box)
     if not (math.isfinite(cells_per_box) and cells_per_box >= 1.0):
         raise ValueError(f"cells_per_box must be >= 1, got {cells_per_box!r}")
@@ -343,7 +362,9 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     last_wing_row = np.full(ny, -1)
     np.maximum.at(last_wing_row, jj[wing], ii[wing])
     wake = (~wing) & (ii > last_wing_row[jj]) & (last_wing_row[jj] >= 0)
-    cand = np.flatnonzero((~wing) & (~wake))
+    # behind supersonic trailing edges the wake cannot reach the wing: leave it out; behind a
+    # subsonic one it can, and its cells are solved with DeltaCp = 0
+    cand = np.flatnonzero((~wing) & (~wake)) if not subsonic_te else np.flatnonzero(~wing)
     wi, wj = ii[wing], jj[wing]
     # keep the off-wing cells inside the downstream Mach cone of some wing cell and ahead of
     # another's: per column, the most upstream / downstream wing cell decides (the cone test
@@ -370,7 +391,7 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
                          f"{100 * area[empty].sum() / area.sum():.2g} % of the area): raise "
                          "cells_per_box")
     return MachGrid(x_min, y0, dx, dy, nx, ny, beta, wi, wj, owner[box[wing]], is_img[box[wing]],
-                    ii[dia], jj[dia])
+                    ii[dia], jj[dia], wake[dia] if subsonic_te else None)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -448,14 +469,17 @@ def _grid_solve(grid: MachGrid, mach: float, k: float, b_ref: float,
     field[:, grid.wing_i, grid.wing_j] = w_wing
     spec = conv.spectrum(field)
     if grid.dia_i.size:
-        phi_w = conv.apply(spec, 0)[:, grid.dia_i, grid.dia_j]              # (m, n_d)
         order = np.lexsort((grid.dia_j, grid.dia_i))
         di, dj = grid.dia_i[order], grid.dia_j[order]
+        wake = grid.wake_mask()[order]
+        rhs = -conv.apply(spec, 0)[:, di, dj].T                             # (n_d, m)
+        if wake.any():
+            rhs[wake] = -conv.apply(spec, 1)[:, di[wake], dj[wake]].T
         d_i = di[:, None] - di[None, :]
         d_j = np.abs(dj[:, None] - dj[None, :])
         ok = d_i >= 0
-        mat = np.where(ok, kphi[np.where(ok, d_i, 0), d_j], 0.0)
-        rhs = -phi_w[:, order].T
+        safe = np.where(ok, d_i, 0)
+        mat = np.where(ok, np.where(wake[:, None], kp[safe, d_j], kphi[safe, d_j]), 0.0)
         if grid.dx <= grid.beta * grid.dy * (1 + 1e-12):
             wd = sla.solve_triangular(mat, rhs, lower=True, check_finite=False)
         else:
@@ -489,8 +513,15 @@ class _Pattern:
     table: np.ndarray
     shape: tuple
 
-    def matrix(self, signed: np.ndarray) -> sp.csr_matrix:
-        return sp.csr_matrix((signed[self.table], self.indices, self.indptr), shape=self.shape)
+    def matrix(self, signed: np.ndarray, rows_alt: np.ndarray | None = None,
+               alt: np.ndarray | None = None) -> sp.csr_matrix:
+        """The matrix with values from ``signed``, and from ``alt`` in the rows ``rows_alt``
+        (bool per row) when given."""
+        data = signed[self.table]
+        if rows_alt is not None and rows_alt.any():
+            entry = np.repeat(rows_alt, np.diff(self.indptr))
+            data[entry] = alt[self.table[entry]]
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape)
 
 
 def _pattern(rkey: np.ndarray, ckey: np.ndarray, n2: int, off: int,
@@ -539,6 +570,7 @@ class _GridGather:
     wd: _Pattern
     dd: np.ndarray
     triangular: bool
+    wake: np.ndarray
 
 
 def _grid_gather(grid: MachGrid) -> _GridGather:
@@ -554,7 +586,7 @@ def _grid_gather(grid: MachGrid) -> _GridGather:
     reach = reach.astype(it)
     return _GridGather(_pattern(cw, cw, n2, off, reach), _pattern(cd, cw, n2, off, reach),
                        _pattern(cw, cd, n2, off, reach), cd[:, None] - cd[None, :] + off,
-                       grid.dx <= grid.beta * grid.dy * (1 + 1e-12))
+                       grid.dx <= grid.beta * grid.dy * (1 + 1e-12), grid.wake_mask()[order])
 
 
 def _grid_matrix(grid: MachGrid, gather: _GridGather, mach: float, k: float, b_ref: float,
@@ -570,8 +602,11 @@ def _grid_matrix(grid: MachGrid, gather: _GridGather, mach: float, k: float, b_r
     out = (tw @ (gather.ww.matrix(tp) @ s)).toarray()
     if gather.dd.size:
         tphi = _signed_table(kphi)
-        rhs = -(gather.dw.matrix(tphi) @ s).toarray()          # (n_d, n): -K^phi_dw S
+        wake = gather.wake                  # rows with DeltaCp = 0 (wake) instead of phi = 0
+        rhs = -(gather.dw.matrix(tphi, wake, tp) @ s).toarray()   # (n_d, n): -K^phi_dw S
         mat = tphi[gather.dd]
+        if wake.any():
+            mat[wake] = tp[gather.dd[wake]]
         if gather.triangular:
             wd = sla.solve_triangular(mat, rhs, lower=True, check_finite=False)
         else:
