@@ -459,8 +459,9 @@ def _kernels(grid: MachGrid, mach: float, k: float, b_ref: float):
 def _grid_solve(grid: MachGrid, mach: float, k: float, b_ref: float,
                 w_wing: np.ndarray) -> np.ndarray:
     """DeltaCp at the wing-cell centres (m, n_w) for wing-cell normalwash w/U (m, n_w): the
-    diaphragm w from phi = 0 at its centres (forward substitution row by row when the grid
-    keeps same-row cells apart, dx <= beta dy; LU otherwise), then the pressure by FFT."""
+    off-wing w from phi = 0 at the diaphragm and DeltaCp = 0 at the wake cell centres
+    (:func:`_offwing_solve`), the influences of the wing cells on them and the pressure by
+    FFT convolution."""
     kphi, kp = _kernels(grid, mach, k, b_ref)
     nx, ny = grid.nx, grid.ny
     m = w_wing.shape[0]
@@ -475,15 +476,7 @@ def _grid_solve(grid: MachGrid, mach: float, k: float, b_ref: float,
         rhs = -conv.apply(spec, 0)[:, di, dj].T                             # (n_d, m)
         if wake.any():
             rhs[wake] = -conv.apply(spec, 1)[:, di[wake], dj[wake]].T
-        d_i = di[:, None] - di[None, :]
-        d_j = np.abs(dj[:, None] - dj[None, :])
-        ok = d_i >= 0
-        safe = np.where(ok, d_i, 0)
-        mat = np.where(ok, np.where(wake[:, None], kp[safe, d_j], kphi[safe, d_j]), 0.0)
-        if grid.dx <= grid.beta * grid.dy * (1 + 1e-12):
-            wd = sla.solve_triangular(mat, rhs, lower=True, check_finite=False)
-        else:
-            wd = sla.lu_solve(sla.lu_factor(mat, check_finite=False), rhs, check_finite=False)
+        wd = _offwing_solve(_offwing(grid), _signed_table(kphi), _signed_table(kp), rhs)
         dfield = np.zeros((m, nx, ny), complex)
         dfield[:, di, dj] = wd.T
         spec = spec + conv.spectrum(dfield)
@@ -561,16 +554,13 @@ class _GridGather:
     sparse matrices.
 
     ``ww`` wing <- wing, ``dw`` diaphragm <- wing, ``wd`` wing <- diaphragm (:class:`_Pattern`),
-    ``dd`` (n_d, n_d) dense table indices diaphragm <- diaphragm, the diaphragm cells sorted by
-    row, then column; ``triangular`` when cells of one row lie outside each other's Mach cones
-    (dx <= beta dy), which makes dd lower triangular."""
+    ``off`` the off-wing cells among themselves (:class:`_OffWing`), sorted by row, then
+    column."""
 
     ww: _Pattern
     dw: _Pattern
     wd: _Pattern
-    dd: np.ndarray
-    triangular: bool
-    wake: np.ndarray
+    off: "_OffWing"
 
 
 def _grid_gather(grid: MachGrid) -> _GridGather:
@@ -581,12 +571,59 @@ def _grid_gather(grid: MachGrid) -> _GridGather:
     cw = (grid.wing_i * n2 + grid.wing_j).astype(it)
     if np.any(np.diff(cw) <= 0):
         raise AssertionError("wing cells must be sorted by row, then column")
-    order = np.lexsort((grid.dia_j, grid.dia_i))
-    cd = (grid.dia_i[order] * n2 + grid.dia_j[order]).astype(it)
+    ow = _offwing(grid)
     reach = reach.astype(it)
-    return _GridGather(_pattern(cw, cw, n2, off, reach), _pattern(cd, cw, n2, off, reach),
-                       _pattern(cw, cd, n2, off, reach), cd[:, None] - cd[None, :] + off,
-                       grid.dx <= grid.beta * grid.dy * (1 + 1e-12), grid.wake_mask()[order])
+    return _GridGather(_pattern(cw, cw, n2, off, reach), _pattern(ow.key, cw, n2, off, reach),
+                       _pattern(cw, ow.key, n2, off, reach), ow)
+
+
+@dataclass(frozen=True)
+class _OffWing:
+    """The solved off-wing cells (diaphragm and wake) sorted by row, then column: ``order``
+    into ``grid.dia_*``, cell keys ``key`` (:class:`_GridGather`), ``wake`` (n_d,) their
+    kind, ``dd`` the pattern of their influences on one another, ``blocks`` the index ranges
+    of each grid row; ``triangular`` when the cells of one row lie outside each other's Mach
+    cones (dx <= beta dy), so that a row depends on earlier rows and itself only."""
+
+    order: np.ndarray
+    key: np.ndarray
+    wake: np.ndarray
+    dd: _Pattern
+    blocks: tuple
+    triangular: bool
+
+
+def _offwing(grid: MachGrid) -> _OffWing:
+    n2 = 2 * grid.ny
+    it = np.int32 if 2 * grid.nx * n2 < 2**31 else np.int64
+    reach = (_cone_mask(grid).sum(axis=1) - 1).astype(it)
+    order = np.lexsort((grid.dia_j, grid.dia_i))
+    key = (grid.dia_i[order] * n2 + grid.dia_j[order]).astype(it)
+    rows = grid.dia_i[order]
+    cut = np.flatnonzero(np.diff(rows)) + 1
+    edges = np.concatenate([[0], cut, [rows.size]]).astype(int)
+    return _OffWing(order, key, grid.wake_mask()[order],
+                    _pattern(key, key, n2, grid.nx * n2 + grid.ny, reach),
+                    tuple(zip(edges[:-1], edges[1:])),
+                    grid.dx <= grid.beta * grid.dy * (1 + 1e-12))
+
+
+def _offwing_solve(ow: _OffWing, tphi: np.ndarray, tp: np.ndarray,
+                   rhs: np.ndarray) -> np.ndarray:
+    """w/U of the off-wing cells (n_d, m) from L w = rhs, L their influences on one another
+    (phi rows for the diaphragm, DeltaCp rows for the wake, from the signed tables ``tphi``,
+    ``tp``), sparse over the Mach cones: forward substitution grid row by grid row,
+    w_R = (rhs_R - L_R w) / diag(L)_R while w_R is still zero, when ``ow.triangular``; a dense
+    LU otherwise."""
+    lmat = ow.dd.matrix(tphi, ow.wake, tp)
+    if not ow.triangular:
+        dense = lmat.toarray()
+        return sla.lu_solve(sla.lu_factor(dense, check_finite=False), rhs, check_finite=False)
+    diag = lmat.diagonal()
+    x = np.zeros(rhs.shape, complex)
+    for a, b in ow.blocks:
+        x[a:b] = (rhs[a:b] - lmat[a:b] @ x) / diag[a:b, None]
+    return x
 
 
 def _grid_matrix(grid: MachGrid, gather: _GridGather, mach: float, k: float, b_ref: float,
@@ -600,17 +637,12 @@ def _grid_matrix(grid: MachGrid, gather: _GridGather, mach: float, k: float, b_r
     kphi, kp = _kernels(grid, mach, k, b_ref)
     tp = _signed_table(kp)
     out = (tw @ (gather.ww.matrix(tp) @ s)).toarray()
-    if gather.dd.size:
+    ow = gather.off
+    if ow.key.size:
         tphi = _signed_table(kphi)
-        wake = gather.wake                  # rows with DeltaCp = 0 (wake) instead of phi = 0
-        rhs = -(gather.dw.matrix(tphi, wake, tp) @ s).toarray()   # (n_d, n): -K^phi_dw S
-        mat = tphi[gather.dd]
-        if wake.any():
-            mat[wake] = tp[gather.dd[wake]]
-        if gather.triangular:
-            wd = sla.solve_triangular(mat, rhs, lower=True, check_finite=False)
-        else:
-            wd = sla.lu_solve(sla.lu_factor(mat, check_finite=False), rhs, check_finite=False)
+        # (n_d, n): -K^phi_dw S on the diaphragm, -K^p_dw S on the wake
+        rhs = -(gather.dw.matrix(tphi, ow.wake, tp) @ s).toarray()
+        wd = _offwing_solve(ow, tphi, tp, rhs)
         out += (tw @ gather.wd.matrix(tp)).toarray() @ wd
     return out
 
