@@ -292,6 +292,7 @@ def test_grid_converges_on_the_fin():
 # ---- bad input --------------------------------------------------------------------------------
 @pytest.mark.parametrize("kwargs, match", [
     ({"mach": 1.0}, "mach"), ({"mach": 0.7}, "mach"), ({"mach": float("inf")}, "mach"),
+    ({"mach": float("nan")}, "mach"), ({"k": [0.1, -0.1]}, "k must"),
     ({"k": -0.5}, "k must"), ({"k": float("nan")}, "k must"), ({"b_ref": -1.0}, "b_ref"),
 ])
 def test_bad_arguments(kwargs, match):
@@ -332,6 +333,25 @@ def test_bad_meshes():
                                    max_cells=500)
 
 
+def test_grid_too_coarse_for_small_boxes():
+    """Strips of unequal width, some much narrower than a Mach box (dy = dx / beta): after
+    refining the grid 1.5x three times the narrow boxes still hold no cell centre, and the
+    error names cells_per_box (no silent loss of their area)."""
+    from asekit.aero.supersonic import GridTooCoarseError
+    mesh = mesh_surfaces([TrapezoidSurface((0, 0), 1.0, (0, 1.0), 1.0, 4, 2),
+                          TrapezoidSurface((0, 1.0), 1.0, (0, 1.08), 1.0, 4, 8)])
+    with pytest.raises(GridTooCoarseError, match="cells_per_box"):
+        supersonic_pressure_matrix(mesh, 2.0, 0.0, 0.5)
+
+
+def test_bad_normalwash():
+    mesh = _rect(1.0, 1.0, 4, 4)
+    with pytest.raises(ValueError, match="normalwash"):
+        supersonic_pressures(mesh, 2.0, [0.1], 0.5, np.ones((1, mesh.n + 1, 1)))
+    with pytest.raises(ValueError, match="normalwash"):
+        supersonic_pressures(mesh, 2.0, [0.1], 0.5, np.full((1, mesh.n, 1), np.nan))
+
+
 def test_coarse_mesh_warning():
     """Boxes per kernel wavelength 2 pi b (M-1)/(k M): warn naming Mach and k."""
     mesh = _rect(1.0, 1.0, 4, 4)
@@ -360,8 +380,12 @@ def test_dispatcher_and_transonic_gap():
         resolve_method("piston", 1.0)
     with pytest.raises(ValueError, match="method must be one of"):
         resolve_method("zona51", 2.0)
-    with pytest.warns(TransonicWarning, match="mach=1.1"):
+    with pytest.warns(TransonicWarning, match="mach=1.1.*overpredicts the flutter speed"):
         resolve_method("supersonic", 1.1)
+    with pytest.warns(TransonicWarning, match="mach=1.141"):
+        resolve_method("piston", 1.141)
+    with pytest.raises(TransonicGapError, match="mach=1.072"):
+        resolve_method("auto", 1.072)
 
 
 def test_gaf_hook_any_method():
