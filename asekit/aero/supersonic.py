@@ -76,7 +76,9 @@ tests/test_supersonic.py); at subsonic leading edges
 the staircase of cells and the square-root pressure singularity cost accuracy (delta wings with
 beta cot Lambda = 0.33-0.56: lift slope 4-7 % above Stewart's conical-flow value, against
 0.1-0.3 % with supersonic leading edges; tests/test_supersonic.py). The reference fin's leading
-edge is supersonic from M 1.13. The box mesh must resolve
+edge is supersonic from M 1.13. On the AGARD 445.6 wing at M 1.072 and 1.141 (subsonic
+leading and trailing edges) the flutter speed index moves by 1-2 % (M 1.141) and 2-7 %
+(M 1.072) under grid refinement (tests/test_supersonic.py). The box mesh must resolve
 the shortest kernel wavelength 2 pi b (M - 1) / (k M) with at least ``bpw_min`` boxes (a
 :class:`~asekit.aero.boxes.MeshRuleWarning` otherwise); the cell grid resolves it with
 ``cells_per_wavelength`` cells and every box with about ``cells_per_box`` cells chordwise.
@@ -714,7 +716,7 @@ def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
 
     Parameters
     ----------
-    mesh : planar :class:`~asekit.aero.boxes.BoxMesh` in z = 0, supersonic trailing edges.
+    mesh : planar :class:`~asekit.aero.boxes.BoxMesh` in z = 0 (subsonic or supersonic edges).
     mach : M > 1 (intended range about 1.15 to 3).
     k : reduced frequencies omega b_ref / U >= 0, scalar or 1-D.
     b_ref : reference semi-chord (m) of k.
