@@ -231,6 +231,50 @@ def test_matrix_and_column_paths_agree():
         np.testing.assert_allclose(cp[ik], a[ik] @ w, rtol=1e-10, atol=1e-12)
 
 
+@pytest.mark.parametrize("mach, symmetric", [(1.2, False), (2.0, False), (3.0, False),
+                                             (1.5, True)])
+def test_direct_matrix_equals_fft_columns(mach, symmetric):
+    """The full matrix (direct summation over the gathered Mach-cone kernel tables, sparse
+    transfers) equals the FFT-convolution path applied to the unit columns (the method's
+    original implementation) to 1e-12 of the largest entry, at each k: a vectorisation, not a
+    change of the result."""
+    mesh = fin_boxes()
+    ks = [0.0, 0.5, 1.2]
+    a = supersonic_pressure_matrices(mesh, mach, ks, 0.078, symmetric=symmetric, warn=False)
+    cols = supersonic_pressures(mesh, mach, ks, 0.078, np.eye(mesh.n)[None].repeat(3, 0),
+                                symmetric=symmetric, warn=False)
+    for ik in range(len(ks)):
+        scale = np.abs(cols[ik]).max()
+        assert np.abs(a[ik] - cols[ik]).max() < 1e-12 * scale, (mach, ks[ik])
+
+
+def test_direct_matrix_equals_fft_columns_with_wake():
+    """The same with wake cells (subsonic trailing edge, tan 0.6 > beta 0.5)."""
+    mesh = mesh_surfaces([TrapezoidSurface((0, 0), 1.0, (0, 1.0), 1.6, 8, 8)])
+    ks = [0.0, 0.4]
+    a = supersonic_pressure_matrices(mesh, 1.118, ks, 0.5, symmetric=True, warn=False)
+    cols = supersonic_pressures(mesh, 1.118, ks, 0.5, np.eye(mesh.n)[None].repeat(2, 0),
+                                symmetric=True, warn=False)
+    for ik in range(len(ks)):
+        assert np.abs(a[ik] - cols[ik]).max() < 1e-12 * np.abs(cols[ik]).max()
+
+
+def test_grid_location_equals_brute_force():
+    """The grid builder locates cell centres box by box (candidates in each box's bounding
+    rectangle); the brute-force test of every centre against every box gives the same owner."""
+    from asekit.aero.supersonic import _locate, _locate_grid, mach_grid
+    for mesh, sym in ((fin_boxes(), False), (_half_delta(1.0, 0.5, 12), True)):
+        for mach in (1.2, 3.0):
+            g = mach_grid(mesh, mach, 0.5, 0.078, sym, max_cells=20000)
+            corners = np.concatenate([mesh.corners, mesh.mirrored().corners]) if sym else \
+                mesh.corners
+            ii, jj = np.meshgrid(np.arange(g.nx), np.arange(g.ny), indexing="ij")
+            cen = np.column_stack([g.x0 + (ii.ravel() + 0.5) * g.dx,
+                                   g.y0 + (jj.ravel() + 0.5) * g.dy])
+            np.testing.assert_array_equal(_locate_grid(corners, g.x0, g.y0, g.dx, g.dy, g.nx,
+                                                       g.ny), _locate(corners, cen))
+
+
 def test_grid_converges_on_the_fin():
     """Re Q_cc of the fin's rigid pitch at M 2 (steady): default grid within 2 % of a grid with
     twice as many cells per box chord (diaphragm march stable as the grid is refined)."""
@@ -248,6 +292,7 @@ def test_grid_converges_on_the_fin():
 # ---- bad input --------------------------------------------------------------------------------
 @pytest.mark.parametrize("kwargs, match", [
     ({"mach": 1.0}, "mach"), ({"mach": 0.7}, "mach"), ({"mach": float("inf")}, "mach"),
+    ({"mach": float("nan")}, "mach"), ({"k": [0.1, -0.1]}, "k must"),
     ({"k": -0.5}, "k must"), ({"k": float("nan")}, "k must"), ({"b_ref": -1.0}, "b_ref"),
 ])
 def test_bad_arguments(kwargs, match):
@@ -257,16 +302,54 @@ def test_bad_arguments(kwargs, match):
         supersonic_pressure_matrices(_rect(1.0, 1.0, 4, 4), **args)
 
 
+@pytest.mark.parametrize("mach", [1.077, 1.118])
+def test_subsonic_trailing_edge_flow_reversal(mach):
+    """Subsonic trailing edge (wake cells with DeltaCp = 0). The flow-reversal theorem of
+    linearised supersonic flow (Ursell & Ward 1950, Q. J. Mech. Appl. Math. 3; Brown 1950,
+    NACA TN 1944; Jones & Cohen 1960): a flat wing at incidence has the same lift in forward
+    and in reversed flow. Wing A: unswept (supersonic) leading edge, trailing edge swept back
+    with tan 0.6 > beta (subsonic; beta = 0.40 and 0.50); wing B, A reversed: a forward-swept
+    subsonic leading edge (diaphragm) and an unswept trailing edge. Wall at the root, 20 x 20
+    boxes. asekit: 2.2 % (M 1.077) and 1.2 % (M 1.118) apart, within 3 %; leaving the wake
+    out (the method before the wake condition) gives A 19 % and 10 % below B."""
+    a = mesh_surfaces([TrapezoidSurface((0, 0), 1.0, (0, 1.0), 1.6, 20, 20)])
+    b = mesh_surfaces([TrapezoidSurface((0.6, 0), 1.0, (0, 1.0), 1.6, 20, 20)])
+    from asekit.aero.supersonic import has_subsonic_trailing_edge
+    assert has_subsonic_trailing_edge(a, mach) and not has_subsonic_trailing_edge(b, mach)
+    lifts = []
+    for mesh in (a, b):
+        cp = supersonic_pressures(mesh, mach, [0.0], 0.5, -np.ones((1, mesh.n, 1)),
+                                  symmetric=True, warn=False, max_cells=40000)[0, :, 0]
+        lifts.append(_lift(mesh, cp).real)
+    assert lifts[0] == pytest.approx(lifts[1], rel=0.03)
+
+
 def test_bad_meshes():
-    swept_te = mesh_surfaces([TrapezoidSurface((0, 0), 1.0, (0.0, 1.0), 2.0, 4, 4)])
-    with pytest.raises(ValueError, match="trailing edge"):
-        supersonic_pressure_matrix(swept_te, 1.2, 0.0, 0.5)       # tan 45 deg > beta 0.66
     tilted = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, 1.0, 0.5), 1.0, 4, 4)])
     with pytest.raises(ValueError, match="planar"):
         supersonic_pressure_matrix(tilted, 2.0, 0.0, 0.5)
     with pytest.raises(ValueError, match="max_cells"):
         supersonic_pressure_matrix(_rect(1.0, 1.0, 4, 4), 2.0, 0.0, 0.5, cells_per_box=40,
                                    max_cells=500)
+
+
+def test_grid_too_coarse_for_small_boxes():
+    """Strips of unequal width, some much narrower than a Mach box (dy = dx / beta): after
+    refining the grid 1.5x three times the narrow boxes still hold no cell centre, and the
+    error names cells_per_box (no silent loss of their area)."""
+    from asekit.aero.supersonic import GridTooCoarseError
+    mesh = mesh_surfaces([TrapezoidSurface((0, 0), 1.0, (0, 1.0), 1.0, 4, 2),
+                          TrapezoidSurface((0, 1.0), 1.0, (0, 1.08), 1.0, 4, 8)])
+    with pytest.raises(GridTooCoarseError, match="cells_per_box"):
+        supersonic_pressure_matrix(mesh, 2.0, 0.0, 0.5)
+
+
+def test_bad_normalwash():
+    mesh = _rect(1.0, 1.0, 4, 4)
+    with pytest.raises(ValueError, match="normalwash"):
+        supersonic_pressures(mesh, 2.0, [0.1], 0.5, np.ones((1, mesh.n + 1, 1)))
+    with pytest.raises(ValueError, match="normalwash"):
+        supersonic_pressures(mesh, 2.0, [0.1], 0.5, np.full((1, mesh.n, 1), np.nan))
 
 
 def test_coarse_mesh_warning():
@@ -297,8 +380,12 @@ def test_dispatcher_and_transonic_gap():
         resolve_method("piston", 1.0)
     with pytest.raises(ValueError, match="method must be one of"):
         resolve_method("zona51", 2.0)
-    with pytest.warns(TransonicWarning, match="mach=1.1"):
+    with pytest.warns(TransonicWarning, match="mach=1.1.*overpredicts the flutter speed"):
         resolve_method("supersonic", 1.1)
+    with pytest.warns(TransonicWarning, match="mach=1.141"):
+        resolve_method("piston", 1.141)
+    with pytest.raises(TransonicGapError, match="mach=1.072"):
+        resolve_method("auto", 1.072)
 
 
 def test_gaf_hook_any_method():
@@ -323,3 +410,155 @@ def test_gaf_hook_any_method():
     assert db.Q.shape == (2, 2, 2, 2) and np.all(np.isfinite(db.Q))
     with pytest.raises(TransonicGapError):
         build_gaf_database(modes, mesh, [0.6, 1.0], ks, b, 1, method="auto", progress=False)
+
+
+# ---- AGARD 445.6 weakened wing 3 at its supersonic test Mach numbers ----------------------------
+# Yates (1987), AGARD R-765 / NASA TM-100492. The wing and the M 0.499 mass ratio and density
+# (mu 33.465 at 0.4278 kg/m^3, so m / V = 14.316 kg/m^3 in Yates's mu = m / (rho V)) are those
+# of data/cases/agard445_6.toml and tests/test_case.py. The experimental flutter speed indices
+# and frequency ratios of the M 1.072 and M 1.141 points (and their test densities) could NOT
+# be retrieved and verified from a source when these tests were written, so no test compares
+# with them: the tests below check what the comparison rests on (the method refuses / warns as
+# it should, the result is insensitive to the unknown test density at M 1.141, the Mach-box
+# grid is converged, piston theory is out of its range); the numbers are in the notebook
+# bring_your_own_surface.ipynb and the branch report.
+AGARD_SS = None
+
+
+def _agard_mu(rho):
+    return 33.465 * 0.4278 / rho          # Yates's mass ratio at density rho (header above)
+
+
+def _agard_fsi(result):
+    """(FSI, omega_f / omega_alpha) of a p-k result of the AGARD case: b_s 0.2789 m,
+    f_alpha 38.10 Hz (the measured first torsion, Yates 1987)."""
+    f = result.flutter
+    w_a = 2 * math.pi * 38.10
+    return (f.speed / (0.2789 * w_a * math.sqrt(_agard_mu(result.condition.density))),
+            f.frequency_hz / 38.10)
+
+
+@pytest.fixture(scope="module")
+def agard_supersonic():
+    from asekit.aero.methods import TransonicWarning
+    from asekit.case import load_case
+    from asekit.case import pipeline as P
+    from asekit.paths import CASES_DIR
+    with pytest.warns(TransonicWarning, match="overpredicts the flutter speed"):
+        case = load_case(CASES_DIR / "agard445_6_supersonic.toml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TransonicWarning)
+        fa = P.flutter(case, db=P.gaf_database(case, progress=False, cache=False))
+    return case, fa
+
+
+def test_agard445_6_supersonic_method_choice():
+    """"auto" refuses M 1.072 and 1.141 (transonic gap) with the reason; the case file chooses
+    the Mach boxes explicitly and gets a warning; the wing's leading and trailing edges are
+    subsonic at both Mach numbers (so diaphragm and wake are solved)."""
+    import tomllib
+    from asekit.aero.supersonic import has_subsonic_trailing_edge
+    from asekit.case import CaseError, case_from_dict
+    from asekit.case import pipeline as P
+    from asekit.paths import CASES_DIR
+    d = tomllib.loads((CASES_DIR / "agard445_6_supersonic.toml").read_text())
+    d["aero"]["method"] = "auto"
+    with pytest.raises(CaseError, match=r"aero\.machs\[0\] = 1\.072.*transonic gap"):
+        case_from_dict(d)
+    d["aero"]["method"] = "supersonic"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        mesh = P.box_mesh(case_from_dict(d))
+    tan_le = 0.8094 / 0.762
+    for mach in (1.072, 1.141):
+        beta = math.sqrt(mach**2 - 1)
+        assert beta / tan_le < 1                                  # subsonic leading edge
+        assert has_subsonic_trailing_edge(mesh, mach)             # and trailing edge
+
+
+def test_agard445_6_supersonic_flutter(agard_supersonic):
+    """p-k with the Mach-box GAFs at M 1.072 and 1.141, densities 0.05-0.2 kg/m^3 (mu 286-72):
+    bending-torsion flutter (first mode) everywhere, none at the first point of the sweep; at
+    M 1.141 the flutter speed index varies by less than 5 % over the densities (asekit 2.9 %),
+    so the comparison with the test is insensitive to the test density; at M 1.072, nearer the
+    gap, by 10 %. Linear theory gives the lower index at M 1.072 (0.33-0.37) than at M 1.141
+    (0.45-0.46)."""
+    case, fa = agard_supersonic
+    fsi = {1.072: [], 1.141: []}
+    for r in fa.results:
+        assert r.flutter is not None and r.flutter.mode == 0 and not r.unstable_at_start
+        fsi[r.mach].append(_agard_fsi(r))
+    f1141 = np.array(fsi[1.141])
+    assert np.ptp(f1141[:, 0]) < 0.05 * f1141[:, 0].mean()
+    assert np.ptp(f1141[:, 1]) < 0.05 * f1141[:, 1].mean()
+    assert max(v[0] for v in fsi[1.072]) < f1141[:, 0].min()
+
+
+@pytest.mark.slow
+def test_agard445_6_supersonic_mach_box_convergence():
+    """Mach-box grid at M 1.141 (density 0.1 kg/m^3): the default grid (1.5 cells per box
+    chord, Mach boxes dx = beta dy, box mesh 16 x 16) against 2.25 cells per box chord and a
+    24 x 24 box mesh: flutter speed index within 2 % of both (asekit: 1.0 % and 1.1 %; the
+    finest grids run, 24 x 24 boxes at 3 cells per box chord and 32 x 32 at 1.5, give 1.9 % and
+    2.2 % above the default: FSI 0.452 -> 0.462); the frequency ratio within 1 %. At M 1.072
+    the same refinements move the index by 1.7-7 % (0.344 -> 0.350-0.369): not asserted, that
+    point lies in the transonic range anyway."""
+    import tomllib
+    from asekit.aero.gaf import build_gaf_database
+    from asekit.aero.spline import fe_spline
+    from asekit.case import case_from_dict
+    from asekit.case import pipeline as P
+    from asekit.paths import CASES_DIR
+    d = tomllib.loads((CASES_DIR / "agard445_6_supersonic.toml").read_text())
+    d["aero"]["machs"] = [1.141]
+    d["flight"]["densities"] = [0.1]
+    out = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for boxes, cpb in ((16, 1.5), (16, 2.25), (24, 1.5)):
+            d["aero"]["boxes"] = [{"n_chord": boxes, "n_span": boxes}]
+            case = case_from_dict(d)
+            model, mesh = P.modal_model(case), P.box_mesh(case)
+            db = build_gaf_database(fe_spline(model, mesh), mesh, [1.141],
+                                    case.aero.reduced_frequencies, 0.2789, model.n_rigid,
+                                    symmetric=True, method="supersonic", progress=False,
+                                    aero_options={"cells_per_box": cpb, "max_cells": 40000})
+            out.append(_agard_fsi(P.flutter(case, db=db).results[0]))
+    out = np.array(out)
+    assert np.all(np.abs(out[1:, 0] / out[0, 0] - 1) < 0.02), out
+    assert np.all(np.abs(out[1:, 1] / out[0, 1] - 1) < 0.01), out
+
+
+def test_agard445_6_piston_theory_out_of_range():
+    """Piston theory at M 1.141 is outside its bound (M >= 2 or M k >= 2; here M k ~ 0.1) and
+    says so naming Mach and k; its 2-D load 4/M per unit w/U is beta/M = 0.48 of Ackeret's
+    4/beta, so it puts the flutter speed far too high: above 1.4x the Mach-box value."""
+    import tomllib
+    from asekit.aero.methods import TransonicWarning
+    from asekit.aero.piston import PistonValidityWarning
+    from asekit.case import case_from_dict
+    from asekit.case import pipeline as P
+    from asekit.paths import CASES_DIR
+    d = tomllib.loads((CASES_DIR / "agard445_6_supersonic.toml").read_text())
+    d["aero"]["machs"] = [1.141]
+    d["flight"]["densities"] = [0.1]
+    d["flight"]["velocities"] = {"min": 50.0, "max": 2000.0, "step": 5.0}
+    res = {}
+    for method in ("supersonic", "piston"):
+        d["aero"]["method"] = method
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            case = case_from_dict(d)
+        if method == "piston":
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", TransonicWarning)
+                with pytest.warns(PistonValidityWarning, match=r"mach=1\.141"):
+                    db = P.gaf_database(case, progress=False, cache=False)
+        else:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                db = P.gaf_database(case, progress=False, cache=False)
+        r = P.flutter(case, db=db).results[0]
+        res[method] = None if r.flutter is None else r.flutter.speed
+    assert res["supersonic"] is not None
+    assert res["piston"] is None or res["piston"] > 1.4 * res["supersonic"]

@@ -81,7 +81,10 @@ def resolve_method(method: str, mach: float) -> str:
     if DLM_MACH_MAX < m < SUPERSONIC_MACH_MIN:
         warnings.warn(f"method={name!r} at mach={m:g}, inside the transonic gap "
                       f"({DLM_MACH_MAX:g}, {SUPERSONIC_MACH_MIN:g}) where linear theory is not "
-                      "trusted", TransonicWarning, stacklevel=2)
+                      "trusted: shocks and their motion, not modelled, carry the unsteady loads "
+                      "there, and linear theory usually overpredicts the flutter speed (the "
+                      "transonic dip); treat the result as doubtful", TransonicWarning,
+                      stacklevel=2)
     return name
 
 

@@ -27,6 +27,9 @@ plane inside the forward Mach cone of (x, y). The pressure jump follows from the
 potential, DeltaCp = Cp_lower - Cp_upper = (4 / U^2) (i omega phi + U phi_x): Delta Cp > 0 pushes
 along +z, the DLM convention. Off the wing the plane carries no load, so phi = 0 there (the
 diaphragm of [PDN55]); behind a supersonic trailing edge the wake cannot reach the wing.
+Behind a subsonic trailing edge (|tan Lambda_TE| >= beta) it can: the wake carries a potential
+jump but no load, so there DeltaCp = 0 (the linearised wake condition, with phi = 0 off the
+wing and the wake the boundary conditions of [PDN55] for wings with subsonic edges).
 
 Discretisation (asekit's). The plane is cut into a uniform grid of rectangular cells, Mach boxes
 with dx = beta dy as in [ZH55] (the diaphragm march is unstable on finer grids otherwise);
@@ -43,7 +46,9 @@ F(X) to (theta_2 - theta_1) / beta, and in 2-D (far from edges) DeltaCp = -4 (w/
 Ackeret's 4 alpha / beta. The influences depend on the cell offset only. Cells whose centre lies
 in a box are wing cells; off-wing cells ahead of the trailing edge within the Mach cones of the
 wing (beyond side edges, ahead of subsonic leading edges) are diaphragm cells whose w follows
-from phi = 0 at their centres; the pressure is evaluated at the wing-cell centres.
+from phi = 0 at their centres, and off-wing cells behind a subsonic trailing edge are wake
+cells whose w follows from DeltaCp = 0 at their centres (all solved together, row by row);
+the pressure is evaluated at the wing-cell centres.
 
 Transfer to the box mesh. The input is the normalwash w/U at the DLM control points (3/4 chord
 of each box, w/U = dh/dx + i k h / b); it is interpolated linearly in x along each chordwise
@@ -57,12 +62,23 @@ The result is a
 pressure-per-normalwash matrix DeltaCp = A (w/U) with DeltaCp lumped at the load points, the
 same kind of matrix as the DLM's AIC, so :mod:`asekit.aero.gaf` uses either.
 
-Limits. Planar meshes in z = 0 only; trailing edges must be supersonic (|tan Lambda_TE| < beta),
-else ValueError. Leading and side edges may be subsonic or supersonic; at subsonic leading edges
+Two evaluations of the same sums. Columns (a few modes, :func:`supersonic_pressures`): each
+normalwash field is convolved with the offset tables by 2-D FFT. The full matrix
+(:func:`supersonic_pressure_matrices`): the influence coefficients depend only on the cell
+offset (di, |dj|) and k, so one nx x ny table per k is evaluated and gathered into sparse
+influence matrices holding only the cell pairs inside each other's Mach cone (10-30 % of them);
+their index pattern is built once per grid and reused for every k, and the strip-local
+transfers are sparse too. The two agree to rounding (tests/test_supersonic.py, 1e-12).
+
+Limits. Planar meshes in z = 0 only. Leading, side and trailing edges may be subsonic or
+supersonic (a subsonic trailing edge checked by the flow-reversal theorem, 1-3 %,
+tests/test_supersonic.py); at subsonic leading edges
 the staircase of cells and the square-root pressure singularity cost accuracy (delta wings with
 beta cot Lambda = 0.33-0.56: lift slope 4-7 % above Stewart's conical-flow value, against
 0.1-0.3 % with supersonic leading edges; tests/test_supersonic.py). The reference fin's leading
-edge is supersonic from M 1.13. The box mesh must resolve
+edge is supersonic from M 1.13. On the AGARD 445.6 wing at M 1.072 and 1.141 (subsonic
+leading and trailing edges) the flutter speed index moves by 1-2 % (M 1.141) and 2-7 %
+(M 1.072) under grid refinement (tests/test_supersonic.py). The box mesh must resolve
 the shortest kernel wavelength 2 pi b (M - 1) / (k M) with at least ``bpw_min`` boxes (a
 :class:`~asekit.aero.boxes.MeshRuleWarning` otherwise); the cell grid resolves it with
 ``cells_per_wavelength`` cells and every box with about ``cells_per_box`` cells chordwise.
@@ -79,6 +95,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft as sfft
 import scipy.linalg as sla
+import scipy.sparse as sp
 
 from .boxes import BoxMesh, MeshRuleWarning
 from .piston import _check_k, check_supersonic_mach, piston_transfer, strip_interpolation
@@ -165,7 +182,9 @@ class MachGrid:
     ``x0, y0`` grid origin (m), ``dx, dy`` cell size (m), ``nx, ny`` cells per direction;
     ``wing_i, wing_j`` (n_w,) indices of the wing cells and ``wing_box`` the box (index into the
     mesh) each lies in, ``image`` (n_w,) True for cells of the mirror image (symmetric case);
-    ``dia_i, dia_j`` (n_d,) the diaphragm cells.
+    ``dia_i, dia_j`` (n_d,) the off-wing cells solved for (diaphragm and wake) and
+    ``dia_wake`` (n_d,) True for the wake cells among them (behind a subsonic trailing edge:
+    DeltaCp = 0 there instead of phi = 0; None: no wake cells).
     """
 
     x0: float
@@ -181,6 +200,11 @@ class MachGrid:
     image: np.ndarray
     dia_i: np.ndarray
     dia_j: np.ndarray
+    dia_wake: np.ndarray | None = None
+
+    def wake_mask(self) -> np.ndarray:
+        """(n_d,) bool: which solved off-wing cells are wake cells."""
+        return np.zeros(self.dia_i.size, bool) if self.dia_wake is None else self.dia_wake
 
     @property
     def n_cells(self) -> int:
@@ -215,16 +239,53 @@ def _locate(corners: np.ndarray, pts: np.ndarray) -> np.ndarray:
     return out
 
 
-def _check_trailing_edges(mesh: BoxMesh, beta: float, mach: float) -> None:
+def _locate_grid(corners: np.ndarray, x0: float, y0: float, dx: float, dy: float, nx: int,
+                 ny: int) -> np.ndarray:
+    """:func:`_locate` for the centres of an nx x ny cell grid (origin x0, y0, cells dx x dy),
+    raveled row-major (index i ny + j): only the cells in each box's bounding rectangle (plus
+    one cell around it) are tested, with the same containment test, and a centre in two boxes
+    goes to the lower box index, as in :func:`_locate`."""
+    y1, y2 = corners[:, 0, 1], corners[:, 3, 1]
+    ylo, yhi = np.minimum(y1, y2), np.maximum(y1, y2)
+    xs = corners[:, :, 0]
+    j0 = np.clip(np.floor((ylo - y0) / dy - 0.5).astype(int) - 1, 0, ny)
+    j1 = np.clip(np.ceil((yhi - y0) / dy - 0.5).astype(int) + 1, 0, ny)
+    i0 = np.clip(np.floor((xs.min(axis=1) - x0) / dx - 0.5).astype(int) - 1, 0, nx)
+    i1 = np.clip(np.ceil((xs.max(axis=1) - x0) / dx - 0.5).astype(int) + 1, 0, nx)
+    ni, nj = i1 - i0, j1 - j0
+    count = ni * nj
+    box = np.repeat(np.arange(corners.shape[0]), count)
+    local = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+    ii = i0[box] + local // nj[box]
+    jj = j0[box] + local % nj[box]
+    px, py = x0 + (ii + 0.5) * dx, y0 + (jj + 0.5) * dy
+    c = corners[box]
+    f = (py - c[:, 0, 1]) / (c[:, 3, 1] - c[:, 0, 1])
+    xle = c[:, 0, 0] + f * (c[:, 3, 0] - c[:, 0, 0])
+    xte = c[:, 1, 0] + f * (c[:, 2, 0] - c[:, 1, 0])
+    inside = (py >= ylo[box]) & (py < yhi[box]) & (px >= xle) & (px < xte)
+    out = np.full(nx * ny, corners.shape[0])
+    np.minimum.at(out, (ii * ny + jj)[inside], box[inside])
+    out[out == corners.shape[0]] = -1
+    return out
+
+
+def trailing_edge_tangents(mesh: BoxMesh) -> np.ndarray:
+    """|tan Lambda_TE| (n_strips,) of the trailing edge of every chordwise strip."""
+    out = []
     for s in np.unique(mesh.strip):
         members = np.flatnonzero(mesh.strip == s)
         last = members[np.argmax(mesh.corners[members, 1, 0])]
         c = mesh.corners[last]
-        tan_te = (c[2, 0] - c[1, 0]) / (c[2, 1] - c[1, 1])
-        if abs(tan_te) >= beta:
-            raise ValueError(f"mach={mach:g}: the trailing edge of strip {s} is subsonic "
-                             f"(|tan sweep| {abs(tan_te):.3g} >= sqrt(M^2 - 1) = {beta:.3g}); the "
-                             "supersonic method needs supersonic trailing edges")
+        out.append(abs((c[2, 0] - c[1, 0]) / (c[2, 1] - c[1, 1])))
+    return np.array(out)
+
+
+def has_subsonic_trailing_edge(mesh: BoxMesh, mach: float) -> bool:
+    """True when some trailing edge is subsonic, |tan Lambda_TE| >= sqrt(M^2 - 1): its wake
+    then lies inside the forward Mach cones of wing points (module docstring)."""
+    m = check_supersonic_mach(mach)
+    return bool(np.any(trailing_edge_tangents(mesh) >= math.sqrt(m * m - 1.0)))
 
 
 def kernel_wavelength(mach: float, k: float, b_ref: float) -> float:
@@ -248,7 +309,7 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     m = check_supersonic_mach(mach)
     beta = math.sqrt(m * m - 1.0)
     _check_planar(mesh)
-    _check_trailing_edges(mesh, beta, m)
+    subsonic_te = has_subsonic_trailing_edge(mesh, m)
     cells_per_box = float(cells_per_box)
     if not (math.isfinite(cells_per_box) and cells_per_box >= 1.0):
         raise ValueError(f"cells_per_box must be >= 1, got {cells_per_box!r}")
@@ -293,8 +354,7 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
                          "cells_per_box / cells_per_wavelength or lower k")
     ii, jj = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     ii, jj = ii.ravel(), jj.ravel()
-    cen = np.column_stack([x_min + (ii + 0.5) * dx, y0 + (jj + 0.5) * dy])
-    box = _locate(all_c, cen)
+    box = _locate_grid(all_c, x_min, y0, dx, dy, nx, ny)
     wing = box >= 0
     if not wing.any():
         raise ValueError("no grid cell centre lies on the mesh: the mesh is degenerate")
@@ -304,7 +364,9 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     last_wing_row = np.full(ny, -1)
     np.maximum.at(last_wing_row, jj[wing], ii[wing])
     wake = (~wing) & (ii > last_wing_row[jj]) & (last_wing_row[jj] >= 0)
-    cand = np.flatnonzero((~wing) & (~wake))
+    # behind supersonic trailing edges the wake cannot reach the wing: leave it out; behind a
+    # subsonic one it can, and its cells are solved with DeltaCp = 0
+    cand = np.flatnonzero((~wing) & (~wake)) if not subsonic_te else np.flatnonzero(~wing)
     wi, wj = ii[wing], jj[wing]
     # keep the off-wing cells inside the downstream Mach cone of some wing cell and ahead of
     # another's: per column, the most upstream / downstream wing cell decides (the cone test
@@ -331,19 +393,25 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
                          f"{100 * area[empty].sum() / area.sum():.2g} % of the area): raise "
                          "cells_per_box")
     return MachGrid(x_min, y0, dx, dy, nx, ny, beta, wi, wj, owner[box[wing]], is_img[box[wing]],
-                    ii[dia], jj[dia])
+                    ii[dia], jj[dia], wake[dia] if subsonic_te else None)
 
 
 # ---------------------------------------------------------------------------------------------
 # solution on the grid
 # ---------------------------------------------------------------------------------------------
+def _cone_mask(grid: MachGrid) -> np.ndarray:
+    """(nx, ny) bool over offsets (di, dj >= 0): the Mach cone of a receiving cell centre
+    reaches the cell, beta (dj - 1/2) dy < (di + 1/2) dx; the influence tables are zero
+    elsewhere (both, since the cone grows with di)."""
+    di, dj = np.meshgrid(np.arange(grid.nx), np.arange(grid.ny), indexing="ij")
+    return grid.beta * (dj - 0.5) * grid.dy < (di + 0.5) * grid.dx * (1.0 + 1e-9)
+
+
 def _offset_tables(grid: MachGrid, lam: float, kap: float):
     """Influence tables over offsets (di >= 0, dj >= 0): potential I[di, dj] at a cell centre
     and edge integrals F[m, dj] at X = (m + 1/2) dx; evaluated only where the Mach cone of the
     receiving point reaches the cell (beta (dj - 1/2) dy < (di + 1/2) dx), zero elsewhere."""
-    di, dj = np.meshgrid(np.arange(grid.nx), np.arange(grid.ny), indexing="ij")
-    inside = grid.beta * (dj - 0.5) * grid.dy < (di + 0.5) * grid.dx * (1.0 + 1e-9)
-    di, dj = di[inside], dj[inside]
+    di, dj = np.nonzero(_cone_mask(grid))
     xb = (di + 0.5) * grid.dx
     t1 = (dj - 0.5) * grid.dy
     t2 = (dj + 0.5) * grid.dy
@@ -393,8 +461,9 @@ def _kernels(grid: MachGrid, mach: float, k: float, b_ref: float):
 def _grid_solve(grid: MachGrid, mach: float, k: float, b_ref: float,
                 w_wing: np.ndarray) -> np.ndarray:
     """DeltaCp at the wing-cell centres (m, n_w) for wing-cell normalwash w/U (m, n_w): the
-    diaphragm w from phi = 0 at its centres (forward substitution row by row when the grid
-    keeps same-row cells apart, dx <= beta dy; LU otherwise), then the pressure by FFT."""
+    off-wing w from phi = 0 at the diaphragm and DeltaCp = 0 at the wake cell centres
+    (:func:`_offwing_solve`), the influences of the wing cells on them and the pressure by
+    FFT convolution."""
     kphi, kp = _kernels(grid, mach, k, b_ref)
     nx, ny = grid.nx, grid.ny
     m = w_wing.shape[0]
@@ -403,22 +472,181 @@ def _grid_solve(grid: MachGrid, mach: float, k: float, b_ref: float,
     field[:, grid.wing_i, grid.wing_j] = w_wing
     spec = conv.spectrum(field)
     if grid.dia_i.size:
-        phi_w = conv.apply(spec, 0)[:, grid.dia_i, grid.dia_j]              # (m, n_d)
         order = np.lexsort((grid.dia_j, grid.dia_i))
         di, dj = grid.dia_i[order], grid.dia_j[order]
-        d_i = di[:, None] - di[None, :]
-        d_j = np.abs(dj[:, None] - dj[None, :])
-        ok = d_i >= 0
-        mat = np.where(ok, kphi[np.where(ok, d_i, 0), d_j], 0.0)
-        rhs = -phi_w[:, order].T
-        if grid.dx <= grid.beta * grid.dy * (1 + 1e-12):
-            wd = sla.solve_triangular(mat, rhs, lower=True, check_finite=False)
-        else:
-            wd = sla.lu_solve(sla.lu_factor(mat, check_finite=False), rhs, check_finite=False)
+        wake = grid.wake_mask()[order]
+        rhs = -conv.apply(spec, 0)[:, di, dj].T                             # (n_d, m)
+        if wake.any():
+            rhs[wake] = -conv.apply(spec, 1)[:, di[wake], dj[wake]].T
+        wd = _offwing_solve(_offwing(grid), _signed_table(kphi), _signed_table(kp), rhs)
         dfield = np.zeros((m, nx, ny), complex)
         dfield[:, di, dj] = wd.T
         spec = spec + conv.spectrum(dfield)
     return conv.apply(spec, 1)[:, grid.wing_i, grid.wing_j]
+
+
+def _signed_table(table: np.ndarray) -> np.ndarray:
+    """An (nx, ny) offset table K[di >= 0, dj >= 0] spread to signed offsets and raveled:
+    T[(di + nx) 2 ny + (dj + ny)] = K[di, |dj|] for di >= 0 and 0 for di < 0 (upstream cells
+    feel nothing), so that the influence of cell (i', j') on cell (i, j) is
+    T[(i 2 ny + j) - (i' 2 ny + j') + nx 2 ny + ny] (see :class:`_GridGather`)."""
+    nx, ny = table.shape
+    t = np.zeros((2 * nx, 2 * ny), table.dtype)
+    t[nx:, ny:] = table
+    t[nx:, 1:ny] = table[:, :0:-1]
+    return t.ravel()
+
+
+@dataclass(frozen=True)
+class _Pattern:
+    """Sparsity pattern of one influence matrix (receiving cells x source cells) in CSR form:
+    ``indptr``, ``indices`` and, per stored entry, ``table`` its index into a signed table
+    (:func:`_signed_table`); ``shape``."""
+
+    indptr: np.ndarray
+    indices: np.ndarray
+    table: np.ndarray
+    shape: tuple
+
+    def matrix(self, signed: np.ndarray, rows_alt: np.ndarray | None = None,
+               alt: np.ndarray | None = None) -> sp.csr_matrix:
+        """The matrix with values from ``signed``, and from ``alt`` in the rows ``rows_alt``
+        (bool per row) when given."""
+        data = signed[self.table]
+        if rows_alt is not None and rows_alt.any():
+            entry = np.repeat(rows_alt, np.diff(self.indptr))
+            data[entry] = alt[self.table[entry]]
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape)
+
+
+def _pattern(rkey: np.ndarray, ckey: np.ndarray, n2: int, off: int,
+             reach: np.ndarray) -> _Pattern:
+    """The pairs (receiving cell, source cell) inside the Mach cone: for every receiving cell
+    (key i n2 + j) and every row offset di >= 0, the source cells of row i - di with
+    |j' - j| <= reach[di] (:func:`_cone_mask`), one contiguous run of the sorted source keys
+    ``ckey`` (found by bisection). Entries of a row of the pattern come in ascending source
+    order."""
+    nr, nx = rkey.size, reach.size
+    ip = rkey[:, None] // n2 - np.arange(nx, dtype=rkey.dtype)[::-1][None, :]   # ascending
+    base = ip * n2 + (rkey % n2)[:, None]
+    rr = reach[::-1][None, :]
+    lo = np.searchsorted(ckey, base - rr, "left")
+    cnt = np.where(ip >= 0, np.searchsorted(ckey, base + rr, "right") - lo, 0).ravel()
+    per_row = cnt.reshape(nr, nx).sum(axis=1)
+    indptr = np.zeros(nr + 1, np.int64)
+    np.cumsum(per_row, out=indptr[1:])
+    total = int(indptr[-1])
+    ends = np.cumsum(cnt)
+    cols = np.repeat((lo.ravel() - ends + cnt).astype(rkey.dtype), cnt)
+    cols += np.arange(total, dtype=rkey.dtype)
+    table = np.repeat(rkey + off, per_row)
+    table -= ckey[cols]
+    return _Pattern(indptr, cols, table, (nr, ckey.size))
+
+
+@dataclass(frozen=True)
+class _GridGather:
+    """Index sets of the direct-summation grid operator, built once per (mesh, Mach) grid and
+    reused for every k. The influence of one cell on another depends only on their offset
+    (di, |dj|) and on k (module docstring), so every influence matrix is a gather from the
+    nx x ny coefficient tables of :func:`_kernels` (a Toeplitz reuse: nx ny coefficients per k
+    instead of one per pair of cells). With the cell key c = i 2 ny + j, the table index of the
+    influence of cell b on cell a is c_a - c_b + off (:func:`_signed_table`), and only the pairs
+    inside each other's Mach cone (:func:`_cone_mask`: 10-30 % of them on the fin) are kept, as
+    sparse matrices.
+
+    ``ww`` wing <- wing, ``dw`` diaphragm <- wing, ``wd`` wing <- diaphragm (:class:`_Pattern`),
+    ``off`` the off-wing cells among themselves (:class:`_OffWing`), sorted by row, then
+    column."""
+
+    ww: _Pattern
+    dw: _Pattern
+    wd: _Pattern
+    off: "_OffWing"
+
+
+def _grid_gather(grid: MachGrid) -> _GridGather:
+    n2 = 2 * grid.ny
+    off = grid.nx * n2 + grid.ny
+    reach = _cone_mask(grid).sum(axis=1) - 1          # largest |dj| in the cone, per di
+    it = np.int32 if 2 * grid.nx * n2 < 2**31 else np.int64
+    cw = (grid.wing_i * n2 + grid.wing_j).astype(it)
+    if np.any(np.diff(cw) <= 0):
+        raise AssertionError("wing cells must be sorted by row, then column")
+    ow = _offwing(grid)
+    reach = reach.astype(it)
+    return _GridGather(_pattern(cw, cw, n2, off, reach), _pattern(ow.key, cw, n2, off, reach),
+                       _pattern(cw, ow.key, n2, off, reach), ow)
+
+
+@dataclass(frozen=True)
+class _OffWing:
+    """The solved off-wing cells (diaphragm and wake) sorted by row, then column: ``order``
+    into ``grid.dia_*``, cell keys ``key`` (:class:`_GridGather`), ``wake`` (n_d,) their
+    kind, ``dd`` the pattern of their influences on one another, ``blocks`` the index ranges
+    of each grid row; ``triangular`` when the cells of one row lie outside each other's Mach
+    cones (dx <= beta dy), so that a row depends on earlier rows and itself only."""
+
+    order: np.ndarray
+    key: np.ndarray
+    wake: np.ndarray
+    dd: _Pattern
+    blocks: tuple
+    triangular: bool
+
+
+def _offwing(grid: MachGrid) -> _OffWing:
+    n2 = 2 * grid.ny
+    it = np.int32 if 2 * grid.nx * n2 < 2**31 else np.int64
+    reach = (_cone_mask(grid).sum(axis=1) - 1).astype(it)
+    order = np.lexsort((grid.dia_j, grid.dia_i))
+    key = (grid.dia_i[order] * n2 + grid.dia_j[order]).astype(it)
+    rows = grid.dia_i[order]
+    cut = np.flatnonzero(np.diff(rows)) + 1
+    edges = np.concatenate([[0], cut, [rows.size]]).astype(int)
+    return _OffWing(order, key, grid.wake_mask()[order],
+                    _pattern(key, key, n2, grid.nx * n2 + grid.ny, reach),
+                    tuple(zip(edges[:-1], edges[1:])),
+                    grid.dx <= grid.beta * grid.dy * (1 + 1e-12))
+
+
+def _offwing_solve(ow: _OffWing, tphi: np.ndarray, tp: np.ndarray,
+                   rhs: np.ndarray) -> np.ndarray:
+    """w/U of the off-wing cells (n_d, m) from L w = rhs, L their influences on one another
+    (phi rows for the diaphragm, DeltaCp rows for the wake, from the signed tables ``tphi``,
+    ``tp``), sparse over the Mach cones: forward substitution grid row by grid row,
+    w_R = (rhs_R - L_R w) / diag(L)_R while w_R is still zero, when ``ow.triangular``; a dense
+    LU otherwise."""
+    lmat = ow.dd.matrix(tphi, ow.wake, tp)
+    if not ow.triangular:
+        dense = lmat.toarray()
+        return sla.lu_solve(sla.lu_factor(dense, check_finite=False), rhs, check_finite=False)
+    diag = lmat.diagonal()
+    x = np.zeros(rhs.shape, complex)
+    for a, b in ow.blocks:
+        x[a:b] = (rhs[a:b] - lmat[a:b] @ x) / diag[a:b, None]
+    return x
+
+
+def _grid_matrix(grid: MachGrid, gather: _GridGather, mach: float, k: float, b_ref: float,
+                 s: sp.csr_matrix, tw: sp.csr_matrix) -> np.ndarray:
+    """The pressure-per-normalwash matrix A (n, n) = T_w DeltaCp_grid S by direct summation
+    over the gathered kernel tables K (:class:`_GridGather`): with the diaphragm normalwash
+    w_d = -(K^phi_dd)^-1 K^phi_dw S (phi = 0 on the diaphragm; forward substitution),
+    A = T_w K^p_ww S + (T_w K^p_wd) w_d. ``s`` is S (n_w, n) and ``tw`` T_w (n, n_w), both
+    sparse (two entries per row of S, strip-local T_w). The same sums as :func:`_grid_solve`
+    applied to the columns of S, without the FFT (equal to rounding)."""
+    kphi, kp = _kernels(grid, mach, k, b_ref)
+    tp = _signed_table(kp)
+    out = (tw @ (gather.ww.matrix(tp) @ s)).toarray()
+    ow = gather.off
+    if ow.key.size:
+        tphi = _signed_table(kphi)
+        # (n_d, n): -K^phi_dw S on the diaphragm, -K^p_dw S on the wake
+        rhs = -(gather.dw.matrix(tphi, ow.wake, tp) @ s).toarray()
+        wd = _offwing_solve(ow, tphi, tp, rhs)
+        out += (tw @ gather.wd.matrix(tp)).toarray() @ wd
+    return out
 
 
 def grid_pressure_operator(grid: MachGrid, mach: float, k: float, b_ref: float) -> np.ndarray:
@@ -445,10 +673,9 @@ def _transfer(mesh: BoxMesh, grid: MachGrid):
         cb = mesh.corners[b, :, :2].mean(axis=0)
         near = real_idx[np.argmin(np.sum((cen[real_idx] - cb) ** 2, axis=1))]
         weight[near] += mesh.area[b]
-    agg = np.zeros((mesh.n, grid.wing_i.size))
-    agg[owner, np.arange(owner.size)] = weight
     _, t = piston_transfer(mesh)                      # load points -> box centroids (n, n)
-    return s, (t.T @ agg) / mesh.area[:, None]
+    # T^T @ Agg with Agg (n, n_w) holding each cell's weight in its owner's row
+    return s, (t.T[:, owner] * weight[None, :]) / mesh.area[:, None]
 
 
 def _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box, cells_per_wavelength, max_cells,
@@ -489,7 +716,7 @@ def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
 
     Parameters
     ----------
-    mesh : planar :class:`~asekit.aero.boxes.BoxMesh` in z = 0, supersonic trailing edges.
+    mesh : planar :class:`~asekit.aero.boxes.BoxMesh` in z = 0 (subsonic or supersonic edges).
     mach : M > 1 (intended range about 1.15 to 3).
     k : reduced frequencies omega b_ref / U >= 0, scalar or 1-D.
     b_ref : reference semi-chord (m) of k.
@@ -499,9 +726,16 @@ def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
     bpw_min : boxes of the mesh per kernel wavelength below which a MeshRuleWarning is given.
     warn : give that warning.
     """
-    eye = np.eye(mesh.n)
-    return supersonic_pressures(mesh, mach, k, b_ref, lambda _k: eye, symmetric, cells_per_box,
-                                cells_per_wavelength, max_cells, bpw_min, warn)
+    m, ks, b, grid, s, tw = _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box,
+                                     cells_per_wavelength, max_cells, bpw_min, warn)
+    gather = _grid_gather(grid)                   # one index set for every k
+    s_sp, tw_sp = sp.csr_matrix(s), sp.csr_matrix(tw)
+    out = np.empty((ks.size, mesh.n, mesh.n), complex)
+    for ik, kk in enumerate(ks):
+        out[ik] = _grid_matrix(grid, gather, m, float(kk), b, s_sp, tw_sp)
+    if not np.all(np.isfinite(out)):
+        raise FloatingPointError("supersonic pressures are not finite")
+    return out
 
 
 def supersonic_pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash,

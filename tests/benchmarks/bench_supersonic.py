@@ -15,25 +15,28 @@ Times (best of ``--repeat``) at one reduced frequency on the fin's default box m
 - piston theory: its matrix (a banded transfer, no solve).
 
 Measured on the 2-core project machine (shared with other jobs, loaded: repeated runs vary by
-up to 1.5x), k 0.5, best of 3, default grid (1.5 cells per mean box chord, Mach boxes
-dx = beta dy):
+up to 2x), k 0.5, best of 5, default grid (1.5 cells per mean box chord, Mach boxes
+dx = beta dy), run of 2026-12-01 22:49 UTC:
 
     case                                              s      x DLM AIC
-    DLM D (M 0.75)                                  0.047      1.08
-    DLM AIC (M 0.75)                                0.044      1.00
-    supersonic matrix M 1.2 (463 + 368 cells)       0.32       7.3
-    supersonic matrix M 2 (1125 + 302 cells)        0.40       9.2
-    supersonic matrix M 3 (1732 + 293 cells)        0.42       9.7
-    DLM 6 mode columns M 0.75 (GAF path)            0.037      0.85
-    supersonic 6 mode columns M 2 (GAF path)        0.042      0.97
-    piston matrix M 3                               0.0007     0.01
+    DLM D (M 0.75)                                  0.0120     0.88
+    DLM AIC (M 0.75)                                0.0136     1.00
+    supersonic matrix M 1.2 (463 + 368 cells)       0.0193     1.42
+    supersonic matrix M 2 (1125 + 302 cells)        0.0197     1.46
+    supersonic matrix M 3 (1732 + 293 cells)        0.0244     1.80
+    DLM 6 mode columns M 0.75 (GAF path)            0.0078     0.57
+    supersonic 6 mode columns M 2 (GAF path)        0.0101     0.74
+    piston matrix M 3                               0.0006     0.04
 
-(run of 2026-12-01 20:30 UTC; wing + diaphragm cells in brackets; other runs the same hour gave
-3.2-5.4x for the matrices and 0.6-1.1x for the GAF path.) The issue's target, the supersonic
-AIC within 3x the DLM's time for the same boxes, is met where the GAF builder uses it (the six
-modal columns: about the DLM's own time), but NOT by the full 140 x 140 matrix, which takes
-about 3-10x: it costs one grid solve per box, each two 2-D FFTs over the Mach-box grid (6-12
-wing cells per box for the fin at M 1.2-3) plus the diaphragm's forward substitution.
+(wing + diaphragm cells in brackets.) The issue's target, the supersonic AIC within 3x the
+DLM's time for the same boxes, is met at M 1.2-3 (1.4-1.8x). Before the direct-summation
+matrix path (the full matrix was one FFT grid solve per box: 140 pairs of 2-D FFTs over the
+padded Mach-box grid) the same bench gave 3.6x (M 1.2), 7.2x (M 2) and 6.4x (M 3) the DLM
+(22:38 UTC, best of 3); old and new side by side in one process (22:49 UTC, best of 5):
+M 1.2 0.067 -> 0.015 s, M 2 0.164 -> 0.026 s, M 3 0.118 -> 0.021 s (4.4-6.4x faster; DLM AIC
+0.014 s). The new matrix path: one nx x ny kernel table per k, gathered into sparse influence
+matrices over the cell pairs inside each other's Mach cone (their index pattern built once per
+grid), sparse transfers, grid cells located per box instead of all cells against all boxes.
 """
 
 from __future__ import annotations
@@ -49,7 +52,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", ".."))
 
 import numpy as np  # noqa: E402
 
-from asekit.aero.boxes import fin_boxes  # noqa: E402
+from asekit.reproduction.fin import fin_boxes  # noqa: E402
 from asekit.aero.dlm import aic_matrix, normalwash_matrix  # noqa: E402
 from asekit.aero.gaf import gaf_from_box_modes  # noqa: E402
 from asekit.aero.piston import piston_pressure_matrix  # noqa: E402
