@@ -313,9 +313,99 @@ class Crossovers:
         return float(self.gain_margins_db[0]) if self.gain_margins_db.size else math.inf
 
 
+def state_space_response(A, B, C, D, s, block: int = 4096) -> np.ndarray:
+    """G(s) = C (s I - A)^-1 B + D of the state space (A, B, C, D) at every complex ``s``,
+    shape (n_outputs, n_inputs, len(s)): all frequencies in one batched pass.
+
+    Method (Laub 1981, "Efficient multivariable frequency response computations", IEEE TAC
+    26(2), the approach of SLICOT TB05AD with the Schur instead of the Hessenberg form):
+    A is balanced by an exact power-of-two diagonal similarity T (``scipy.linalg.matrix_balance``;
+    A_b = T^-1 A T, B_b = T^-1 B, C_b = C T) and reduced once to complex Schur form
+    A_b = U R U^H (R upper triangular, U unitary), so that
+
+        G(s) = (C_b U) (s I - R)^-1 (U^H B_b) + D,
+
+    and the triangular systems of all frequencies are solved together by back substitution,
+    x_i = (b_i + sum_{j>i} R_ij x_j) / (s - R_ii), n vectorised steps instead of one O(n^3)
+    LU per frequency. One step of iterative refinement on the balanced system
+    (r = B_b - (s I - A_b) x, solved again through the Schur form) brings the error to that of a
+    pivoted LU solve of each frequency (agreement with python-control's per-frequency solve
+    to about 1e-14 relative on the fin's 37-state loops; tests/test_ase.py).
+
+    Parameters
+    ----------
+    A (n, n), B (n, m), C (p, n), D (p, m) : real or complex arrays; n = 0 gives D.
+    s : complex frequencies (rad/s for continuous systems, s = j omega), any shape, flattened.
+    block : frequencies per batch (bounds the memory to about 3 n m block complex numbers).
+
+    Raises ValueError if some s is numerically an eigenvalue of A (the response is infinite
+    there), naming that s.
+    """
+    import scipy.linalg as sla
+
+    A, B, C, D = (np.atleast_2d(np.asarray(x)) for x in (A, B, C, D))
+    s = np.asarray(s, complex).ravel()
+    n = A.shape[0]
+    p, m = D.shape
+    if n == 0:
+        return np.broadcast_to(D[:, :, None].astype(complex), (p, m, s.size)).copy()
+    if A.shape != (n, n) or B.shape != (n, m) or C.shape != (p, n):
+        raise ValueError(f"inconsistent state-space shapes A {A.shape}, B {B.shape}, "
+                         f"C {C.shape}, D {D.shape}")
+    Ab, (scale, _) = sla.matrix_balance(A, permute=False, separate=True)
+    Bb = B / scale[:, None]
+    Cb = C * scale[None, :]
+    R, U = sla.schur(Ab.astype(complex), output="complex")
+    Uh = U.conj().T
+    diag = np.diag(R)
+
+    def tri_solve(rhs, sw):
+        """(s I - R)^-1 rhs for rhs (n, q): q = m nb columns, column c at frequency sw[c]."""
+        X = np.empty_like(rhs)
+        for i in range(n - 1, -1, -1):
+            acc = rhs[i] + R[i, i + 1:] @ X[i + 1:] if i < n - 1 else rhs[i]
+            X[i] = acc / (sw - diag[i])
+        return X
+
+    out = np.empty((p, m, s.size), complex)
+    bt = (Uh @ Bb).astype(complex)
+    for k0 in range(0, s.size, block):
+        sb = s[k0:k0 + block]
+        nb = sb.size
+        sw = np.tile(sb, m)                       # columns ordered input-major: (m, nb)
+        rhs = np.repeat(bt, nb, axis=1)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            Z = U @ tri_solve(rhs, sw)
+            # one refinement step: residual of the balanced system, solved again
+            res = np.repeat(Bb, nb, axis=1) - (sw * Z - Ab @ Z)
+            Z = Z + U @ tri_solve(Uh @ res, sw)
+            out[:, :, k0:k0 + nb] = (Cb @ Z).reshape(p, m, nb) + D[:, :, None]
+    bad = ~np.all(np.isfinite(out), axis=(0, 1))
+    for k in np.nonzero(bad)[0]:
+        try:                                   # on (or numerically at) a pole: decide exactly
+            x = np.linalg.solve(s[k] * np.eye(n) - A, B)
+            out[:, :, k] = C @ x + D
+        except np.linalg.LinAlgError:
+            pass
+        if not np.all(np.isfinite(out[:, :, k])):
+            raise ValueError(f"frequency s = {s[k]:.6g} is a pole of the system (sI - A "
+                             "singular): the frequency response is infinite there")
+    return out
+
+
 def frequency_response(sys, f_hz: np.ndarray) -> np.ndarray:
-    """Complex frequency response of a SISO system at frequencies ``f_hz`` (Hz)."""
-    return np.asarray(ct.frequency_response(sys, 2 * np.pi * np.asarray(f_hz)).complex).ravel()
+    """Complex frequency response of a SISO system at frequencies ``f_hz`` (Hz).
+
+    State-space systems (continuous, s = j 2 pi f, or discrete, z = exp(j 2 pi f dt)) go
+    through the batched :func:`state_space_response`; other LTI objects (transfer functions)
+    through :func:`control.frequency_response`."""
+    w = 2 * np.pi * np.asarray(f_hz, float).ravel()
+    if isinstance(sys, ct.StateSpace):
+        if sys.ninputs != 1 or sys.noutputs != 1:
+            raise ValueError(f"sys must be SISO, got {sys.noutputs}x{sys.ninputs}")
+        s = 1j * w if sys.isctime() else np.exp(1j * w * float(sys.dt))
+        return state_space_response(sys.A, sys.B, sys.C, sys.D, s)[0, 0]
+    return np.asarray(ct.frequency_response(sys, w).complex).ravel()
 
 
 def crossovers(loop, f_hz: np.ndarray | None = None) -> Crossovers:
