@@ -1313,7 +1313,19 @@ def simulate_sampled(plant: SampledPlant, controller, command: float,
     x = np.zeros(plant.Ad.shape[0])
     xc = np.zeros(Ac.shape[0])
     held = [0.0] * max(int(delay_samples), 0)
-    ts_all, ys, vs, vds = [], [], [], []
+    # the m substeps of a sample at once: x_j = Ad^j x + (sum_{i<j} Ad^i Bd) v, j = 0..m
+    n = plant.Ad.shape[0]
+    Pw = np.empty((m + 1, n, n))
+    Gw = np.empty((m + 1, n))
+    Pw[0], Gw[0] = np.eye(n), 0.0
+    for j in range(1, m + 1):
+        Pw[j] = plant.Ad @ Pw[j - 1]
+        Gw[j] = plant.Ad @ Gw[j - 1] + plant.Bd[:, 0]
+    P_sub, G_sub = Pw[:m].reshape(m * n, n), Gw[:m]
+    P_m, G_m = Pw[m], Gw[m]
+    X = np.empty((n_s * m, n))
+    vs = np.empty(n_s * m)
+    vds = np.empty(n_s * m)
     cm = plant.C[plant.i_meas]
     v_app = 0.0
     for k in range(n_s):
@@ -1334,14 +1346,12 @@ def simulate_sampled(plant: SampledPlant, controller, command: float,
         if delay_samples:
             held = held[1:] + [float(np.clip(u, -vmax, vmax))]
         v_app = v_now
-        for j in range(m):
-            ts_all.append((k * m + j) * plant.sample_time / m)
-            ys.append(plant.C @ x + plant.D[:, 0] * v_app)
-            vs.append(v_app)
-            vds.append(u)
-            x = plant.Ad @ x + plant.Bd[:, 0] * v_app
-    Y = np.array(ys).T
+        X[k * m:(k + 1) * m] = (P_sub @ x).reshape(m, n) + G_sub * v_app
+        vs[k * m:(k + 1) * m] = v_app
+        vds[k * m:(k + 1) * m] = u
+        x = P_m @ x + G_m * v_app
+    t = np.arange(n_s * m) * plant.sample_time / m
+    Y = plant.C @ X.T + plant.D[:, :1] * vs[None, :]
     outs = {nm: Y[i] for i, nm in enumerate(plant.output_names)}
-    return SampledSimulation(t=np.array(ts_all), outputs=outs, voltage=np.array(vs),
-                             voltage_demand=np.array(vds), command=float(command),
-                             topology=plant.topology)
+    return SampledSimulation(t=t, outputs=outs, voltage=vs, voltage_demand=vds,
+                             command=float(command), topology=plant.topology)
