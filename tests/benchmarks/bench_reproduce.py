@@ -20,7 +20,6 @@ GAF caches as they are) and prints its per-chapter seconds.
 """
 
 import json
-import math
 import os
 import subprocess
 import sys
