@@ -824,9 +824,21 @@ def _simulate_exact(model, controller, command, topology, lim, t_out, x0, sample
     piecewise-linear propagation (:class:`_PiecewiseAffineLoop`). With ``sample_time`` the
     demand is the ZOH digital PD of :func:`_integrate_zoh` (same sampling, same derivative)."""
     mats = _loop_matrices(model, controller, command, topology)
+    bounds = _voltage_bounds(model.actuator, lim, mats["F"].shape[0])
+    return propagate_exact(mats, bounds, controller, command, t_out, x0, sample_time)
+
+
+def propagate_exact(mats: dict, bounds: list, controller, command: float, t_out, x0,
+                    sample_time: float | None = None):
+    """Exact propagation of x' = F x + g V(x) (:class:`_PiecewiseAffineLoop`) from x0 over the
+    grid ``t_out`` (uniform, from 0): ``mats`` as :func:`_loop_matrices` (F, g, k, k0, fb_row,
+    om_row), ``bounds`` as :func:`_voltage_bounds`. The demand is the continuous PD
+    V_cmd = k x + k0, or with ``sample_time`` the ZOH digital PD ``controller.voltage(command -
+    y_k, -(y_k - y_k-1) / T)`` of the sampled feedback y = fb_row x (the first backward
+    difference consistent with the initial rate om_row x0). Returns (x (n, n_out), V_cmd
+    (n_out,))."""
     F, g = mats["F"], mats["g"]
     n = F.shape[0]
-    bounds = _voltage_bounds(model.actuator, lim, n)
     t_final = float(t_out[-1])
     if sample_time is None:
         loop = _PiecewiseAffineLoop(F, g, mats["k"], bounds)

@@ -149,10 +149,32 @@ def _copy_model(model: ModalModel) -> ModalModel:
 
 @lru_cache(maxsize=32)
 def _modal_model(fin: FinDefinition, n_chord: int, n_span: int, shaft: str, f_max_hz: float,
-                 model: str) -> ModalModel:
-    """The FN2 (``model="FN2"``) or FN1 modal model; memoised on the (hashable, frozen) fin
-    definition and the arguments, so a run that asks for the same model twice computes it
-    once. Callers get copies (:func:`_copy_model`): the memo cannot change a result."""
+                 model: str):
+    """(model, warnings): the FN2 (``model="FN2"``) or FN1 modal model and the warnings its
+    computation gave; memoised on the (hashable, frozen) fin definition and the arguments, so
+    a run that asks for the same model twice computes it once. Callers get copies
+    (:func:`_copy_model`) and the warnings again (:func:`_memo_result`): the memo changes
+    neither a result nor what the caller is told."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = _compute_modal_model(fin, n_chord, n_span, shaft, f_max_hz, model)
+    return result, tuple((w.message, w.category) for w in caught)
+
+
+def _memo_result(memo) -> ModalModel:
+    """A copy of a memoised model, its computation's warnings issued again (as from the
+    public function's caller, under the caller's warning filters)."""
+    import warnings
+
+    result, caught = memo
+    for message, category in caught:
+        warnings.warn(message, category, stacklevel=3)
+    return _copy_model(result)
+
+
+def _compute_modal_model(fin, n_chord, n_span, shaft, f_max_hz, model) -> ModalModel:
     mesh = fin_mesh(fin, n_chord, n_span)
     K, M = assemble(mesh, fin.material)
     s = fin.shaft
@@ -190,7 +212,7 @@ def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None
     shaft : "single_node" (thesis) or "distributed" (rigid region of radius fin.shaft.radius).
     f_max_hz : frequency limit for the elastic modes kept (Hz), > 0.
     """
-    return _copy_model(_modal_model(*_model_key(fin, n_chord, n_span, shaft, f_max_hz), "FN2"))
+    return _memo_result(_modal_model(*_model_key(fin, n_chord, n_span, shaft, f_max_hz), "FN2"))
 
 
 def fin_fn1_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None,
@@ -198,7 +220,7 @@ def fin_fn1_modal_model(fin: FinDefinition | None = None, n_chord: int | None = 
                         f_max_hz: float = 1000.0) -> ModalModel:
     """The thesis's model FN1 (shaft spring to ground, no rigid mode; thesis Sec. 3.1.1, Fig 12)
     as a ModalModel with n_rigid = 0; arguments as :func:`fin_modal_model` (memoised too)."""
-    return _copy_model(_modal_model(*_model_key(fin, n_chord, n_span, shaft, f_max_hz), "FN1"))
+    return _memo_result(_modal_model(*_model_key(fin, n_chord, n_span, shaft, f_max_hz), "FN1"))
 
 
 @dataclass(frozen=True)
