@@ -8,7 +8,8 @@ thread), with the largest difference between the two results:
   (:func:`asekit.ase.state_space_response`), FWTF 3 of the fin on the 20000-point grid of
   :func:`asekit.ase.crossovers`;
 * the five closed-loop simulations of Ch. 5 (:func:`asekit.reproduction.ase.compute`):
-  ``method="RK45"`` vs the exact piecewise-linear propagation (default);
+  ``method="RK45"`` vs the exact piecewise-linear propagation (default), and five rigid-fin
+  ones of Ch. 4-5 (:func:`asekit.simulate.simulate`, the same);
 * the structure chapter's 96 x 112 distributed-shaft FN2 model: eigsh's own shift-invert
   factor (COLAMD, partial pivoting) vs the symmetric one
   (:func:`asekit.structure.modes.shift_invert_operator`), and a repeated call (memo);
@@ -20,6 +21,7 @@ GAF caches as they are) and prints its per-chapter seconds.
 """
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -87,6 +89,24 @@ def main(argv):
               for a, b in zip(r_a, r_b))
     row("Ch. 5 closed-loop simulations (5, 0.1-0.3 s)", t_b, t_a,
         f"{dev:.1e} of peak theta (RK45 rtol 1e-7)")
+
+    # 2b. the rigid-fin simulations of Ch. 4 and Ch. 5 (asekit.simulate.simulate)
+    from asekit.simulate import simulate
+    from asekit.servo import SYSTEM_2
+    rigid, hm = fin.rigid_fin_actuator(), fin.steady_hinge_moment()
+    rruns = [(SYSTEM_3, U, 0.0, 0.2), (SYSTEM_3, F, 0.0, 0.2), (SYSTEM_2, math.radians(14.0),
+             0.0, 0.1), (SYSTEM_3, 0.0, F, 0.1), (SYSTEM_3, -F, F, 0.12)]
+
+    def rigid_sims(method):
+        return [simulate(rigid, c, cmd, t_final=tf, theta0=th0, limits=THESIS_LIMITS,
+                         hinge_moment=hm, method=method) for c, cmd, th0, tf in rruns]
+
+    t_b, r_b = best_of(lambda: rigid_sims("RK45"), 1)
+    t_a, r_a = best_of(lambda: rigid_sims("auto"))
+    dev = max(np.max(np.abs(a.theta - b.theta)) / np.max(np.abs(b.theta))
+              for a, b in zip(r_a, r_b))
+    row("rigid-fin power-limited simulations (5, Ch. 4-5)", t_b, t_a,
+        f"{dev:.1e} of peak theta (RK45 rtol 1e-8)")
 
     # 3. the structure chapter's distributed-shaft model, and the memo
     fdef = reffin.load_fin()
