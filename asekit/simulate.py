@@ -329,7 +329,7 @@ def simulate(params: ActuatorParameters, controller: PDController,
              theta0: float = 0.0, limits: PowerLimits = THESIS_LIMITS,
              hinge_moment: Callable[[float, float, float], float] | None = None,
              sample_time: float | None = None, n_out: int = 2001,
-             max_step: float = 5e-5) -> SimulationResult:
+             max_step: float = 5e-5, method: str = "auto") -> SimulationResult:
     """Simulate the PD-controlled actuator on a rigid fin (thesis Figs 46, 52, 53, 55-57).
 
     Parameters
@@ -344,7 +344,13 @@ def simulate(params: ActuatorParameters, controller: PDController,
     sample_time : None for the continuous controller; else a zero-order-hold controller
         sampling every ``sample_time`` s (thesis Table 2: 1 kHz -> 1e-3), its derivative the
         backward difference of the sampled feedback.
-    n_out : number of output samples. max_step : integrator's largest step (s).
+    n_out : number of output samples. max_step : integrator's largest step (s) of RK45.
+    method : ``"auto"`` (default): exact piecewise-linear propagation (matrix exponential per
+        limit region, region changes located on the exact solution,
+        :func:`asekit.ase.propagate_exact`) when the loop is piecewise linear -- a constant
+        command and a :class:`SteadyHingeMoment` or :func:`no_hinge_moment` -- else RK45;
+        ``"RK45"``: always ``solve_ivp`` RK45 (rtol 1e-8; the two agree within it,
+        tests/test_simulate.py); ``"exact"``: refuse (ValueError) what is not piecewise linear.
 
     Raises ValueError/TypeError naming the argument for bad input, and ValueError before any
     work when the estimated step count (:func:`estimate_steps`) exceeds :data:`MAX_SIM_STEPS`.
@@ -381,8 +387,21 @@ def simulate(params: ActuatorParameters, controller: PDController,
     theta0 = in_range("theta0", theta0, -math.inf)
     x0 = np.array([theta0, 0.0, holding_current(params, hm(0.0, theta0, 0.0))])
     t_out = np.linspace(0.0, t_final, n_out)
+    if method not in ("auto", "exact", "RK45"):
+        raise ValueError(f"method must be 'auto', 'exact' or 'RK45', got {method!r}")
+    linear_hm = isinstance(hm, SteadyHingeMoment) or hm is no_hinge_moment
+    exact = method != "RK45" and linear_hm and not callable(command)
+    if method == "exact" and not exact:
+        raise ValueError("method='exact' needs a constant command and a SteadyHingeMoment or "
+                         "no_hinge_moment (a piecewise-linear loop); use 'auto' or 'RK45'")
 
-    if sample_time is None:
+    if exact:
+        from .ase import _voltage_bounds, propagate_exact
+        stiffness = hm.stiffness if isinstance(hm, SteadyHingeMoment) else 0.0
+        mats = _rigid_loop_matrices(params, controller, cmd(0.0), stiffness)
+        x, v_cmd = propagate_exact(mats, _voltage_bounds(params, limits, 3), controller,
+                                   cmd(0.0), t_out, x0, sample_time)
+    elif sample_time is None:
         def rhs(t, x):
             return actuator_rhs(params, controller, limits, x, cmd(t), x[0], x[1],
                                 hm(t, x[0], x[1]))
@@ -405,6 +424,26 @@ def simulate(params: ActuatorParameters, controller: PDController,
         alpha=alpha, current=x[2], voltage=volt, voltage_command=v_cmd,
         torque=motor_torque_at_fin(params, x[2]), hinge_moment=hinge, theta0=theta0,
         meta={"controller": controller, "limits": limits, "sample_time": sample_time})
+
+
+def _rigid_loop_matrices(params: ActuatorParameters, controller: PDController, command: float,
+                         stiffness: float) -> dict:
+    """The PD loop of :func:`simulate` on the rigid fin with the hinge moment ``stiffness``
+    theta (N m) as x' = F x + g V, x = [theta, omega, I] (Eqs. 2.30-2.37, module docstring),
+    and the PD demand V_cmd = k x + k0 on the transmission angle and rate, in the form of
+    :func:`asekit.ase.propagate_exact`."""
+    m, tr = params.motor, params.transmission
+    n, eta = tr.ratio, tr.efficiency
+    nj = n * params.inertia_at_motor
+    arow = np.array([stiffness / (n * eta) / nj, -m.viscous_damping * n / nj,
+                     m.torque_constant / nj])
+    F = np.array([[0.0, 1.0, 0.0], arow,
+                  [0.0, -m.back_emf_constant * n / m.inductance, -m.resistance / m.inductance]])
+    g = np.array([0.0, 0.0, 1.0 / m.inductance])
+    fb, om = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    kc, kp, kd = controller.gain, controller.kp, controller.kd
+    return {"F": F, "g": g, "arow": arow, "k": -kc * (kp * fb + kd * om),
+            "k0": kc * kp * command, "fb_row": fb, "om_row": om}
 
 
 def _simulate_zoh(params, controller, limits, cmd, hm, x0, t_out, ts, max_step):

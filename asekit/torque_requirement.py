@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -177,9 +178,21 @@ def tune_rate_limit(natural_frequency: float = 157.0, damping_ratio: float = 1.0
     bracket : rate limits (rad/s) bracketing the answer.
 
     Raises ValueError if even the upper bracket (nearly linear) cannot settle in time.
+
+    Memoised on its arguments (the result is an immutable dataclass of floats): the servo and
+    supersonic chapters of one reproduction tune the same profile once.
     """
     in_range("settling_time", settling_time)
+    args = (natural_frequency, damping_ratio, step, settling_time, band, tuple(bracket))
+    try:
+        hash(args)
+    except TypeError:                       # unhashable arguments: not memoised
+        return _tune_rate_limit.__wrapped__(*args)
+    return _tune_rate_limit(*args)
 
+
+@lru_cache(maxsize=64)
+def _tune_rate_limit(natural_frequency, damping_ratio, step, settling_time, band, bracket):
     def excess(rate):
         prof = SecondOrderProfile(natural_frequency, damping_ratio, rate)
         return profile_step(prof, step, t_final=4.0 * settling_time, band=band,

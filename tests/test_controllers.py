@@ -30,7 +30,7 @@ def test_sampled_simulation_matches_the_nonlinear_integrator(model):
     # motor equations) and by the exact discretisation with the clip on the held voltage
     cmd = math.radians(1.0)
     ref = ase.simulate_closed_loop(model, SYSTEM_3, cmd, "AEM1", t_final=0.03, n_out=301,
-                                   sample_time=1e-3)
+                                   sample_time=1e-3, method="RK45")
     plant = ase.sampled_plant(model, "AEM1", 1e-3)
     r = ase.simulate_sampled(plant, pd_controller(10.0, 275.0, 1.0), cmd, t_final=0.03,
                              delay_samples=0)

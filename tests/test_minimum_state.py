@@ -164,3 +164,31 @@ def test_bad_input_raises():
         minimum_state_fit(k, Q, -1.0)
     with pytest.raises(ValueError, match="k_band"):
         reduced_frequency_weights(k, 0.0)
+
+
+@pytest.mark.parametrize("con", [dict(k0_con=True, match_idx=None), dict(k0_con=True, match_idx=9),
+                                 dict(k0_con=False, match_idx=None)])
+def test_batched_column_solves_equal_the_column_by_column_solves(con):
+    # issue 12: with one weight per k the column (row) problems of both ALS steps share the
+    # design matrix and the constraint rows, so they are solved together (several right-hand
+    # sides); that must equal the problem-by-problem solution to round-off, constraints
+    # included (k = 0 steady value, match at one k)
+    from asekit.rfa.minimum_state import _Als
+
+    k, Q, r = _ms_data(n=4, roots=(0.1, 0.4, 1.2))
+    Q = Q + 1e-2 * np.random.default_rng(5).normal(size=Q.shape)      # not exactly of the form
+    W = np.broadcast_to(np.linspace(1.0, 2.0, k.size)[:, None, None], Q.shape).copy()
+    als = _Als(k, Q, W, r, **con)
+    assert als.batch
+    D = np.random.default_rng(6).normal(size=(4, r.size))
+    E = np.random.default_rng(7).normal(size=(r.size, 4))
+    A_b, E_b = als.step_E(D)
+    A_d, D_b = als.step_D(E)
+    als.batch = False
+    A_c, E_c = als.step_E(D)
+    A_e, D_c = als.step_D(E)
+    for x, y in ((A_b, A_c), (E_b, E_c), (A_d, A_e), (D_b, D_c)):
+        np.testing.assert_allclose(x, y, rtol=1e-10, atol=1e-12 * np.abs(y).max())
+    if con["k0_con"]:                # the steady constraint holds: A0 + D (g(0)) E = Q(k0)
+        Qt = als.evaluate(A_b, D, E_b)
+        np.testing.assert_allclose(Qt[0].real, Q[0].real, atol=1e-10)

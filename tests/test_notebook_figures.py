@@ -13,8 +13,8 @@ after the inline backend has displayed (and closed) the cell's figures. It check
 
 Slow (all six chapter notebooks: about 100 s on an idle two-core machine, 4 min on a loaded
 one; the first run after a change to the physics also recomputes the cached converged-flutter
-study of ch3_flutter, several minutes): marked ``slow``; it runs in the default ``pytest`` (and
-CI), deselect with ``-m "not slow"``.
+study of ch3_flutter, several minutes): marked ``slow``; the default ``pytest`` deselects it,
+``pytest -m slow`` (and CI, .ci/run) runs it.
 """
 
 from __future__ import annotations

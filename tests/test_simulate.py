@@ -182,3 +182,29 @@ def test_fin_inertia_through_the_hinge_moment_is_equivalent():
     for _ in range(200):
         alpha = motor_rhs(p0, NO_LIMITS, x, 10.0, 0.3 - m_eff * alpha)[1]
     assert alpha == pytest.approx(a[1], rel=1e-9)
+
+
+@pytest.mark.parametrize("sample_time", [None, 1e-3])
+@pytest.mark.parametrize("limits", ["thesis", "regulator"])
+def test_exact_propagation_agrees_with_rk45(limits, sample_time):
+    # issue 12: with a constant command and the steady hinge moment the power-limited loop is
+    # piecewise linear, so method="auto" propagates it exactly (matrix exponential per limit
+    # region); it must agree with the RK45 integration (rtol 1e-8) of the same equations to
+    # RK45's accuracy (measured <= 2e-6 of each history's peak; 1e-5 allowed). 15 deg steps
+    # that saturate the 24 V supply; the regulator case with a 3 A limit that binds.
+    lim = THESIS_LIMITS if limits == "thesis" else PowerLimits(
+        current_limit=3.0, current_limit_model="regulator")
+    kw = dict(t_final=0.08, theta0=15 * DEG, limits=lim, sample_time=sample_time,
+              hinge_moment=SteadyHingeMoment())
+    ex = simulate(P, SYSTEM_3, -15 * DEG, **kw)
+    rk = simulate(P, SYSTEM_3, -15 * DEG, method="RK45", **kw)
+    for name in ("theta", "omega", "current", "voltage", "alpha", "torque", "hinge_moment"):
+        a, b = getattr(ex, name), getattr(rk, name)
+        assert np.max(np.abs(a - b)) <= 1e-5 * np.max(np.abs(b)), name
+    assert np.max(np.abs(ex.voltage)) == pytest.approx(24.0, rel=1e-12)   # the clip binds
+    if limits == "regulator":
+        assert 3.0 * 0.999 < np.max(np.abs(ex.current)) <= 3.0 * (1 + 1e-12)
+    with pytest.raises(ValueError, match="method"):
+        simulate(P, SYSTEM_3, lambda t: 0.1, method="exact")
+    with pytest.raises(ValueError, match="method"):
+        simulate(P, SYSTEM_3, 0.1, method="euler")

@@ -336,3 +336,20 @@ def test_mitc4_passes_the_constant_curvature_patch_test_on_a_distorted_mesh():
     K = K.toarray()
     ui = np.linalg.solve(K[np.ix_(idof, idof)], -K[np.ix_(idof, bdof)] @ u[bdof])
     np.testing.assert_allclose(ui, u[idof], rtol=0, atol=1e-10 * np.abs(u).max())
+
+
+def test_memoised_modal_model_is_a_copy_and_warns_every_time(fin):
+    # issue 12: fin_modal_model is computed once per definition and arguments in a process;
+    # every call must still get its own arrays (bit-identical to the first) and the warnings
+    # of the computation
+    for _ in range(2):
+        with pytest.warns(UserWarning, match="not resolved"):
+            a = fin_modal_model(fin, shaft="distributed")
+    with pytest.warns(UserWarning, match="not resolved"):
+        b = fin_modal_model(fin, shaft="distributed")
+    assert a is not b and a.M is not b.M and a.shapes is not b.shapes
+    for name in ("frequencies_hz", "M", "K", "C", "shapes", "nodes", "elements"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    a.M[0, 0] = -1.0                       # a caller's edit does not reach the next caller
+    with pytest.warns(UserWarning, match="not resolved"):
+        assert fin_modal_model(fin, shaft="distributed").M[0, 0] == b.M[0, 0] > 0

@@ -151,10 +151,14 @@ def dc_gains(plant, controller, names, delay=DELAY) -> dict:
 
 
 def check(controller: DigitalController, model, topology: str, mach=0.5, altitude=0.0,
-          case="nominal", sensor=None, t_final: float = 0.15, delay: int = DELAY) -> Check:
+          case="nominal", sensor=None, t_final: float = 0.15, delay: int = DELAY,
+          plant=None) -> Check:
     """Table 2 at the fin root (module docstring) for ``controller`` on ``model``, with
-    ``delay`` samples of computational delay (default one, the thesis's processor)."""
-    plant = ase.sampled_plant(model, topology, SAMPLE_TIME, sensor=sensor)
+    ``delay`` samples of computational delay (default one, the thesis's processor).
+    ``plant``: the ``ase.sampled_plant(model, topology, SAMPLE_TIME, sensor=sensor)`` if the
+    caller has it already (it is built otherwise)."""
+    if plant is None:
+        plant = ase.sampled_plant(model, topology, SAMPLE_TIME, sensor=sensor)
     Phi, _ = ase.closed_loop_sampled_matrix(plant, controller, delay)
     stable = bool(np.max(np.abs(np.linalg.eigvals(Phi))) < 1.0)
     corners = [f"theta_{c}" for c in reffin.CORNERS]
@@ -343,8 +347,12 @@ def envelope_table(data=None, design_set=None, machs=MACHS, altitudes=ALTITUDES,
         for h in altitudes:
             for case in cases:
                 model = fin_model(M, h, case, data=data)
+                plants = {}                  # one sampled plant per topology and condition
                 for key, (ctl, topo) in design_set.items():
-                    c = check(controller_at(ctl, M, h), model, topo, M, h, case)
+                    if topo not in plants:
+                        plants[topo] = ase.sampled_plant(model, topo, SAMPLE_TIME)
+                    c = check(controller_at(ctl, M, h), model, topo, M, h, case,
+                              plant=plants[topo])
                     out.append(replace(c, design=key))
     return out
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -140,12 +141,69 @@ def fin_supported(fin: FinDefinition, mesh: PlateMesh, model: str, shaft: str = 
                          fictitious_inertia_factor=s.fictitious_inertia_factor)
 
 
+def _copy_model(model: ModalModel) -> ModalModel:
+    """A copy of ``model`` with its own arrays (what the memo hands out)."""
+    return replace(model, **{f: np.array(getattr(model, f)) for f in
+                             ("frequencies_hz", "M", "K", "C", "nodes", "shapes", "elements")})
+
+
+@lru_cache(maxsize=32)
+def _modal_model(fin: FinDefinition, n_chord: int, n_span: int, shaft: str, f_max_hz: float,
+                 model: str):
+    """(model, warnings): the FN2 (``model="FN2"``) or FN1 modal model and the warnings its
+    computation gave; memoised on the (hashable, frozen) fin definition and the arguments, so
+    a run that asks for the same model twice computes it once. Callers get copies
+    (:func:`_copy_model`) and the warnings again (:func:`_memo_result`): the memo changes
+    neither a result nor what the caller is told."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = _compute_modal_model(fin, n_chord, n_span, shaft, f_max_hz, model)
+    return result, tuple((w.message, w.category) for w in caught)
+
+
+def _memo_result(memo) -> ModalModel:
+    """A copy of a memoised model, its computation's warnings issued again (as from the
+    public function's caller, under the caller's warning filters)."""
+    import warnings
+
+    result, caught = memo
+    for message, category in caught:
+        warnings.warn(message, category, stacklevel=3)
+    return _copy_model(result)
+
+
+def _compute_modal_model(fin, n_chord, n_span, shaft, f_max_hz, model) -> ModalModel:
+    mesh = fin_mesh(fin, n_chord, n_span)
+    K, M = assemble(mesh, fin.material)
+    s = fin.shaft
+    if model == "FN2":
+        return fictitious_mass_modal_model(mesh, K, M, s.axis_point, s.torsional_stiffness,
+                                           region=_region(shaft), radius=s.radius,
+                                           fictitious_inertia_factor=s.fictitious_inertia_factor,
+                                           f_max_hz=f_max_hz)
+    fn1 = fin_supported(fin, mesh, "FN1", shaft, K, M)
+    return elastic_modal_model(modes_up_to(fn1, f_max_hz, M_fin=M), M, f_max_hz,
+                               axis_x=fin.shaft.axis_point[0])
+
+
+def _model_key(fin, n_chord, n_span, shaft, f_max_hz):
+    fin = load_fin() if fin is None else fin
+    positive("f_max_hz", f_max_hz)
+    _region(shaft)
+    n_c = fin.n_chord if n_chord is None else n_chord
+    n_s = fin.n_span if n_span is None else n_span
+    return fin, n_c, n_s, shaft, f_max_hz
+
+
 def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None,
                     n_span: int | None = None, shaft: str = "single_node",
                     f_max_hz: float = 1000.0) -> ModalModel:
     """The FN2 modal model of a fin definition: rigid pitch mode + elastic modes below
     ``f_max_hz`` with out-of-plane motion (thesis Sec. 3.1, Table 6, Eqs. (2.45)-(2.46)); see
-    :func:`fictitious_mass_modal_model`.
+    :func:`fictitious_mass_modal_model`. Computed once per definition and arguments within a
+    process (memoised; every call returns its own copy).
 
     Parameters
     ----------
@@ -154,29 +212,15 @@ def fin_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None
     shaft : "single_node" (thesis) or "distributed" (rigid region of radius fin.shaft.radius).
     f_max_hz : frequency limit for the elastic modes kept (Hz), > 0.
     """
-    fin = load_fin() if fin is None else fin
-    positive("f_max_hz", f_max_hz)
-    mesh = fin_mesh(fin, n_chord, n_span)
-    K, M = assemble(mesh, fin.material)
-    s = fin.shaft
-    return fictitious_mass_modal_model(mesh, K, M, s.axis_point, s.torsional_stiffness,
-                                       region=_region(shaft), radius=s.radius,
-                                       fictitious_inertia_factor=s.fictitious_inertia_factor,
-                                       f_max_hz=f_max_hz)
+    return _memo_result(_modal_model(*_model_key(fin, n_chord, n_span, shaft, f_max_hz), "FN2"))
 
 
 def fin_fn1_modal_model(fin: FinDefinition | None = None, n_chord: int | None = None,
                         n_span: int | None = None, shaft: str = "single_node",
                         f_max_hz: float = 1000.0) -> ModalModel:
     """The thesis's model FN1 (shaft spring to ground, no rigid mode; thesis Sec. 3.1.1, Fig 12)
-    as a ModalModel with n_rigid = 0; arguments as :func:`fin_modal_model`."""
-    fin = load_fin() if fin is None else fin
-    positive("f_max_hz", f_max_hz)
-    mesh = fin_mesh(fin, n_chord, n_span)
-    K, M = assemble(mesh, fin.material)
-    fn1 = fin_supported(fin, mesh, "FN1", shaft, K, M)
-    return elastic_modal_model(modes_up_to(fn1, f_max_hz, M_fin=M), M, f_max_hz,
-                               axis_x=fin.shaft.axis_point[0])
+    as a ModalModel with n_rigid = 0; arguments as :func:`fin_modal_model` (memoised too)."""
+    return _memo_result(_modal_model(*_model_key(fin, n_chord, n_span, shaft, f_max_hz), "FN1"))
 
 
 @dataclass(frozen=True)

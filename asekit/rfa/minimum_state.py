@@ -158,11 +158,14 @@ class MinimumStateFit:
 # least squares with equality constraints
 # ---------------------------------------------------------------------------------------------
 def _lsq_eq(G, h, C, d):
-    """min ||G x - h|| subject to C x = d (null-space method); C may be empty."""
+    """min ||G x - h|| subject to C x = d (null-space method); C may be empty. ``h`` and ``d``
+    may hold several right-hand sides as columns (one problem per column, same G and C)."""
     if C is None or C.shape[0] == 0:
         return np.linalg.lstsq(G, h, rcond=None)[0]
     x_p = np.linalg.lstsq(C, d, rcond=None)[0]
-    if np.linalg.norm(C @ x_p - d) > 1e-8 * max(np.linalg.norm(d), 1.0):
+    res = np.linalg.norm(np.reshape(C @ x_p - d, (C.shape[0], -1)), axis=0)
+    ref = np.maximum(np.linalg.norm(np.reshape(d, (C.shape[0], -1)), axis=0), 1.0)
+    if np.any(res > 1e-8 * ref):
         raise ValueError("the equality constraints of the fit are inconsistent (constrain_k0 "
                          "and match_k together at the same k, or too few coefficients)")
     _, sv, vt = np.linalg.svd(C)
@@ -196,8 +199,9 @@ class _Als:
             self.con_rows.append((0, "re"))
         if match_idx is not None:
             self.con_rows += [(match_idx, "re"), (match_idx, "im")]
-        # one weight per k and no constraint: all column (row) problems share one matrix
-        self.batch = (not self.con_rows) and bool(np.all(W == W[:, :1, :1]))
+        # one weight per k: all column (row) problems share one design matrix (and the same
+        # constraint rows), so they are solved together with several right-hand sides
+        self.batch = bool(np.all(W == W[:, :1, :1]))
 
     def _solve(self, lag_coef, q, w):
         """One column (or row) problem. lag_coef (n_k, n_other, n_L) complex: coefficient of
@@ -225,7 +229,8 @@ class _Als:
 
     def _solve_all(self, lag_coef, Qs):
         """All n column (or row) problems at once when the weights are one per k: the
-        design matrix is common, so one least-squares solve with n right-hand sides.
+        design matrix (and the constraint rows of :meth:`_solve`) is common, so one
+        (constrained) least-squares solve with n right-hand sides.
         Qs (n_k, n_other, n_problems). Returns (a0, a1, a2 (n, n_problems), lag (n_L, n_p))."""
         n, nk = self.n, self.k.size
         Gc = np.zeros((nk, n, 3 * n + self.nL), complex)
@@ -236,7 +241,13 @@ class _Als:
         Gw, qw = Gc * w, Qs * w
         G = np.vstack([Gw.real.reshape(nk * n, -1), Gw.imag.reshape(nk * n, -1)])
         h = np.vstack([qw.real.reshape(nk * n, -1), qw.imag.reshape(nk * n, -1)])
-        x = np.linalg.lstsq(G, h, rcond=None)[0]
+        C, d = None, None
+        if self.con_rows:
+            C = np.vstack([getattr(Gc[f], "real" if part == "re" else "imag")
+                           for f, part in self.con_rows])
+            d = np.vstack([getattr(Qs[f], "real" if part == "re" else "imag")
+                           for f, part in self.con_rows])
+        x = _lsq_eq(G, h, C, d)
         return x[:n], x[n:2 * n], x[2 * n:3 * n], x[3 * n:]
 
     def step_E(self, D):

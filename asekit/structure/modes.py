@@ -62,8 +62,46 @@ def _fin_mass_share(fin_vecs: np.ndarray, M_fin) -> np.ndarray:
     return np.divide(w_part, total, out=np.zeros_like(total), where=total > 0)
 
 
+#: From this many degrees of freedom the shift-invert factor of K - sigma M is a symmetric
+#: (minimum-degree on A^T + A, no pivoting) sparse LU instead of eigsh's default (COLAMD, partial
+#: pivoting): K - sigma M = K + |sigma| M is positive definite for sigma < 0, so no pivoting is
+#: needed, and the fill is 2.4x smaller (the fin's 96 x 112 distributed-shaft FN2 system, 32816
+#: dof: factor 0.5 s vs 2.0 s, a solve 15 ms vs 47 ms, issue 12). Smaller systems keep eigsh's
+#: own factor bit for bit (the shipped GAF database's mode set).
+SYMMETRIC_LU_MIN_DOF = 2000
+
+
+def shift_invert_operator(system: SupportedSystem, sigma: float):
+    """(K - sigma M)^-1 as a ``LinearOperator`` for ``eigsh(..., sigma=sigma, OPinv=...)``,
+    factored once (reusable across eigsh calls on the same system), or None below
+    :data:`SYMMETRIC_LU_MIN_DOF` (eigsh then factors itself).
+
+    SuperLU with ``permc_spec="MMD_AT_PLUS_A"``, ``diag_pivot_thresh=0`` and symmetric mode
+    (valid for the positive definite K + |sigma| M, sigma < 0); the factor is checked by the
+    residual of one solve and, if that is not small (an indefinite or singular matrix), redone
+    with SuperLU's default partial pivoting."""
+    n = system.K.shape[0]
+    if n < SYMMETRIC_LU_MIN_DOF:
+        return None
+    A = (system.K - sigma * system.M).tocsc()
+    b = np.cos(np.arange(n, dtype=float))
+    lu = None
+    if sigma < 0:
+        try:
+            lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                           options={"SymmetricMode": True})
+            x = lu.solve(b)
+            if not np.linalg.norm(A @ x - b) <= 1e-6 * np.linalg.norm(b):
+                lu = None
+        except RuntimeError:                 # a zero pivot: not positive definite
+            lu = None
+    if lu is None:
+        lu = spla.splu(A)
+    return spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
+
+
 def normal_modes(system: SupportedSystem, n_modes: int = 10, M_fin=None,
-                 shift_hz: float = 1.0) -> NormalModes:
+                 shift_hz: float = 1.0, opinv=None) -> NormalModes:
     """Lowest ``n_modes`` natural modes of a supported system (thesis Eq. (2.4)).
 
     Shift-invert Lanczos (``eigsh``) about the negative shift -(2 pi ``shift_hz``)^2, so that a
@@ -74,6 +112,7 @@ def normal_modes(system: SupportedSystem, n_modes: int = 10, M_fin=None,
 
     M_fin : the fin's global (unsupported) mass matrix, used for each mode's out-of-plane
     kinetic-energy share; without it ``out_of_plane`` is NaN.
+    opinv : a :func:`shift_invert_operator` of this system and shift (default: made here).
     """
     n_q = system.K.shape[0]
     if int(n_modes) != n_modes or n_modes < 1:
@@ -86,7 +125,10 @@ def normal_modes(system: SupportedSystem, n_modes: int = 10, M_fin=None,
         lam, q = sla.eigh(system.K.toarray(), system.M.toarray(), subset_by_index=(0, n_modes - 1))
     else:
         v0 = np.ones(n_q) / math.sqrt(n_q)
-        lam, q = spla.eigsh(system.K, k=n_modes, M=system.M, sigma=sigma, which="LM", v0=v0)
+        if opinv is None:
+            opinv = shift_invert_operator(system, sigma)
+        lam, q = spla.eigsh(system.K, k=n_modes, M=system.M, sigma=sigma, which="LM", v0=v0,
+                            OPinv=opinv)
     order = np.argsort(lam)
     lam, q = lam[order], q[:, order]
     # exact mass normalisation (ARPACK returns M-orthonormal vectors to ~1e-12)
@@ -128,11 +170,13 @@ def select_modes(frequencies_hz: np.ndarray, out_of_plane: np.ndarray, f_max_hz:
 
 
 def modes_up_to(system: SupportedSystem, f_max_hz: float, M_fin=None, n_start: int = 12) -> NormalModes:
-    """All modes below ``f_max_hz`` plus at least one above it (to show where the cut falls)."""
+    """All modes below ``f_max_hz`` plus at least one above it (to show where the cut falls);
+    the shift-invert factor is made once for all the eigsh calls."""
     n = n_start
     n_q = system.K.shape[0]
+    opinv = shift_invert_operator(system, -(2 * math.pi) ** 2)       # normal_modes' shift
     while True:
-        modes = normal_modes(system, n, M_fin=M_fin)
+        modes = normal_modes(system, n, M_fin=M_fin, opinv=opinv)
         if modes.frequencies_hz[-1] > f_max_hz or n >= n_q:
             return modes
         n = min(2 * n, n_q)
