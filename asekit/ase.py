@@ -42,6 +42,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .aeroelastic import aeroelastic_matrices, aeroelastic_model
+from .blas import small_dense
 from .servo import ActuatorParameters, PDController, actuator_state_space
 from .simulate import THESIS_LIMITS, PowerLimits, applied_voltage, controller_voltage, motor_rhs
 from .validate import finite, positive
@@ -313,6 +314,7 @@ class Crossovers:
         return float(self.gain_margins_db[0]) if self.gain_margins_db.size else math.inf
 
 
+@small_dense
 def state_space_response(A, B, C, D, s, block: int = 4096) -> np.ndarray:
     """G(s) = C (s I - A)^-1 B + D of the state space (A, B, C, D) at every complex ``s``,
     shape (n_outputs, n_inputs, len(s)): all frequencies in one batched pass.
@@ -924,6 +926,7 @@ def propagate_exact(mats: dict, bounds: list, controller, command: float, t_out,
     return x_out, v_out
 
 
+@small_dense
 def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController, command: float,
                          topology: str = "AEM1", limits: PowerLimits | None = THESIS_LIMITS,
                          t_final: float = 0.2, theta0: float = 0.0, n_out: int = 4001,
@@ -1145,6 +1148,7 @@ class SampledPlant:
         return list(self.sys.output_labels)
 
 
+@small_dense
 def sampled_plant(model: AeroservoelasticModel, topology: str, sample_time: float = 1e-3,
                   sensor: SensorModel | None = None, substeps: int = 10) -> SampledPlant:
     """The plant seen by a digital controller: voltage in (held over each sample, ZOH),

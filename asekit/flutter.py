@@ -37,6 +37,7 @@ import numpy as np
 from scipy import linalg, optimize
 
 from .aeroelastic import ModalArrays, aeroelastic_matrices, modal_arrays
+from .blas import small_dense
 from .validate import positive, positive_array
 
 #: relative tolerance of the stability test: a root is unstable when Re p > RTOL_UNSTABLE * scale,
@@ -293,6 +294,7 @@ class _PkProblem:
         return p_best, v_best, abs(p_best.imag) * b / U, False
 
 
+@small_dense
 def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
                include_rigid: bool = False, interpolation: str = "linear", tol: float = 1e-7,
                max_iter: int = 60) -> PkResult:
@@ -605,6 +607,7 @@ def _eig_structural(mats, ns):
     return lam, vec[:ns]
 
 
+@small_dense
 def root_locus(modal, rfa, density: float, velocities, substeps: int | None = None
                ) -> RootLocusResult:
     """Eigenvalues of A_sys (Eq. 2.63) over ``velocities`` with the aeroelastic roots tracked.
@@ -736,6 +739,7 @@ def initial_state(n_states: int, coordinate: int = 1) -> np.ndarray:
     return z0
 
 
+@small_dense
 def simulate_free_response(A: np.ndarray, z0: np.ndarray, t_end: float = 0.25,
                            max_step: float = 1e-4, method: str = "RK45", n_out: int = 2501,
                            rtol: float = 1e-6, atol: float = 1e-9) -> TimeResponse:
@@ -851,6 +855,7 @@ class TimeDomainSweep:
         return f"onset at {self.onset_speed:.6g} {unit}"
 
 
+@small_dense
 def time_domain_sweep(modal, rfa, density: float, velocities, coordinate: int = 1,
                       t_end: float = 0.25, max_step: float = 1e-4, method: str = "exact",
                       window: float | None = None, refine: bool = True) -> TimeDomainSweep:

@@ -107,6 +107,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
+from .blas import small_dense
 from .validate import finite, in_range, positive
 
 # ---------------------------------------------------------------------------------------------
@@ -348,6 +349,7 @@ class HarmonicBalance:
         return s[-1] if s else None
 
 
+@small_dense
 def harmonic_balance(system: ConnectedSystem, connection: Connection, n_grid: int = 48,
                      amplitude_range: tuple[float, float] | None = None,
                      min_frequency_hz: float = 0.05) -> HarmonicBalance:
@@ -480,6 +482,7 @@ class LcoCurve:
         return None
 
 
+@small_dense
 def lco_curve(system_at, velocities, connection: Connection, **kwargs) -> LcoCurve:
     """:func:`harmonic_balance` at each airspeed. ``system_at(U)`` returns the
     :class:`ConnectedSystem` at airspeed U (m/s); extra keyword arguments go to
@@ -703,6 +706,7 @@ def _transfer(system: ConnectedSystem, s: complex) -> complex:
     return complex(system.c @ np.linalg.solve(s * np.eye(n) - system.A0, system.b))
 
 
+@small_dense
 def multi_harmonic_balance(system: ConnectedSystem, connection: Connection, amplitude: float,
                            frequency_hz: float, bias: float = 0.0, n_harmonics: int = 7,
                            n_samples: int = 1024, tol: float = 1e-10,
@@ -940,6 +944,7 @@ def _check_run(connection, system, x0, t_final):
     return x, positive("t_final", t_final)
 
 
+@small_dense
 def simulate(system: ConnectedSystem, connection: Connection, x0, t_final: float,
              u=None, n_out: int = 20001, rtol: float = 1e-8, atol: float = 1e-11,
              method: str = "RK45", max_step: float = math.inf, max_switches: int = 200000,
@@ -1073,6 +1078,7 @@ def simulate(system: ConnectedSystem, connection: Connection, x0, t_final: float
                                diverged=diverged)
 
 
+@small_dense
 def simulate_exact(system: ConnectedSystem, connection: Connection, x0, t_final: float,
                    u=None, step: float = 5e-5, max_switches: int = 200000,
                    divergence_limit: float | None = None) -> PiecewiseSimulation:

@@ -54,6 +54,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from . import metrics
+from .blas import small_dense
 from .servo import ActuatorParameters, PDController
 from .validate import in_range
 from .torque_requirement import (SEA_LEVEL_DENSITY, SEA_LEVEL_SPEED_OF_SOUND, THESIS_Q_CC,
@@ -324,6 +325,7 @@ def estimate_steps(params: ActuatorParameters, controller: PDController, t_final
     return int(min(steps, 1e18)), lam
 
 
+@small_dense
 def simulate(params: ActuatorParameters, controller: PDController,
              command: float | Callable[[float], float], t_final: float = 0.1,
              theta0: float = 0.0, limits: PowerLimits = THESIS_LIMITS,

@@ -49,6 +49,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..blas import small_dense
 from ..validate import positive
 from .roger import check_gaf_table, default_lag_roots, fit_errors, gaf_at_mach
 
@@ -337,6 +338,7 @@ def _initial_D(n: int, nL: int) -> np.ndarray:
     return D0
 
 
+@small_dense
 def minimum_state_fit(k, Q, b_ref: float, n_states: int = 4, lag_roots=None, weights=None,
                       normalize: bool = False, normalize_floor: float = 0.01,
                       constrain_k0: bool = False, match_k: float | None = None,

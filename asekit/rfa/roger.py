@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..blas import small_dense
 from ..validate import in_range, positive
 
 
@@ -164,6 +165,7 @@ def design_rows(k: np.ndarray, lag_roots: np.ndarray) -> tuple[np.ndarray, np.nd
     return kr, ki
 
 
+@small_dense
 def roger_fit(k, Q, b_ref: float, lag_roots=None, n_lags: int = 4, weights=None,
               constrain_k0: bool = False, mach: float | None = None) -> RogerFit:
     """Least-squares Roger fit of tabulated GAFs, Eqs. (2.13)-(2.24).
