@@ -174,3 +174,19 @@ def test_method_pressures_dlm_equals_pressure_matrices():
         assert np.abs(got[ik] - ref).max() <= 1e-12 * np.abs(ref).max()
     with pytest.raises(ValueError, match="normalwash"):
         pressures(m, 0.5, ks, 0.5, lambda kk: np.ones(3), method="dlm")
+
+
+def test_control_point_on_a_side_edge_line_is_refused_not_nan():
+    # the wing's control points (y = 1) lie on the spanwise line of the tail boxes' tip edges
+    # (y = 1): the closed-form kernel integrals are infinite there ([R71] Eq. 31, F = 2e /
+    # (ybar^2 - e^2)) and D would hold NaN (PanelAero 2025.8 gives NaN on these boxes as well)
+    m = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, 2, 0), 1.0, 2, 1, "wing"),
+                       TrapezoidSurface((3, 0, 0), 1.0, (3, 1, 0), 1.0, 2, 1, "tail")])
+    with pytest.raises(ValueError, match="mesh: the DLM normalwash matrix is not finite"):
+        normalwash_matrix(m, 0.5, 0.5, 0.5)
+    with pytest.raises(ValueError, match="mesh"):
+        list(iter_normalwash_matrices(m, 0.5, [0.1, 0.5], 0.5))
+    # shifting the tail tip off the line gives a finite matrix
+    m2 = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, 2, 0), 1.0, 2, 1, "wing"),
+                        TrapezoidSurface((3, 0, 0), 1.0, (3, 0.9, 0), 1.0, 2, 1, "tail")])
+    assert np.isfinite(normalwash_matrix(m2, 0.5, 0.5, 0.5)).all()

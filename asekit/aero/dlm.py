@@ -856,7 +856,31 @@ def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str
 
 def _normalwash_batch(mesh: BoxMesh, mach: float, ks: np.ndarray, b: float, method: str,
                       symmetric: bool, progress=None, d0: np.ndarray | None = None) -> np.ndarray:
-    """D (n_k, n, n) of validated arguments; ``d0`` the vortex lattice D0 if already known."""
+    """D (n_k, n, n) of validated arguments; ``d0`` the vortex lattice D0 if already known.
+    Raises ValueError for a mesh whose matrix is not finite (:func:`_check_finite`)."""
+    out = _normalwash_batch_unchecked(mesh, mach, ks, b, method, symmetric, progress, d0)
+    _check_finite(mesh, out)
+    return out
+
+
+def _check_finite(mesh: BoxMesh, d: np.ndarray) -> None:
+    """Refuse a non-finite D: the one configuration known to give it is a control point on the
+    spanwise line of a sending box's side edge in its plane (|ybar| = e, zbar = 0), where the
+    closed-form line integrals of [R71] Eq. 31 (F = 2e / (ybar^2 - e^2)) are infinite; the
+    kernel numerator there is zero upstream (inf * 0 = NaN) and PanelAero gives NaN too."""
+    if np.isfinite(d).all():
+        return
+    _, r, s = (int(v) for v in np.argwhere(~np.isfinite(d))[0])
+    raise ValueError(
+        f"mesh: the DLM normalwash matrix is not finite at receiver {r} (control point "
+        f"{np.round(mesh.control_point[r], 6).tolist()}) and sender {s} (doublet line "
+        f"{np.round(mesh.doublet_p1[s], 6).tolist()} to {np.round(mesh.doublet_p3[s], 6).tolist()}): "
+        "a control point on the spanwise line of another box's side edge makes the kernel "
+        "integrals singular; shift the strip edges of one surface so that no control point is "
+        "spanwise-aligned with a box edge of another surface in its plane")
+
+
+def _normalwash_batch_unchecked(mesh, mach, ks, b, method, symmetric, progress, d0):
     snd = _Senders(mesh, symmetric)
     n = mesh.n
     out = np.empty((ks.size, n, n), complex)
