@@ -129,13 +129,14 @@ def test_stream_bad_input_is_refused_before_any_work():
 
 
 def test_streamed_sweep_memory_is_one_batch():
-    # 12 matrices of 600 boxes (5.8 MB each): all at once 69 MB; streamed one at a time, the
-    # traced peak must stay below half of that (one D, D0, one chunk of kernel arrays: 22 MB;
-    # 76 MB unstreamed)
+    # 12 matrices of 600 boxes (one D: 5.5 MiB): all at once the traced peak is 76 MiB; streamed
+    # one at a time it must stay below 3.5 D (measured 16 MiB: one D, D0 = 0.5 D and the kernel
+    # chunk; a stream that kept the previous D alive while computing the next measured 21.5)
     m = mesh_surfaces(TrapezoidSurface((0, 0, 0), 1.0, (0.5, 3, 0.0), 0.6, 12, 50))
     ks = np.linspace(0.05, 1.5, 12)
     one = 16 * m.n ** 2
     w = _modal_wash(m, 0.1, 0.5)
+    normalwash_matrices(m, 0.6, [0.1], 0.5)                 # JIT compilation outside the trace
     tracemalloc.start()
     q = map_normalwash_matrices(m, 0.6, ks, 0.5,
                                 lambda i, kk, d: factor_normalwash_matrix(d, True).pressures(w),
@@ -143,7 +144,7 @@ def test_streamed_sweep_memory_is_one_batch():
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     assert len(q) == ks.size
-    assert peak < ks.size * one / 2, (peak / 2**20, ks.size * one / 2**20)
+    assert peak < 3.5 * one, (peak / 2**20, one / 2**20)
 
 
 def test_gaf_builder_streams_to_the_same_matrices():

@@ -75,6 +75,7 @@ pairwise path to rounding (tests/test_dlm.py).
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -130,6 +131,41 @@ def _check_method(method: str):
     if method not in _METHODS:
         raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}")
     return _METHODS[method]
+
+
+#: Implementations of the all-planar kernel loop: the numpy one (always available) and the
+#: compiled numba one (:mod:`asekit.aero._dlm_compiled`, when numba is installed).
+KERNELS = ("numpy", "compiled")
+#: Environment variable that chooses the default kernel implementation (``numpy`` or
+#: ``compiled``); unset: compiled if numba is installed, else numpy.
+KERNEL_ENV = "ASEKIT_DLM_KERNEL"
+
+
+def compiled_kernel_available() -> bool:
+    """True if numba is installed (the compiled kernel can be used)."""
+    import importlib.util
+    return importlib.util.find_spec("numba") is not None
+
+
+def default_kernel() -> str:
+    """The kernel implementation used when none is given: ``$ASEKIT_DLM_KERNEL`` if set, else
+    "compiled" when numba is installed, else "numpy"."""
+    env = os.environ.get(KERNEL_ENV, "").strip()
+    if env:
+        if env not in KERNELS:
+            raise ValueError(f"{KERNEL_ENV} must be one of {list(KERNELS)}, got {env!r}")
+        return env
+    return "compiled" if compiled_kernel_available() else "numpy"
+
+
+def _check_kernel(kernel) -> str:
+    name = default_kernel() if kernel is None else kernel
+    if name not in KERNELS:
+        raise ValueError(f"kernel must be one of {list(KERNELS)} or None, got {kernel!r}")
+    if name == "compiled" and not compiled_kernel_available():
+        raise ValueError("kernel='compiled' needs numba (pip install numba); use "
+                         "kernel='numpy'")
+    return name
 
 
 # ---------------------------------------------------------------------------------------------
@@ -827,7 +863,8 @@ def _check_request(mesh, mach, k, b_ref, method):
 
 
 def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str = "quartic",
-                        symmetric: bool = False, progress=None) -> np.ndarray:
+                        symmetric: bool = False, progress=None, kernel: str | None = None
+                        ) -> np.ndarray:
     """DLM normalwash matrices D(M, k) for several reduced frequencies at one Mach number.
 
     Parameters
@@ -839,6 +876,9 @@ def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str
     method : "quartic" ([R98], Desmarais integrals; default) or "parabolic" ([R71], Laschka).
     symmetric : add the mirror image in y = 0 (wall/symmetry plane at the root).
     progress : optional callable(n_done, n_total) called after each row chunk.
+    kernel : implementation of the all-planar kernel loop, "numpy" or "compiled" (numba, a
+        fused loop, 2-3x faster; same equations, agreement to rounding); None:
+        :func:`default_kernel`. The pairwise (nonplanar) path is numpy in both.
 
     Returns
     -------
@@ -851,14 +891,17 @@ def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str
     check_matrix_memory(mesh.n, ks.size, 16, "the DLM normalwash matrices",
                         "use fewer boxes or fewer reduced frequencies per call, or "
                         "asekit.aero.dlm.iter_normalwash_matrices (one k at a time)")
-    return _normalwash_batch(mesh, mach, ks, b, method, symmetric, progress)
+    return _normalwash_batch(mesh, mach, ks, b, method, symmetric, progress,
+                             kernel=_check_kernel(kernel))
 
 
 def _normalwash_batch(mesh: BoxMesh, mach: float, ks: np.ndarray, b: float, method: str,
-                      symmetric: bool, progress=None, d0: np.ndarray | None = None) -> np.ndarray:
+                      symmetric: bool, progress=None, d0: np.ndarray | None = None,
+                      kernel: str = "numpy") -> np.ndarray:
     """D (n_k, n, n) of validated arguments; ``d0`` the vortex lattice D0 if already known.
     Raises ValueError for a mesh whose matrix is not finite (:func:`_check_finite`)."""
-    out = _normalwash_batch_unchecked(mesh, mach, ks, b, method, symmetric, progress, d0)
+    out = _normalwash_batch_unchecked(mesh, mach, ks, b, method, symmetric, progress, d0,
+                                      kernel)
     _check_finite(mesh, out)
     return out
 
@@ -880,7 +923,7 @@ def _check_finite(mesh: BoxMesh, d: np.ndarray) -> None:
         "spanwise-aligned with a box edge of another surface in its plane")
 
 
-def _normalwash_batch_unchecked(mesh, mach, ks, b, method, symmetric, progress, d0):
+def _normalwash_batch_unchecked(mesh, mach, ks, b, method, symmetric, progress, d0, kernel):
     snd = _Senders(mesh, symmetric)
     n = mesh.n
     out = np.empty((ks.size, n, n), complex)
@@ -896,7 +939,7 @@ def _normalwash_batch_unchecked(mesh, mach, ks, b, method, symmetric, progress, 
         out[ik, sl] += _fold(d1, n, snd.n_images)
 
     if _all_planar(mesh, snd):
-        _planar_rows(mesh, snd, mach, method, kds, ik_nz, add_all, progress)
+        _planar_rows(mesh, snd, mach, method, kds, ik_nz, add_all, progress, kernel)
         return out
     blocks = _plane_blocks(mesh, snd)
     if blocks is None:
@@ -915,8 +958,10 @@ def _normalwash_batch_unchecked(mesh, mach, ks, b, method, symmetric, progress, 
                 if part.any():
                     out[ik][np.ix_(rows, cols[part])] += d1[:, part]
 
-        path = _planar_rows if _all_planar(rec, sub) else _pairwise_rows
-        path(rec, sub, mach, method, kds, ik_nz, add_block, None)
+        if _all_planar(rec, sub):
+            _planar_rows(rec, sub, mach, method, kds, ik_nz, add_block, None, kernel)
+        else:
+            _pairwise_rows(rec, sub, mach, method, kds, ik_nz, add_block, None)
         done += r_idx.size * s_idx.size
         if progress is not None:
             progress(int(round(n * done / total)), n)
@@ -929,7 +974,7 @@ STREAM_BYTES = 2**30
 
 def iter_normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
                              method: str = "quartic", symmetric: bool = False,
-                             max_bytes: int | None = None):
+                             max_bytes: int | None = None, kernel: str | None = None):
     """Stream the normalwash matrices D(M, k) of a k sweep: yields ``(k_i, D_i)`` in the order
     of ``k``, holding at most ``max_bytes`` of matrices (default :data:`STREAM_BYTES`, 1 GiB;
     at least one matrix, 16 n^2 bytes) plus the vortex lattice D0 (8 n^2 bytes, computed once).
@@ -954,12 +999,12 @@ def iter_normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
                          f"{max_bytes!r}")
     check_matrix_memory(mesh.n, 1, 16, "one DLM normalwash matrix", "use fewer boxes")
     per_batch = max(1, int(max_bytes) // (16 * mesh.n * mesh.n))
-    return _stream(mesh, mach, ks, b, method, symmetric, per_batch)
+    return _stream(mesh, mach, ks, b, method, symmetric, per_batch, _check_kernel(kernel))
 
 
 def map_normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, fn,
                             method: str = "quartic", symmetric: bool = False,
-                            max_bytes: int | None = None) -> list:
+                            max_bytes: int | None = None, kernel: str | None = None) -> list:
     """``[fn(i, k_i, D_i) for each k_i]`` over the streamed matrices of
     :func:`iter_normalwash_matrices` (same arguments), dropping each D_i after ``fn`` returns:
     the callback form of the stream, e.g. ``fn`` factors D_i in place, projects the pressures
@@ -968,18 +1013,20 @@ def map_normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, fn,
     if not callable(fn):
         raise TypeError(f"fn must be callable (i, k, D) -> result, got {type(fn).__name__}")
     out = []
-    for i, (kk, d) in enumerate(iter_normalwash_matrices(mesh, mach, k, b_ref, method,
-                                                         symmetric, max_bytes)):
-        out.append(fn(i, kk, d))
+    # no enumerate(): its reused result tuple would keep the last D (and so its whole batch)
+    # alive while the generator computes the next batch
+    for kk, d in iter_normalwash_matrices(mesh, mach, k, b_ref, method, symmetric, max_bytes,
+                                          kernel):
+        out.append(fn(len(out), kk, d))
         del d                           # before the next batch is computed
     return out
 
 
-def _stream(mesh, mach, ks, b, method, symmetric, per_batch):
+def _stream(mesh, mach, ks, b, method, symmetric, per_batch, kernel):
     d0 = vlm_normalwash_matrix(mesh, mach, symmetric)
     for i0 in range(0, ks.size, per_batch):
         batch = ks[i0:i0 + per_batch]
-        d = _normalwash_batch(mesh, mach, batch, b, method, symmetric, d0=d0)
+        d = _normalwash_batch(mesh, mach, batch, b, method, symmetric, d0=d0, kernel=kernel)
         for i, kk in enumerate(batch):
             yield float(kk), d[i]
         del d
@@ -1025,10 +1072,30 @@ def _pairwise_rows(rec, snd: _Senders, mach: float, method: str, kds, ik_nz, add
             progress(sl.stop, n)
 
 
-def _planar_rows(rec, snd: _Senders, mach: float, method: str, kds, ik_nz, add, progress):
+def _compiled_planar(geo: "_PlanarChunk", kds, ik_nz, p_n, a_n, add) -> None:
+    """The k loop of one planar chunk by the compiled kernel: ``add(ik, d1)`` per k."""
+    from . import _dlm_compiled
+    t1w = np.stack(geo.t1w)
+    small = np.zeros(geo.absu.shape, bool)
+    if geo.small is not None:
+        small[geo.small] = True
+    xr, xq = np.ascontiguousarray(geo.xr), np.ascontiguousarray(geo.xq)
+    e1 = np.exp(-p_n[0] * geo.absu)                  # the first series term, k-independent
+    for ik in ik_nz:
+        d1 = np.empty(geo.k10_sum.shape, complex)
+        _dlm_compiled.planar_increment(float(kds[ik]), e1, geo.sgn_r1sq, geo.gc, geo.r1,
+                                       geo.phase, geo.neg2, small, xr, xq, geo.r_local,
+                                       geo.yz_class, geo.r1sq_groups, geo.index, t1w,
+                                       geo.k10_sum, p_n, a_n, p_n.size == 12, d1)
+        add(ik, d1)
+
+
+def _planar_rows(rec, snd: _Senders, mach: float, method: str, kds, ik_nz, add, progress,
+                 kernel: str = "numpy"):
     """D1 of receivers ``rec`` against senders ``snd``, all pairs planar (module docstring):
     kernel per distinct station point in row chunks of about PLANAR_POINTS_PER_CHUNK
-    (receiver, point) pairs, weights per block of chunks; ``add(ik, rows, d1)``."""
+    (receiver, point) pairs, weights per block of chunks; ``add(ik, rows, d1)``. ``kernel``
+    "compiled": the k loop by :func:`asekit.aero._dlm_compiled.planar_increment`."""
     stations, p_n, a_n = _METHODS[method]
     n, ns = rec.n, snd.mid.shape[0]
     pts = _StationPoints(rec, snd, stations)
@@ -1045,6 +1112,9 @@ def _planar_rows(rec, snd: _Senders, mach: float, method: str, kds, ik_nz, add, 
             sl = slice(j0, min(bl.stop, j0 + rows))
             sub = slice(sl.start - i0, sl.stop - i0)
             geo = _PlanarChunk(rec, pts, sl, mach, [w[sub] for w in t1w])
+            if kernel == "compiled":
+                _compiled_planar(geo, kds, ik_nz, p_n, a_n, lambda ik, d1: add(ik, sl, d1))
+                continue
             for ik in ik_nz:
                 add(ik, sl, _planar_increment(geo, kds[ik], p_n, a_n))
         if progress is not None:
