@@ -26,21 +26,23 @@ import numpy as np
 
 
 @numba.njit(cache=True, error_model="numpy", nogil=True)
-def planar_increment(kd, e1s, sgn_r1sq, gc, r1, phase, neg2, small, xr, xq, r_local, yz_class,
-                     r1sq_groups, index, t1w, k10_sum, p_n, a_n, desmarais, out):
+def planar_increment(kd, e1s, sgn_r1sq, gc, r1, phase, neg2, small, k10, xr, xq, r_local,
+                     yz_class, r1sq_groups, index, t1w, p_n, a_n, desmarais, out):
     """D1 of an all-planar row chunk at omega / U = kd (1/m), written into ``out`` (rows,
     senders) complex.
 
     Arrays (rows, points): exp(-p_1 |u1|) (k-independent, computed once per chunk), sgn(u1) r1^2, gc, r1, the phase x0 + r1 u1, 2 [u1 < 0],
-    r1 ~ 0 (bool); xr (rows,), xq (points,) streamwise coordinates; r1^2 per (receiver
+    r1 ~ 0 (bool), K10 (:func:`planar_geometry`); xr (rows,), xq (points,) streamwise
+    coordinates; r1^2 per (receiver
     group, point group) ``r1sq_groups`` with the groups ``r_local`` (rows,) and ``yz_class``
     (points,); index (senders, stations) point of each station; t1w (stations, rows, senders);
-    k10_sum (rows, senders); p_n, a_n the exponents and coefficients of the kernel series;
+    p_n, a_n the exponents and coefficients of the kernel series;
     ``desmarais``: p_n = 2^n b (powers by squaring) rather than n c.
 
     r1, and so k1 = kd r1, depends on the (y, z) groups only: the factors a_n / (p_n^2 +
     k1^2) and Re I1(0) are tabulated per group pair (no division per pair), and
-    e^(-i kd x0) = e^(-i kd x_r) e^(i kd x_q) from per-row and per-point values.
+    e^(-i kd x0) = e^(-i kd x_r) e^(i kd x_q) from per-row and per-point values; the steady
+    part K10 is added per point before the gather, D1 = sum_j T1 W1_j (-K1_j e_j + K10_j).
     """
     rows, nq = e1s.shape
     ns, nst = index.shape
@@ -78,7 +80,7 @@ def planar_increment(kd, e1s, sgn_r1sq, gc, r1, phase, neg2, small, xr, xq, r_lo
             sx = sr[i] * cq[q] - cr[i] * sq[q]
             if small[i, q]:                              # r1 -> 0: -K1 = 2 downstream, 0 up
                 down = 2.0 if xr[i] - xq[q] >= 0.0 else 0.0
-                fr[q] = down * cx
+                fr[q] = down * cx + k10[i, q]
                 fi[q] = -down * sx
                 continue
             h = yz_class[q]
@@ -106,10 +108,10 @@ def planar_increment(kd, e1s, sgn_r1sq, gc, r1, phase, neg2, small, xr, xq, r_lo
                 r0 = re0[g, h] * w0
                 vr += r0 * cx
                 vi -= r0 * sx
-            fr[q] = vr
+            fr[q] = vr + k10[i, q]
             fi[q] = vi
         for s_ in range(ns):
-            accr = k10_sum[i, s_]
+            accr = 0.0
             acci = 0.0
             for j in range(nst):
                 w = t1w[j, i, s_]
@@ -117,3 +119,58 @@ def planar_increment(kd, e1s, sgn_r1sq, gc, r1, phase, neg2, small, xr, xq, r_lo
                 accr += fr[q] * w
                 acci += fi[q] * w
             out[i, s_] = complex(accr, acci)
+
+
+@numba.njit(cache=True, error_model="numpy", nogil=True)
+def planar_geometry(pr, xyz, e, mach, p1):
+    """k-independent kernel geometry of receivers ``pr`` (rows, 3) against the station points
+    ``xyz`` (points, 3) of half-widths ``e``, all pairs planar: the arrays of
+    :class:`asekit.aero.dlm._PlanarChunk` in one pass ([R71] Eqs. 4, 7, 10-12, 15).
+
+    Returns (rows, points) arrays exp(-p1 |u1|), sgn(u1) r1^2, gc = sgn(u1) (1 - |u1| /
+    sqrt(1 + u1^2)) + M r1 / (R sqrt(1 + u1^2)), r1, the phase x0 + r1 u1, 2 [u1 < 0],
+    r1 ~ 0 (r1 <= 1e-12 e: receiver on the doublet line; r1 and r1^2 are then 0) and
+    K10 = -1 - x0 / R.
+    """
+    rows = pr.shape[0]
+    nq = xyz.shape[0]
+    beta2 = 1.0 - mach * mach
+    e1s = np.empty((rows, nq))
+    sgn_r1sq = np.empty((rows, nq))
+    gc = np.empty((rows, nq))
+    r1o = np.empty((rows, nq))
+    phase = np.empty((rows, nq))
+    neg2 = np.empty((rows, nq))
+    small = np.empty((rows, nq), np.bool_)
+    k10 = np.empty((rows, nq))
+    for i in range(rows):
+        for q in range(nq):
+            x0 = pr[i, 0] - xyz[q, 0]                    # xbar - eta tan(Lambda)
+            dy = pr[i, 1] - xyz[q, 1]
+            dz = pr[i, 2] - xyz[q, 2]
+            r1sq = dy * dy + dz * dz                     # r1^2, [R71] Eq. 4
+            big_r = math.sqrt(x0 * x0 + beta2 * r1sq)    # R, Eq. 10
+            r1 = math.sqrt(r1sq)
+            sm = r1 <= 1e-12 * e[q]
+            if sm:
+                r1 = 1.0
+                if big_r <= 0.0:
+                    big_r = 1.0
+            t = mach * big_r - x0
+            u1 = 0.0 if sm else t / (r1 * beta2)         # u1, Eq. 11
+            u1 += 0.0                                    # no -0.0
+            k10[i, q] = -(x0 / big_r + 1.0)              # K10, Eq. 15
+            sq = math.sqrt(u1 * u1 + 1.0)
+            c1 = mach * r1 / (big_r * sq)
+            absu = abs(u1)
+            gc[i, q] = math.copysign(1.0 - absu / sq, u1) + c1
+            neg2[i, q] = 2.0 if u1 < 0.0 else 0.0
+            if sm:
+                r1 = 0.0
+                r1sq = 0.0
+            small[i, q] = sm
+            r1o[i, q] = r1
+            sgn_r1sq[i, q] = math.copysign(r1sq, u1)
+            phase[i, q] = t / beta2 + x0                  # k1 u1 + kd x0 = kd * phase
+            e1s[i, q] = math.exp(-p1 * absu)
+    return e1s, sgn_r1sq, gc, r1o, phase, neg2, small, k10

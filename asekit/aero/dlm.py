@@ -1072,21 +1072,27 @@ def _pairwise_rows(rec, snd: _Senders, mach: float, method: str, kds, ik_nz, add
             progress(sl.stop, n)
 
 
-def _compiled_planar(geo: "_PlanarChunk", kds, ik_nz, p_n, a_n, add) -> None:
-    """The k loop of one planar chunk by the compiled kernel: ``add(ik, d1)`` per k."""
-    from . import _dlm_compiled
-    t1w = np.stack(geo.t1w)
-    small = np.zeros(geo.absu.shape, bool)
-    if geo.small is not None:
-        small[geo.small] = True
-    xr, xq = np.ascontiguousarray(geo.xr), np.ascontiguousarray(geo.xq)
-    e1 = np.exp(-p_n[0] * geo.absu)                  # the first series term, k-independent
+def _compiled_planar(rec, pts: "_StationPoints", rows: slice, mach: float, t1w: list, kds,
+                     ik_nz, p_n, a_n, add) -> None:
+    """One planar row chunk by the compiled kernel (:mod:`asekit.aero._dlm_compiled`): the
+    geometry of :class:`_PlanarChunk` in one compiled pass, then ``add(ik, d1)`` per k."""
+    from . import _dlm_compiled as C
+    pr = np.ascontiguousarray(rec.control_point[rows])
+    e1, sgn_r1sq, gc, r1, phase, neg2, small, k10 = C.planar_geometry(pr, pts.xyz, pts.e, mach,
+                                                                      float(p_n[0]))
+    rc, r_local = np.unique(pts.r_class[rows], return_inverse=True)
+    ryz = pts.r_yz[rc]
+    tab = np.subtract.outer(ryz[:, 0], pts.yz[:, 0])
+    tab *= tab
+    dz = np.subtract.outer(ryz[:, 1], pts.yz[:, 1])
+    tab += dz * dz                                              # r1^2 per group pair
+    t1w = np.stack(t1w)
+    xq = np.ascontiguousarray(pts.xyz[:, 0])
     for ik in ik_nz:
-        d1 = np.empty(geo.k10_sum.shape, complex)
-        _dlm_compiled.planar_increment(float(kds[ik]), e1, geo.sgn_r1sq, geo.gc, geo.r1,
-                                       geo.phase, geo.neg2, small, xr, xq, geo.r_local,
-                                       geo.yz_class, geo.r1sq_groups, geo.index, t1w,
-                                       geo.k10_sum, p_n, a_n, p_n.size == 12, d1)
+        d1 = np.empty(t1w.shape[1:], complex)
+        C.planar_increment(float(kds[ik]), e1, sgn_r1sq, gc, r1, phase, neg2, small, k10,
+                           pr[:, 0].copy(), xq, r_local.reshape(-1), pts.yz_class, tab,
+                           pts.index, t1w, p_n, a_n, p_n.size == 12, d1)
         add(ik, d1)
 
 
@@ -1111,10 +1117,11 @@ def _planar_rows(rec, snd: _Senders, mach: float, method: str, kds, ik_nz, add, 
         for j0 in range(bl.start, bl.stop, rows):
             sl = slice(j0, min(bl.stop, j0 + rows))
             sub = slice(sl.start - i0, sl.stop - i0)
-            geo = _PlanarChunk(rec, pts, sl, mach, [w[sub] for w in t1w])
             if kernel == "compiled":
-                _compiled_planar(geo, kds, ik_nz, p_n, a_n, lambda ik, d1: add(ik, sl, d1))
+                _compiled_planar(rec, pts, sl, mach, [w[sub] for w in t1w], kds, ik_nz, p_n,
+                                 a_n, lambda ik, d1: add(ik, sl, d1))
                 continue
+            geo = _PlanarChunk(rec, pts, sl, mach, [w[sub] for w in t1w])
             for ik in ik_nz:
                 add(ik, sl, _planar_increment(geo, kds[ik], p_n, a_n))
         if progress is not None:
