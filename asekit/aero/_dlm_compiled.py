@@ -28,8 +28,8 @@ import numpy as np
 @numba.njit(cache=True, error_model="numpy", nogil=True)
 def planar_increment(kd, e1s, sgn_r1sq, gc, r1, phase, neg2, k10, xr, xq, r_local, yz_class,
                      r1sq_groups, index_t, t1w, p_n, a_n, desmarais, out):
-    """D1 of an all-planar row chunk at omega / U = kd (1/m), written into ``out`` (rows,
-    senders) complex.
+    """D1 of an all-planar row chunk at omega / U = kd (1/m), added into ``out`` (rows,
+    senders) complex (zeros, or the rows of D already holding D0).
 
     Arrays (rows, points) from :func:`planar_geometry`: exp(-p_1 |u1|), sgn(u1) r1^2, gc, r1,
     the phase x0 + r1 u1, 2 [u1 < 0] and K10 (receivers on the doublet line are encoded there
@@ -125,14 +125,14 @@ def planar_increment(kd, e1s, sgn_r1sq, gc, r1, phase, neg2, k10, xr, xq, r_loca
                                       t1w[3, i, s_], t1w[4, i, s_])
                 accr = fr[q0] * w0 + fr[q1] * w1 + fr[q2] * w2 + fr[q3] * w3 + fr[q4] * w4
                 acci = fi[q0] * w0 + fi[q1] * w1 + fi[q2] * w2 + fi[q3] * w3 + fi[q4] * w4
-                out[i, s_] = complex(accr, acci)
+                out[i, s_] += complex(accr, acci)
         elif nst == 3:
             for s_ in range(ns):
                 q0, q1, q2 = index_t[0, s_], index_t[1, s_], index_t[2, s_]
                 w0, w1, w2 = t1w[0, i, s_], t1w[1, i, s_], t1w[2, i, s_]
                 accr = fr[q0] * w0 + fr[q1] * w1 + fr[q2] * w2
                 acci = fi[q0] * w0 + fi[q1] * w1 + fi[q2] * w2
-                out[i, s_] = complex(accr, acci)
+                out[i, s_] += complex(accr, acci)
         else:
             for s_ in range(ns):
                 accr = 0.0
@@ -142,7 +142,7 @@ def planar_increment(kd, e1s, sgn_r1sq, gc, r1, phase, neg2, k10, xr, xq, r_loca
                     q = index_t[j, s_]
                     accr += fr[q] * w
                     acci += fi[q] * w
-                out[i, s_] = complex(accr, acci)
+                out[i, s_] += complex(accr, acci)
 
 
 @numba.njit(cache=True, error_model="numpy", nogil=True)
