@@ -85,3 +85,13 @@ def test_kernel_choice_argument_and_environment(monkeypatch):
     with pytest.raises(ValueError, match="numba"):
         normalwash_matrices(m, 0.5, [0.5], 0.5, kernel="compiled")
     assert np.isfinite(normalwash_matrices(m, 0.5, [0.5], 0.5)).all()
+
+
+@pytest.mark.parametrize("name,sym", [("wing", True), ("wing_fin", False), ("fin", True)])
+def test_compiled_vortex_lattice_equals_numpy(name, sym):
+    # the steady part D0 (horseshoe vortices, Katz & Plotkin Eq. 10.115) by the same loop
+    from asekit.aero.vlm import vlm_normalwash_matrix
+    m = _mesh(name)
+    ref = vlm_normalwash_matrix(m, 0.7, sym, kernel="numpy")
+    got = vlm_normalwash_matrix(m, 0.7, sym, kernel="compiled")
+    assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()

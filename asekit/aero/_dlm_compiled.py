@@ -201,3 +201,59 @@ def planar_geometry(pr, xyz, e, mach, p1):
                 phase[i, q] = x0
                 neg2[i, q] = 0.0
     return e1s, sgn_r1sq, gc, r1o, phase, neg2, k10
+
+
+@numba.njit(cache=True, error_model="numpy", nogil=True)
+def horseshoe_normalwash(p, n_r, v, ia, ib, scale, weight, out):
+    """Add to ``out`` (m, s) the normal velocity at points ``p`` (m, 3) along normals ``n_r``
+    induced by horseshoe vortices inf -> a -> b -> inf (a = v[ia], b = v[ib], legs along +x),
+    times ``weight`` (s,): the loop form of :func:`asekit.aero.vlm._horseshoe_normalwash`
+    (Katz & Plotkin Eq. 10.115 for the bound segment, the semi-infinite legs per corner;
+    points on a vortex line receive zero from that segment)."""
+    m = p.shape[0]
+    nv = v.shape[0]
+    ns = ia.size
+    eps = (1e-10 * scale) ** 2
+    rx = np.empty(nv)
+    ry = np.empty(nv)
+    rz = np.empty(nv)
+    nrm = np.empty(nv)
+    leg = np.empty(nv)
+    c4 = 1.0 / (4.0 * np.pi)
+    for i in range(m):
+        ny = n_r[i, 1]
+        nz = n_r[i, 2]
+        for q in range(nv):
+            x = p[i, 0] - v[q, 0]
+            y = p[i, 1] - v[q, 1]
+            z = p[i, 2] - v[q, 2]
+            d2 = y * y + z * z
+            r = math.sqrt(x * x + d2)
+            if r == 0.0:
+                r = 1.0
+            rx[q] = x
+            ry[q] = y
+            rz[q] = z
+            nrm[q] = r
+            # leg from corner q to +inf: (x_hat x r) / |x_hat x r|^2 (1 + r_x / |r|)
+            leg[q] = (x / r + 1.0) / d2 * (y * nz - z * ny) if d2 > eps else 0.0
+        for s in range(ns):
+            a = ia[s]
+            b = ib[s]
+            r1x, r1y, r1z, n1 = rx[a], ry[a], rz[a], nrm[a]
+            r2x, r2y, r2z, n2 = rx[b], ry[b], rz[b], nrm[b]
+            r0x = v[b, 0] - v[a, 0]
+            r0y = v[b, 1] - v[a, 1]
+            r0z = v[b, 2] - v[a, 2]
+            cx = r1y * r2z - r1z * r2y
+            cy = r1z * r2x - r1x * r2z
+            cz = r1x * r2y - r1y * r2x
+            c2 = cx * cx + cy * cy + cz * cz
+            w = 0.0
+            if c2 > eps:
+                fac = ((r0x * r1x + r0y * r1y + r0z * r1z) / n1
+                       - (r0x * r2x + r0y * r2y + r0z * r2z) / n2)
+                w = fac / c2 * (cy * ny + cz * nz)
+            w += leg[b]
+            w -= leg[a]
+            out[i, s] += (w * c4) * weight[s]

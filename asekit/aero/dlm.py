@@ -936,7 +936,7 @@ def _normalwash_batch_unchecked(mesh, mach, ks, b, method, symmetric, progress, 
     snd = _Senders(mesh, symmetric)
     n = mesh.n
     out = np.empty((ks.size, n, n), complex)
-    out[:] = (vlm_normalwash_matrix(mesh, mach, symmetric) if d0 is None else d0)[None]
+    out[:] = (vlm_normalwash_matrix(mesh, mach, symmetric, kernel) if d0 is None else d0)[None]
     ik_nz = np.flatnonzero(ks > 0.0)
     if ik_nz.size == 0:
         if progress is not None:
@@ -1034,7 +1034,7 @@ def map_normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, fn,
 
 
 def _stream(mesh, mach, ks, b, method, symmetric, per_batch, kernel):
-    d0 = vlm_normalwash_matrix(mesh, mach, symmetric)
+    d0 = vlm_normalwash_matrix(mesh, mach, symmetric, kernel)
     for i0 in range(0, ks.size, per_batch):
         batch = ks[i0:i0 + per_batch]
         d = _normalwash_batch(mesh, mach, batch, b, method, symmetric, d0=d0, kernel=kernel)
