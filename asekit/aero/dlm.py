@@ -1251,9 +1251,9 @@ def aic_matrix(mesh: BoxMesh, mach: float, k: float, b_ref: float, method: str =
     complex matrix. To apply the AIC to a few normalwash columns, use
     :func:`factor_aic` and :meth:`AicFactor.pressures` instead: measured at 1200 boxes, one
     (M, k), 6 columns, one BLAS thread (``tests/benchmarks/bench_aero_speed.py --only aic``),
-    aic_matrix followed by the product took 1.68 times the CPU time of factor-and-solve
-    (0.93 s against 0.56 s; D itself 0.45 s of each), the solve part alone 4.1 times
-    (0.45 s against 0.11 s).
+    aic_matrix followed by the product took 1.7-2.0 times the CPU time of factor-and-solve
+    (four runs: 1.68, 1.66, 1.92, 1.96; e.g. 0.98 s against 0.50 s, D about 0.35-0.45 s of
+    each), the solve part alone 4.1-4.7 times (e.g. 0.55 s against 0.12 s).
     """
     d = normalwash_matrix(mesh, mach, k, b_ref, method, symmetric)
     return np.linalg.solve(d, np.eye(d.shape[0]))
