@@ -15,6 +15,14 @@ LU + 6-column solve + projection, and the peak resident memory so far
 matrix D0 (8 n^2) and one chunk of kernel arrays. All matrices at once would be 15 x 16 n^2
 (24 GB at 10,000 boxes). The wing and the tail lie in one plane (the all-planar DLM path);
 BLAS runs on ``--blas-threads`` threads (threadpoolctl).
+
+Measured once (``OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 python tests/benchmarks/bench_stream.py
+--boxes 10000``, code of commit 9a511d5: compiled k loop, numpy geometry and vortex lattice;
+2-core machine shared with other jobs, load ~3): 10,002 boxes, 15 k: 1496 s CPU, 2917 s wall
+(D 631 s CPU, 31-55 s per k; LU + 6-column solve 866 s CPU, 53-63 s per k), peak RSS
+2.59 GiB (one D is 1.49 GiB, all 15 would be 22.4 GiB). A first run whose stream kept the
+previous batch alive while computing the next reached 3.92 GiB after two k (fixed in
+:func:`asekit.aero.dlm.map_normalwash_matrices`).
 """
 
 from __future__ import annotations
