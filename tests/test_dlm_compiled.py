@@ -61,6 +61,7 @@ def test_compiled_kernel_with_tiny_chunks_and_no_weight_table(monkeypatch):
     ref = normalwash_matrices(m, 0.6, ks, 0.078, kernel="numpy")
     monkeypatch.setattr(dlm, "PLANAR_POINTS_PER_CHUNK", 50)
     monkeypatch.setattr(dlm, "COMPILED_POINTS_PER_CHUNK", 50)
+    monkeypatch.setattr(dlm, "COMPILED_MIN_ROWS", 1)
     monkeypatch.setattr(dlm, "PAIRS_PER_CHUNK", 37)
     monkeypatch.setattr(dlm, "PLANAR_WEIGHT_TABLE_BYTES", 0)
     _agree(normalwash_matrices(m, 0.6, ks, 0.078, kernel="compiled"), ref, ks)

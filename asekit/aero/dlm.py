@@ -117,6 +117,9 @@ PLANAR_POINTS_PER_CHUNK = 32768
 #: The same for the compiled kernel: larger chunks amortise its per-chunk tables (a 15-k
 #: sweep at 1200 boxes: 2.39 s CPU at 32768, 1.9-2.1 s at 131072-524288).
 COMPILED_POINTS_PER_CHUNK = 262144
+#: ... but at least this many rows (its per-chunk tables are per point: at 5000 boxes, 2 k,
+#: 20.1 s CPU with 13 rows per chunk, 14.8 s with 48; numpy path 24.1 s)
+COMPILED_MIN_ROWS = 48
 #: Largest table of planar weights per (receiver group, sender group) (:class:`_PlanarWeights`).
 PLANAR_WEIGHT_TABLE_BYTES = 64 * 2**20
 
@@ -1123,8 +1126,11 @@ def _planar_rows(rec, snd: _Senders, mach: float, method: str, kds, ik_nz, add, 
     weights = _PlanarWeights(rec, snd, stations, PLANAR_WEIGHT_TABLE_BYTES)
     nq = pts.xyz.shape[0]
     # the chunk holds ~12 real arrays per (row, point) and ~stations + 4 per (row, sender)
-    per_chunk = COMPILED_POINTS_PER_CHUNK if kernel == "compiled" else PLANAR_POINTS_PER_CHUNK
-    rows = max(1, min(n, per_chunk // nq,
+    if kernel == "compiled":
+        per_row = max(COMPILED_POINTS_PER_CHUNK // nq, COMPILED_MIN_ROWS)
+    else:
+        per_row = PLANAR_POINTS_PER_CHUNK // nq
+    rows = max(1, min(n, per_row,
                       int(CHUNK_BYTES // (8 * (16 * nq + (stations.size + 6) * ns)))))
     block = rows * max(1, PAIRS_PER_CHUNK // (ns * rows))
     for i0 in range(0, n, block):
