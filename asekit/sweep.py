@@ -52,7 +52,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import scipy.linalg as sla
 
 
 class SweepError(ValueError):
@@ -545,7 +544,9 @@ class AicFactors:
     """LU factors of the DLM normalwash matrices D(M, k) of one box mesh.
 
     key : what the factors depend on (box corners, k, b_ref, kernel, symmetry);
-    k : (n_k,) reduced frequencies; b_ref : m; lu : {mach: ((n_k, n, n) LU, (n_k, n) pivots)}.
+    k : (n_k,) reduced frequencies; b_ref : m; lu : {mach: ((n_k, n, n) LU, (n_k, n) pivots)},
+    the LAPACK factors of D^T (:class:`asekit.aero.dlm.AicFactor` with ``transposed=True``, the
+    in-place factorisation of the C-ordered D).
     """
 
     key: str
@@ -590,14 +591,21 @@ def aic_factors(case, machs) -> AicFactors:
 
 
 def _factors(case, boxes, ks, machs) -> AicFactors:
-    from .aero.dlm import normalwash_matrices
+    from .aero.dlm import factor_normalwash_matrix, map_normalwash_matrices
     a = case.aero
     lu = {}
     for m in sorted({float(x) for x in machs}):
-        d = normalwash_matrices(boxes, m, ks, a.reference_semichord, a.kernel,
+        # streamed: the factors plus one batch of D in memory (not all D, their LU and a stack)
+        lus = np.empty((ks.size, boxes.n, boxes.n), complex)
+        pivs = np.empty((ks.size, boxes.n), np.int32)
+
+        def factor(i, _k, d, lus=lus, pivs=pivs):
+            f = factor_normalwash_matrix(d, overwrite=True)      # LU of D^T, in place
+            lus[i], pivs[i] = f.lu, f.piv
+
+        map_normalwash_matrices(boxes, m, ks, a.reference_semichord, factor, a.kernel,
                                 a.symmetry == "wall")
-        fac = [sla.lu_factor(d[i], check_finite=False) for i in range(ks.size)]
-        lu[m] = (np.stack([f[0] for f in fac]), np.stack([f[1] for f in fac]))
+        lu[m] = (lus, pivs)
     return AicFactors(aero_key(case), ks, float(a.reference_semichord), lu)
 
 
@@ -605,6 +613,7 @@ def projected_gaf(model, case, factors: AicFactors, mach: float) -> np.ndarray:
     """Q(M, k) (n_k, n_modes, n_modes) of ``model`` from the factored D(M, k):
     Q = H_lp^T diag(A) D^-1 (dH/dx + i k H / b) per k (Eqs. 2.10-2.12), the operations of
     :func:`asekit.aero.gaf.gaf_from_box_modes` on precomputed factors."""
+    from .aero.dlm import AicFactor
     from .aero.spline import fe_spline, modal_forces
     from .case import pipeline as P
     boxes = P.box_mesh(case)
@@ -613,7 +622,7 @@ def projected_gaf(model, case, factors: AicFactors, mach: float) -> np.ndarray:
     n = bm.h_cp.shape[1]
     out = np.empty((factors.k.size, n, n), complex)
     for ik, kk in enumerate(factors.k):
-        cp = sla.lu_solve((lu[ik], piv[ik]), bm.normalwash(kk, factors.b_ref))
+        cp = AicFactor(lu[ik], piv[ik], True).pressures(bm.normalwash(kk, factors.b_ref))
         out[ik] = modal_forces(bm, cp, boxes.area)
     return out
 

@@ -220,10 +220,11 @@ def test_projected_gafs_equal_a_rebuilt_database_bit_for_bit(tmp_path, one_blas_
 
 
 def test_structural_sweep_builds_the_dlm_once_per_mach(monkeypatch):
+    # every DLM matrix build, whole sweep or streamed batch, goes through _normalwash_batch
     import asekit.aero.dlm as dlm
     calls = []
-    real = dlm.normalwash_matrices
-    monkeypatch.setattr(dlm, "normalwash_matrices",
+    real = dlm._normalwash_batch
+    monkeypatch.setattr(dlm, "_normalwash_batch",
                         lambda *a, **k: calls.append(a[1]) or real(*a, **k))
     sw = S.sweep_from_dict(sweep_dict(MC, samples=3, outputs=["f1_hz"]))
     df = S.run_sweep(sw)

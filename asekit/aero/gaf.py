@@ -23,13 +23,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import scipy.linalg as sla
 
 from .. import __version__
 from ..cache import CacheError, load_npz, save_npz
 from ..paths import DATA_DIR, user_cache_dir
 from .boxes import BoxMesh
-from .dlm import check_k, normalwash_matrices
+from .dlm import check_k, factor_normalwash_matrix, map_normalwash_matrices
 from .spline import BoxModes, fe_spline, modal_forces
 from .vlm import check_mach
 
@@ -62,11 +61,15 @@ class GafDatabase:
 
 def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref: float,
                        symmetric: bool = False, method: str = "quartic",
-                       progress=None, aero_options: dict | None = None) -> np.ndarray:
+                       progress=None, aero_options: dict | None = None,
+                       max_bytes: int | None = None) -> np.ndarray:
     """Q(M, k) (n_k, n_modes, n_modes) for mode shapes already interpolated to the boxes.
 
-    One LU factorisation of D(M, k) per k solves for all modes at once; the kernel geometry
-    is shared by all k (:func:`asekit.aero.dlm.normalwash_matrices`). ``method`` "auto",
+    The k sweep is streamed (:func:`asekit.aero.dlm.map_normalwash_matrices`): one LU
+    factorisation of D(M, k) per k, in place, solves for all modes at once and the matrix is
+    dropped after its projection, so at most ``max_bytes`` of normalwash matrices (default
+    :data:`asekit.aero.dlm.STREAM_BYTES`, at least one matrix) are held; the kernel geometry is
+    shared by the k of a batch (all k on small meshes). ``method`` "auto",
     "dlm", "supersonic" or "piston" chooses the aerodynamics per Mach
     (:mod:`asekit.aero.methods`; ``aero_options`` go to its pressure matrices); "quartic" and
     "parabolic" are the DLM kernels.
@@ -81,13 +84,15 @@ def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref
                 progress(ks.size)
             return np.stack([modal_forces(box_modes, c, mesh.area) for c in cp])
         method = "quartic"
-    d = normalwash_matrices(mesh, mach, ks, b_ref, method, symmetric)
     out = np.empty((ks.size, box_modes.h_cp.shape[1], box_modes.h_cp.shape[1]), complex)
-    for ik, kk in enumerate(ks):
-        cp = sla.lu_solve(sla.lu_factor(d[ik], check_finite=False), box_modes.normalwash(kk, b_ref))
+
+    def project(ik, kk, d):
+        cp = factor_normalwash_matrix(d, overwrite=True).pressures(box_modes.normalwash(kk, b_ref))
         out[ik] = modal_forces(box_modes, cp, mesh.area)
         if progress is not None:
             progress(1)
+
+    map_normalwash_matrices(mesh, mach, ks, b_ref, project, method, symmetric, max_bytes)
     return out
 
 

@@ -92,7 +92,8 @@ def pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str =
                       symmetric: bool = False, dlm_kernel: str = "quartic",
                       **options) -> np.ndarray:
     """Pressure-per-normalwash matrices A (n_k, n, n) complex, DeltaCp = A (w/U), of the method
-    chosen by :func:`resolve_method` (for the DLM, A = D^-1, its AIC). ``options`` go to the
+    chosen by :func:`resolve_method` (for the DLM, A = D^-1, its AIC, formed explicitly: to
+    apply it to a few normalwash columns, :func:`pressures` is cheaper). ``options`` go to the
     supersonic (``cells_per_box``, ...) or piston (``order``, ``thickness_slope``, ...)
     function; ``symmetric`` is not available for piston theory (a local law: it has no images).
     """
@@ -113,12 +114,24 @@ def pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash, method: s
               symmetric: bool = False, dlm_kernel: str = "quartic", **options) -> np.ndarray:
     """DeltaCp (n_k, n, m) for the normalwash columns ``normalwash`` (callable k -> (n, m), or
     an (n_k, n, m) array): ``pressure_matrices(...)[ik] @ normalwash(k)`` without forming the
-    supersonic matrices (:func:`asekit.aero.supersonic.supersonic_pressures`)."""
+    supersonic matrices (:func:`asekit.aero.supersonic.supersonic_pressures`) or the DLM's
+    inverse (:class:`asekit.aero.dlm.AicFactor`, one LU per k, streamed)."""
     name = resolve_method(method, mach)
     if name == "supersonic":
         from .supersonic import supersonic_pressures
         return supersonic_pressures(mesh, mach, k, b_ref, normalwash, symmetric, **options)
     ks = np.atleast_1d(np.asarray(k, float))
+
+    def wash(ik, kk):
+        return np.asarray(normalwash(float(kk)) if callable(normalwash) else normalwash[ik])
+
+    if name == "dlm":               # factor and solve per k, streamed (no explicit inverse)
+        from .dlm import factor_normalwash_matrix, map_normalwash_matrices
+        kernel = method if method in DLM_KERNELS else dlm_kernel
+        return np.stack(map_normalwash_matrices(
+            mesh, mach, ks, b_ref,
+            lambda ik, kk, d: factor_normalwash_matrix(d, overwrite=True).pressures(wash(ik, kk)),
+            kernel, symmetric))
     a = pressure_matrices(mesh, mach, ks, b_ref, method, symmetric, dlm_kernel, **options)
     ws = [np.asarray(normalwash(float(kk)) if callable(normalwash) else normalwash[ik])
           for ik, kk in enumerate(ks)]

@@ -107,7 +107,8 @@ def _horseshoe_normalwash(p: np.ndarray, n_r: np.ndarray, v: np.ndarray, ia: np.
     return w
 
 
-def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False) -> np.ndarray:
+def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False,
+                          kernel: str | None = None) -> np.ndarray:
     """Steady normalwash matrix D0 (n, n): w/U at control points per unit Delta Cp of each box.
 
     Parameters
@@ -116,6 +117,8 @@ def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False) -
     mach : free-stream Mach number, 0 <= M < 1 (Prandtl-Glauert x -> x / beta).
     symmetric : add the image of every box in the plane y = 0 with the same loading (a wall
         or symmetry plane at the root, e.g. a fin mounted on a body); default isolated.
+    kernel : "numpy" or "compiled" (numba loop, :mod:`asekit.aero._dlm_compiled`; same
+        equations); None: :func:`asekit.aero.dlm.default_kernel`.
 
     Returns
     -------
@@ -125,6 +128,8 @@ def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False) -
     if not isinstance(mesh, BoxMesh):
         raise TypeError(f"mesh must be a BoxMesh, got {type(mesh).__name__}")
     check_matrix_memory(mesh.n, 1, 8, "the VLM normalwash matrix", "use fewer boxes")
+    from .dlm import _check_kernel
+    compiled = _check_kernel(kernel) == "compiled"
     beta = math.sqrt(1.0 - mach * mach)
     sx = np.array([1.0 / beta, 1.0, 1.0])
     p = mesh.control_point * sx
@@ -137,6 +142,11 @@ def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False) -
         scale = float(np.max(np.linalg.norm(b - a, axis=1)))
         v, ia, ib = _distinct_vertices(a, b)
         half_chord = 0.5 * img.chord
+        if compiled:
+            from . import _dlm_compiled
+            _dlm_compiled.horseshoe_normalwash(np.ascontiguousarray(p), np.ascontiguousarray(n_r),
+                                               v, ia, ib, scale, half_chord, d)
+            continue
         for i0 in range(0, mesh.n, rows):
             sl = slice(i0, min(mesh.n, i0 + rows))
             d[sl] += _horseshoe_normalwash(p[sl], n_r[sl], v, ia, ib, scale) * half_chord[None, :]
