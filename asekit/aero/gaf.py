@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..blas import blas_threads_for
 from ..cache import CacheError, load_npz, save_npz
 from ..paths import DATA_DIR, user_cache_dir
 from .boxes import BoxMesh
@@ -151,11 +152,7 @@ SMALL_SOLVE_BOXES = 2000
 
 def _blas_threads_for(n_boxes: int):
     """A context limiting BLAS to one thread for small systems (threadpoolctl), else a no-op."""
-    import contextlib
-    if n_boxes >= SMALL_SOLVE_BOXES:
-        return contextlib.nullcontext()
-    from threadpoolctl import threadpool_limits
-    return threadpool_limits(limits=1, user_api="blas")
+    return blas_threads_for(n_boxes, SMALL_SOLVE_BOXES)
 
 
 def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: float, n_rigid: int,
