@@ -359,7 +359,7 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
                       f"(tol {tol:g}) at {len(bad)} of {conv.size} points: {listed}{more}; "
                       "their roots are the last iterate (PkResult.converged is False there). "
                       "Raise max_iter or check those points.",
-                      FlutterConvergenceWarning, stacklevel=2)
+                      FlutterConvergenceWarning, stacklevel=3)   # caller, past @small_dense
     return PkResult(velocities=U, p=P, k=KK, vectors=V, converged=conv,
                     structural_frequencies_hz=w[modes] / (2 * np.pi), density=rho,
                     mach=gaf.mach, b_ref=gaf.b_ref)
