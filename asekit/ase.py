@@ -1016,7 +1016,6 @@ def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController,
     else:
         x, v_out = _integrate_zoh(derivatives, controller, command, x0, t_out, sample_time,
                                   opts)
-    z = x[3:]
     # derived histories
     volt = np.empty(n_out)
     alpha = np.empty(n_out)
@@ -1024,16 +1023,25 @@ def simulate_closed_loop(model: AeroservoelasticModel, controller: PDController,
         dx, _, _, v_cmd = derivatives(x[:, i], None if v_out is None else v_out[i])
         alpha[i] = dx[1]
         volt[i] = applied_voltage(act, lim, x[:3, i], v_cmd)
+    return AseSimulation(t=t_out, command=np.full(n_out, command), theta=x[0], omega=x[1],
+                         alpha=alpha, current=x[2], voltage=volt,
+                         outputs=_output_histories(model, x, alpha), topology=topology,
+                         limits=limits, theta0=float(theta0))
+
+
+def _output_histories(model: AeroservoelasticModel, x: np.ndarray, alpha: np.ndarray) -> dict:
+    """The model's outputs over states x (n, n_out) with fin accelerations alpha (n_out,); the
+    hinge moment in full, its acceleration term (moved into the actuator) included."""
+    z = x[3:]
+    ih = model.output_index("hinge_moment")
+    Ch, Dh = model.output_C[ih], model.output_D[ih]
     hm_part = Ch @ z + Dh[0] * x[0] + Dh[1] * x[1]
     u = np.vstack([x[0], x[1], alpha])
     y = model.output_C @ z + model.output_D @ u
     outputs = {name: y[j] for j, name in enumerate(model.output_names)}
-    # the full hinge moment, including the acceleration term moved into the actuator
     outputs["hinge_moment"] = hm_part - model.effective_fin_inertia * alpha \
         if not model.meta.get("count_fin_inertia_twice") else hm_part
-    return AseSimulation(t=t_out, command=np.full(n_out, command), theta=x[0], omega=x[1],
-                         alpha=alpha, current=x[2], voltage=volt, outputs=outputs,
-                         topology=topology, limits=limits, theta0=float(theta0))
+    return outputs
 
 
 def _closed_loop_result(model, topology, limits, lim, t_out, x, v_dem, command, theta0, arow):
@@ -1045,19 +1053,10 @@ def _closed_loop_result(model, topology, limits, lim, t_out, x, v_dem, command, 
                                 _voltage_bounds(model.actuator, lim, n))
     volt = loop.applied(x, demand=v_dem)
     alpha = arow @ x
-    z = x[3:]
-    ih = model.output_index("hinge_moment")
-    Ch, Dh = model.output_C[ih], model.output_D[ih]
-    hm_part = Ch @ z + Dh[0] * x[0] + Dh[1] * x[1]
-    u = np.vstack([x[0], x[1], alpha])
-    y = model.output_C @ z + model.output_D @ u
-    outputs = {name: y[j] for j, name in enumerate(model.output_names)}
-    outputs["hinge_moment"] = hm_part - model.effective_fin_inertia * alpha \
-        if not model.meta.get("count_fin_inertia_twice") else hm_part
     return AseSimulation(t=t_out, command=np.full(t_out.size, command), theta=x[0].copy(),
                          omega=x[1].copy(), alpha=alpha, current=x[2].copy(), voltage=volt,
-                         outputs=outputs, topology=topology, limits=limits,
-                         theta0=float(theta0))
+                         outputs=_output_histories(model, x, alpha), topology=topology,
+                         limits=limits, theta0=float(theta0))
 
 
 def _integrate_zoh(derivatives, controller, command, x0, t_out, ts, opts):
