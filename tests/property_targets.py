@@ -267,12 +267,14 @@ GAF_AT_MACH = Target(
 
 
 # ---- flutter -----------------------------------------------------------------------------------
-def _two_dof(c):
-    """The hand-derivable 2-dof quasi-steady coalescence model of tests/test_flutter.py."""
+def two_dof_coalescence(c):
+    """The hand-derivable 2-dof quasi-steady coalescence model of tests/test_flutter.py:
+    (modal, gaf, fit) with stiffnesses 100^2, 150^2, coupling Q = [[0, 1], [-2, 0]] and modal
+    damping c (also used by tests/test_flutter_onset.py)."""
     from asekit.aeroelastic import modal_arrays
     from asekit.flutter import TabulatedGaf
     from asekit.rfa import RogerFit
-    k1, k2, a, d = 100.0 ** 2, 150.0 ** 2, 1.0, -2.0
+    k1, k2, a, d = TWO_DOF
     Q = np.array([[0.0, a], [d, 0.0]], complex)
     modal = modal_arrays(M=np.eye(2), K=np.diag([k1, k2]), C=c * np.eye(2))
     gaf = TabulatedGaf(np.array([0.0, 10.0]), np.array([Q, Q]), 1.0)
@@ -281,6 +283,10 @@ def _two_dof(c):
     fit = RogerFit(A=A, lag_roots=np.array([]), b_ref=1.0, k=gaf.k, Q=gaf.Q,
                    element_error=np.zeros((2, 2)), fit_error=0.0)
     return modal, gaf, fit
+
+
+#: (k1, k2, a, d) of :func:`two_dof_coalescence`
+TWO_DOF = (100.0 ** 2, 150.0 ** 2, 1.0, -2.0)
 
 
 _velocities = st.one_of(st.lists(reals(0.1, 300.0), min_size=0, max_size=8),
@@ -308,7 +314,7 @@ def _unreported(result_sigma, velocities, instabilities):
 def _pk(c, density, velocities, max_iter, tol):
     from asekit.flutter import pk_flutter, pk_instabilities
     import warnings
-    modal, gaf, _ = _two_dof(c)
+    modal, gaf, _ = two_dof_coalescence(c)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         res = pk_flutter(modal, gaf, density, velocities, max_iter=max_iter, tol=tol)
@@ -334,7 +340,7 @@ PK = Target(
 
 def _rl(c, density, velocities):
     from asekit.flutter import root_locus, root_locus_instabilities
-    modal, _, fit = _two_dof(c)
+    modal, _, fit = two_dof_coalescence(c)
     res = root_locus(modal, fit, density, velocities)
     return res, root_locus_instabilities(res, modal, fit)
 
@@ -353,7 +359,7 @@ ROOT_LOCUS = Target(
 
 def _td(c, density, velocities, t_end, window):
     from asekit.flutter import time_domain_sweep
-    modal, _, fit = _two_dof(c)
+    modal, _, fit = two_dof_coalescence(c)
     return time_domain_sweep(modal, fit, density, velocities, coordinate=0, t_end=t_end,
                              window=window)
 

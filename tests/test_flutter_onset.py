@@ -19,7 +19,9 @@ from asekit.flutter import (FlutterConvergenceWarning, PkResult, RootLocusResult
                             pk_flutter, pk_instabilities, root_locus, root_locus_instabilities,
                             time_domain_sweep, growth_rate, simulate_free_response)
 from asekit.nastran import load_ha145b
-from asekit.rfa import RogerFit, roger_fit
+from asekit.rfa import roger_fit
+
+from property_targets import TWO_DOF, two_dof_coalescence
 
 HA145B_FLUTTER_SPEED = 12672.0      # in/s, Nastran HA145B (see module docstring)
 
@@ -42,15 +44,9 @@ def ha145b():
 
 def _coalescence(c=2.0):
     """2-dof quasi-steady model of tests/test_flutter.py (hand-derived flutter q_f)."""
-    k1, k2, a, d = 100.0 ** 2, 150.0 ** 2, 1.0, -2.0
-    Q = np.array([[0.0, a], [d, 0.0]], complex)
+    k1, k2, a, d = TWO_DOF
     q_f = np.sqrt((((k1 - k2) / 2) ** 2 + c ** 2 * (k1 + k2) / 2) / (-a * d))
-    modal = modal_arrays(M=np.eye(2), K=np.diag([k1, k2]), C=c * np.eye(2))
-    gaf = TabulatedGaf(np.array([0.0, 10.0]), np.array([Q, Q]), 1.0)
-    A = np.zeros((3, 2, 2))
-    A[0] = Q.real
-    fit = RogerFit(A=A, lag_roots=np.array([]), b_ref=1.0, k=gaf.k, Q=gaf.Q,
-                   element_error=np.zeros((2, 2)), fit_error=0.0)
+    modal, gaf, fit = two_dof_coalescence(c)
     return modal, gaf, fit, np.sqrt(2 * q_f)          # rho = 1
 
 
