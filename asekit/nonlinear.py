@@ -503,6 +503,12 @@ def refine_onset(system_at, connection: Connection, u_lo: float, u_hi: float,
         return bool(r.lcos) or r.inside_band_unstable
     if has(u_lo) or not has(u_hi):
         raise ValueError(f"[{u_lo:g}, {u_hi:g}] m/s does not bracket the LCO onset")
+    return bisect_onset(has, u_lo, u_hi, xtol)
+
+
+def bisect_onset(has, u_lo: float, u_hi: float, xtol: float) -> float:
+    """Bisection of a bracketed onset: ``has(u)`` False at ``u_lo``, True at ``u_hi`` (the
+    caller checks both); returns the upper end of the final bracket, within ``xtol``."""
     a, b = float(u_lo), float(u_hi)
     while b - a > xtol:
         m = 0.5 * (a + b)

@@ -43,8 +43,8 @@ import numpy as np
 
 from ..aeroelastic import aeroelastic_matrices, fin_outputs, modal_arrays
 from ..atmosphere import standard_atmosphere
-from ..nonlinear import (Connection, ConnectedSystem, biased_harmonic_balance, equilibria,
-                         growth_rate, harmonic_balance, simulate_exact)
+from ..nonlinear import (Connection, ConnectedSystem, biased_harmonic_balance, bisect_onset,
+                         equilibria, growth_rate, harmonic_balance, simulate_exact)
 from ..reproduce import ChapterResult, Quantity
 from ..servo import SYSTEM_3, ActuatorParameters, PDController, actuator_state_space
 
@@ -340,11 +340,7 @@ def lco_onset(model: FinFreeplayModel, cfg: str, density: float, u_lo: float, u_
         return None
     if has(u_lo):
         raise ValueError(f"a stable LCO exists already at {u_lo:g} m/s; lower u_lo")
-    a, b = float(u_lo), float(u_hi)
-    while b - a > xtol:
-        mid = 0.5 * (a + b)
-        a, b = (a, mid) if has(mid) else (mid, b)
-    return b
+    return bisect_onset(has, u_lo, u_hi, xtol)
 
 
 def run(figures: bool = False) -> ChapterResult:
