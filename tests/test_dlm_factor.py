@@ -18,15 +18,7 @@ from asekit.aero.gaf import gaf_from_box_modes
 from asekit.aero.methods import pressure_matrices, pressures
 from asekit.aero.spline import analytic_modes
 
-
-def _planar():
-    return mesh_surfaces(TrapezoidSurface((0, 0, 0), 1.0, (0.5, 2, 0.0), 0.6, 6, 8))
-
-
-def _nonplanar():
-    return mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0.3, 1, 0.0), 0.8, 5, 4, "wing"),
-                          TrapezoidSurface((0.3, 1, 0), 0.8, (0.6, 1.5, 0.5), 0.5, 5, 3, "winglet"),
-                          TrapezoidSurface((2.0, 0, 0.3), 0.5, (2.2, 0.8, 0.3), 0.4, 4, 4, "tail")])
+from test_dlm import _nonplanar, _planar          # the same planar and non-planar meshes
 
 
 def _modal_wash(mesh, k, b, n_modes=6):
