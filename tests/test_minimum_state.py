@@ -120,12 +120,9 @@ def test_aeroelastic_eigenvalues_solve_the_flutter_determinant(fin):
 
 
 def _elastic(fin, mach):
-    db, modal = fin
-    m = modal_arrays(modal)
-    s_ = slice(m.n_rigid, m.n_modes)
-    me = modal_arrays(M=m.M[s_, s_], K=m.K[s_, s_], C=m.C[s_, s_], n_rigid=0)
-    k, Q = gaf_at_mach(db, mach)
-    return me, k, Q[:, s_, s_], db.b_ref
+    """The clamped flutter problem (ModalArrays, k, Q_ss, b_ref) of the fin at ``mach``."""
+    from asekit.reproduction.design import elastic_problem
+    return elastic_problem(fin, mach)
 
 
 @pytest.mark.parametrize("mach", [0.75, 0.6])
