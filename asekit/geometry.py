@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .validate import positive
+from asekit.util.validate import positive
 
 
 @dataclass(frozen=True)

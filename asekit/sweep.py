@@ -420,7 +420,7 @@ def _base_condition(case_dict: dict, case) -> tuple[float, float]:
 
 def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
     """Build and check a :class:`Sweep` from a parsed sweep file (see ``data/sweeps/``)."""
-    from .case import CaseError, case_from_dict
+    from asekit.case import CaseError, case_from_dict
     if not isinstance(d, dict):
         raise SweepError("a sweep must be a table")
     extra = sorted(set(d) - {"sweep", "case", "parameter"})
@@ -443,7 +443,7 @@ def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
     if not p.is_absolute():
         p = Path(base_dir) / p
         if not p.exists():
-            from .paths import CASES_DIR
+            from asekit.util.paths import CASES_DIR
             if (CASES_DIR / cpath).exists():          # a shipped case by name
                 p = CASES_DIR / cpath
     try:
@@ -531,7 +531,7 @@ def _check_condition(where: str, path: str, v: float) -> None:
 
 def load_sweep(path) -> Sweep:
     """Read and check a sweep file (TOML); SweepError naming the key, or FileNotFoundError."""
-    from .validate import read_toml
+    from asekit.util.validate import read_toml
     path = Path(path)
     return sweep_from_dict(read_toml(path, SweepError), base_dir=path.parent, source=str(path))
 
@@ -571,7 +571,7 @@ def _one_blas_thread():
 def aero_key(case) -> str:
     """SHA-256 of what the AIC factors of ``case`` depend on besides Mach: its boxes (corners),
     reduced frequencies, reference semichord, kernel and symmetry."""
-    from .case import pipeline as P
+    from asekit.case import pipeline as P
     a = case.aero
     boxes = P.box_mesh(case)
     h = hashlib.sha256(np.ascontiguousarray(boxes.corners).tobytes())
@@ -583,7 +583,7 @@ def aero_key(case) -> str:
 def aic_factors(case, machs) -> AicFactors:
     """LU factors of D(M, k) (:func:`asekit.aero.dlm.normalwash_matrices`) for the case's
     boxes at every Mach of ``machs`` and the case's reduced frequencies (BLAS on one thread)."""
-    from .case import pipeline as P
+    from asekit.case import pipeline as P
     boxes = P.box_mesh(case)
     ks = P.reduced_frequencies(case)
     with _one_blas_thread():
@@ -591,7 +591,7 @@ def aic_factors(case, machs) -> AicFactors:
 
 
 def _factors(case, boxes, ks, machs) -> AicFactors:
-    from .aero.dlm import factor_normalwash_matrix, map_normalwash_matrices
+    from asekit.aero.dlm import factor_normalwash_matrix, map_normalwash_matrices
     a = case.aero
     lu = {}
     for m in sorted({float(x) for x in machs}):
@@ -613,9 +613,9 @@ def projected_gaf(model, case, factors: AicFactors, mach: float) -> np.ndarray:
     """Q(M, k) (n_k, n_modes, n_modes) of ``model`` from the factored D(M, k):
     Q = H_lp^T diag(A) D^-1 (dH/dx + i k H / b) per k (Eqs. 2.10-2.12), the operations of
     :func:`asekit.aero.gaf.gaf_from_box_modes` on precomputed factors."""
-    from .aero.dlm import AicFactor
-    from .aero.spline import fe_spline, modal_forces
-    from .case import pipeline as P
+    from asekit.aero.dlm import AicFactor
+    from asekit.aero.spline import fe_spline, modal_forces
+    from asekit.case import pipeline as P
     boxes = P.box_mesh(case)
     bm = fe_spline(model, boxes)
     lu, piv = factors.lu[float(mach)]
@@ -641,7 +641,7 @@ def needed_machs(sweep: Sweep) -> set:
 
 def base_factors(sweep: Sweep) -> AicFactors:
     """The factors of the base case at :func:`needed_machs` (computed once per sweep)."""
-    from .case import case_from_dict
+    from asekit.case import case_from_dict
     return aic_factors(case_from_dict(copy.deepcopy(sweep.base)), needed_machs(sweep))
 
 
@@ -649,7 +649,7 @@ def base_factors(sweep: Sweep) -> AicFactors:
 # one sample
 # ---------------------------------------------------------------------------------------------
 def _database(model, case, factors: AicFactors, machs):
-    from .aero.gaf import GafDatabase
+    from asekit.aero.gaf import GafDatabase
     ms = np.array(sorted({float(m) for m in machs}))
     Q = np.stack([projected_gaf(model, case, factors, m) for m in ms])
     return GafDatabase(ms, factors.k, Q, factors.b_ref, model.n_rigid, {})
@@ -689,10 +689,10 @@ def _safe(sweep, values):
 
 
 def _analyse(sweep: Sweep, factors: AicFactors, values: dict):
-    from .atmosphere import standard_atmosphere
-    from .case import case_from_dict
-    from .case import pipeline as P
-    from .flutter import divergence_speeds
+    from asekit.atmosphere import standard_atmosphere
+    from asekit.case import case_from_dict
+    from asekit.case import pipeline as P
+    from asekit.aeroelastic.flutter import divergence_speeds
     d, mach, alt = sweep.case_dict(values)
     _check_condition("flight.mach", "flight.mach", mach)
     _check_condition("flight.altitude", "flight.altitude", alt)

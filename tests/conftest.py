@@ -11,5 +11,5 @@ def pytest_configure(config):
         from hypothesis.configuration import set_hypothesis_home_dir
     except ImportError:                     # hypothesis absent: nothing to redirect
         return
-    from asekit.paths import user_cache_dir
+    from asekit.util.paths import user_cache_dir
     set_hypothesis_home_dir(str(user_cache_dir() / "hypothesis"))

@@ -268,11 +268,11 @@ GAF_AT_MACH = Target(
 
 # ---- flutter -----------------------------------------------------------------------------------
 def two_dof_coalescence(c):
-    """The hand-derivable 2-dof quasi-steady coalescence model of tests/test_flutter.py:
+    """The hand-derivable 2-dof quasi-steady coalescence model of tests/aeroelastic/test_flutter.py:
     (modal, gaf, fit) with stiffnesses 100^2, 150^2, coupling Q = [[0, 1], [-2, 0]] and modal
-    damping c (also used by tests/test_flutter_onset.py)."""
-    from asekit.aeroelastic import modal_arrays
-    from asekit.flutter import TabulatedGaf
+    damping c (also used by tests/aeroelastic/test_flutter_onset.py)."""
+    from asekit.aeroelastic.statespace import modal_arrays
+    from asekit.aeroelastic.flutter import TabulatedGaf
     from asekit.rfa import RogerFit
     k1, k2, a, d = TWO_DOF
     Q = np.array([[0.0, a], [d, 0.0]], complex)
@@ -312,7 +312,7 @@ def _unreported(result_sigma, velocities, instabilities):
 
 
 def _pk(c, density, velocities, max_iter, tol):
-    from asekit.flutter import pk_flutter, pk_instabilities
+    from asekit.aeroelastic.flutter import pk_flutter, pk_instabilities
     import warnings
     modal, gaf, _ = two_dof_coalescence(c)
     with warnings.catch_warnings():
@@ -339,7 +339,7 @@ PK = Target(
 
 
 def _rl(c, density, velocities):
-    from asekit.flutter import root_locus, root_locus_instabilities
+    from asekit.aeroelastic.flutter import root_locus, root_locus_instabilities
     modal, _, fit = two_dof_coalescence(c)
     res = root_locus(modal, fit, density, velocities)
     return res, root_locus_instabilities(res, modal, fit)
@@ -358,7 +358,7 @@ ROOT_LOCUS = Target(
 
 
 def _td(c, density, velocities, t_end, window):
-    from asekit.flutter import time_domain_sweep
+    from asekit.aeroelastic.flutter import time_domain_sweep
     modal, _, fit = two_dof_coalescence(c)
     return time_domain_sweep(modal, fit, density, velocities, coordinate=0, t_end=t_end,
                              window=window)
@@ -389,9 +389,9 @@ SERVO_NAMES = ("resistance", "inductance", "torque_constant", "back_emf_constant
 
 
 def _servo(scale_l, scale_r, ratio, efficiency, gain, kp, kd, supply, current_limit):
-    from asekit.servo import (ActuatorParameters, DCMotor, PDController, Transmission,
+    from asekit.servo.actuator import (ActuatorParameters, DCMotor, PDController, Transmission,
                               closed_loop_poles, open_loop_poles)
-    from asekit.simulate import PowerLimits
+    from asekit.servo.simulate import PowerLimits
     motor = DCMotor(resistance=5.78 * scale_r, inductance=550e-6 * scale_l)
     p = ActuatorParameters(motor=motor, transmission=Transmission(ratio, efficiency))
     ctrl = PDController(gain, kp, kd)
@@ -410,8 +410,8 @@ SERVO = Target(
 
 
 def _simulate(scale_l, gain, kd, command, t_final, sample_time, limits):
-    from asekit.servo import ActuatorParameters, DCMotor, PDController
-    from asekit.simulate import NO_LIMITS, THESIS_LIMITS, simulate
+    from asekit.servo.actuator import ActuatorParameters, DCMotor, PDController
+    from asekit.servo.simulate import NO_LIMITS, THESIS_LIMITS, simulate
     lim = {"thesis": THESIS_LIMITS, "none": NO_LIMITS}.get(limits, limits)
     p = ActuatorParameters(motor=DCMotor(inductance=550e-6 * scale_l))
     return simulate(p, PDController(gain, 275.0, kd), command, t_final=t_final,
@@ -439,7 +439,7 @@ SIMULATE = Target(
 
 # ---- OP4 round trip ----------------------------------------------------------------------------
 def _op4(name, values, shape, cplx, digits):
-    from asekit.nastran import read_op4, write_op4
+    from asekit.io.op4 import read_op4, write_op4
     a = np.resize(np.asarray(values, float), shape) if values else np.zeros(shape)
     if cplx:
         a = a + 1j * a[::-1]

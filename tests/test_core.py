@@ -5,11 +5,11 @@ import math
 import numpy as np
 import pytest
 
-from asekit.cache import CacheError, load_npz, save_npz
+from asekit.util.cache import CacheError, load_npz, save_npz
 from asekit.geometry import LinearThickness, Material, Planform
 from asekit.reproduction.fin import load_fin
-from asekit.reproduce import CHAPTERS, difference
-from asekit.thesis import all_keys, thesis_value
+from asekit.reproduction.driver import CHAPTERS, difference
+from asekit.reproduction.thesis import all_keys, thesis_value
 
 
 def test_reference_fin_geometry_matches_fin_md():

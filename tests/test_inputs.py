@@ -12,8 +12,8 @@ from asekit.aero.boxes import BoxMesh, TrapezoidSurface, mesh_surfaces
 from asekit.reproduction.fin import fin_boxes, fin_surface
 from asekit.aero.dlm import normalwash_matrix
 from asekit.aero.vlm import lift_curve_slope, steady_pressure
-from asekit.nastran import read_op4, write_op4
-from asekit.servo import SYSTEM_3, ActuatorParameters, DCMotor, PDController
+from asekit.io.op4 import read_op4, write_op4
+from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, DCMotor, PDController
 from asekit.simulate import simulate
 
 

@@ -19,7 +19,7 @@ import pytest
 from asekit import sweep as S
 from asekit.case import case_from_dict
 from asekit.case import pipeline as P
-from asekit.paths import FIN_FILE
+from asekit.util.paths import FIN_FILE
 
 ROOT = Path(__file__).resolve().parent.parent
 FAST_V = {"min": 150.0, "max": 350.0, "step": 10.0}
@@ -243,7 +243,7 @@ def test_a_sample_is_the_pipeline_on_the_edited_case(one_blas_thread):
     """Row = asekit.case.pipeline on the case file edited by hand (same flutter speed,
     frequency, divergence speed and flags); flight.mach / flight.altitude pick the condition."""
     from asekit.atmosphere import standard_atmosphere
-    from asekit.flutter import divergence_speeds
+    from asekit.aeroelastic.flutter import divergence_speeds
     ps = [{"path": "support.torsional_stiffness", "values": [100.0]},
           {"path": "damping.modal_damping_ratio", "values": [0.005]},
           {"path": "flight.mach", "values": [0.5]}, {"path": "flight.altitude", "values": [2500.0]}]

@@ -14,7 +14,7 @@ distinct kernel station point q ([R71] Eqs. A.1, A.4, A.5, 7, 12 in the form of
 stations of every sender with the weights T1 W1_j: D1 = sum_j T1 W1_j (-K1_j e_j + K10_j)
 ([R71] Eq. 27b). ``error_model="numpy"`` (division by zero gives inf/nan as in numpy, no
 Python exception checks in the loop); no fastmath (no reassociation): the result agrees with
-the numpy path to rounding (tests/test_dlm_compiled.py).
+the numpy path to rounding (tests/aero/test_dlm_compiled.py).
 """
 
 from __future__ import annotations

@@ -25,7 +25,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..validate import positive
+from asekit.util.validate import positive
 
 
 #: largest dense aerodynamic matrix set a single call may allocate (bytes); calls that would need

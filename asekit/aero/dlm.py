@@ -69,12 +69,12 @@ depend on ybar, zbar and e only, come from a table over (receiver strip, sender 
 Re I1(0) of Eq. A.5, a function of r1 only, from a table over the (y, z) groups. Meshes with
 surfaces in several planes are cut into blocks of (receivers in one plane, senders in one
 plane): coplanar blocks take this path, the others the pairwise one. The result equals the
-pairwise path to rounding (tests/test_dlm.py).
+pairwise path to rounding (tests/aero/test_dlm.py).
 
 Implementations. The all-planar path has two implementations of the same equations: numpy
 array expressions (always available) and a compiled numba loop (:mod:`asekit.aero._dlm_compiled`,
 used by default when numba is installed; ``kernel=`` or ``$ASEKIT_DLM_KERNEL`` choose). They
-agree to about 1e-14 relative to max |D| (tests/test_dlm_compiled.py). The pairwise path is
+agree to about 1e-14 relative to max |D| (tests/aero/test_dlm_compiled.py). The pairwise path is
 numpy only.
 """
 
@@ -87,8 +87,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from .boxes import BoxMesh, check_matrix_memory
-from .vlm import check_mach, vlm_normalwash_matrix, CHUNK_BYTES
+from asekit.aero.boxes import BoxMesh, check_matrix_memory
+from asekit.aero.vlm import check_mach, vlm_normalwash_matrix, CHUNK_BYTES
 
 #: Laschka's approximation of u / sqrt(1 + u^2) ~ 1 - sum a_n exp(-n c u) ([R71] Eq. A.4;
 #: coefficients as tabulated by Blair 1992, WL-TR-92-3028, p. 89).
@@ -1091,7 +1091,7 @@ def _compiled_planar(rec, pts: "_StationPoints", rows: slice, mach: float, t1w: 
     """One planar row chunk by the compiled kernel (:mod:`asekit.aero._dlm_compiled`): the
     geometry of :class:`_PlanarChunk` in one compiled pass, then per k ``add(ik, d1)``, or, if
     ``target`` is given, D1 added into the array ``target(ik)`` by the kernel itself."""
-    from . import _dlm_compiled as C
+    from asekit.aero import _dlm_compiled as C
     pr = np.ascontiguousarray(rec.control_point[rows])
     e1, sgn_r1sq, gc, r1, phase, neg2, k10 = C.planar_geometry(pr, pts.xyz, pts.e, mach,
                                                                float(p_n[0]))

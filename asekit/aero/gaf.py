@@ -24,17 +24,17 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
-from ..blas import blas_threads_for
-from ..cache import CacheError, load_npz, save_npz
-from ..paths import DATA_DIR, user_cache_dir
-from .boxes import BoxMesh
-from .dlm import check_k, factor_normalwash_matrix, map_normalwash_matrices
-from .spline import BoxModes, fe_spline, modal_forces
-from .vlm import check_mach
+from asekit import __version__
+from asekit.util.blas import blas_threads_for
+from asekit.util.cache import CacheError, load_npz, save_npz
+from asekit.util.paths import DATA_DIR, user_cache_dir
+from asekit.aero.boxes import BoxMesh
+from asekit.aero.dlm import check_k, factor_normalwash_matrix, map_normalwash_matrices
+from asekit.aero.spline import BoxModes, fe_spline, modal_forces
+from asekit.aero.vlm import check_mach
 
 #: The reference fin's database, shipped read-only with the repository (so CI does not rebuild
-#: it). Rebuilt databases go to the user cache directory (:func:`asekit.paths.user_cache_dir`).
+#: it). Rebuilt databases go to the user cache directory (:func:`asekit.util.paths.user_cache_dir`).
 GAF_FILE = DATA_DIR / "gaf_fin.npz"
 #: Databases shipped with asekit: any whose fingerprint matches a request is used as is.
 SHIPPED_DATABASES = (GAF_FILE,)
@@ -77,7 +77,7 @@ def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref
     """
     ks = check_k(k)
     if method not in ("quartic", "parabolic"):
-        from .methods import pressures, resolve_method
+        from asekit.aero.methods import pressures, resolve_method
         if resolve_method(method, mach) != "dlm" or aero_options:
             cp = pressures(mesh, mach, ks, b_ref, lambda kk: box_modes.normalwash(kk, b_ref),
                            method, symmetric, **(aero_options or {}))
@@ -165,7 +165,7 @@ def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: flo
     if method in ("quartic", "parabolic"):
         machs = np.array([check_mach(m) for m in np.atleast_1d(machs)])
     else:
-        from .methods import resolve_method
+        from asekit.aero.methods import resolve_method
         machs = np.array([float(m) for m in np.atleast_1d(machs) if resolve_method(method, m)])
     ks = check_k(ks)
     if np.any(np.diff(ks) <= 0):
@@ -235,7 +235,7 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
 
     Lookup order: ``path`` if given, else the shipped databases (:data:`SHIPPED_DATABASES`,
     read-only) and ``cache_dir`` / ``gaf_<fingerprint>.npz`` (default
-    :func:`asekit.paths.user_cache_dir`). A file is used only if its checksum passes and its
+    :func:`asekit.util.paths.user_cache_dir`). A file is used only if its checksum passes and its
     fingerprint (mode set + settings), Mach and k arrays, b_ref and array shape all match.
     A rebuild that cannot be written (read-only folder) is returned all the same, with a warning.
     """

@@ -26,7 +26,7 @@ import warnings
 
 import numpy as np
 
-from .boxes import BoxMesh
+from asekit.aero.boxes import BoxMesh
 
 #: auto: highest Mach number given to the DLM, lowest given to the supersonic method.
 DLM_MACH_MAX = 0.9
@@ -99,14 +99,14 @@ def pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str =
     """
     name = resolve_method(method, mach)
     if name == "dlm":
-        from .dlm import normalwash_matrices
+        from asekit.aero.dlm import normalwash_matrices
         kernel = method if method in DLM_KERNELS else dlm_kernel
         d = normalwash_matrices(mesh, mach, k, b_ref, kernel, symmetric)
         return np.linalg.solve(d, np.broadcast_to(np.eye(mesh.n), d.shape))
     if name == "supersonic":
-        from .supersonic import supersonic_pressure_matrices
+        from asekit.aero.supersonic import supersonic_pressure_matrices
         return supersonic_pressure_matrices(mesh, mach, k, b_ref, symmetric, **options)
-    from .piston import piston_pressure_matrices
+    from asekit.aero.piston import piston_pressure_matrices
     return piston_pressure_matrices(mesh, mach, k, b_ref, **options)
 
 
@@ -118,7 +118,7 @@ def pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash, method: s
     inverse (:class:`asekit.aero.dlm.AicFactor`, one LU per k, streamed)."""
     name = resolve_method(method, mach)
     if name == "supersonic":
-        from .supersonic import supersonic_pressures
+        from asekit.aero.supersonic import supersonic_pressures
         return supersonic_pressures(mesh, mach, k, b_ref, normalwash, symmetric, **options)
     ks = np.atleast_1d(np.asarray(k, float))
 
@@ -126,7 +126,7 @@ def pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash, method: s
         return np.asarray(normalwash(float(kk)) if callable(normalwash) else normalwash[ik])
 
     if name == "dlm":               # factor and solve per k, streamed (no explicit inverse)
-        from .dlm import factor_normalwash_matrix, map_normalwash_matrices
+        from asekit.aero.dlm import factor_normalwash_matrix, map_normalwash_matrices
         kernel = method if method in DLM_KERNELS else dlm_kernel
         return np.stack(map_normalwash_matrices(
             mesh, mach, ks, b_ref,

@@ -50,7 +50,7 @@ import warnings
 
 import numpy as np
 
-from .boxes import BoxMesh
+from asekit.aero.boxes import BoxMesh
 
 #: Validity bound ([AZ56] Section II, asekit's choice of ">>"): M >= 2 or M k >= 2.
 PISTON_MACH_MIN = 2.0

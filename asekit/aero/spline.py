@@ -64,7 +64,7 @@ def fe_spline(model, mesh) -> BoxModes:
 
     The boxes must lie in the structure's plane (z = 0, horizontal); raises ValueError otherwise.
     """
-    from ..structure.modes import mode_shapes_at
+    from asekit.structure.modes import mode_shapes_at
     if np.any(np.abs(mesh.corners[:, :, 2]) > 1e-9) or np.any(np.abs(mesh.dihedral) > 1e-12):
         raise ValueError("fe_spline needs boxes in the structural plane z = 0; "
                          "use InfinitePlateSpline for other configurations")

@@ -68,17 +68,17 @@ normalwash field is convolved with the offset tables by 2-D FFT. The full matrix
 offset (di, |dj|) and k, so one nx x ny table per k is evaluated and gathered into sparse
 influence matrices holding only the cell pairs inside each other's Mach cone (10-30 % of them);
 their index pattern is built once per grid and reused for every k, and the strip-local
-transfers are sparse too. The two agree to rounding (tests/test_supersonic.py, 1e-12).
+transfers are sparse too. The two agree to rounding (tests/aero/test_supersonic.py, 1e-12).
 
 Limits. Planar meshes in z = 0 only. Leading, side and trailing edges may be subsonic or
 supersonic (a subsonic trailing edge checked by the flow-reversal theorem, 1-3 %,
-tests/test_supersonic.py); at subsonic leading edges
+tests/aero/test_supersonic.py); at subsonic leading edges
 the staircase of cells and the square-root pressure singularity cost accuracy (delta wings with
 beta cot Lambda = 0.33-0.56: lift slope 4-7 % above Stewart's conical-flow value, against
-0.1-0.3 % with supersonic leading edges; tests/test_supersonic.py). The reference fin's leading
+0.1-0.3 % with supersonic leading edges; tests/aero/test_supersonic.py). The reference fin's leading
 edge is supersonic from M 1.13. On the AGARD 445.6 wing at M 1.072 and 1.141 (subsonic
 leading and trailing edges) the flutter speed index moves by 1-2 % (M 1.141) and 2-7 %
-(M 1.072) under grid refinement (tests/test_supersonic.py). The box mesh must resolve
+(M 1.072) under grid refinement (tests/aero/test_supersonic.py). The box mesh must resolve
 the shortest kernel wavelength 2 pi b (M - 1) / (k M) with at least ``bpw_min`` boxes (a
 :class:`~asekit.aero.boxes.MeshRuleWarning` otherwise); the cell grid resolves it with
 ``cells_per_wavelength`` cells and every box with about ``cells_per_box`` cells chordwise.
@@ -97,8 +97,8 @@ import scipy.fft as sfft
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .boxes import BoxMesh, MeshRuleWarning
-from .piston import _check_k, check_supersonic_mach, piston_transfer, strip_interpolation
+from asekit.aero.boxes import BoxMesh, MeshRuleWarning
+from asekit.aero.piston import _check_k, check_supersonic_mach, piston_transfer, strip_interpolation
 
 _GAUSS_PHI = np.polynomial.legendre.leggauss(12)
 _GAUSS_F = np.polynomial.legendre.leggauss(32)

@@ -24,8 +24,8 @@ import math
 
 import numpy as np
 
-from ..validate import positive
-from .boxes import BoxMesh, check_matrix_memory
+from asekit.util.validate import positive
+from asekit.aero.boxes import BoxMesh, check_matrix_memory
 
 #: Upper bound (bytes) for the temporaries of one row chunk (VLM and DLM).
 CHUNK_BYTES = 256 * 2**20
@@ -128,7 +128,7 @@ def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False,
     if not isinstance(mesh, BoxMesh):
         raise TypeError(f"mesh must be a BoxMesh, got {type(mesh).__name__}")
     check_matrix_memory(mesh.n, 1, 8, "the VLM normalwash matrix", "use fewer boxes")
-    from .dlm import _check_kernel
+    from asekit.aero.dlm import _check_kernel
     compiled = _check_kernel(kernel) == "compiled"
     beta = math.sqrt(1.0 - mach * mach)
     sx = np.array([1.0 / beta, 1.0, 1.0])
@@ -143,7 +143,7 @@ def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False,
         v, ia, ib = _distinct_vertices(a, b)
         half_chord = 0.5 * img.chord
         if compiled:
-            from . import _dlm_compiled
+            from asekit.aero import _dlm_compiled
             _dlm_compiled.horseshoe_normalwash(np.ascontiguousarray(p), np.ascontiguousarray(n_r),
                                                v, ia, ib, scale, half_chord, d)
             continue

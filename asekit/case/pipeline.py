@@ -15,16 +15,16 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..aero.boxes import TrapezoidSurface, mesh_surfaces
-from ..aero.gaf import GafDatabase, cached_gaf_database, default_reduced_frequencies
-from ..atmosphere import standard_atmosphere
-from ..flutter import (Instability, PkResult, TabulatedGaf, divergence_speeds, first_of,
-                       pk_flutter, pk_instabilities)
-from ..structure.assembly import assemble, clamped_edge, point_mass_matrix, shaft_support
-from ..structure.mesh import PlateMesh, panels_mesh
-from ..structure.modes import (ModalModel, fictitious_mass_modal_model, fixed_modal_model,
-                               with_damping)
-from .schema import Case, CaseError
+from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
+from asekit.aero.gaf import GafDatabase, cached_gaf_database, default_reduced_frequencies
+from asekit.atmosphere import standard_atmosphere
+from asekit.aeroelastic.flutter import (Instability, PkResult, TabulatedGaf, divergence_speeds, first_of,
+                            pk_flutter, pk_instabilities)
+from asekit.structure.assembly import assemble, clamped_edge, point_mass_matrix, shaft_support
+from asekit.structure.mesh import PlateMesh, panels_mesh
+from asekit.structure.modes import (ModalModel, fictitious_mass_modal_model, fixed_modal_model,
+                                    with_damping)
+from asekit.case.schema import Case, CaseError
 
 
 # ---------------------------------------------------------------------------------------------
@@ -59,7 +59,7 @@ def modal_model(case: Case) -> ModalModel:
         if s.kind == "clamped_root":
             model = fixed_modal_model(clamped_edge(mesh, K, M), M, md.f_max, md.count)
         elif s.kind == "edges":
-            from ..structure.supports import planform_edge_supports
+            from asekit.structure.supports import planform_edge_supports
             model = fixed_modal_model(planform_edge_supports(mesh, K, M, **dict(s.edges)), M,
                                       md.f_max, md.count)
         else:
@@ -212,7 +212,7 @@ def analyse_condition(case: Case, db: GafDatabase, mach: float, cond: FlightCond
     U = np.asarray(case.flight.velocities, float)
     pk = pk_flutter(model, gaf, cond.density, U)
     inst = tuple(pk_instabilities(pk, model, gaf))
-    start = [i for i in inst if i.at_first_point]          # unstable at U0 (asekit.flutter)
+    start = [i for i in inst if i.at_first_point]          # unstable at U0 (asekit.aeroelastic.flutter)
     crossings = [i for i in inst if not i.at_first_point]
     return ConditionResult(float(mach), cond, pk, inst, first_of(crossings, "flutter"),
                            first_of(crossings, "divergence"), bool(start),
@@ -325,10 +325,10 @@ def corner_points(case: Case) -> dict:
 def actuator_setup(case: Case):
     """(ActuatorParameters, PDController, PowerLimits) of the case's ``[actuator]``: the keys
     it sets, asekit's defaults (thesis Tables 12, 16, 17) for the rest. The actuator's load
-    inertia is 0: the fin's inertia enters through its modal model (:func:`asekit.ase.build_model`)."""
-    from ..servo import SYSTEM_3, ActuatorParameters, DCMotor, Transmission
-    from ..simulate import THESIS_LIMITS
-    from .schema import MOTOR_KEYS, TRANSMISSION_KEYS
+    inertia is 0: the fin's inertia enters through its modal model (:func:`asekit.ase.loop.build_model`)."""
+    from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, DCMotor, Transmission
+    from asekit.servo.simulate import THESIS_LIMITS
+    from asekit.case.schema import MOTOR_KEYS, TRANSMISSION_KEYS
     a = case.actuator
     if a is None:
         raise CaseError("the case has no [actuator]")
@@ -349,10 +349,10 @@ def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
     """The Ch. 5 analysis of the case's actuator (None without ``[actuator]``)."""
     if case.actuator is None:
         return None
-    from .. import ase as ase_mod
-    from .. import metrics
-    from ..aeroelastic import fin_outputs
-    from ..rfa import gaf_at_mach, roger_fit
+    from asekit.ase import loop as ase_mod
+    from asekit.ase import metrics
+    from asekit.aeroelastic.statespace import fin_outputs
+    from asekit.rfa import gaf_at_mach, roger_fit
 
     a = case.actuator
     model = modal_model(case)

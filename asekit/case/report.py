@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .schema import Case
+from asekit.case.schema import Case
 
 
 @dataclass(frozen=True)
@@ -36,7 +36,7 @@ class Analysis:
 
 def run_analysis(case: Case, progress: bool = False) -> Analysis:
     """Run the whole pipeline of ``case`` and time each step."""
-    from . import pipeline as P
+    from asekit.case import pipeline as P
     sec = {}
     t = time.perf_counter()
     modal = P.modal_model(case)
@@ -177,8 +177,8 @@ def format_summary(s: dict, width: int = 100) -> str:
 # figures and the HTML report
 # ---------------------------------------------------------------------------------------------
 def fig_planform(a: Analysis):
-    from ..plotting import new_figure
-    from . import pipeline as P
+    from asekit.util.plotting import new_figure
+    from asekit.case import pipeline as P
     fig, ax = new_figure(f"{a.case.name}: planform, FE mesh (black) and aerodynamic boxes (blue)")
     mesh = P.structural_mesh(a.case)
     for e in mesh.elements:
@@ -199,7 +199,7 @@ def fig_planform(a: Analysis):
 
 
 def fig_modes(a: Analysis, n: int = 4):
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     m = a.modal
     idx = list(range(m.n_rigid, min(len(m.frequencies_hz), m.n_rigid + n)))
     fig, axes = new_figure(f"{a.case.name}: mode shapes (w, contours)", ncols=len(idx),
@@ -219,7 +219,7 @@ def fig_modes(a: Analysis, n: int = 4):
 
 
 def fig_vg(a: Analysis, result):
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     pk = result.pk
     alt = result.condition.altitude
     where = f"{alt:g} m" if alt is not None else f"rho {result.condition.density:.4g} kg/m^3"
@@ -242,7 +242,7 @@ def fig_vg(a: Analysis, result):
 
 
 def fig_root_locus(a: Analysis, result):
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     pk = result.pk
     fig, ax = new_figure(f"{a.case.name}: root locus of the p-k roots, M {result.mach:g}")
     for j in range(pk.p.shape[1]):
@@ -258,8 +258,8 @@ def fig_root_locus(a: Analysis, result):
 
 
 def fig_ase_bode(a: Analysis):
-    from .. import ase as ase_mod
-    from ..plotting import new_figure
+    from asekit.ase import loop as ase_mod
+    from asekit.util.plotting import new_figure
     s = a.ase
     f = np.logspace(0, 3.5, 800)
     fig, (ax1, ax2) = new_figure(f"{a.case.name}: forward paths FWTF 1-3, M {s.mach:g}",
@@ -281,7 +281,7 @@ def fig_ase_bode(a: Analysis):
 
 
 def fig_ase_steps(a: Analysis):
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     s = a.ase
     fig, ax = new_figure(f"{a.case.name}: power-limited step, fin-root pitch")
     for t, sim in s.simulations.items():
@@ -312,7 +312,7 @@ def figures(a: Analysis) -> dict:
 def write_report(a: Analysis, directory) -> Path:
     """Write ``directory/index.html`` (summary table and figures) with the PNGs beside it and
     ``summary.json``; returns the index path."""
-    from ..plotting import save_figure
+    from asekit.util.plotting import save_figure
     d = Path(directory)
     d.mkdir(parents=True, exist_ok=True)
     s = summary(a)

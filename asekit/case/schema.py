@@ -17,7 +17,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
+from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
 
 
 class CaseError(ValueError):
@@ -127,8 +127,8 @@ class FlightSpec:
     envelope_altitude: tuple[float, float] | None = None
 
 
-#: The actuator keys of a case file, each None (the default of :class:`asekit.servo.DCMotor`,
-#: :class:`asekit.servo.Transmission`, the thesis's System 3 and power limits) unless given.
+#: The actuator keys of a case file, each None (the default of :class:`asekit.servo.actuator.DCMotor`,
+#: :class:`asekit.servo.actuator.Transmission`, the thesis's System 3 and power limits) unless given.
 MOTOR_KEYS = ("resistance", "inductance", "torque_constant", "back_emf_constant",
               "rotor_inertia", "viscous_damping")
 TRANSMISSION_KEYS = {"ratio": "ratio", "efficiency": "efficiency",
@@ -139,8 +139,8 @@ TRANSMISSION_KEYS = {"ratio": "ratio", "efficiency": "efficiency",
 class ActuatorSpec:
     """The servo-actuator (thesis Ch. 4-5): DC motor, transmission, PD controller
     K_c (K_P + K_D s), power limits, and the flight condition of the ASE analysis. A value left
-    None takes asekit's default: the Faulhaber 2642 drive of :class:`asekit.servo.DCMotor` and
-    :class:`asekit.servo.Transmission` (thesis Table 12), System 3 (Table 17), 24 V / 10 A
+    None takes asekit's default: the Faulhaber 2642 drive of :class:`asekit.servo.actuator.DCMotor` and
+    :class:`asekit.servo.actuator.Transmission` (thesis Table 12), System 3 (Table 17), 24 V / 10 A
     (Table 16)."""
 
     resistance: float | None = None
@@ -210,19 +210,19 @@ class Case:
 
     # the pipeline (asekit.case.pipeline) -- thin methods so a case reads naturally
     def modal_model(self):
-        from .pipeline import modal_model
+        from asekit.case.pipeline import modal_model
         return modal_model(self)
 
     def gaf_database(self, progress: bool = True, cache: bool = True):
-        from .pipeline import gaf_database
+        from asekit.case.pipeline import gaf_database
         return gaf_database(self, progress=progress, cache=cache)
 
     def flutter(self, progress: bool = False):
-        from .pipeline import flutter
+        from asekit.case.pipeline import flutter
         return flutter(self, progress=progress)
 
     def ase(self):
-        from .pipeline import ase
+        from asekit.case.pipeline import ase
         return ase(self)
 
 
@@ -422,7 +422,7 @@ def _support(t: _Table, panels) -> SupportSpec:
         t.done()
         return SupportSpec(kind="clamped_root")
     if kind == "edges":
-        from ..structure.supports import EDGE_TYPES, PLANFORM_EDGES
+        from asekit.structure.supports import EDGE_TYPES, PLANFORM_EDGES
         defaults = {"root": "clamped", "tip": "free", "leading_edge": "free",
                     "trailing_edge": "free"}
         edges = tuple((e, t.string(e, EDGE_TYPES, default=defaults[e])) for e in PLANFORM_EDGES)
@@ -499,7 +499,7 @@ def _aero(t: _Table, panels) -> AeroSpec:
     method = t.string("method", ("dlm", "auto", "supersonic", "piston"), default="dlm")
     machs = t.numbers("machs", required=True, low=0.0, low_open=False,
                       high=1.0 if method == "dlm" else 10.0, high_open=True, ascending=True)
-    from ..aero.methods import resolve_method
+    from asekit.aero.methods import resolve_method
     for i, m in enumerate(machs):
         try:
             resolve_method(method, m)
@@ -643,5 +643,5 @@ def case_from_dict(d: dict, source: str = "") -> Case:
 def load_case(path) -> Case:
     """Read and check a case file (TOML). Raises :class:`CaseError` (a ValueError) naming the
     offending key and its valid range, or FileNotFoundError."""
-    from ..validate import read_toml
+    from asekit.util.validate import read_toml
     return case_from_dict(read_toml(path, CaseError), source=str(path))

@@ -15,16 +15,16 @@ from __future__ import annotations
 import numpy as np
 from scipy.special import hankel2
 
-from ..aero.boxes import TrapezoidSurface, check_mesh_rules, mesh_surfaces
+from asekit.aero.boxes import TrapezoidSurface, check_mesh_rules, mesh_surfaces
 from asekit.reproduction.fin import fin_boxes
-from ..aero.dlm import normalwash_matrices, pressure_jump
-from ..aero.gaf import steady_hinge_coefficient
+from asekit.aero.dlm import normalwash_matrices, pressure_jump
+from asekit.aero.gaf import steady_hinge_coefficient
 from asekit.reproduction.fin import fin_gaf_database
-from ..aero.vlm import lift_curve_slope, steady_pressure
+from asekit.aero.vlm import lift_curve_slope, steady_pressure
 from asekit.reproduction.fin import load_fin
-from ..plotting import THESIS_COLOR, new_figure
-from ..reproduce import ChapterResult, Quantity
-from ..thesis import thesis_value
+from asekit.util.plotting import THESIS_COLOR, new_figure
+from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.reproduction.thesis import thesis_value
 
 #: Mach of the steady hinge-moment coefficient (thesis Eq. 4.6).
 STEADY_MACH = 0.6

@@ -10,7 +10,7 @@ Definitions used for the reported numbers:
 * resonances of OPLOOP 3: the first two local maxima of |OPLOOP 3| above 10 Hz;
 * FWTF phase margins and crossovers: at the first (lowest) gain crossover; FWTF 3's gain margin:
   at its first phase crossover (it has several), the thesis's reading of Fig 68;
-* Nyquist margins (:func:`asekit.margins.nyquist_margins`): the open-loop right-half-plane poles
+* Nyquist margins (:func:`asekit.ase.margins.nyquist_margins`): the open-loop right-half-plane poles
   are counted (OPLOOP 2/3 and FWTF 2/3 have one, about +15.5 rad/s, from the de-centering hinge
   moment), so FWTF 2's lower gain margin (at zero frequency, where L(0) < 0) is found; the
   upper and lower gain margins bound the range of loop gain with a stable closed loop;
@@ -32,13 +32,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import ase, metrics
-from ..margins import NyquistMargins, nyquist_margins
-from ..plotting import THESIS_COLOR, new_figure
-from ..reproduce import ChapterResult, Quantity
-from ..servo import SYSTEM_3, PDController
-from ..simulate import THESIS_LIMITS, SimulationResult, simulate
-from . import fin as reffin
+from asekit.ase import loop as ase
+from asekit.ase import metrics
+from asekit.ase.margins import NyquistMargins, nyquist_margins
+from asekit.util.plotting import THESIS_COLOR, new_figure
+from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.servo.actuator import SYSTEM_3, PDController
+from asekit.servo.simulate import THESIS_LIMITS, SimulationResult, simulate
+from asekit.reproduction import fin as reffin
 
 #: Thesis Table 2 requirements checked on the elastic fin.
 SETTLING_REQUIREMENT = 0.05      # s

@@ -3,7 +3,7 @@ elastic fin in the loop, checked against thesis Table 2 over the flight envelope
 
 Plant: asekit's fin (6 x 7 MITC4 plate, single-node 120 N m/rad shaft, own DLM GAFs), the
 actuator of Ch. 4, the thesis's processor: 1 kHz sampling, zero-order hold, one sample of
-computational delay (:func:`asekit.ase.sampled_plant`, :func:`asekit.ase.simulate_sampled`,
+computational delay (:func:`asekit.ase.loop.sampled_plant`, :func:`asekit.ase.loop.simulate_sampled`,
 power-limited: 24 V supply, 10 A limit as the thesis's voltage clip).
 
 Requirements (thesis Table 2 and Sec. 4.1.1) checked at the fin root, for power-limited steps
@@ -33,10 +33,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .. import ase, metrics
-from ..controllers import DigitalController, pd_controller, pid_filtered
-from ..reproduce import ChapterResult, Quantity
-from . import fin as reffin
+from asekit.ase import loop as ase
+from asekit.ase import metrics
+from asekit.servo.controllers import DigitalController, pd_controller, pid_filtered
+from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.reproduction import fin as reffin
 
 MACHS = (0.4, 0.5, 0.6)
 ALTITUDES = (0.0, 2500.0, 5000.0)
@@ -71,7 +72,7 @@ def perturbed_modal(modal, shaft_scale: float = 1.0, freq_scales=(1.0, 1.0)):
     K_ss (Rayleigh-Ritz on the kept modes). Frequencies: K_ss -> S K_ss S with S = diag(s1,
     s2, 1, ...).
     """
-    from ..aeroelastic import fin_outputs
+    from asekit.aeroelastic.statespace import fin_outputs
     from asekit.reproduction.fin import load_fin
 
     if shaft_scale <= 0 or min(freq_scales) <= 0:
@@ -92,7 +93,7 @@ def perturbed_modal(modal, shaft_scale: float = 1.0, freq_scales=(1.0, 1.0)):
 def ms_fit(n_states: int = 6):
     """A minimum-state fit factory for :func:`asekit.reproduction.fin.fin_ase` (``n_states`` shared lag
     states, steady constraint)."""
-    from ..rfa import minimum_state_fit
+    from asekit.rfa import minimum_state_fit
 
     def fit(k, q, b_ref, mach):
         return minimum_state_fit(k, q, b_ref, n_states=n_states, constrain_k0=True, mach=mach)
@@ -295,7 +296,7 @@ def redesign_a(data=None, max_evaluations: int = 500, x0=None):
 
 def design_b(data=None, topology: str = "AEM2", **overrides) -> DigitalController:
     """Design (b), LQG + integral action on the minimum-state plant (:data:`DESIGN_B`)."""
-    from ..controllers import lqg_integral as _lqg
+    from asekit.servo.controllers import lqg_integral as _lqg
 
     m = fin_model(*DESIGN_B_CONDITION, data=data, fit=ms_fit(DESIGN_B_STATES))
     plant = ase.sampled_plant(m, topology, SAMPLE_TIME)
@@ -307,7 +308,7 @@ def design_b_scheduled(data=None, **overrides):
     """Design (b) scheduled on the flight condition: a factory ``(mach, altitude) ->``
     LQG + integral designed (:data:`DESIGN_B` weights) on the minimum-state plant of that
     condition -- the missile's autopilot knows its Mach and altitude. Designs are cached."""
-    from ..controllers import lqg_integral as _lqg
+    from asekit.servo.controllers import lqg_integral as _lqg
 
     data = load() if data is None else data
     cache = {}
@@ -389,7 +390,7 @@ def rfa_state_study(data=None, mach: float = 0.75, roger_lags=range(0, 8),
                     ms_states=(1, 2, 4, 6, 8, 10, 12, 16), max_iter: int = 2000) -> dict:
     """Fit error against the number of aerodynamic lag states: Roger (N lags -> N n states)
     and minimum-state (n_L states), unweighted, at ``mach``."""
-    from ..rfa import gaf_at_mach, minimum_state_fit, roger_fit
+    from asekit.rfa import gaf_at_mach, minimum_state_fit, roger_fit
 
     db, _ = load() if data is None else data
     k, Q = gaf_at_mach(db, mach)
@@ -409,8 +410,8 @@ def states_for_error(table: np.ndarray, target: float = 0.01):
 
 def elastic_problem(data, mach):
     """The clamped (rigid mode held) flutter problem: (ModalArrays, k, Q_ss, b_ref)."""
-    from ..aeroelastic import modal_arrays
-    from ..rfa import gaf_at_mach
+    from asekit.aeroelastic.statespace import modal_arrays
+    from asekit.rfa import gaf_at_mach
 
     db, modal = data
     m = modal_arrays(modal)
@@ -425,10 +426,10 @@ def flutter_comparison(data=None, mach: float = 0.75, altitude: float = 0.0,
                        order: int = 4, velocities=np.arange(150.0, 461.0, 5.0)) -> dict:
     """Flutter speed of the fin (rigid mode held) by p-k and by the root locus with Roger fits
     and minimum-state fits (unweighted and weighted to k <= ``band`` k_f, k_f from p-k)."""
-    from ..atmosphere import standard_atmosphere
-    from ..flutter import (TabulatedGaf, first_of, pk_flutter, pk_instabilities, root_locus,
-                           root_locus_instabilities)
-    from ..rfa import minimum_state_fit, reduced_frequency_weights, roger_fit
+    from asekit.atmosphere import standard_atmosphere
+    from asekit.aeroelastic.flutter import (TabulatedGaf, first_of, pk_flutter, pk_instabilities, root_locus,
+                                root_locus_instabilities)
+    from asekit.rfa import minimum_state_fit, reduced_frequency_weights, roger_fit
 
     data = load() if data is None else data
     me, k, Qe, b = elastic_problem(data, mach)
@@ -583,7 +584,7 @@ def format_envelope(checks, designs_order=None) -> str:
 
 
 def fig_fit_error(study):
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, ax = new_figure(f"RFA fit error vs aerodynamic lag states (fin, Mach {study['mach']})",
                          "beyond the thesis")
     rg, ms = study["roger"], study["minimum_state"]
@@ -597,7 +598,7 @@ def fig_fit_error(study):
 
 
 def fig_loop_bode(plant, design_set, f_hz=None):
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     f = np.logspace(0, np.log10(480.0), 2000) if f_hz is None else f_hz
     fig, ax = new_figure(f"Loop gain at the voltage demand, {plant.topology}, sampled 1 kHz",
                          "beyond the thesis", nrows=2, sharex=True, figsize=(7.5, 6.5))
@@ -615,7 +616,7 @@ def fig_loop_bode(plant, design_set, f_hz=None):
 
 def fig_steps(model, design_set, limits=ase.THESIS_LIMITS, t_final=0.1):
     """Fin-root responses to 1 deg and 15 deg steps (normalised), voltage and current."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     label = "power limited" if limits is not None else "linear"
     fig, ax = new_figure(f"Steps at the fin root, AEM2, {label}", "beyond the thesis", nrows=3,
                          sharex=True, figsize=(7.5, 8.0))

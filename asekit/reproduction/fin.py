@@ -5,7 +5,7 @@ mesh from the mesh rules, its GAF database (shipped read-only in ``data/gaf_fin.
 into the user cache), and its aeroservoelastic model of Ch. 5.
 
 Everything here is a thin wrapper over the generic physics (:mod:`asekit.structure`,
-:mod:`asekit.aero`, :mod:`asekit.ase`) that knows no fin; a new surface goes through
+:mod:`asekit.aero`, :mod:`asekit.ase.loop`) that knows no fin; a new surface goes through
 :mod:`asekit.case` instead.
 """
 
@@ -20,17 +20,17 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
-from ..aero.boxes import BoxMesh, TrapezoidSurface, check_matrix_memory, mesh_surfaces
-from ..aero.gaf import cached_gaf_database, database_settings, default_reduced_frequencies
-from ..ase import AeroservoelasticModel, build_model
-from ..geometry import Material, OrthotropicMaterial, Planform, Thickness
-from ..paths import FIN_FILE
-from ..servo import ActuatorParameters
-from ..structure.assembly import SupportedSystem, assemble, shaft_support
-from ..structure.mesh import PlateMesh, structured_mesh
-from ..structure.modes import (ModalModel, elastic_modal_model, fictitious_mass_modal_model,
-                               modes_up_to)
-from ..validate import finite, positive
+from asekit.aero.boxes import BoxMesh, TrapezoidSurface, check_matrix_memory, mesh_surfaces
+from asekit.aero.gaf import cached_gaf_database, database_settings, default_reduced_frequencies
+from asekit.ase.loop import AeroservoelasticModel, build_model
+from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness
+from asekit.util.paths import FIN_FILE
+from asekit.servo.actuator import ActuatorParameters
+from asekit.structure.assembly import SupportedSystem, assemble, shaft_support
+from asekit.structure.mesh import PlateMesh, structured_mesh
+from asekit.structure.modes import (ModalModel, elastic_modal_model, fictitious_mass_modal_model,
+                                    modes_up_to)
+from asekit.util.validate import finite, positive
 
 
 #: Radius (m) of the fin's physical shaft region assumed for the distributed-shaft model when
@@ -113,7 +113,7 @@ def fin_definition(case) -> FinDefinition:
 def load_fin(path: str | Path = FIN_FILE) -> FinDefinition:
     """The fin definition of a case file (default: the reference fin,
     ``data/cases/nalci2013_fin.toml``), see :func:`fin_definition`."""
-    from ..case.schema import load_case
+    from asekit.case.schema import load_case
     return fin_definition(load_case(path))
 
 
@@ -246,7 +246,7 @@ def fin_inplane_modes(fin: FinDefinition | None = None, n_chord: int | None = No
     in-plane motion does not couple with bending or with the aerodynamics."""
     import scipy.sparse as sp
 
-    from ..structure.plate import membrane_matrices
+    from asekit.structure.plate import membrane_matrices
     fin = load_fin() if fin is None else fin
     mesh = fin_mesh(fin, n_chord, n_span)
     Ke, Me = membrane_matrices(mesh, fin.material)
@@ -395,8 +395,8 @@ class FinAse:
 
     def steady_hinge_moment(self):
         """The Ch. 4 steady hinge moment q Q_cc theta at this flight condition (asekit's Q_cc)."""
-        from ..simulate import SteadyHingeMoment
-        from ..atmosphere import standard_atmosphere
+        from asekit.servo.simulate import SteadyHingeMoment
+        from asekit.atmosphere import standard_atmosphere
 
         atm = standard_atmosphere(self.altitude)
         return SteadyHingeMoment(q_cc=self.q_cc, mach=self.mach, density=float(atm.density),
@@ -417,9 +417,9 @@ def fin_ase(mach: float = 0.5, altitude: float = 0.0, actuator: ActuatorParamete
     ``fit``: optional callable ``fit(k, Q, b_ref, mach) -> RFA`` replacing the Roger fit (e.g.
     a :func:`asekit.rfa.minimum_state_fit`).
     """
-    from ..aeroelastic import fin_outputs
-    from ..atmosphere import standard_atmosphere
-    from ..rfa import roger_fit, gaf_at_mach
+    from asekit.aeroelastic.statespace import fin_outputs
+    from asekit.atmosphere import standard_atmosphere
+    from asekit.rfa import roger_fit, gaf_at_mach
 
     mach = finite("mach", mach)
     altitude = finite("altitude", altitude)

@@ -16,10 +16,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..atmosphere import standard_atmosphere
-from ..flutter import (TabulatedGaf, divergence_speeds, first_of, pk_flutter, pk_instabilities,
-                       root_locus, root_locus_instabilities, time_domain_sweep)
-from ..reproduce import ChapterResult, Quantity
+from asekit.atmosphere import standard_atmosphere
+from asekit.aeroelastic.flutter import (TabulatedGaf, divergence_speeds, first_of, pk_flutter,
+                            pk_instabilities, root_locus, root_locus_instabilities,
+                            time_domain_sweep)
+from asekit.reproduction.driver import ChapterResult, Quantity
 
 VELOCITIES = np.arange(100.0, 460.0 + 1e-9, 2.0)      # m/s
 ALTITUDES = (0.0, 2500.0, 5000.0)                       # m
@@ -42,14 +43,14 @@ def load_fin_gafs():
 
 def fin_gaf(db, mach: float) -> TabulatedGaf:
     """The database's GAFs at one Mach as a :class:`TabulatedGaf` (exact Mach required)."""
-    from ..rfa import gaf_at_mach
+    from asekit.rfa import gaf_at_mach
     k, q = gaf_at_mach(db, mach)
     return TabulatedGaf(k, q, db.b_ref, mach=mach)
 
 
 def fin_rfa(db, mach: float, n_lags: int = N_LAGS, constrain_k0: bool = False, lag_roots=None):
     """Roger fit of the fin's GAFs at ``mach`` (default lag roots over the database's k)."""
-    from ..rfa import roger_fit_database
+    from asekit.rfa import roger_fit_database
     return roger_fit_database(db, mach, n_lags=n_lags, constrain_k0=constrain_k0,
                               lag_roots=lag_roots)
 
@@ -69,7 +70,7 @@ def analyse_condition(modal, db, mach: float, altitude: float, velocities=VELOCI
 def time_domain_first(modal, fit, rho: float, velocities=np.arange(100.0, 461.0, 10.0)):
     """Time-domain growth sweep and the onset kind (flutter if the A_sys root crossing near the
     onset is oscillatory, else divergence)."""
-    from ..aeroelastic import aeroelastic_matrices
+    from asekit.aeroelastic.statespace import aeroelastic_matrices
     td = time_domain_sweep(modal, fit, rho, velocities, coordinate=1)
     kind = None
     if td.onset_speed is not None:
@@ -81,9 +82,9 @@ def time_domain_first(modal, fit, rho: float, velocities=np.arange(100.0, 461.0,
 
 def ha145b_check() -> dict | None:
     """p-k, root locus and time domain on Nastran's HA145B (None if the file is absent)."""
-    from ..aeroelastic import modal_arrays
-    from ..nastran import ha145b_path, load_ha145b
-    from ..rfa import roger_fit
+    from asekit.aeroelastic.statespace import modal_arrays
+    from asekit.io.op4 import ha145b_path, load_ha145b
+    from asekit.rfa import roger_fit
     if not ha145b_path().exists():
         return None
     case = load_ha145b()
@@ -214,7 +215,7 @@ def run(figures: bool = False) -> ChapterResult:
 # --------------------------------------------------------------------------------------------
 def fig_rfa_element(fit, i: int, j: int, thesis_figure: str = "Fig 23"):
     """Data vs Roger fit of element Q_ij in the complex plane (Figs 23-24)."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, ax = new_figure(f"RFA fit of Q_{i + 1}{j + 1} (Mach {fit.mach})", thesis_figure)
     kk = np.geomspace(max(fit.k[0], 1e-4), fit.k[-1], 300)
     qf = fit.evaluate(kk)[:, i, j]
@@ -255,7 +256,7 @@ def _envelope():
 def fig_mach_airspeed_altitude(points=(), thesis_figure: str = "Fig 25"):
     """Mach lines in the airspeed-altitude plane (Fig 25) with the analysis envelope of
     data/fin.toml shaded; optional (U, h, label) points, one marker style per label."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, ax = new_figure("Mach - airspeed - altitude (1976 standard atmosphere)", thesis_figure)
     h = np.linspace(0, 12000, 100)
     a = standard_atmosphere(h).speed_of_sound
@@ -286,9 +287,9 @@ def fig_mach_airspeed_altitude(points=(), thesis_figure: str = "Fig 25"):
 def fig_match_points(table, thesis_figure: str = "Figs 26-28"):
     """The match-point check (Sec. 3.3.1.1), one panel per altitude: the flight Mach M = U/a(h)
     of the standard atmosphere and the p-k flutter speed at each analysis Mach (rows of
-    :func:`asekit.flutter.match_point_table`); where the two meet is the matched flutter point.
+    :func:`asekit.aeroelastic.flutter.match_point_table`); where the two meet is the matched flutter point.
     The flight envelope's Mach band (Table 3) and the customary +15 % margin are drawn."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     alts = sorted({r.altitude for r in table})
     fig, axes = new_figure("Match point: flutter speed per analysis Mach vs flight Mach",
                            thesis_figure, ncols=len(alts), figsize=(4.2 * len(alts), 4.2),
@@ -308,7 +309,7 @@ def fig_match_points(table, thesis_figure: str = "Figs 26-28"):
         for r in rows:
             ax.annotate(f"{r.speed:.0f}", (r.speed, r.mach), textcoords="offset points",
                         xytext=(5, -3), fontsize=7, color="C3")
-        from ..flutter import matched_mach
+        from asekit.aeroelastic.flutter import matched_mach
         mm = matched_mach(table, h)
         if mm is not None:
             ax.plot(mm * a, mm, "*", color="C2", ms=12, label=f"matched M {mm:.3f}")
@@ -338,7 +339,7 @@ def _damping_frequency_figure(title, thesis_figure, velocities, damping_ratio, f
                               root: str, flutter, thesis_point, unit):
     """Damping ratio and frequency of every tracked root vs airspeed (two panels), the flutter
     point marked beside the thesis's; ``root`` names the eigenvalue in the axis label."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, (a1, a2) = new_figure(title, thesis_figure, nrows=2, figsize=(6.4, 6.5), sharex=True)
     for j in range(damping_ratio.shape[1]):
         a1.plot(velocities, damping_ratio[:, j], label=f"mode {j + 1}")
@@ -360,14 +361,14 @@ def fig_pk(res, title="p-k damping and frequency", thesis_figure="Figs 30-31", u
            flutter=None, thesis_point=None):
     """Damping ratio xi = -Re p / |p| (Eq. 3.13, the sign used throughout: xi < 0 unstable) and
     frequency vs airspeed of every tracked mode (Figs 30-31). ``flutter``: an
-    :class:`asekit.flutter.Instability` to mark; ``thesis_point``: (speed, Hz) drawn beside it.
+    :class:`asekit.aeroelastic.flutter.Instability` to mark; ``thesis_point``: (speed, Hz) drawn beside it.
     The frequency axis shows the first two modes, whose coalescence is the flutter."""
     return _damping_frequency_figure(title, thesis_figure, res.velocities, res.damping_ratio,
                                      res.frequency_hz, "p", flutter, thesis_point, unit)
 
 
 def _mark_flutter(a1, a2, flutter, thesis_point, unit):
-    from ..plotting import THESIS_COLOR
+    from asekit.util.plotting import THESIS_COLOR
     if flutter is not None:
         a1.plot(flutter.speed, 0.0, "*", color="C3", ms=12, zorder=5,
                 label=f"asekit {flutter.speed:.1f} {unit}")
@@ -386,7 +387,7 @@ def _mark_flutter(a1, a2, flutter, thesis_point, unit):
 def fig_root_locus(rl, thesis_figure="Figs 32, 35", flutter=None):
     """Aeroelastic roots over airspeed in the complex plane (Figs 32, 35); the flutter root
     marked when ``flutter`` is given."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, ax = new_figure("Root locus of A_sys (aeroelastic roots)", thesis_figure)
     for j in range(rl.elastic.shape[1]):
         ax.plot(rl.elastic[:, j].real, rl.elastic[:, j].imag / (2 * np.pi), ".-", ms=3,
@@ -413,7 +414,7 @@ def fig_root_locus_damping(rl, thesis_figure="Figs 33-34", unit="m/s", flutter=N
 def fig_time_responses(responses, coordinate=1, thesis_figure="Figs 36-38"):
     """Free responses of one elastic coordinate, one panel per (label, speed, response), filled
     column by column (Figs 36-38: the thesis's speeds left, asekit's onset speeds right)."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     n = len(responses)
     fig, axes = new_figure(f"Free response of zeta_{coordinate + 1} (Eq. 3.15)", thesis_figure,
                            nrows=(n + 1) // 2, ncols=2, figsize=(11, 2.6 * ((n + 1) // 2) + 0.8),
@@ -430,7 +431,7 @@ def fig_time_responses(responses, coordinate=1, thesis_figure="Figs 36-38"):
 
 def fig_time_response(resp, coordinate=1, speed=None, thesis_figure="Figs 36-38"):
     """Elastic coordinate history (Figs 36-38)."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, ax = new_figure(f"Free response, zeta_{coordinate + 1}"
                          + (f" at {speed:.0f} m/s" if speed else ""), thesis_figure)
     ax.plot(resp.t, resp.z[:, coordinate], lw=0.8)
@@ -441,7 +442,7 @@ def fig_time_response(resp, coordinate=1, speed=None, thesis_figure="Figs 36-38"
 
 def fig_step_sizes(resp, speed: float, thesis_figure="Fig 39"):
     """RK45 step sizes of one free-response run (Fig 39), as 1/step on a log axis."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, ax = new_figure(f"RK45 step sizes of the free response at {speed:.1f} m/s",
                          thesis_figure)
     ax.semilogy(np.cumsum(resp.steps), 1.0 / resp.steps, ".", ms=2)
@@ -455,7 +456,7 @@ def fig_step_sizes(resp, speed: float, thesis_figure="Fig 39"):
 def fig_flutter_mode(modal, flutter, thesis_figure="Fig 29"):
     """Flutter mode shape (Fig 29): magnitude and phase of the out-of-plane displacement of the
     flutter eigenvector expanded on the elastic mode shapes (normalised to its largest value)."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     v = flutter.vector / flutter.vector[np.argmax(np.abs(flutter.vector))]
     w = modal.shapes[:, 0, modal.n_rigid:] @ v
     w = w / w[np.argmax(np.abs(w))]
@@ -477,7 +478,7 @@ def fig_flutter_mode(modal, flutter, thesis_figure="Fig 29"):
 
 def fig_growth(td, thesis_figure="Table 11", unit="m/s"):
     """Growth rate of the free response vs airspeed."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, ax = new_figure("Time domain: growth rate vs airspeed", thesis_figure)
     ax.plot(td.velocities, td.growth, "o-")
     ax.axhline(0, color="k", lw=0.8)
@@ -491,7 +492,7 @@ def fig_growth(td, thesis_figure="Table 11", unit="m/s"):
 
 def fig_damping_study(rows, thesis_speed: float | None = None):
     """Flutter speed vs modal damping ratio and vs structural g (equivalent at g = 2 zeta)."""
-    from ..plotting import THESIS_COLOR, new_figure
+    from asekit.util.plotting import THESIS_COLOR, new_figure
     fig, ax = new_figure("Flutter speed vs structural damping, Mach 0.75, sea level, 6x7 model")
     z = [(r["value"], r["speed"]) for r in rows if r["kind"] == "zeta" and r["speed"]]
     g = [(r["value"], r["speed"]) for r in rows if r["kind"] == "g" and r["speed"]]
@@ -509,8 +510,8 @@ def free_responses(modal, fit, rho: float, onset: float | None, t_end: float = 0
     """Free responses (Eq. 3.15, unit initial zeta_2, RK45 with steps <= 1e-4 s) at the thesis's
     248 / 254 / 260 m/s (Figs 36-38) and at asekit's onset -6 / 0 / +6 m/s: a list of
     (label, speed, FreeResponse)."""
-    from ..aeroelastic import aeroelastic_matrices
-    from ..flutter import initial_state, simulate_free_response
+    from asekit.aeroelastic.statespace import aeroelastic_matrices
+    from asekit.aeroelastic.flutter import initial_state, simulate_free_response
     cases = [("thesis Fig 36", 248.0), ("thesis Fig 37", 254.0), ("thesis Fig 38", 260.0)]
     if onset:
         cases += [("asekit onset - 6", onset - 6.0), ("asekit onset", onset),
@@ -562,7 +563,7 @@ def root_locus_panel(modal, db, mach: float = 0.75, n_lags: int = N_LAGS):
     except ImportError:
         return None
     import matplotlib.pyplot as plt
-    from ..aeroelastic import aeroelastic_matrices
+    from asekit.aeroelastic.statespace import aeroelastic_matrices
     fit = fin_rfa(db, mach, n_lags=n_lags)
     out = w.Output()
     speed = w.FloatSlider(value=250.0, min=100.0, max=460.0, step=2.0, description="U (m/s)")
@@ -602,7 +603,7 @@ def scaled_modal(modal, mass_scale: float = 1.0, elastic_hz=None):
     ``mass_scale`` (a different material density with the same mode shapes: M -> s M, K and
     the GAFs unchanged), and/or the elastic stiffnesses set so that the elastic frequencies
     become ``elastic_hz`` (same shapes, K_ss diagonal rescaled; assumes M_ss diagonal)."""
-    from ..aeroelastic import ModalArrays, modal_arrays
+    from asekit.aeroelastic.statespace import ModalArrays, modal_arrays
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
     M = m.M * mass_scale
     K = m.K.copy()
@@ -617,7 +618,7 @@ def sensitivity_study(modal, db, mach: float = 0.75, altitude: float = 0.0,
                       velocities=VELOCITIES) -> list[dict]:
     """p-k (and root-locus) flutter speed of the fin under modelling variants that the thesis
     leaves open or states differently. Returns rows {label, speed, freq, first, first_kind}."""
-    from ..aeroelastic import modal_arrays
+    from asekit.aeroelastic.statespace import modal_arrays
     rho0 = float(standard_atmosphere(altitude).density)
     gaf = fin_gaf(db, mach)
     base = modal_arrays(modal)
@@ -641,7 +642,7 @@ def sensitivity_study(modal, db, mach: float = 0.75, altitude: float = 0.0,
     for label, mod, g, rho, kw in variants:
         if mod is None:      # truncated modal basis
             n = base.n_rigid + 2
-            from ..aeroelastic import ModalArrays
+            from asekit.aeroelastic.statespace import ModalArrays
             mod = ModalArrays(M=base.M[:n, :n], K=base.K[:n, :n], C=base.C[:n, :n],
                               n_rigid=base.n_rigid)
             g = TabulatedGaf(gaf.k, gaf.Q[:, :n, :n], gaf.b_ref, gaf.mach)
@@ -660,7 +661,7 @@ def rfa_sensitivity(modal, db, mach: float = 0.75, altitude: float = 0.0,
                     velocities=VELOCITIES) -> list[dict]:
     """Root-locus flutter speed for several Roger fits (lag count, lag spread, steady-load
     constraint): the RFA-side spread the thesis names in Section 3.3.4."""
-    from ..rfa import default_lag_roots
+    from asekit.rfa import default_lag_roots
     rho = float(standard_atmosphere(altitude).density)
     kmax = float(np.max(db.k))
     cases = [("2 lags", {"n_lags": 2}), ("4 lags (default)", {"n_lags": 4}),
@@ -688,8 +689,8 @@ def aero_variant_gafs(modal, db, mach: float = 0.75, symmetric: bool = False,
     asekit.aero; a few seconds per variant). ``modal`` is the ModalModel whose shapes are used.
     """
     from asekit.reproduction.fin import fin_boxes
-    from ..aero.gaf import gaf_from_box_modes
-    from ..aero.spline import InfinitePlateSpline, fe_spline
+    from asekit.aero.gaf import gaf_from_box_modes
+    from asekit.aero.spline import InfinitePlateSpline, fe_spline
     from asekit.reproduction.fin import load_fin
     boxes = fin_boxes(load_fin(), n_chord, n_span)
     if spline == "fe":
@@ -717,7 +718,7 @@ def model_sensitivity(db, mach: float = 0.75, altitude: float = 0.0, velocities=
     """p-k flutter speed with the structure and/or GAFs rebuilt for modelling variants (support
     model, structural mesh, spline, symmetry plane, aerodynamic mesh) at one Mach and altitude.
     Rows: label, elastic frequencies (Hz), Q_cc(k_min), speed, freq, first, first_kind."""
-    from ..aeroelastic import modal_arrays
+    from asekit.aeroelastic.statespace import modal_arrays
     from asekit.reproduction.fin import fin_modal_model
     rho = float(standard_atmosphere(altitude).density)
     rows = []
@@ -757,7 +758,7 @@ def damped_modal(modal, zeta: float = 0.0, g: float = 0.0, omega_ref: float | No
     (rad/s) — at the flutter point when omega_ref is the flutter frequency (p = i omega_f:
     p (g/omega_f) K = i g K). The rigid mode stays undamped. ``zeta`` in [0, 1), ``g`` >= 0.
     """
-    from ..aeroelastic import ModalArrays, modal_arrays
+    from asekit.aeroelastic.statespace import ModalArrays, modal_arrays
     if not (0.0 <= zeta < 1.0):
         raise ValueError(f"zeta must be in [0, 1), got {zeta!r}")
     if not (g >= 0.0 and np.isfinite(g)):
@@ -844,7 +845,7 @@ def _study_fingerprint(db, mach, altitude, velocities, structure, aero) -> str:
     import hashlib
     from pathlib import Path
 
-    from ..paths import FIN_FILE
+    from asekit.util.paths import FIN_FILE
     h = hashlib.sha256()
     h.update(f"v{_STUDY_VERSION} {mach!r} {altitude!r} {structure!r} {aero!r}".encode())
     h.update(np.ascontiguousarray(np.asarray(velocities, float)).tobytes())
@@ -852,7 +853,8 @@ def _study_fingerprint(db, mach, altitude, velocities, structure, aero) -> str:
     h.update(repr(float(db.b_ref)).encode())
     h.update(Path(FIN_FILE).read_bytes())
     pkg = Path(__file__).resolve().parent.parent
-    for rel in sorted(["flutter.py", "aeroelastic.py", "atmosphere.py", "geometry.py"]
+    for rel in sorted(["aeroelastic/flutter.py", "aeroelastic/statespace.py", "atmosphere.py",
+                       "geometry.py"]
                       + [f"structure/{p.name}" for p in (pkg / "structure").glob("*.py")]
                       + [f"aero/{p.name}" for p in (pkg / "aero").glob("*.py")]):
         h.update(rel.encode())
@@ -872,7 +874,7 @@ def _distributed_model(structure):
 
 def _mesh_flutter(model, db, mach, rho, velocities, aero):
     """(elastic Hz (first 3), speed, freq) of ``model`` with GAFs on the ``aero`` box mesh."""
-    from ..aeroelastic import modal_arrays
+    from asekit.aeroelastic.statespace import modal_arrays
     g = aero_variant_gafs(model, db, mach, n_chord=aero[0], n_span=aero[1])
     m = modal_arrays(model)
     fl = first_of(pk_instabilities(pk_flutter(m, g, rho, velocities), m, g), "flutter")
@@ -897,13 +899,13 @@ def converged_flutter_study(db, mach: float = 0.75, altitude: float = 0.0,
     last structural and aerodynamic refinement.
 
     The finest meshes take minutes (about 8 min and 7 GB for 384 x 448), so with ``cache`` the
-    result is stored (atomically, with a checksum, :mod:`asekit.cache`) in the user cache
-    directory (:func:`asekit.paths.user_cache_dir`) under a fingerprint of all its inputs and
+    result is stored (atomically, with a checksum, :mod:`asekit.util.cache`) in the user cache
+    directory (:func:`asekit.util.paths.user_cache_dir`) under a fingerprint of all its inputs and
     the physics source, and reused while the fingerprint matches. With ``compute=False`` a
     missing or stale cache returns None instead of computing.
     """
-    from ..paths import user_cache_dir
-    from ..cache import CacheError, load_npz, save_npz
+    from asekit.util.paths import user_cache_dir
+    from asekit.util.cache import CacheError, load_npz, save_npz
     key = _study_fingerprint(db, mach, altitude, velocities, structure, aero)
     path = user_cache_dir() / f"flutter_convergence_{key[:16]}.npz"
     if cache:

@@ -1,7 +1,7 @@
 """Freeplay in the actuator-fin connection of the reference fin (thesis Sec. 6.2, future work;
 asekit issue 14): LCO amplitude and frequency versus airspeed, fin alone and in the AEM1 loop.
 
-Model (see :mod:`asekit.nonlinear` for the fictitious-mass argument). The FN2 modal model of
+Model (see :mod:`asekit.aeroelastic.nonlinear` for the fictitious-mass argument). The FN2 modal model of
 the fin (rigid pitch mode first, then the elastic modes computed with the 120 N m/rad shaft
 spring, Sec. 3.1.1) is used as a Ritz basis of the *fin alone*: coordinates xi = [theta_f,
 zeta_1..zeta_n], with the plate's own stiffness K_plate = blockdiag(0, K_ss - k_s r r^T) (r: the
@@ -11,11 +11,11 @@ elastic modes' rotation of the shaft node) and the connection moment f(d) acting
 
 on the fin as the generalised force -[1, r] f(d) and on the transmission as the hinge moment
 +f(d). The aerodynamics are the fin's Roger RFA over the same modes (all treated as free
-coordinates, n_rigid = 0 in :func:`asekit.aeroelastic.aeroelastic_matrices`). With the linear
+coordinates, n_rigid = 0 in :func:`asekit.aeroelastic.statespace.aeroelastic_matrices`). With the linear
 spring this reproduces the thesis's clamped-actuator flutter model (checked in the tests).
 
 * fin alone: theta_t = 0 (actuator locked, rigid transmission); d = fin-root pitch.
-* AEM1: the actuator (:func:`asekit.servo.actuator_state_space`, no power limits) with its own
+* AEM1: the actuator (:func:`asekit.servo.actuator.actuator_state_space`, no power limits) with its own
   inertia only (the fin is reached through the spring), PD on the transmission angle and rate
   (``voltage = K_c (K_P (theta_cmd - theta_t) - K_D omega_t)``, thesis Sec. 5.1).
 
@@ -23,7 +23,7 @@ Airspeed sweeps are at fixed Mach (the RFA of that Mach) and sea-level density, 
 p-k tables (unmatched). Reported amplitudes are the fin-root pitch amplitude (deg) of the
 describing-function LCO, freeplay half-width delta (total freeplay 2 delta).
 
-What the analysis finds (tests/test_nonlinear.py, notebooks/freeplay.ipynb): a softer connection
+What the analysis finds (tests/aeroelastic/test_nonlinear.py, notebooks/freeplay.ipynb): a softer connection
 raises the fin's flutter speed (zero stiffness: no flutter below 900 m/s at Mach 0.5), but makes
 the fin statically unstable inside the band (pressure centre ahead of the shaft). So below the
 linear flutter speed the fin rests against a stop, offset by d_e ~ delta k / (k - k_aero), and
@@ -41,12 +41,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..aeroelastic import aeroelastic_matrices, fin_outputs, modal_arrays
-from ..atmosphere import standard_atmosphere
-from ..nonlinear import (Connection, ConnectedSystem, biased_harmonic_balance, bisect_onset,
-                         equilibria, growth_rate, harmonic_balance, simulate_exact)
-from ..reproduce import ChapterResult, Quantity
-from ..servo import SYSTEM_3, ActuatorParameters, PDController, actuator_state_space
+from asekit.aeroelastic.statespace import aeroelastic_matrices, fin_outputs, modal_arrays
+from asekit.atmosphere import standard_atmosphere
+from asekit.aeroelastic.nonlinear import (Connection, ConnectedSystem, biased_harmonic_balance, bisect_onset,
+                              equilibria, growth_rate, harmonic_balance, simulate_exact)
+from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, PDController, actuator_state_space
 
 MACHS = {"M05": 0.5, "M075": 0.75}
 FREEPLAYS_DEG = (0.05, 0.1, 0.25, 0.5)
@@ -151,7 +151,7 @@ def fin_freeplay_model(mach: float, data=None, n_lags: int = N_LAGS) -> FinFreep
     """Build :class:`FinFreeplayModel` from the cached GAF database (``data`` = (db, modal) as
     :func:`asekit.reproduction.flutter.load_fin_gafs` returns; loaded when None)."""
     from asekit.reproduction.fin import load_fin
-    from .flutter import fin_rfa, load_fin_gafs
+    from asekit.reproduction.flutter import fin_rfa, load_fin_gafs
 
     if data is None:
         data, reason = load_fin_gafs()
@@ -348,7 +348,7 @@ def run(figures: bool = False) -> ChapterResult:
     LCO onset speed and amplitude at 200 m/s (fin alone and AEM1), linear flutter speeds,
     the static offset at 200 m/s and the freeplay limit for a 0.1 deg excursion up to the
     matched flight speed."""
-    from .flutter import load_fin_gafs
+    from asekit.reproduction.flutter import load_fin_gafs
 
     data, reason = load_fin_gafs()
     keys = ["freeplay.M05.h0.lco_onset_ms", "freeplay.M05.h0.amplitude_deg_at_200ms",
@@ -401,7 +401,7 @@ def run(figures: bool = False) -> ChapterResult:
 def fig_excursion(results: dict, label: str):
     """Fin-root LCO amplitude (biased LCO) and static offset (deg) vs airspeed for each
     ``(config, delta_deg) -> ConfigResult`` entry, with the linear flutter speeds."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, (a1, a2) = new_figure(f"Freeplay: fin-root motion, {label}, sea-level density", None,
                                nrows=2, figsize=(6.4, 6.5))
     for j, ((cfg, dd), res) in enumerate(sorted(results.items())):
@@ -426,7 +426,7 @@ def fig_fin_lco(results: dict, freeplays_deg=FREEPLAYS_DEG):
     """Biased-LCO fin-root amplitude (deg, top) and frequency (Hz, bottom) vs airspeed for
     ``{(label, config): ConfigResult}``, one line per freeplay (amplitude proportional to
     delta), with each configuration's linear flutter speed (vertical line)."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, (a1, a2) = new_figure("Freeplay LCO of the fin (dual-input DF), sea-level density",
                                None, nrows=2, figsize=(7.0, 7.0))
     styles = ["-", "--", ":", "-."]
@@ -452,9 +452,9 @@ def fig_fin_lco(results: dict, freeplays_deg=FREEPLAYS_DEG):
 
 
 def fig_history(sim, delta: float, title: str, t_window: float | None = None):
-    """d / delta vs time of a :class:`asekit.nonlinear.PiecewiseSimulation` (last
+    """d / delta vs time of a :class:`asekit.aeroelastic.nonlinear.PiecewiseSimulation` (last
     ``t_window`` s, default all), band edges dashed."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, ax = new_figure(title, None, figsize=(7.0, 3.0))
     sel = sim.t >= (sim.t[-1] - t_window if t_window else 0.0)
     ax.plot(sim.t[sel], sim.d[sel] / delta, lw=0.6)
@@ -469,7 +469,7 @@ def fig_growth_map(system_at, k: float, velocities, kappas=np.linspace(0.0, 1.0,
                    title: str = "growth rate of the quasi-linear system"):
     """Largest real part of the oscillatory roots (1/s) over (airspeed, equivalent stiffness
     ratio N/k): the harmonic-balance LCOs lie on its zero contour."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, ax = new_figure(title, None, figsize=(6.4, 4.2))
     v = np.asarray(velocities, float)
     sig = np.array([[growth_rate(system_at(u), kp * k)[0] for u in v] for kp in kappas])
@@ -520,13 +520,13 @@ def conner_study(delta_half_deg: float | None = None, velocities=np.arange(3.0, 
                  t_final: float = 30.0, step: float = 1e-3, n_harmonics: int = 11) -> ConnerStudy:
     """Harmonic balance (describing function and ``n_harmonics`` multi-harmonic balance) over
     ``velocities`` and exact piecewise time integration at ``td_velocities`` (``t_final`` s,
-    output every ``step`` s; :func:`asekit.nonlinear.simulate_exact`) of the Conner section with
+    output every ``step`` s; :func:`asekit.aeroelastic.nonlinear.simulate_exact`) of the Conner section with
     a flap freeplay of half-width ``delta_half_deg`` (default: Conner et al., +-2.12 deg)."""
     from scipy.optimize import brentq
 
-    from ..nonlinear import multi_harmonic_balance, steady_oscillation
-    from ..typical_section import (CONNER_FREEPLAY_HALF_WIDTH_DEG, conner_1997,
-                                   connected_system, flutter_speed, flutter_speed_exact)
+    from asekit.aeroelastic.nonlinear import multi_harmonic_balance, steady_oscillation
+    from asekit.aeroelastic.typical_section import (CONNER_FREEPLAY_HALF_WIDTH_DEG, conner_1997,
+                                        connected_system, flutter_speed, flutter_speed_exact)
     sec = conner_1997()
     dl = math.radians(CONNER_FREEPLAY_HALF_WIDTH_DEG if delta_half_deg is None
                       else delta_half_deg)
@@ -588,7 +588,7 @@ def repeat_period(t: np.ndarray, y: np.ndarray, frequency_hz: float, window: flo
 @dataclass(frozen=True)
 class PathPoint:
     """One airspeed of :func:`conner_path_following`: ``flap`` the steady oscillation of the
-    flap angle (rad; :func:`asekit.nonlinear.steady_oscillation`), r.m.s. of flap, pitch (rad)
+    flap angle (rad; :func:`asekit.aeroelastic.nonlinear.steady_oscillation`), r.m.s. of flap, pitch (rad)
     and plunge (m) over the last ``tail`` s (Conner et al. 1997, Eq. 7), ``period`` from
     :func:`repeat_period` (None when not periodic or not an LCO), ``maxima_per_cycle``: flap
     maxima (prominence > 0.05 delta) per fundamental period over the last ``tail`` s (1 for a
@@ -610,7 +610,7 @@ def conner_path_following(velocities, delta_half_deg: float | None = None,
                           plunge_kick: float = 1.0, step: float = 1e-3) -> tuple:
     """Path following in airspeed on the Conner et al. section, as Conner et al. (1997,
     Sec. 11.2) ran their model and experiment: at each airspeed of the increasing sequence
-    ``velocities`` (m/s) the exact piecewise integration (:func:`asekit.nonlinear.
+    ``velocities`` (m/s) the exact piecewise integration (:func:`asekit.aeroelastic.nonlinear.
     simulate_exact`, ``t_final`` s) starts from the end state of the previous speed; at the
     first speed, and after a run that decayed to rest, it starts from the disturbance "flap
     resting on a band edge" (beta = delta, as in the experiment) plus a plunge displacement of
@@ -618,8 +618,8 @@ def conner_path_following(velocities, delta_half_deg: float | None = None,
     starts the LCO). Returns a tuple of :class:`PathPoint`."""
     from scipy.signal import find_peaks
 
-    from ..nonlinear import steady_oscillation
-    from ..typical_section import CONNER_FREEPLAY_HALF_WIDTH_DEG, conner_1997, connected_system
+    from asekit.aeroelastic.nonlinear import steady_oscillation
+    from asekit.aeroelastic.typical_section import CONNER_FREEPLAY_HALF_WIDTH_DEG, conner_1997, connected_system
     v = np.asarray(velocities, float)
     if v.size == 0 or np.any(np.diff(v) <= 0):
         raise ValueError("velocities must be a non-empty increasing sequence")
@@ -651,7 +651,7 @@ def conner_path_following(velocities, delta_half_deg: float | None = None,
 def fig_conner(cs: ConnerStudy):
     """Flap LCO amplitude / delta (DF; time domain first harmonic and half peak-to-peak) and
     frequency vs airspeed for the Conner et al. section."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     fig, (a1, a2) = new_figure("Conner et al. (1997) section with flap freeplay", None,
                                nrows=2, figsize=(6.4, 6.5))
     for branch, mk in ((True, "-"), (False, ":")):

@@ -24,14 +24,14 @@ from dataclasses import dataclass
 import control as ct
 import numpy as np
 
-from ..plotting import THESIS_COLOR, new_figure
-from ..reproduce import ChapterResult, Quantity
-from ..servo import (NO_CONTROLLER, SYSTEM_1, SYSTEM_2, SYSTEM_3, ActuatorParameters, Margins,
-                     PDController, closed_loop, closed_loop_poles, forward_path, margins,
-                     open_loop_poles, root_locus_data, step_response)
-from ..simulate import SimulationResult, THESIS_LIMITS, SteadyHingeMoment, simulate
-from ..torque_requirement import (ProfileResponse, SecondOrderProfile, TorqueRequirement,
-                                  profile_step, required_stall_torque, tune_rate_limit)
+from asekit.util.plotting import THESIS_COLOR, new_figure
+from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.servo.actuator import (NO_CONTROLLER, SYSTEM_1, SYSTEM_2, SYSTEM_3, ActuatorParameters, Margins,
+                          PDController, closed_loop, closed_loop_poles, forward_path, margins,
+                          open_loop_poles, root_locus_data, step_response)
+from asekit.servo.simulate import SimulationResult, THESIS_LIMITS, SteadyHingeMoment, simulate
+from asekit.servo.torque_requirement import (ProfileResponse, SecondOrderProfile, TorqueRequirement,
+                                       profile_step, required_stall_torque, tune_rate_limit)
 
 #: Thesis Table 2: the settling-time and steady-state error requirements.
 SETTLING_REQUIREMENT = 0.05      # s
@@ -110,8 +110,8 @@ def asekit_fin_inputs(mach: float = 0.6) -> FinInputs:
     except (ImportError, AttributeError, ValueError) as exc:      # structure not available
         notes.append(f"J_fin unavailable ({exc})")
     try:
-        from ..aero.gaf import GAF_FILE, GafDatabase, steady_hinge_coefficient
-        from ..cache import CacheError, load_npz
+        from asekit.aero.gaf import GAF_FILE, GafDatabase, steady_hinge_coefficient
+        from asekit.util.cache import CacheError, load_npz
         try:
             arrays, meta = load_npz(GAF_FILE)
             db = GafDatabase(arrays["machs"], arrays["k"], arrays["Q"], float(meta["b_ref"]),

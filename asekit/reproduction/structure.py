@@ -23,12 +23,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from asekit.reproduction.fin import FinDefinition, load_fin
-from ..plotting import THESIS_COLOR, new_figure
-from ..reproduce import ChapterResult, Quantity
-from ..structure.assembly import assemble, rigid_pitch_vector
-from ..structure.modes import ModalModel, NormalModes, normal_modes
+from asekit.util.plotting import THESIS_COLOR, new_figure
+from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.structure.assembly import assemble, rigid_pitch_vector
+from asekit.structure.modes import ModalModel, NormalModes, normal_modes
 from asekit.reproduction.fin import fin_mesh, fin_modal_model, fin_supported, pitch_inertia_exact
-from ..thesis import thesis_value
+from asekit.reproduction.thesis import thesis_value
 
 #: Mesh used for the distributed-shaft result (the 5 mm shaft radius of the fin case file is resolved
 #: by 23 nodes here; 192 x 224 changes modes 1-2 by a further +0.3 / +1.0 %).

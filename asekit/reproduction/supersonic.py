@@ -28,18 +28,18 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
-from ..aero.boxes import MeshRuleWarning
+from asekit import __version__
+from asekit.aero.boxes import MeshRuleWarning
 from asekit.reproduction.fin import fin_boxes
-from ..aero.gaf import gaf_from_box_modes
+from asekit.aero.gaf import gaf_from_box_modes
 from asekit.reproduction.fin import database_k, fin_gaf_database
-from ..aero.methods import DLM_MACH_MAX, SUPERSONIC_MACH_MIN, pressures
-from ..aero.spline import fe_spline
-from ..atmosphere import standard_atmosphere
-from ..cache import CacheError, load_npz, save_npz
-from ..flutter import TabulatedGaf, divergence_speeds, first_of, pk_flutter, pk_instabilities
+from asekit.aero.methods import DLM_MACH_MAX, SUPERSONIC_MACH_MIN, pressures
+from asekit.aero.spline import fe_spline
+from asekit.atmosphere import standard_atmosphere
+from asekit.util.cache import CacheError, load_npz, save_npz
+from asekit.aeroelastic.flutter import TabulatedGaf, divergence_speeds, first_of, pk_flutter, pk_instabilities
 from asekit.reproduction.fin import load_fin
-from ..reproduce import ChapterResult, Quantity
+from asekit.reproduction.driver import ChapterResult, Quantity
 
 MACHS = (0.4, 0.5, 0.6, 0.75, 0.9, 1.15, 1.2, 1.5, 2.0, 2.5, 3.0)
 ALTITUDES = (0.0, 2500.0, 5000.0)
@@ -49,8 +49,8 @@ CACHE_FORMAT = 3
 
 
 def cache_dir() -> Path:
-    """The user cache directory (:func:`asekit.paths.user_cache_dir`, never the repository)."""
-    from ..paths import user_cache_dir
+    """The user cache directory (:func:`asekit.util.paths.user_cache_dir`, never the repository)."""
+    from asekit.util.paths import user_cache_dir
     return user_cache_dir()
 
 
@@ -116,7 +116,7 @@ def _compute(model, boxes, ks, b_ref) -> dict:
 
 def _peak_acceleration() -> float:
     """|theta''|_max of the Section 4.1.1 command profile (as in the servo chapter)."""
-    from ..torque_requirement import profile_step, tune_rate_limit
+    from asekit.servo.torque_requirement import profile_step, tune_rate_limit
     profile = tune_rate_limit(natural_frequency=157.0, damping_ratio=1.0,
                               step=math.radians(15.0), settling_time=0.05, band=0.02)
     return float(profile_step(profile, math.radians(15.0), t_final=0.08).peak_acceleration)
@@ -165,8 +165,8 @@ def torque_at_worst_supersonic(env: dict) -> dict:
     """Section 4.1.1 stall torque (Eqs. 4.1, 4.7, 4.10-4.12) re-evaluated with Q_cc(M) at the
     supersonic (Mach, altitude) of the largest steady hinge moment |q Q_cc| (q = rho (M a)^2/2);
     the command profile and fin inertia as in the servo chapter."""
-    from ..servo import THESIS_FIN_INERTIA
-    from ..torque_requirement import required_stall_torque
+    from asekit.servo.actuator import THESIS_FIN_INERTIA
+    from asekit.servo.torque_requirement import required_stall_torque
     best = None
     for im, mach in enumerate(env["machs"]):
         if mach < SUPERSONIC_MACH_MIN:
@@ -234,7 +234,7 @@ def _gap(ax):
 
 def fig_flutter_vs_mach(env=None):
     """Flutter and divergence speed vs Mach at each altitude, with the flight speed M a(h)."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     env = envelope() if env is None else env
     fig, ax = new_figure("Fin flutter and divergence across the envelope")
     m = env["machs"]
@@ -254,7 +254,7 @@ def fig_flutter_vs_mach(env=None):
 
 def fig_qcc_vs_mach(env=None):
     """Steady hinge coefficient Q_cc(M) and the centre of pressure."""
-    from ..plotting import new_figure
+    from asekit.util.plotting import new_figure
     env = envelope() if env is None else env
     fig, axes = new_figure("Steady hinge coefficient and centre of pressure vs Mach", ncols=2)
     m = env["machs"]

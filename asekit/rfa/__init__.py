@@ -8,14 +8,14 @@ A0, A1, A2 in front, ``lag_realization()``, ``fit_error``, ``b_ref``):
 * :mod:`asekit.rfa.minimum_state` -- the minimum-state fit of Karpel (1982) by the iterative
   least squares of Tiffany & Adams (1988), n_L lag states shared by all elements.
 
-The aeroelastic state space (:mod:`asekit.aeroelastic`), the root locus and the ASE loop take
+The aeroelastic state space (:mod:`asekit.aeroelastic.statespace`), the root locus and the ASE loop take
 either.
 """
 
-from .minimum_state import (MinimumStateFit, default_ms_roots, minimum_state_fit,
-                            minimum_state_fit_database, reduced_frequency_weights)
-from .roger import (RogerFit, default_lag_roots, design_rows, gaf_at_mach, roger_fit,
-                    roger_fit_database)
+from asekit.rfa.minimum_state import (MinimumStateFit, default_ms_roots, minimum_state_fit,
+                                      minimum_state_fit_database, reduced_frequency_weights)
+from asekit.rfa.roger import (RogerFit, default_lag_roots, design_rows, gaf_at_mach, roger_fit,
+                              roger_fit_database)
 
 __all__ = ["RogerFit", "MinimumStateFit", "default_lag_roots", "default_ms_roots",
            "design_rows", "gaf_at_mach", "roger_fit", "roger_fit_database",

@@ -38,7 +38,7 @@ never increases. Options:
   ``root_bounds`` (default 1e-3 k_max to 2 k_max).
 
 In the Laplace domain (s = i omega, p = s b / U) the lag term is
-D (s I + (U/b) diag(beta))^-1 E s: the aeroelastic state space (:mod:`asekit.aeroelastic`)
+D (s I + (U/b) diag(beta))^-1 E s: the aeroelastic state space (:mod:`asekit.aeroelastic.statespace`)
 carries n_L lag states x_a with x_a' = -(U/b) diag(beta) x_a + E zeta' and a generalized force
 q D x_a.
 """
@@ -49,9 +49,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..blas import small_dense
-from ..validate import positive
-from .roger import check_gaf_table, default_lag_roots, fit_errors, gaf_at_mach
+from asekit.util.blas import small_dense
+from asekit.util.validate import positive
+from asekit.rfa.roger import check_gaf_table, default_lag_roots, fit_errors, gaf_at_mach
 
 
 def default_ms_roots(k_max: float, n_states: int) -> np.ndarray:

@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..blas import small_dense
-from ..validate import in_range, positive
+from asekit.util.blas import small_dense
+from asekit.util.validate import in_range, positive
 
 
 def default_lag_roots(k_max: float, n_lags: int = 4) -> np.ndarray:

@@ -4,6 +4,6 @@ mesh (structured quadrilateral meshes) -> plate (MITC4 element) -> assembly (spa
 supports) -> modes (eigen-analysis, mode selection, the modal model).
 """
 
-from .modes import ModalModel, mode_shapes_at
+from asekit.structure.modes import ModalModel, mode_shapes_at
 
 __all__ = ["ModalModel", "mode_shapes_at"]

@@ -34,10 +34,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..geometry import Material
-from ..validate import positive
-from .mesh import PlateMesh
-from .plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness
+from asekit.geometry import Material
+from asekit.util.validate import positive
+from asekit.structure.mesh import PlateMesh
+from asekit.structure.plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness
 
 
 def element_dofs(mesh: PlateMesh) -> np.ndarray:
@@ -229,8 +229,8 @@ def point_mass_matrix(mesh: PlateMesh, masses) -> sp.csr_matrix:
     (kinetic energy 1/2 m (N w)^2 + 1/2 I_xx (N theta_x)^2 + 1/2 I_yy (N theta_y)^2), so a
     mass need not sit on a node; at a node this is the usual lumped CONM2-like mass.
     """
-    from .modes import locate_points
-    from .plate import shape_functions
+    from asekit.structure.modes import locate_points
+    from asekit.structure.plate import shape_functions
     n = DOF_PER_NODE * mesh.n_nodes
     M = sp.csr_matrix((n, n))
     masses = list(masses)

@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import LinearThickness, Planform, Thickness, ThicknessField
-from ..validate import positive
+from asekit.geometry import LinearThickness, Planform, Thickness, ThicknessField
+from asekit.util.validate import positive
 
 
 @dataclass(frozen=True)

@@ -24,10 +24,10 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
-from ..validate import positive
-from .assembly import SupportedSystem, rigid_pitch_vector, shaft_support
-from .mesh import PlateMesh
-from .plate import shape_functions
+from asekit.util.validate import positive
+from asekit.structure.assembly import SupportedSystem, rigid_pitch_vector, shaft_support
+from asekit.structure.mesh import PlateMesh
+from asekit.structure.plate import shape_functions
 
 #: Modes whose share of kinetic energy in the out-of-plane translation w is below this are
 #: "modes with no out-of-plane motion" and are dropped (thesis Fig. 15/16: in-plane mode).

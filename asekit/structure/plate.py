@@ -39,8 +39,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import Material
-from .mesh import PlateMesh
+from asekit.geometry import Material
+from asekit.structure.mesh import PlateMesh
 
 #: Natural coordinates of the four corner nodes, counter-clockwise.
 NODE_RS = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])

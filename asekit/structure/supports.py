@@ -24,9 +24,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .assembly import SupportedSystem
-from .mesh import PlateMesh
-from .plate import DOF_PER_NODE
+from asekit.structure.assembly import SupportedSystem
+from asekit.structure.mesh import PlateMesh
+from asekit.structure.plate import DOF_PER_NODE
 
 EDGE_TYPES = ("free", "simply_supported", "clamped", "sliding")
 EDGES = ("x0", "x1", "y0", "y1")

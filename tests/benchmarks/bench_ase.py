@@ -10,8 +10,8 @@ import time
 import control as ct
 import numpy as np
 
-from asekit import ase
-from asekit.servo import SYSTEM_3
+from asekit.ase import loop as ase
+from asekit.servo.actuator import SYSTEM_3
 from asekit.reproduction import fin as reffin
 
 

@@ -9,8 +9,8 @@ import time
 
 import numpy as np
 
-from asekit.aeroelastic import modal_arrays
-from asekit.flutter import (TabulatedGaf, pk_flutter, root_locus, time_domain_sweep)
+from asekit.aeroelastic.statespace import modal_arrays
+from asekit.aeroelastic.flutter import (TabulatedGaf, pk_flutter, root_locus, time_domain_sweep)
 from asekit.rfa import roger_fit
 
 
@@ -59,7 +59,7 @@ def main():
     timed("time-domain growth sweep (17 speeds, expm)",
           lambda: time_domain_sweep(modal, fit, 1.225, U[::10], refine=False), repeat=1)
 
-    from asekit.nastran import ha145b_path, load_ha145b
+    from asekit.io.op4 import ha145b_path, load_ha145b
     if ha145b_path().exists():
         case = load_ha145b()
         m = modal_arrays(M=case.M, K=case.K)

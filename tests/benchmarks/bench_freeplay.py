@@ -16,12 +16,12 @@ import time
 
 import numpy as np
 
-from asekit.nonlinear import (Connection, biased_harmonic_balance, lco_curve,
+from asekit.aeroelastic.nonlinear import (Connection, biased_harmonic_balance, lco_curve,
                               multi_harmonic_balance, simulate, simulate_exact,
                               steady_oscillation)
 from asekit.reproduction.flutter import load_fin_gafs
 from asekit.reproduction.freeplay import fin_freeplay_model
-from asekit.typical_section import (CONNER_FREEPLAY_HALF_WIDTH_DEG, conner_1997,
+from asekit.aeroelastic.typical_section import (CONNER_FREEPLAY_HALF_WIDTH_DEG, conner_1997,
                                     connected_system)
 
 

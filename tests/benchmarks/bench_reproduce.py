@@ -5,8 +5,8 @@ the code path it replaced, in this one run (best of ``REPEAT`` wall-clock times,
 thread), with the largest difference between the two results:
 
 * frequency responses: python-control's per-frequency solve vs the batched Schur-form one
-  (:func:`asekit.ase.state_space_response`), FWTF 3 of the fin on the 20000-point grid of
-  :func:`asekit.ase.crossovers`;
+  (:func:`asekit.ase.loop.state_space_response`), FWTF 3 of the fin on the 20000-point grid of
+  :func:`asekit.ase.loop.crossovers`;
 * the five closed-loop simulations of Ch. 5 (:func:`asekit.reproduction.ase.compute`):
   ``method="RK45"`` vs the exact piecewise-linear propagation (default), and five rigid-fin
   ones of Ch. 4-5 (:func:`asekit.simulate.simulate`, the same);
@@ -58,12 +58,12 @@ def _theta_deviation(after, before) -> float:
 
 
 def main(argv):
-    from asekit import ase
+    from asekit.ase import loop as ase
     from asekit.reproduction import ase as rep
     from asekit.reproduction import fin as reffin
     from asekit.rfa import gaf_at_mach, minimum_state as ms
-    from asekit.servo import SYSTEM_3
-    from asekit.simulate import THESIS_LIMITS
+    from asekit.servo.actuator import SYSTEM_3
+    from asekit.servo.simulate import THESIS_LIMITS
     from asekit.structure import modes
 
     print(f"{'':58s} {'before':>10s} {'after':>10s}  {'ratio':>7s}   largest difference")
@@ -97,7 +97,7 @@ def main(argv):
 
     # 2b. the rigid-fin simulations of Ch. 4 and Ch. 5 (asekit.simulate.simulate)
     from asekit.simulate import simulate
-    from asekit.servo import SYSTEM_2
+    from asekit.servo.actuator import SYSTEM_2
     rigid, hm = fin.rigid_fin_actuator(), fin.steady_hinge_moment()
     rruns = [(SYSTEM_3, U, 0.0, 0.2), (SYSTEM_3, F, 0.0, 0.2), (SYSTEM_2, math.radians(14.0),
              0.0, 0.1), (SYSTEM_3, 0.0, F, 0.1), (SYSTEM_3, -F, F, 0.12)]

@@ -41,7 +41,7 @@ sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
 
-from asekit import sweep as S  # noqa: E402
+from asekit import sweep as S
 
 
 def _peak_rss_mb() -> float:

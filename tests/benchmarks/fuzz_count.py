@@ -73,8 +73,8 @@ def main(argv=None) -> int:
     ap.add_argument("--show", type=int, default=2, help="sample failures printed per kind")
     args = ap.parse_args(argv)
     # import everything first: an alarm inside a first import leaves a half-initialised module
-    import asekit.aero.dlm, asekit.aero.vlm, asekit.atmosphere, asekit.flutter  # noqa: E401,F401
-    import asekit.nastran, asekit.rfa, asekit.servo, asekit.simulate  # noqa: E401,F401
+    import asekit.aero.dlm, asekit.aero.vlm, asekit.atmosphere, asekit.aeroelastic.flutter  # noqa: E401,F401
+    import asekit.io.op4, asekit.rfa, asekit.servo.actuator, asekit.servo.simulate  # noqa: E401,F401
     signal.signal(signal.SIGALRM, _alarm)
     warnings.simplefilter("ignore")
     total: Counter = Counter()

@@ -1,0 +1,921 @@
+"""Flutter and divergence by three methods (thesis Section 3.3): p-k, root locus, time domain.
+
+* p-k (Eq. 3.12): for each airspeed U and each tracked mode, solve
+
+      (p^2 M + p (C - rho b U / (2k) Q^I(k)) + (K - q Q^R(k))) zeta = 0
+
+  iterating k = Im(p) b / U to convergence (Hassig, "An approximate true damping solution of
+  the flutter equation by determinant iteration", J. Aircraft 8(11), 1971; the MSC Nastran PK
+  method with linear interpolation of Q in k). Modes are tracked across airspeed and inside the
+  k-iteration by eigenvector correlation (modal assurance criterion), not by frequency order.
+  Damping is reported as g = 2 Re(p)/|p| (Nastran's g = 2 gamma for oscillatory roots; +-2 for
+  real roots) and the decay rate sigma = Re(p) (1/s).
+* root locus (Section 3.3.2): eigenvalues of A_sys (Eq. 2.63) over airspeed; aeroelastic roots
+  are continued from the structural roots (U -> 0) and separated from the aerodynamic lag roots
+  by continuation with eigenvector correlation; damping ratio and frequency by Eq. (3.13).
+* time domain (Section 3.3.3, Eqs. 3.14-3.15): free response of z' = A_sys z from a unit initial
+  value of one elastic coordinate, by scipy's RK45 with a maximum step (the thesis used ode45
+  with steps no larger than 1e-4 s) and by the exact matrix exponential; the growth rate of the
+  late response over airspeed gives the onset speed.
+
+Instabilities: flutter where an oscillatory root crosses to Re(p) > 0, divergence where a real
+(zero-frequency) root does. All interpolated to Re(p) = 0 and refined by a scalar root search.
+A root already unstable at the first airspeed of the sweep is reported as its own result
+(``Instability.at_first_point``: "flutter at or below U0"), never dropped. "Unstable" means
+Re(p) > tol with a tolerance scaled to the roots' magnitude (``crossing_tolerance``), so that
+rounding (Re p = +1e-14 on an undamped structure at U -> 0) is not taken for an instability.
+
+Units: any consistent set (SI for the fin; inch-lbf-s for Nastran's HA145B).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import linalg, optimize
+
+from asekit.aeroelastic.statespace import ModalArrays, aeroelastic_matrices, modal_arrays
+from asekit.util.blas import small_dense
+from asekit.util.validate import positive, positive_array
+
+#: relative tolerance of the stability test: a root is unstable when Re p > RTOL_UNSTABLE * scale,
+#: ``scale`` the largest root magnitude of the sweep (rounding of eigenvalues is ~1e-16 of it).
+RTOL_UNSTABLE = 1e-9
+#: largest number of steps / samples a single call may ask for before it is refused.
+MAX_STEPS = 5_000_000
+
+
+class FlutterConvergenceWarning(RuntimeWarning):
+    """The p-k frequency iteration did not converge within ``max_iter`` for some (mode, speed)."""
+
+
+def crossing_tolerance(roots) -> float:
+    """Tolerance of the stability test for a set of roots (any shape, complex, 1/s):
+    ``RTOL_UNSTABLE * max |p|`` over the finite roots (0 if there are none). A root counts as
+    unstable when Re p > tolerance."""
+    r = np.abs(np.asarray(roots))
+    r = r[np.isfinite(r)]
+    return float(RTOL_UNSTABLE * r.max()) if r.size else 0.0
+
+
+def _ascending(name: str, values) -> np.ndarray:
+    """Finite, > 0, strictly ascending 1-D array, else ValueError naming ``name``."""
+    U = positive_array(name, values)
+    if U.ndim != 1:
+        raise ValueError(f"{name} must be a 1-D sequence of airspeeds, got shape {U.shape}")
+    if np.any(np.diff(U) <= 0):
+        raise ValueError(f"{name} must be strictly ascending (no repeats); got {U}. Pass "
+                         f"np.unique({name}) to sort them.")
+    return U
+
+
+def _pressure_ok(rho: float, U: np.ndarray) -> None:
+    """Refuse density x velocities whose dynamic pressure overflows (ValueError naming both)."""
+    with np.errstate(over="ignore"):
+        q = 0.5 * rho * np.square(np.max(U))
+    if not np.isfinite(q):
+        raise ValueError(f"density = {rho:g} and velocities up to {np.max(U):g} give an "
+                         "infinite dynamic pressure")
+
+
+def _count(name: str, value, low: int = 1) -> int:
+    """An integer >= low (bool refused), else TypeError/ValueError naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} must be an integer >= {low}, got {value!r}")
+    if value < low:
+        raise ValueError(f"{name} must be an integer >= {low}, got {value}")
+    return int(value)
+
+
+# --------------------------------------------------------------------------------------------
+# tabulated GAFs
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class TabulatedGaf:
+    """Complex GAFs Q (n_k, n, n) at reduced frequencies k (ascending, >= 0) of one Mach,
+    per unit dynamic pressure (F = q Q zeta), reference semi-chord ``b_ref``."""
+
+    k: np.ndarray
+    Q: np.ndarray
+    b_ref: float
+    mach: float | None = None
+
+    def __post_init__(self):
+        k = np.asarray(self.k, dtype=float)
+        Q = np.asarray(self.Q, dtype=complex)
+        if k.ndim != 1 or Q.shape[0] != k.size or Q.ndim != 3 or Q.shape[1] != Q.shape[2]:
+            raise ValueError(f"Q must be (n_k, n, n) with n_k = len(k); got k {k.shape}, "
+                             f"Q {Q.shape}")
+        if k.size < 2 or np.any(np.diff(k) <= 0) or k[0] < 0:
+            raise ValueError(f"k must hold >= 2 ascending values >= 0, got {k}")
+        if not (np.isfinite(self.b_ref) and self.b_ref > 0):
+            raise ValueError(f"b_ref must be > 0, got {self.b_ref}")
+        object.__setattr__(self, "k", k)
+        object.__setattr__(self, "Q", Q)
+
+    def parts(self, k: float, method: str = "linear") -> tuple[np.ndarray, np.ndarray]:
+        """(Q^R(k), Q^I(k)/k): real part and imaginary part divided by k, interpolated in k.
+
+        Linear interpolation (Nastran's IMETH=L) or ``method="cubic"`` (not-a-knot spline).
+        Outside the table: Q^R and Q^I/k are held at the end values (k below the first point
+        uses Q^I(k_1)/k_1, the finite k -> 0 limit of a smooth Q^I).
+        """
+        kk = self.k
+        qi_over_k = self.Q.imag / np.where(kk > 0, kk, 1.0)[:, None, None]
+        if kk[0] == 0:
+            qi_over_k[0] = qi_over_k[1]
+        kq = float(np.clip(k, kk[0], kk[-1]))
+        if method == "linear":
+            j = int(np.clip(np.searchsorted(kk, kq) - 1, 0, kk.size - 2))
+            t = (kq - kk[j]) / (kk[j + 1] - kk[j])
+            qr = (1 - t) * self.Q.real[j] + t * self.Q.real[j + 1]
+            qik = (1 - t) * qi_over_k[j] + t * qi_over_k[j + 1]
+        elif method == "cubic":
+            from scipy.interpolate import CubicSpline
+            qr = CubicSpline(kk, self.Q.real, axis=0)(kq)
+            qik = CubicSpline(kk, qi_over_k, axis=0)(kq)
+        else:
+            raise ValueError(f"method must be 'linear' or 'cubic', got {method!r}")
+        return qr, qik
+
+
+def _mac(a: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Modal assurance criterion of vector a against the columns of B (complex)."""
+    num = np.abs(a.conj() @ B) ** 2
+    den = (np.real(a.conj() @ a) * np.real(np.sum(B.conj() * B, axis=0))) + 1e-300
+    return num / den
+
+
+def _elastic_part(modal: ModalArrays, Q: np.ndarray, include_rigid: bool):
+    if include_rigid or modal.n_rigid == 0:
+        return modal.M, modal.K, modal.C, Q
+    s = slice(modal.n_rigid, modal.n_modes)
+    return modal.M[s, s], modal.K[s, s], modal.C[s, s], Q[:, s, s]
+
+
+# --------------------------------------------------------------------------------------------
+# p-k method
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PkResult:
+    """p-k solution over airspeed for each tracked mode.
+
+    velocities (n_v,), p (n_v, n_t) complex roots, sigma = Re p (1/s), frequency_hz = Im p/2pi,
+    damping_g = 2 Re p/|p|, k (n_v, n_t), vectors (n_v, n_t, n) eigenvectors (modal
+    coordinates), converged (n_v, n_t) bool, structural_frequencies_hz (n_t,), density, mach.
+    """
+
+    velocities: np.ndarray
+    p: np.ndarray
+    k: np.ndarray
+    vectors: np.ndarray
+    converged: np.ndarray
+    structural_frequencies_hz: np.ndarray
+    density: float
+    mach: float | None = None
+    b_ref: float = 1.0
+
+    @property
+    def sigma(self) -> np.ndarray:
+        return self.p.real
+
+    @property
+    def frequency_hz(self) -> np.ndarray:
+        return np.abs(self.p.imag) / (2 * np.pi)
+
+    @property
+    def damping_g(self) -> np.ndarray:
+        return 2 * self.p.real / np.maximum(np.abs(self.p), 1e-300)
+
+    @property
+    def damping_ratio(self) -> np.ndarray:
+        return -self.p.real / np.maximum(np.abs(self.p), 1e-300)
+
+
+@dataclass(frozen=True)
+class Instability:
+    """A flutter or divergence point: ``kind`` ('flutter' or 'divergence'), tracked ``mode``
+    index (0-based among the modes solved), ``speed`` (m/s), ``frequency_hz`` (0 for divergence),
+    ``vector`` (modal eigenvector at the point, if known), ``method``.
+
+    ``at_first_point`` marks the other result kind: the root is already unstable at the first
+    airspeed of the sweep, so the instability is *at or below* ``speed`` (= U0, an upper bound,
+    not a crossing); ``frequency_hz`` is then the frequency at U0. Start the sweep lower to
+    locate it.
+    """
+
+    kind: str
+    mode: int
+    speed: float
+    frequency_hz: float
+    vector: np.ndarray | None = field(default=None, repr=False)
+    method: str = ""
+    at_first_point: bool = False
+
+    def describe(self, unit: str = "m/s") -> str:
+        """One-line description, e.g. 'flutter at 218.1 m/s, 140.9 Hz (mode 2, p-k)' or
+        'unstable at the first point of the sweep: flutter at or below 250 m/s (mode 2, p-k)'."""
+        where = f"mode {self.mode + 1}" + (f", {self.method}" if self.method else "")
+        if self.at_first_point:
+            return (f"unstable at the first point of the sweep: {self.kind} at or below "
+                    f"{self.speed:.6g} {unit} ({where})")
+        freq = f", {self.frequency_hz:.4g} Hz" if self.kind == "flutter" else ""
+        return f"{self.kind} at {self.speed:.6g} {unit}{freq} ({where})"
+
+
+class _PkProblem:
+    def __init__(self, M, K, C, gaf: TabulatedGaf, rho, interpolation):
+        self.M, self.K, self.C = M, K, C
+        self.Minv = np.linalg.inv(M)
+        self.gaf = gaf
+        self.rho = rho
+        self.n = M.shape[0]
+        self.interp = interpolation
+        # pre-split for speed (linear interpolation inline)
+        kk = gaf.k
+        self._qr = gaf.Q.real
+        qik = gaf.Q.imag / np.where(kk > 0, kk, 1.0)[:, None, None]
+        if kk[0] == 0:
+            qik[0] = qik[1]
+        self._qik = qik
+
+    def _parts(self, k):
+        if self.interp != "linear":
+            return self.gaf.parts(k, self.interp)
+        kk = self.gaf.k
+        kq = min(max(k, kk[0]), kk[-1])
+        j = min(max(int(np.searchsorted(kk, kq)) - 1, 0), kk.size - 2)
+        t = (kq - kk[j]) / (kk[j + 1] - kk[j])
+        return ((1 - t) * self._qr[j] + t * self._qr[j + 1],
+                (1 - t) * self._qik[j] + t * self._qik[j + 1])
+
+    def eig(self, U, k):
+        """All roots p and modal eigenvectors of Eq. (3.12) at (U, k)."""
+        qr, qik = self._parts(k)
+        q = 0.5 * self.rho * U ** 2
+        b = self.gaf.b_ref
+        Keff = self.K - q * qr
+        Ceff = self.C - 0.5 * self.rho * b * U * qik
+        n = self.n
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.eye(n)
+        A[n:, :n] = -self.Minv @ Keff
+        A[n:, n:] = -self.Minv @ Ceff
+        lam, vec = np.linalg.eig(A)
+        return lam, vec[:n]
+
+    def solve_mode(self, U, omega_guess, ref, tol=1e-7, max_iter=60):
+        """Converge one root: returns (p, vector, k, converged)."""
+        b = self.gaf.b_ref
+        omega = max(float(omega_guess), 0.0)
+        p_best, v_best = None, None
+        for _ in range(max_iter):
+            k = omega * b / U
+            lam, vec = self.eig(U, k)
+            upper = lam.imag >= -1e-9 * np.maximum(np.abs(lam), 1.0)
+            lam_u, vec_u = lam[upper], vec[:, upper]
+            mac = _mac(ref, vec_u)
+            # among well-correlated roots prefer the one nearest the current frequency
+            score = mac - 0.2 * np.abs(np.abs(lam_u.imag) - omega) / max(omega, np.abs(lam).max()
+                                                                        * 1e-3, 1e-12)
+            real_roots = np.abs(lam_u.imag) <= 1e-9 * np.maximum(np.abs(lam_u), 1.0)
+            j = int(np.argmax(score))
+            if real_roots[j]:
+                # a real pair: report the least stable of the well-correlated real roots
+                cand = np.nonzero(real_roots & (mac >= 0.8 * mac[j]))[0]
+                j = int(cand[np.argmax(lam_u.real[cand])])
+            p_best, v_best = lam_u[j], vec_u[:, j]
+            omega_new = abs(p_best.imag)
+            if abs(omega_new - omega) <= tol * max(omega_new, 1e-6 * U / b, 1e-12):
+                return p_best, v_best, omega_new * b / U, True
+            omega = omega_new
+        return p_best, v_best, abs(p_best.imag) * b / U, False
+
+
+@small_dense
+def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
+               include_rigid: bool = False, interpolation: str = "linear", tol: float = 1e-7,
+               max_iter: int = 60) -> PkResult:
+    """p-k solution of Eq. (3.12) over a list of airspeeds.
+
+    Parameters
+    ----------
+    modal : ModalArrays or ModalModel-like (M, K, C, n_rigid). By default the rigid modes are
+        held (actuator clamped), as in Eq. (3.12) which uses the elastic (s-set) matrices only.
+    gaf : :class:`TabulatedGaf` of all modes (rigid first).
+    density : air density (kg/m^3 or the model's unit), > 0.
+    velocities : ascending airspeeds (> 0).
+    modes : indices (among the modes solved) to track; default all.
+    include_rigid : solve with the rigid modes free too.
+    interpolation : "linear" (Nastran's default) or "cubic" in k.
+    tol, max_iter : k-iteration convergence (relative frequency change) and limit.
+
+    Returns
+    -------
+    :class:`PkResult`
+    """
+    m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
+    rho = positive("density", density)
+    U = _ascending("velocities", velocities)
+    _pressure_ok(rho, U)
+    max_iter = _count("max_iter", max_iter)
+    tol = positive("tol", tol)
+    if interpolation not in ("linear", "cubic"):
+        raise ValueError(f"interpolation must be 'linear' or 'cubic', got {interpolation!r}")
+    if not isinstance(gaf, TabulatedGaf):
+        raise TypeError(f"gaf must be a TabulatedGaf, got {type(gaf).__name__}")
+    if gaf.Q.shape[1] != m.n_modes:
+        raise ValueError(f"gaf has {gaf.Q.shape[1]} modes, the modal model {m.n_modes}")
+    M, K, C, _ = _elastic_part(m, gaf.Q, include_rigid)
+    sel = slice(0, m.n_modes) if (include_rigid or m.n_rigid == 0) else slice(m.n_rigid,
+                                                                               m.n_modes)
+    g = TabulatedGaf(gaf.k, gaf.Q[:, sel, sel], gaf.b_ref, gaf.mach)
+    prob = _PkProblem(M, K, C, g, rho, interpolation)
+    w2, phi = linalg.eigh(K, M)
+    w = np.sqrt(np.clip(w2, 0, None))
+    order = np.argsort(w)
+    w, phi = w[order], phi[:, order]
+    modes = np.arange(M.shape[0]) if modes is None else np.atleast_1d(np.asarray(modes, int))
+    if np.any(modes < 0) or np.any(modes >= M.shape[0]):
+        raise ValueError(f"modes must be indices in [0, {M.shape[0] - 1}], got {modes}")
+    nv, nt, n = U.size, modes.size, M.shape[0]
+    P = np.zeros((nv, nt), complex)
+    KK = np.zeros((nv, nt))
+    V = np.zeros((nv, nt, n), complex)
+    conv = np.zeros((nv, nt), bool)
+    for jt, jm in enumerate(modes):
+        omega, ref = w[jm], phi[:, jm].astype(complex)
+        for i, u in enumerate(U):
+            p, v, k, ok = prob.solve_mode(u, omega, ref, tol, max_iter)
+            P[i, jt], V[i, jt], KK[i, jt], conv[i, jt] = p, v, k, ok
+            omega, ref = abs(p.imag), v
+    if not conv.all():
+        bad = np.argwhere(~conv)
+        listed = ", ".join(f"mode {modes[jt] + 1} at U = {U[i]:.6g}" for i, jt in bad[:8])
+        more = f" and {len(bad) - 8} more" if len(bad) > 8 else ""
+        warnings.warn(f"p-k: the k-iteration did not converge within max_iter = {max_iter} "
+                      f"(tol {tol:g}) at {len(bad)} of {conv.size} points: {listed}{more}; "
+                      "their roots are the last iterate (PkResult.converged is False there). "
+                      "Raise max_iter or check those points.",
+                      FlutterConvergenceWarning, stacklevel=3)   # caller, past @small_dense
+    return PkResult(velocities=U, p=P, k=KK, vectors=V, converged=conv,
+                    structural_frequencies_hz=w[modes] / (2 * np.pi), density=rho,
+                    mach=gaf.mach, b_ref=gaf.b_ref)
+
+
+def _crossings(U, sigma, freq_hz, real_mask, tol: float = 0.0):
+    """Onsets of instability along one branch: (i, U*, f*, kind, at_first_point) tuples.
+
+    Unstable means sigma > tol. A branch unstable at the first point gives (0, U[0], f[0], kind,
+    True) ("at or below U0"); each later stable-to-unstable change between i-1 and i gives the
+    linear interpolation to sigma = tol (clipped to [U[i-1], U[i]]).
+    """
+    unstable = np.asarray(sigma) > tol
+    out = []
+    if unstable.size and unstable[0]:
+        kind = "divergence" if real_mask[0] else "flutter"
+        out.append((0, float(U[0]), float(freq_hz[0]), kind, True))
+    for i in range(1, len(U)):
+        if not unstable[i - 1] and unstable[i]:
+            t = float(np.clip((tol - sigma[i - 1]) / (sigma[i] - sigma[i - 1]), 0.0, 1.0))
+            us = U[i - 1] + t * (U[i] - U[i - 1])
+            f = freq_hz[i - 1] + t * (freq_hz[i] - freq_hz[i - 1])
+            kind = "divergence" if real_mask[i] else "flutter"
+            out.append((i, us, f, kind, False))
+    return out
+
+
+def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = None,
+                     refine: bool = True, include_rigid: bool = False,
+                     interpolation: str = "linear") -> list[Instability]:
+    """All flutter / divergence onsets of a p-k sweep, sorted by speed.
+
+    Linear interpolation of Re(p) to zero between sweep points; with ``refine`` (needs the
+    ``modal`` and ``gaf`` of the sweep) the crossing is refined by Brent's method on Re(p)(U) of
+    the tracked root, continued from the sub-critical sweep point. A root unstable at the first
+    airspeed (Re p > :func:`crossing_tolerance`) is returned with ``at_first_point=True`` and
+    ``speed = velocities[0]`` (flutter or divergence at or below U0).
+    """
+    found = []
+    U = result.velocities
+    prob = None
+    if refine and modal is not None and gaf is not None:
+        m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
+        M, K, C, _ = _elastic_part(m, gaf.Q, include_rigid)
+        sel = slice(0, m.n_modes) if (include_rigid or m.n_rigid == 0) else slice(
+            m.n_rigid, m.n_modes)
+        prob = _PkProblem(M, K, C, TabulatedGaf(gaf.k, gaf.Q[:, sel, sel], gaf.b_ref),
+                          result.density, interpolation)
+    tol = crossing_tolerance(result.p)
+    for jt in range(result.p.shape[1]):
+        p = result.p[:, jt]
+        real_mask = np.abs(p.imag) <= 1e-6 * np.maximum(np.abs(p), 1e-12)
+        for i, us, f, kind, first in _crossings(U, p.real, np.abs(p.imag) / (2 * np.pi),
+                                                real_mask, tol):
+            vec = result.vectors[i, jt]
+            if first:
+                found.append(Instability(kind=kind, mode=jt, speed=float(us),
+                                         frequency_hz=0.0 if kind == "divergence" else float(f),
+                                         vector=vec, method="p-k", at_first_point=True))
+                continue
+            if prob is not None:
+                # continue from the unstable side: at an undamped coalescence the sub-critical
+                # vector correlates equally with the stable and the unstable partner
+                w0, ref0 = abs(result.p[i, jt].imag), result.vectors[i, jt]
+
+                def re_p(u, w0=w0, ref0=ref0):
+                    # Re p - tol: an undamped sub-critical root (Re = 0 +- rounding) stays < 0
+                    return prob.solve_mode(u, w0, ref0)[0].real - tol
+
+                try:
+                    us = optimize.brentq(re_p, U[i - 1], U[i], xtol=1e-6 * U[i])
+                    pz, vec, _, _ = prob.solve_mode(us, w0, ref0)
+                    f = abs(pz.imag) / (2 * np.pi)
+                    kind = "divergence" if abs(pz.imag) <= 1e-6 * max(abs(pz), 1e-9) \
+                        and f < 1e-6 else kind
+                except ValueError:
+                    pass
+            found.append(Instability(kind=kind, mode=jt, speed=float(us),
+                                     frequency_hz=0.0 if kind == "divergence" else float(f),
+                                     vector=vec, method="p-k"))
+    return sorted(found, key=lambda s: s.speed)
+
+
+def first_of(instabilities: list[Instability], kind: str | None = None) -> Instability | None:
+    """The lowest-speed instability of ``kind`` ('flutter', 'divergence' or None for any)."""
+    for s in sorted(instabilities, key=lambda s: s.speed):
+        if kind is None or s.kind == kind:
+            return s
+    return None
+
+
+def divergence_speeds(modal, Q0: np.ndarray, density: float, include_rigid: bool = False
+                      ) -> np.ndarray:
+    """Static divergence speeds: det(K - q Q^R(0)) = 0, i.e. the positive real eigenvalues q of
+    K x = q Q^R(0) x, U = sqrt(2 q / rho). Returns ascending speeds (empty if none).
+
+    ``Q0`` is the (n, n) GAF at (or nearest) k = 0 (rigid modes first); rigid modes are held
+    unless ``include_rigid``.
+    """
+    m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
+    rho = float(positive_array("density", density)[0])
+    Q0 = np.asarray(Q0)
+    _, K, _, Qs = _elastic_part(m, Q0[None], include_rigid)
+    mu = linalg.eigvals(Qs[0].real, K)                # Q x = mu K x, q = 1/mu
+    mu = mu[np.abs(mu.imag) <= 1e-9 * np.maximum(np.abs(mu), 1e-300)].real
+    q = 1.0 / mu[mu > 0]
+    return np.sort(np.sqrt(2 * q / rho))
+
+
+# --------------------------------------------------------------------------------------------
+# match point (Section 3.3.1.1)
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class MatchPointRow:
+    """One row of Tables 9-10: Mach, altitude (m), density, speed of sound, the first flutter
+    speed (None if none below the sweep top) and frequency, U_eq (Eq. 3.10) and M_eq = U_f/a.
+
+    ``at_first_point``: the sweep was already unstable at its first airspeed, so ``speed``,
+    ``equivalent_speed`` and ``mach_equivalent`` are upper bounds (flutter at or below U0), not
+    values; :func:`matched_mach` does not interpolate through such rows.
+    """
+
+    mach: float
+    altitude: float
+    density: float
+    speed_of_sound: float
+    speed: float | None
+    frequency_hz: float | None
+    equivalent_speed: float | None
+    mach_equivalent: float | None
+    kind: str | None = None
+    at_first_point: bool = False
+
+    def describe(self, unit: str = "m/s") -> str:
+        """'none in the sweep', 'flutter at 218.1 m/s' or 'unstable at the first point of the
+        sweep: flutter at or below 250 m/s'."""
+        if self.speed is None:
+            return "no instability in the sweep"
+        if self.at_first_point:
+            return (f"unstable at the first point of the sweep: {self.kind} at or below "
+                    f"{self.speed:.6g} {unit}")
+        return f"{self.kind} at {self.speed:.6g} {unit}"
+
+
+def match_point_table(modal, gaf_for_mach, machs, altitudes, velocities, kind="flutter",
+                      densities=None) -> list[MatchPointRow]:
+    """p-k over Mach x altitude pairs (thesis Tables 9-10) with the match check of 3.3.1.1.
+
+    ``gaf_for_mach(mach) -> TabulatedGaf``; densities default to the 1976 standard atmosphere
+    (pass ``densities`` (per altitude) to use others, e.g. the thesis's). ``kind`` selects
+    'flutter', 'divergence' or None (first instability of any kind). A condition unstable at the
+    first airspeed gives a row with ``at_first_point=True`` (and a warning naming it).
+    """
+    from asekit.atmosphere import standard_atmosphere
+
+    if kind not in ("flutter", "divergence", None):
+        raise ValueError(f"kind must be 'flutter', 'divergence' or None, got {kind!r}")
+    altitudes = list(np.atleast_1d(altitudes))
+    if densities is not None and len(np.atleast_1d(densities)) != len(altitudes):
+        raise ValueError(f"densities must have one value per altitude ({len(altitudes)}), "
+                         f"got {len(np.atleast_1d(densities))}")
+    rows = []
+    for mach in np.atleast_1d(machs):
+        g = gaf_for_mach(mach)
+        for ia, h in enumerate(altitudes):
+            atm = standard_atmosphere(h)
+            rho = float(atm.density) if densities is None else float(
+                np.atleast_1d(densities)[ia])
+            a = float(atm.speed_of_sound)
+            res = pk_flutter(modal, g, rho, velocities)
+            inst = first_of(pk_instabilities(res, modal, g), kind)
+            if inst is None:
+                rows.append(MatchPointRow(mach, h, rho, a, None, None, None, None))
+            else:
+                ueq = inst.speed * np.sqrt(rho / 1.225)
+                rows.append(MatchPointRow(mach, h, rho, a, inst.speed, inst.frequency_hz,
+                                          float(ueq), inst.speed / a, inst.kind,
+                                          inst.at_first_point))
+                if inst.at_first_point:
+                    warnings.warn(f"match point Mach {mach:g}, altitude {h:g} m: "
+                                  f"{inst.describe()}; lower the first velocity",
+                                  RuntimeWarning, stacklevel=2)
+    return rows
+
+
+def matched_mach(rows: list[MatchPointRow], altitude: float) -> float | None:
+    """Mach at which the flutter Mach M_eq equals the analysis Mach, by linear interpolation of
+    M_eq - M over the analysed Machs at ``altitude`` (None if no sign change or no flutter).
+
+    Rows flagged ``at_first_point`` (flutter at or below the sweep's first speed: only an upper
+    bound of M_eq) are not interpolated through; if the match lies next to such a row the
+    result is None and a warning says so.
+    """
+    here = [r for r in rows if r.altitude == altitude and r.mach_equivalent is not None]
+    bounded = sorted(r.mach for r in here if r.at_first_point)
+    pts = sorted((r.mach, r.mach_equivalent) for r in here if not r.at_first_point)
+    for (m0, e0), (m1, e1) in zip(pts[:-1], pts[1:]):
+        d0, d1 = e0 - m0, e1 - m1
+        if d0 == 0:
+            return m0
+        if d0 * d1 <= 0:
+            return m0 + (m1 - m0) * d0 / (d0 - d1)
+    if bounded:
+        warnings.warn(f"matched_mach at altitude {altitude:g} m: the sweep was unstable at its "
+                      f"first point for Mach {', '.join(f'{b:g}' for b in bounded)} (flutter at "
+                      "or below U0); the match cannot be located there", RuntimeWarning,
+                      stacklevel=2)
+    return None
+
+
+# --------------------------------------------------------------------------------------------
+# root locus (Section 3.3.2)
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class RootLocusResult:
+    """Eigenvalues of A_sys over airspeed.
+
+    velocities (n_v,), eigenvalues (n_v, n_z) all roots, elastic (n_v, n_s) the aeroelastic roots
+    continued from the structural roots (upper half plane or real axis), max_real (n_v,) the
+    largest real part of all roots, density.
+    """
+
+    velocities: np.ndarray
+    eigenvalues: np.ndarray
+    elastic: np.ndarray
+    max_real: np.ndarray
+    density: float
+
+    @property
+    def damping_ratio(self) -> np.ndarray:
+        """xi of Eq. (3.13) for the aeroelastic roots."""
+        return -self.elastic.real / np.maximum(np.abs(self.elastic), 1e-300)
+
+    @property
+    def natural_frequency_hz(self) -> np.ndarray:
+        return np.abs(self.elastic) / (2 * np.pi)
+
+    @property
+    def frequency_hz(self) -> np.ndarray:
+        return np.abs(self.elastic.imag) / (2 * np.pi)
+
+
+def _eig_structural(mats, ns):
+    lam, vec = np.linalg.eig(mats.A)
+    return lam, vec[:ns]
+
+
+@small_dense
+def root_locus(modal, rfa, density: float, velocities, substeps: int | None = None
+               ) -> RootLocusResult:
+    """Eigenvalues of A_sys (Eq. 2.63) over ``velocities`` with the aeroelastic roots tracked.
+
+    Tracking starts from the structural roots at a speed 1e-3 of the first velocity and
+    continues in small steps (``substeps`` between list points; by default enough that U
+    changes by at most 5 % per step); each step assigns the new roots to the
+    branches by a cost combining eigenvalue distance and eigenvector correlation (Hungarian
+    assignment), so lag roots, which start near the origin on the real axis, are never taken
+    for aeroelastic roots.
+    """
+    m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
+    rho = positive("density", density)
+    U = _ascending("velocities", velocities)
+    _pressure_ok(rho, U)
+    if substeps is not None:
+        substeps = _count("substeps", substeps)
+    ns = m.n_elastic
+    s = slice(m.n_rigid, m.n_modes)
+    w2, phi = linalg.eigh(m.K[s, s], m.M[s, s])
+    order = np.argsort(w2)
+    lam_prev = 1j * np.sqrt(np.clip(w2[order], 0, None))
+    vec_prev = phi[:, order].astype(complex)
+    # continuation path
+    path = list(np.geomspace(1e-3 * U[0], U[0], 25)[:-1])
+    marks = []
+    for i, u in enumerate(U):
+        if i > 0:
+            n_sub = substeps if substeps is not None else int(
+                np.ceil(np.log(U[i] / U[i - 1]) / np.log(1.05)))
+            path += list(np.linspace(U[i - 1], U[i], max(n_sub, 1) + 1)[1:-1])
+        marks.append(len(path))
+        path.append(u)
+    if len(path) > MAX_STEPS // 100:
+        raise ValueError(f"root_locus would solve {len(path)} eigenproblems (velocities "
+                         f"{U.size}, substeps {substeps}); limit {MAX_STEPS // 100}: use fewer "
+                         "velocities or substeps")
+    from scipy.optimize import linear_sum_assignment
+    all_eigs, elastic = [], []
+    for ip, u in enumerate(path):
+        mats = aeroelastic_matrices(m, rfa, rho, u)
+        lam, vec = _eig_structural(mats, ns)
+        up = lam.imag >= -1e-9 * np.maximum(np.abs(lam), 1.0)
+        lam_u, vec_u = lam[up], vec[:, up]
+        scale = np.maximum(np.abs(lam_prev), 1e-6 * np.abs(lam_prev).max() + 1e-12)
+        cost = np.zeros((ns, lam_u.size))
+        for j in range(ns):
+            cost[j] = (np.abs(lam_u - lam_prev[j]) / scale[j]
+                       + (1 - _mac(vec_prev[:, j], vec_u)))
+        rows, cols = linear_sum_assignment(cost)
+        new_lam = lam_prev.copy()
+        new_vec = vec_prev.copy()
+        new_lam[rows] = lam_u[cols]
+        new_vec[:, rows] = vec_u[:, cols]
+        lam_prev, vec_prev = new_lam, new_vec
+        if ip in marks:
+            all_eigs.append(lam)
+            elastic.append(new_lam.copy())
+    eig_arr = np.array(all_eigs)
+    return RootLocusResult(velocities=U, eigenvalues=eig_arr, elastic=np.array(elastic),
+                           max_real=eig_arr.real.max(axis=1), density=rho)
+
+
+def root_locus_instabilities(result: RootLocusResult, modal=None, rfa=None,
+                             refine: bool = True) -> list[Instability]:
+    """Crossings of the aeroelastic roots into Re > 0, interpolated (and, given ``modal`` and
+    ``rfa``, refined by Brent's method on the real part of the eigenvalue of A_sys nearest the
+    crossing root). A root unstable at the first airspeed (Re > :func:`crossing_tolerance`) is
+    returned with ``at_first_point=True`` and ``speed = velocities[0]`` (at or below U0)."""
+    U = result.velocities
+    out = []
+    tol = crossing_tolerance(result.elastic)
+    for j in range(result.elastic.shape[1]):
+        lam = result.elastic[:, j]
+        real_mask = np.abs(lam.imag) <= 1e-6 * np.maximum(np.abs(lam), 1e-12)
+        for i, us, f, kind, first in _crossings(U, lam.real, np.abs(lam.imag) / (2 * np.pi),
+                                                real_mask, tol):
+            if first:
+                out.append(Instability(kind=kind, mode=j, speed=float(us),
+                                       frequency_hz=0.0 if kind == "divergence" else float(f),
+                                       method="root locus", at_first_point=True))
+                continue
+            if refine and modal is not None and rfa is not None:
+                # follow the tracked branch: the eigenvalue nearest its linear interpolation
+                # between the sweep points (at a coalescence the sub-critical root alone would
+                # be equidistant from the stable and the unstable partner)
+                def pick_at(u, i=i, lam=lam):
+                    ev = np.linalg.eigvals(aeroelastic_matrices(modal, rfa, result.density,
+                                                                u).A)
+                    ev = ev[ev.imag >= -1e-9]
+                    t = (u - U[i - 1]) / (U[i] - U[i - 1])
+                    return ev[np.argmin(np.abs(ev - (lam[i - 1] + t * (lam[i] - lam[i - 1]))))]
+
+                def re_lam(u):
+                    return pick_at(u).real - tol     # undamped: Re = 0 +- rounding stays < 0
+
+                try:
+                    us = optimize.brentq(re_lam, U[i - 1], U[i], xtol=1e-6 * U[i])
+                    f = abs(pick_at(us).imag) / (2 * np.pi)
+                except ValueError:
+                    pass
+            out.append(Instability(kind=kind, mode=j, speed=float(us),
+                                   frequency_hz=0.0 if kind == "divergence" else float(f),
+                                   method="root locus"))
+    return sorted(out, key=lambda s: s.speed)
+
+
+# --------------------------------------------------------------------------------------------
+# time domain (Section 3.3.3)
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class TimeResponse:
+    """Free response z(t) of z' = A_sys z: ``t`` (n_t,), ``z`` (n_t, n_z), ``steps`` (accepted
+    step sizes of the integrator, empty for the exact solution), ``method``."""
+
+    t: np.ndarray
+    z: np.ndarray
+    steps: np.ndarray
+    method: str
+
+
+def initial_state(n_states: int, coordinate: int = 1) -> np.ndarray:
+    """Eq. (3.15) initial condition: all zero except elastic coordinate ``coordinate``
+    (0-based; the thesis used the second, index 1) set to one."""
+    z0 = np.zeros(n_states)
+    if not 0 <= coordinate < n_states:
+        raise ValueError(f"coordinate must be in [0, {n_states - 1}], got {coordinate}")
+    z0[coordinate] = 1.0
+    return z0
+
+
+@small_dense
+def simulate_free_response(A: np.ndarray, z0: np.ndarray, t_end: float = 0.25,
+                           max_step: float = 1e-4, method: str = "RK45", n_out: int = 2501,
+                           rtol: float = 1e-6, atol: float = 1e-9) -> TimeResponse:
+    """Integrate Eq. (3.14) z' = A z from z0 over [0, t_end] s.
+
+    ``method="RK45"`` (or any scipy solve_ivp method) with ``max_step`` (s; the thesis capped
+    ode45's step at 1e-4 s), or ``method="exact"``: the matrix exponential, z(t_j) =
+    expm(A dt)^j z0 on a uniform grid of ``n_out`` points.
+
+    Raises ValueError (before any work) when the record would need more than ``MAX_STEPS``
+    steps (t_end / max_step) or output samples (n_out), naming the estimate and the knob.
+    """
+    from scipy.integrate import solve_ivp
+
+    A = np.asarray(A, dtype=float)
+    z0 = np.asarray(z0, dtype=float)
+    if A.ndim != 2 or A.shape[0] != A.shape[1] or z0.shape != (A.shape[0],):
+        raise ValueError(f"A must be square (n, n) and z0 (n,); got A {A.shape}, z0 {z0.shape}")
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(z0))):
+        raise ValueError("A and z0 must be finite")
+    t_end = positive("t_end", t_end)
+    n_out = _count("n_out", n_out, 2)
+    if n_out > MAX_STEPS:
+        raise ValueError(f"n_out = {n_out} output samples exceeds the limit {MAX_STEPS}; "
+                         "lower n_out")
+    t = np.linspace(0.0, t_end, n_out)
+    if method == "exact":
+        E = linalg.expm(A * (t[1] - t[0]))
+        z = np.empty((t.size, z0.size))
+        z[0] = z0
+        for j in range(1, t.size):
+            z[j] = E @ z[j - 1]
+        return TimeResponse(t=t, z=z, steps=np.array([]), method="exact")
+    max_step = positive("max_step", max_step)
+    if t_end / max_step > MAX_STEPS:
+        raise ValueError(f"t_end / max_step = {t_end / max_step:.3g} steps exceeds the limit "
+                         f"{MAX_STEPS}; raise max_step or shorten t_end (or use "
+                         "method='exact')")
+    extra = {"jac": A} if method in ("Radau", "BDF", "LSODA") else {}
+    sol = solve_ivp(lambda _t, y: A @ y, (0.0, t_end), z0, method=method, t_eval=t,
+                    max_step=max_step, rtol=rtol, atol=atol, **extra)
+    if not sol.success:
+        raise RuntimeError(f"solve_ivp failed: {sol.message}")
+    # accepted step sizes are not returned by solve_ivp's t_eval output: rerun cheaply
+    sol_steps = solve_ivp(lambda _t, y: A @ y, (0.0, t_end), z0, method=method,
+                          max_step=max_step, rtol=rtol, atol=atol)
+    return TimeResponse(t=sol.t, z=sol.y.T, steps=np.diff(sol_steps.t), method=method)
+
+
+def growth_rate(t: np.ndarray, y: np.ndarray, window: float) -> float:
+    """Exponential growth rate (1/s) of a response: slope of log(max |y| per window) over the
+    second half of the record (windows of ``window`` s, at least a period of the slowest
+    oscillation). Negative = decaying, positive = growing. ``y`` may be (n_t,) or (n_t, m)
+    (its row norms are used).
+
+    Raises ValueError if ``window`` is not > 0, the record holds fewer than 4 windows, or more
+    windows than samples (a window shorter than the sampling step measures nothing).
+    """
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y)
+    if t.ndim != 1 or t.size < 2 or y.shape[0] != t.size:
+        raise ValueError(f"t must be (n_t,) with n_t >= 2 and y (n_t, ...); got t {t.shape}, "
+                         f"y {y.shape}")
+    window = positive("window", window)
+    n_win = (t[-1] - t[0]) / window
+    if n_win > t.size:
+        raise ValueError(f"window = {window:g} s is shorter than the sampling step "
+                         f"({(t[-1] - t[0]) / (t.size - 1):g} s): {n_win:.3g} windows for "
+                         f"{t.size} samples; use a window of at least a period")
+    mag = np.abs(y) if y.ndim == 1 else np.linalg.norm(y.reshape(t.size, -1), axis=1)
+    if not np.all(np.isfinite(mag)):
+        raise ValueError("y holds non-finite values (the response overflowed: shorten t_end)")
+    edges = np.arange(t[0], t[-1] + 1e-15, window)
+    centers, peaks = [], []
+    for a, b in zip(edges[:-1], edges[1:]):
+        sel = (t >= a) & (t < b)
+        if np.any(sel):
+            j = np.argmax(mag[sel])
+            centers.append(t[sel][j])
+            peaks.append(mag[sel][j])
+    centers, peaks = np.array(centers), np.array(peaks)
+    half = centers >= t[0] + 0.5 * (t[-1] - t[0])
+    if half.sum() < 2:
+        raise ValueError(f"record too short for the window: need at least 4 windows of "
+                         f"{window:g} s, the record is {t[-1] - t[0]:g} s")
+    peaks = np.maximum(peaks, 1e-300)
+    return float(np.polyfit(centers[half], np.log(peaks[half]), 1)[0])
+
+
+@dataclass(frozen=True)
+class TimeDomainSweep:
+    """Growth rate of the free response over airspeed: velocities, growth (1/s), and the onset
+    speed (growth = 0, None if none in the range).
+
+    ``at_first_point``: the response already grows at the first airspeed, so the onset is at or
+    below ``velocities[0]``; ``onset_speed`` is then that first airspeed (an upper bound).
+    """
+
+    velocities: np.ndarray
+    growth: np.ndarray
+    onset_speed: float | None
+    method: str
+    at_first_point: bool = False
+
+    def describe(self, unit: str = "m/s") -> str:
+        """'onset at 219.6 m/s', 'unstable at the first point of the sweep: onset at or below
+        250 m/s' or 'no growth up to 460 m/s'."""
+        if self.onset_speed is None:
+            return f"no growth up to {self.velocities[-1]:.6g} {unit}"
+        if self.at_first_point:
+            return (f"unstable at the first point of the sweep: onset at or below "
+                    f"{self.onset_speed:.6g} {unit}")
+        return f"onset at {self.onset_speed:.6g} {unit}"
+
+
+@small_dense
+def time_domain_sweep(modal, rfa, density: float, velocities, coordinate: int = 1,
+                      t_end: float = 0.25, max_step: float = 1e-4, method: str = "exact",
+                      window: float | None = None, refine: bool = True) -> TimeDomainSweep:
+    """Growth rate of the response of z' = A_sys z (unit initial value on elastic coordinate
+    ``coordinate``) over ``velocities``, and the onset speed where it crosses zero (interpolated,
+    refined by Brent's method when ``refine``). The growth is measured on the elastic modal
+    coordinates zeta_s. ``method`` "exact" (matrix exponential) or a solve_ivp method.
+
+    ``window`` (s) must be at least one period T1 = 2 pi / omega_1 of the slowest elastic
+    structural mode, and ``t_end`` at least 4 windows; the default window is
+    max(T1, min(2 T1, t_end / 8)). A response growing at the first airspeed (growth > tol, tol
+    = 1e-9 omega_max of the structure) gives ``at_first_point=True``, ``onset_speed = U0``.
+    """
+    m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
+    U = _ascending("velocities", velocities)
+    rho = positive("density", density)
+    _pressure_ok(rho, U)
+    t_end = positive("t_end", t_end)
+    ns = m.n_elastic
+    if ns == 0:
+        raise ValueError("modal has no elastic modes: nothing to measure")
+    s = slice(m.n_rigid, m.n_modes)
+    w2 = linalg.eigvalsh(m.K[s, s], m.M[s, s])
+    w1 = np.sqrt(max(w2.min(), 1e-12))
+    period = 2 * np.pi / w1
+    if window is None:
+        window = max(period, min(2 * period, t_end / 8))
+    else:
+        window = positive("window", window)
+        if window < period * (1 - 1e-9):
+            raise ValueError(f"window = {window:g} s is shorter than a period of the slowest "
+                             f"elastic mode ({period:g} s, {w1 / 2 / np.pi:.4g} Hz): the peaks "
+                             f"per window would not measure growth; use window >= {period:g}")
+    if t_end < 4 * window:
+        raise ValueError(f"t_end = {t_end:g} s holds fewer than 4 windows of {window:g} s "
+                         f"(one or two periods of the slowest elastic mode, {period:g} s): "
+                         f"use t_end >= {4 * window:g}")
+    tol = RTOL_UNSTABLE * np.sqrt(max(w2.max(), 0.0))
+
+    def rate(u):
+        mats = aeroelastic_matrices(m, rfa, rho, u)
+        z0 = initial_state(mats.n_states, coordinate)
+        r = simulate_free_response(mats.A, z0, t_end, max_step, method)
+        return growth_rate(r.t, r.z[:, :ns], window)
+
+    g = np.array([rate(u) for u in U])
+    if g[0] > tol:
+        return TimeDomainSweep(velocities=U, growth=g, onset_speed=float(U[0]), method=method,
+                               at_first_point=True)
+    onset = None
+    for i in range(1, U.size):
+        if g[i - 1] <= tol < g[i]:
+            onset = U[i - 1] + (tol - g[i - 1]) * (U[i] - U[i - 1]) / (g[i] - g[i - 1])
+            onset = float(np.clip(onset, U[i - 1], U[i]))
+            if refine:
+                try:
+                    onset = optimize.brentq(lambda u: rate(u) - tol, U[i - 1], U[i],
+                                            xtol=1e-4 * U[i])
+                except ValueError:
+                    pass
+            break
+    return TimeDomainSweep(velocities=U, growth=g, onset_speed=None if onset is None
+                           else float(onset), method=method)

@@ -1,0 +1,353 @@
+"""The two-dimensional pitch-plunge-flap typical section with Theodorsen aerodynamics in
+state-space form (Wagner's indicial function in R. T. Jones' two-exponential approximation).
+
+Coordinates q = [h, alpha, beta]: plunge h (m, positive down), pitch alpha about the elastic
+axis (rad, nose up), flap beta about the hinge (rad, trailing edge down); semichord b, elastic
+axis at x = a b and hinge at x = c b from mid-chord (positive aft). Everything per unit span.
+
+Structure (Theodorsen 1935, NACA Report 496, Eqs. for the three-degree-of-freedom section):
+
+    M_s = [[m_h, S_a, S_b], [S_a, I_a, I_b + b (c - a) S_b], [S_b, I_b + b (c - a) S_b, I_b]],
+    K_s = diag(K_h, K_a, K_b),  D_s = diag(2 zeta_i sqrt(K_i M_s,ii))   (uncoupled damping)
+
+Aerodynamic forces (Theodorsen 1935, NACA 496, with his geometric functions T1..T14 of c and a):
+the plunge force P (positive down), pitching moment M_a and hinge moment M_b are a
+non-circulatory part (apparent mass, damping and stiffness, exact in the time domain) and a
+circulatory part proportional to the effective downwash at the three-quarter chord
+
+    Q = U alpha + h' + b (1/2 - a) alpha' + (U / pi) T10 beta + (b / (2 pi)) T11 beta',
+    P_c = -2 pi rho U b C Q,  M_a,c = 2 pi rho U b^2 (a + 1/2) C Q,  M_b,c = -rho U b^2 T12 C Q,
+
+C being Theodorsen's function. In the time domain C acts as the convolution with Wagner's
+function phi(s), s = U t / b, approximated by R. T. Jones (NACA Report 681, 1940) as
+phi(s) = 1 - 0.165 exp(-0.0455 s) - 0.335 exp(-0.3 s). With two lag states x_i' =
+-(U/b) eps_i x_i + Q the effective downwash is
+
+    Q_eff = (1 - A1 - A2) Q + (U/b) (A1 eps1 x1 + A2 eps2 x2),  A = (0.165, 0.335),
+    eps = (0.0455, 0.3),
+
+whose transfer function Q_eff / Q = 1 - sum A_i i k / (i k + eps_i) is Jones' approximation of
+C(k) (within about 1-2 % of the exact C(k) = H1(k) / (H1(k) + i H0(k)), Hankel functions of
+the second kind). This is the model of Conner, Tang, Dowell & Virgin (J. Fluids Struct. 11,
+1997, Sec. 2) and Edwards, Ashley & Breakwell (AIAA J. 17, 1979).
+
+State x = [h, alpha, beta, h', alpha', beta', x1, x2] (8 states), x' = A x. The flap spring
+K_b is the connection of :mod:`asekit.aeroelastic.nonlinear`: :func:`connected_system` returns
+(A0 with K_b = 0, b, c) so the hinge spring can be freeplay.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.optimize import brentq
+from scipy.special import hankel2
+
+from asekit.aeroelastic.nonlinear import ConnectedSystem
+from asekit.util.validate import in_range, positive
+
+JONES_A = (0.165, 0.335)
+JONES_EPS = (0.0455, 0.3)
+STATE_NAMES = ("h", "alpha", "beta", "h_dot", "alpha_dot", "beta_dot", "lag1", "lag2")
+
+
+@dataclass(frozen=True)
+class TypicalSection:
+    """A pitch-plunge-flap section, per unit span, SI.
+
+    semichord b (m); a, c : elastic axis and hinge from mid-chord in semichords (-1 < a < c < 1);
+    heave_mass (kg/m) : mass moving in plunge; static_moment_alpha S_a, static_moment_beta S_b
+    (kg m/m; S_a about the elastic axis, S_b about the hinge, positive when the centre of mass
+    is aft); inertia_alpha I_a about the elastic axis, inertia_beta I_b about the hinge
+    (kg m^2/m); stiffness_h (N/m/m), stiffness_alpha, stiffness_beta (N m/rad/m);
+    damping ratios zeta_h, zeta_alpha, zeta_beta (uncoupled); density rho (kg/m^3).
+    """
+
+    semichord: float
+    a: float
+    c: float
+    heave_mass: float
+    static_moment_alpha: float
+    static_moment_beta: float
+    inertia_alpha: float
+    inertia_beta: float
+    stiffness_h: float
+    stiffness_alpha: float
+    stiffness_beta: float
+    zeta_h: float = 0.0
+    zeta_alpha: float = 0.0
+    zeta_beta: float = 0.0
+    density: float = 1.225
+
+    def __post_init__(self):
+        for n in ("semichord", "heave_mass", "inertia_alpha", "inertia_beta", "stiffness_h",
+                  "stiffness_alpha", "density"):
+            positive(n, getattr(self, n))
+        in_range("stiffness_beta", self.stiffness_beta, 0.0, inclusive=True)
+        in_range("a", self.a, -1.0, high=1.0, high_inclusive=False)
+        in_range("c", self.c, self.a, high=1.0, high_inclusive=False)
+        for n in ("zeta_h", "zeta_alpha", "zeta_beta"):
+            in_range(n, getattr(self, n), 0.0, inclusive=True, high=1.0)
+
+    def with_flap_stiffness(self, k_beta: float) -> "TypicalSection":
+        return replace(self, stiffness_beta=float(k_beta))
+
+
+def theodorsen_t(a: float, c: float) -> dict:
+    """Theodorsen's geometric functions T1..T14 (NACA Report 496, 1935) for elastic axis a and
+    hinge c (semichords from mid-chord)."""
+    s = math.sqrt(1.0 - c * c)
+    ac = math.acos(c)
+    T = {}
+    T[1] = -s * (2 + c * c) / 3 + c * ac
+    T[2] = c * (1 - c * c) - s * (1 + c * c) * ac + c * ac * ac
+    T[3] = -(1 / 8 + c * c) * ac * ac + c * s * ac * (7 + 2 * c * c) / 4 \
+        - (1 - c * c) * (5 * c * c + 4) / 8
+    T[4] = -ac + c * s
+    T[5] = -(1 - c * c) - ac * ac + 2 * c * s * ac
+    T[6] = T[2]
+    T[7] = -(1 / 8 + c * c) * ac + c * s * (7 + 2 * c * c) / 8
+    T[8] = -s * (2 * c * c + 1) / 3 + c * ac
+    T[9] = 0.5 * (s ** 3 / 3 + a * T[4])
+    T[10] = s + ac
+    T[11] = ac * (1 - 2 * c) + s * (2 - c)
+    T[12] = s * (2 + c) - ac * (2 * c + 1)
+    T[13] = 0.5 * (-T[7] - (c - a) * T[1])
+    T[14] = 1 / 16 + a * c / 2
+    return T
+
+
+def theodorsen_function(k):
+    """Theodorsen's C(k) = H1(k) / (H1(k) + i H0(k)) (Hankel functions of the second kind),
+    k = omega b / U > 0."""
+    k = np.asarray(k, dtype=float)
+    h1, h0 = hankel2(1, k), hankel2(0, k)
+    return h1 / (h1 + 1j * h0)
+
+
+def jones_function(k):
+    """R. T. Jones' approximation of C(k): 1 - sum A_i i k / (i k + eps_i)."""
+    k = np.asarray(k, dtype=float)
+    return 1.0 - sum(A * 1j * k / (1j * k + e) for A, e in zip(JONES_A, JONES_EPS))
+
+
+@dataclass(frozen=True)
+class SectionMatrices:
+    """Structural M_s, D_s, K_s; non-circulatory aerodynamic M_nc, B_nc, K_nc (left-hand side);
+    circulatory force vector f_c (per unit effective downwash Q, N/(m/s)), downwash rows w_q,
+    w_qd (Q = w_q q + w_qd q'), all 3 x 3 / 3-vectors at airspeed U."""
+
+    M_s: np.ndarray
+    D_s: np.ndarray
+    K_s: np.ndarray
+    M_nc: np.ndarray
+    B_nc: np.ndarray
+    K_nc: np.ndarray
+    f_c: np.ndarray
+    w_q: np.ndarray
+    w_qd: np.ndarray
+
+
+def section_matrices(sec: TypicalSection, velocity: float) -> SectionMatrices:
+    """The matrices of the module docstring at airspeed U = ``velocity`` (m/s, >= 0)."""
+    U = in_range("velocity", velocity, 0.0, inclusive=True)
+    b, a, c, rho = sec.semichord, sec.a, sec.c, sec.density
+    T = theodorsen_t(a, c)
+    pi = math.pi
+    Sa, Sb, Ia, Ib = (sec.static_moment_alpha, sec.static_moment_beta, sec.inertia_alpha,
+                      sec.inertia_beta)
+    cab = Ib + b * (c - a) * Sb
+    M_s = np.array([[sec.heave_mass, Sa, Sb], [Sa, Ia, cab], [Sb, cab, Ib]])
+    K_s = np.diag([sec.stiffness_h, sec.stiffness_alpha, sec.stiffness_beta])
+    zeta = np.array([sec.zeta_h, sec.zeta_alpha, sec.zeta_beta])
+    D_s = np.diag(2 * zeta * np.sqrt(np.diag(K_s) * np.diag(M_s)))
+    r = rho * b * b
+    bb = b * b
+    M_nc = r * np.array([[pi, -pi * b * a, -T[1] * b],
+                         [-a * pi * b, pi * bb * (1 / 8 + a * a), -(T[7] + (c - a) * T[1]) * bb],
+                         [-T[1] * b, 2 * T[13] * bb, -T[3] * bb / pi]])
+    b_ab = (T[1] - T[8] - (c - a) * T[4] + 0.5 * T[11]) * b          # M_a per beta'
+    b_ba = (-2 * T[9] - T[1] + T[4] * (a - 0.5)) * b                  # M_b per alpha'
+    B_nc = r * U * np.array([[0.0, pi, -T[4]],
+                             [0.0, pi * (0.5 - a) * b, b_ab],
+                             [0.0, b_ba, -T[4] * T[11] * b / (2 * pi)]])
+    K_nc = r * U * U * np.array([[0.0, 0.0, 0.0],
+                                 [0.0, 0.0, T[4] + T[10]],
+                                 [0.0, 0.0, (T[5] - T[4] * T[10]) / pi]])
+    f_c = np.array([-2 * pi * rho * U * b, 2 * pi * rho * U * b * b * (a + 0.5),
+                    -rho * U * b * b * T[12]])
+    w_q = np.array([0.0, U, U * T[10] / pi])
+    w_qd = np.array([1.0, b * (0.5 - a), b * T[11] / (2 * pi)])
+    return SectionMatrices(M_s, D_s, K_s, M_nc, B_nc, K_nc, f_c, w_q, w_qd)
+
+
+def state_matrix(sec: TypicalSection, velocity: float) -> np.ndarray:
+    """The 8 x 8 aeroelastic state matrix (module docstring) at U = ``velocity`` (m/s > 0)."""
+    U = positive("velocity", velocity)
+    m = section_matrices(sec, U)
+    b = sec.semichord
+    Mt = m.M_s + m.M_nc
+    Minv = np.linalg.inv(Mt)
+    phi0 = 1.0 - sum(JONES_A)
+    # forces on the right-hand side: -B q' - K q + f_c Q_eff
+    # Q_eff = phi0 (w_q q + w_qd q') + (U/b) sum A_i eps_i x_i
+    K_eff = m.K_s + m.K_nc - phi0 * np.outer(m.f_c, m.w_q)
+    D_eff = m.D_s + m.B_nc - phi0 * np.outer(m.f_c, m.w_qd)
+    lag_w = np.array([(U / b) * A * e for A, e in zip(JONES_A, JONES_EPS)])
+    A = np.zeros((8, 8))
+    A[0:3, 3:6] = np.eye(3)
+    A[3:6, 0:3] = -Minv @ K_eff
+    A[3:6, 3:6] = -Minv @ D_eff
+    A[3:6, 6:8] = Minv @ np.outer(m.f_c, lag_w)
+    for i, e in enumerate(JONES_EPS):
+        A[6 + i, 0:3] = m.w_q
+        A[6 + i, 3:6] = m.w_qd
+        A[6 + i, 6 + i] = -(U / b) * e
+    return A
+
+
+def frequency_domain_matrix(sec: TypicalSection, velocity: float, omega: float,
+                            theodorsen: str = "exact") -> np.ndarray:
+    """The 3 x 3 flutter matrix -omega^2 (M_s + M_nc) + i omega (D_s + B_nc) + K_s + K_nc
+    - f_c C(k) (w_q + i omega w_qd) at U, omega (rad/s), with the exact C(k) (``"exact"``) or
+    Jones' approximation (``"jones"``)."""
+    U = positive("velocity", velocity)
+    m = section_matrices(sec, U)
+    k = omega * sec.semichord / U
+    Ck = theodorsen_function(k) if theodorsen == "exact" else jones_function(k)
+    return (-omega ** 2 * (m.M_s + m.M_nc) + 1j * omega * (m.D_s + m.B_nc) + m.K_s + m.K_nc
+            - Ck * np.outer(m.f_c, m.w_q + 1j * omega * m.w_qd))
+
+
+def connected_system(sec: TypicalSection, velocity: float) -> ConnectedSystem:
+    """The section at U with the flap spring as the connection (:mod:`asekit.aeroelastic.nonlinear`):
+    A0 = the state matrix with K_b = 0 (the structural damping keeps its nominal value),
+    b = -(M_s + M_nc)^-1 e_beta in the acceleration rows, d = beta. Outputs h, alpha, beta."""
+    m = section_matrices(sec, velocity)
+    Minv = np.linalg.inv(m.M_s + m.M_nc)
+    bvec = np.zeros(8)
+    bvec[3:6] = -Minv[:, 2]
+    cvec = np.zeros(8)
+    cvec[2] = 1.0
+    # K_b enters the state matrix only as -Minv e_b K_b e_b^T: A = A0 + K_b b c^T exactly
+    A0 = state_matrix(sec, velocity) - sec.stiffness_beta * np.outer(bvec, cvec)
+    outs = {n: (np.eye(8)[i], np.zeros(0)) for i, n in enumerate(("h", "alpha", "beta"))}
+    return ConnectedSystem(A0, bvec, cvec, outputs=outs, velocity=float(velocity),
+                           state_names=STATE_NAMES)
+
+
+def flutter_speed(sec: TypicalSection, u_lo: float, u_hi: float, n: int = 60):
+    """(U_F (m/s), f_F (Hz)) of the linear section: the lowest airspeed in [u_lo, u_hi] at
+    which a root of :func:`state_matrix` crosses into the right half-plane (scan of n speeds,
+    then Brent); None if none in the range. Raises ValueError if it is unstable at u_lo."""
+    u_lo, u_hi = positive("u_lo", u_lo), positive("u_hi", u_hi)
+    if u_hi <= u_lo:
+        raise ValueError(f"u_hi must exceed u_lo, got {u_lo}, {u_hi}")
+
+    def sig(u):
+        ev = np.linalg.eigvals(state_matrix(sec, u))
+        return float(np.max(ev.real))
+    us = np.linspace(u_lo, u_hi, int(n))
+    s = np.array([sig(u) for u in us])
+    if s[0] > 0:
+        raise ValueError(f"the section is already unstable at u_lo = {u_lo:g} m/s")
+    idx = np.nonzero(s > 0)[0]
+    if idx.size == 0:
+        return None
+    i = idx[0]
+    uf = brentq(sig, us[i - 1], us[i], xtol=1e-8)
+    ev = np.linalg.eigvals(state_matrix(sec, uf))
+    j = np.argmax(ev.real)
+    return float(uf), float(abs(ev[j].imag) / (2 * math.pi))
+
+
+def flutter_speed_exact(sec: TypicalSection, u_guess: float, f_guess_hz: float,
+                        theodorsen: str = "exact"):
+    """(U_F, f_F) solving det(frequency_domain_matrix(U, omega)) = 0 for real U and omega
+    (neutral stability with the exact C(k) or Jones' C(k)) by Newton iteration from a guess."""
+    from scipy.optimize import fsolve
+
+    def res(p):
+        u, w = p
+        dt = np.linalg.det(frequency_domain_matrix(sec, u, w, theodorsen))
+        return [dt.real, dt.imag]
+    scale = np.array([u_guess, 2 * math.pi * f_guess_hz])
+    sol, info, ier, msg = fsolve(lambda z: res(z * scale), np.ones(2), full_output=True,
+                                 xtol=1e-12)
+    if ier != 1:
+        raise RuntimeError(f"flutter determinant did not converge: {msg}")
+    u, w = sol * scale
+    return float(u), float(w / (2 * math.pi))
+
+
+# ---------------------------------------------------------------------------------------------
+# the published case
+# ---------------------------------------------------------------------------------------------
+#: Span of the Duke wind-tunnel model (m; Conner et al. 1997, Table A.1). Informational only: the
+#: parameters of :func:`conner_1997` are per unit span as published and are not divided by it.
+CONNER_SPAN = 0.52
+
+#: Conner et al. (1997) freeplay "Gap 3" (Sec. 11.2, p. 101: freeplay regions of +-1.15, +-1.83 and
+#: +-2.12 deg), the case of Tang, Dowell & Virgin (1998, Sec. 4.2: "a nominal angular gap of 4.24
+#: deg, i.e. delta = +-2.12 deg"): the flap moves freely from -2.12 to +2.12 deg, a half-width of
+#: 2.12 deg.
+CONNER_FREEPLAY_HALF_WIDTH_DEG = 2.12
+
+
+def conner_1997(heave_mass: float = 3.39298, wing_mass: float = 1.5666) -> TypicalSection:
+    """The typical section of Conner, Tang, Dowell & Virgin, "Nonlinear behavior of a typical
+    airfoil section with control surface freeplay: a numerical and experimental study",
+    J. Fluids Struct. 11 (1997) 89-109, Appendix A, Table A.1 (p. 108), per unit span.
+
+    Values (per unit span, SI): semichord b = 0.127 m (chord 0.254 m, span 0.52 m), elastic
+    axis a = -0.5, hinge c = 0.5; S_alpha = 0.08587 kg m/m, S_beta = 0.00395 kg m/m,
+    I_alpha = 0.01347 kg m^2/m, I_beta = 0.0003264 kg m^2/m; damping ratios zeta_alpha =
+    0.01626, zeta_beta = 0.0115, zeta_h = 0.0113 (log-decrement); rho = 1.225 kg/m^3.
+
+    Masses: Table A.1 lists the wing 0.62868 kg, the aileron 0.18597 kg and the support blocks
+    2 x 0.47485 kg (the two blocks move only in plunge, Sec. 7), so the plunging mass per span is
+    m_T = (0.62868 + 0.18597 + 2 x 0.47485) / 0.52 = 3.39298 kg/m (``heave_mass``) and the
+    wing-aileron mass is (0.62868 + 0.18597) / 0.52 = 1.5666 kg/m (``wing_mass``); the table's
+    "mass/length of wing-aileron" M = 1.558 kg/m is the one its nondimensional values use.
+
+    Stiffnesses: Table A.1 gives them reduced as in Theodorsen (1935): K_alpha = C_alpha / (M b^2)
+    = 1486 1/s^2, K_beta = C_beta / (M b^2) = 155 1/s^2, K_h = C_h / M = 1809 1/s^2 (M = 1.558);
+    the dimensional values used here, C_alpha = 37.34 N m/rad/m, C_beta = 3.9 N m/rad/m,
+    C_h = 2818.8 N/m/m, are those of Tang, Dowell & Virgin, J. Fluids Struct. 12 (1998) 839-858,
+    Table 1 (p. 841: 37.3, 3.9 and 2818.8 "per span"), and reproduce Table A.1's reduced values
+    to its three to four digits (tests). Nondimensional set of Table A.1: x_alpha = 0.434,
+    x_beta = 0.01996, r_alpha = 0.7321, r_beta = 0.11397, kappa = pi rho b^2 / M = 0.03984.
+
+    Checks against the paper (tests/aeroelastic/test_typical_section.py): the in-vacuo coupled natural
+    frequencies 4.444, 9.209, 19.442 Hz against Conner et al. Table 1 (p. 98, "numerical")
+    4.455, 9.218, 19.442 Hz (Tang et al. 1998 Table 1: 4.45, 9.21, 19.44 Hz), which also
+    confirms that m_T (not M) moves in plunge (with M the plunge frequency would be 5.8 Hz);
+    linear flutter 24.03 m/s, 6.10 Hz with Jones' C(k) against Table 1's 23.9 m/s, 6.112 Hz.
+
+    Differences from the paper's model: Conner et al. (Sec. 3, Eq. 6) treat the measured
+    damping ratios as *modal* ratios of the coupled in-vacuo modes and transform that damping
+    back to [alpha, beta, h] (a full matrix); here the damping is uncoupled,
+    diag(2 zeta_i sqrt(K_i M_s,ii)). The flutter speed moves by 0.1 % between the two (tests).
+    Freeplay: Conner et al. test +-1.15, +-1.83 and +-2.12 deg (Gaps 1-3, Sec. 11.2, p. 101);
+    Tang et al. (1998, Sec. 4.2) use delta = +-2.12 deg, a 4.24 deg total gap
+    (:data:`CONNER_FREEPLAY_HALF_WIDTH_DEG` is the half-width).
+
+    ``heave_mass`` (kg/m): the plunging mass, default m_T; ``wing_mass`` is informational (the
+    nondimensional form of the equations uses M for mu, x_alpha, r_alpha; here the dimensional
+    S and I are used directly).
+    """
+    positive("wing_mass", wing_mass)
+    return TypicalSection(semichord=0.127, a=-0.5, c=0.5,
+                          heave_mass=positive("heave_mass", heave_mass),
+                          static_moment_alpha=0.08587, static_moment_beta=0.00395,
+                          inertia_alpha=0.01347, inertia_beta=0.0003264,
+                          stiffness_h=2818.8, stiffness_alpha=37.34, stiffness_beta=3.9,
+                          zeta_h=0.0113, zeta_alpha=0.01626, zeta_beta=0.0115, density=1.225)
+
+
+__all__ = ["TypicalSection", "theodorsen_t", "theodorsen_function", "jones_function",
+           "section_matrices", "state_matrix", "frequency_domain_matrix", "connected_system",
+           "flutter_speed", "flutter_speed_exact", "conner_1997", "CONNER_SPAN",
+           "CONNER_FREEPLAY_HALF_WIDTH_DEG"]

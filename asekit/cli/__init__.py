@@ -1,0 +1,1 @@
+"""The command line: ``python -m asekit reproduce | analyse | sweep`` and the static site."""
