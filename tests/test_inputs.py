@@ -14,7 +14,7 @@ from asekit.aero.dlm import normalwash_matrix
 from asekit.aero.vlm import lift_curve_slope, steady_pressure
 from asekit.io.op4 import read_op4, write_op4
 from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, DCMotor, PDController
-from asekit.simulate import simulate
+from asekit.servo.simulate import simulate
 
 
 def _plate(n_chord=4, n_span=4, y0=0.0):

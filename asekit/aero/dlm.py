@@ -81,13 +81,13 @@ numpy only.
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
 
 from asekit.aero.boxes import BoxMesh, check_matrix_memory
+from asekit.aero.kernels import check_kernel
 from asekit.aero.vlm import check_mach, vlm_normalwash_matrix, CHUNK_BYTES
 
 #: Laschka's approximation of u / sqrt(1 + u^2) ~ 1 - sum a_n exp(-n c u) ([R71] Eq. A.4;
@@ -145,39 +145,6 @@ def _check_method(method: str):
     return _METHODS[method]
 
 
-#: Implementations of the all-planar kernel loop: the numpy one (always available) and the
-#: compiled numba one (:mod:`asekit.aero._dlm_compiled`, when numba is installed).
-KERNELS = ("numpy", "compiled")
-#: Environment variable that chooses the default kernel implementation (``numpy`` or
-#: ``compiled``); unset: compiled if numba is installed, else numpy.
-KERNEL_ENV = "ASEKIT_DLM_KERNEL"
-
-
-def compiled_kernel_available() -> bool:
-    """True if numba is installed (the compiled kernel can be used)."""
-    import importlib.util
-    return importlib.util.find_spec("numba") is not None
-
-
-def default_kernel() -> str:
-    """The kernel implementation used when none is given: ``$ASEKIT_DLM_KERNEL`` if set, else
-    "compiled" when numba is installed, else "numpy"."""
-    env = os.environ.get(KERNEL_ENV, "").strip()
-    if env:
-        if env not in KERNELS:
-            raise ValueError(f"{KERNEL_ENV} must be one of {list(KERNELS)}, got {env!r}")
-        return env
-    return "compiled" if compiled_kernel_available() else "numpy"
-
-
-def _check_kernel(kernel) -> str:
-    name = default_kernel() if kernel is None else kernel
-    if name not in KERNELS:
-        raise ValueError(f"kernel must be one of {list(KERNELS)} or None, got {kernel!r}")
-    if name == "compiled" and not compiled_kernel_available():
-        raise ValueError("kernel='compiled' needs numba (pip install numba); use "
-                         "kernel='numpy'")
-    return name
 
 
 # ---------------------------------------------------------------------------------------------
@@ -890,7 +857,7 @@ def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str
     progress : optional callable(n_done, n_total) called after each row chunk.
     kernel : implementation of the all-planar kernel loop, "numpy" or "compiled" (numba, a
         fused loop, 2-3x faster; same equations, agreement to rounding); None:
-        :func:`default_kernel`. The pairwise (nonplanar) path is numpy in both.
+        :func:`asekit.aero.kernels.default_kernel`. The pairwise (nonplanar) path is numpy in both.
 
     Returns
     -------
@@ -904,7 +871,7 @@ def normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str
                         "use fewer boxes or fewer reduced frequencies per call, or "
                         "asekit.aero.dlm.iter_normalwash_matrices (one k at a time)")
     return _normalwash_batch(mesh, mach, ks, b, method, symmetric, progress,
-                             kernel=_check_kernel(kernel))
+                             kernel=check_kernel(kernel))
 
 
 def _normalwash_batch(mesh: BoxMesh, mach: float, ks: np.ndarray, b: float, method: str,
@@ -1013,7 +980,7 @@ def iter_normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
                          f"{max_bytes!r}")
     check_matrix_memory(mesh.n, 1, 16, "one DLM normalwash matrix", "use fewer boxes")
     per_batch = max(1, int(max_bytes) // (16 * mesh.n * mesh.n))
-    return _stream(mesh, mach, ks, b, method, symmetric, per_batch, _check_kernel(kernel))
+    return _stream(mesh, mach, ks, b, method, symmetric, per_batch, check_kernel(kernel))
 
 
 def map_normalwash_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, fn,

@@ -26,6 +26,7 @@ import numpy as np
 
 from asekit.util.validate import positive
 from asekit.aero.boxes import BoxMesh, check_matrix_memory
+from asekit.aero.kernels import check_kernel
 
 #: Upper bound (bytes) for the temporaries of one row chunk (VLM and DLM).
 CHUNK_BYTES = 256 * 2**20
@@ -118,7 +119,7 @@ def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False,
     symmetric : add the image of every box in the plane y = 0 with the same loading (a wall
         or symmetry plane at the root, e.g. a fin mounted on a body); default isolated.
     kernel : "numpy" or "compiled" (numba loop, :mod:`asekit.aero._dlm_compiled`; same
-        equations); None: :func:`asekit.aero.dlm.default_kernel`.
+        equations); None: :func:`asekit.aero.kernels.default_kernel`.
 
     Returns
     -------
@@ -128,8 +129,7 @@ def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False,
     if not isinstance(mesh, BoxMesh):
         raise TypeError(f"mesh must be a BoxMesh, got {type(mesh).__name__}")
     check_matrix_memory(mesh.n, 1, 8, "the VLM normalwash matrix", "use fewer boxes")
-    from asekit.aero.dlm import _check_kernel
-    compiled = _check_kernel(kernel) == "compiled"
+    compiled = check_kernel(kernel) == "compiled"
     beta = math.sqrt(1.0 - mach * mach)
     sx = np.array([1.0 / beta, 1.0, 1.0])
     p = mesh.control_point * sx

@@ -208,23 +208,6 @@ class Case:
             d.pop(k)
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
 
-    # the pipeline (asekit.case.pipeline) -- thin methods so a case reads naturally
-    def modal_model(self):
-        from asekit.case.pipeline import modal_model
-        return modal_model(self)
-
-    def gaf_database(self, progress: bool = True, cache: bool = True):
-        from asekit.case.pipeline import gaf_database
-        return gaf_database(self, progress=progress, cache=cache)
-
-    def flutter(self, progress: bool = False):
-        from asekit.case.pipeline import flutter
-        return flutter(self, progress=progress)
-
-    def ase(self):
-        from asekit.case.pipeline import ase
-        return ase(self)
-
 
 # ---------------------------------------------------------------------------------------------
 # reading and checking

@@ -56,6 +56,7 @@ from scipy.integrate import solve_ivp
 from asekit.ase import metrics
 from asekit.util.blas import small_dense
 from asekit.servo.actuator import ActuatorParameters, PDController
+from asekit.servo.piecewise import propagate_exact, voltage_bounds
 from asekit.util.validate import in_range
 from asekit.servo.torque_requirement import (SEA_LEVEL_DENSITY, SEA_LEVEL_SPEED_OF_SOUND, THESIS_Q_CC,
                                        dynamic_pressure)
@@ -349,7 +350,7 @@ def simulate(params: ActuatorParameters, controller: PDController,
     n_out : number of output samples. max_step : integrator's largest step (s) of RK45.
     method : ``"auto"`` (default): exact piecewise-linear propagation (matrix exponential per
         limit region, region changes located on the exact solution,
-        :func:`asekit.ase.loop.propagate_exact`) when the loop is piecewise linear -- a constant
+        :func:`asekit.servo.piecewise.propagate_exact`) when the loop is piecewise linear -- a constant
         command and a :class:`SteadyHingeMoment` or :func:`no_hinge_moment` -- else RK45;
         ``"RK45"``: always ``solve_ivp`` RK45 (rtol 1e-8; the two agree within it,
         tests/servo/test_simulate.py); ``"exact"``: refuse (ValueError) what is not piecewise linear.
@@ -398,10 +399,9 @@ def simulate(params: ActuatorParameters, controller: PDController,
                          "no_hinge_moment (a piecewise-linear loop); use 'auto' or 'RK45'")
 
     if exact:
-        from asekit.ase.loop import _voltage_bounds, propagate_exact
         stiffness = hm.stiffness if isinstance(hm, SteadyHingeMoment) else 0.0
         mats = _rigid_loop_matrices(params, controller, cmd(0.0), stiffness)
-        x, v_cmd = propagate_exact(mats, _voltage_bounds(params, limits, 3), controller,
+        x, v_cmd = propagate_exact(mats, voltage_bounds(params, limits, 3), controller,
                                    cmd(0.0), t_out, x0, sample_time)
     elif sample_time is None:
         def rhs(t, x):
@@ -433,7 +433,7 @@ def _rigid_loop_matrices(params: ActuatorParameters, controller: PDController, c
     """The PD loop of :func:`simulate` on the rigid fin with the hinge moment ``stiffness``
     theta (N m) as x' = F x + g V, x = [theta, omega, I] (Eqs. 2.30-2.37, module docstring),
     and the PD demand V_cmd = k x + k0 on the transmission angle and rate, in the form of
-    :func:`asekit.ase.loop.propagate_exact`."""
+    :func:`asekit.servo.piecewise.propagate_exact`."""
     m, tr = params.motor, params.transmission
     n, eta = tr.ratio, tr.efficiency
     nj = n * params.inertia_at_motor

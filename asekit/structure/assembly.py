@@ -229,8 +229,7 @@ def point_mass_matrix(mesh: PlateMesh, masses) -> sp.csr_matrix:
     (kinetic energy 1/2 m (N w)^2 + 1/2 I_xx (N theta_x)^2 + 1/2 I_yy (N theta_y)^2), so a
     mass need not sit on a node; at a node this is the usual lumped CONM2-like mass.
     """
-    from asekit.structure.modes import locate_points
-    from asekit.structure.plate import shape_functions
+    from asekit.structure.plate import locate_points, shape_functions
     n = DOF_PER_NODE * mesh.n_nodes
     M = sp.csr_matrix((n, n))
     masses = list(masses)

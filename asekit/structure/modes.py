@@ -27,7 +27,7 @@ import scipy.sparse.linalg as spla
 from asekit.util.validate import positive
 from asekit.structure.assembly import SupportedSystem, rigid_pitch_vector, shaft_support
 from asekit.structure.mesh import PlateMesh
-from asekit.structure.plate import shape_functions
+from asekit.structure.plate import locate_points, shape_functions
 
 #: Modes whose share of kinetic energy in the out-of-plane translation w is below this are
 #: "modes with no out-of-plane motion" and are dropped (thesis Fig. 15/16: in-plane mode).
@@ -232,55 +232,6 @@ def modal_partition(model: ModalModel) -> ModalPartition:
     return ModalPartition(M_cc=model.M[:c, :c].copy(), M_cs=model.M[:c, c:].copy(),
                           M_sc=model.M[c:, :c].copy(), M_ss=model.M[c:, c:].copy(),
                           C_ss=model.C[c:, c:].copy(), K_ss=model.K[c:, c:].copy())
-
-
-def locate_points(nodes: np.ndarray, elements: np.ndarray, points: np.ndarray,
-                  tol: float = 1e-9) -> tuple[np.ndarray, np.ndarray]:
-    """Element index and natural coordinates (r, s) of each (x, y) point.
-
-    Inverts the bilinear isoparametric map of the candidate elements (bounding-box filter, then
-    Newton iterations). Raises ValueError naming the points that lie on no element.
-    """
-    p = np.atleast_2d(np.asarray(points, float))
-    if p.ndim != 2 or p.shape[1] != 2 or not np.all(np.isfinite(p)):
-        raise ValueError(f"points must be a finite (n_points, 2) array of x, y in m, got shape {p.shape}")
-    xy = nodes[elements]
-    size = float(np.ptp(nodes, axis=0).max())
-    atol = tol * max(size, 1.0)
-    lo, hi = xy.min(axis=1) - atol, xy.max(axis=1) + atol
-    elem = np.full(p.shape[0], -1)
-    rs = np.zeros((p.shape[0], 2))
-    chunk = max(1, 2_000_000 // max(elements.shape[0], 1))
-    for start in range(0, p.shape[0], chunk):
-        pc = p[start:start + chunk]
-        cand = np.all((pc[:, None, :] >= lo[None]) & (pc[:, None, :] <= hi[None]), axis=2)
-        pi, ei = np.nonzero(cand)
-        if pi.size == 0:
-            continue
-        X = xy[ei]
-        r = np.zeros(pi.size)
-        s = np.zeros(pi.size)
-        for _ in range(25):
-            N, dNr, dNs = shape_functions(r, s)
-            res = np.einsum("pk,pkd->pd", N, X) - pc[pi]
-            a = np.einsum("pk,pk->p", dNr, X[:, :, 0]); b = np.einsum("pk,pk->p", dNs, X[:, :, 0])
-            c = np.einsum("pk,pk->p", dNr, X[:, :, 1]); d = np.einsum("pk,pk->p", dNs, X[:, :, 1])
-            det = a * d - b * c
-            dr = (d * res[:, 0] - b * res[:, 1]) / det
-            ds = (-c * res[:, 0] + a * res[:, 1]) / det
-            r -= dr
-            s -= ds
-            if np.max(np.abs(dr) + np.abs(ds)) < 1e-14:
-                break
-        ok = (np.abs(r) <= 1 + 1e-7) & (np.abs(s) <= 1 + 1e-7)
-        for k in np.flatnonzero(ok)[::-1]:          # reversed: the first hit wins
-            elem[start + pi[k]] = ei[k]
-            rs[start + pi[k]] = np.clip([r[k], s[k]], -1, 1)
-    missing = np.flatnonzero(elem < 0)
-    if missing.size:
-        raise ValueError(f"points {missing[:10].tolist()} (e.g. {tuple(p[missing[0]])}) lie "
-                         f"outside the structural surface")
-    return elem, rs
 
 
 def mode_shapes_at(model: ModalModel, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -8,7 +8,7 @@ the numpy path is tied to PanelAero and Theodorsen in tests/aero/test_dlm.py. Th
 import numpy as np
 import pytest
 
-from asekit.aero import dlm
+from asekit.aero import dlm, kernels
 from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
 from asekit.aero.dlm import normalwash_matrices
 from asekit.reproduction.fin import fin_boxes
@@ -69,20 +69,20 @@ def test_compiled_kernel_with_tiny_chunks_and_no_weight_table(monkeypatch):
 
 def test_kernel_choice_argument_and_environment(monkeypatch):
     m = _mesh("wing")
-    monkeypatch.setenv(dlm.KERNEL_ENV, "numpy")
-    assert dlm.default_kernel() == "numpy"
-    monkeypatch.setenv(dlm.KERNEL_ENV, "compiled")
-    assert dlm.default_kernel() == "compiled"
-    monkeypatch.setenv(dlm.KERNEL_ENV, "cuda")
-    with pytest.raises(ValueError, match=dlm.KERNEL_ENV):
-        dlm.default_kernel()
-    monkeypatch.delenv(dlm.KERNEL_ENV)
-    assert dlm.default_kernel() == "compiled"          # numba is installed (importorskip)
+    monkeypatch.setenv(kernels.KERNEL_ENV, "numpy")
+    assert kernels.default_kernel() == "numpy"
+    monkeypatch.setenv(kernels.KERNEL_ENV, "compiled")
+    assert kernels.default_kernel() == "compiled"
+    monkeypatch.setenv(kernels.KERNEL_ENV, "cuda")
+    with pytest.raises(ValueError, match=kernels.KERNEL_ENV):
+        kernels.default_kernel()
+    monkeypatch.delenv(kernels.KERNEL_ENV)
+    assert kernels.default_kernel() == "compiled"          # numba is installed (importorskip)
     with pytest.raises(ValueError, match="kernel"):
         normalwash_matrices(m, 0.5, [0.5], 0.5, kernel="fortran")
     # without numba: the numpy path is the default and the compiled one is refused by name
-    monkeypatch.setattr(dlm, "compiled_kernel_available", lambda: False)
-    assert dlm.default_kernel() == "numpy"
+    monkeypatch.setattr(kernels, "compiled_kernel_available", lambda: False)
+    assert kernels.default_kernel() == "numpy"
     with pytest.raises(ValueError, match="numba"):
         normalwash_matrices(m, 0.5, [0.5], 0.5, kernel="compiled")
     assert np.isfinite(normalwash_matrices(m, 0.5, [0.5], 0.5)).all()

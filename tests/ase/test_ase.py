@@ -10,7 +10,7 @@ import pytest
 from asekit.ase import loop as ase
 from asekit.ase import metrics
 from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, PDController, actuator_transfer_function
-from asekit.servo import margins as servo_margins
+from asekit.servo.actuator import margins as servo_margins
 from asekit.reproduction import fin as reffin
 
 

@@ -59,7 +59,7 @@ from threadpoolctl import threadpool_limits
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 sys.path.insert(0, os.path.dirname(__file__))
 
-from asekit.aero import dlm  # noqa: E402
+from asekit.aero import dlm, kernels  # noqa: E402
 from asekit.aero.gaf import default_reduced_frequencies  # noqa: E402
 from bench_dlm import grid  # noqa: E402
 
@@ -186,7 +186,7 @@ def case_fin(repeat):
 
 
 def case_kernel(mesh, repeat):
-    if not dlm.compiled_kernel_available():
+    if not kernels.compiled_kernel_available():
         print("kernel  numba not installed: compiled kernel not available")
         return
     ks = [K_SINGLE]
@@ -212,7 +212,7 @@ def main(argv=None):
     args = ap.parse_args(argv)
     mesh = grid(args.boxes)
     print(f"issue 12 aerodynamics benchmark: numpy {np.__version__}, {os.cpu_count()} CPUs, "
-          f"one BLAS thread (threadpoolctl), kernel default {getattr(dlm, 'default_kernel', lambda: 'numpy')()!r}")
+          f"one BLAS thread (threadpoolctl), kernel default {kernels.default_kernel()!r}")
     with threadpool_limits(limits=1, user_api="blas"):
         dlm.normalwash_matrices(grid(300), MACH, [K_SINGLE], B_REF)       # warm-up (and JIT)
         if "aic" in args.only:

@@ -9,7 +9,7 @@ thread), with the largest difference between the two results:
   :func:`asekit.ase.loop.crossovers`;
 * the five closed-loop simulations of Ch. 5 (:func:`asekit.reproduction.ase.compute`):
   ``method="RK45"`` vs the exact piecewise-linear propagation (default), and five rigid-fin
-  ones of Ch. 4-5 (:func:`asekit.simulate.simulate`, the same);
+  ones of Ch. 4-5 (:func:`asekit.servo.simulate.simulate`, the same);
 * the structure chapter's 96 x 112 distributed-shaft FN2 model: eigsh's own shift-invert
   factor (COLAMD, partial pivoting) vs the symmetric one
   (:func:`asekit.structure.modes.shift_invert_operator`), and a repeated call (memo);
@@ -95,8 +95,8 @@ def main(argv):
     row("Ch. 5 closed-loop simulations (5, 0.1-0.3 s)", t_b, t_a,
         f"{dev:.1e} of peak theta (RK45 rtol 1e-7)")
 
-    # 2b. the rigid-fin simulations of Ch. 4 and Ch. 5 (asekit.simulate.simulate)
-    from asekit.simulate import simulate
+    # 2b. the rigid-fin simulations of Ch. 4 and Ch. 5 (asekit.servo.simulate.simulate)
+    from asekit.servo.simulate import simulate
     from asekit.servo.actuator import SYSTEM_2
     rigid, hm = fin.rigid_fin_actuator(), fin.steady_hinge_moment()
     rruns = [(SYSTEM_3, U, 0.0, 0.2), (SYSTEM_3, F, 0.0, 0.2), (SYSTEM_2, math.radians(14.0),

@@ -40,7 +40,7 @@ from threadpoolctl import threadpool_limits
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
-from asekit.aero import dlm  # noqa: E402
+from asekit.aero import dlm, kernels  # noqa: E402
 from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces  # noqa: E402
 from asekit.aero.gaf import default_reduced_frequencies  # noqa: E402
 from asekit.aero.spline import analytic_modes, modal_forces  # noqa: E402
@@ -94,7 +94,7 @@ def main(argv=None):
     ks = default_reduced_frequencies(2.0)[:args.nk]
     print(f"streamed sweep: {mesh.n} boxes (wing + tail, one plane), M {MACH}, {ks.size} k, "
           f"6 modes, BLAS threads {args.blas_threads}, kernel "
-          f"{getattr(dlm, 'default_kernel', lambda: 'numpy')()}, one D = "
+          f"{kernels.default_kernel()}, one D = "
           f"{16 * mesh.n ** 2 / 2**30:.2f} GiB, all D = {ks.size * 16 * mesh.n ** 2 / 2**30:.1f} "
           f"GiB; start RSS {rss_gb():.2f} GiB", flush=True)
     rows = []
