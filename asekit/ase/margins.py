@@ -199,8 +199,14 @@ def nyquist_margins(loop, points_per_decade: int = 400) -> NyquistMargins:
     # crossings of the real axis at 0 < w < inf: (w_i, Re L(j w_i), direction)
     crossings = []           # (w, x, ccw weight on the ray when k > -1/x)
     im = h.imag
-    for i in np.nonzero(np.sign(im[:-1]) * np.sign(im[1:]) < 0)[0]:
-        wc = brentq(lambda v: L(v)[0].imag, w[i], w[i + 1], xtol=1e-12 * w[i], rtol=1e-12)
+    # brackets between consecutive grid points of nonzero Im L of opposite signs: a grid point
+    # that lands exactly on a crossing (Im L = 0, e.g. w = sqrt(10) of a logspace grid) lies
+    # inside its bracket instead of hiding the sign change
+    nz = np.nonzero(np.sign(im) != 0)[0]
+    for i, j in zip(nz[:-1], nz[1:]):
+        if np.sign(im[i]) * np.sign(im[j]) >= 0:
+            continue
+        wc = brentq(lambda v: L(v)[0].imag, w[i], w[j], xtol=1e-12 * w[i], rtol=1e-12)
         x = L(wc)[0].real
         if x < 0:
             # downward crossing (Im + -> -) of the leftward ray is counter-clockwise: +1;

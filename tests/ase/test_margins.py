@@ -112,3 +112,16 @@ def test_bad_input():
     m = nyquist_margins(ct.tf([1.0], [1, 1]))
     with pytest.raises(ValueError, match="positive"):
         m.stable_at(-1.0)
+
+
+def test_crossing_exactly_on_a_grid_point():
+    # L = 8 (s + 5) / (s (s - 2)) crosses the real axis at w = sqrt(10) rad/s (Im L = 0 there:
+    # Im[(40 + 8jw)(-w^2 + 2jw)] = 80 w - 8 w^3), a point of the default logspace grid, where
+    # Im L is exactly 0 in floating point; the crossing must still be counted (Routh: stable).
+    from asekit.ase.margins import _frequency_grid
+    L = ct.tf([8.0, 40.0], [1.0, -2.0, 0.0])
+    w = _frequency_grid(np.array([0.0, 2.0]), np.array([-5.0]), 400)
+    assert np.any(w == math.sqrt(10.0))
+    m = nyquist_margins(L)
+    assert m.closed_loop_unstable_poles == 0
+    assert m.lower_gain_margin == pytest.approx(2.0 / 8.0, rel=1e-9)   # k K > a
