@@ -1,9 +1,28 @@
-"""asekit: an open Python workbench for the aeroservoelastic modelling of all-movable fins.
+"""asekit: an open Python workbench for the aeroservoelastic modelling of control surfaces.
 
-The package follows the chapters of the reference thesis (Nalci 2013, "Aeroservoelastic
-Modeling of a Missile Control Fin"): structure -> aerodynamics -> rational function
-approximation -> aeroelastic state space -> flutter -> servo-actuator -> aeroservoelastic loop.
-SI units everywhere inside the package; degrees and Hz only at the edges (plots, tables).
+One road from a surface to its answers: a case (a TOML case file, a Nastran deck or frozen
+dataclasses built in Python) goes through the case pipeline -- structure (plate FE -> modes) ->
+aerodynamics (boxes -> doublet lattice, Mach box or piston theory -> GAFs) -> rational function
+approximation -> flutter and the aeroservoelastic loop. SI units everywhere inside the package;
+degrees and Hz only at the edges (plots, tables); conventions in ``docs/conventions.md``, the
+layout in ``docs/architecture.md``.
+
+The public API is small:
+
+- :func:`load_case`, :class:`Case`, :class:`CaseError` (:mod:`asekit.case`);
+- :mod:`pipeline` (:mod:`asekit.case.pipeline`): ``modal_model(case)``, ``box_mesh(case)``,
+  ``gaf_database(case)``, ``flutter(case)``, ``ase(case)``.
+
+Examples
+--------
+>>> import asekit
+>>> case = asekit.load_case(asekit.FIN_FILE)
+>>> case.name
+'nalci2013_fin'
 """
 
-__version__ = "0.1.0"
+from asekit.case import Case, CaseError, load_case, pipeline
+from asekit.util.paths import CASES_DIR, FIN_FILE
+from asekit.util.version import __version__
+
+__all__ = ["CASES_DIR", "Case", "CaseError", "FIN_FILE", "load_case", "pipeline", "__version__"]

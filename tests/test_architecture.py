@@ -16,7 +16,7 @@ PKG = ROOT / "asekit"
 LAYERS = (
     ("utilities", ("asekit.util",)),
     ("physics", ("asekit.geometry", "asekit.atmosphere", "asekit.structure", "asekit.aero",
-                 "asekit.rfa", "asekit.aeroelastic.statespace", "asekit.servo.actuator", "asekit.ase.loop")),
+                 "asekit.rfa", "asekit.aeroelastic", "asekit.servo", "asekit.ase")),
     ("case", ("asekit.case",)),
     ("io and sweeps", ("asekit.io", "asekit.sweep")),
     ("applications", ("asekit.reproduction", "asekit.cli", "asekit.__main__")),

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from asekit import __version__
+from asekit.util.version import __version__
 from asekit.util.blas import blas_threads_for
 from asekit.util.cache import CacheError, load_npz, save_npz
 from asekit.util.paths import DATA_DIR, user_cache_dir

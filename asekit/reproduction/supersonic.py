@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from asekit import __version__
+from asekit.util.version import __version__
 from asekit.aero.boxes import MeshRuleWarning
 from asekit.reproduction.fin import fin_boxes
 from asekit.aero.gaf import gaf_from_box_modes
