@@ -18,8 +18,11 @@ import numpy as np
 from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
 from asekit.aero.gaf import GafDatabase, cached_gaf_database, default_reduced_frequencies
 from asekit.atmosphere import standard_atmosphere
-from asekit.aeroelastic.flutter import (Instability, PkResult, TabulatedGaf, divergence_speeds, first_of,
-                            pk_flutter, pk_instabilities)
+from asekit.aeroelastic.flutter import (Instability, PkResult, TabulatedGaf, divergence_speeds,
+                                        first_of)
+from asekit.aeroelastic.methods import flutter_method
+from asekit.rfa.methods import rfa_kind
+from asekit.rfa.roger import gaf_at_mach
 from asekit.structure.assembly import assemble, clamped_edge, point_mass_matrix, shaft_support
 from asekit.structure.mesh import PlateMesh, panels_mesh
 from asekit.structure.modes import (ModalModel, fictitious_mass_modal_model, fixed_modal_model,
@@ -205,13 +208,25 @@ class FlutterAnalysis:
     notes: tuple[str, ...] = field(default_factory=tuple)
 
 
+def rfa_at(case: Case, db: GafDatabase, mach: float):
+    """The case's rational function approximation (``flutter.rfa`` with ``flutter.lags`` lag
+    roots, :data:`asekit.rfa.methods.RFA_FITS`) of the GAFs at ``mach`` (interpolated linearly
+    between the database's Mach numbers)."""
+    k, q = gaf_at_mach(db, mach, interpolate=True)
+    return rfa_kind(case.flutter.rfa).fit(k, q, db.b_ref, mach, case.flutter.lags)
+
+
 def analyse_condition(case: Case, db: GafDatabase, mach: float, cond: FlightCondition,
                       model: ModalModel | None = None) -> ConditionResult:
+    """The case's flutter method (``flutter.method``, :data:`FLUTTER_METHODS`) at one Mach and
+    flight condition: the tracked roots over ``flight.velocities`` and their instabilities."""
     model = modal_model(case) if model is None else model
     gaf = gaf_at(db, mach)
     U = np.asarray(case.flight.velocities, float)
-    pk = pk_flutter(model, gaf, cond.density, U)
-    inst = tuple(pk_instabilities(pk, model, gaf))
+    method = flutter_method(case.flutter.method)
+    rfa = rfa_at(case, db, mach) if method.needs_rfa else None
+    pk, inst = method.solve(model, gaf, rfa, cond.density, U)
+    inst = tuple(inst)
     start = [i for i in inst if i.at_first_point]          # unstable at U0 (asekit.aeroelastic.flutter)
     crossings = [i for i in inst if not i.at_first_point]
     return ConditionResult(float(mach), cond, pk, inst, first_of(crossings, "flutter"),
@@ -352,13 +367,11 @@ def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
     from asekit.ase import loop as ase_mod
     from asekit.ase import metrics
     from asekit.aeroelastic.statespace import fin_outputs
-    from asekit.rfa import gaf_at_mach, roger_fit
 
     a = case.actuator
     model = modal_model(case)
     db = gaf_database(case, progress=False) if db is None else db
-    k, q = gaf_at_mach(db, a.mach, interpolate=True)
-    rfa = roger_fit(k, q, db.b_ref, n_lags=4, mach=a.mach)
+    rfa = rfa_at(case, db, a.mach)
     atm = standard_atmosphere(a.altitude)
     rho, U = float(atm.density), a.mach * float(atm.speed_of_sound)
     corners = corner_points(case)

@@ -17,7 +17,9 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from asekit.aeroelastic.methods import FLUTTER_METHODS
 from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
+from asekit.rfa.methods import RFA_FITS
 
 
 class CaseError(ValueError):
@@ -174,6 +176,19 @@ class FlutterIndexSpec:
 
 
 @dataclass(frozen=True)
+class FlutterSpec:
+    """How flutter is analysed (``[flutter]``): ``method``, a key of
+    :data:`asekit.aeroelastic.methods.FLUTTER_METHODS` ("pk" by default, "root_locus"); ``rfa``,
+    a key of :data:`asekit.rfa.methods.RFA_FITS` ("roger" by default, "minimum_state"), the
+    rational function approximation of the root-locus method and the ASE loop, with ``lags``
+    lag roots (4)."""
+
+    method: str = "pk"
+    rfa: str = "roger"
+    lags: int = 4
+
+
+@dataclass(frozen=True)
 class Case:
     """A complete case: what the surface is, how it is held and analysed."""
 
@@ -189,6 +204,7 @@ class Case:
     point_masses: tuple[PointMass, ...] = ()
     actuator: ActuatorSpec | None = None
     flutter_index: FlutterIndexSpec | None = None
+    flutter: FlutterSpec = FlutterSpec()
     reference: str = ""
     source: str = field(default="", compare=False)
 
@@ -582,6 +598,16 @@ def _actuator(t: _Table | None) -> ActuatorSpec | None:
     return ActuatorSpec(**vals)
 
 
+def _flutter(t: _Table | None) -> FlutterSpec:
+    if t is None:
+        return FlutterSpec()
+    method = t.string("method", tuple(FLUTTER_METHODS), default="pk")
+    rfa = t.string("rfa", tuple(RFA_FITS), default="roger")
+    lags = t.integer("lags", default=4, low=1, high=12)
+    t.done()
+    return FlutterSpec(method, rfa, lags)
+
+
 def case_from_dict(d: dict, source: str = "") -> Case:
     """Build and check a :class:`Case` from the parsed TOML dictionary ``d``."""
     top = _Table(d, "")
@@ -601,6 +627,7 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     aero = _aero(top.table("aero", required=True), panels)
     flight = _flight(top.table("flight", required=True))
     actuator = _actuator(top.table("actuator"))
+    flutter = _flutter(top.table("flutter"))
     fsi = top.table("flutter_speed_index")
     if fsi is not None:
         fsi_spec = FlutterIndexSpec(fsi.number("semichord", required=True, low=0.0, unit="m"),
@@ -620,7 +647,7 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     return Case(name=name, panels=panels, thickness=thickness, material=material,
                 support=support, aero=aero, flight=flight, modes=modes, damping=damping,
                 point_masses=masses, actuator=actuator, flutter_index=fsi_spec,
-                reference=reference, source=source)
+                flutter=flutter, reference=reference, source=source)
 
 
 def load_case(path) -> Case:
