@@ -35,15 +35,20 @@ from asekit.case.schema import Case, CaseError
 # ---------------------------------------------------------------------------------------------
 @lru_cache(maxsize=16)
 def structural_mesh(case: Case) -> PlateMesh:
-    """The plate mesh of all panels (``panel[i].n_chord x n_span`` elements each)."""
+    """The plate mesh of all panels (``panel[i].n_chord x n_span`` elements each), or the
+    imported model's mesh (``case.structure``)."""
+    if case.structure is not None:
+        return case.structure.mesh
     return panels_mesh([p.planform for p in case.panels], case.thickness,
                        case.panels[0].n_chord, [p.n_span for p in case.panels])
 
 
 def mass_and_stiffness(case: Case):
-    """Global sparse K (plate) and M (plate + point masses) of the case's mesh."""
+    """Global sparse K (plate) and M (plate + point masses) of the case's mesh (the imported
+    model's K and M when ``case.structure`` is given, plus the case's point masses)."""
     mesh = structural_mesh(case)
-    K, M = assemble(mesh, case.material)
+    K, M = _imported_matrices(case) if case.structure is not None else assemble(mesh,
+                                                                                 case.material)
     if case.point_masses:
         M = (M + point_mass_matrix(mesh, [(p.position, p.mass, p.inertia)
                                           for p in case.point_masses])).tocsr()
@@ -54,7 +59,9 @@ def mass_and_stiffness(case: Case):
 def modal_model(case: Case) -> ModalModel:
     """The case's modal model (thesis Eqs. 2.45-2.46): for a shaft with ``model = "FN2"`` and
     ``modes.keep_rigid`` the rigid pitch mode first (n_rigid = 1), otherwise the elastic modes
-    only; damping from ``[damping]``."""
+    only; damping from ``[damping]``. An imported structure: :func:`imported_modal_model`."""
+    if case.structure is not None:
+        return imported_modal_model(case)
     mesh = structural_mesh(case)
     K, M = mass_and_stiffness(case)
     s, md = case.support, case.modes
@@ -90,6 +97,69 @@ def modal_model(case: Case) -> ModalModel:
 
 
 # ---------------------------------------------------------------------------------------------
+# an imported structure (case.structure: asekit.case.imported.ImportedModel)
+# ---------------------------------------------------------------------------------------------
+def _imported_matrices(case: Case):
+    """(K, M) of the imported model, CSR."""
+    return case.structure.K.tocsr(), case.structure.M.tocsr()
+
+
+def imported_modal_model(case: Case) -> ModalModel:
+    """The modal model (n_rigid = 0) of a case with an imported structure.
+
+    The structure's own supports (its reduction u = T q: constraints and rigid links; springs
+    in K) on K and M (+ the case's point masses): the first ``modes.count`` out-of-plane
+    modes, or all below ``modes.f_max`` (Hz), mass-normalised. Damping: the case's
+    ``damping`` if it gives any, else the structure's table ``damping_g`` at each mode's
+    frequency (zeta = g / 2, :func:`asekit.structure.modes.with_damping`).
+
+    Raises
+    ------
+    CaseError
+        No elastic mode in the range, or a bad damping value.
+    """
+    s, md = case.structure, case.modes
+    K, M = mass_and_stiffness(case)
+    try:
+        model = fixed_modal_model(s.supported_system(K, M), M, md.f_max, md.count)
+    except ValueError as exc:
+        raise CaseError(f"structure / modes: {exc}") from None
+    if len(model.frequencies_hz) < 1:
+        raise CaseError(f"modes: no mode below modes.f_max = {md.f_max:g} Hz; raise f_max or "
+                        f"give modes.count")
+    d = case.damping
+    g = d.structural_g
+    if d.modal_damping_ratio is None and g is None:
+        g = s.structural_g_at(model.frequencies_hz)
+    try:
+        return with_damping(model, d.modal_damping_ratio, g)
+    except ValueError as exc:
+        raise CaseError(str(exc)) from None
+
+
+def imported_corner_points(case: Case) -> dict:
+    """The imported mesh's four corners: the nodes of least and greatest x on its root
+    (least y) and tip (greatest y) stations, (x, y) m."""
+    nodes = case.structure.mesh.nodes
+    tol = 1e-9 * max(float(np.ptp(nodes[:, 1])), 1.0)
+    out = {}
+    for name, y in (("root", nodes[:, 1].min()), ("tip", nodes[:, 1].max())):
+        row = nodes[np.abs(nodes[:, 1] - y) <= tol]
+        for edge, pick in (("le", np.argmin), ("te", np.argmax)):
+            x, yy = row[pick(row[:, 0])]
+            out[f"{name}_{edge}"] = (float(x), float(yy))
+    return {k: out[k] for k in ("root_le", "root_te", "tip_le", "tip_te")}
+
+
+def imported_box_mesh(case: Case):
+    """The imported structure's boxes; CaseError if it has none."""
+    if case.structure.boxes is None:
+        raise CaseError(f"{case.name}: the imported structure has no aerodynamic boxes "
+                        f"(a deck without CAERO1): modes only")
+    return case.structure.boxes
+
+
+# ---------------------------------------------------------------------------------------------
 # aerodynamics
 # ---------------------------------------------------------------------------------------------
 def _auto_boxes(planform, u_min: float, f_max: float, bpw_min: float = 15.0,
@@ -106,7 +176,10 @@ def _auto_boxes(planform, u_min: float, f_max: float, bpw_min: float = 15.0,
 
 @lru_cache(maxsize=16)
 def box_mesh(case: Case):
-    """The doublet-lattice boxes, per panel ``aero.boxes`` or automatic (mesh rules)."""
+    """The doublet-lattice boxes, per panel ``aero.boxes`` or automatic (mesh rules), or the
+    imported structure's boxes."""
+    if case.structure is not None:
+        return imported_box_mesh(case)
     a = case.aero
     surfaces = []
     for i, p in enumerate(case.panels):
@@ -131,6 +204,9 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True) -> GafDa
     """Q_mm(M, k) over ``aero.machs`` x the reduced frequencies, cached per fingerprint in the
     user cache directory (:func:`asekit.aero.gaf.cached_gaf_database`)."""
     a = case.aero
+    if a is None:
+        raise CaseError(f"{case.name}: the case has no aerodynamics (an imported deck without "
+                        f"CAERO1 / MKAERO1)")
     # the database's method: the DLM kernel name, or the aerodynamic method (asekit.aero.methods)
     method = a.kernel if a.method == "dlm" else a.method
     return cached_gaf_database(modal_model(case), box_mesh(case), a.machs,
@@ -162,7 +238,11 @@ class FlightCondition:
 
 
 def flight_conditions(case: Case) -> list[FlightCondition]:
+    """The analysed conditions: per altitude (standard atmosphere) or per density."""
     f = case.flight
+    if f is None:
+        raise CaseError(f"{case.name}: the case has no flight conditions (an imported deck "
+                        f"without FLUTTER / FLFACT): give flight = FlightSpec(...)")
     if f.altitudes is not None:
         out = []
         for h in f.altitudes:
@@ -331,7 +411,10 @@ class AseResult:
 
 
 def corner_points(case: Case) -> dict:
-    """The surface's four corners (root LE/TE of the first panel, tip LE/TE of the last)."""
+    """The surface's four corners (root LE/TE of the first panel, tip LE/TE of the last; of an
+    imported structure: :func:`imported_corner_points`)."""
+    if case.structure is not None:
+        return imported_corner_points(case)
     r, t = case.panels[0].planform, case.panels[-1].planform
     return {"root_le": r.root_le, "root_te": (r.root_le[0] + r.root_chord, r.root_le[1]),
             "tip_le": t.tip_le, "tip_te": (t.tip_le[0] + t.tip_chord, t.tip_le[1])}

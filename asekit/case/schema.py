@@ -13,13 +13,14 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
 from asekit.aeroelastic.methods import FLUTTER_METHODS
 from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
 from asekit.rfa.methods import RFA_FITS
+from asekit.case.imported import ImportedModel
 
 
 class CaseError(ValueError):
@@ -50,7 +51,9 @@ class SupportSpec:
         N m/rad of the actuator-fin connection, optional ``bending_stiffness`` N m/rad about the
         chordwise axis, ``model`` "FN2" (fictitious mass: rigid pitch mode + elastic modes) or
         "FN1" (spring to ground), ``radius`` None for the single-node shaft or the radius (m) of
-        a rigid shaft region, ``fictitious_inertia_factor``).
+        a rigid shaft region, ``fictitious_inertia_factor``), or ``"imported"`` (the
+        constraints, rigid links and springs of ``Case.structure``, e.g. a deck's SPC / RBE2 /
+        CELAS, applied as they are; not a case-file kind).
     """
 
     kind: str = "clamped_root"
@@ -190,7 +193,14 @@ class FlutterSpec:
 
 @dataclass(frozen=True)
 class Case:
-    """A complete case: what the surface is, how it is held and analysed."""
+    """A complete case: what the surface is, how it is held and analysed.
+
+    ``structure`` : an :class:`~asekit.case.imported.ImportedModel` (e.g. a Nastran deck read by
+    :func:`asekit.io.bdf.read_bdf`) whose mesh, K, M, supports and boxes the pipeline uses instead
+    of ``panels`` / ``thickness`` / ``material`` / ``support`` and the automatic boxes; such a
+    case has ``panels = ()``, ``thickness = material = None`` and ``support.kind =
+    "imported"``. None (default): the declarative case of a case file.
+    """
 
     name: str
     panels: tuple[PanelSpec, ...]
@@ -207,6 +217,7 @@ class Case:
     flutter: FlutterSpec = FlutterSpec()
     reference: str = ""
     source: str = field(default="", compare=False)
+    structure: ImportedModel | None = None
 
     @classmethod
     def from_toml(cls, path) -> "Case":
@@ -215,13 +226,19 @@ class Case:
 
     @property
     def span(self) -> float:
+        """Spanwise extent (m) of the panels, or of the imported mesh."""
+        if self.structure is not None:
+            return float(np.ptp(self.structure.mesh.nodes[:, 1]))
         return self.panels[-1].planform.tip_le[1] - self.panels[0].planform.root_le[1]
 
     def fingerprint(self) -> str:
-        """SHA-256 of everything that defines the case (not its name or file location)."""
-        d = asdict(self)
+        """SHA-256 of everything that defines the case (not its name or file location); an
+        imported structure enters through its content digest."""
+        d = asdict(replace(self, structure=None))
         for k in ("name", "reference", "source"):
             d.pop(k)
+        if self.structure is not None:      # (absent otherwise: the file cases' digests stay)
+            d["structure"] = self.structure.digest
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
 
 

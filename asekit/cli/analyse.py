@@ -1,4 +1,5 @@
-"""``python -m asekit analyse CASE.toml [--json PATH] [--report DIR]``: run a case file through
+"""``python -m asekit analyse CASE.toml|DECK.bdf [--units U] [--json PATH] [--report DIR]``: run a
+case file (or a Nastran deck, :func:`asekit.io.bdf.read_bdf`) through
 the pipeline (modes -> GAF database -> p-k flutter -> match points and margins -> ASE loop when
 an actuator is given), print the summary table, and optionally write the JSON summary and an
 HTML report. A bad case file gets one line naming the key and exit status 2."""
@@ -13,7 +14,11 @@ from pathlib import Path
 def add_parser(sub) -> None:
     p = sub.add_parser("analyse", aliases=["analyze"],
                        help="analyse a case file (flutter, divergence, match points, ASE)")
-    p.add_argument("case", metavar="CASE.toml", help="the case file (see docs/case-format.md)")
+    p.add_argument("case", metavar="CASE.toml",
+                   help="the case file (see docs/case-format.md), or a Nastran deck (.bdf, "
+                        ".dat, .nas: read by asekit.io.bdf.read_bdf, needs pyNastran)")
+    p.add_argument("--units", default="SI", choices=("SI", "mm-t-s", "in-lbf-s"),
+                   help="a Nastran deck's unit system (default SI)")
     p.add_argument("--json", metavar="PATH", help="write the summary as JSON ('-': stdout)")
     p.add_argument("--report", metavar="DIR", help="write index.html, figures and summary.json")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -32,6 +37,18 @@ def _check_writable(path: Path, what: str) -> str | None:
     return None
 
 
+#: File suffixes read as Nastran bulk data.
+DECK_SUFFIXES = (".bdf", ".dat", ".nas", ".blk")
+
+
+def _read_case(args, load_case):
+    """The case of ``args.case``: a Nastran deck (by suffix) through asekit.io.bdf, else TOML."""
+    if Path(args.case).suffix.lower() in DECK_SUFFIXES:
+        from asekit.io import bdf
+        return bdf.read_bdf(args.case, units=getattr(args, "units", "SI"))
+    return load_case(args.case)
+
+
 def run(args) -> int:
     from asekit.case import CaseError, load_case
     from asekit.case.report import format_summary, run_analysis, summary, write_report
@@ -43,11 +60,14 @@ def run(args) -> int:
             print(f"error: {what} needs a path", file=sys.stderr)
             return 2
     try:
-        case = load_case(args.case)
+        case = _read_case(args, load_case)
+    except ImportError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     except FileNotFoundError:
         print(f"error: case file {args.case} not found", file=sys.stderr)
         return 2
-    except CaseError as exc:
+    except (CaseError, ValueError) as exc:
         print(f"error: {Path(args.case).name}: {exc}", file=sys.stderr)
         return 2
     try:

@@ -1,10 +1,22 @@
 """Nastran bulk data (BDF) in and out, through pyNastran.
 
-Import (:func:`read_bdf`): a flat plate-wing deck becomes an asekit model built with asekit's
-own finite elements (MITC4, :mod:`asekit.structure.plate`) and its own doublet lattice
-(:mod:`asekit.aero.dlm`) -- not Nastran's matrices -- so that a user can compare the two codes.
-Export (:func:`write_case_bdf`): a case's structural model and boxes as a deck that pyNastran
-reads and Nastran runs (SOL 103 or SOL 145 case control).
+Import (:func:`read_bdf`): a flat plate-wing deck becomes a :class:`~asekit.case.Case` of the
+case pipeline, its structure built with asekit's own finite elements (MITC4,
+:mod:`asekit.structure.plate`) -- not Nastran's matrices -- so that a user can compare the two
+codes: ``case.structure`` (:class:`~asekit.case.imported.ImportedModel`) holds the mesh, K, M,
+the deck's own supports (SPC / GRID PS / RBE2 / CELAS, applied as they are) and the CAERO1
+boxes; ``case.aero`` / ``case.flight`` / ``case.modes`` hold MKAERO1, FLUTTER + FLFACT and
+EIGRL. Everything else is the pipeline's::
+
+    case = bdf.read_bdf("data/benchmarks/ha145e/ha145e.bdf", units="in-lbf-s")
+    pipeline.modal_model(case); pipeline.gaf_database(case); pipeline.flutter(case)
+
+(asekit's own doublet lattice, :mod:`asekit.aero.dlm`, and p-k). :func:`read_deck` gives the
+deck's record (:class:`BdfModel`, with the Nastran ids) and :func:`deck_case` makes it a case;
+one reader per card (``_read_grids``, ``_read_pshell``, ``_read_celas``, ... each with the
+card's field table). Export (:func:`write_case_bdf`): a case -- declarative or imported -- as
+a deck that pyNastran reads and Nastran runs (SOL 103 or SOL 145 case control), its support
+written by kind (:data:`SUPPORT_CARDS`).
 
 Supported cards and what asekit makes of them
 ---------------------------------------------
@@ -47,10 +59,14 @@ import numpy as np
 import scipy.sparse as sp
 
 from asekit.aero.boxes import BoxMesh
+from asekit.case import pipeline as pl
+from asekit.case.imported import IMPORTED_SUPPORT, ImportedModel
+from asekit.case.schema import AeroSpec, Case, FlightSpec, ModesSpec, SupportSpec
 from asekit.geometry import Material, OrthotropicMaterial
-from asekit.structure.assembly import SupportedSystem, element_dofs
+from asekit.structure.assembly import SupportedSystem, element_dofs, pitch_inertia
 from asekit.structure.mesh import PlateMesh
 from asekit.structure.plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness
+from asekit.structure.supports import planform_edge_supports
 
 #: length, mass and time of one deck unit in SI (m, kg, s).
 UNITS = {"SI": (1.0, 1.0, 1.0), "mm-t-s": (1e-3, 1e3, 1.0),
@@ -109,7 +125,9 @@ class FlutterRequest:
 
 @dataclass(frozen=True)
 class BdfModel:
-    """A plate-wing deck as an asekit model (SI).
+    """A read plate-wing deck, the record :func:`read_deck` gives (SI): what the case of
+    :func:`deck_case` is made of, plus the Nastran ids the export writes back (the case's
+    ``structure.deck``). Analyse the case, not this record.
 
     mesh : the plate mesh over all GRIDs (nodes that no element uses carry only springs,
         masses or rigid links); node_ids : (n_nodes,) the GRID id of each node.
@@ -127,7 +145,8 @@ class BdfModel:
         springs : (dof a, dof b or -1 for ground, k SI) in global DOF numbers; masses :
         (node index, mass kg, offset (3,) m, (I11, I21, I22) kg m^2); fixed : the constrained
         global DOFs; rigid : (independent node index, component string, dependent node
-        indices) per RBE2; ignored : the (card, count, first id) left out; notes.
+        indices) per RBE2; ignored : the (card, count, first id) left out; notes; path : the
+        file read; units : its unit system (a key of :data:`UNITS`).
     """
 
     mesh: PlateMesh
@@ -155,6 +174,8 @@ class BdfModel:
     rigid: tuple = ()
     ignored: tuple[tuple[str, int, object], ...] = ()
     notes: tuple[str, ...] = ()
+    path: str = ""
+    units: str = "SI"
 
     def node_index(self, grid_id: int) -> int:
         """Mesh node index of GRID ``grid_id``."""
@@ -181,9 +202,8 @@ def _card_report(model) -> tuple[list, list]:
         if card in REFUSED_CARDS:
             refused.append((card, n, _first_id(model, card)))
         elif card == "PARAM":
-            for name in sorted(model.params):
-                if name not in _USED_PARAMS:
-                    ignored.append((f"PARAM {name}", 1, None))
+            ignored += [(f"PARAM {name}", 1, None) for name in sorted(model.params)
+                        if name not in _USED_PARAMS]
         elif card not in SUPPORTED_CARDS:
             ignored.append((card, n, _first_id(model, card)))
     return refused, ignored
@@ -204,36 +224,7 @@ def _plane(xyz: np.ndarray, tol: float) -> float:
 
 def _components(c) -> list[int]:
     """asekit DOF indices (0 w, 1 theta_x, 2 theta_y) of a Nastran component string."""
-    out = []
-    for ch in str(c if c is not None else ""):
-        if ch in "345":
-            out.append("345".index(ch))
-    return out
-
-
-def _material(mat, wtmass: float, L: float, Mu: float, T: float, angle: float, pid: int):
-    """asekit material of a MAT1 / MAT8 in SI (stress F / L^2, density m / L^3)."""
-    stress = Mu / (L * T * T)                       # force / area in SI per deck unit
-    dens = Mu / L**3
-    if mat.type == "MAT1":
-        E, G, nu = mat.e, mat.g, mat.nu
-        if E is None or E <= 0:
-            raise BdfError(f"MAT1 {mat.mid} (PSHELL {pid}): E must be > 0, got {E}")
-        if nu is None:
-            nu = E / (2 * G) - 1.0
-        elif G is not None and abs(G - E / (2 * (1 + nu))) > 1e-3 * G:
-            raise BdfError(f"MAT1 {mat.mid}: E, G and NU all given and G = {G:g} differs from "
-                           f"E / (2 (1 + NU)) = {E / (2 * (1 + nu)):g}: asekit's isotropic "
-                           f"material takes E and NU (give two of the three)")
-        return Material(E * stress, nu, mat.rho * wtmass * dens, name=f"MAT1 {mat.mid}")
-    if mat.type == "MAT8":
-        g1z = mat.g1z if mat.g1z else mat.g12
-        g2z = mat.g2z if mat.g2z else mat.g12
-        return OrthotropicMaterial(mat.e11 * stress, mat.e22 * stress, mat.g12 * stress,
-                                   mat.nu12, mat.rho * wtmass * dens, g1z * stress,
-                                   g2z * stress, angle, name=f"MAT8 {mat.mid}")
-    raise BdfError(f"PSHELL {pid}: material {mat.type} {mat.mid} is not supported "
-                   f"(MAT1 or MAT8)")
+    return ["345".index(ch) for ch in str(c if c is not None else "") if ch in "345"]
 
 
 def _scatter(mesh: PlateMesh, Ke: np.ndarray, n: int) -> sp.csr_matrix:
@@ -244,268 +235,481 @@ def _scatter(mesh: PlateMesh, Ke: np.ndarray, n: int) -> sp.csr_matrix:
     return (0.5 * (A + A.T)).tocsr()
 
 
-def _element_angle(elem, xyz_of, g1, g2, model) -> float:
-    """Material 1-axis angle from +x (rad) of a CQUAD4: THETA (deg) from the G1-G2 edge, or
-    the projection of the MCID system's x axis."""
-    tm = elem.theta_mcid
-    d = xyz_of(g2) - xyz_of(g1)
-    edge = math.atan2(d[1], d[0])
-    if isinstance(tm, int):
-        cs = model.coords[tm]
-        ax = np.asarray(cs.i, float)
-        return math.atan2(ax[1], ax[0])
-    return edge + math.radians(float(tm or 0.0))
+# ---------------------------------------------------------------------------------------------
+# one reader per card (the field tables are those of the MSC Nastran Quick Reference Guide)
+# ---------------------------------------------------------------------------------------------
+@dataclass
+class _Deck:
+    """The working state of one import: the pyNastran model, the deck's units (one deck unit
+    of length L m, mass Mu kg, time T s), PARAM WTMASS, the GRIDs (ids, index, basic
+    coordinates in deck units, in-plane SI coordinates), the plate's plane z0 (deck units)
+    and the notes collected on the way."""
+
+    model: object
+    name: str
+    L: float
+    Mu: float
+    T: float
+    wtmass: float = 1.0
+    nids: np.ndarray | None = None
+    index: dict = field(default_factory=dict)
+    xyz: np.ndarray | None = None
+    nodes: np.ndarray | None = None
+    z0: float = 0.0
+    notes: list = field(default_factory=list)
+
+    @property
+    def n_dof(self) -> int:
+        return DOF_PER_NODE * len(self.nids)
+
+    def dof(self, nid, comp: int) -> int:
+        """Global DOF of GRID ``nid``, asekit component ``comp`` (0 w, 1 theta_x, 2 theta_y)."""
+        return DOF_PER_NODE * self.index[int(nid)] + comp
 
 
-def read_bdf(path, units: str = "SI", tol: float | None = None,
-             thickness_rule: str = "gauss") -> BdfModel:
-    """Read a flat plate-wing BDF with pyNastran and build the asekit model.
-
-    Parameters
-    ----------
-    path : the deck (executive and case control optional).
-    units : the deck's unit system, a key of :data:`UNITS` (``"SI"``, ``"mm-t-s"``,
-        ``"in-lbf-s"``); everything is converted to SI.
-    tol : flatness tolerance in deck length units (default 1e-6 x the model size).
-    thickness_rule : ``"gauss"`` (default: the corner thicknesses T1-T4 interpolated
-        bilinearly to every integration point) or ``"centroid"`` (each element at its mean
-        corner thickness, constant over the element).
-
-    Returns
-    -------
-    BdfModel. Raises :class:`BdfError` (a ValueError) for a deck asekit cannot represent
-    (refused cards listed); warns :class:`UnsupportedCardWarning` once, listing every card
-    that was read but is not represented (name, count, first id).
-    """
-    if units not in UNITS:
-        raise ValueError(f"units must be one of {sorted(UNITS)}, got {units!r}")
-    L, Mu, T = UNITS[units]
-    BDF = _need_pynastran()
-    path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"BDF not found: {path}")
+def _open_deck(path: Path, BDF):
+    """The pyNastran model of ``path`` (cross-referenced; a file without BEGIN BULK is read as
+    bulk data only)."""
     model = BDF(debug=None)
-    text = path.read_text(errors="replace").upper()
-    punch = "BEGIN BULK" not in text
+    punch = "BEGIN BULK" not in path.read_text(errors="replace").upper()
     model.read_bdf(str(path), punch=punch, xref=True)
-    refused, ignored = _card_report(model)
-    if refused:
-        raise BdfError(f"{path.name}: asekit cannot represent these cards: {_fmt(refused)}. "
-                       f"It models a flat plate of CQUAD4 / CTRIA3 elements (PSHELL, "
-                       f"MAT1/MAT8) with CONM2, CELAS1/2, RBE2 and SPC supports (CTRIA3 as a "
-                       f"degenerated MITC4).")
-    notes = []
-    wt = model.params.get("WTMASS")
-    wtmass = float(wt.values[0]) if wt is not None else 1.0
+    return model
 
-    # ---- grids -------------------------------------------------------------------------
+
+def _read_param_wtmass(model) -> float:
+    """PARAM WTMASS: the factor from the deck's mass input to its mass unit (default 1).
+
+    +-------+--------+--------+
+    |   1   |   2    |   3    |
+    +=======+========+========+
+    | PARAM | WTMASS | value  |
+    +-------+--------+--------+
+    """
+    wt = model.params.get("WTMASS")
+    return float(wt.values[0]) if wt is not None else 1.0
+
+
+def _shell_elements(model, name: str) -> list:
     quads = [e for e in model.elements.values() if e.type in ("CQUAD4", "CTRIA3")]
     if not quads:
-        raise BdfError(f"{path.name}: no CQUAD4 or CTRIA3 element: nothing asekit can model")
-    is_tri = np.array([e.type == "CTRIA3" for e in quads])
+        raise BdfError(f"{name}: no CQUAD4 or CTRIA3 element: nothing asekit can model")
+    return quads
+
+
+def _read_grids(deck: _Deck, quads, tol: float | None) -> None:
+    """GRID: every grid in basic coordinates (pyNastran resolves CP through CORD2R / CORD1R /
+    CORD2C / CORD2S); CD must be basic (0); the plate's grids must lie in one plane z = z0.
+
+    +------+-----+----+----+----+----+----+----+------+
+    |  1   |  2  | 3  | 4  | 5  | 6  | 7  | 8  |  9   |
+    +======+=====+====+====+====+====+====+====+======+
+    | GRID | ID  | CP | X1 | X2 | X3 | CD | PS | SEID |
+    +------+-----+----+----+----+----+----+----+------+
+
+    PS (permanent single-point constraints) is read by :func:`_read_grid_ps`.
+    """
+    model = deck.model
     nids = np.array(sorted(model.nodes), dtype=np.int64)
     bad_cd = [int(n) for n in nids if model.nodes[n].cd not in (0, None)]
     if bad_cd:
         raise BdfError(f"GRIDs {bad_cd[:10]} have a displacement coordinate system CD != 0: "
                        f"asekit needs T3, R1, R2 along the basic z, x, y axes")
     xyz = np.array([model.nodes[n].get_position() for n in nids], float)
-    index = {int(n): i for i, n in enumerate(nids)}
+    deck.nids, deck.xyz = nids, xyz
+    deck.index = {int(n): i for i, n in enumerate(nids)}
     size = float(np.ptp(xyz[:, :2], axis=0).max())
     tol = 1e-6 * size if tol is None else float(tol)
     plate_nodes = sorted({n for e in quads for n in e.node_ids})
-    z0 = _plane(xyz[[index[n] for n in plate_nodes]], tol)
-    nodes = xyz[:, :2] * L
+    deck.z0 = _plane(xyz[[deck.index[n] for n in plate_nodes]], tol)
+    deck.nodes = xyz[:, :2] * deck.L
 
-    # ---- elements, thickness, materials --------------------------------------------------
-    # a CTRIA3 is a degenerated MITC4 with its third node repeated (G1 G2 G3 G3)
-    conn = np.array([[index[n] for n in (list(e.node_ids) + [e.node_ids[2]])[:4]]
-                     for e in quads], dtype=np.int64)
-    xy = nodes[conn]
+
+def _read_pshell(p, e) -> None:
+    """PSHELL: checked for what asekit's plate represents (one material for membrane and
+    bending, MID1 = MID2 or MID1 blank; 12I/T^3 = 1; no element offset ZOFFS).
+
+    +--------+-------+------+--------+------+----------+------+------+---------+
+    |   1    |   2   |  3   |   4    |  5   |    6     |  7   |  8   |    9    |
+    +========+=======+======+========+======+==========+======+======+=========+
+    | PSHELL |  PID  | MID1 |   T    | MID2 | 12I/T**3 | MID3 | TS/T |   NSM   |
+    +--------+-------+------+--------+------+----------+------+------+---------+
+    |        |  Z1   |  Z2  |  MID4  |      |          |      |      |         |
+    +--------+-------+------+--------+------+----------+------+------+---------+
+
+    NSM (non-structural mass per area) is applied by :func:`_plate_matrices`.
+    """
+    if p.type != "PSHELL":
+        raise BdfError(f"{e.type} {e.eid}: property {p.type} {e.pid} is not supported "
+                       f"(PSHELL only)")
+    if p.mid2 is None:
+        raise BdfError(f"PSHELL {p.pid}: MID2 is blank (no bending stiffness): asekit "
+                       f"models plate bending")
+    if p.mid1 is not None and p.mid1 != p.mid2:
+        raise BdfError(f"PSHELL {p.pid}: MID1 = {p.mid1} differs from MID2 = {p.mid2}: "
+                       f"asekit's plate takes one material for bending")
+    if abs(float(p.twelveIt3 or 1.0) - 1.0) > 1e-9:
+        raise BdfError(f"PSHELL {p.pid}: 12I/T^3 = {p.twelveIt3} is not supported (1.0)")
+    if (e.zoffset or 0.0) != 0.0:
+        raise BdfError(f"{e.type} {e.eid}: ZOFFS = {e.zoffset} is not supported")
+
+
+def _shell_thickness(e, p, tri: bool) -> list[float]:
+    """Corner thicknesses (deck units) of a CQUAD4 (T1-T4) or CTRIA3 (T1-T3, T3 repeated for
+    the degenerated MITC4): blank or negative -> PSHELL T; TFLAG = 1 -> multiples of T.
+
+    +--------+-------+-------+----+----+----+----+------------+-------+
+    |   1    |   2   |   3   | 4  | 5  | 6  | 7  |     8      |   9   |
+    +========+=======+=======+====+====+====+====+============+=======+
+    | CQUAD4 |  EID  |  PID  | G1 | G2 | G3 | G4 | THETA/MCID | ZOFFS |
+    +--------+-------+-------+----+----+----+----+------------+-------+
+    |        |       | TFLAG | T1 | T2 | T3 | T4 |            |       |
+    +--------+-------+-------+----+----+----+----+------------+-------+
+
+    +--------+-------+-------+----+----+----+------------+-------+
+    |   1    |   2   |   3   | 4  | 5  | 6  |     7      |   8   |
+    +========+=======+=======+====+====+====+============+=======+
+    | CTRIA3 |  EID  |  PID  | G1 | G2 | G3 | THETA/MCID | ZOFFS |
+    +--------+-------+-------+----+----+----+------------+-------+
+    |        |       | TFLAG | T1 | T2 | T3 |            |       |
+    +--------+-------+-------+----+----+----+------------+-------+
+    """
+    t = [e.T1, e.T2, e.T3, e.T3] if tri else [e.T1, e.T2, e.T3, e.T4]
+    if getattr(e, "tflag", 0) == 1:
+        t = [(v if v is not None else 1.0) * p.t for v in t]
+    return [p.t if v is None or v < 0 else v for v in t]
+
+
+def _element_angle(elem, xyz_of, g1, g2, model) -> float:
+    """Material 1-axis angle from +x (rad) of a CQUAD4 / CTRIA3: THETA (deg) from the G1-G2
+    edge, or the projection of the MCID system's x axis."""
+    tm = elem.theta_mcid
+    d = xyz_of(g2) - xyz_of(g1)
+    edge = math.atan2(d[1], d[0])
+    if isinstance(tm, int):
+        ax = np.asarray(model.coords[tm].i, float)
+        return math.atan2(ax[1], ax[0])
+    return edge + math.radians(float(tm or 0.0))
+
+
+def _orient(deck: _Deck, conn, th, is_tri) -> None:
+    """Renumber (in place) the elements numbered clockwise seen from +z: a quadrilateral
+    reversed, a triangle G1 G3 G2 (G2 repeated)."""
+    xy = deck.nodes[conn]
     area2 = ((xy[:, 2, 0] - xy[:, 0, 0]) * (xy[:, 3, 1] - xy[:, 1, 1])
              - (xy[:, 3, 0] - xy[:, 1, 0]) * (xy[:, 2, 1] - xy[:, 0, 1]))
     flip = area2 < 0
-    th = np.zeros((len(quads), 4))
-    angles = np.zeros(len(quads))
-    pids = np.array([e.pid for e in quads])
-    props = {}
-    for j, e in enumerate(quads):
-        p = model.properties[e.pid]
-        if p.type != "PSHELL":
-            raise BdfError(f"CQUAD4 {e.eid}: property {p.type} {e.pid} is not supported "
-                           f"(PSHELL only)")
-        if p.mid2 is None:
-            raise BdfError(f"PSHELL {p.pid}: MID2 is blank (no bending stiffness): asekit "
-                           f"models plate bending")
-        if p.mid1 is not None and p.mid1 != p.mid2:
-            raise BdfError(f"PSHELL {p.pid}: MID1 = {p.mid1} differs from MID2 = {p.mid2}: "
-                           f"asekit's plate takes one material for bending")
-        if abs(float(p.twelveIt3 or 1.0) - 1.0) > 1e-9:
-            raise BdfError(f"PSHELL {p.pid}: 12I/T^3 = {p.twelveIt3} is not supported (1.0)")
-        if (e.zoffset or 0.0) != 0.0:
-            raise BdfError(f"CQUAD4 {e.eid}: ZOFFS = {e.zoffset} is not supported")
-        props[e.pid] = p
-        t = [e.T1, e.T2, e.T3, e.T3] if is_tri[j] else [e.T1, e.T2, e.T3, e.T4]
-        if getattr(e, "tflag", 0) == 1:
-            t = [(v if v is not None else 1.0) * p.t for v in t]
-        th[j] = [p.t if v is None or v < 0 else v for v in t]
-        angles[j] = _element_angle(e, lambda g: xyz[index[g]], e.node_ids[0], e.node_ids[1],
-                                   model)
     fq, ft = flip & ~is_tri, flip & is_tri
     conn[fq] = conn[fq][:, ::-1]
     th[fq] = th[fq][:, ::-1]
     conn[ft] = conn[ft][:, [0, 2, 1, 1]]
     th[ft] = th[ft][:, [0, 2, 1, 1]]
     if flip.any():
-        notes.append(f"{int(flip.sum())} elements numbered clockwise seen from +z were "
-                     f"renumbered (same element)")
+        deck.notes.append(f"{int(flip.sum())} elements numbered clockwise seen from +z were "
+                          f"renumbered (same element)")
+
+
+def _read_shells(deck: _Deck, quads):
+    """CQUAD4 / CTRIA3 (fields in :func:`_shell_thickness`) with their PSHELL: connectivity
+    (a CTRIA3 as a degenerated MITC4, G1 G2 G3 G3), corner thicknesses (m), material angles
+    (rad) and property ids; returns (conn, th, angles, pids, props)."""
+    is_tri = np.array([e.type == "CTRIA3" for e in quads])
+    conn = np.array([[deck.index[n] for n in (list(e.node_ids) + [e.node_ids[2]])[:4]]
+                     for e in quads], dtype=np.int64)
+    th = np.zeros((len(quads), 4))
+    angles = np.zeros(len(quads))
+    props = {}
+    for j, e in enumerate(quads):
+        p = deck.model.properties[e.pid]
+        _read_pshell(p, e)
+        props[e.pid] = p
+        th[j] = _shell_thickness(e, p, bool(is_tri[j]))
+        angles[j] = _element_angle(e, lambda g: deck.xyz[deck.index[g]], e.node_ids[0],
+                                   e.node_ids[1], deck.model)
+    _orient(deck, conn, th, is_tri)
     if is_tri.any():
-        notes.append(f"{int(is_tri.sum())} CTRIA3 modelled as degenerated MITC4 (G3 repeated; "
-                     f"Bathe, Finite Element Procedures, 1996, Ch. 5: collapsed "
-                     f"quadrilaterals; less accurate than the quadrilateral)")
-    th = th * L
-    mids3 = {p.pid: p.mid3 for p in props.values()}
-    if any(m is None for m in mids3.values()):
-        notes.append("PSHELL MID3 blank (Nastran: no transverse shear flexibility, Kirchhoff "
-                     "plate); asekit's plate is Reissner-Mindlin with G from the material -- "
-                     "negligible for a thin plate")
-    n = DOF_PER_NODE * nodes.shape[0]
+        deck.notes.append(f"{int(is_tri.sum())} CTRIA3 modelled as degenerated MITC4 (G3 "
+                          f"repeated; Bathe, Finite Element Procedures, 1996, Ch. 5: collapsed "
+                          f"quadrilaterals; less accurate than the quadrilateral)")
+    if any(p.mid3 is None for p in props.values()):
+        deck.notes.append("PSHELL MID3 blank (Nastran: no transverse shear flexibility, "
+                          "Kirchhoff plate); asekit's plate is Reissner-Mindlin with G from the "
+                          "material -- negligible for a thin plate")
+    return conn, th * deck.L, angles, np.array([e.pid for e in quads]), props
+
+
+def _read_mat1(mat, deck: _Deck, pid: int) -> Material:
+    """MAT1 in SI (stress F / L^2, density m / L^3, x WTMASS): two of E, G, NU (all three only
+    if consistent).
+
+    +------+-----+---+---+----+-----+---+------+----+
+    |  1   |  2  | 3 | 4 | 5  |  6  | 7 |  8   | 9  |
+    +======+=====+===+===+====+=====+===+======+====+
+    | MAT1 | MID | E | G | NU | RHO | A | TREF | GE |
+    +------+-----+---+---+----+-----+---+------+----+
+    """
+    stress, dens = deck.Mu / (deck.L * deck.T * deck.T), deck.Mu / deck.L**3
+    E, G, nu = mat.e, mat.g, mat.nu
+    if E is None or E <= 0:
+        raise BdfError(f"MAT1 {mat.mid} (PSHELL {pid}): E must be > 0, got {E}")
+    if nu is None:
+        nu = E / (2 * G) - 1.0
+    elif G is not None and abs(G - E / (2 * (1 + nu))) > 1e-3 * G:
+        raise BdfError(f"MAT1 {mat.mid}: E, G and NU all given and G = {G:g} differs from "
+                       f"E / (2 (1 + NU)) = {E / (2 * (1 + nu)):g}: asekit's isotropic "
+                       f"material takes E and NU (give two of the three)")
+    return Material(E * stress, nu, mat.rho * deck.wtmass * dens, name=f"MAT1 {mat.mid}")
+
+
+def _read_mat8(mat, deck: _Deck, angle: float) -> OrthotropicMaterial:
+    """MAT8 in SI at the element's material angle (rad); G1Z / G2Z blank -> G12.
+
+    +------+-----+-----+------+------+-----+-----+-----+-----+
+    |  1   |  2  |  3  |  4   |  5   |  6  |  7  |  8  |  9  |
+    +======+=====+=====+======+======+=====+=====+=====+=====+
+    | MAT8 | MID | E1  |  E2  | NU12 | G12 | G1Z | G2Z | RHO |
+    +------+-----+-----+------+------+-----+-----+-----+-----+
+    """
+    stress, dens = deck.Mu / (deck.L * deck.T * deck.T), deck.Mu / deck.L**3
+    g1z = mat.g1z if mat.g1z else mat.g12
+    g2z = mat.g2z if mat.g2z else mat.g12
+    return OrthotropicMaterial(mat.e11 * stress, mat.e22 * stress, mat.g12 * stress,
+                               mat.nu12, mat.rho * deck.wtmass * dens, g1z * stress,
+                               g2z * stress, angle, name=f"MAT8 {mat.mid}")
+
+
+def _material(deck: _Deck, mat, angle: float, pid: int):
+    """asekit material of a MAT1 / MAT8 (SI)."""
+    if mat.type == "MAT1":
+        return _read_mat1(mat, deck, pid)
+    if mat.type == "MAT8":
+        return _read_mat8(mat, deck, angle)
+    raise BdfError(f"PSHELL {pid}: material {mat.type} {mat.mid} is not supported "
+                   f"(MAT1 or MAT8)")
+
+
+def _material_groups(deck: _Deck, pids, props, angles) -> dict:
+    """{(pid, material angle rad, 0 for MAT1): element indices}."""
+    keys = {}
+    for j, pid in enumerate(pids):
+        mat = deck.model.materials[props[pid].mid2]
+        ang = round(float(angles[j]), 9) if mat.type == "MAT8" else 0.0
+        keys.setdefault((int(pid), ang), []).append(j)
+    return keys
+
+
+def _nsm_mass(sub: PlateMesh, nsm: float) -> np.ndarray:
+    """Element mass matrices of a non-structural mass ``nsm`` (kg/m^2): translational only
+    (Nastran's NSM), the consistent plate mass of unit density rescaled from rho h to nsm."""
+    me = consistent_mass(sub, Material(1.0, 0.3, 1.0))
+    h = sub.corner_thickness.mean(axis=1)
+    for r in (1, 2):
+        me[:, r::3, :] = 0.0
+        me[:, :, r::3] = 0.0
+    return me * (nsm / h)[:, None, None]
+
+
+def _plate_matrices(deck: _Deck, conn, th, pids, props, angles, thickness_rule):
+    """Global K and M (SI) of the plate elements, grouped by property and material angle:
+    MITC4 stiffness and consistent mass (:mod:`asekit.structure.plate`) plus the PSHELL NSM.
+    Returns (K, M, materials {(pid, angle): material}, groups, mesh)."""
+    nodes, n = deck.nodes, deck.n_dof
     K = sp.csr_matrix((n, n))
     M = sp.csr_matrix((n, n))
-    materials = {}
     span = max(float(np.ptp(nodes[:, 1])), 1e-12)
-    # group elements by property and (for MAT8) material angle
-    keys = {}
-    for j in range(len(quads)):
-        mat = props[pids[j]].mid2_ref if hasattr(props[pids[j]], "mid2_ref") else None
-        mat = mat if mat is not None else model.materials[props[pids[j]].mid2]
-        ang = round(float(angles[j]), 9) if mat.type == "MAT8" else 0.0
-        keys.setdefault((int(pids[j]), ang), []).append(j)
+    keys = _material_groups(deck, pids, props, angles)
+    materials = {}
     for (pid, ang), idx in keys.items():
         p = props[pid]
-        mat = model.materials[p.mid2]
-        material = _material(mat, wtmass, L, Mu, T, ang, pid)
+        material = _material(deck, deck.model.materials[p.mid2], ang, pid)
         materials[(pid, ang)] = material
         idx = np.asarray(idx)
         sub = PlateMesh(nodes=nodes, elements=conn[idx], thickness_root=1.0, thickness_tip=1.0,
                         y_root=float(nodes[:, 1].min()), span=span, corner_thickness=th[idx])
         K = K + _scatter(sub, mitc4_stiffness(sub, material, thickness_rule), n)
         M = M + _scatter(sub, consistent_mass(sub, material, thickness_rule), n)
-        nsm = float(p.nsm or 0.0) * wtmass * Mu / L**2
+        nsm = float(p.nsm or 0.0) * deck.wtmass * deck.Mu / deck.L**2
         if nsm:
-            # non-structural mass per area: translational only (Nastran's NSM)
-            me = consistent_mass(sub, Material(1.0, 0.3, 1.0))
-            h = sub.corner_thickness.mean(axis=1)
-            me[:, 1::3, :] = 0.0
-            me[:, :, 1::3] = 0.0
-            me[:, 2::3, :] = 0.0
-            me[:, :, 2::3] = 0.0
-            # consistent_mass integrates rho h: rescale to nsm per unit area
-            me *= (nsm / h)[:, None, None]
-            M = M + _scatter(sub, me, n)
+            M = M + _scatter(sub, _nsm_mass(sub, nsm), n)
     mesh = PlateMesh(nodes=nodes, elements=conn, thickness_root=float(th.max()),
                      thickness_tip=float(th.max()), y_root=float(nodes[:, 1].min()), span=span,
                      corner_thickness=th)
+    return K, M, materials, keys, mesh
 
-    # ---- springs and masses ---------------------------------------------------------------
+
+def _celas_dofs(deck: _Deck, e):
+    """(dof a, dof b) of a CELAS1 / CELAS2 (None: ground or an in-plane component) and
+    whether any end is on an in-plane component."""
+    dofs, dropped = [], False
+    for nid, c in zip(e.node_ids, (e.c1, e.c2)):
+        comp = [] if nid in (None, 0) or c in (None, 0) else _components(c)
+        dropped |= nid not in (None, 0) and c not in (None, 0) and not comp
+        dofs.append(deck.dof(nid, comp[0]) if comp else None)
+    rot = [c in (4, 5) for c in (e.c1, e.c2)]
+    if rot[0] != rot[1] and all(d is not None for d in dofs):
+        raise BdfError(f"CELAS {e.eid} couples a translation and a rotation: not supported")
+    return dofs, any(rot), dropped
+
+
+def _read_celas(deck: _Deck):
+    """CELAS1 (with PELAS K) and CELAS2 springs to ground or between two grids, in SI (force
+    per length, or moment per radian on R1 / R2); springs on in-plane components are dropped.
+
+    +--------+-----+-----+----+----+----+----+
+    |   1    |  2  |  3  | 4  | 5  | 6  | 7  |
+    +========+=====+=====+====+====+====+====+
+    | CELAS1 | EID | PID | G1 | C1 | G2 | C2 |
+    +--------+-----+-----+----+----+----+----+
+    | CELAS2 | EID |  K  | G1 | C1 | G2 | C2 |
+    +--------+-----+-----+----+----+----+----+
+    | PELAS  | PID |  K  | GE | S  |    |    |
+    +--------+-----+-----+----+----+----+----+
+
+    Returns (springs: (dof a, dof b or -1 for ground, k), global spring stiffness K_s).
+    """
+    n = deck.n_dof
     Kx = sp.lil_matrix((n, n))
-    Mx = sp.lil_matrix((n, n))
-    dropped_springs = []
-    springs, masses, rigid = [], [], []
-    for e in model.elements.values():
+    springs, dropped = [], []
+    for e in deck.model.elements.values():
         if e.type not in ("CELAS1", "CELAS2"):
             continue
-        k = float(e.k if e.type == "CELAS2" else model.properties[e.pid].k)
-        rot = [c in (4, 5) for c in (e.c1, e.c2)]
-        dofs = []
-        for nid, c in zip(e.node_ids, (e.c1, e.c2)):
-            if nid in (None, 0) or c in (None, 0):
-                dofs.append(None)
-                continue
-            comp = _components(c)
-            dofs.append(None if not comp else DOF_PER_NODE * index[nid] + comp[0])
-            if not comp:
-                dropped_springs.append(e.eid)
-        scale = Mu * L * L / (T * T) if any(rot) else Mu / (T * T)
-        if rot[0] != rot[1] and all(d is not None for d in dofs):
-            raise BdfError(f"CELAS {e.eid} couples a translation and a rotation: not supported")
-        k *= scale
-        a, b = dofs
-        if a is None and b is None:
-            continue
+        k = float(e.k if e.type == "CELAS2" else deck.model.properties[e.pid].k)
+        (a, b), rot, lost = _celas_dofs(deck, e)
+        if lost:
+            dropped.append(e.eid)
+        k *= deck.Mu * deck.L**2 / deck.T**2 if rot else deck.Mu / deck.T**2
         if a is None:
             a, b = b, None
+        if a is None:
+            continue
         springs.append((int(a), -1 if b is None else int(b), float(k)))
-        if a is not None:
-            Kx[a, a] += k
+        Kx[a, a] += k
         if b is not None:
             Kx[b, b] += k
-        if a is not None and b is not None:
             Kx[a, b] -= k
             Kx[b, a] -= k
-    if dropped_springs:
-        notes.append(f"CELAS {dropped_springs[:5]}... on in-plane DOFs (1, 2, 6) ignored: "
-                     f"uncoupled from bending" if len(dropped_springs) > 5 else
-                     f"CELAS {dropped_springs} on in-plane DOFs (1, 2, 6) ignored: uncoupled "
-                     f"from bending")
-    for m in model.masses.values():
+    if dropped:
+        more = "..." if len(dropped) > 5 else ""
+        deck.notes.append(f"CELAS {dropped[:5]}{more} on in-plane DOFs (1, 2, 6) ignored: "
+                          f"uncoupled from bending")
+    return tuple(springs), Kx.tocsr()
+
+
+def _read_conm2(deck: _Deck):
+    """CONM2 point masses in SI (x WTMASS) with their offset X (rigid: w_m = w + theta_x dy -
+    theta_y dx) and inertias I11, I21, I22 (about the offset point); CID basic only.
+
+    +-------+-----+-----+-----+-----+-----+-----+-----+-----+
+    |   1   |  2  |  3  |  4  |  5  |  6  |  7  |  8  |  9  |
+    +=======+=====+=====+=====+=====+=====+=====+=====+=====+
+    | CONM2 | EID |  G  | CID |  M  | X1  | X2  | X3  |     |
+    +-------+-----+-----+-----+-----+-----+-----+-----+-----+
+    |       | I11 | I21 | I22 | I31 | I32 | I33 |     |     |
+    +-------+-----+-----+-----+-----+-----+-----+-----+-----+
+
+    Returns (masses: (node index, mass, offset (3,) m, (I11, I21, I22)), global mass M_m).
+    """
+    n = deck.n_dof
+    Mx = sp.lil_matrix((n, n))
+    masses = []
+    sm, si = deck.wtmass * deck.Mu, deck.wtmass * deck.Mu * deck.L**2
+    for m in deck.model.masses.values():
         if m.type != "CONM2":
             continue
-        i = index[m.nid]
         if m.cid not in (0, -1, None):
             raise BdfError(f"CONM2 {m.eid}: CID = {m.cid} is not supported (basic only)")
-        mass = float(m.mass) * wtmass * Mu
-        X = np.asarray(m.X if m.X is not None else np.zeros(3), float) * L
-        I = np.asarray(m.I, float) * wtmass * Mu * L * L
+        i = deck.index[m.nid]
+        mass = float(m.mass) * sm
+        X = np.asarray(m.X if m.X is not None else np.zeros(3), float) * deck.L
+        I = np.asarray(m.I, float) * si
         masses.append((i, mass, X.copy(), (float(I[0]), float(I[1]), float(I[2]))))
         d = DOF_PER_NODE * i
-        # mass at offset (dx, dy): w_m = w + theta_x dy - theta_y dx (rigid offset)
         r = np.array([1.0, X[1], -X[0]])
         Mx[d:d + 3, d:d + 3] += mass * np.outer(r, r)
         Mx[d + 1, d + 1] += I[0] + mass * X[2] ** 2
         Mx[d + 2, d + 2] += I[2] + mass * X[2] ** 2
         Mx[d + 1, d + 2] -= I[1]
         Mx[d + 2, d + 1] -= I[1]
-    K = (K + Kx.tocsr()).tocsr()
-    M = (M + Mx.tocsr()).tocsr()
+    return tuple(masses), Mx.tocsr()
 
-    # ---- constraints: GRID PS, SPC/SPC1 (all sets), RBE2 -----------------------------------
-    fixed = set()
-    for nid, g in model.nodes.items():
-        for c in _components(g.ps):
-            fixed.add(DOF_PER_NODE * index[nid] + c)
-    spc_ids = sorted(model.spcs)
-    cc_spc = _case_value(model, "SPC")
-    if cc_spc is not None and cc_spc in model.spcs:
-        spc_ids = [cc_spc]
-    elif len(spc_ids) > 1:
-        notes.append(f"several SPC sets {spc_ids} and no SPC = in the case control: all applied")
-    for sid in spc_ids:
-        for c in model.spcs[sid]:
-            if c.type == "SPC1":
-                for nid in c.node_ids:
-                    for k in _components(c.components):
-                        fixed.add(DOF_PER_NODE * index[nid] + k)
-            elif c.type == "SPC":
-                for nid, comp, val in zip(c.node_ids, c.components, c.enforced):
-                    if val:
-                        raise BdfError(f"SPC {sid}: enforced displacement {val} is not "
-                                       f"supported")
-                    for k in _components(comp):
-                        fixed.add(DOF_PER_NODE * index[nid] + k)
-            else:
-                raise BdfError(f"{c.type} {sid} is not supported (SPC, SPC1)")
-    dep = {}
-    for r in model.rigid_elements.values():
+
+def _read_grid_ps(deck: _Deck) -> set:
+    """GRID PS (permanent single-point constraints, field 8 of GRID, :func:`_read_grids`):
+    the constrained global DOFs (components 3, 4, 5; 1, 2, 6 are in-plane)."""
+    return {deck.dof(nid, c) for nid, g in deck.model.nodes.items() for c in _components(g.ps)}
+
+
+def _spc_set_ids(deck: _Deck) -> list:
+    """The SPC sets applied: the case control's SPC = n, else all (with a note if several)."""
+    model = deck.model
+    ids = sorted(model.spcs)
+    cc = _case_value(model, "SPC")
+    if cc is not None and cc in model.spcs:
+        return [cc]
+    if len(ids) > 1:
+        deck.notes.append(f"several SPC sets {ids} and no SPC = in the case control: all "
+                          f"applied")
+    return ids
+
+
+def _read_spc_card(deck: _Deck, sid: int, c) -> set:
+    """The DOFs an SPC1 or SPC card fixes (zero enforced displacement only).
+
+    +------+-----+----+----+------+----+----+----+
+    |  1   |  2  | 3  | 4  |  5   | 6  | 7  | 8  |
+    +======+=====+====+====+======+====+====+====+
+    | SPC1 | SID | C  | G1 |  G2  | G3 | G4 | G5 |
+    +------+-----+----+----+------+----+----+----+
+    | SPC  | SID | G1 | C1 |  D1  | G2 | C2 | D2 |
+    +------+-----+----+----+------+----+----+----+
+    """
+    if c.type == "SPC1":
+        return {deck.dof(nid, k) for nid in c.node_ids for k in _components(c.components)}
+    if c.type != "SPC":
+        raise BdfError(f"{c.type} {sid} is not supported (SPC, SPC1)")
+    out = set()
+    for nid, comp, val in zip(c.node_ids, c.components, c.enforced):
+        if val:
+            raise BdfError(f"SPC {sid}: enforced displacement {val} is not supported")
+        out |= {deck.dof(nid, k) for k in _components(comp)}
+    return out
+
+
+def _read_spcs(deck: _Deck) -> set:
+    """Every DOF fixed by GRID PS and the applied SPC / SPC1 sets."""
+    fixed = _read_grid_ps(deck)
+    for sid in _spc_set_ids(deck):
+        for c in deck.model.spcs[sid]:
+            fixed |= _read_spc_card(deck, sid, c)
+    return fixed
+
+
+def _read_rbe2(deck: _Deck, fixed: set):
+    """RBE2 rigid links: the dependent grids' components CM (3, 4, 5) follow the independent
+    grid GN rigidly (w_j = w_i + theta_x,i dy - theta_y,i dx). No chains, no dependent DOF
+    that is also constrained.
+
+    +------+-----+-----+-----+------+-------+-----+-----+-----+
+    |  1   |  2  |  3  |  4  |  5   |   6   |  7  |  8  |  9  |
+    +======+=====+=====+=====+======+=======+=====+=====+=====+
+    | RBE2 | EID | GN  | CM  | GM1  |  GM2  | GM3 | GM4 | GM5 |
+    +------+-----+-----+-----+------+-------+-----+-----+-----+
+
+    Returns (dep {dependent DOF: {independent DOF: coefficient}}, rigid: (independent node,
+    component string, dependent nodes) per RBE2).
+    """
+    dep, rigid = {}, []
+    for r in deck.model.rigid_elements.values():
         if r.type != "RBE2":
             raise BdfError(f"{r.type} {r.eid} is not supported (RBE2 only)")
-        gi = index[r.gn]
-        rigid.append((gi, "".join(str(k + 3) for k in _components(r.cm)),
-                      tuple(index[g] for g in r.Gmi_node_ids)))
+        gi = deck.index[r.gn]
+        comps = _components(r.cm)
+        rigid.append((gi, "".join(str(k + 3) for k in comps),
+                      tuple(deck.index[g] for g in r.Gmi_node_ids)))
         for gm in r.Gmi_node_ids:
-            j = index[gm]
-            dx, dy = nodes[j] - nodes[gi]
+            j = deck.index[gm]
+            dx, dy = deck.nodes[j] - deck.nodes[gi]
             rows = {0: {0: 1.0, 1: dy, 2: -dx}, 1: {1: 1.0}, 2: {2: 1.0}}
-            for k in _components(r.cm):
+            for k in comps:
                 dep[DOF_PER_NODE * j + k] = {DOF_PER_NODE * gi + a: v
                                              for a, v in rows[k].items() if v != 0.0}
     for d, comb in dep.items():
@@ -513,98 +717,138 @@ def read_bdf(path, units: str = "SI", tol: float | None = None,
             raise BdfError("RBE2 chains (a dependent grid of one RBE2 as the independent grid "
                            "of another) are not supported")
         if d in fixed:
-            raise BdfError(f"grid {nids[d // 3]} is both constrained (SPC) and an RBE2 "
+            raise BdfError(f"grid {deck.nids[d // 3]} is both constrained (SPC) and an RBE2 "
                            f"dependent grid (Nastran: a fatal error)")
+    return dep, tuple(rigid)
+
+
+def _reduction(n: int, fixed: set, dep: dict, K, M) -> sp.csr_matrix:
+    """The support reduction u = T q: the fixed and RBE2-dependent DOFs eliminated, and the
+    DOFs without stiffness and mass (grids only in-plane, unattached) removed as well."""
     free = [d for d in range(n) if d not in fixed and d not in dep]
     col = {d: i for i, d in enumerate(free)}
-    rows_, cols_, vals_ = [], [], []
-    for d in free:
-        rows_.append(d), cols_.append(col[d]), vals_.append(1.0)
+    rows, cols, vals = list(free), list(range(len(free))), [1.0] * len(free)
     for d, comb in dep.items():
         for c, v in comb.items():
             if c in col:
-                rows_.append(d), cols_.append(col[c]), vals_.append(v)
-    Tm = sp.csr_matrix((vals_, (rows_, cols_)), shape=(n, len(free)))
-    # DOFs without stiffness and mass (grids only in-plane, unattached) are removed as well
+                rows.append(d), cols.append(col[c]), vals.append(v)
+    Tm = sp.csr_matrix((vals, (rows, cols)), shape=(n, len(free)))
     Kr = (Tm.T @ K @ Tm).tocsr()
     Mr = (Tm.T @ M @ Tm).tocsr()
-    empty = np.flatnonzero((np.abs(Kr).sum(axis=1).A1 == 0) & (np.abs(Mr).sum(axis=1).A1 == 0))
-    if empty.size:
-        keep = np.setdiff1d(np.arange(len(free)), empty)
-        Tm = Tm[:, keep]
-        Kr = (Tm.T @ K @ Tm).tocsr()
-        Mr = (Tm.T @ M @ Tm).tocsr()
-    label = f"BDF {path.name}: {len(quads)} CQUAD4, {len(nids)} GRID"
-    system = SupportedSystem(K=Kr, M=Mr, T=Tm.tocsr(), shaft_index=None, ground_index=None,
-                             fictitious_inertia=0.0, shaft_nodes=np.array([], dtype=np.int64),
-                             mesh=mesh, label=label)
+    empty = (np.abs(Kr).sum(axis=1).A1 == 0) & (np.abs(Mr).sum(axis=1).A1 == 0)
+    return Tm[:, np.flatnonzero(~empty)].tocsr() if empty.any() else Tm
 
-    # ---- eigen and damping --------------------------------------------------------------
-    n_modes = f_max = None
-    meth = _case_value(model, "METHOD")
+
+def _read_eigen_method(model, T: float):
+    """EIGRL (or EIGR) of the case control's METHOD (else the first): (ND number of modes or
+    None, V2 / F2 upper frequency Hz or None).
+
+    +-------+-----+----+----+----+-------+-------+-----+
+    |   1   |  2  | 3  | 4  | 5  |   6   |   7   |  8  |
+    +=======+=====+====+====+====+=======+=======+=====+
+    | EIGRL | SID | V1 | V2 | ND | MSGLVL| MAXSET|SHFSC|
+    +-------+-----+----+----+----+-------+-------+-----+
+    | EIGR  | SID |METH| F1 | F2 |  NE   |  ND   |     |
+    +-------+-----+----+----+----+-------+-------+-----+
+    """
     methods = model.methods
-    if methods:
-        mth = methods.get(meth) if meth in methods else methods[sorted(methods)[0]]
-        nd = getattr(mth, "nd", None)
-        n_modes = int(nd) if nd else None
-        v2 = getattr(mth, "v2", None) if mth.type == "EIGRL" else getattr(mth, "f2", None)
-        f_max = float(v2) / T if v2 else None
-    damping = None
-    if getattr(model, "tables_sdamping", None):
-        tab = model.tables_sdamping[sorted(model.tables_sdamping)[0]]
-        g = np.asarray(tab.y, float) * (2.0 if tab.Type == "CRIT" else 1.0)
-        if tab.Type not in ("G", "CRIT"):
-            raise BdfError(f"TABDMP1 {tab.tid}: TYPE {tab.Type} is not supported (G, CRIT)")
-        damping = tuple((float(f) / T, float(v)) for f, v in zip(tab.x, g))
-
-    # ---- aero ---------------------------------------------------------------------------------
-    boxes = box_ids = None
-    b_ref = rho_ref = None
-    symmetric = False
-    machs, ks, flut = (), (), ()
-    if model.caeros:
-        boxes, box_ids = _boxes(model, L, z0 * L)
-        _check_splines(model, box_ids, notes)
-        aero = model.aero or model.aeros
-        if aero is None:
-            raise BdfError("CAERO1 without AERO / AEROS: the reference chord is unknown")
-        b_ref = 0.5 * float(aero.cref) * L
-        symmetric = int(aero.sym_xz or 0) == 1
-        if int(getattr(aero, "sym_xy", 0) or 0) != 0:
-            raise BdfError("SYMXY (ground effect) is not supported")
-        if model.aero is not None:
-            rho_ref = float(model.aero.rho_ref) * Mu / L**3
-        pairs = []
-        for mk in model.mkaeros:
-            if mk.type != "MKAERO1":
-                raise BdfError(f"{mk.type} is not supported (MKAERO1)")
-            pairs += [(float(m), float(k)) for m in mk.machs for k in mk.reduced_freqs]
-        machs = tuple(sorted({p[0] for p in pairs}))
-        ks = tuple(sorted({p[1] for p in pairs}))
-        for m in machs:
-            if m >= 1.0:
-                raise BdfError(f"MKAERO1 Mach {m} >= 1: asekit's doublet lattice is subsonic")
-        flut = tuple(_flutter(model, f, rho_ref, L, Mu, T) for f in model.flutters.values())
-    elif model.flutters:
-        raise BdfError("FLUTTER without CAERO1 boxes")
-    if ignored:
-        warnings.warn(f"{path.name}: cards read but not represented by asekit: "
-                      f"{_fmt(ignored)}", UnsupportedCardWarning, stacklevel=2)
-    return BdfModel(mesh=mesh, node_ids=nids, K=K, M=M, system=system, boxes=boxes,
-                    box_ids=box_ids, b_ref=b_ref, rho_ref=rho_ref, symmetric=symmetric,
-                    machs=machs, reduced_frequencies=ks, flutter=flut, n_modes=n_modes,
-                    f_max_hz=f_max, damping_g=damping, materials=materials,
-                    element_pids=pids.copy(),
-                    element_angles=_angles(keys, len(quads)),
-                    springs=tuple(springs), masses=tuple(masses), fixed=tuple(sorted(fixed)),
-                    rigid=tuple(rigid), ignored=tuple(ignored), notes=tuple(notes))
+    if not methods:
+        return None, None
+    meth = _case_value(model, "METHOD")
+    mth = methods.get(meth) if meth in methods else methods[min(methods)]
+    nd = getattr(mth, "nd", None)
+    v2 = getattr(mth, "v2", None) if mth.type == "EIGRL" else getattr(mth, "f2", None)
+    return (int(nd) if nd else None), (float(v2) / T if v2 else None)
 
 
-def _angles(keys, n):
-    out = np.zeros(n)
-    for (pid, ang), idx in keys.items():
-        out[np.asarray(idx)] = ang
-    return out
+def _read_tabdmp1(model, T: float):
+    """TABDMP1 (the first): modal damping vs frequency as ((f Hz, g), ...); TYPE G as given,
+    CRIT (fraction of critical) as g = 2 zeta.
+
+    +---------+-----+------+----+----+----+----+----+----+
+    |    1    |  2  |  3   | 4  | 5  | 6  | 7  | 8  | 9  |
+    +=========+=====+======+====+====+====+====+====+====+
+    | TABDMP1 | TID | TYPE |    |    |    |    |    |    |
+    +---------+-----+------+----+----+----+----+----+----+
+    |         | f1  |  g1  | f2 | g2 | f3 | g3 |... |ENDT|
+    +---------+-----+------+----+----+----+----+----+----+
+    """
+    tables = getattr(model, "tables_sdamping", None)
+    if not tables:
+        return None
+    tab = tables[min(tables)]
+    if tab.Type not in ("G", "CRIT"):
+        raise BdfError(f"TABDMP1 {tab.tid}: TYPE {tab.Type} is not supported (G, CRIT)")
+    g = np.asarray(tab.y, float) * (2.0 if tab.Type == "CRIT" else 1.0)
+    return tuple((float(f) / T, float(v)) for f, v in zip(tab.x, g))
+
+
+def _read_aero_card(deck: _Deck):
+    """AERO / AEROS: (reference semichord REFC / 2 m, RHOREF kg/m^3 or None, SYMXZ = 1);
+    SYMXY (ground effect) refused.
+
+    +-------+-------+-------+--------+--------+-------+-------+
+    |   1   |   2   |   3   |   4    |   5    |   6   |   7   |
+    +=======+=======+=======+========+========+=======+=======+
+    | AERO  | ACSID | VELO  |  REFC  | RHOREF | SYMXZ | SYMXY |
+    +-------+-------+-------+--------+--------+-------+-------+
+    | AEROS | ACSID | RCSID |  REFC  |  REFB  | REFS  | SYMXZ | SYMXY |
+    +-------+-------+-------+--------+--------+-------+-------+
+    """
+    model = deck.model
+    aero = model.aero or model.aeros
+    if aero is None:
+        raise BdfError("CAERO1 without AERO / AEROS: the reference chord is unknown")
+    if int(getattr(aero, "sym_xy", 0) or 0) != 0:
+        raise BdfError("SYMXY (ground effect) is not supported")
+    rho_ref = (float(model.aero.rho_ref) * deck.Mu / deck.L**3 if model.aero is not None
+               else None)
+    return 0.5 * float(aero.cref) * deck.L, rho_ref, int(aero.sym_xz or 0) == 1
+
+
+def _read_mkaero1(model):
+    """MKAERO1: the Mach numbers and reduced frequencies of the GAF database (all pairs of
+    all cards; subsonic only, asekit's doublet lattice).
+
+    +---------+----+----+----+----+----+----+----+----+
+    |    1    | 2  | 3  | 4  | 5  | 6  | 7  | 8  | 9  |
+    +=========+====+====+====+====+====+====+====+====+
+    | MKAERO1 | m1 | m2 | m3 | m4 | m5 | m6 | m7 | m8 |
+    +---------+----+----+----+----+----+----+----+----+
+    |         | k1 | k2 | k3 | k4 | k5 | k6 | k7 | k8 |
+    +---------+----+----+----+----+----+----+----+----+
+    """
+    pairs = []
+    for mk in model.mkaeros:
+        if mk.type != "MKAERO1":
+            raise BdfError(f"{mk.type} is not supported (MKAERO1)")
+        pairs += [(float(m), float(k)) for m in mk.machs for k in mk.reduced_freqs]
+    machs = tuple(sorted({p[0] for p in pairs}))
+    for m in machs:
+        if m >= 1.0:
+            raise BdfError(f"MKAERO1 Mach {m} >= 1: asekit's doublet lattice is subsonic")
+    return machs, tuple(sorted({p[1] for p in pairs}))
+
+
+def _read_aero(deck: _Deck) -> dict:
+    """The aerodynamic part (CAERO1 boxes, splines checked, AERO, MKAERO1, FLUTTER): the
+    keyword arguments of :class:`BdfModel` it sets (empty without CAERO1)."""
+    model = deck.model
+    if not model.caeros:
+        if model.flutters:
+            raise BdfError("FLUTTER without CAERO1 boxes")
+        return {}
+    boxes, box_ids = _boxes(model, deck.L, deck.z0 * deck.L)
+    _check_splines(model, box_ids, deck.notes)
+    b_ref, rho_ref, symmetric = _read_aero_card(deck)
+    machs, ks = _read_mkaero1(model)
+    flut = [_flutter(model, f, rho_ref, deck.L, deck.Mu, deck.T)
+            for f in model.flutters.values()]
+    fm = _case_value(model, "FMETHOD")
+    flut.sort(key=lambda r: r.sid != fm)          # the case control's FMETHOD first
+    return {"boxes": boxes, "box_ids": box_ids, "b_ref": b_ref, "rho_ref": rho_ref,
+            "symmetric": symmetric, "machs": machs, "reduced_frequencies": ks,
+            "flutter": tuple(flut)}
 
 
 def _case_value(model, key: str):
@@ -622,6 +866,14 @@ def _case_value(model, key: str):
 
 
 def _divisions(caero, n, aefact, name):
+    """Box division fractions 0..1 of a CAERO1 side: N uniform boxes, or an AEFACT list.
+
+    +--------+-----+----+----+----+----+----+----+----+
+    |   1    |  2  | 3  | 4  | 5  | 6  | 7  | 8  | 9  |
+    +========+=====+====+====+====+====+====+====+====+
+    | AEFACT | SID | D1 | D2 | D3 | D4 | D5 | D6 | D7 |
+    +--------+-----+----+----+----+----+----+----+----+
+    """
     if n:
         return np.linspace(0.0, 1.0, int(n) + 1)
     if aefact is None:
@@ -633,38 +885,54 @@ def _divisions(caero, n, aefact, name):
     return f
 
 
+def _caero1_boxes(c, L):
+    """One CAERO1 (with PAERO1) as box corners (n, 4, 3) m and Nastran box ids, ordered
+    spanwise from the root (the box ids run chordwise first from P1).
+
+    +--------+-----+-----+----+-------+--------+--------+--------+------+
+    |   1    |  2  |  3  | 4  |   5   |   6    |   7    |   8    |  9   |
+    +========+=====+=====+====+=======+========+========+========+======+
+    | CAERO1 | EID | PID | CP | NSPAN | NCHORD | LSPAN  | LCHORD | IGID |
+    +--------+-----+-----+----+-------+--------+--------+--------+------+
+    |        | X1  | Y1  | Z1 |  X12  |   X4   |   Y4   |   Z4   | X43  |
+    +--------+-----+-----+----+-------+--------+--------+--------+------+
+    """
+    p1, _, _, p4 = (np.asarray(p, float) for p in c.get_points())
+    eta = _divisions(c, c.nspan, c.lspan_ref if c.lspan else None, "SPAN")
+    xi = _divisions(c, c.nchord, c.lchord_ref if c.lchord else None, "CHORD")
+    flip = p4[1] < p1[1]
+    r, t = (p4, p1) if flip else (p1, p4)
+    cr, ct = (c.x43, c.x12) if flip else (c.x12, c.x43)
+    e = (1 - eta[::-1]) if flip else eta
+    le = r[None, :] + e[:, None] * (t - r)[None, :]
+    ch = cr + e * (ct - cr)
+    grid = le[:, None, :] + xi[None, :, None] * ch[:, None, None] * np.array([1.0, 0, 0])
+    ns, nc = len(eta) - 1, len(xi) - 1
+    box = np.stack([grid[:-1, :-1], grid[:-1, 1:], grid[1:, 1:], grid[1:, :-1]],
+                   axis=2).reshape(-1, 4, 3)
+    bid = c.eid + np.arange(ns * nc).reshape(ns, nc)
+    return box * L, (bid[::-1] if flip else bid).ravel(), ns, nc
+
+
 def _boxes(model, L, z0):
+    """Every CAERO1 as one :class:`BoxMesh` (in the structure's plane, z = 0 in asekit) and
+    the Nastran box ids."""
     corners, strip, surface, ids, names = [], [], [], [], []
     s0 = 0
     for i, cid in enumerate(sorted(model.caeros)):
         c = model.caeros[cid]
         if c.type != "CAERO1":
             raise BdfError(f"{c.type} {cid} is not supported (CAERO1)")
-        p1, p2, p3, p4 = (np.asarray(p, float) for p in c.get_points())
+        p1, p4 = (np.asarray(p, float) for p in (c.get_points()[0], c.get_points()[3]))
         if abs(p1[2] - p4[2]) > 1e-9 * max(1.0, abs(p4[1] - p1[1])) \
                 or abs(p1[2] * L - z0) > 1e-6 * max(1.0, abs(z0)):
             raise BdfError(f"CAERO1 {cid}: the surface must lie in the structure's plane "
                            f"z = {z0 / L:g} (no dihedral)")
-        eta = _divisions(c, c.nspan, c.lspan_ref if c.lspan else None, "SPAN")
-        xi = _divisions(c, c.nchord, c.lchord_ref if c.lchord else None, "CHORD")
-        flip = p4[1] < p1[1]
-        r, t = (p4, p1) if flip else (p1, p4)
-        cr, ct = (c.x43, c.x12) if flip else (c.x12, c.x43)
-        e = (1 - eta[::-1]) if flip else eta
-        le = r[None, :] + e[:, None] * (t - r)[None, :]
-        ch = cr + e * (ct - cr)
-        grid = le[:, None, :] + xi[None, :, None] * ch[:, None, None] * np.array([1.0, 0, 0])
-        ns, nc = len(eta) - 1, len(xi) - 1
-        box = np.stack([grid[:-1, :-1], grid[:-1, 1:], grid[1:, 1:], grid[1:, :-1]],
-                       axis=2).reshape(-1, 4, 3)
-        # Nastran box ids run chordwise first, from P1 spanwise
-        bid = cid + np.arange(ns * nc).reshape(ns, nc)
-        if flip:
-            bid = bid[::-1]
-        corners.append(box * L)
+        box, bid, ns, nc = _caero1_boxes(c, L)
+        corners.append(box)
         strip.append(s0 + np.repeat(np.arange(ns), nc))
         surface.append(np.full(ns * nc, i))
-        ids.append(bid.ravel())
+        ids.append(bid)
         names.append(f"CAERO1 {cid}")
         s0 += ns
     c = np.concatenate(corners)
@@ -673,15 +941,28 @@ def _boxes(model, L, z0):
         np.concatenate(ids)
 
 
+def _splined_boxes(model, s) -> set:
+    """Box ids a SPLINE1 (BOX1-BOX2) or SPLINE4 (AELIST) interpolates.
+
+    +---------+-----+-------+------+------+------+-----+------+-------+
+    |    1    |  2  |   3   |  4   |  5   |  6   |  7  |  8   |   9   |
+    +=========+=====+=======+======+======+======+=====+======+=======+
+    | SPLINE1 | EID | CAERO | BOX1 | BOX2 | SETG | DZ  | METH | USAGE |
+    +---------+-----+-------+------+------+------+-----+------+-------+
+    | SPLINE4 | EID | CAERO |AELIST|      | SETG | DZ  | METH | USAGE |
+    +---------+-----+-------+------+------+------+-----+------+-------+
+    """
+    if s.type == "SPLINE1":
+        return set(range(int(s.box1), int(s.box2) + 1))
+    if s.type == "SPLINE4":
+        return {int(b) for b in model.aelists[s.aelist].elements}
+    raise BdfError(f"{s.type} {s.eid} is not supported (SPLINE1, SPLINE4)")
+
+
 def _check_splines(model, box_ids, notes):
     splined = set()
     for s in model.splines.values():
-        if s.type == "SPLINE1":
-            splined.update(range(int(s.box1), int(s.box2) + 1))
-        elif s.type == "SPLINE4":
-            splined.update(int(b) for b in model.aelists[s.aelist].elements)
-        else:
-            raise BdfError(f"{s.type} {s.eid} is not supported (SPLINE1, SPLINE4)")
+        splined |= _splined_boxes(model, s)
     missing = [int(b) for b in box_ids if int(b) not in splined]
     if missing:
         raise BdfError(f"boxes {missing[:10]}{'...' if len(missing) > 10 else ''} are not "
@@ -693,11 +974,22 @@ def _check_splines(model, box_ids, notes):
 
 
 def _flutter(model, f, rho_ref, L, Mu, T) -> FlutterRequest:
+    """A FLUTTER request with its FLFACT lists in SI (densities x RHOREF, |velocities|).
+
+    +---------+-----+--------+------+------+-------+-------+-------+------+
+    |    1    |  2  |   3    |  4   |  5   |   6   |   7   |   8   |  9   |
+    +=========+=====+========+======+======+=======+=======+=======+======+
+    | FLUTTER | SID | METHOD | DENS | MACH | RFREQ | IMETH | NVALUE| OMAX |
+    +---------+-----+--------+------+------+-------+-------+-------+------+
+    | FLFACT  | SID |   F1   |  F2  |  F3  |  F4   |  F5   |  F6   |  F7  |
+    +---------+-----+--------+------+------+-------+-------+-------+------+
+    """
     method = f.method
     if method not in ("PK", "PKNL"):
         raise BdfError(f"FLUTTER {f.sid}: method {method} is not supported (PK, PKNL)")
     if rho_ref is None:
         raise BdfError(f"FLUTTER {f.sid} needs AERO (RHOREF)")
+
     def fl(v):
         sid = v if isinstance(v, (int, np.integer)) else v.sid
         return np.asarray(model.flfacts[int(sid)].factors, float)
@@ -710,69 +1002,220 @@ def _flutter(model, f, rho_ref, L, Mu, T) -> FlutterRequest:
                           tuple(map(float, vel)))
 
 
+def _angles(keys, n):
+    out = np.zeros(n)
+    for (pid, ang), idx in keys.items():
+        out[np.asarray(idx)] = ang
+    return out
+
+
 # ---------------------------------------------------------------------------------------------
-# analysis of an imported model with asekit
+# the import
 # ---------------------------------------------------------------------------------------------
-def modal_model(bdf: BdfModel, n_modes: int | None = None, f_max_hz: float | None = None):
-    """The asekit modal model (n_rigid = 0) of an imported deck: the first ``n_modes``
-    out-of-plane modes (default EIGR/EIGRL ND) or all below ``f_max_hz`` (default its V2 /
-    F2, else 1000 Hz), with the TABDMP1 damping applied at each mode's frequency
-    (g -> zeta = g / 2, :func:`asekit.structure.modes.with_damping`)."""
-    from asekit.structure.modes import fixed_modal_model, with_damping
-    n = bdf.n_modes if n_modes is None and f_max_hz is None else n_modes
-    fm = f_max_hz if f_max_hz is not None else (bdf.f_max_hz or 1e300 if n else 1000.0)
-    model = fixed_modal_model(bdf.system, bdf.M, fm, n)
-    if bdf.damping_g:
-        f, g = np.array(bdf.damping_g).T
-        model = with_damping(model, structural_g=np.interp(model.frequencies_hz, f, g))
-    return model
+def _check_cards(model, name: str) -> list:
+    """Refuse the decks holding a card asekit cannot represent; the ignored cards."""
+    refused, ignored = _card_report(model)
+    if refused:
+        raise BdfError(f"{name}: asekit cannot represent these cards: {_fmt(refused)}. "
+                       f"It models a flat plate of CQUAD4 / CTRIA3 elements (PSHELL, "
+                       f"MAT1/MAT8) with CONM2, CELAS1/2, RBE2 and SPC supports (CTRIA3 as a "
+                       f"degenerated MITC4).")
+    return ignored
 
 
-@dataclass(frozen=True)
-class BdfFlutterPoint:
-    """asekit's p-k flutter result of one (FLUTTER request, density, Mach): speed (m/s, None
-    if no flutter in the sweep), frequency (Hz), mode index."""
+def read_deck(path, units: str = "SI", tol: float | None = None,
+              thickness_rule: str = "gauss") -> BdfModel:
+    """Read a flat plate-wing BDF with pyNastran into a :class:`BdfModel` (the deck's record:
+    asekit's matrices and Nastran's ids); :func:`read_bdf` makes it a case.
 
-    sid: int
-    density: float
-    mach: float
-    speed: float | None
-    frequency_hz: float | None
-    mode: int | None
+    Parameters
+    ----------
+    path : str or Path
+        The deck (executive and case control optional).
+    units : str
+        The deck's unit system, a key of :data:`UNITS` (``"SI"``, ``"mm-t-s"``,
+        ``"in-lbf-s"``); everything is converted to SI.
+    tol : float, optional
+        Flatness tolerance in deck length units (default 1e-6 x the model size).
+    thickness_rule : str
+        ``"gauss"`` (default: the corner thicknesses T1-T4 interpolated bilinearly to every
+        integration point) or ``"centroid"`` (each element at its mean corner thickness).
+
+    Returns
+    -------
+    BdfModel
+        Raises :class:`BdfError` (a ValueError) for a deck asekit cannot represent (refused
+        cards listed); warns :class:`UnsupportedCardWarning` once, listing every card read
+        but not represented (name, count, first id).
+    """
+    if units not in UNITS:
+        raise ValueError(f"units must be one of {sorted(UNITS)}, got {units!r}")
+    BDF = _need_pynastran()
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"BDF not found: {path}")
+    model = _open_deck(path, BDF)
+    ignored = _check_cards(model, path.name)
+    deck = _Deck(model, path.name, *UNITS[units], wtmass=_read_param_wtmass(model))
+    quads = _shell_elements(model, path.name)
+    _read_grids(deck, quads, tol)
+    conn, th, angles, pids, props = _read_shells(deck, quads)
+    K, M, materials, keys, mesh = _plate_matrices(deck, conn, th, pids, props, angles,
+                                                  thickness_rule)
+    springs, Ks = _read_celas(deck)
+    masses, Mm = _read_conm2(deck)
+    K, M = (K + Ks).tocsr(), (M + Mm).tocsr()
+    fixed = _read_spcs(deck)
+    dep, rigid = _read_rbe2(deck, fixed)
+    Tm = _reduction(deck.n_dof, fixed, dep, K, M)
+    system = SupportedSystem(K=(Tm.T @ K @ Tm).tocsr(), M=(Tm.T @ M @ Tm).tocsr(), T=Tm,
+                             shaft_index=None, ground_index=None, fictitious_inertia=0.0,
+                             shaft_nodes=np.array([], dtype=np.int64), mesh=mesh,
+                             label=f"BDF {path.name}: {len(quads)} CQUAD4, {len(deck.nids)} "
+                                   f"GRID")
+    n_modes, f_max = _read_eigen_method(model, deck.T)
+    aero = _read_aero(deck)
+    if ignored:
+        warnings.warn(f"{path.name}: cards read but not represented by asekit: "
+                      f"{_fmt(ignored)}", UnsupportedCardWarning, stacklevel=2)
+    return BdfModel(mesh=mesh, node_ids=deck.nids, K=K, M=M, system=system, **aero,
+                    n_modes=n_modes, f_max_hz=f_max, damping_g=_read_tabdmp1(model, deck.T),
+                    materials=materials, element_pids=pids.copy(),
+                    element_angles=_angles(keys, len(quads)), springs=springs, masses=masses,
+                    fixed=tuple(sorted(fixed)), rigid=rigid, ignored=tuple(ignored),
+                    notes=tuple(deck.notes), path=str(path), units=units)
 
 
-def flutter(bdf: BdfModel, model=None, progress: bool = False, method: str = "quartic"):
-    """asekit's own analysis of the deck's FLUTTER requests: the GAFs of ``model`` (default
-    :func:`modal_model`) with asekit's doublet lattice on the CAERO1 boxes over the MKAERO1
-    grid, then p-k (:func:`asekit.aeroelastic.flutter.pk_flutter`) at every density x Mach over the
-    velocities. Returns (list of :class:`BdfFlutterPoint`, GafDatabase, model)."""
-    from asekit.aero.gaf import build_gaf_database
-    from asekit.aero.spline import fe_spline
-    from asekit.aeroelastic.flutter import TabulatedGaf, first_of, pk_flutter, pk_instabilities
-    if bdf.boxes is None or not bdf.flutter:
-        raise ValueError("bdf has no CAERO1 boxes or no FLUTTER request")
-    model = modal_model(bdf) if model is None else model
-    db = build_gaf_database(fe_spline(model, bdf.boxes), bdf.boxes, bdf.machs,
-                            bdf.reduced_frequencies, bdf.b_ref, model.n_rigid, bdf.symmetric,
-                            method, progress)
-    out = []
-    for req in bdf.flutter:
-        combos = (list(zip(req.densities, req.machs)) if req.method == "PKNL"
-                  else [(r, m) for r in req.densities for m in req.machs])
-        for rho, mach in combos:
-            i = int(np.argmin(np.abs(db.machs - mach)))
-            if abs(db.machs[i] - mach) > 1e-9:
-                raise ValueError(f"FLUTTER {req.sid}: Mach {mach} is not on the MKAERO1 grid "
-                                 f"{db.machs.tolist()}")
-            gaf = TabulatedGaf(db.k, db.Q[i], db.b_ref, mach=float(mach))
-            U = np.array(sorted(set(req.velocities)))
-            pk = pk_flutter(model, gaf, rho, U)
-            inst = first_of(list(pk_instabilities(pk, model, gaf)), "flutter")
-            out.append(BdfFlutterPoint(req.sid, rho, float(mach),
-                                       None if inst is None else float(inst.speed),
-                                       None if inst is None else float(inst.frequency_hz),
-                                       None if inst is None else int(inst.mode)))
-    return out, db, model
+# ---------------------------------------------------------------------------------------------
+# the deck as a case of the pipeline
+# ---------------------------------------------------------------------------------------------
+def _clamped_root(bdf: BdfModel) -> bool:
+    """Whether the fixed DOFs are exactly T3, R1, R2 of every plate node on the root station
+    (least y) and nothing else holds the structure."""
+    used = np.unique(bdf.mesh.elements)
+    y = bdf.mesh.nodes[used, 1]
+    root = used[np.abs(y - y.min()) <= 1e-9 * max(float(np.ptp(y)), 1.0)]
+    want = {DOF_PER_NODE * int(i) + c for i in root for c in range(DOF_PER_NODE)}
+    return set(bdf.fixed) == want and not bdf.rigid and not bdf.springs
+
+
+def _support_words(bdf: BdfModel) -> str:
+    """What holds the deck's structure, in words (its own cards, applied as they are)."""
+    parts = []
+    if bdf.fixed:
+        grids = len({d // DOF_PER_NODE for d in bdf.fixed})
+        parts.append(f"SPC / GRID PS on {len(bdf.fixed)} DOFs of {grids} grids"
+                     + (" (a clamped root)" if _clamped_root(bdf) else ""))
+    if bdf.rigid:
+        parts.append(f"{len(bdf.rigid)} RBE2")
+    grounded = sum(1 for _, b, _ in bdf.springs if b < 0)
+    if grounded:
+        parts.append(f"{grounded} CELAS to ground")
+    return ", ".join(parts) if parts else "nothing (free-free)"
+
+
+def _flight_of(bdf: BdfModel) -> FlightSpec | None:
+    """The flight conditions of the deck's first FLUTTER request (the case control's FMETHOD):
+    its densities and its velocities (ascending, duplicates dropped)."""
+    if not bdf.flutter:
+        return None
+    req = bdf.flutter[0]
+    return FlightSpec(velocities=tuple(sorted(set(req.velocities))),
+                      densities=tuple(dict.fromkeys(req.densities)))
+
+
+def _aero_of(bdf: BdfModel) -> AeroSpec | None:
+    """The aerodynamics of the deck: the first FLUTTER request's Mach numbers (on the MKAERO1
+    grid; without FLUTTER the MKAERO1 Mach numbers), the MKAERO1 reduced frequencies,
+    REFC / 2, SYMXZ as a wall at y = 0; asekit's doublet lattice (quartic kernel)."""
+    if bdf.boxes is None:
+        return None
+    machs = bdf.machs
+    if bdf.flutter:
+        req = bdf.flutter[0]
+        off = [m for m in req.machs if not any(abs(m - g) <= 1e-9 for g in bdf.machs)]
+        if off:
+            raise BdfError(f"FLUTTER {req.sid}: Mach {off[0]} is not on the MKAERO1 grid "
+                           f"{list(bdf.machs)}")
+        machs = tuple(sorted(set(req.machs)))
+    return AeroSpec(machs=machs, reference_semichord=bdf.b_ref,
+                    reduced_frequencies=bdf.reduced_frequencies,
+                    symmetry="wall" if bdf.symmetric else "none")
+
+
+def _modes_of(bdf: BdfModel) -> ModesSpec:
+    """EIGRL / EIGR as the case's modes: the first ND (below V2 if given), else all below V2
+    (default 1000 Hz)."""
+    if bdf.n_modes:
+        return ModesSpec(count=bdf.n_modes, f_max=bdf.f_max_hz or 1e300, keep_rigid=False)
+    return ModesSpec(count=None, f_max=bdf.f_max_hz or 1000.0, keep_rigid=False)
+
+
+def deck_case(bdf: BdfModel, name: str | None = None) -> Case:
+    """A read deck as a :class:`~asekit.case.Case` of the pipeline.
+
+    The case's ``structure`` (:class:`~asekit.case.imported.ImportedModel`) holds the mesh,
+    K, M, the deck's own supports (the SPC / GRID PS / RBE2 reduction; CELAS in K: applied as
+    they are, ``support.kind = "imported"``), the CAERO1 boxes and the TABDMP1 table; EIGRL /
+    EIGR give ``modes``; AERO, MKAERO1 and the first FLUTTER request (FMETHOD's) give
+    ``aero`` (its Mach numbers, the MKAERO1 k, REFC / 2, SYMXZ) and ``flight`` (its FLFACT
+    densities x RHOREF and velocities); None without CAERO1 / FLUTTER. A PKNL request's
+    matched (density, Mach, velocity) triples become the full grid density x Mach over all
+    velocities (a superset). Further FLUTTER requests are listed in ``bdf.flutter`` only.
+
+    Parameters
+    ----------
+    bdf : BdfModel
+        From :func:`read_deck`.
+    name : str, optional
+        The case name (default the file's stem).
+
+    Returns
+    -------
+    Case
+        ``pipeline.modal_model(case)``, ``gaf_database(case)``, ``flutter(case)`` and the
+        report work on it; the export :func:`case_bdf` writes it back with the deck's ids.
+    """
+    stem = Path(bdf.path).stem if bdf.path else "bdf"
+    structure = ImportedModel(mesh=bdf.mesh, K=bdf.K, M=bdf.M, T=bdf.system.T, boxes=bdf.boxes,
+                              damping_g=bdf.damping_g, support=_support_words(bdf),
+                              label=bdf.system.label, deck=bdf)
+    return Case(name=name or stem, panels=(), thickness=None, material=None,
+                support=SupportSpec(kind=IMPORTED_SUPPORT), aero=_aero_of(bdf),
+                flight=_flight_of(bdf), modes=_modes_of(bdf),
+                reference=f"Nastran deck {Path(bdf.path).name if bdf.path else ''} "
+                          f"(units {bdf.units}, converted to SI)",
+                source=bdf.path or "", structure=structure)
+
+
+def read_bdf(path, units: str = "SI", tol: float | None = None,
+             thickness_rule: str = "gauss", name: str | None = None) -> Case:
+    """Read a flat plate-wing BDF into a :class:`~asekit.case.Case` of the pipeline
+    (:func:`read_deck`, then :func:`deck_case`).
+
+    Parameters
+    ----------
+    path, units, tol, thickness_rule : see :func:`read_deck`.
+    name : str, optional
+        The case name (default the file's stem).
+
+    Returns
+    -------
+    Case
+        With ``case.structure.deck`` the :class:`BdfModel` record.
+
+    Examples
+    --------
+    The HA145E wing (needs pyNastran; tests/io/test_bdf.py runs it):
+
+    >>> from asekit import bdf                                    # doctest: +SKIP
+    >>> from asekit.case import pipeline                          # doctest: +SKIP
+    >>> case = bdf.read_bdf("data/benchmarks/ha145e/ha145e.bdf",
+    ...                     units="in-lbf-s")                     # doctest: +SKIP
+    >>> round(pipeline.flutter(case).results[0].flutter.speed / 0.0254)   # doctest: +SKIP
+    6066
+    """
+    return deck_case(read_deck(path, units, tol, thickness_rule), name=name)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -784,152 +1227,303 @@ def _mkaero_cards(bdf, machs, ks):
             bdf.add_mkaero1(list(machs[i:i + 8]), list(ks[j:j + 8]))
 
 
-def case_bdf(case, sol: int = 145, n_modes: int | None = None):
-    """The case as a pyNastran ``BDF`` object (SI units: m, kg, s, N).
+def _material_card(model, mid: int, mat) -> None:
+    """MAT1 (isotropic) or MAT8 (orthotropic; its angle goes on the elements' THETA)."""
+    if isinstance(mat, Material):
+        model.add_mat1(mid, mat.youngs_modulus, None, mat.poisson_ratio, rho=mat.density)
+    else:
+        model.add_mat8(mid, mat.e1, mat.e2, mat.nu12, g12=mat.g12, g1z=mat.g13, g2z=mat.g23,
+                       rho=mat.density)
 
-    Structure: one GRID per node (PS = 126: the in-plane DOFs, uncoupled from bending, are
-    held), one CQUAD4 per element with its corner thicknesses T1-T4 from the case's
-    thickness law, PSHELL (MID1 = MID2 = MID3) and MAT1 or MAT8 (material angle THETA from the
-    G1-G2 edge), CONM2 for point masses at nodes, SPC1 for a clamped root; a shaft as a shaft
-    GRID held in T3 and R1 (or on a CELAS2 in R1 with ``bending_stiffness``), an RBE2 (CM 345)
-    to the nodes of a shaft region, the torsional spring as CELAS2 on R2 (FN1: to ground; FN2:
-    to a ground GRID carrying the fictitious inertia as CONM2 I22). Aerodynamics: one CAERO1
-    (PAERO1) per panel with the case's boxes, SPLINE1 (IPS) on all grids, AERO (REFC = 2 b,
-    RHOREF = 1 so the FLFACT densities are in kg/m^3), MKAERO1 over the case's Mach and k,
-    FLFACT densities / Machs / velocities and FLUTTER (PK). Case control: SOL 103 (METHOD =
-    EIGRL) or SOL 145 (also FMETHOD).
-    """
-    from pyNastran.bdf.case_control_deck import CaseControlDeck
-    from asekit.case import pipeline as pl
-    BDF = _need_pynastran()
-    if sol not in (103, 145):
-        raise ValueError(f"sol must be 103 or 145, got {sol!r}")
+
+def _plate_cards(model, case) -> tuple[list[int], int]:
+    """GRID (PS 126) per node, MAT1 / MAT8 + PSHELL, CQUAD4 with T1-T4 from the case's
+    thickness law; returns (GRID id per mesh node, next element id)."""
     mesh = pl.structural_mesh(case)
-    model = BDF(debug=None)
-    nn = mesh.n_nodes
     for i, (x, y) in enumerate(mesh.nodes):
         model.add_grid(i + 1, [float(x), float(y), 0.0], ps="126")
     xy = mesh.nodes[mesh.elements]
     # corner thicknesses from the case's law (evaluated at the nodes)
     cth = mesh.thickness_xy(xy[:, :, 0].ravel(), xy[:, :, 1].ravel()).reshape(-1, 4)
     mat = case.material
-    if isinstance(mat, Material):
-        model.add_mat1(1, mat.youngs_modulus, None, mat.poisson_ratio, rho=mat.density)
-        ang_mat = 0.0
-    else:
-        model.add_mat8(1, mat.e1, mat.e2, mat.nu12, g12=mat.g12, g1z=mat.g13, g2z=mat.g23,
-                       rho=mat.density)
-        ang_mat = mat.fibre_angle
-    t_ref = float(np.max(cth))
-    model.add_pshell(1, mid1=1, t=t_ref, mid2=1, mid3=1)
+    _material_card(model, 1, mat)
+    ang_mat = 0.0 if isinstance(mat, Material) else mat.fibre_angle
+    model.add_pshell(1, mid1=1, t=float(np.max(cth)), mid2=1, mid3=1)
     for e, conn in enumerate(mesh.elements):
         d = xy[e, 1] - xy[e, 0]
         theta = math.degrees(ang_mat - math.atan2(d[1], d[0]))
         model.add_cquad4(e + 1, 1, [int(c) + 1 for c in conn], theta_mcid=float(theta),
                          T1=float(cth[e, 0]), T2=float(cth[e, 1]), T3=float(cth[e, 2]),
                          T4=float(cth[e, 3]))
-    eid = mesh.n_elements + 1
-    for pm in case.point_masses:
-        i = mesh.node_at(pm.position, tol=1e-9 * max(mesh.span, 1.0),
-                         name="point_mass position (BDF export puts a CONM2 on a node)")
-        model.add_conm2(eid, i + 1, pm.mass, I=[pm.inertia[0], 0.0, pm.inertia[1], 0.0, 0.0,
-                                                0.0])
+    return list(range(1, mesh.n_nodes + 1)), mesh.n_elements + 1
+
+
+def _deck_of(case) -> BdfModel:
+    deck = case.structure.deck
+    if not isinstance(deck, BdfModel):
+        raise BdfError(f"{case.name}: the imported structure has no BDF record "
+                       f"(structure.deck is {type(deck).__name__}): the export writes an "
+                       f"imported model from the deck it was read from")
+    return deck
+
+
+def _imported_shell_cards(model, bdf: BdfModel) -> tuple[list[int], int]:
+    """GRIDs (the deck's ids, PS 126), one MAT1 / MAT8 + PSHELL per property, CQUAD4 / CTRIA3
+    with the corner thicknesses (MAT8 angle as THETA); returns (ids, next element id)."""
+    ids = [int(g) for g in bdf.node_ids]
+    for g, (x, y) in zip(ids, bdf.mesh.nodes):
+        model.add_grid(g, [float(x), float(y), 0.0], ps="126")
+    for (pid, _), mat in bdf.materials.items():
+        if pid in model.properties:
+            continue
+        _material_card(model, pid, mat)
+        sel = bdf.element_pids == pid
+        model.add_pshell(pid, mid1=pid, t=float(bdf.mesh.corner_thickness[sel].max()),
+                         mid2=pid, mid3=pid)
+    xy = bdf.mesh.nodes[bdf.mesh.elements]
+    th = bdf.mesh.corner_thickness
+    for e, conn in enumerate(bdf.mesh.elements):
+        pid, ang = int(bdf.element_pids[e]), float(bdf.element_angles[e])
+        mat = bdf.materials.get((pid, ang))
+        theta = 0.0
+        if mat is not None and not isinstance(mat, Material):
+            d = xy[e, 1] - xy[e, 0]
+            theta = math.degrees(ang - math.atan2(d[1], d[0]))
+        t = [float(v) for v in th[e]]
+        if conn[2] == conn[3]:
+            model.add_ctria3(e + 1, pid, [ids[c] for c in conn[:3]], theta_mcid=float(theta),
+                             T1=t[0], T2=t[1], T3=t[2])
+        else:
+            model.add_cquad4(e + 1, pid, [ids[c] for c in conn], theta_mcid=float(theta),
+                             T1=t[0], T2=t[1], T3=t[2], T4=t[3])
+    return ids, bdf.mesh.n_elements + 1
+
+
+def _imported_support_cards(model, bdf: BdfModel, ids, eid: int) -> int:
+    """The deck's own masses and supports as read: CONM2, CELAS2, RBE2, SPC1 (SPC set 1)."""
+    for i, m, X, I in bdf.masses:
+        model.add_conm2(eid, ids[i], float(m), X=[float(v) for v in X],
+                        I=[I[0], I[1], I[2], 0.0, 0.0, 0.0])
         eid += 1
-    s = case.support
-    if s.kind == "clamped_root":
-        root = np.flatnonzero(np.abs(mesh.nodes[:, 1] - mesh.y_root) <= 1e-9 * mesh.span)
-        model.add_spc1(1, "345", [int(i) + 1 for i in root])
+    for a, b, k in bdf.springs:
+        nb = 0 if b < 0 else ids[b // 3]
+        model.add_celas2(eid, k, [ids[a // 3], nb], a % 3 + 3, 0 if b < 0 else b % 3 + 3)
+        eid += 1
+    for gi, cm, dep in bdf.rigid:
+        model.add_rbe2(eid, ids[gi], cm, [ids[j] for j in dep])
+        eid += 1
+    _spc1_cards(model, ids, bdf.fixed)
+    return eid
+
+
+def _spc1_cards(model, ids, fixed) -> None:
+    """SPC1 (set 1) per component of the fixed global DOFs (w, theta_x, theta_y -> 3, 4, 5)."""
+    by_comp = {}
+    for d in fixed:
+        by_comp.setdefault(str(d % 3 + 3), []).append(ids[d // 3])
+    for comp, nodes in sorted(by_comp.items()):
+        model.add_spc1(1, comp, nodes)
+
+
+def _point_mass_cards(model, case, ids, eid: int) -> int:
+    """CONM2 for the case's point masses (each on a node)."""
+    mesh = pl.structural_mesh(case)
+    for pm in case.point_masses:
+        i = mesh.node_at(pm.position, tol=1e-9 * max(float(np.ptp(mesh.nodes[:, 1])), 1.0),
+                         name="point_mass position (BDF export puts a CONM2 on a node)")
+        model.add_conm2(eid, ids[i], pm.mass, I=[pm.inertia[0], 0.0, pm.inertia[1], 0.0, 0.0,
+                                                 0.0])
+        eid += 1
+    return eid
+
+
+def _clamped_root_cards(model, case, ids, eid: int) -> int:
+    """SPC1 345 on the root-chord nodes."""
+    mesh = pl.structural_mesh(case)
+    root = np.flatnonzero(np.abs(mesh.nodes[:, 1] - mesh.y_root) <= 1e-9 * mesh.span)
+    model.add_spc1(1, "345", [ids[i] for i in root])
+    return eid
+
+
+def _edges_cards(model, case, ids, eid: int) -> int:
+    """SPC1 on the DOFs the edge conditions fix (those with no column in the reduction T of
+    :func:`asekit.structure.supports.planform_edge_supports`)."""
+    mesh = pl.structural_mesh(case)
+    K, M = pl.mass_and_stiffness(case)
+    T = planform_edge_supports(mesh, K, M, **dict(case.support.edges)).T
+    _spc1_cards(model, ids, np.flatnonzero(np.abs(T).sum(axis=1).A1 == 0))
+    return eid
+
+
+def _shaft_cards(model, case, ids, eid: int) -> int:
+    """A shaft GRID held in T3 and R1 (or on a CELAS2 in R1 with ``bending_stiffness``), an
+    RBE2 (CM 345) to a shaft region's nodes, the torsional spring as CELAS2 on R2 (FN1: to
+    ground; FN2: to a ground GRID carrying the fictitious inertia as CONM2 I22)."""
+    s, mesh = case.support, pl.structural_mesh(case)
+    nn = mesh.n_nodes
+    if s.radius is None:
+        shaft = ids[mesh.node_at(s.axis_point, tol=1e-9 * max(mesh.span, 1.0),
+                                 name="shaft axis_point")]
     else:
-        if s.radius is None:
-            shaft = mesh.node_at(s.axis_point, tol=1e-9 * max(mesh.span, 1.0),
-                                 name="shaft axis_point") + 1
-        else:
-            shaft = nn + 1
-            model.add_grid(shaft, [float(s.axis_point[0]), float(s.axis_point[1]), 0.0],
-                           ps="126")
-            d = np.hypot(*(mesh.nodes - np.asarray(s.axis_point)).T)
-            region = np.flatnonzero(d <= s.radius * (1 + 1e-9))
-            model.add_rbe2(eid, shaft, "345", [int(i) + 1 for i in region])
-            eid += 1
-        if s.bending_stiffness is None:
-            model.add_spc1(1, "34", [shaft])
-        else:
-            model.add_spc1(1, "3", [shaft])
-            model.add_celas2(eid, s.bending_stiffness, [shaft, 0], 4, 0)
-            eid += 1
-        if s.model == "FN1" or not case.modes.keep_rigid:
-            model.add_celas2(eid, s.torsional_stiffness, [shaft, 0], 5, 0)
-            eid += 1
-        else:
-            from asekit.structure.assembly import pitch_inertia
-            ground = nn + 2
-            model.add_grid(ground, [float(s.axis_point[0]), float(s.axis_point[1]), 0.0],
-                           ps="12346")
-            _, Mp = pl.mass_and_stiffness(case)
-            i_f = s.fictitious_inertia_factor * pitch_inertia(mesh, Mp, s.axis_point[0])
-            model.add_celas2(eid, s.torsional_stiffness, [shaft, ground], 5, 5)
-            eid += 1
-            model.add_conm2(eid, ground, 0.0, I=[0.0, 0.0, i_f, 0.0, 0.0, 0.0])
-            eid += 1
+        shaft = nn + 1
+        model.add_grid(shaft, [float(s.axis_point[0]), float(s.axis_point[1]), 0.0], ps="126")
+        d = np.hypot(*(mesh.nodes - np.asarray(s.axis_point)).T)
+        model.add_rbe2(eid, shaft, "345", [ids[i] for i in np.flatnonzero(d <= s.radius
+                                                                           * (1 + 1e-9))])
+        eid += 1
+    if s.bending_stiffness is None:
+        model.add_spc1(1, "34", [shaft])
+    else:
+        model.add_spc1(1, "3", [shaft])
+        model.add_celas2(eid, s.bending_stiffness, [shaft, 0], 4, 0)
+        eid += 1
+    if s.model == "FN1" or not case.modes.keep_rigid:
+        model.add_celas2(eid, s.torsional_stiffness, [shaft, 0], 5, 0)
+        return eid + 1
+    ground = nn + 2
+    model.add_grid(ground, [float(s.axis_point[0]), float(s.axis_point[1]), 0.0], ps="12346")
+    _, Mp = pl.mass_and_stiffness(case)
+    i_f = s.fictitious_inertia_factor * pitch_inertia(mesh, Mp, s.axis_point[0])
+    model.add_celas2(eid, s.torsional_stiffness, [shaft, ground], 5, 5)
+    model.add_conm2(eid + 1, ground, 0.0, I=[0.0, 0.0, i_f, 0.0, 0.0, 0.0])
+    return eid + 2
+
+
+#: The BDF cards of each support kind of a case (``case.support.kind``).
+SUPPORT_CARDS = {"clamped_root": _clamped_root_cards, "edges": _edges_cards,
+                 "shaft": _shaft_cards}
+
+
+def _support_cards(model, case, ids, eid: int) -> int:
+    if case.structure is not None:
+        return _imported_support_cards(model, _deck_of(case), ids, eid)
+    kind = case.support.kind
+    if kind not in SUPPORT_CARDS:
+        raise BdfError(f"support.kind = {kind!r} has no BDF export (known: "
+                       f"{', '.join(sorted(SUPPORT_CARDS))})")
+    return SUPPORT_CARDS[kind](model, case, ids, eid)
+
+
+def _panel_aero_cards(model, case, nn: int) -> None:
+    """One CAERO1 (PAERO1) per panel with the case's boxes, SPLINE1 on all grids."""
+    boxes = pl.box_mesh(case)
+    start = 100001
+    model.add_paero1(1)
+    for ip, p in enumerate(case.panels):
+        sel = boxes.surface == ip
+        nc = int(np.sum(boxes.strip[sel] == boxes.strip[sel][0]))
+        ns = int(sel.sum() // nc)
+        pf = p.planform
+        model.add_caero1(start, 1, 1, [pf.root_le[0], pf.root_le[1], 0.0],
+                         pf.root_chord, [pf.tip_le[0], pf.tip_le[1], 0.0], pf.tip_chord,
+                         nspan=ns, nchord=nc)
+        model.add_set1(start, list(range(1, nn + 1)))
+        model.add_spline1(start, start, start, start + ns * nc - 1, start)
+        start += 10 ** int(math.ceil(math.log10(ns * nc + 1)) + 1)
+
+
+def _flutter_cards(model, case, ids) -> None:
+    """Boxes (per panel, or the imported ones with AEFACT where not uniform), AERO (REFC =
+    2 b, RHOREF = 1 so the FLFACT densities are in kg/m^3), MKAERO1 over the case's Mach and
+    k, FLFACT densities / Machs / velocities and FLUTTER 20 (PK)."""
+    a = case.aero
+    if case.structure is not None:
+        _aero_cards(model, pl.box_mesh(case), 100001, ids)
+    else:
+        _panel_aero_cards(model, case, len(ids))
+    model.add_aero(None, 2.0 * a.reference_semichord, 1.0,
+                   sym_xz=1 if a.symmetry == "wall" else 0)
+    _mkaero_cards(model, list(a.machs), [float(k) for k in pl.reduced_frequencies(case)])
+    model.add_flfact(1, [c.density for c in pl.flight_conditions(case)])
+    model.add_flfact(2, list(a.machs))
+    model.add_flfact(3, list(case.flight.velocities))
+    model.add_flutter(20, "PK", 1, 2, 3, imethod="L")
+
+
+def _damping_table(case):
+    """(frequencies Hz, values, TYPE) of the case's damping as a TABDMP1, or None: the case's
+    ``damping`` (constant: two points; per mode: a point at each mode), else an imported
+    structure's own table (G)."""
+    d = case.damping
+    if d.modal_damping_ratio is None and d.structural_g is None:
+        if case.structure is not None and case.structure.damping_g:
+            f, g = zip(*case.structure.damping_g)
+            return list(f), list(g), "G"
+        return None
+    ref = pl.modal_model(case)
+    f = ref.frequencies_hz[ref.n_rigid:]
+    kind = "G" if d.structural_g is not None else "CRIT"
+    v = d.structural_g if d.structural_g is not None else d.modal_damping_ratio
+    g = np.broadcast_to(np.asarray(v, float), f.shape)
+    if np.ptp(g) == 0:
+        return [0.0, 1.0e5], [float(g[0])] * 2, kind
+    return list(map(float, f)), list(map(float, g)), kind          # a table through each mode
+
+
+def _export_sol(case, sol):
+    if sol is None:
+        sol = 145 if case.aero is not None and case.flight is not None else 103
+    if sol not in (103, 145):
+        raise ValueError(f"sol must be 103 or 145, got {sol!r}")
+    if sol == 145 and (case.aero is None or case.flight is None):
+        raise ValueError(f"sol = 145 needs the case's aero and flight ({case.name} has "
+                         f"{'no aero' if case.aero is None else 'no flight conditions'}); "
+                         f"use sol = 103")
+    return sol
+
+
+def case_bdf(case, sol: int | None = None, n_modes: int | None = None):
+    """The case as a pyNastran ``BDF`` object (SI units: m, kg, s, N).
+
+    Structure: one GRID per node (PS = 126: the in-plane DOFs, uncoupled from bending, are
+    held), one CQUAD4 per element with its corner thicknesses T1-T4 from the case's
+    thickness law, PSHELL (MID1 = MID2 = MID3) and MAT1 or MAT8 (material angle THETA from the
+    G1-G2 edge), CONM2 for point masses at nodes. Supports by kind (:data:`SUPPORT_CARDS`):
+    SPC1 for a clamped root or for the DOFs edge conditions fix; a shaft as a shaft GRID held
+    in T3 and R1 (or on a CELAS2 in R1 with ``bending_stiffness``), an RBE2 (CM 345) to the
+    nodes of a shaft region, the torsional spring as CELAS2 on R2 (FN1: to ground; FN2: to a
+    ground GRID carrying the fictitious inertia as CONM2 I22). A case with an imported
+    structure (:func:`read_bdf`) is written with the deck's GRID ids, properties, CTRIA3 /
+    CQUAD4, CONM2, CELAS2, RBE2 and SPC1 as read (in SI), its boxes with AEFACT where not
+    uniform. Aerodynamics: one CAERO1 (PAERO1) per panel with the case's boxes, SPLINE1 (IPS)
+    on all grids, AERO (REFC = 2 b, RHOREF = 1 so the FLFACT densities are in kg/m^3),
+    MKAERO1 over the case's Mach and k, FLFACT densities / Machs / velocities and FLUTTER
+    (PK). Case control: SOL 103 (METHOD = EIGRL) or SOL 145 (also FMETHOD); ``sol`` None:
+    145 when the case has aero and flight conditions, else 103.
+    """
+    from pyNastran.bdf.case_control_deck import CaseControlDeck
+    BDF = _need_pynastran()
+    sol = _export_sol(case, sol)
+    model = BDF(debug=None)
+    if case.structure is not None:
+        ids, eid = _imported_shell_cards(model, _deck_of(case))
+    else:
+        ids, eid = _plate_cards(model, case)
+    eid = _point_mass_cards(model, case, ids, eid)
+    _support_cards(model, case, ids, eid)
     nmod = n_modes if n_modes is not None else case.modes.count
     model.add_eigrl(10, v1=None if nmod else -1.0e-3,
                     v2=None if nmod else float(case.modes.f_max), nd=nmod)
     lines = [f"TITLE = {case.name} (asekit export, SI: m kg s N)", "ECHO = NONE", "SPC = 1",
              "METHOD = 10", "DISP = ALL"]
     if sol == 145:
-        a = case.aero
-        boxes = pl.box_mesh(case)
-        start = 100001
-        model.add_paero1(1)
-        for ip, p in enumerate(case.panels):
-            sel = boxes.surface == ip
-            nc = int(np.sum(boxes.strip[sel] == boxes.strip[sel][0]))
-            ns = int(sel.sum() // nc)
-            pf = p.planform
-            model.add_caero1(start, 1, 1, [pf.root_le[0], pf.root_le[1], 0.0],
-                             pf.root_chord, [pf.tip_le[0], pf.tip_le[1], 0.0], pf.tip_chord,
-                             nspan=ns, nchord=nc)
-            model.add_set1(start, list(range(1, nn + 1)))
-            model.add_spline1(start, start, start, start + ns * nc - 1, start)
-            start += 10 ** int(math.ceil(math.log10(ns * nc + 1)) + 1)
-        model.add_aero(None, 2.0 * a.reference_semichord, 1.0,
-                       sym_xz=1 if a.symmetry == "wall" else 0)
-        _mkaero_cards(model, list(a.machs), [float(k) for k in pl.reduced_frequencies(case)])
-        conds = pl.flight_conditions(case)
-        model.add_flfact(1, [c.density for c in conds])
-        model.add_flfact(2, list(a.machs))
-        model.add_flfact(3, list(case.flight.velocities))
-        model.add_flutter(20, "PK", 1, 2, 3, imethod="L")
+        _flutter_cards(model, case, ids)
         lines.insert(4, "FMETHOD = 20")
-    d = case.damping
-    if d.modal_damping_ratio is not None or d.structural_g is not None:
-        ref = pl.modal_model(case)
-        f = ref.frequencies_hz[ref.n_rigid:]
-        if d.structural_g is not None:
-            g = np.broadcast_to(np.asarray(d.structural_g, float), f.shape)
-            kind = "G"
-        else:
-            g = np.broadcast_to(np.asarray(d.modal_damping_ratio, float), f.shape)
-            kind = "CRIT"
-        if np.ptp(g) == 0:
-            x, y = [0.0, 1.0e5], [float(g[0])] * 2
-        else:                                          # per mode: a table through each mode
-            x, y = list(map(float, f)), list(map(float, g))
-        model.add_tabdmp1(30, np.array(x), np.array(y), Type=kind)
+    tab = _damping_table(case)
+    if tab is not None:
+        model.add_tabdmp1(30, np.array(tab[0]), np.array(tab[1]), Type=tab[2])
         lines.append("SDAMP = 30")
     model.sol = sol
     model.case_control_deck = CaseControlDeck(lines + ["BEGIN BULK"])
     return model
 
 
-def write_case_bdf(case, path, sol: int = 145, n_modes: int | None = None) -> Path:
+def write_case_bdf(case, path, sol: int | None = None, n_modes: int | None = None) -> Path:
     """Write :func:`case_bdf` to ``path`` in large (16-character) fields; returns the path."""
     model = case_bdf(case, sol=sol, n_modes=n_modes)
     path = Path(path)
     model.write_bdf(str(path), size=16, elements_size=8, is_double=False, enddata=True)
     return path
-
-
 
 
 def _aero_cards(model, boxes: BoxMesh, eid0: int, set_nodes: list[int]):
@@ -967,97 +1561,17 @@ def _aero_cards(model, boxes: BoxMesh, eid0: int, set_nodes: list[int]):
         start += 10 ** int(math.ceil(math.log10(ns * nc + 1)) + 1)
 
 
-def bdf_model_deck(bdf: BdfModel):
-    """An imported :class:`BdfModel` as a pyNastran ``BDF`` (SI units), rebuilt from the
-    asekit model's parts: GRIDs (PS 126), CQUAD4 with corner thicknesses, one PSHELL and
-    MAT1 / MAT8 per property (MAT8 angle as CQUAD4 THETA), CONM2, CELAS2, RBE2, SPC1, and
-    the aerodynamic and flutter cards when present (SOL 145, else SOL 103)."""
-    from pyNastran.bdf.case_control_deck import CaseControlDeck
-    BDF = _need_pynastran()
-    model = BDF(debug=None)
-    ids = [int(g) for g in bdf.node_ids]
-    for g, (x, y) in zip(ids, bdf.mesh.nodes):
-        model.add_grid(g, [float(x), float(y), 0.0], ps="126")
-    done = set()
-    for (pid, ang), mat in bdf.materials.items():
-        if pid in done:
-            continue
-        done.add(pid)
-        if isinstance(mat, Material):
-            model.add_mat1(pid, mat.youngs_modulus, None, mat.poisson_ratio, rho=mat.density)
-        else:
-            model.add_mat8(pid, mat.e1, mat.e2, mat.nu12, g12=mat.g12, g1z=mat.g13,
-                           g2z=mat.g23, rho=mat.density)
-        sel = bdf.element_pids == pid
-        model.add_pshell(pid, mid1=pid, t=float(bdf.mesh.corner_thickness[sel].max()),
-                         mid2=pid, mid3=pid)
-    xy = bdf.mesh.nodes[bdf.mesh.elements]
-    th = bdf.mesh.corner_thickness
-    for e, conn in enumerate(bdf.mesh.elements):
-        pid = int(bdf.element_pids[e])
-        mat = bdf.materials[(pid, float(bdf.element_angles[e]))] \
-            if (pid, float(bdf.element_angles[e])) in bdf.materials else None
-        theta = 0.0
-        if mat is not None and not isinstance(mat, Material):
-            d = xy[e, 1] - xy[e, 0]
-            theta = math.degrees(float(bdf.element_angles[e]) - math.atan2(d[1], d[0]))
-        if conn[2] == conn[3]:
-            model.add_ctria3(e + 1, pid, [ids[c] for c in conn[:3]], theta_mcid=float(theta),
-                             T1=float(th[e, 0]), T2=float(th[e, 1]), T3=float(th[e, 2]))
-        else:
-            model.add_cquad4(e + 1, pid, [ids[c] for c in conn], theta_mcid=float(theta),
-                             T1=float(th[e, 0]), T2=float(th[e, 1]), T3=float(th[e, 2]),
-                             T4=float(th[e, 3]))
-    eid = bdf.mesh.n_elements + 1
-    for i, m, X, I in bdf.masses:
-        model.add_conm2(eid, ids[i], float(m), X=[float(v) for v in X],
-                        I=[I[0], I[1], I[2], 0.0, 0.0, 0.0])
-        eid += 1
-    for a, b, k in bdf.springs:
-        nb = 0 if b < 0 else ids[b // 3]
-        model.add_celas2(eid, k, [ids[a // 3], nb], a % 3 + 3, 0 if b < 0 else b % 3 + 3)
-        eid += 1
-    for gi, cm, dep in bdf.rigid:
-        model.add_rbe2(eid, ids[gi], cm, [ids[j] for j in dep])
-        eid += 1
-    by_comp = {}
-    for d in bdf.fixed:
-        by_comp.setdefault(str(d % 3 + 3), []).append(ids[d // 3])
-    for comp, nodes in sorted(by_comp.items()):
-        model.add_spc1(1, comp, nodes)
-    nd = bdf.n_modes
-    model.add_eigrl(10, v1=None if nd else -1.0e-3, v2=bdf.f_max_hz if not nd else None, nd=nd)
-    lines = ["TITLE = asekit export of an imported deck (SI: m kg s N)", "ECHO = NONE",
-             "SPC = 1", "METHOD = 10", "DISP = ALL"]
-    sol = 103
-    if bdf.damping_g:
-        f, g = zip(*bdf.damping_g)
-        model.add_tabdmp1(30, np.array(f), np.array(g), Type="G")
-        lines.append("SDAMP = 30")
-    if bdf.boxes is not None:
-        _aero_cards(model, bdf.boxes, 100001, ids)
-        model.add_aero(None, 2.0 * bdf.b_ref, bdf.rho_ref or 1.0,
-                       sym_xz=1 if bdf.symmetric else 0)
-        _mkaero_cards(model, list(bdf.machs), list(bdf.reduced_frequencies))
-        for j, req in enumerate(bdf.flutter):
-            f0 = 3 * j + 1
-            model.add_flfact(f0, [r / (bdf.rho_ref or 1.0) for r in req.densities])
-            model.add_flfact(f0 + 1, list(req.machs))
-            model.add_flfact(f0 + 2, list(req.velocities))
-            model.add_flutter(req.sid, req.method, f0, f0 + 1, f0 + 2, imethod="L")
-        if bdf.flutter:
-            sol = 145
-            lines.insert(4, f"FMETHOD = {bdf.flutter[0].sid}")
-    model.sol = sol
-    model.case_control_deck = CaseControlDeck(lines + ["BEGIN BULK"])
-    return model
+def bdf_model_deck(bdf):
+    """A read deck (:class:`BdfModel`, or the case :func:`read_bdf` gives) as a pyNastran
+    ``BDF`` (SI units): :func:`case_bdf` of its case."""
+    return case_bdf(deck_case(bdf) if isinstance(bdf, BdfModel) else bdf)
 
 
-def write_bdf_model(bdf: BdfModel, path) -> Path:
+def write_bdf_model(bdf, path) -> Path:
     """Write :func:`bdf_model_deck` to ``path`` in large fields; returns the path."""
     path = Path(path)
     bdf_model_deck(bdf).write_bdf(str(path), size=16, elements_size=8, is_double=False,
-                                    enddata=True)
+                                  enddata=True)
     return path
 
 

@@ -5,6 +5,7 @@ data/benchmarks/ha145e/ (README there): Nastran SOL 103 eigenvalues from ha145e.
 ZAERO flutter summary of the same example (ha145e.out, M 0.45: 5753.150 in/s, 111.7046 Hz).
 """
 
+import dataclasses
 import os
 import warnings
 
@@ -20,15 +21,27 @@ else:
 from asekit.io import bdf as B
 from asekit.case import case_from_dict, load_case               # noqa: E402
 from asekit.case import pipeline as pl                          # noqa: E402
+from asekit.case.schema import PointMass                        # noqa: E402
 from asekit.util.paths import DATA_DIR                               # noqa: E402
 
 HA145E = DATA_DIR / "benchmarks" / "ha145e"
 
 
 def _read(path, **kw):
+    """The deck as a case of the pipeline (asekit.io.bdf.read_bdf)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", B.UnsupportedCardWarning)
         return B.read_bdf(path, **kw)
+
+
+def _modes(case, n_modes=None, f_max_hz=None):
+    """pipeline.modal_model of the imported case, with its modes selection replaced when
+    ``n_modes`` or ``f_max_hz`` is given (the first n, or all below f_max)."""
+    if n_modes is not None or f_max_hz is not None:
+        md = dataclasses.replace(case.modes, count=n_modes,
+                                 f_max=case.modes.f_max if f_max_hz is None else f_max_hz)
+        case = dataclasses.replace(case, modes=md)
+    return pl.modal_model(case)
 
 
 @pytest.fixture(scope="module")
@@ -61,19 +74,23 @@ def test_fin_modes_survive_export_and_round_trip(fin, tmp_path):
     the thickness is written with 5 digits); BDF -> asekit -> BDF -> asekit is exact."""
     ref = pl.modal_model(fin)
     a = _read(B.write_case_bdf(fin, tmp_path / "a.bdf"))
-    fa = B.modal_model(a, f_max_hz=fin.modes.f_max).frequencies_hz
+    assert a.support.kind == "imported" and a.structure is not None
+    fa = _modes(a, f_max_hz=fin.modes.f_max).frequencies_hz
     np.testing.assert_allclose(fa, ref.frequencies_hz[ref.n_rigid:], rtol=2e-5)
-    b = _read(B.write_bdf_model(a, tmp_path / "b.bdf"))
-    fb = B.modal_model(b, f_max_hz=fin.modes.f_max).frequencies_hz
+    b = _read(B.write_case_bdf(a, tmp_path / "b.bdf"))
+    fb = _modes(b, f_max_hz=fin.modes.f_max).frequencies_hz
     np.testing.assert_allclose(fb, fa, rtol=1e-9)
-    np.testing.assert_allclose(b.boxes.corners, a.boxes.corners, atol=1e-12)
-    np.testing.assert_allclose(a.boxes.corners, pl.box_mesh(fin).corners, atol=1e-12)
-    assert a.flutter == b.flutter
-    np.testing.assert_allclose(a.flutter[0].velocities, fin.flight.velocities)
-    assert a.machs == fin.aero.machs
+    np.testing.assert_allclose(pl.box_mesh(b).corners, pl.box_mesh(a).corners, atol=1e-12)
+    np.testing.assert_allclose(pl.box_mesh(a).corners, pl.box_mesh(fin).corners, atol=1e-12)
+    assert a.aero == b.aero and a.modes == b.modes
+    np.testing.assert_allclose(b.flight.densities, a.flight.densities, rtol=1e-12)
+    np.testing.assert_allclose(b.flight.velocities, a.flight.velocities, rtol=1e-12)
+    np.testing.assert_allclose(a.flight.velocities, fin.flight.velocities)
+    assert a.aero.machs == fin.aero.machs
     # MKAERO1 is written in 8-character fields (7 significant digits)
-    np.testing.assert_allclose(a.reduced_frequencies, pl.reduced_frequencies(fin), rtol=1e-6)
-    assert a.b_ref == pytest.approx(fin.aero.reference_semichord, rel=1e-12)
+    np.testing.assert_allclose(a.aero.reduced_frequencies, pl.reduced_frequencies(fin),
+                               rtol=1e-6)
+    assert a.aero.reference_semichord == pytest.approx(fin.aero.reference_semichord, rel=1e-12)
 
 
 def _variant(fin_path, **changes):
@@ -101,11 +118,19 @@ def test_shaft_region_bending_spring_point_mass_orthotropic_round_trip(tmp_path)
                     modes={"count": 5, "keep_rigid": False})
     ref = pl.modal_model(case).frequencies_hz
     a = _read(B.write_case_bdf(case, tmp_path / "a.bdf", sol=103))
-    assert a.boxes is None and len(a.rigid) == 1 and len(a.masses) == 1
-    fa = B.modal_model(a, n_modes=5).frequencies_hz
+    deck = a.structure.deck
+    assert a.aero is None and a.flight is None and a.structure.boxes is None
+    assert len(deck.rigid) == 1 and len(deck.masses) == 1
+    # the deck's RBE2, SPC1 and CELAS2 hold it as they are (not re-read as a shaft)
+    assert a.support.kind == "imported"
+    assert "1 RBE2" in a.structure.support and "2 CELAS to ground" in a.structure.support
+    fa = _modes(a, n_modes=5).frequencies_hz
     np.testing.assert_allclose(fa, ref, rtol=2e-5)
-    b = _read(B.write_bdf_model(a, tmp_path / "b.bdf"))
-    np.testing.assert_allclose(B.modal_model(b, n_modes=5).frequencies_hz, fa, rtol=1e-9)
+    b = _read(B.write_case_bdf(a, tmp_path / "b.bdf"))
+    assert B.case_bdf(a).sol == 103                        # no aero: SOL 103 by default
+    np.testing.assert_allclose(_modes(b, n_modes=5).frequencies_hz, fa, rtol=1e-9)
+    # the deck's record written directly is the same deck (same structure digest)
+    assert _read(B.write_bdf_model(deck, tmp_path / "c.bdf")).structure == b.structure
 
 
 def test_unsupported_cards_warned_once_with_count_and_id(fin, tmp_path):
@@ -136,14 +161,18 @@ def test_units_in_lbf_s_equal_si(tmp_path):
     x 0.0254 and the mass unit converted) would give the same: checked through the plate
     bending frequency scaling f ~ (t / L^2) sqrt(E / rho), invariant under unit changes."""
     a = _read(HA145E / "ha145e.bdf", units="in-lbf-s")
-    f_in = B.modal_model(a).frequencies_hz
+    f_in = _modes(a).frequencies_hz
     # the same deck read as if it were SI: lengths 1/0.0254 smaller in m, E in Pa, rho in
     # kg/m^3: f scales as (1/L) sqrt(E/rho) in consistent units -> identical numbers when
     # the deck's own unit system is consistent
     s = _read(HA145E / "ha145e.bdf", units="SI")
-    np.testing.assert_allclose(B.modal_model(s).frequencies_hz, f_in, rtol=1e-9)
-    assert a.b_ref == pytest.approx(2.07055 / 2 * 0.0254, rel=1e-12)
-    assert a.rho_ref == pytest.approx(1.0726e-7 * 4.4482216152605 / 0.0254**4, rel=1e-12)
+    np.testing.assert_allclose(_modes(s).frequencies_hz, f_in, rtol=1e-9)
+    assert a.aero.reference_semichord == pytest.approx(2.07055 / 2 * 0.0254, rel=1e-12)
+    rho = 1.0726e-7 * 4.4482216152605 / 0.0254**4
+    assert a.structure.deck.rho_ref == pytest.approx(rho, rel=1e-12)
+    assert a.flight.densities == pytest.approx((rho,), rel=1e-12)     # FLFACT 1.0 x RHOREF
+    np.testing.assert_allclose(np.asarray(a.flight.velocities)[[0, -1]],
+                               [4000 * 0.0254, 6400 * 0.0254], rtol=1e-12)
 
 
 def test_ha145e_modes_against_nastran():
@@ -159,11 +188,11 @@ def test_ha145e_modes_against_nastran():
     nastran = B.read_f06_eigenvalues(HA145E / "ha145e.f06")
     np.testing.assert_allclose(nastran, [34.34399, 210.0004, 260.4287, 634.7608], rtol=1e-6)
     m = _read(HA145E / "ha145e.bdf", units="in-lbf-s", thickness_rule="centroid")
-    f = B.modal_model(m).frequencies_hz
+    f = _modes(m).frequencies_hz
     assert f.size == 4
     err = f / nastran - 1
     assert np.all(np.abs(err) < 0.03), err
-    g = B.modal_model(_read(HA145E / "ha145e.bdf", units="in-lbf-s")).frequencies_hz
+    g = _modes(_read(HA145E / "ha145e.bdf", units="in-lbf-s")).frequencies_hz
     assert np.all(g > f) and np.all(g / nastran - 1 < 0.07)
 
 
@@ -175,9 +204,10 @@ def test_ha145e_flutter_against_published():
     gives 6051 in/s (12 x 8) and 6102 in/s (18 x 12), so the box-converged asekit flutter
     speed lies about 6 % above the coarse-grid ZONA6 value (not asserted here)."""
     m = _read(HA145E / "ha145e.bdf", units="in-lbf-s", thickness_rule="centroid")
-    res, db, model = B.flutter(m)
-    (r,) = res
-    assert r.speed is not None
+    (res,) = pl.flutter(m).results                       # one Mach x one density
+    assert res.mach == 0.45 and not res.unstable_at_start
+    r = res.flutter
+    assert r is not None
     v_in = r.speed / 0.0254
     assert abs(v_in / 5753.150 - 1) < 0.05, v_in
     assert abs(r.frequency_hz / 111.7046 - 1) < 0.05, r.frequency_hz
@@ -215,10 +245,10 @@ def test_two_panels_cord2r_grids_and_damping(tmp_path):
     m.write_bdf(str(p2), size=16, elements_size=8)
     assert "CORD2R" in p2.read_text()
     a = _read(p2)
-    mm = B.modal_model(a, n_modes=4)
+    mm = _modes(a, n_modes=4)
     np.testing.assert_allclose(mm.frequencies_hz, ref.frequencies_hz, rtol=2e-5)
     np.testing.assert_allclose(np.diag(mm.C), np.diag(ref.C), rtol=2e-5)
-    assert a.boxes.n == pl.box_mesh(case).n
+    assert pl.box_mesh(a).n == pl.box_mesh(case).n
 
 
 def _split_into_triangles(src, dst):
@@ -253,16 +283,15 @@ def test_ctria3_degenerated_mitc4_converges_to_nafems_fv16(tmp_path):
         quad = pl.modal_model(case).frequencies_hz[:5]
         src = B.write_case_bdf(case, tmp_path / f"q{n}.bdf", sol=103, n_modes=5)
         tri = _read(_split_into_triangles(src, tmp_path / f"t{n}.bdf"))
-        assert tri.mesh.n_elements == 2 * n * n
-        f = B.modal_model(tri, n_modes=5).frequencies_hz
+        assert pl.structural_mesh(tri).n_elements == 2 * n * n
+        f = _modes(tri, n_modes=5).frequencies_hz
         assert np.all(f > quad * (1 - 1e-6))           # stiffer, never softer
         errs.append(np.abs(f / quad - 1).max())
         if n == 32:
             np.testing.assert_allclose(f, quad, rtol=0.01)
             np.testing.assert_allclose(f, nafems, rtol=0.01)
-            back = _read(B.write_bdf_model(tri, tmp_path / "back.bdf"))
-            np.testing.assert_allclose(B.modal_model(back, n_modes=5).frequencies_hz, f,
-                                       rtol=1e-9)
+            back = _read(B.write_case_bdf(tri, tmp_path / "back.bdf"))
+            np.testing.assert_allclose(_modes(back, n_modes=5).frequencies_hz, f, rtol=1e-9)
     assert errs[1] < errs[0] / 4                       # converging
 
 
@@ -270,10 +299,9 @@ def test_aefact_box_divisions_round_trip_and_bulk_only_file(tmp_path):
     """Non-uniform boxes (cosine chordwise, stretched spanwise) are written as CAERO1 with
     AEFACT LCHORD / LSPAN and read back (8-character AEFACT fields: 1e-6 m); a bulk-data-only
     file (no executive / case control) reads as well."""
-    import dataclasses
     from asekit.aero.boxes import BoxMesh
     s = _read(HA145E / "ha145e_structure.bdf", units="in-lbf-s")
-    assert s.boxes is None and s.n_modes == 4
+    assert s.structure.boxes is None and s.aero is None and s.modes.count == 4
     m = _read(HA145E / "ha145e.bdf", units="in-lbf-s")
     i = 0.0254
     xi = 0.5 * (1 - np.cos(np.linspace(0, np.pi, 6)))
@@ -283,11 +311,12 @@ def test_aefact_box_divisions_round_trip_and_bulk_only_file(tmp_path):
     g = le[:, None, :] + xi[None, :, None] * c * np.array([1.0, 0.0, 0.0])
     box = np.stack([g[:-1, :-1], g[:-1, 1:], g[1:, 1:], g[1:, :-1]], axis=2).reshape(-1, 4, 3)
     bm = BoxMesh(box, np.repeat(np.arange(7), 5), np.zeros(35, int))
-    p = B.write_bdf_model(dataclasses.replace(m, boxes=bm, box_ids=100001 + np.arange(35)),
-                          tmp_path / "nu.bdf")
+    nu = dataclasses.replace(m, structure=dataclasses.replace(m.structure, boxes=bm))
+    assert nu != m and nu.fingerprint() != m.fingerprint()      # the boxes are in the digest
+    p = B.write_case_bdf(nu, tmp_path / "nu.bdf")
     assert p.read_text().count("AEFACT") == 2
     back = _read(p)
-    np.testing.assert_allclose(back.boxes.corners, bm.corners, atol=1e-6)
+    np.testing.assert_allclose(pl.box_mesh(back).corners, bm.corners, atol=1e-6)
 
 
 def test_fin_flutter_through_the_bdf_equals_the_case(fin, tmp_path):
@@ -295,12 +324,116 @@ def test_fin_flutter_through_the_bdf_equals_the_case(fin, tmp_path):
     velocities all read back from CAERO1 / MKAERO1 / FLFACT) flutters where the case's own
     pipeline says (M 0.5, sea level; the case holds the rigid pitch mode, the deck's FN2
     ground inertia does the same): measured 210.0457 vs 210.0441 m/s."""
-    import dataclasses
     m = _read(B.write_case_bdf(fin, tmp_path / "fin.bdf"))
-    req = dataclasses.replace(m.flutter[0], machs=(0.5,), densities=m.flutter[0].densities[:1])
-    res, _, _ = B.flutter(dataclasses.replace(m, machs=(0.5,), flutter=(req,)))
+    m = dataclasses.replace(m, aero=dataclasses.replace(m.aero, machs=(0.5,)),
+                            flight=dataclasses.replace(m.flight,
+                                                       densities=m.flight.densities[:1]))
+    (res,) = pl.flutter(m).results
     cond = pl.flight_conditions(fin)[0]
-    assert cond.altitude == 0.0 and req.densities[0] == pytest.approx(cond.density, rel=1e-7)
+    assert cond.altitude == 0.0 and res.condition.density == pytest.approx(cond.density,
+                                                                           rel=1e-7)
     ref = pl.analyse_condition(fin, pl.gaf_database(fin, progress=False), 0.5, cond)
-    assert res[0].speed == pytest.approx(ref.flutter.speed, rel=1e-4)
-    assert res[0].frequency_hz == pytest.approx(ref.flutter.frequency_hz, rel=1e-4)
+    assert res.flutter.speed == pytest.approx(ref.flutter.speed, rel=1e-4)
+    assert res.flutter.frequency_hz == pytest.approx(ref.flutter.frequency_hz, rel=1e-4)
+
+
+def test_imported_case_is_hashed_by_content_and_cached(tmp_path):
+    """Two reads of one deck are equal cases with one hash and one fingerprint, so the
+    pipeline's lru_cache returns the same modal model; a changed structure is another case."""
+    a = _read(HA145E / "ha145e.bdf", units="in-lbf-s")
+    b = _read(HA145E / "ha145e.bdf", units="in-lbf-s")
+    assert a.structure is not b.structure
+    assert a == b and hash(a) == hash(b) and a.fingerprint() == b.fingerprint()
+    assert pl.modal_model(a) is pl.modal_model(b)
+    c = _read(HA145E / "ha145e.bdf", units="in-lbf-s", thickness_rule="centroid")
+    assert c.structure != a.structure and c.fingerprint() != a.fingerprint()
+    # a point mass added to an imported case enters its mass matrix (the pipeline's M)
+    tip = tuple(float(v) for v in pl.structural_mesh(a).nodes[-1])
+    heavy = dataclasses.replace(a, point_masses=(PointMass(tip, 0.05),))
+    assert heavy != a
+    f0, f1 = pl.modal_model(a).frequencies_hz, pl.modal_model(heavy).frequencies_hz
+    assert np.all(f1 < f0)                      # added mass, same stiffness: every mode lower
+
+
+def test_imported_case_gets_the_report(tmp_path):
+    """An imported deck runs through the whole analyse road: summary, text table and the
+    HTML report with its figures (planform with the deck's mesh and boxes, modes, V-g)."""
+    from asekit.case import report
+    m = _read(HA145E / "ha145e.bdf", units="in-lbf-s", thickness_rule="centroid")
+    a = report.run_analysis(m)
+    s = report.summary(a)
+    assert s["case"] == "ha145e" and s["boxes"] == 24
+    (row,) = s["flutter"]
+    assert row["speed_ms"] == pytest.approx(a.flutter.results[0].flutter.speed, rel=1e-12)
+    assert "ha145e" in report.format_summary(s)
+    index = report.write_report(a, tmp_path / "rep")
+    names = {p.name for p in index.parent.glob("*.png")}
+    assert {"planform.png", "modes.png", "vg_0.png"} <= names
+
+
+def test_edges_support_exports_as_its_constraints(tmp_path):
+    """A case held on its edges (NAFEMS FV16's clamped root as an "edges" support) is written
+    as SPC1 on the DOFs the edge conditions fix, not as a shaft, and gives the case's modes."""
+    import tomllib
+    d = tomllib.load(open(DATA_DIR / "cases" / "nafems_fv16.toml", "rb"))
+    d["support"] = {"kind": "edges", "root": "clamped", "leading_edge": "simply_supported"}
+    d["modes"] = {"count": 4}
+    case = case_from_dict(d)
+    ref = pl.modal_model(case).frequencies_hz
+    deck = B.case_bdf(case, sol=103)
+    assert "CELAS2" not in deck.card_count and "RBE2" not in deck.card_count
+    back = _read(B.write_case_bdf(case, tmp_path / "e.bdf", sol=103))
+    np.testing.assert_allclose(_modes(back).frequencies_hz, ref, rtol=1e-6)
+
+
+def test_deck_without_flutter_request_has_no_flight(tmp_path):
+    """A deck without FLUTTER is a case without flight conditions: modes and GAFs work, the
+    flutter step says what is missing."""
+    s = _read(HA145E / "ha145e_structure.bdf", units="in-lbf-s")
+    assert _modes(s).frequencies_hz.size == 4
+    with pytest.raises(ValueError, match="no aerodynamic boxes"):
+        pl.box_mesh(s)
+    m = _read(HA145E / "ha145e.bdf", units="in-lbf-s")
+    with pytest.raises(ValueError, match="no flight conditions"):
+        pl.flight_conditions(dataclasses.replace(m, flight=None))
+
+
+def test_analyse_cli_reads_a_deck(tmp_path, capsys):
+    """``python -m asekit analyse DECK.bdf --units in-lbf-s``: the deck's case through the
+    analyse road (JSON summary with the deck's flutter point); a deck without aero is refused
+    with one line naming the file."""
+    import json
+    from asekit.__main__ import main
+    out = tmp_path / "s.json"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", B.UnsupportedCardWarning)
+        assert main(["analyse", str(HA145E / "ha145e.bdf"), "--units", "in-lbf-s", "--quiet",
+                     "--json", str(out)]) == 0
+        s = json.loads(out.read_text())
+        ref = pl.flutter(_read(HA145E / "ha145e.bdf", units="in-lbf-s")).results[0].flutter
+        assert s["flutter"][0]["speed_ms"] == pytest.approx(ref.speed, rel=1e-12)
+        assert main(["analyse", str(HA145E / "ha145e_structure.bdf"), "--units",
+                     "in-lbf-s", "--quiet"]) == 2
+    assert "ha145e_structure.bdf" in capsys.readouterr().err
+
+
+def test_imported_case_state_space_flutters_where_pk_says():
+    """The deck's aeroelastic state space (asekit.io.export.case_state_spaces: Roger RFA, the
+    imported mesh's corners as outputs) at sea level is stable at 0.9 U_f and unstable at
+    1.1 U_f, U_f the pipeline's p-k flutter speed at the same density."""
+    from asekit.io import export
+    from asekit.atmosphere import standard_atmosphere
+    m = _read(HA145E / "ha145e.bdf", units="in-lbf-s")
+    rho = float(standard_atmosphere(0.0).density)
+    sea = dataclasses.replace(m, flight=dataclasses.replace(m.flight, densities=(rho,)))
+    uf = pl.flutter(sea).results[0].flutter.speed
+    corners = pl.corner_points(m)
+    assert corners["root_le"] == (0.0, 0.0)
+    assert corners["tip_te"][1] == corners["tip_le"][1] > 0.0           # one tip station
+    assert corners["tip_te"][0] > corners["tip_le"][0]                  # TE aft of LE
+    growth = []
+    for u in (0.9 * uf, 1.1 * uf):
+        ss = export.case_state_spaces(m, mach=0.45, altitude=0.0, velocity=u)["aeroelastic"]
+        assert "w_tip_te" in ss.output_labels
+        growth.append(np.linalg.eigvals(np.asarray(ss.A)).real.max())
+    assert growth[0] < 0 < growth[1], growth
