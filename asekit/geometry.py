@@ -4,7 +4,7 @@ Axes: x chordwise (downstream, the free-stream direction), y spanwise, z normal 
 rotation about +y moves the trailing edge down: nose-up, i.e. a positive angle of attack.
 
 The reference fin is one case file, ``data/cases/nalci2013_fin.toml``, read by
-:func:`asekit.reproduction.fin.load_fin`; nothing here knows it.
+:func:`asekit.case.load_case`; nothing here knows it.
 """
 
 from __future__ import annotations

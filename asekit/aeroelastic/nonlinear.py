@@ -20,9 +20,9 @@ with large local structural variations", J. Aircraft 31(2), 1994, 396-403; Karpe
 Love, "Modal-based structural optimization with static aeroelastic and stress constraints",
 J. Aircraft 34(3), 1997): normal modes computed with a large fictitious mass at the connection
 contain the local connection motion, so one modal basis represents the structure for any
-connection stiffness. asekit's FN2 model (:func:`asekit.reproduction.fin.fin_modal_model`) is
-exactly that basis: the rigid pitch mode (a unit rotation of the whole fin about the shaft) and
-the elastic modes computed with the shaft spring k_s present. Used as Ritz vectors for the *fin
+connection stiffness. asekit's FN2 model (:func:`asekit.case.pipeline.modal_model` of a shaft
+case) is exactly that basis: the rigid pitch mode (a unit rotation of the whole fin about the
+shaft) and the elastic modes computed with the shaft spring k_s present. Used as Ritz vectors for the *fin
 alone* -- fin coordinates xi = [theta_f, zeta_s], fin displacement phi_R theta_f + Phi_s zeta_s
 -- the structure's stiffness splits exactly into the plate's own and the connection's:
 

@@ -8,14 +8,16 @@ memoised on the case (frozen, hashable) so that one run computes each once.
 
 from __future__ import annotations
 
+import functools
 import math
 import time
+import warnings
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
 
-from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
+from asekit.aero.boxes import TrapezoidSurface, check_matrix_memory, mesh_surfaces
 from asekit.aero.gaf import GafDatabase, cached_gaf_database, default_reduced_frequencies
 from asekit.atmosphere import standard_atmosphere
 from asekit.aeroelastic.flutter import (Instability, PkResult, TabulatedGaf, divergence_speeds,
@@ -23,10 +25,13 @@ from asekit.aeroelastic.flutter import (Instability, PkResult, TabulatedGaf, div
 from asekit.aeroelastic.methods import flutter_method
 from asekit.rfa.methods import rfa_kind
 from asekit.rfa.roger import gaf_at_mach
-from asekit.structure.assembly import assemble, clamped_edge, point_mass_matrix, shaft_support
+from asekit.structure.assembly import (SupportedSystem, assemble, plate_pitch_inertia,
+                                       point_mass_matrix)
 from asekit.structure.mesh import PlateMesh, panels_mesh
-from asekit.structure.modes import (ModalModel, fictitious_mass_modal_model, fixed_modal_model,
-                                    with_damping)
+from asekit.structure.modes import InPlaneModes, ModalModel, fixed_modal_model, with_damping
+from asekit.structure.modes import inplane_modes as _inplane_modes
+from asekit.structure.supports import support_kind
+from asekit.util.validate import positive
 from asekit.case.schema import Case, CaseError
 
 
@@ -55,35 +60,72 @@ def mass_and_stiffness(case: Case):
     return K, M
 
 
-@lru_cache(maxsize=16)
+def _read_only(model: ModalModel) -> ModalModel:
+    """``model`` with its arrays made read-only (a memoised result is shared by every caller:
+    one that changes an array in place gets an error instead of corrupting the memo)."""
+    for f in ("frequencies_hz", "M", "K", "C", "nodes", "shapes", "elements"):
+        getattr(model, f).setflags(write=False)
+    return model
+
+
+def _memo_with_warnings(fn):
+    """Memoise ``fn(case)`` on the frozen (hashable) case, the warnings of its one computation
+    issued again on every call (under the caller's filters), so the memo changes neither a
+    result nor what the caller is told."""
+    @lru_cache(maxsize=32)
+    def memo(case):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            result = fn(case)
+        return result, tuple((w.message, w.category) for w in caught)
+
+    @functools.wraps(fn)
+    def wrapper(case):
+        result, caught = memo(case)
+        for message, category in caught:
+            warnings.warn(message, category, stacklevel=2)
+        return result
+    wrapper.cache_clear = memo.cache_clear
+    return wrapper
+
+
+def supported_system(case: Case) -> SupportedSystem:
+    """The case's supported structure (its ``support.kind`` of
+    :data:`asekit.structure.supports.SUPPORTS`; for a shaft, the FN1 or FN2 system as
+    ``support.model`` says) on :func:`structural_mesh` with :func:`mass_and_stiffness`."""
+    K, M = mass_and_stiffness(case)
+    if case.structure is not None:             # the imported deck's own supports
+        return case.structure.supported_system(K, M)
+    try:
+        return support_kind(case.support.kind).system(structural_mesh(case), K, M, case.support)
+    except ValueError as exc:
+        raise CaseError(f"support: {exc}") from None
+
+
+@_memo_with_warnings
 def modal_model(case: Case) -> ModalModel:
     """The case's modal model (thesis Eqs. 2.45-2.46): for a shaft with ``model = "FN2"`` and
     ``modes.keep_rigid`` the rigid pitch mode first (n_rigid = 1), otherwise the elastic modes
-    only; damping from ``[damping]``. An imported structure: :func:`imported_modal_model`."""
+    only; damping from ``[damping]``. Built by the support kind's ``modal_model``
+    (:data:`asekit.structure.supports.SUPPORTS`); memoised on the case, its arrays read-only.
+    An imported structure: :func:`imported_modal_model`.
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import FIN_FILE
+    >>> m = modal_model(load_case(FIN_FILE))
+    >>> m.n_rigid, m.frequencies_hz.size, m.label
+    (1, 6, 'FN2 6x7 single-node shaft')
+    """
     if case.structure is not None:
         return imported_modal_model(case)
     mesh = structural_mesh(case)
     K, M = mass_and_stiffness(case)
     s, md = case.support, case.modes
     try:
-        if s.kind == "clamped_root":
-            model = fixed_modal_model(clamped_edge(mesh, K, M), M, md.f_max, md.count)
-        elif s.kind == "edges":
-            from asekit.structure.supports import planform_edge_supports
-            model = fixed_modal_model(planform_edge_supports(mesh, K, M, **dict(s.edges)), M,
-                                      md.f_max, md.count)
-        else:
-            region = "single_node" if s.radius is None else "distributed"
-            radius = 0.0 if s.radius is None else s.radius
-            if s.model == "FN2" and md.keep_rigid:
-                model = fictitious_mass_modal_model(
-                    mesh, K, M, s.axis_point, s.torsional_stiffness, region=region,
-                    radius=radius, fictitious_inertia_factor=s.fictitious_inertia_factor,
-                    bending_stiffness=s.bending_stiffness, f_max_hz=md.f_max, n_modes=md.count)
-            else:
-                fn1 = shaft_support(mesh, K, M, s.axis_point, s.torsional_stiffness, "FN1",
-                                    region, radius, bending_stiffness=s.bending_stiffness)
-                model = fixed_modal_model(fn1, M, md.f_max, md.count, axis_x=s.axis_point[0])
+        model = support_kind(s.kind).modal_model(mesh, K, M, s, md.f_max, md.count,
+                                                 md.keep_rigid)
     except ValueError as exc:
         raise CaseError(f"support / modes: {exc}") from None
     if len(model.frequencies_hz) - model.n_rigid < 1:
@@ -91,9 +133,39 @@ def modal_model(case: Case) -> ModalModel:
                         f"f_max or give modes.count")
     d = case.damping
     try:
-        return with_damping(model, d.modal_damping_ratio, d.structural_g)
+        return _read_only(with_damping(model, d.modal_damping_ratio, d.structural_g))
     except ValueError as exc:
         raise CaseError(str(exc)) from None
+
+
+def _one_panel(case: Case, what: str):
+    if len(case.panels) != 1:
+        raise CaseError(f"{what} needs a one-panel case, got {len(case.panels)} panels")
+    return case.panels[0]
+
+
+def _shaft(case: Case, what: str):
+    if case.support.kind != "shaft":
+        raise CaseError(f"{what} needs support.kind = \"shaft\", got {case.support.kind!r}")
+    return case.support
+
+
+def pitch_inertia_exact(case: Case) -> float:
+    """Pitch inertia (kg m^2) of a one-panel flat case about its shaft axis by exact integration
+    (:func:`asekit.structure.assembly.plate_pitch_inertia`; no point masses)."""
+    p = _one_panel(case, "pitch_inertia_exact")
+    try:
+        return plate_pitch_inertia(p.planform, case.thickness, case.material.density,
+                                   _shaft(case, "pitch_inertia_exact").axis_point[0])
+    except ValueError as exc:
+        raise CaseError(f"thickness / material: {exc}") from None
+
+
+def inplane_modes(case: Case, n_modes: int = 4) -> InPlaneModes:
+    """In-plane modes of a shaft-supported case held only at the shaft node
+    (:func:`asekit.structure.modes.inplane_modes` on :func:`structural_mesh`)."""
+    return _inplane_modes(structural_mesh(case), case.material,
+                          _shaft(case, "inplane_modes").axis_point, n_modes)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -162,32 +234,54 @@ def imported_box_mesh(case: Case):
 # ---------------------------------------------------------------------------------------------
 # aerodynamics
 # ---------------------------------------------------------------------------------------------
-def _auto_boxes(planform, u_min: float, f_max: float, bpw_min: float = 15.0,
-                ar_max: float = 3.0) -> tuple[int, int]:
-    """Box counts of one panel from the mesh rules (thesis Sec. 3.2.1): the smallest
-    n_chord >= 4 with boxes per wavelength U_min / (f_max dx) > ``bpw_min`` on the root strip
-    and the smallest n_span keeping the tip boxes' aspect ratio below 0.9 ``ar_max``."""
-    dx_max = u_min / (bpw_min * f_max)
-    n_chord = max(4, math.floor(planform.root_chord / dx_max) + 1)
-    dx_tip = planform.tip_chord / n_chord
-    n_span = max(1, math.ceil(planform.span / (0.9 * ar_max * dx_tip)))
-    return n_chord, n_span
+def auto_boxes(planform, u_min: float, f_max: float, n_chord: int | None = None,
+               n_span: int | None = None, bpw_min: float = 15.0,
+               ar_max: float = 3.0) -> tuple[int, int]:
+    """Box counts (n_chord, n_span) of one panel from the mesh rules (thesis Sec. 3.2.1).
+
+    n_chord (unless given): the smallest n_chord >= 4 with boxes per wavelength
+    U_min / (f_max dx) > ``bpw_min`` (strictly) on the root strip, dx = root chord / n_chord
+    (Eq. 3.5); n_span (unless given): the smallest keeping the tip boxes' aspect ratio
+    span / (n_span dx_tip) below 0.9 ``ar_max`` (a 10 % margin), dx_tip = tip chord / n_chord.
+    u_min in m/s, f_max in Hz.
+
+    Examples
+    --------
+    >>> from asekit.geometry import Planform
+    >>> auto_boxes(Planform((0.0, 0.0), 0.156, (0.078, 0.15), 0.078), 180.0, 1000.0)
+    (14, 10)
+    """
+    u_min, f_max = positive("aero.u_min", u_min), positive("aero.f_max", f_max)
+    bpw_min, ar_max = positive("bpw_min", bpw_min), positive("ar_max", ar_max)
+    if n_chord is None:
+        dx_max = u_min / (bpw_min * f_max)
+        n_chord = max(4, math.floor(planform.root_chord / dx_max) + 1)
+    if n_span is None:
+        dx_tip = planform.tip_chord / n_chord
+        n_span = max(1, math.ceil(planform.span / (0.9 * ar_max * dx_tip)))
+    return int(n_chord), int(n_span)
 
 
 @lru_cache(maxsize=16)
 def box_mesh(case: Case):
-    """The doublet-lattice boxes, per panel ``aero.boxes`` or automatic (mesh rules), or the
-    imported structure's boxes."""
+    """The doublet-lattice boxes, per panel ``aero.boxes`` or automatic (:func:`auto_boxes`),
+    or the imported structure's boxes; the surfaces are named ``"surface"`` (one panel) or
+    ``"panel<i>"``. Refuses (ValueError from :func:`asekit.aero.boxes.check_matrix_memory`) a
+    mesh whose dense DLM matrix would not fit in memory."""
     if case.structure is not None:
         return imported_box_mesh(case)
     a = case.aero
     surfaces = []
     for i, p in enumerate(case.panels):
         pf = p.planform
-        nc, ns = a.boxes[i] if a.boxes is not None else _auto_boxes(pf, a.u_min, a.f_max)
+        nc, ns = a.boxes[i] if a.boxes is not None else auto_boxes(pf, a.u_min, a.f_max)
         surfaces.append(TrapezoidSurface(pf.root_le + (0.0,), pf.root_chord, pf.tip_le + (0.0,),
                                          pf.tip_chord, nc, ns,
                                          name=f"panel{i}" if len(case.panels) > 1 else "surface"))
+    n_boxes = sum(sf.n_chord * sf.n_span for sf in surfaces)
+    check_matrix_memory(n_boxes, 1, 16, f"one DLM matrix of case {case.name!r} ({n_boxes} boxes"
+                        f"{' from the mesh rules' if a.boxes is None else ''})",
+                        "give aero.boxes" if a.boxes is None else "lower aero.boxes")
     return mesh_surfaces(surfaces)
 
 
@@ -200,9 +294,13 @@ def reduced_frequencies(case: Case) -> np.ndarray:
     return default_reduced_frequencies(2 * math.pi * a.f_max * a.reference_semichord / a.u_min)
 
 
-def gaf_database(case: Case, progress: bool = True, cache: bool = True) -> GafDatabase:
-    """Q_mm(M, k) over ``aero.machs`` x the reduced frequencies, cached per fingerprint in the
-    user cache directory (:func:`asekit.aero.gaf.cached_gaf_database`)."""
+def gaf_database(case: Case, progress: bool = True, cache: bool = True,
+                 path=None) -> GafDatabase:
+    """Q_mm(M, k) over ``aero.machs`` x the reduced frequencies of :func:`modal_model` on
+    :func:`box_mesh`, loaded from a shipped database (the fin's ``data/gaf_fin.npz``) or the
+    user cache when one matches its fingerprint (mode set, boxes' corners, Mach, k, b_ref,
+    symmetry, method), else rebuilt (``cache=False``: always) into the user cache or ``path``
+    (:func:`asekit.aero.gaf.cached_gaf_database`)."""
     a = case.aero
     if a is None:
         raise CaseError(f"{case.name}: the case has no aerodynamics (an imported deck without "
@@ -212,7 +310,7 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True) -> GafDa
     return cached_gaf_database(modal_model(case), box_mesh(case), a.machs,
                                reduced_frequencies(case), a.reference_semichord,
                                symmetric=a.symmetry == "wall", method=method,
-                               progress=progress, rebuild=not cache,
+                               progress=progress, rebuild=not cache, path=path,
                                metadata={"case": case.name})
 
 
@@ -443,25 +541,111 @@ def actuator_setup(case: Case):
     return act, ctl, lim
 
 
+@dataclass(frozen=True)
+class AseCondition:
+    """A case's aeroservoelastic model at one flight condition and what it was built from:
+    ``model`` (:class:`asekit.ase.loop.AeroservoelasticModel`), ``modal`` (ModalModel), ``rfa``
+    (the rational fit at ``mach``), ``q_cc`` (steady Re Q_cc at ``mach`` and the database's
+    lowest k, m^3/rad), ``mach``, ``altitude`` (m), ``density`` (kg/m^3), ``velocity``
+    (m/s)."""
+
+    model: object
+    modal: object
+    rfa: object
+    q_cc: float
+    mach: float
+    altitude: float
+    density: float
+    velocity: float
+
+    @property
+    def dynamic_pressure(self) -> float:
+        """q = rho U^2 / 2 (Pa)."""
+        return 0.5 * self.density * self.velocity ** 2
+
+    def rigid_fin_actuator(self):
+        """The thesis's Ch. 4 design model: the actuator with the rigid surface's pitch inertia
+        J_fin (of the structural model) as its load."""
+        return replace(self.model.actuator, fin_inertia=float(self.modal.J_fin))
+
+    def steady_hinge_moment(self):
+        """The Ch. 4 steady hinge moment q Q_cc theta at this flight condition
+        (:class:`asekit.servo.simulate.SteadyHingeMoment`)."""
+        from asekit.servo.simulate import SteadyHingeMoment
+        atm = standard_atmosphere(self.altitude)
+        return SteadyHingeMoment(q_cc=self.q_cc, mach=self.mach, density=float(atm.density),
+                                 speed_of_sound=float(atm.speed_of_sound))
+
+
+def ase_condition(case: Case, mach: float | None = None, altitude: float | None = None,
+                  actuator=None, count_fin_inertia_twice: bool = False, n_lags: int | None = None,
+                  fit=None, db: GafDatabase | None = None,
+                  modal: ModalModel | None = None) -> AseCondition:
+    """The case's aeroservoelastic model (thesis Ch. 5) at (``mach``, ``altitude`` m).
+
+    The GAFs of :func:`gaf_database` at ``mach`` (interpolated linearly between the database's
+    Mach numbers; outside them a ValueError), the case's RFA (``flutter.rfa``, Roger by
+    default) with ``n_lags`` lag roots (default ``flutter.lags``, 4), or ``fit(k, Q, b_ref,
+    mach) -> RFA`` (e.g. :func:`asekit.rfa.minimum_state_fit`), the 1976
+    standard atmosphere at ``altitude`` and U = mach x speed of sound, assembled by
+    :func:`asekit.ase.loop.build_model`. Outputs: the root pitch at the shaft (the AEM2 feedback),
+    ``theta_<corner>`` and ``w_<corner>`` at the four corners of :func:`corner_points`, and
+    the modal coordinates.
+
+    Parameters
+    ----------
+    case : a shaft-supported case with a rigid pitch mode (FN2, ``modes.keep_rigid``).
+    mach, altitude : the flight condition (default ``[actuator.condition]``, else 0.5 and 0 m).
+    actuator : :class:`asekit.servo.actuator.ActuatorParameters` (default: build_model's, the thesis's).
+    count_fin_inertia_twice : the thesis's Simulink choice (see build_model).
+    n_lags, fit : the rational fit.
+    db, modal : a database and its modal model to use instead of the case's.
+
+    Returns
+    -------
+    :class:`AseCondition`.
+    """
+    from asekit.ase import loop as ase_mod
+    from asekit.aeroelastic.statespace import fin_outputs
+    from asekit.util.validate import finite
+
+    a = case.actuator
+    mach = finite("mach", (a.mach if a is not None else 0.5) if mach is None else mach)
+    altitude = finite("altitude", (a.altitude if a is not None else 0.0) if altitude is None
+                      else altitude)
+    shaft = _shaft(case, "ase_condition")
+    db = gaf_database(case, progress=False) if db is None else db
+    modal = modal_model(case) if modal is None else modal
+    lo, hi = float(np.min(db.machs)), float(np.max(db.machs))
+    if not lo <= mach <= hi:
+        raise ValueError(f"mach must lie within the GAF database's range [{lo}, {hi}], "
+                         f"got {mach}")
+    k, q = gaf_at_mach(db, mach, interpolate=True)
+    lags = case.flutter.lags if n_lags is None else n_lags
+    rfa = (rfa_kind(case.flutter.rfa).fit(k, q, db.b_ref, mach, lags) if fit is None
+           else fit(k, q, db.b_ref, mach))
+    atm = standard_atmosphere(altitude)
+    rho, sos = float(atm.density), float(atm.speed_of_sound)
+    corners = corner_points(case)
+    rows = fin_outputs(modal, np.array(list(corners.values())), names=list(corners),
+                       shaft_point=shaft.axis_point)
+    model = ase_mod.build_model(modal, rfa, rho, mach * sos, rows, actuator=actuator, mach=mach,
+                                count_fin_inertia_twice=count_fin_inertia_twice)
+    return AseCondition(model=model, modal=modal, rfa=rfa, q_cc=float(np.real(q[0, 0, 0])),
+                        mach=mach, altitude=altitude, density=rho, velocity=mach * sos)
+
+
 def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
     """The Ch. 5 analysis of the case's actuator (None without ``[actuator]``)."""
     if case.actuator is None:
         return None
     from asekit.ase import loop as ase_mod
     from asekit.ase import metrics
-    from asekit.aeroelastic.statespace import fin_outputs
 
     a = case.actuator
-    model = modal_model(case)
-    db = gaf_database(case, progress=False) if db is None else db
-    rfa = rfa_at(case, db, a.mach)
-    atm = standard_atmosphere(a.altitude)
-    rho, U = float(atm.density), a.mach * float(atm.speed_of_sound)
-    corners = corner_points(case)
-    rows = fin_outputs(model, np.array(list(corners.values())), names=list(corners),
-                       shaft_point=case.support.axis_point)
     act, ctl, lim = actuator_setup(case)
-    m = ase_mod.build_model(model, rfa, rho, U, rows, actuator=act, mach=a.mach)
+    cond = ase_condition(case, a.mach, a.altitude, actuator=act, db=db)
+    m, U, corners = cond.model, cond.velocity, corner_points(case)
     stable, maxre, sims, settle, err, over = {}, {}, {}, {}, {}, {}
     step = math.radians(a.step_deg)
     for topo in ase_mod.TOPOLOGIES:

@@ -10,6 +10,7 @@ SI units throughout the file, except keys whose name says otherwise (``fibre_ang
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import math
@@ -21,6 +22,7 @@ from asekit.aeroelastic.methods import FLUTTER_METHODS
 from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
 from asekit.rfa.methods import RFA_FITS
 from asekit.case.imported import ImportedModel
+from asekit.structure.supports import SUPPORTS
 
 
 class CaseError(ValueError):
@@ -42,7 +44,8 @@ class PanelSpec:
 
 @dataclass(frozen=True)
 class SupportSpec:
-    """How the surface is held.
+    """How the surface is held; ``kind`` is a key of :data:`asekit.structure.supports.SUPPORTS`
+    (which reads the kind's keys and builds its structure), the other fields are the kinds' keys.
 
     kind : ``"clamped_root"`` (every DOF of the root-chord nodes fixed), ``"edges"`` (``edges``:
         the condition -- clamped, simply_supported, sliding or free -- of the root, tip, leading
@@ -54,6 +57,7 @@ class SupportSpec:
         a rigid shaft region, ``fictitious_inertia_factor``), or ``"imported"`` (the
         constraints, rigid links and springs of ``Case.structure``, e.g. a deck's SPC / RBE2 /
         CELAS, applied as they are; not a case-file kind).
+    options : the keys of any other kind, as sorted (key, value) pairs (values hashable).
     """
 
     kind: str = "clamped_root"
@@ -64,6 +68,13 @@ class SupportSpec:
     radius: float | None = None
     fictitious_inertia_factor: float = 1.0e6
     edges: tuple[tuple[str, str], ...] | None = None
+    options: tuple[tuple[str, object], ...] = ()
+
+    def option(self, name: str, default=None):
+        """The value of a kind's own key that has no field here (``options``, set by a kind
+        registered in :data:`asekit.structure.supports.SUPPORTS` without touching this
+        class), or ``default``."""
+        return dict(self.options).get(name, default)
 
 
 @dataclass(frozen=True)
@@ -433,41 +444,19 @@ def _material(t: _Table):
 
 
 def _support(t: _Table, panels) -> SupportSpec:
-    kind = t.string("kind", ("clamped_root", "shaft", "edges"), required=True)
-    if kind == "clamped_root":
-        t.done()
-        return SupportSpec(kind="clamped_root")
-    if kind == "edges":
-        from asekit.structure.supports import EDGE_TYPES, PLANFORM_EDGES
-        defaults = {"root": "clamped", "tip": "free", "leading_edge": "free",
-                    "trailing_edge": "free"}
-        edges = tuple((e, t.string(e, EDGE_TYPES, default=defaults[e])) for e in PLANFORM_EDGES)
-        t.done()
-        if all(k == "free" for _, k in edges):
-            raise CaseError("support: all four edges free leaves rigid-body modes; hold at "
-                            "least one edge (support.root = \"clamped\", ...)")
-        return SupportSpec(kind="edges", edges=edges)
-    axis = t.numbers("axis_point", required=True, length=2, unit="m")
-    k = t.number("torsional_stiffness", required=True, low=0.0, high=1e12, unit="N m/rad")
-    kb = t.number("bending_stiffness", low=0.0, high=1e12, unit="N m/rad")
-    model = t.string("model", ("FN1", "FN2"), default="FN2")
-    region = t.raw("region", "single_node")
-    fif = t.number("fictitious_inertia_factor", default=1.0e6, low=1.0, high=1e12)
-    t.done()
-    if region == "single_node":
-        radius = None
-    elif isinstance(region, (int, float)) and not isinstance(region, bool):
-        radius = _number("support.region", region, 0.0, 1e3, True, False, "m")
-    else:
-        raise CaseError(f"support.region must be \"single_node\" or a shaft radius > 0 m, "
-                        f"got {region!r}")
-    root = panels[0].planform
-    if abs(axis[1] - root.root_le[1]) > 1e-9 * max(root.span, 1.0) or not (
-            root.root_le[0] <= axis[0] <= root.root_le[0] + root.root_chord):
-        raise CaseError(f"support.axis_point {list(axis)} must lie on the root chord "
-                        f"(y = {root.root_le[1]:g} m, x in [{root.root_le[0]:g}, "
-                        f"{root.root_le[0] + root.root_chord:g}] m)")
-    return SupportSpec("shaft", axis, k, kb, model, radius, fif)
+    """The ``[support]`` table: its ``kind`` picks a :class:`asekit.structure.supports.SupportKind`
+    of :data:`asekit.structure.supports.SUPPORTS`, which reads the kind's own keys."""
+    kind = t.string("kind", tuple(SUPPORTS), required=True)
+    try:
+        fields = SUPPORTS[kind].parse(t, panels[0].planform)
+    except CaseError:
+        raise
+    except ValueError as exc:             # the kind's own checks name their key path
+        raise CaseError(str(exc)) from None
+    known = {f.name for f in dataclasses.fields(SupportSpec)} - {"kind", "options"}
+    extra = tuple(sorted((k, v) for k, v in fields.items() if k not in known))
+    return SupportSpec(kind=kind, options=extra,
+                       **{k: v for k, v in fields.items() if k in known})
 
 
 def _point_masses(raw) -> tuple[PointMass, ...]:
@@ -506,8 +495,8 @@ def _modes(t: _Table | None, support: SupportSpec) -> ModesSpec:
     f_max = t.number("f_max", default=1000.0, low=0.0, high=1e7, unit="Hz")
     keep = t.boolean("keep_rigid", True)
     t.done()
-    if keep and not (support.kind == "shaft" and support.model == "FN2"):
-        keep = False         # only the FN2 shaft has a rigid pitch mode
+    if keep and not SUPPORTS[support.kind].has_rigid_mode(support):
+        keep = False         # only a kind with a rigid mode (the FN2 shaft) keeps one
     return ModesSpec(count, f_max, keep)
 
 
@@ -654,7 +643,7 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     else:
         fsi_spec = None
     top.done()
-    if actuator is not None and not (support.kind == "shaft" and support.model == "FN2"
+    if actuator is not None and not (SUPPORTS[support.kind].has_rigid_mode(support)
                                      and modes.keep_rigid):
         raise CaseError("actuator needs support.kind = \"shaft\" with model \"FN2\" and "
                         "modes.keep_rigid = true (the actuator drives the rigid pitch mode)")

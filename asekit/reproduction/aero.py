@@ -16,15 +16,15 @@ import numpy as np
 from scipy.special import hankel2
 
 from asekit.aero.boxes import TrapezoidSurface, check_mesh_rules, mesh_surfaces
-from asekit.reproduction.fin import fin_boxes
 from asekit.aero.dlm import normalwash_matrices, pressure_jump
 from asekit.aero.gaf import steady_hinge_coefficient
-from asekit.reproduction.fin import fin_gaf_database
 from asekit.aero.vlm import lift_curve_slope, steady_pressure
-from asekit.reproduction.fin import load_fin
+from asekit.case import pipeline
+from asekit.case.variants import with_boxes
 from asekit.util.plotting import THESIS_COLOR, new_figure
 from asekit.reproduction.driver import ChapterResult, Quantity
 from asekit.reproduction.thesis import thesis_value
+from asekit.reproduction.fin import fin_case
 
 #: Mach of the steady hinge-moment coefficient (thesis Eq. 4.6).
 STEADY_MACH = 0.6
@@ -43,26 +43,35 @@ def theodorsen_pitch_lift(k, a: float = -0.5) -> np.ndarray:
     return np.pi * (1j * k + a * k**2) + 2 * np.pi * theodorsen(k) * (1 + (0.5 - a) * 1j * k)
 
 
-def pitch_axis_x(fin=None) -> float:
-    fin = load_fin() if fin is None else fin
-    return fin.shaft.axis_point[0]
+def pitch_axis_x(case=None) -> float:
+    """x (m) of the fin's pitch axis (default case :func:`fin_case`)."""
+    case = fin_case() if case is None else case
+    return case.support.axis_point[0]
+
+
+def _fin_boxes(n_chord: int | None = None, n_span: int | None = None, case=None):
+    """The fin's box mesh (:func:`asekit.case.pipeline.box_mesh`), default from the mesh rules;
+    a count given replaces the rule's (:func:`asekit.case.variants.with_boxes`)."""
+    case = fin_case() if case is None else case
+    return pipeline.box_mesh(with_boxes(case, n_chord, n_span) if (n_chord, n_span) != (None, None)
+                             else case)
 
 
 def hinge_coefficient(mesh, mach: float, k: float = 0.001, symmetric: bool = False,
-                      fin=None) -> float:
+                      case=None) -> float:
     """Re Q_cc (m^3/rad) of the rigid pitch mode on ``mesh`` (analytic mode shape)."""
-    fin = load_fin() if fin is None else fin
-    xa, b = pitch_axis_x(fin), fin.aero.reference_semichord
+    case = fin_case() if case is None else case
+    xa, b = pitch_axis_x(case), case.aero.reference_semichord
     x, xl = mesh.control_point[:, 0], mesh.load_point[:, 0]
     cp = pressure_jump(mesh, mach, k, b, -1.0 + 1j * k * (-(x - xa)) / b, symmetric=symmetric)
     return float(np.sum(-(xl - xa) * cp * mesh.area).real)
 
 
 def run(figures: bool = False) -> ChapterResult:
-    fin = load_fin()
-    db, model = fin_gaf_database(rebuild=False, progress=False)
-    mesh = fin_boxes(fin)
-    rep = check_mesh_rules(mesh, fin.aero.u_min, fin.aero.f_max, warn=False)
+    case = fin_case()
+    db = pipeline.gaf_database(case, progress=False)
+    mesh = pipeline.box_mesh(case)
+    rep = check_mesh_rules(mesh, case.aero.u_min, case.aero.f_max, warn=False)
     qcc = steady_hinge_coefficient(db, STEADY_MACH)
     cla = lift_curve_slope(mesh, STEADY_MACH)
     quantities = (
@@ -70,9 +79,9 @@ def run(figures: bool = False) -> ChapterResult:
                  f"isolated fin, {mesh.n} boxes; -> about 5.6e-4 with 1200 boxes; wall at root "
                  f"{hinge_coefficient(mesh, STEADY_MACH, symmetric=True):.3g}"),
         Quantity("aero.CLalpha_fin_per_rad", cla, "1/rad",
-                 f"isolated fin, M {STEADY_MACH}, VLM, S = {fin.planform.area:.5f} m^2"),
+                 f"isolated fin, M {STEADY_MACH}, VLM, S = {case.panels[0].planform.area:.5f} m^2"),
         Quantity("aero.boxes", float(mesh.n), "-",
-                 f"{fin_boxes(fin).strip.max() + 1} strips x {mesh.n // (mesh.strip.max() + 1)} "
+                 f"{mesh.strip.max() + 1} strips x {mesh.n // (mesh.strip.max() + 1)} "
                  "chordwise, from the mesh rules"),
         Quantity("aero.min_bpw", float(rep.bpw.min()), "-", "U_min 180 m/s, f_max 1000 Hz"),
         Quantity("aero.max_box_aspect_ratio", float(rep.aspect_ratio.max()), "-",
@@ -161,9 +170,9 @@ def _draw_mesh(ax, mesh, values, label, cmap="viridis", vmin=None, vmax=None):
 
 def fig_mesh_bpw(mesh=None, rep=None):
     """Fig 20: the aerodynamic mesh coloured by boxes per wavelength of each strip (Eq. 3.5)."""
-    fin = load_fin()
-    mesh = fin_boxes(fin) if mesh is None else mesh
-    rep = check_mesh_rules(mesh, fin.aero.u_min, fin.aero.f_max, warn=False) if rep is None else rep
+    case = fin_case()
+    mesh = pipeline.box_mesh(case) if mesh is None else mesh
+    rep = check_mesh_rules(mesh, case.aero.u_min, case.aero.f_max, warn=False) if rep is None else rep
     fig, ax = new_figure(f"Aerodynamic mesh - boxes per wavelength (min {rep.bpw.min():.1f}, "
                          "rule >= 15)", "Fig 20", figsize=(6.4, 5.2))
     _draw_mesh(ax, mesh, rep.bpw[mesh.strip], "BPW = U_min / (f_max dx)")
@@ -172,9 +181,9 @@ def fig_mesh_bpw(mesh=None, rep=None):
 
 def fig_mesh_aspect_ratio(mesh=None, rep=None):
     """Fig 21: the aerodynamic mesh coloured by box aspect ratio."""
-    fin = load_fin()
-    mesh = fin_boxes(fin) if mesh is None else mesh
-    rep = check_mesh_rules(mesh, fin.aero.u_min, fin.aero.f_max, warn=False) if rep is None else rep
+    case = fin_case()
+    mesh = pipeline.box_mesh(case) if mesh is None else mesh
+    rep = check_mesh_rules(mesh, case.aero.u_min, case.aero.f_max, warn=False) if rep is None else rep
     fig, ax = new_figure(f"Aerodynamic mesh - box aspect ratio (max {rep.aspect_ratio.max():.2f}, "
                          "rule < 3)", "Fig 21", figsize=(6.4, 5.2))
     _draw_mesh(ax, mesh, rep.aspect_ratio, "box aspect ratio", cmap="magma", vmin=1.0, vmax=3.0)
@@ -183,15 +192,15 @@ def fig_mesh_aspect_ratio(mesh=None, rep=None):
 
 def fig_steady_pressure(mesh=None, mach: float = STEADY_MACH):
     """Steady Delta Cp per radian of incidence on the fin, and the span loading c_l c / c_ref."""
-    fin = load_fin()
-    mesh = fin_boxes(fin) if mesh is None else mesh
+    case = fin_case()
+    mesh = pipeline.box_mesh(case) if mesh is None else mesh
     fig, axes = new_figure(f"Steady pressure jump and span loading, M {mach}, isolated fin vs "
                            "wall at root", ncols=2, figsize=(12.0, 5.0))
     cp = steady_pressure(mesh, mach, -np.ones(mesh.n))
     _draw_mesh(axes[0], mesh, cp, "Delta Cp per rad", cmap="plasma")
     n_strips = mesh.strip.max() + 1
     y = np.array([mesh.load_point[mesh.strip == s, 1].mean() for s in range(n_strips)])
-    c_ref = fin.planform.mean_aerodynamic_chord
+    c_ref = case.panels[0].planform.mean_aerodynamic_chord
     for sym, label in ((False, "isolated"), (True, "wall at root (symmetry plane)")):
         cps = steady_pressure(mesh, mach, -np.ones(mesh.n), symmetric=sym)
         load = np.array([np.sum(cps[mesh.strip == s] * mesh.chord[mesh.strip == s])
@@ -206,7 +215,7 @@ def fig_steady_pressure(mesh=None, mach: float = STEADY_MACH):
 def fig_gaf_vs_k(db=None, elements=((0, 0), (0, 1), (1, 0), (2, 2))):
     """A few GAF elements (real and imaginary parts) vs k at each Mach of the database."""
     if db is None:
-        db, _ = fin_gaf_database(progress=False)
+        db = pipeline.gaf_database(fin_case(), progress=False)
     fig, axes = new_figure("GAF elements Q_ij(M, k) of the fin (mode 0 = rigid pitch)",
                            nrows=2, ncols=len(elements), figsize=(3.4 * len(elements), 6.0))
     for j, (r, c) in enumerate(elements):
@@ -226,7 +235,7 @@ def convergence(box_counts=((4, 4), (8, 6), (14, 10), (20, 16), (28, 24)), mach=
     """Q_cc (steady, isolated) vs box count, refining both directions: (n_boxes, Q_cc)."""
     n, q = [], []
     for nc, ns in box_counts:
-        m = fin_boxes(n_chord=nc, n_span=ns)
+        m = _fin_boxes(n_chord=nc, n_span=ns)
         n.append(m.n)
         q.append(hinge_coefficient(m, mach))
     return np.array(n), np.array(q)
@@ -237,10 +246,10 @@ def convergence_by_direction(mach=STEADY_MACH, chordwise=(4, 7, 14, 28), spanwis
     returns {"chordwise": (counts, Q_cc) at 10 strips, "spanwise": (counts, Q_cc) at 14 boxes
     per chord}."""
     return {"chordwise": (np.array(chordwise),
-                          np.array([hinge_coefficient(fin_boxes(n_chord=c, n_span=10), mach)
+                          np.array([hinge_coefficient(_fin_boxes(n_chord=c, n_span=10), mach)
                                     for c in chordwise])),
             "spanwise": (np.array(spanwise),
-                         np.array([hinge_coefficient(fin_boxes(n_chord=14, n_span=s), mach)
+                         np.array([hinge_coefficient(_fin_boxes(n_chord=14, n_span=s), mach)
                                    for s in spanwise]))}
 
 

@@ -34,12 +34,13 @@ import numpy as np
 
 from asekit.ase import loop as ase
 from asekit.ase import metrics
+from asekit.case import pipeline
 from asekit.ase.margins import NyquistMargins, nyquist_margins
 from asekit.util.plotting import THESIS_COLOR, new_figure
 from asekit.reproduction.driver import ChapterResult, Quantity
 from asekit.servo.actuator import SYSTEM_3, PDController
 from asekit.servo.simulate import THESIS_LIMITS, SimulationResult, simulate
-from asekit.reproduction import fin as reffin
+from asekit.reproduction.fin import CORNERS, fin_case
 
 #: Thesis Table 2 requirements checked on the elastic fin.
 SETTLING_REQUIREMENT = 0.05      # s
@@ -52,7 +53,7 @@ FULL_STEP = math.radians(15.0)
 class AseChapter:
     """Every computed Ch. 5 result (SI units)."""
 
-    fin: reffin.FinAse
+    fin: pipeline.AseCondition
     controller: PDController
     oploops: dict                 # 1, 2, 3 -> StateSpace
     fwtfs: dict                   # 1, 2, 3 -> StateSpace
@@ -76,7 +77,7 @@ class AseChapter:
 def compute(mach: float = 0.5, altitude: float = 0.0,
             controller: PDController = SYSTEM_3) -> AseChapter:
     """Run the Ch. 5 analyses (a few seconds)."""
-    fin = reffin.fin_ase(mach=mach, altitude=altitude)
+    fin = pipeline.ase_condition(fin_case(), mach=mach, altitude=altitude)
     m = fin.model
     oploops = {i: ase.open_loop(m, i) for i in (1, 2, 3)}
     fwtfs = {i: ase.forward_path(m, controller, i) for i in (1, 2, 3)}
@@ -95,7 +96,7 @@ def compute(mach: float = 0.5, altitude: float = 0.0,
                           hinge_moment=hm)
     rigid_full = simulate(rigid, controller, FULL_STEP, t_final=0.2, limits=THESIS_LIMITS,
                           hinge_moment=hm)
-    corner_names = [f"theta_{c}" for c in reffin.CORNERS]
+    corner_names = [f"theta_{c}" for c in CORNERS]
     gains = ase.static_gains(loops["AEM1"], ["theta", ase.FIN_ROOT] + corner_names)
     spec1 = metrics.spectrum_after_rise(aem1_nl.t, aem1_nl.fin_root, UNIT_STEP)
     spec2 = metrics.spectrum_after_rise(aem2_nl.t, aem2_nl.fin_root, UNIT_STEP)
@@ -112,7 +113,7 @@ def compute(mach: float = 0.5, altitude: float = 0.0,
 def corner_overshoots(ch: AseChapter) -> dict:
     """Overshoot (fraction) of each corner rotation in the power-limited AEM1 unit step."""
     r = ch.aem1_nonlinear
-    return {c: metrics.overshoot(r.outputs[f"theta_{c}"], UNIT_STEP) for c in reffin.CORNERS}
+    return {c: metrics.overshoot(r.outputs[f"theta_{c}"], UNIT_STEP) for c in CORNERS}
 
 
 def requirement_table(ch: AseChapter) -> list[tuple[str, str, str, bool]]:
@@ -126,7 +127,7 @@ def requirement_table(ch: AseChapter) -> list[tuple[str, str, str, bool]]:
     st_root = metrics.settling_time(r.t, r.fin_root, r.fin_root[-1], UNIT_STEP)
     rows.append(("settling time, fin root", "< 50 ms", f"{st_root * 1e3:.1f} ms",
                  st_root < SETTLING_REQUIREMENT))
-    for name in ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in reffin.CORNERS]:
+    for name in ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in CORNERS]:
         err = abs(ch.static_gains[name] - 1.0)
         rows.append((f"steady error, {name}", "< 2 %", f"{100 * err:.2f} %",
                      err < ERROR_REQUIREMENT))
@@ -145,7 +146,7 @@ def quantities(ch: AseChapter) -> tuple[Quantity, ...]:
     c1, c2, c3 = ch.crossovers[1], ch.crossovers[2], ch.crossovers[3]
     r = ch.aem1_nonlinear
     ov = corner_overshoots(ch)
-    corner_gain = [ch.static_gains[f"theta_{c}"] for c in reffin.CORNERS]
+    corner_gain = [ch.static_gains[f"theta_{c}"] for c in CORNERS]
     peaks1 = metrics.spectrum_peaks(*ch.aem1_spectrum, n=2)
     amp, freq = ch.aem2_limit_cycle
     note_struct = "asekit 6x7 MITC4 modes + own DLM, M 0.5 sea level"
@@ -356,7 +357,7 @@ def fig_aem1_transmission(ch: AseChapter):
 def fig_corners(ch: AseChapter):
     fig, ax = new_figure("AEM1 unit step (power limited): fin corners vs rigid fin", "Fig 71")
     r = ch.aem1_nonlinear
-    for c in reffin.CORNERS:
+    for c in CORNERS:
         ax.plot(1e3 * r.t, np.degrees(r.outputs[f"theta_{c}"]), lw=1.0, label=c.replace("_", " "))
     ax.plot(1e3 * r.t, np.degrees(r.fin_root), "k", lw=1.0, label="fin root")
     ax.plot(1e3 * ch.rigid_unit.t, np.degrees(ch.rigid_unit.theta), color="g", lw=2,
@@ -370,19 +371,18 @@ def fig_corners(ch: AseChapter):
 def fig_corner_locations(ch: AseChapter):
     """Fig 72: where the fin-corner rotations of Fig 71 are taken (planform corners), the fin
     root and the pitch axis."""
-    from asekit.reproduction.fin import load_fin
-    fin = load_fin()
-    p = fin.planform
+    case = fin_case()
+    p = case.panels[0].planform
     fig, ax = new_figure("Fin positions of Fig 71", "Fig 72", figsize=(5.5, 5))
     c = np.asarray(p.corners) * 1e3
     ax.fill(c[:, 0], c[:, 1], color="0.9", edgecolor="k")
-    for name, (xi, eta) in reffin.CORNERS.items():
+    for name, (xi, eta) in CORNERS.items():
         pt = np.asarray(p.point(np.array([xi]), np.array([eta])))[0] * 1e3
         ax.plot(pt[0], pt[1], "o", color="C3")
         ax.annotate(name.replace("_", " "), pt[:2], textcoords="offset points",
                     xytext=(6 if xi > 0.5 else -6, 6), ha="left" if xi > 0.5 else "right",
                     fontsize=8, color="C3")
-    xa = fin.shaft.axis_point[0] * 1e3
+    xa = case.support.axis_point[0] * 1e3
     ax.axvline(xa, color="C0", ls="--", lw=1, label=f"pitch axis x = {xa:g} mm")
     ax.plot(xa, 0.0, "s", color="C0", label="fin root (shaft)")
     ax.set_xlabel("x (mm)")

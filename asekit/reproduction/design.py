@@ -37,7 +37,8 @@ from asekit.ase import loop as ase
 from asekit.ase import metrics
 from asekit.servo.controllers import DigitalController, pd_controller, pid_filtered
 from asekit.reproduction.driver import ChapterResult, Quantity
-from asekit.reproduction import fin as reffin
+from asekit.case import pipeline
+from asekit.reproduction.fin import CORNERS, fin_case
 
 MACHS = (0.4, 0.5, 0.6)
 ALTITUDES = (0.0, 2500.0, 5000.0)
@@ -59,8 +60,8 @@ DELAY = 1
 # ---------------------------------------------------------------------------------------------
 def load():
     """(database, modal) of the fin (cached GAFs)."""
-    from asekit.reproduction.fin import fin_gaf_database
-    return fin_gaf_database(rebuild=False, progress=False)
+    case = fin_case()
+    return pipeline.gaf_database(case, progress=False), pipeline.modal_model(case)
 
 
 def perturbed_modal(modal, shaft_scale: float = 1.0, freq_scales=(1.0, 1.0)):
@@ -73,17 +74,15 @@ def perturbed_modal(modal, shaft_scale: float = 1.0, freq_scales=(1.0, 1.0)):
     s2, 1, ...).
     """
     from asekit.aeroelastic.statespace import fin_outputs
-    from asekit.reproduction.fin import load_fin
-
     if shaft_scale <= 0 or min(freq_scales) <= 0:
         raise ValueError("shaft_scale and freq_scales must be > 0")
-    fin = load_fin()
+    shaft = fin_case().support
     nr = modal.n_rigid
-    r = fin_outputs(modal, np.zeros((0, 2)), [], shaft_point=fin.shaft.axis_point)[
+    r = fin_outputs(modal, np.zeros((0, 2)), [], shaft_point=shaft.axis_point)[
         "fin_root_pitch"][nr:]
     K = np.array(modal.K, dtype=float).copy()
     s = slice(nr, K.shape[0])
-    K[s, s] += (shaft_scale - 1.0) * fin.shaft.torsional_stiffness * np.outer(r, r)
+    K[s, s] += (shaft_scale - 1.0) * shaft.torsional_stiffness * np.outer(r, r)
     S = np.ones(K.shape[0] - nr)
     S[:len(freq_scales)] = freq_scales
     K[s, s] = S[:, None] * K[s, s] * S[None, :]
@@ -91,7 +90,7 @@ def perturbed_modal(modal, shaft_scale: float = 1.0, freq_scales=(1.0, 1.0)):
 
 
 def ms_fit(n_states: int = 6):
-    """A minimum-state fit factory for :func:`asekit.reproduction.fin.fin_ase` (``n_states`` shared lag
+    """A minimum-state fit factory for :func:`asekit.case.pipeline.ase_condition` (``n_states`` shared lag
     states, steady constraint)."""
     from asekit.rfa import minimum_state_fit
 
@@ -106,7 +105,7 @@ def fin_model(mach=0.5, altitude=0.0, case="nominal", data=None, fit=None):
     ks, f1, f2 = ROBUSTNESS[case]
     if (ks, f1, f2) != (1.0, 1.0, 1.0):
         modal = perturbed_modal(modal, ks, (f1, f2))
-    return reffin.fin_ase(mach, altitude, database=db, modal=modal, fit=fit).model
+    return pipeline.ase_condition(fin_case(), mach, altitude, db=db, modal=modal, fit=fit).model
 
 
 # ---------------------------------------------------------------------------------------------
@@ -162,7 +161,7 @@ def check(controller: DigitalController, model, topology: str, mach=0.5, altitud
         plant = ase.sampled_plant(model, topology, SAMPLE_TIME, sensor=sensor)
     Phi, _ = ase.closed_loop_sampled_matrix(plant, controller, delay)
     stable = bool(np.max(np.abs(np.linalg.eigvals(Phi))) < 1.0)
-    corners = [f"theta_{c}" for c in reffin.CORNERS]
+    corners = [f"theta_{c}" for c in CORNERS]
     if not stable:
         return Check(controller.name, topology, mach, altitude, case, False, math.inf,
                      math.inf, math.inf, math.nan, math.nan, math.nan)
@@ -376,10 +375,10 @@ def static_deflections(data=None, mach=0.6, altitude=0.0, case="nominal",
     model = fin_model(mach, altitude, case, data=data)
     plant = ase.sampled_plant(model, "AEM2", SAMPLE_TIME)
     ctl = design_a(data) if controller is None else controller
-    names = ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in reffin.CORNERS]
+    names = ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in CORNERS]
     g = dc_gains(plant, ctl, names)
     ratios = {n: g[n] / g[ase.FIN_ROOT] for n in names}
-    corners = [ratios[f"theta_{c}"] for c in reffin.CORNERS]
+    corners = [ratios[f"theta_{c}"] for c in CORNERS]
     return {"ratios": ratios, "best_corner_error": best_corner_error(corners)}
 
 

@@ -1,7 +1,7 @@
 """Chapter 3.2.2-3.3 reproduction: RFA fit, p-k (Tables 9-10), root locus, time domain
 (Table 11) and divergence for the reference fin, plus the HA145B cross-check.
 
-The fin's GAF database comes from :func:`asekit.reproduction.fin.fin_gaf_database` (rigid pitch mode
+The fin's GAF database comes from :func:`asekit.case.pipeline.gaf_database` on the fin's case (rigid pitch mode
 first). When that module or its cache is not available the fin quantities are reported as None
 with a note, and only the Nastran HA145B validation is computed.
 
@@ -30,12 +30,11 @@ N_LAGS = 4
 
 def load_fin_gafs():
     """(GafDatabase, ModalModel) of the fin, or (None, reason) when not available."""
+    from asekit.case import pipeline
+    from asekit.reproduction.fin import fin_case
     try:
-        from asekit.reproduction.fin import fin_gaf_database
-    except ImportError as exc:           # the aerodynamics module is not there yet
-        return None, f"asekit.aero.gaf not available ({exc.__class__.__name__})"
-    try:
-        db, modal = fin_gaf_database(rebuild=False, progress=False)
+        case = fin_case()
+        db, modal = pipeline.gaf_database(case, progress=False), pipeline.modal_model(case)
     except Exception as exc:             # noqa: BLE001 - report any build/cache failure as a note
         return None, f"fin GAF database unavailable: {exc}"
     return (db, modal), ""
@@ -248,9 +247,9 @@ FLUTTER_MARGIN = 0.15
 
 def _envelope():
     """(u_min, u_max, h_max) of the analysis envelope in data/fin.toml (m/s, m/s, m)."""
-    from asekit.reproduction.fin import load_fin
-    a = load_fin().aero
-    return float(a.u_min), float(a.u_max), float(max(a.altitudes))
+    from asekit.reproduction.fin import fin_case
+    c = fin_case()
+    return float(c.aero.u_min), float(c.flight.velocities[-1]), float(max(c.flight.altitudes))
 
 
 def fig_mach_airspeed_altitude(points=(), thesis_figure: str = "Fig 25"):
@@ -688,11 +687,14 @@ def aero_variant_gafs(modal, db, mach: float = 0.75, symmetric: bool = False,
     nodes instead of the finite-element shape functions, on the database's k and b_ref (uses
     asekit.aero; a few seconds per variant). ``modal`` is the ModalModel whose shapes are used.
     """
-    from asekit.reproduction.fin import fin_boxes
     from asekit.aero.gaf import gaf_from_box_modes
     from asekit.aero.spline import InfinitePlateSpline, fe_spline
-    from asekit.reproduction.fin import load_fin
-    boxes = fin_boxes(load_fin(), n_chord, n_span)
+    from asekit.case import pipeline
+    from asekit.case.variants import with_boxes
+    from asekit.reproduction.fin import fin_case
+    case = fin_case()
+    boxes = pipeline.box_mesh(case if (n_chord, n_span) == (None, None)
+                              else with_boxes(case, n_chord, n_span))
     if spline == "fe":
         bm = fe_spline(modal, boxes)
     elif spline == "ips":
@@ -704,7 +706,7 @@ def aero_variant_gafs(modal, db, mach: float = 0.75, symmetric: bool = False,
 
 
 #: Modelling variants of :func:`model_sensitivity`: (label, structure kwargs for
-#: ``fin_modal_model``, aerodynamic kwargs for :func:`aero_variant_gafs`).
+#: :func:`structure_variant`, aerodynamic kwargs for :func:`aero_variant_gafs`).
 MODEL_VARIANTS = (
     ("symmetry wall at the root (fin on a body)", {}, {"symmetric": True}),
     ("finer aerodynamic mesh 20 x 14 boxes", {}, {"n_chord": 20, "n_span": 14}),
@@ -713,17 +715,31 @@ MODEL_VARIANTS = (
 )
 
 
+def structure_variant(n_chord: int | None = None, n_span: int | None = None,
+                      shaft: str = "single_node"):
+    """The fin's case on an ``n_chord x n_span`` structural mesh (default the case's) with the
+    ``"single_node"`` (thesis) or ``"distributed"`` shaft
+    (:func:`asekit.reproduction.fin.distributed_case`)."""
+    from asekit.case.variants import with_mesh
+    from asekit.reproduction.fin import distributed_case, fin_case
+    if shaft == "single_node":
+        return with_mesh(fin_case(), n_chord, n_span)
+    if shaft == "distributed":
+        return distributed_case(n_chord, n_span)
+    raise ValueError(f"shaft must be 'single_node' or 'distributed', got {shaft!r}")
+
+
 def model_sensitivity(db, mach: float = 0.75, altitude: float = 0.0, velocities=VELOCITIES,
                       variants=MODEL_VARIANTS) -> list[dict]:
     """p-k flutter speed with the structure and/or GAFs rebuilt for modelling variants (support
     model, structural mesh, spline, symmetry plane, aerodynamic mesh) at one Mach and altitude.
     Rows: label, elastic frequencies (Hz), Q_cc(k_min), speed, freq, first, first_kind."""
     from asekit.aeroelastic.statespace import modal_arrays
-    from asekit.reproduction.fin import fin_modal_model
+    from asekit.case import pipeline
     rho = float(standard_atmosphere(altitude).density)
     rows = []
     for label, skw, akw in variants:
-        model = fin_modal_model(**skw)
+        model = pipeline.modal_model(structure_variant(**skw))
         g = aero_variant_gafs(model, db, mach, **akw)
         m = modal_arrays(model)
         res = pk_flutter(m, g, rho, velocities)
@@ -866,10 +882,10 @@ def _distributed_model(structure):
     """The FN2 modal model with the distributed shaft region on a ``structure`` mesh."""
     import warnings
 
-    from asekit.reproduction.fin import fin_modal_model
+    from asekit.case import pipeline
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")          # unresolved shaft region on the coarse meshes
-        return fin_modal_model(n_chord=structure[0], n_span=structure[1], shaft="distributed")
+        return pipeline.modal_model(structure_variant(structure[0], structure[1], "distributed"))
 
 
 def _mesh_flutter(model, db, mach, rho, velocities, aero):

@@ -150,7 +150,7 @@ class FinFreeplayModel:
 def fin_freeplay_model(mach: float, data=None, n_lags: int = N_LAGS) -> FinFreeplayModel:
     """Build :class:`FinFreeplayModel` from the cached GAF database (``data`` = (db, modal) as
     :func:`asekit.reproduction.flutter.load_fin_gafs` returns; loaded when None)."""
-    from asekit.reproduction.fin import load_fin
+    from asekit.reproduction.fin import CORNERS, fin_case
     from asekit.reproduction.flutter import fin_rfa, load_fin_gafs
 
     if data is None:
@@ -160,16 +160,15 @@ def fin_freeplay_model(mach: float, data=None, n_lags: int = N_LAGS) -> FinFreep
     db, modal = data
     if getattr(modal, "n_rigid", 0) != 1:
         raise ValueError("the fin model needs the FN2 modal model (one rigid pitch mode first)")
-    fin = load_fin()
-    rows = fin_outputs(modal, np.zeros((0, 2)), names=[], shaft_point=fin.shaft.axis_point)
-    from asekit.reproduction.fin import CORNERS
-    pts = fin.planform.point(np.array([v[0] for v in CORNERS.values()]),
+    case = fin_case()
+    rows = fin_outputs(modal, np.zeros((0, 2)), names=[], shaft_point=case.support.axis_point)
+    pts = case.panels[0].planform.point(np.array([v[0] for v in CORNERS.values()]),
                              np.array([v[1] for v in CORNERS.values()]))
     rows.update(fin_outputs(modal, pts, names=list(CORNERS)))
     c = np.asarray(rows["fin_root_pitch"], float)
     if abs(c[0] - 1.0) > 1e-12:
         raise ValueError("the fin-root pitch row must carry the rigid mode with unit weight")
-    k_s = float(fin.shaft.torsional_stiffness)
+    k_s = float(case.support.torsional_stiffness)
     r = c[1:]
     K = np.array(modal.K, float)
     K_plate = np.zeros_like(K)

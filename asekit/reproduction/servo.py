@@ -86,7 +86,7 @@ def compute(params: ActuatorParameters | None = None,
 @dataclass(frozen=True)
 class FinInputs:
     """asekit's own values of the two fin inputs of Ch. 4: ``fin_inertia`` (kg m^2, exact
-    integral over the reference geometry, :func:`asekit.reproduction.fin.pitch_inertia_exact`)
+    integral over the reference geometry, :func:`asekit.case.pipeline.pitch_inertia_exact`)
     and ``q_cc`` (Re Q_cc at M 0.6, k 0.001 from the cached DLM database, m^3/rad; None when the
     database file is not available). ``source`` says where each came from."""
 
@@ -103,9 +103,9 @@ def asekit_fin_inputs(mach: float = 0.6) -> FinInputs:
     notes = []
     j_fin = q_cc = None
     try:
-        from asekit.reproduction.fin import load_fin
-        from asekit.reproduction.fin import pitch_inertia_exact
-        j_fin = pitch_inertia_exact(load_fin())
+        from asekit.case import pipeline
+        from asekit.reproduction.fin import fin_case
+        j_fin = pipeline.pitch_inertia_exact(fin_case())
         notes.append("J_fin: exact plate integral")
     except (ImportError, AttributeError, ValueError) as exc:      # structure not available
         notes.append(f"J_fin unavailable ({exc})")

@@ -15,20 +15,21 @@ artificial drilling stiffness, and the thesis discards it.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from asekit.reproduction.fin import FinDefinition, load_fin
+from asekit.case import pipeline
+from asekit.case.schema import Case
+from asekit.case.variants import with_mesh, with_modes
 from asekit.util.plotting import THESIS_COLOR, new_figure
 from asekit.reproduction.driver import ChapterResult, Quantity
-from asekit.structure.assembly import assemble, rigid_pitch_vector
+from asekit.structure.assembly import rigid_pitch_vector
 from asekit.structure.modes import ModalModel, NormalModes, normal_modes
-from asekit.reproduction.fin import fin_mesh, fin_modal_model, fin_supported, pitch_inertia_exact
 from asekit.reproduction.thesis import thesis_value
+from asekit.reproduction.fin import distributed_case, fin_case, fn1_case
 
 #: Mesh used for the distributed-shaft result (the 5 mm shaft radius of the fin case file is resolved
 #: by 23 nodes here; 192 x 224 changes modes 1-2 by a further +0.3 / +1.0 %).
@@ -41,7 +42,7 @@ CONVERGENCE_MESHES = ((6, 7), (12, 14), (24, 28), (48, 56), (96, 112))
 class StructureChapter:
     """Every computed Ch. 3.1 result (SI units, frequencies in Hz)."""
 
-    fin: FinDefinition
+    case: Case                      # the reference fin (data/cases/nalci2013_fin.toml)
     fn2: ModalModel                 # thesis model: FN2 6x7 single-node shaft, modes kept
     fn1_modes: NormalModes          # FN1 6x7, 9 modes (Table 4 left column, no in-plane mode)
     fn2_modes: NormalModes          # FN2 6x7 raw eigen-solution, rigid + 9 elastic (Table 4/5)
@@ -49,29 +50,34 @@ class StructureChapter:
     distributed: ModalModel         # FN2 with the distributed shaft on CONVERGED_MESH
 
 
-def compute(fin: FinDefinition | None = None) -> StructureChapter:
-    """Run the Ch. 3.1 analyses on the reference fin (default ``data/cases/nalci2013_fin.toml``)."""
-    fin = load_fin() if fin is None else fin
-    mesh = fin_mesh(fin)
-    K, M = assemble(mesh, fin.material)
-    fn1 = normal_modes(fin_supported(fin, mesh, "FN1", "single_node", K, M), 9, M_fin=M)
-    fn2 = normal_modes(fin_supported(fin, mesh, "FN2", "single_node", K, M), 10, M_fin=M)
-    return StructureChapter(fin=fin, fn2=fin_modal_model(fin), fn1_modes=fn1, fn2_modes=fn2,
-                            J_exact=pitch_inertia_exact(fin),
-                            distributed=fin_modal_model(fin, *CONVERGED_MESH, shaft="distributed"))
+def compute(case: Case | None = None) -> StructureChapter:
+    """Run the Ch. 3.1 analyses on the reference fin (default :func:`fin_case`)."""
+    case = fin_case() if case is None else case
+    M = pipeline.mass_and_stiffness(case)[1]
+    fn1 = normal_modes(pipeline.supported_system(fn1_case(case)), 9, M_fin=M)
+    fn2 = normal_modes(pipeline.supported_system(case), 10, M_fin=M)
+    return StructureChapter(case=case, fn2=pipeline.modal_model(case), fn1_modes=fn1,
+                            fn2_modes=fn2, J_exact=pipeline.pitch_inertia_exact(case),
+                            distributed=pipeline.modal_model(
+                                distributed_case(*CONVERGED_MESH, case=case)))
 
 
-def convergence_study(fin: FinDefinition | None = None, meshes=CONVERGENCE_MESHES,
+def convergence_study(case: Case | None = None, meshes=CONVERGENCE_MESHES,
                       shaft: str = "single_node", radius: float | None = None,
                       n_elastic: int = 5, progress: bool = False) -> np.ndarray:
     """Elastic frequencies (Hz), shape (len(meshes), n_elastic), of the FN2 model per mesh.
 
-    ``radius`` (m) overrides the shaft radius of the distributed model. Modes above 1000 Hz are
-    included here (f_max raised) so that every mesh gives ``n_elastic`` values.
+    ``shaft``: ``"single_node"`` (the thesis) or ``"distributed"`` (a rigid region of
+    ``radius`` m, default :data:`asekit.reproduction.fin.DEFAULT_SHAFT_RADIUS`). Modes above
+    1000 Hz are included here (f_max raised to 5000 Hz) so that every mesh gives ``n_elastic``
+    values.
     """
-    fin = load_fin() if fin is None else fin
-    if radius is not None:
-        fin = dataclasses.replace(fin, shaft=dataclasses.replace(fin.shaft, radius=radius))
+    case = fin_case() if case is None else case
+    if shaft not in ("single_node", "distributed"):
+        raise ValueError(f"shaft must be 'single_node' or 'distributed', got {shaft!r}")
+    case = with_modes(case, f_max=5000.0)
+    if shaft == "distributed":
+        case = distributed_case(radius=radius, case=case)
     iterator = meshes
     if progress:
         from tqdm.auto import tqdm
@@ -80,7 +86,7 @@ def convergence_study(fin: FinDefinition | None = None, meshes=CONVERGENCE_MESHE
     for n_c, n_s in iterator:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")            # unresolved-region warning on coarse meshes
-            m = fin_modal_model(fin, n_c, n_s, shaft=shaft, f_max_hz=5000.0)
+            m = pipeline.modal_model(with_mesh(case, n_c, n_s))
         out.append(m.frequencies_hz[m.n_rigid:m.n_rigid + n_elastic])
     return np.array(out)
 
@@ -108,37 +114,42 @@ def run(figures: bool = False) -> ChapterResult:
                  "exact integral over the planform"),
         Quantity("structure.distributed_frequencies_hz",
                  [float(f) for f in ch.distributed.frequencies_hz[1:]], "Hz",
-                 f"rigid shaft region r={ch.fin.shaft.radius * 1e3:g} mm, "
+                 f"rigid shaft region r={_radius(ch) * 1e3:g} mm, "
                  f"{CONVERGED_MESH[0]}x{CONVERGED_MESH[1]} mesh (192x224: mode 2 +1 %)"),
     )
     figs = {}
     if figures:
-        figs = {"fig03_planform": fig_planform(ch.fin), "fig04_thickness": fig_thickness(ch.fin),
-                "fig12_fn1": fig_fe_model(ch.fn2, ch.fin, "FN1"),
-                "fig16_inplane": fig_inplane(ch.fin),
-                "fig13_fn2": fig_fe_model(ch.fn2, ch.fin, "FN2"),
+        figs = {"fig03_planform": fig_planform(ch.case), "fig04_thickness": fig_thickness(ch.case),
+                "fig12_fn1": fig_fe_model(ch.fn2, ch.case, "FN1"),
+                "fig16_inplane": fig_inplane(ch.case),
+                "fig13_fn2": fig_fe_model(ch.fn2, ch.case, "FN2"),
                 "fig17_modes": fig_mode_shapes(ch.fn2),
                 "fig18_rigid": fig_rigid_mode(ch),
                 "fig19_fn1_fn2": fig_fn1_vs_fn2(ch)}
     return ChapterResult("structure", q, figs)
 
 
+def _radius(ch: StructureChapter) -> float:
+    """The shaft radius (m) of the distributed-shaft result."""
+    return float(distributed_case(case=ch.case).support.radius)
+
+
 # ---- figures -------------------------------------------------------------------------------
 
-def _outline(ax, fin: FinDefinition, **kw):
-    c = fin.planform.corners
+def _outline(ax, case: Case, **kw):
+    c = case.panels[0].planform.corners
     c = np.vstack([c, c[:1]])
     ax.plot(c[:, 0] * 1e3, c[:, 1] * 1e3, "k-", **kw)
 
 
-def fig_planform(fin: FinDefinition):
+def fig_planform(case: Case):
     """Fig 3: the fin's planform with the shaft axis (mm)."""
     fig, ax = new_figure("Missile control fin planform", "Fig 3", figsize=(5.5, 5))
-    _outline(ax, fin)
-    xa, ya = fin.shaft.axis_point
+    _outline(ax, case)
+    xa, ya = case.support.axis_point
     ax.axvline(xa * 1e3, color="C3", ls="--", lw=1, label="pitch (shaft) axis")
     ax.plot(xa * 1e3, ya * 1e3, "o", color="C3")
-    for x, y in fin.planform.corners:
+    for x, y in case.panels[0].planform.corners:
         ax.annotate(f"({x * 1e3:.0f}, {y * 1e3:.0f})", (x * 1e3, y * 1e3), fontsize=8,
                     textcoords="offset points", xytext=(4, 4))
     ax.set_xlabel("x, chordwise (mm)")
@@ -148,12 +159,12 @@ def fig_planform(fin: FinDefinition):
     return fig
 
 
-def fig_thickness(fin: FinDefinition):
+def fig_thickness(case: Case):
     """Fig 4: thickness profile along the span (mm)."""
     fig, ax = new_figure("Fin thickness profile", "Fig 4", figsize=(5.5, 3.5))
     eta = np.linspace(0, 1, 11)
-    ax.plot(fin.planform.root_le[1] * 1e3 + eta * fin.planform.span * 1e3,
-            fin.thickness.at(eta) * 1e3)
+    pf = case.panels[0].planform
+    ax.plot(pf.root_le[1] * 1e3 + eta * case.span * 1e3, case.thickness.at(eta) * 1e3)
     ax.set_xlabel("y, spanwise (mm)")
     ax.set_ylabel("thickness h (mm)")
     ax.set_ylim(0, None)
@@ -166,19 +177,19 @@ def _mesh_lines(ax, model: ModalModel, **kw):
         ax.plot(p[:, 0], p[:, 1], "-", color="0.5", lw=0.7, **kw)
 
 
-def fig_fe_model(model: ModalModel, fin: FinDefinition, which: str = "FN1"):
+def fig_fe_model(model: ModalModel, case: Case, which: str = "FN1"):
     """Figs 12/13: the 6x7 QUAD mesh, the shaft node, its spring (FN1) or spring + fictitious
     inertia at the free ground point (FN2)."""
     number = "Fig 12" if which == "FN1" else "Fig 13"
     fig, ax = new_figure(f"Finite-element model {which}", number, figsize=(5.5, 5))
     _mesh_lines(ax, model)
-    xa, ya = fin.shaft.axis_point
+    xa, ya = case.support.axis_point
     ax.plot(xa * 1e3, ya * 1e3, "s", color="C3", ms=8, label="shaft node")
-    k = fin.shaft.torsional_stiffness
+    k = case.support.torsional_stiffness
     if which == "FN1":
         text = f"theta_y: spring {k:g} N m/rad to ground"
     else:
-        I_f = fin.shaft.fictitious_inertia_factor * model.J_fin
+        I_f = case.support.fictitious_inertia_factor * model.J_fin
         text = (f"theta_y: spring {k:g} N m/rad to a free ground point\n"
                 f"with fictitious inertia {I_f:.3g} kg m^2 (1e6 J_fin)")
     ax.annotate(text, (xa * 1e3, ya * 1e3), xytext=(-60, -45), textcoords="offset points",
@@ -238,7 +249,7 @@ def fig_rigid_mode(ch: StructureChapter):
     sys = modes.system
     q = modes.q[:, 0] / modes.q[sys.shaft_index, 0]
     phi = sys.T @ q
-    r = rigid_pitch_vector(sys.mesh, ch.fin.shaft.axis_point[0])
+    r = rigid_pitch_vector(sys.mesh, ch.case.support.axis_point[0])
     fig, ax = new_figure("Rigid-body mode: FN2 eigenvector vs exact rigid pitch", "Fig 18")
     dof = np.arange(phi.size)
     ax.plot(dof, r, "o", mfc="none", color=THESIS_COLOR, ms=5, label="exact unit pitch rotation")
@@ -286,13 +297,13 @@ def fig_convergence(meshes, single: np.ndarray, distributed: dict, n_modes: int 
     return fig
 
 
-def fig_inplane(fin: FinDefinition, n_chord: int | None = None, n_span: int | None = None):
+def fig_inplane(case: Case, n_chord: int | None = None, n_span: int | None = None):
     """Fig 16 (the thesis's discarded in-plane mode): asekit's membrane check. In-plane modes of
     the fin held only at the shaft node: the first is a rigid in-plane rotation about that node
     (0 Hz without artificial drilling stiffness), the next a genuine in-plane mode (kHz)."""
-    from asekit.reproduction.fin import fin_inplane_modes
-    ip = fin_inplane_modes(fin, n_chord, n_span)
-    mesh = fin_mesh(fin, n_chord, n_span)
+    case = with_mesh(case, n_chord, n_span)
+    ip = pipeline.inplane_modes(case)
+    mesh = pipeline.structural_mesh(case)
     fig, axes = new_figure("In-plane modes with the single-node shaft (membrane check)", "Fig 16",
                            ncols=2, figsize=(11, 4.6))
     for j, ax in enumerate(axes):
@@ -301,7 +312,7 @@ def fig_inplane(fin: FinDefinition, n_chord: int | None = None, n_span: int | No
             p = mesh.nodes[np.append(e, e[0])] * 1e3
             ax.plot(p[:, 0], p[:, 1], "-", color="0.75", lw=0.6)
         ax.quiver(mesh.nodes[:, 0] * 1e3, mesh.nodes[:, 1] * 1e3, uv[:, 0], uv[:, 1], color="C0")
-        xa, ya = fin.shaft.axis_point
+        xa, ya = case.support.axis_point
         ax.plot(xa * 1e3, ya * 1e3, "s", color="C3", ms=7)
         kind = "in-plane rigid rotation about the shaft node" if j == 0 else "first in-plane elastic mode"
         ax.set_title(f"{kind}: {ip.frequencies_hz[j]:.3g} Hz", fontsize=9)

@@ -5,8 +5,8 @@ Section 4.1.1 torque requirement at the worst supersonic condition.
 
 Aerodynamics per Mach by :mod:`asekit.aero.methods` ``method="auto"``: the DLM up to M 0.9
 (the cached database for M 0.4-0.75), the supersonic Mach-box method from M 1.15; nothing in
-the gap between (linear theory is not trusted there). Structure: ``fin_modal_model()`` (FN2,
-rigid pitch + elastic modes), GAFs over :func:`asekit.reproduction.fin.database_k`.
+the gap between (linear theory is not trusted there). Structure: the fin case's ``pipeline.modal_model`` (FN2,
+rigid pitch + elastic modes), GAFs over :func:`asekit.case.pipeline.reduced_frequencies`.
 
 Reproduce keys: ``aero.Qcc_steady_m3.M12/.M20/.M30`` (Re Q_cc at k 0.001, m^3/rad, positive
 de-centering), ``flutter.pk.M12.h0.speed_ms`` (and ``.M20.``, ``.M30.``; None when no flutter is
@@ -30,16 +30,15 @@ import numpy as np
 
 from asekit.util.version import __version__
 from asekit.aero.boxes import MeshRuleWarning
-from asekit.reproduction.fin import fin_boxes
 from asekit.aero.gaf import gaf_from_box_modes
-from asekit.reproduction.fin import database_k, fin_gaf_database
 from asekit.aero.methods import DLM_MACH_MAX, SUPERSONIC_MACH_MIN, pressures
 from asekit.aero.spline import fe_spline
 from asekit.atmosphere import standard_atmosphere
 from asekit.util.cache import CacheError, load_npz, save_npz
+from asekit.case import pipeline
 from asekit.aeroelastic.flutter import TabulatedGaf, divergence_speeds, first_of, pk_flutter, pk_instabilities
-from asekit.reproduction.fin import load_fin
 from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.reproduction.fin import fin_case
 
 MACHS = (0.4, 0.5, 0.6, 0.75, 0.9, 1.15, 1.2, 1.5, 2.0, 2.5, 3.0)
 ALTITUDES = (0.0, 2500.0, 5000.0)
@@ -66,7 +65,7 @@ def _fingerprint(model, boxes, ks) -> str:
 
 def _compute(model, boxes, ks, b_ref) -> dict:
     """GAFs, steady loads and p-k / divergence results over MACHS x ALTITUDES."""
-    db, _ = fin_gaf_database(rebuild=False, progress=False)
+    db = pipeline.gaf_database(fin_case(), progress=False)
     bm = fe_spline(model, boxes)
     nm = model.frequencies_hz.size
     q = np.empty((len(MACHS), ks.size, nm, nm), complex)
@@ -131,12 +130,11 @@ def envelope(rebuild: bool = False) -> dict:
     ``divergence`` (m/s, NaN none), ``peak_acceleration`` (rad/s^2, the Section 4.1.1
     profile's), ``flight_speed`` (M a(h), m/s), ``x_axis`` (m), ``model``.
     """
-    from asekit.reproduction.fin import fin_modal_model
-    fin = load_fin()
-    model = fin_modal_model(fin)
-    boxes = fin_boxes(fin)
-    ks = database_k(fin)
-    b_ref = fin.aero.reference_semichord
+    case = fin_case()
+    model = pipeline.modal_model(case)
+    boxes = pipeline.box_mesh(case)
+    ks = pipeline.reduced_frequencies(case)
+    b_ref = case.aero.reference_semichord
     fp = _fingerprint(model, boxes, ks)
     path = cache_dir() / "supersonic_envelope.npz"
     data = None
@@ -155,7 +153,7 @@ def envelope(rebuild: bool = False) -> dict:
             pass
     out = dict(data)
     out.update(machs=np.array(MACHS), altitudes=np.array(ALTITUDES), k=ks, model=model,
-               x_axis=fin.shaft.axis_point[0], Qcc=np.asarray(data["Q"])[:, 0, 0, 0].real,
+               x_axis=case.support.axis_point[0], Qcc=np.asarray(data["Q"])[:, 0, 0, 0].real,
                flight_speed=np.array([[m * float(standard_atmosphere(h).speed_of_sound)
                                        for h in ALTITUDES] for m in MACHS]))
     return out

@@ -17,7 +17,8 @@ import numpy as np
 from asekit.servo.actuator import (SYSTEM_3, ActuatorParameters, Margins, PDController, closed_loop_poles,
                           margins, step_response)
 from asekit.servo.simulate import PowerLimits, SimulationResult, SteadyHingeMoment, simulate
-from asekit.reproduction import fin as reffin
+from asekit.case import pipeline
+from asekit.reproduction.fin import CORNERS, fin_case
 
 
 @dataclass(frozen=True)
@@ -166,16 +167,17 @@ def ase_snapshot(gain: float, kp: float, kd: float, mach: float = 0.5, altitude:
                  topology: str = "AEM1", t_final: float = 0.1, fin=None) -> AseSnapshot:
     """Forward path, margins and the linear closed-loop unit step of the elastic fin for PD
     gains at (mach, altitude) (SI; altitude in m). ``fin``: a prebuilt
-    :class:`asekit.reproduction.fin.FinAse` to reuse (else built with :func:`asekit.reproduction.fin.fin_ase`)."""
+    :class:`asekit.case.pipeline.AseCondition` to reuse (else built with
+    :func:`asekit.case.pipeline.ase_condition` on the fin's case)."""
     import control as ct
 
     from asekit.ase import loop as ase
 
     ctrl = PDController(gain, kp, kd, name="panel")
-    fin = reffin.fin_ase(mach=mach, altitude=altitude) if fin is None else fin
+    fin = pipeline.ase_condition(fin_case(), mach=mach, altitude=altitude) if fin is None else fin
     which = 2 if topology == "AEM1" else 3
     fwtf = ase.forward_path(fin.model, ctrl, which)
-    names = ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in reffin.CORNERS]
+    names = ["theta", ase.FIN_ROOT] + [f"theta_{c}" for c in CORNERS]
     cl = ase.closed_loop(fin.model, ctrl, topology, outputs=names)
     t = np.linspace(0.0, t_final, 1001)
     y = np.asarray(ct.forced_response(cl, t, np.ones_like(t)).outputs)
@@ -243,7 +245,7 @@ def ase_panel(controller: PDController = SYSTEM_3, mach: float = 0.5, altitude: 
         v = {k: s.value for k, s in sliders.items()}
         key = (round(v["mach"], 4), round(v["altitude"], 1))
         if key not in fins:
-            fins[key] = reffin.fin_ase(mach=key[0], altitude=key[1])
+            fins[key] = pipeline.ase_condition(fin_case(), mach=key[0], altitude=key[1])
         snap = ase_snapshot(v["gain"], v["kp"], v["kd"], key[0], key[1], v["topology"],
                             fin=fins[key])
         out.clear_output(wait=True)

@@ -22,12 +22,13 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from asekit.util.validate import positive
 from asekit.structure.assembly import SupportedSystem, rigid_pitch_vector, shaft_support
 from asekit.structure.mesh import PlateMesh
-from asekit.structure.plate import locate_points, shape_functions
+from asekit.structure.plate import locate_points, membrane_matrices, shape_functions
 
 #: Modes whose share of kinetic energy in the out-of-plane translation w is below this are
 #: "modes with no out-of-plane motion" and are dropped (thesis Fig. 15/16: in-plane mode).
@@ -420,3 +421,65 @@ def elastic_modal_model(modes: NormalModes, M_fin, f_max_hz: float = 1000.0,
                       elements=sys_.mesh.elements.copy(), label=sys_.label)
 
 
+
+
+@dataclass(frozen=True)
+class InPlaneModes:
+    """In-plane (membrane) modes of a plate pinned at one node (u = v = 0), the situation of the
+    thesis's discarded mode (Fig. 16).
+
+    frequencies_hz : (n,) ascending; the first is the in-plane rigid rotation about the pinned
+        node (0 Hz up to round-off: nothing but an artificial drilling stiffness restrains it).
+    shapes : (n_nodes, 2, n) u, v per node (mass-normalised).
+    J_z : in-plane rotational inertia of the plate about the pinned node (kg m^2).
+    """
+
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray
+    J_z: float
+
+
+def inplane_modes(mesh: PlateMesh, material, pinned_point, n_modes: int = 4) -> InPlaneModes:
+    """In-plane modes of the plate held only at the node at ``pinned_point`` (x, y) m:
+    K_m phi = omega^2 M_m phi with the plane-stress Q4 membrane matrices
+    (:func:`asekit.structure.plate.membrane_matrices`), u = v = 0 at that node. Not part of a
+    modal model: a flat plate's in-plane motion couples neither with bending nor with the
+    aerodynamics.
+
+    Parameters
+    ----------
+    mesh : the plate mesh; material : its material; pinned_point : (x, y) of a mesh node (m);
+    n_modes : number of modes (>= 1).
+
+    Returns
+    -------
+    :class:`InPlaneModes`.
+    """
+    if int(n_modes) != n_modes or n_modes < 1:
+        raise ValueError(f"n_modes must be an integer >= 1, got {n_modes!r}")
+    n_modes = int(n_modes)
+    Ke, Me = membrane_matrices(mesh, material)
+    dofs = (2 * mesh.elements[:, :, None] + np.arange(2)).reshape(-1, 8)
+    rows, cols = np.repeat(dofs, 8, axis=1).ravel(), np.tile(dofs, (1, 8)).ravel()
+    n = 2 * mesh.n_nodes
+    K = sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(n, n))
+    M = sp.csr_matrix((Me.ravel(), (rows, cols)), shape=(n, n))
+    node = mesh.node_at(pinned_point, name="shaft axis_point")
+    free = np.setdiff1d(np.arange(n), [2 * node, 2 * node + 1])
+    Kf = K[free][:, free]
+    Mf = M[free][:, free]
+    if free.size <= 2000:
+        lam, q = sla.eigh(Kf.toarray(), Mf.toarray(), subset_by_index=(0, n_modes - 1))
+    else:
+        lam, q = spla.eigsh(Kf.tocsc(), k=n_modes, M=Mf.tocsc(), sigma=-(2 * math.pi) ** 2,
+                            which="LM", v0=np.ones(free.size) / math.sqrt(free.size))
+        order = np.argsort(lam)
+        lam, q = lam[order], q[:, order]
+    phi = np.zeros((n, n_modes))
+    phi[free] = q
+    xa, ya = mesh.nodes[node]
+    rz = np.zeros(n)
+    rz[0::2] = -(mesh.nodes[:, 1] - ya)
+    rz[1::2] = mesh.nodes[:, 0] - xa
+    return InPlaneModes(frequencies_hz=np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi),
+                        shapes=phi.reshape(mesh.n_nodes, 2, n_modes), J_z=float(rz @ (M @ rz)))

@@ -21,11 +21,15 @@ Edges are named ``x0`` (x = x_min, the leading edge for flow along +x), ``x1`` (
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
 import numpy as np
 import scipy.sparse as sp
 
-from asekit.structure.assembly import SupportedSystem
+from asekit.structure.assembly import SupportedSystem, clamped_edge, shaft_support
 from asekit.structure.mesh import PlateMesh
+from asekit.structure.modes import fictitious_mass_modal_model, fixed_modal_model
 from asekit.structure.plate import DOF_PER_NODE
 
 EDGE_TYPES = ("free", "simply_supported", "clamped", "sliding")
@@ -140,3 +144,140 @@ def planform_edge_supports(mesh: PlateMesh, K, M, root: str = "clamped", tip: st
     return SupportedSystem(K=(T.T @ K @ T).tocsr(), M=(T.T @ M @ T).tocsr(), T=T,
                            shaft_index=None, ground_index=None, fictitious_inertia=0.0,
                            shaft_nodes=np.array([], dtype=np.int64), mesh=mesh, label=label)
+
+
+# ---------------------------------------------------------------------------------------------
+# the support kinds of a case file (registry read by asekit.case.schema and asekit.case.pipeline)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class SupportKind:
+    """How one kind of support is read from a case file and turned into a structure.
+
+    name : the ``support.kind`` value.
+    description : one line for error messages and documentation.
+    parse : ``parse(table, root_planform) -> dict`` of the kind's values from the ``[support]``
+        table, read with its typed getters (``number``, ``numbers``, ``string``, ``raw``; they
+        name the key path) and closed with ``done()``; other bad input raises ValueError naming
+        ``support.<key>``. A key that is a field of :class:`asekit.case.SupportSpec` sets the
+        field; any other goes to ``spec.options`` (read it with ``spec.option(key)``; values
+        hashable), so a new kind needs no new field.
+    system : ``system(mesh, K, M, spec) -> SupportedSystem``, the supported structure (the
+        FN1 or FN2 shaft system as ``spec.model`` says).
+    modal_model : ``modal_model(mesh, K, M, spec, f_max_hz, n_modes, keep_rigid) ->
+        ModalModel`` (thesis Eqs. 2.45-2.46): the elastic modes kept below ``f_max_hz`` (Hz) or
+        the first ``n_modes``, with the rigid pitch mode first when the kind has one and
+        ``keep_rigid``.
+    has_rigid_mode : ``has_rigid_mode(spec) -> bool``, whether the model can keep a rigid
+        mode (needed by the ASE loop's actuator).
+
+    Adding a support kind: write its functions here and add it to :data:`SUPPORTS` (and its
+    keys to ``docs/case-format.md``); the schema and the pipeline read it from there.
+    """
+
+    name: str
+    description: str
+    parse: Callable
+    system: Callable
+    modal_model: Callable
+    has_rigid_mode: Callable = field(default=lambda spec: False)
+
+
+def _parse_clamped_root(t, root) -> dict:
+    t.done()
+    return {}
+
+
+def _parse_edges(t, root) -> dict:
+    defaults = {"root": "clamped", "tip": "free", "leading_edge": "free",
+                "trailing_edge": "free"}
+    edges = tuple((e, t.string(e, EDGE_TYPES, default=defaults[e])) for e in PLANFORM_EDGES)
+    t.done()
+    if all(k == "free" for _, k in edges):
+        raise ValueError("support: all four edges free leaves rigid-body modes; hold at "
+                         "least one edge (support.root = \"clamped\", ...)")
+    return {"edges": edges}
+
+
+def _parse_shaft(t, root) -> dict:
+    axis = t.numbers("axis_point", required=True, length=2, unit="m")
+    k = t.number("torsional_stiffness", required=True, low=0.0, high=1e12, unit="N m/rad")
+    kb = t.number("bending_stiffness", low=0.0, high=1e12, unit="N m/rad")
+    model = t.string("model", ("FN1", "FN2"), default="FN2")
+    region = t.raw("region", "single_node")
+    fif = t.number("fictitious_inertia_factor", default=1.0e6, low=1.0, high=1e12)
+    t.done()
+    if region == "single_node":
+        radius = None
+    elif (isinstance(region, (int, float)) and not isinstance(region, bool)
+          and np.isfinite(region) and 0.0 < region <= 1e3):
+        radius = float(region)
+    else:
+        raise ValueError(f"support.region must be \"single_node\" or a shaft radius in "
+                         f"(0, 1000] m, got {region!r}")
+    if abs(axis[1] - root.root_le[1]) > 1e-9 * max(root.span, 1.0) or not (
+            root.root_le[0] <= axis[0] <= root.root_le[0] + root.root_chord):
+        raise ValueError(f"support.axis_point {list(axis)} must lie on the root chord "
+                         f"(y = {root.root_le[1]:g} m, x in [{root.root_le[0]:g}, "
+                         f"{root.root_le[0] + root.root_chord:g}] m)")
+    return {"axis_point": axis, "torsional_stiffness": k, "bending_stiffness": kb,
+            "model": model, "radius": radius, "fictitious_inertia_factor": fif}
+
+
+def _shaft_region(spec) -> tuple[str, float]:
+    """(region, radius) of a shaft spec: the single node (radius None) or a rigid region."""
+    return ("single_node", 0.0) if spec.radius is None else ("distributed", float(spec.radius))
+
+
+def _shaft_system(mesh, K, M, spec) -> SupportedSystem:
+    region, radius = _shaft_region(spec)
+    return shaft_support(mesh, K, M, spec.axis_point, spec.torsional_stiffness, spec.model,
+                         region, radius, fictitious_inertia_factor=spec.fictitious_inertia_factor,
+                         bending_stiffness=spec.bending_stiffness)
+
+
+def _shaft_modal_model(mesh, K, M, spec, f_max_hz, n_modes, keep_rigid):
+    region, radius = _shaft_region(spec)
+    if spec.model == "FN2" and keep_rigid:
+        return fictitious_mass_modal_model(
+            mesh, K, M, spec.axis_point, spec.torsional_stiffness, region=region, radius=radius,
+            fictitious_inertia_factor=spec.fictitious_inertia_factor,
+            bending_stiffness=spec.bending_stiffness, f_max_hz=f_max_hz, n_modes=n_modes)
+    fn1 = _shaft_system(mesh, K, M, replace(spec, model="FN1"))
+    return fixed_modal_model(fn1, M, f_max_hz, n_modes, axis_x=spec.axis_point[0])
+
+
+def _clamped_system(mesh, K, M, spec) -> SupportedSystem:
+    return clamped_edge(mesh, K, M)
+
+
+def _edges_system(mesh, K, M, spec) -> SupportedSystem:
+    return planform_edge_supports(mesh, K, M, **dict(spec.edges))
+
+
+def _fixed_modal_model(system):
+    """A modal_model function of a kind with no rigid mode: the modes of ``system``."""
+    def modal_model(mesh, K, M, spec, f_max_hz, n_modes, keep_rigid):
+        return fixed_modal_model(system(mesh, K, M, spec), M, f_max_hz, n_modes)
+    return modal_model
+
+
+#: The support kinds of a case file, by ``support.kind``.
+SUPPORTS: dict[str, SupportKind] = {s.name: s for s in (
+    SupportKind("clamped_root", "every degree of freedom of the root-chord nodes fixed",
+                _parse_clamped_root, _clamped_system, _fixed_modal_model(_clamped_system)),
+    SupportKind("edges", "clamped, simply supported, sliding or free root, tip, leading and "
+                "trailing edges", _parse_edges, _edges_system, _fixed_modal_model(_edges_system)),
+    SupportKind("shaft", "the thesis's pitch shaft (FN2: rigid pitch mode + elastic modes; "
+                "FN1: spring to ground)", _parse_shaft, _shaft_system, _shaft_modal_model,
+                has_rigid_mode=lambda spec: spec.model == "FN2"),
+)}
+
+
+def support_kind(kind: str) -> SupportKind:
+    """The :class:`SupportKind` of ``kind``; ValueError naming ``support.kind`` and the known
+    kinds otherwise."""
+    try:
+        return SUPPORTS[kind]
+    except (KeyError, TypeError):
+        raise ValueError(f"support.kind must be one of {', '.join(map(repr, SUPPORTS))}, "
+                         f"got {kind!r}") from None

@@ -163,15 +163,16 @@ def case_sweep(mesh, repeat):
 def case_fin(repeat):
     from asekit.aero.gaf import build_gaf_database
     from asekit.aero.spline import fe_spline
-    from asekit.reproduction.fin import database_k, fin_boxes, fin_modal_model, load_fin
-    fin = load_fin()
-    model = fin_modal_model(fin)
-    boxes = fin_boxes(fin)
+    from asekit.case import load_case, pipeline
+    from asekit.util.paths import FIN_FILE
+    case = load_case(FIN_FILE)
+    model = pipeline.modal_model(case)
+    boxes = pipeline.box_mesh(case)
     bm = fe_spline(model, boxes)
-    ks = database_k(fin)
+    ks = pipeline.reduced_frequencies(case)
 
     def build():
-        return build_gaf_database(bm, boxes, fin.aero.machs, ks, fin.aero.reference_semichord,
+        return build_gaf_database(bm, boxes, case.aero.machs, ks, case.aero.reference_semichord,
                                   model.n_rigid, progress=False)
 
     walls, cpus = [], []
@@ -180,7 +181,7 @@ def case_fin(repeat):
         build()
         walls.append(time.perf_counter() - t0)
         cpus.append(time.process_time() - c0)
-    print(f"fin     GAF database rebuild ({len(fin.aero.machs)} Mach x {ks.size} k, {boxes.n} "
+    print(f"fin     GAF database rebuild ({len(case.aero.machs)} Mach x {ks.size} k, {boxes.n} "
           f"boxes, {len(model.frequencies_hz)} modes): {statistics.median(cpus):.2f} s CPU, "
           f"{statistics.median(walls):.2f} s wall (medians of {repeat})")
 

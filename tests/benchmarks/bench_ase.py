@@ -12,7 +12,8 @@ import numpy as np
 
 from asekit.ase import loop as ase
 from asekit.servo.actuator import SYSTEM_3
-from asekit.reproduction import fin as reffin
+from asekit.case import pipeline
+from asekit.reproduction.fin import fin_case
 
 
 def best_of(fn, n=3):
@@ -26,7 +27,7 @@ def best_of(fn, n=3):
 
 def main():
     t0 = time.perf_counter()
-    fin = reffin.fin_ase(mach=0.5, altitude=0.0)
+    fin = pipeline.ase_condition(fin_case(), mach=0.5, altitude=0.0)
     print(f"model build (GAF cache load, RFA, interconnect data): {time.perf_counter() - t0:.3f} s")
     cmd = math.radians(1.0)
     t_nl = best_of(lambda: ase.simulate_closed_loop(fin.model, SYSTEM_3, cmd, "AEM1",

@@ -42,8 +42,10 @@ def timed(label, fn, repeat=3):
 
 def main():
     try:
-        from asekit.reproduction.fin import fin_gaf_database
-        db, modal = fin_gaf_database(rebuild=False, progress=False)
+        from asekit.case import load_case, pipeline
+        from asekit.util.paths import FIN_FILE
+        case = load_case(FIN_FILE)
+        db, modal = pipeline.gaf_database(case, progress=False), pipeline.modal_model(case)
         i = int(np.argmin(np.abs(np.asarray(db.machs) - 0.75)))
         gaf = TabulatedGaf(db.k, db.Q[i], db.b_ref, db.machs[i])
         modal = modal_arrays(modal)

@@ -60,14 +60,15 @@ def _theta_deviation(after, before) -> float:
 def main(argv):
     from asekit.ase import loop as ase
     from asekit.reproduction import ase as rep
-    from asekit.reproduction import fin as reffin
+    from asekit.case import pipeline
+    from asekit.reproduction.fin import distributed_case, fin_case
     from asekit.rfa import gaf_at_mach, minimum_state as ms
     from asekit.servo.actuator import SYSTEM_3
     from asekit.servo.simulate import THESIS_LIMITS
     from asekit.structure import modes
 
     print(f"{'':58s} {'before':>10s} {'after':>10s}  {'ratio':>7s}   largest difference")
-    fin = reffin.fin_ase(mach=0.5, altitude=0.0)
+    fin = pipeline.ase_condition(fin_case(), mach=0.5, altitude=0.0)
     m = fin.model
 
     # 1. frequency responses
@@ -113,14 +114,14 @@ def main(argv):
         f"{dev:.1e} of peak theta (RK45 rtol 1e-8)")
 
     # 3. the structure chapter's distributed-shaft model, and the memo
-    fdef = reffin.load_fin()
+    dcase = distributed_case(96, 112)
 
     def model(min_dof):
         modes.SYMMETRIC_LU_MIN_DOF = min_dof
-        reffin._modal_model.cache_clear()
+        pipeline.modal_model.cache_clear()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return reffin.fin_modal_model(fdef, 96, 112, shaft="distributed")
+            return pipeline.modal_model(dcase)
 
     default_min = modes.SYMMETRIC_LU_MIN_DOF
     t_b, mb = best_of(lambda: model(10 ** 12), 1)
@@ -128,12 +129,12 @@ def main(argv):
     modes.SYMMETRIC_LU_MIN_DOF = default_min
     row("FN2 96x112 distributed shaft (eigsh factor -> symmetric LU)", t_b, t_a,
         f"{np.max(np.abs(ma.frequencies_hz[1:] / mb.frequencies_hz[1:] - 1)):.1e} in frequency")
-    t_memo, mm = best_of(lambda: reffin.fin_modal_model(fdef, 96, 112, shaft="distributed"))
+    t_memo, mm = best_of(lambda: pipeline.modal_model(dcase))
     same = all(np.array_equal(getattr(mm, k), getattr(ma, k)) for k in ("M", "K", "shapes"))
     row("  the same model again (memo)", t_a, t_memo, f"bit-identical {same}")
 
     # 4. the design chapter's minimum-state fit
-    db, _ = reffin.fin_gaf_database(progress=False)
+    db = pipeline.gaf_database(fin_case(), progress=False)
     k, q = gaf_at_mach(db, 0.6, interpolate=True)
     kw = dict(n_states=6, constrain_k0=True, mach=0.6)
     init = ms._Als.__init__

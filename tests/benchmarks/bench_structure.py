@@ -9,17 +9,18 @@ import sys
 import time
 import warnings
 
-from asekit.reproduction.fin import load_fin
-from asekit.reproduction.fin import fin_modal_model
+from asekit.case import pipeline
+from asekit.case.variants import with_mesh
+from asekit.reproduction.fin import distributed_case, fin_case
 
 TARGET_S = 10.0
 
 
 def main(fine: bool = False) -> int:
-    fin = load_fin()
-    fin_modal_model(fin, 6, 7)                       # warm-up (imports, caches)
+    case = fin_case()
+    pipeline.modal_model(case)                       # warm-up (imports, caches)
     t = time.perf_counter()
-    m = fin_modal_model(fin, 100, 100)
+    m = pipeline.modal_model(with_mesh(case, 100, 100))
     dt = time.perf_counter() - t
     n_dof = 3 * m.nodes.shape[0]
     print(f"FN2 100x100 single-node: {n_dof} DOFs, {dt:.2f} s (target < {TARGET_S:g} s)")
@@ -30,8 +31,9 @@ def main(fine: bool = False) -> int:
             t = time.perf_counter()
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                d = fin_modal_model(fin, *mesh, shaft="distributed")
-            print(f"FN2 {mesh[0]}x{mesh[1]} distributed r={fin.shaft.radius * 1e3:g} mm: "
+                dcase = distributed_case(*mesh)
+                d = pipeline.modal_model(dcase)
+            print(f"FN2 {mesh[0]}x{mesh[1]} distributed r={dcase.support.radius * 1e3:g} mm: "
                   f"{time.perf_counter() - t:.1f} s, elastic (Hz):",
                   ", ".join(f"{f:.2f}" for f in d.frequencies_hz[1:]))
     print("PASS" if ok else "FAIL")

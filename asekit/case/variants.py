@@ -1,0 +1,101 @@
+"""Variants of a :class:`~asekit.case.schema.Case`: each is ``dataclasses.replace`` of the case
+(frozen, so the variant is a new case and the pipeline memoises it separately), with the
+checks the case file would make. Used by the thesis reproduction for the fin's FN1 model, its
+refined meshes, the distributed shaft and the symmetry wall, and by anyone studying one case
+around another.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from asekit.case.pipeline import auto_boxes
+from asekit.case.schema import Case, CaseError
+
+
+def _one_panel(case: Case, what: str):
+    if len(case.panels) != 1:
+        raise CaseError(f"{what} needs a one-panel case, got {len(case.panels)} panels")
+    return case.panels[0]
+
+
+def _count(name: str, v) -> int:
+    if isinstance(v, bool) or int(v) != v or not 1 <= v <= 2000:
+        raise CaseError(f"{name} must be an integer in [1, 2000], got {v!r}")
+    return int(v)
+
+
+def with_mesh(case: Case, n_chord: int | None = None, n_span: int | None = None) -> Case:
+    """The one-panel ``case`` on an ``n_chord x n_span`` structural mesh (``panel[0].n_chord``,
+    ``panel[0].n_span``; None keeps the case's).
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import FIN_FILE
+    >>> p = with_mesh(load_case(FIN_FILE), 12, 14).panels[0]
+    >>> p.n_chord, p.n_span
+    (12, 14)
+    """
+    p = _one_panel(case, "with_mesh")
+    nc = p.n_chord if n_chord is None else _count("panel[0].n_chord", n_chord)
+    ns = p.n_span if n_span is None else _count("panel[0].n_span", n_span)
+    return replace(case, panels=(replace(p, n_chord=nc, n_span=ns),))
+
+
+def with_boxes(case: Case, n_chord: int | None = None, n_span: int | None = None) -> Case:
+    """The one-panel ``case`` with ``aero.boxes = [(n_chord, n_span)]``; a count left None
+    follows the mesh rules (:func:`asekit.case.pipeline.auto_boxes`, the spanwise count from
+    the given chordwise one); both None gives the automatic mesh (``aero.boxes = "auto"``)."""
+    p = _one_panel(case, "with_boxes")
+    if n_chord is None and n_span is None:
+        return replace(case, aero=replace(case.aero, boxes=None))
+    a = case.aero
+    nc = None if n_chord is None else _count("aero.boxes[0].n_chord", n_chord)
+    ns = None if n_span is None else _count("aero.boxes[0].n_span", n_span)
+    return replace(case, aero=replace(a, boxes=(auto_boxes(p.planform, a.u_min, a.f_max,
+                                                           nc, ns),)))
+
+
+def with_shaft(case: Case, **changes) -> Case:
+    """The shaft-supported ``case`` with support fields changed, e.g. ``model="FN1"`` (spring to
+    ground, no rigid mode: ``modes.keep_rigid`` turns False) or ``radius=0.005`` (a rigid shaft
+    region of 5 mm instead of the single node; ``radius=None`` the single node)."""
+    s = case.support
+    if s.kind != "shaft":
+        raise CaseError(f"with_shaft needs support.kind = \"shaft\", got {s.kind!r}")
+    unknown = sorted(set(changes) - {"axis_point", "torsional_stiffness", "bending_stiffness",
+                                     "model", "radius", "fictitious_inertia_factor"})
+    if unknown:
+        raise CaseError(f"support.{unknown[0]} is not a shaft key")
+    if changes.get("model", s.model) not in ("FN1", "FN2"):
+        raise CaseError(f"support.model must be 'FN1' or 'FN2', got {changes['model']!r}")
+    r = changes.get("radius", s.radius)
+    if r is not None and not 0.0 < r <= 1e3:
+        raise CaseError(f"support.region must be \"single_node\" or a shaft radius in (0, 1000] m,"
+                        f" got {r!r}")
+    s = replace(s, **changes)
+    modes = case.modes if s.model == "FN2" else replace(case.modes, keep_rigid=False)
+    if case.actuator is not None and not modes.keep_rigid:
+        case = replace(case, actuator=None)      # the actuator drives the rigid mode
+    return replace(case, support=s, modes=modes)
+
+
+def with_modes(case: Case, f_max: float | None = None, count: int | None = None) -> Case:
+    """The ``case`` keeping its elastic modes below ``f_max`` (Hz; ``modes.f_max``) or its first
+    ``count`` (``modes.count``); None keeps the case's."""
+    m = case.modes
+    if f_max is not None and not 0.0 < f_max <= 1e7:
+        raise CaseError(f"modes.f_max must be in (0, 1e7] Hz, got {f_max!r}")
+    return replace(case, modes=replace(m, f_max=m.f_max if f_max is None else float(f_max),
+                                       count=m.count if count is None else
+                                       _count("modes.count", count)))
+
+
+def with_symmetry_wall(case: Case, wall: bool = True) -> Case:
+    """The ``case`` with a reflection plane at the root (``aero.symmetry = "wall"``, the surface
+    on a body) or without (``"none"``)."""
+    if wall and abs(case.panels[0].planform.root_le[1]) > 1e-12:
+        raise CaseError(f"aero.symmetry = \"wall\" puts the reflection plane at y = 0, but the "
+                        f"root is at y = {case.panels[0].planform.root_le[1]:g} m")
+    return replace(case, aero=replace(case.aero, symmetry="wall" if wall else "none"))
