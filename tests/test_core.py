@@ -1,4 +1,5 @@
-"""Geometry, thesis table, cache and the reproduce command's plumbing."""
+"""Geometry of the reference fin's case and the cache's file format. (The thesis table and the
+reproduce command's plumbing: tests/reproduction/test_thesis_table.py.)"""
 
 import math
 
@@ -6,27 +7,25 @@ import numpy as np
 import pytest
 
 from asekit.util.cache import CacheError, load_npz, save_npz
+from asekit.case import pipeline
 from asekit.geometry import LinearThickness, Material, Planform
-from asekit.reproduction.fin import load_fin
-from asekit.reproduction.driver import CHAPTERS, difference
-from asekit.reproduction.thesis import all_keys, thesis_value
 
 
-def test_reference_fin_geometry_matches_fin_md():
+def test_reference_fin_geometry_matches_fin_md(fin_case):
     # shared/reference/fin.md: area 0.01755 m^2, MAC 121.3 mm, LE sweep 27.47 deg, taper 0.5
-    fin = load_fin()
-    p = fin.planform
+    fin = fin_case
+    p = fin.panels[0].planform
     assert p.area == pytest.approx(0.01755, rel=1e-9)
     assert p.mean_aerodynamic_chord == pytest.approx(0.1213, abs=1e-4)
     assert math.degrees(p.leading_edge_sweep) == pytest.approx(27.47, abs=0.01)
     assert p.taper == pytest.approx(0.5)
     assert fin.thickness.at(0.5) == pytest.approx(0.003)
-    # k_max = 2 pi f_max b / U_min with b = 0.078 m
-    assert fin.aero.k_max == pytest.approx(2 * math.pi * 1000 * 0.078 / 180)
+    # k_max = 2 pi f_max b / U_min with b = 0.078 m: the highest of the automatic k
+    assert pipeline.reduced_frequencies(fin)[-1] == pytest.approx(2 * math.pi * 1000 * 0.078 / 180)
 
 
-def test_planform_point_and_contains():
-    p = load_fin().planform
+def test_planform_point_and_contains(fin_case):
+    p = fin_case.panels[0].planform
     corners = p.point(np.array([0, 1, 1, 0]), np.array([0, 0, 1, 1]))
     np.testing.assert_allclose(corners, p.corners)
     assert p.contains(np.array([[0.1, 0.05], [0.01, 0.149], [0.2, 0.1]])).tolist() == [True, False, False]
@@ -48,24 +47,6 @@ def test_material_and_thickness_bad_input():
         LinearThickness(0.004, 0.0)
 
 
-def test_thesis_table_has_units_and_known_values():
-    keys = all_keys()
-    assert "servo.open_loop_poles" in keys
-    for k in keys:
-        assert thesis_value(k).unit
-    assert thesis_value("servo.system3.gain_margin_db").value == math.inf
-    assert thesis_value("aero.CLalpha_fin_per_rad").value is None
-    with pytest.raises(KeyError):
-        thesis_value("no.such.key")
-
-
-def test_difference_formats():
-    assert difference(100.0, 110.0).endswith("(+10.0 %)")
-    assert difference([1.0, 2.0], [1.1, 2.0]) == "[+10.0, +0.0] %"
-    assert difference(None, 3.0) == ""
-    assert difference(math.inf, math.inf) == "same"
-
-
 def test_cache_roundtrip_and_corruption(tmp_path):
     path = tmp_path / "x.npz"
     a = {"q": np.arange(6.0).reshape(2, 3) + 1j}
@@ -82,8 +63,3 @@ def test_cache_roundtrip_and_corruption(tmp_path):
         load_npz(path)
     with pytest.raises(CacheError, match="does not exist"):
         load_npz(tmp_path / "missing.npz")
-
-
-def test_chapter_names_are_unique():
-    names = [n for n, _ in CHAPTERS]
-    assert len(names) == len(set(names))

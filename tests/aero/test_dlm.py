@@ -8,7 +8,6 @@ from scipy.special import hankel2
 
 from asekit.aero import dlm
 from asekit.aero.boxes import BoxMesh, TrapezoidSurface, mesh_surfaces
-from asekit.reproduction.fin import fin_boxes
 from asekit.aero.dlm import aic_matrix, normalwash_matrices, normalwash_matrix, pressure_jump
 from asekit.aero.vlm import vlm_normalwash_matrix
 from panelaero_grid import panelaero_grid
@@ -119,11 +118,11 @@ def test_sweep_equals_single_calls_and_chunking(monkeypatch):
 
 @pytest.mark.parametrize("method", ["parabolic", "quartic"])
 @pytest.mark.parametrize("case", ["wing", "fin_symmetric", "tiny_chunks_no_table"])
-def test_planar_path_equals_pairwise_path(monkeypatch, method, case):
+def test_planar_path_equals_pairwise_path(monkeypatch, method, case, boxes_of):
     """All-planar meshes take a faster path (kernel once per distinct station point, weights
     per strip group, Re I1(0) per (y, z) group); it must give the pairwise path's matrix to
     rounding (the 1e-13 bound is ~100x the differences seen)."""
-    m = fin_boxes(n_chord=6, n_span=5) if case == "fin_symmetric" else _planar()
+    m = boxes_of(6, 5) if case == "fin_symmetric" else _planar()
     sym = case == "fin_symmetric"
     ks = [0.001, 0.4, 2.5]
     if case == "tiny_chunks_no_table":
@@ -178,9 +177,9 @@ def test_symmetry_plane_equals_explicit_image(geom):
     assert np.allclose(cp_sym, cp_full[:m.n], rtol=1e-10, atol=1e-12)
 
 
-def test_fin_pitch_signs_and_lag():
+def test_fin_pitch_signs_and_lag(fin_box_mesh):
     # nose-up pitch about the shaft gives upward load; unsteady lift lags (Theodorsen-like)
-    m = fin_boxes()
+    m = fin_box_mesh
     x = m.control_point[:, 0]
     b = 0.078
     lifts = []
@@ -191,8 +190,8 @@ def test_fin_pitch_signs_and_lag():
     assert abs(lifts[1]) < 2 * abs(lifts[0])
 
 
-def test_compressibility_raises_steady_lift():
-    m = fin_boxes(n_chord=6, n_span=6)
+def test_compressibility_raises_steady_lift(boxes_of):
+    m = boxes_of(6, 6)
     cl = [np.sum(pressure_jump(m, M, 0.001, 0.078, -np.ones(m.n)) * m.area).real
           for M in (0.0, 0.4, 0.75)]
     assert cl[0] < cl[1] < cl[2]

@@ -11,16 +11,17 @@ import pytest
 from asekit.aero import dlm, kernels
 from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
 from asekit.aero.dlm import normalwash_matrices
-from asekit.reproduction.fin import fin_boxes
 
 pytest.importorskip("numba")
 
 
-def _mesh(name):
+def _mesh(name, boxes_of):
+    """The test's box mesh ``name``; "fin": the reference fin on 8 x 6 boxes (``boxes_of``,
+    the tests/conftest.py fixture)."""
     if name == "wing":
         return mesh_surfaces(TrapezoidSurface((0, 0, 0), 1.0, (0.5, 2, 0.0), 0.6, 6, 8))
     if name == "fin":
-        return fin_boxes(n_chord=8, n_span=6)
+        return boxes_of(8, 6)
     if name == "wing_tail":            # two coplanar surfaces (one all-planar block)
         return mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0.4, 2.0, 0.0), 0.6, 5, 7, "w"),
                               TrapezoidSurface((2.2, 0, 0), 0.5, (2.5, 0.83, 0.0), 0.3, 3, 4,
@@ -45,8 +46,8 @@ def _agree(fast, ref, ks):
 @pytest.mark.parametrize("name,mach,sym", [("wing", 0.0, False), ("wing", 0.85, True),
                                            ("fin", 0.6, True), ("wing_tail", 0.5, False),
                                            ("wing_fin", 0.7, False)])
-def test_compiled_kernel_equals_numpy_kernel(method, name, mach, sym):
-    m = _mesh(name)
+def test_compiled_kernel_equals_numpy_kernel(method, name, mach, sym, boxes_of):
+    m = _mesh(name, boxes_of)
     ks = [0.0, 0.001, 0.4, 2.5]
     ref = normalwash_matrices(m, mach, ks, 0.5, method, symmetric=sym, kernel="numpy")
     fast = normalwash_matrices(m, mach, ks, 0.5, method, symmetric=sym, kernel="compiled")
@@ -54,9 +55,9 @@ def test_compiled_kernel_equals_numpy_kernel(method, name, mach, sym):
     _agree(fast, ref, ks)
 
 
-def test_compiled_kernel_with_tiny_chunks_and_no_weight_table(monkeypatch):
+def test_compiled_kernel_with_tiny_chunks_and_no_weight_table(monkeypatch, boxes_of):
     # chunk boundaries inside strips, the receiver-on-doublet-line limit in many chunks
-    m = _mesh("fin")
+    m = _mesh("fin", boxes_of)
     ks = [0.001, 1.0, 3.0]
     ref = normalwash_matrices(m, 0.6, ks, 0.078, kernel="numpy")
     monkeypatch.setattr(dlm, "PLANAR_POINTS_PER_CHUNK", 50)
@@ -67,8 +68,8 @@ def test_compiled_kernel_with_tiny_chunks_and_no_weight_table(monkeypatch):
     _agree(normalwash_matrices(m, 0.6, ks, 0.078, kernel="compiled"), ref, ks)
 
 
-def test_kernel_choice_argument_and_environment(monkeypatch):
-    m = _mesh("wing")
+def test_kernel_choice_argument_and_environment(monkeypatch, boxes_of):
+    m = _mesh("wing", boxes_of)
     monkeypatch.setenv(kernels.KERNEL_ENV, "numpy")
     assert kernels.default_kernel() == "numpy"
     monkeypatch.setenv(kernels.KERNEL_ENV, "compiled")
@@ -89,10 +90,10 @@ def test_kernel_choice_argument_and_environment(monkeypatch):
 
 
 @pytest.mark.parametrize("name,sym", [("wing", True), ("wing_fin", False), ("fin", True)])
-def test_compiled_vortex_lattice_equals_numpy(name, sym):
+def test_compiled_vortex_lattice_equals_numpy(name, sym, boxes_of):
     # the steady part D0 (horseshoe vortices, Katz & Plotkin Eq. 10.115) by the same loop
     from asekit.aero.vlm import vlm_normalwash_matrix
-    m = _mesh(name)
+    m = _mesh(name, boxes_of)
     ref = vlm_normalwash_matrix(m, 0.7, sym, kernel="numpy")
     got = vlm_normalwash_matrix(m, 0.7, sym, kernel="compiled")
     assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()

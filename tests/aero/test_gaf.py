@@ -1,25 +1,25 @@
 """Splines, generalised aerodynamic forces and the fin's GAF database (asekit.aero.spline/gaf)."""
 
+import math
 import shutil
 
 import numpy as np
 import pytest
 
 from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
-from asekit.reproduction.fin import fin_boxes
-from asekit.aero.gaf import GAF_FILE, gaf_from_box_modes, gaf_matrix, steady_hinge_coefficient
-from asekit.reproduction.fin import database_k, fin_gaf_database
+from asekit.aero.gaf import (GAF_FILE, cached_gaf_database, gaf_from_box_modes, gaf_matrix,
+                             steady_hinge_coefficient)
 from asekit.aero.spline import InfinitePlateSpline, analytic_modes, fe_spline, normalwash
-from asekit.reproduction.fin import load_fin
-from asekit.reproduction.thesis import thesis_value
+from asekit.case import pipeline
 
 B = 0.078          # reference semi-chord of the fin (root semi-chord), m
 X_AXIS = 0.078     # shaft axis, m
 
 
 @pytest.fixture(scope="module")
-def fin_db():
-    return fin_gaf_database(rebuild=False, progress=False)
+def fin_db(fin_gafs, fin_modal):
+    """(GafDatabase, ModalModel) of the fin (tests/conftest.py, via the case pipeline)."""
+    return fin_gafs, fin_modal
 
 
 def _plunge_pitch(mesh):
@@ -27,9 +27,9 @@ def _plunge_pitch(mesh):
                                  lambda x, y: (-(x - X_AXIS), -np.ones_like(x))])
 
 
-def test_quasi_steady_plunge_equals_pitch_lift():
+def test_quasi_steady_plunge_equals_pitch_lift(boxes_of):
     # a slow plunge h = 1 is an incidence -i k / b: its lift is -(i k / b) times the pitch lift
-    m = fin_boxes(n_chord=8, n_span=6)
+    m = boxes_of(8, 6)
     lift_mode = analytic_modes(m, [lambda x, y: (np.ones_like(x), np.zeros_like(x))])
     modes = _plunge_pitch(m)
     k = 1e-4
@@ -40,9 +40,9 @@ def test_quasi_steady_plunge_equals_pitch_lift():
     assert lift_mode.h_lp.shape == (m.n, 1)
 
 
-def test_fe_rigid_mode_equals_analytic_pitch(fin_db):
+def test_fe_rigid_mode_equals_analytic_pitch(fin_db, fin_box_mesh):
     db, model = fin_db
-    m = fin_boxes()
+    m = fin_box_mesh
     fe = fe_spline(model, m)
     an = _plunge_pitch(m)
     assert np.allclose(fe.h_cp[:, 0], an.h_cp[:, 1], atol=1e-12)
@@ -52,12 +52,13 @@ def test_fe_rigid_mode_equals_analytic_pitch(fin_db):
     assert q_fe[0, 0] == pytest.approx(q_an[1, 1], rel=1e-10)
 
 
-def test_database_contract(fin_db):
+def test_database_contract(fin_db, fin_case):
     db, model = fin_db
-    fin = load_fin()
+    a = fin_case.aero
+    k_max = 2 * math.pi * a.f_max * a.reference_semichord / a.u_min      # 2 pi f_max b / U_min
     assert db.machs.tolist() == [0.4, 0.5, 0.6, 0.75]
     assert db.k[0] == pytest.approx(0.001) and db.k.size >= 12 and np.all(np.diff(db.k) > 0)
-    assert db.k[-1] == pytest.approx(fin.aero.k_max) and db.k[-1] == pytest.approx(2.7227, abs=1e-3)
+    assert db.k[-1] == pytest.approx(k_max) and db.k[-1] == pytest.approx(2.7227, abs=1e-3)
     assert db.Q.shape == (4, db.k.size, model.M.shape[0], model.M.shape[0])
     assert db.Q.dtype == complex and np.all(np.isfinite(db.Q))
     assert db.b_ref == B and db.n_rigid == model.n_rigid == 1
@@ -66,28 +67,31 @@ def test_database_contract(fin_db):
     assert db.metadata["symmetric"] is False
 
 
-def test_database_matches_a_fresh_computation(fin_db):
+def test_database_matches_a_fresh_computation(fin_db, fin_box_mesh):
     db, model = fin_db
-    m = fin_boxes()
+    m = fin_box_mesh
     for im, ik in ((0, 0), (3, 9), (2, db.k.size - 1)):
         q = gaf_matrix(model, m, db.machs[im], db.k[ik], db.b_ref)
         assert np.allclose(q, db.Q[im, ik], rtol=1e-9, atol=1e-12 * np.abs(q).max())
 
 
-def test_corrupt_cache_is_rebuilt(tmp_path, fin_db):
-    db, _ = fin_db
+def test_corrupt_cache_is_rebuilt(tmp_path, fin_db, fin_case, fin_box_mesh):
+    db, model = fin_db
     p = tmp_path / "gaf.npz"
     shutil.copy(GAF_FILE, p)
     raw = bytearray(p.read_bytes())
     raw[len(raw) // 2] ^= 0xFF
     p.write_bytes(bytes(raw))
-    db2, _ = fin_gaf_database(path=p, progress=False)
+    a = fin_case.aero
+    args = (model, fin_box_mesh, a.machs, pipeline.reduced_frequencies(fin_case),
+            a.reference_semichord)
+    db2 = cached_gaf_database(*args, path=p, progress=False)
     assert np.allclose(db2.Q, db.Q, rtol=1e-9, atol=1e-15)
-    db3, _ = fin_gaf_database(path=p, progress=False)       # now valid: loaded, not rebuilt
+    db3 = cached_gaf_database(*args, path=p, progress=False)  # now valid: loaded, not rebuilt
     assert db3.metadata["sha256"] == db2.metadata["sha256"]
 
 
-def test_hinge_moment_physics(fin_db):
+def test_hinge_moment_physics(fin_db, thesis_table):
     db, _ = fin_db
     qcc = [steady_hinge_coefficient(db, m) for m in db.machs]
     # de-centering (centre of pressure ahead of the mid-root-chord shaft), grows with Mach
@@ -95,24 +99,24 @@ def test_hinge_moment_physics(fin_db):
     assert abs(db.Q[2, 0, 0, 0].imag) < 0.01 * db.Q[2, 0, 0, 0].real
     # thesis Eq. 4.11: 5.825e-4 m^3 (MSC FlightLoads DLM, mesh not given); our rule-based
     # 140-box mesh gives a value within a few per cent (it converges to about 5.6e-4)
-    assert qcc[2] == pytest.approx(thesis_value("aero.Qcc_steady_m3").value, rel=0.05)
+    assert qcc[2] == pytest.approx(thesis_table["aero.Qcc_steady_m3"]["value"], rel=0.05)
     with pytest.raises(ValueError, match="mach"):
         steady_hinge_coefficient(db, 0.55)
 
 
-def test_wall_at_root_raises_hinge_moment(fin_db):
+def test_wall_at_root_raises_hinge_moment(fin_db, boxes_of):
     _, model = fin_db
-    m = fin_boxes(n_chord=8, n_span=6)
+    m = boxes_of(8, 6)
     iso = gaf_matrix(model, m, 0.6, 0.001, B)[0, 0].real
     wall = gaf_matrix(model, m, 0.6, 0.001, B, symmetric=True)[0, 0].real
     assert wall > 1.2 * iso
 
 
-def test_infinite_plate_spline_reproduces_planes_and_conserves_loads():
+def test_infinite_plate_spline_reproduces_planes_and_conserves_loads(boxes_of):
     rng = np.random.default_rng(1)
     nodes = rng.uniform([0, 0], [0.156, 0.15], size=(30, 2))
     ips = InfinitePlateSpline(nodes)
-    m = fin_boxes(n_chord=6, n_span=5)
+    m = boxes_of(6, 5)
     g, gx = ips.matrices(m.control_point)
     plane = 0.3 + 2.0 * nodes[:, 0] - 0.7 * nodes[:, 1]
     assert np.allclose(g @ plane, 0.3 + 2.0 * m.control_point[:, 0] - 0.7 * m.control_point[:, 1])
@@ -133,9 +137,9 @@ def test_infinite_plate_spline_reproduces_planes_and_conserves_loads():
     assert q_ips == pytest.approx(q_an, rel=1e-8)
 
 
-def test_bad_input(fin_db):
+def test_bad_input(fin_db, fin_case, boxes_of):
     _, model = fin_db
-    m = fin_boxes(n_chord=4, n_span=4)
+    m = boxes_of(4, 4)
     with pytest.raises(ValueError, match="k"):
         gaf_matrix(model, m, 0.6, [0.1, 0.2], B)
     with pytest.raises(ValueError, match="k"):
@@ -147,4 +151,4 @@ def test_bad_input(fin_db):
         fe_spline(model, lifted)
     with pytest.raises(ValueError, match="line"):
         InfinitePlateSpline(np.array([[0, 0], [1, 0], [2, 0.0]]))
-    assert database_k(load_fin())[0] == 0.001
+    assert pipeline.reduced_frequencies(fin_case)[0] == 0.001

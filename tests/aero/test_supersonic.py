@@ -26,7 +26,6 @@ import pytest
 from scipy.special import j0
 
 from asekit.aero.boxes import MeshRuleWarning, TrapezoidSurface, mesh_surfaces
-from asekit.reproduction.fin import fin_boxes
 from asekit.aero.piston import piston_pressure_matrices
 from asekit.aero.supersonic import (cell_potential_integral, supersonic_pressure_matrices,
                                     supersonic_pressure_matrix, supersonic_pressures)
@@ -191,11 +190,11 @@ def test_symmetric_equals_explicit_image():
 
 
 # ---- the fin: stability over Mach and the piston limit ------------------------------------------
-def test_fin_smooth_over_mach_and_tends_to_piston():
+def test_fin_smooth_over_mach_and_tends_to_piston(fin_box_mesh):
     """On the fin: lift of the rigid pitch mode finite and smooth over M 1.15-5 (the diaphragm
     march stays stable), and the ratio to first-order piston theory tends to 1 as M grows at
     M 2, 3, 5 (steady and k = 0.5): |ratio - 1| falls monotonically, below 8 % at M 5."""
-    mesh = fin_boxes()
+    mesh = fin_box_mesh
     b, xa = 0.078, 0.078
     x = mesh.control_point[:, 0]
 
@@ -233,12 +232,12 @@ def test_matrix_and_column_paths_agree():
 
 @pytest.mark.parametrize("mach, symmetric", [(1.2, False), (2.0, False), (3.0, False),
                                              (1.5, True)])
-def test_direct_matrix_equals_fft_columns(mach, symmetric):
+def test_direct_matrix_equals_fft_columns(mach, symmetric, fin_box_mesh):
     """The full matrix (direct summation over the gathered Mach-cone kernel tables, sparse
     transfers) equals the FFT-convolution path applied to the unit columns (the method's
     original implementation) to 1e-12 of the largest entry, at each k: a vectorisation, not a
     change of the result."""
-    mesh = fin_boxes()
+    mesh = fin_box_mesh
     ks = [0.0, 0.5, 1.2]
     a = supersonic_pressure_matrices(mesh, mach, ks, 0.078, symmetric=symmetric, warn=False)
     cols = supersonic_pressures(mesh, mach, ks, 0.078, np.eye(mesh.n)[None].repeat(3, 0),
@@ -259,11 +258,11 @@ def test_direct_matrix_equals_fft_columns_with_wake():
         assert np.abs(a[ik] - cols[ik]).max() < 1e-12 * np.abs(cols[ik]).max()
 
 
-def test_grid_location_equals_brute_force():
+def test_grid_location_equals_brute_force(fin_box_mesh):
     """The grid builder locates cell centres box by box (candidates in each box's bounding
     rectangle); the brute-force test of every centre against every box gives the same owner."""
     from asekit.aero.supersonic import _locate, _locate_grid, mach_grid
-    for mesh, sym in ((fin_boxes(), False), (_half_delta(1.0, 0.5, 12), True)):
+    for mesh, sym in ((fin_box_mesh, False), (_half_delta(1.0, 0.5, 12), True)):
         for mach in (1.2, 3.0):
             g = mach_grid(mesh, mach, 0.5, 0.078, sym, max_cells=20000)
             corners = np.concatenate([mesh.corners, mesh.mirrored().corners]) if sym else \
@@ -275,10 +274,10 @@ def test_grid_location_equals_brute_force():
                                                        g.ny), _locate(corners, cen))
 
 
-def test_grid_converges_on_the_fin():
+def test_grid_converges_on_the_fin(fin_box_mesh):
     """Re Q_cc of the fin's rigid pitch at M 2 (steady): default grid within 2 % of a grid with
     twice as many cells per box chord (diaphragm march stable as the grid is refined)."""
-    mesh = fin_boxes()
+    mesh = fin_box_mesh
     b = xa = 0.078
     xl = mesh.load_point[:, 0]
     qcc = []

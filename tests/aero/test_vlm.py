@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from asekit.aero.boxes import BoxMesh, MeshRuleWarning, TrapezoidSurface, check_mesh_rules, mesh_surfaces
-from asekit.reproduction.fin import fin_boxes
 from asekit.aero.vlm import lift_curve_slope, steady_pressure, vlm_normalwash_matrix
 from panelaero_grid import panelaero_grid
 
@@ -138,8 +137,8 @@ def test_symmetry_plane_equals_explicit_image():
     assert np.allclose(cp_full[:m.n], cp_full[m.n:], rtol=1e-10)
 
 
-def test_signs_upward_load_for_positive_incidence():
-    m = fin_boxes()
+def test_signs_upward_load_for_positive_incidence(fin_box_mesh):
+    m = fin_box_mesh
     cp = steady_pressure(m, 0.6, -np.ones(m.n))
     assert np.all(cp > 0)
     assert np.all(np.diag(vlm_normalwash_matrix(m, 0.6)) < 0)
@@ -149,9 +148,9 @@ def test_signs_upward_load_for_positive_incidence():
 
 
 @pytest.mark.parametrize("mach", [-0.1, 1.0, 1.5, float("nan")])
-def test_bad_mach(mach):
+def test_bad_mach(mach, boxes_of):
     with pytest.raises(ValueError, match="mach"):
-        vlm_normalwash_matrix(fin_boxes(n_chord=4, n_span=4), mach)
+        vlm_normalwash_matrix(boxes_of(4, 4), mach)
 
 
 def test_bad_boxes():
@@ -175,8 +174,8 @@ def test_bad_boxes():
         TrapezoidSurface((0, 0, 0), 1.0, (0, 1, 0), 1.0, 2, 0)
 
 
-def test_mesh_rules_warn_with_strip_names():
-    coarse = fin_boxes(n_chord=3, n_span=1)
+def test_mesh_rules_warn_with_strip_names(boxes_of, fin_box_mesh):
+    coarse = boxes_of(3, 1)
     with pytest.warns(MeshRuleWarning) as rec:
         rep = check_mesh_rules(coarse, 180.0, 1000.0)
     text = " ".join(str(r.message) for r in rec)
@@ -185,10 +184,10 @@ def test_mesh_rules_warn_with_strip_names():
     # the default fin mesh satisfies all three rules of thesis Section 3.2.1
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        rep = check_mesh_rules(fin_boxes(), 180.0, 1000.0)
+        rep = check_mesh_rules(fin_box_mesh, 180.0, 1000.0)
     assert rep.ok and rep.bpw.min() >= 15 and rep.aspect_ratio.max() < 3
     # BPW of Eq. (3.5) by hand for the root strip
-    m = fin_boxes()
+    m = fin_box_mesh
     assert rep.bpw[0] == pytest.approx(180.0 / (1000.0 * m.chord[m.strip == 0].max()))
     with pytest.raises(ValueError, match="u_min"):
         check_mesh_rules(m, 0.0, 1000.0)

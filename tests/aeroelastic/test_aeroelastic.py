@@ -150,13 +150,12 @@ def test_roger_fit_into_model_end_to_end():
     assert sys.nstates == 2 * 3 + 2 * 3 + 2 * 1
 
 
-def test_fin_outputs_root_pitch_and_corners():
+def test_fin_outputs_root_pitch_and_corners(fin_modal):
     """With asekit's fin modal model: the fin-root pitch output is theta + elastic rotation at
     the shaft node, with the rigid mode contributing exactly theta; corner outputs exist."""
     pytest.importorskip("asekit.structure.modes")
     from asekit.aeroelastic.statespace import fin_outputs
-    from asekit.reproduction.fin import fin_modal_model
-    modal = fin_modal_model()
+    modal = fin_modal
     corners = np.array([[0.0, 0.0], [0.156, 0.0], [0.078, 0.15], [0.156, 0.15]])
     out = fin_outputs(modal, corners, names=["rle", "rte", "tle", "tte"],
                       shaft_point=(0.078, 0.0))

@@ -14,12 +14,13 @@ import numpy as np
 import pytest
 
 from asekit.aeroelastic.statespace import modal_arrays
+from asekit.case import pipeline
 from asekit.aeroelastic.flutter import (FlutterConvergenceWarning, PkResult, RootLocusResult, TabulatedGaf,
                             crossing_tolerance, first_of, match_point_table, matched_mach,
                             pk_flutter, pk_instabilities, root_locus, root_locus_instabilities,
                             time_domain_sweep, growth_rate, simulate_free_response)
 from asekit.io.op4 import load_ha145b
-from asekit.rfa import roger_fit
+from asekit.rfa import roger_fit, roger_fit_database
 
 from property_targets import TWO_DOF, two_dof_coalescence
 
@@ -27,11 +28,11 @@ HA145B_FLUTTER_SPEED = 12672.0      # in/s, Nastran HA145B (see module docstring
 
 
 @pytest.fixture(scope="module")
-def fin():
-    from asekit.reproduction.fin import fin_gaf_database
-    from asekit.reproduction.flutter import fin_gaf, fin_rfa
-    db, modal = fin_gaf_database(rebuild=False, progress=False)
-    return modal, fin_gaf(db, 0.75), fin_rfa(db, 0.75)
+def fin(fin_modal, fin_gafs):
+    """The fin (tests/conftest.py, via the case pipeline) at M 0.75: modal model, tabulated GAFs
+    and their Roger fit with 4 lags."""
+    return (fin_modal, pipeline.gaf_at(fin_gafs, 0.75),
+            roger_fit_database(fin_gafs, 0.75, n_lags=4))
 
 
 @pytest.fixture(scope="module")

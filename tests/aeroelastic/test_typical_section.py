@@ -377,81 +377,6 @@ def test_conner_preloaded_lco_multi_harmonic_balance_against_time_domain(p):
 # ---------------------------------------------------------------------------------------------
 # against the published LCO results (numbers stated in the text of [C97] and [T98])
 # ---------------------------------------------------------------------------------------------
-PATH_SPEEDS = (4.0, 4.5, 5.0, 6.0, 7.0, 8.0, 8.5, 9.0, 9.5, 10.0, 10.5, 11.0, 11.5, 12.0, 12.5,
-               13.0, 15.0, 17.5, 20.0, 22.0, 23.5, 24.0)
-
-
-@pytest.fixture(scope="module")
-def conner_path():
-    from asekit.reproduction.freeplay import conner_path_following
-    uf = flutter_speed(conner_1997(), 1.0, 60.0, 120)[0]
-    return uf, conner_path_following(PATH_SPEEDS)
-
-
-def test_conner_lco_regimes_against_published_path_following(conner_path):
-    """[C97] Sec. 11.2 (pp. 101-105) describes the numerical model's path following in
-    increasing airspeed (U / U_f, U_f its own linear flutter speed; experiment in brackets):
-    disturbances decay up to ~0.18 (0.23), then a discrete jump to a low-frequency LCO; simple
-    low-frequency motion until ~0.35 (0.37); "from approximately 0.32 U_f to 0.44 U_f
-    predominantly nonperiodic" (p. 102); periodic again from ~0.44 (0.48) as "a more complex
-    low frequency limit cycle" (Fig. 10: "period-2 flap region", 0.49 U_f) with larger
-    amplitudes in all three degrees of freedom; at ~0.50 (0.55) the jump to a stable
-    high-frequency LCO with "a dramatic drop in the plunge amplitude", the flap amplitude
-    jumping up; divergent flutter "within 2% of the linear boundary" (p. 105). [T98] Sec. 4.2.1:
-    the low-frequency LCO is near the plunge natural frequency, the high-frequency one near the
-    pitch natural frequency.
-
-    asekit, same model (Jones' C(k), Table A.1, +-2.12 deg), the same procedure (path
-    following from the flap resting on a band edge plus a plunge kick of delta b;
-    asekit.reproduction.freeplay.conner_path_following), U_f = 24.03 m/s:
-    rest at 0.166, LCO from 0.187 (published 0.18); simple period-one low-frequency LCO
-    (4.6-4.9 Hz) up to 0.395 (published 0.35: +0.045); not period-one at 0.416 (repeats every
-    4 cycles) and 0.437 (no repeat within 8); periodic again from 0.458 to 0.499 with two flap
-    maxima a cycle and an offset (-0.3 delta) (published: periodic again from 0.44, "more
-    complex"); the 10.6-11.4 Hz LCO from 0.520 (published 0.50: +0.02), plunge r.m.s. falling
-    from 0.48 to 0.14 then 0.04 delta b, flap r.m.s. rising; bounded LCO up to 0.999 U_f
-    (published: within 2 %). Not compared: the r.m.s. amplitude curves of Fig. 8 (figures only,
-    not digitised)."""
-    uf, pts = conner_path
-    r = np.array([p.velocity / uf for p in pts])
-    kind = [p.flap.kind for p in pts]
-    f = np.array([p.flap.frequency_hz for p in pts])
-    lco = np.array([k == "lco" for k in kind])
-    # (i) onset from rest: bracket [last decayed, first LCO] within 0.025 of 0.18
-    i_on = int(np.argmax(lco))
-    assert i_on > 0 and all(k == "decayed" for k in kind[:i_on])
-    assert r[i_on] - 0.18 <= 0.025 and 0.18 - r[i_on - 1] <= 0.025
-    # (ii) end of the simple (period-one, one maximum a cycle) low-frequency LCO: 0.35 +- 0.05
-    simple_low = [i for i, p in enumerate(pts)
-                  if lco[i] and f[i] < 7.0 and p.period == 1 and abs(p.maxima_per_cycle - 1) < 0.1]
-    assert simple_low == list(range(i_on, simple_low[-1] + 1))
-    assert abs(r[simple_low[-1]] - 0.35) <= 0.05
-    # (iii) a non-period-one window inside 0.32-0.44, then periodic "more complex" motion
-    non_p1 = [i for i, p in enumerate(pts) if f[i] < 7.0 and lco[i] and p.period != 1]
-    assert non_p1 and all(0.32 <= r[i] <= 0.44 for i in non_p1)
-    complex_p = [i for i, p in enumerate(pts)
-                 if f[i] < 7.0 and p.period == 1 and p.maxima_per_cycle > 1.5]
-    assert complex_p and all(0.44 <= r[i] <= 0.50 for i in complex_p)
-    last_low = pts[complex_p[-1]]
-    assert last_low.flap_rms > pts[simple_low[-1]].flap_rms
-    assert last_low.plunge_rms > pts[simple_low[-1]].plunge_rms
-    # (iv) the jump to the high-frequency LCO: 0.50 +- 0.03, plunge drops, flap rises
-    i_hi = int(np.argmax(f > 7.5))
-    assert abs(r[i_hi] - 0.50) <= 0.03 and np.all(f[i_hi:] > 7.5)
-    settled_hi = [p for p in pts[i_hi:] if p.flap.kind == "lco"]
-    assert settled_hi[0].plunge_rms < last_low.plunge_rms / 5
-    assert settled_hi[0].flap_rms > last_low.flap_rms
-    # (v) bounded up to the linear flutter speed (published: divergence within 2 %)
-    assert all(p.flap.kind == "lco" for p in pts if p.velocity / uf > 0.98)
-    assert max(r[lco]) > 0.98
-    # [T98]: low branch nearer the plunge, high branch nearer the pitch coupled frequency
-    w, _ = _coupled_in_vacuo(conner_1997())
-    fh, fa, fb = w / (2 * math.pi)
-    low, high = f[lco & (f < 7.0)], f[lco & (f > 7.5)]
-    assert np.all(np.abs(low - fh) < np.abs(low - fa))
-    assert np.all(np.abs(high - fa) < np.minimum(np.abs(high - fh), np.abs(high - fb)))
-
-
 def test_conner_lco_fold_against_published_onset():
     """The lowest airspeed of a stable LCO (the fold of the low-frequency branch, multi-harmonic
     balance with Floquet stability): between 4.0 and 4.5 m/s, i.e. 0.166-0.187 U_f, against the
@@ -535,21 +460,3 @@ def test_conner_flap_stiffness_flutter_against_tang_1998():
     assert u_zero[0] == pytest.approx(6.80, abs=0.02)
     assert all(6.4 < u < 7.1 for u in u_zero), u_zero
     assert max(u_zero) < 0.83 * 8.6
-
-
-def test_path_following_helpers():
-    """repeat_period finds the period of a period-doubled signal (a 5 Hz sine plus a 2.5 Hz
-    subharmonic repeats after 2 periods of 5 Hz, a pure sine after 1, an incommensurate sum
-    never within 8); bad input is refused."""
-    from asekit.reproduction.freeplay import conner_path_following, repeat_period
-    t = np.arange(0.0, 10.0, 1e-3)
-    assert repeat_period(t, np.sin(2 * math.pi * 5 * t), 5.0, 1.0) == 1
-    assert repeat_period(t, np.sin(2 * math.pi * 5 * t) + 0.3 * np.sin(math.pi * 5 * t),
-                         5.0, 1.0) == 2
-    assert repeat_period(t, np.sin(2 * math.pi * 5 * t) + 0.3 * np.sin(2 * math.pi * 5 * t
-                                                                        / math.sqrt(5)),
-                         5.0, 1.0) is None
-    with pytest.raises(ValueError, match="frequency_hz"):
-        repeat_period(t, t, 0.0, 1.0)
-    with pytest.raises(ValueError, match="velocities"):
-        conner_path_following([5.0, 4.0])

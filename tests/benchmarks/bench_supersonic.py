@@ -6,7 +6,7 @@ Run on demand (not collected by pytest):
     python tests/benchmarks/bench_supersonic.py [--repeat 3] [--k 0.5]
 
 Times (best of ``--repeat``) at one reduced frequency on the fin's default box mesh
-(``pipeline.box_mesh`` of the fin's case, 140 boxes):
+(``asekit.case.pipeline.box_mesh`` of the fin's case, 140 boxes):
 
 - the DLM: the normalwash matrix D(M 0.75, k) and the AIC = D^-1;
 - the supersonic method: the full pressure-per-normalwash matrix A(M, k) (140 grid solves,
@@ -57,8 +57,8 @@ from asekit.aero.gaf import gaf_from_box_modes  # noqa: E402
 from asekit.aero.piston import piston_pressure_matrix  # noqa: E402
 from asekit.aero.spline import fe_spline  # noqa: E402
 from asekit.aero.supersonic import mach_grid, supersonic_pressure_matrix  # noqa: E402
-from asekit.case import pipeline  # noqa: E402
-from asekit.reproduction.fin import fin_case  # noqa: E402
+from asekit.case import load_case, pipeline  # noqa: E402
+from asekit.util.paths import FIN_FILE  # noqa: E402
 
 
 def best(fn, repeat: int) -> float:
@@ -75,10 +75,10 @@ def main(argv=None) -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--k", type=float, default=0.5)
     args = ap.parse_args(argv)
-    case = fin_case()
-    mesh = pipeline.box_mesh(case)
+    fin = load_case(FIN_FILE)
+    mesh = pipeline.box_mesh(fin)
     b, k, r = 0.078, args.k, args.repeat
-    bm = fe_spline(pipeline.modal_model(case), mesh)
+    bm = fe_spline(pipeline.modal_model(fin), mesh)
     rows = [("DLM D (M 0.75)", best(lambda: normalwash_matrix(mesh, 0.75, k, b), r))]
     t_aic = best(lambda: aic_matrix(mesh, 0.75, k, b), r)
     rows.append(("DLM AIC (M 0.75)", t_aic))

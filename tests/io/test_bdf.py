@@ -403,7 +403,7 @@ def test_analyse_cli_reads_a_deck(tmp_path, capsys):
     analyse road (JSON summary with the deck's flutter point); a deck without aero is refused
     with one line naming the file."""
     import json
-    from asekit.__main__ import main
+    from asekit.cli.main import main
     out = tmp_path / "s.json"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", B.UnsupportedCardWarning)

@@ -27,9 +27,9 @@ def _ms_data(n=3, roots=(0.1, 0.4, 1.2), seed=2):
 
 
 @pytest.fixture(scope="module")
-def fin():
-    from asekit.reproduction.fin import fin_gaf_database
-    return fin_gaf_database(rebuild=False, progress=False)
+def fin(fin_gafs, fin_modal):
+    """(GafDatabase, ModalModel) of the fin (tests/conftest.py, via the case pipeline)."""
+    return fin_gafs, fin_modal
 
 
 def test_exact_recovery_of_a_minimum_state_function():
@@ -120,9 +120,17 @@ def test_aeroelastic_eigenvalues_solve_the_flutter_determinant(fin):
 
 
 def _elastic(fin, mach):
-    """The clamped flutter problem (ModalArrays, k, Q_ss, b_ref) of the fin at ``mach``."""
-    from asekit.reproduction.design import elastic_problem
-    return elastic_problem(fin, mach)
+    """The clamped flutter problem (ModalArrays, k, Q_ss, b_ref) of the fin at ``mach``: the
+    rigid pitch mode held (theta = 0), so only the elastic s-set rows and columns of M, K, C
+    and Q remain (thesis Eq. 2.46 partition). The same problem as
+    asekit.reproduction.design.elastic_problem, written here so that this physics test does not
+    depend on the reproduction."""
+    db, modal = fin
+    m = modal_arrays(modal)
+    s = slice(m.n_rigid, m.n_modes)
+    me = modal_arrays(M=m.M[s, s], K=m.K[s, s], C=m.C[s, s], n_rigid=0)
+    k, Q = gaf_at_mach(db, mach)
+    return me, k, Q[:, s, s], db.b_ref
 
 
 @pytest.mark.parametrize("mach", [0.75, 0.6])
@@ -132,7 +140,7 @@ def test_flutter_speed_with_few_minimum_state_lags_matches_pk(fin, mach, n_state
     # moves the speed by < 0.02 %), sea level, rigid mode held; the fit is weighted towards
     # k <= 2 k_f (reduced_frequency_weights, order 4), k_f the p-k flutter reduced frequency.
     # (The speed depends on the weighting: unweighted 4-6 state fits miss by 3-8 %, and k_band
-    # 3-4 k_f or order 2 by up to 2 %; see asekit.reproduction.design.flutter_weighting_study.)
+    # 3-4 k_f or order 2 by up to 2 %; see the design chapter's flutter_weighting_study.)
     me, k, Qe, b = _elastic(fin, mach)
     rho = 1.225
     gaf = TabulatedGaf(k, Qe, b, mach)

@@ -171,21 +171,6 @@ def test_step_response_system3_fast_and_settles():
     assert t[np.argmax(y > 0.9)] < 0.01
 
 
-def test_widget_panel_builds_without_a_front_end():
-    pytest.importorskip("ipywidgets")
-    import matplotlib.pyplot as plt
-
-    from asekit.reproduction.widgets import servo_panel, servo_snapshot
-    panel = servo_panel()
-    assert set(panel.sliders) == {"gain", "kp", "kd", "supply_voltage"}
-    snap = panel.redraw()
-    np.testing.assert_allclose(snap.poles, closed_loop_poles(P, SYSTEM_3), rtol=1e-9)
-    # gains outside the Routh range: reported as unstable, no simulation, no exception
-    bad = servo_snapshot(1.0, 1e6, 0.0)
-    assert not bad.stable and bad.simulation is None
-    plt.close("all")
-
-
 def test_interconnected_state_space_loop_has_the_design_poles():
     # actuator SS + static PD (derivative on the measured rate) closed through python-control:
     # same characteristic polynomial as Eq. 4.18
