@@ -53,6 +53,8 @@ from pathlib import Path
 
 import numpy as np
 
+from asekit.util.conventions import mode_number
+
 
 class SweepError(ValueError):
     """A sweep file or sweep definition that cannot be run; the message names the key."""
@@ -292,7 +294,7 @@ def _pos(where, d, key):
 POINT_OUTPUTS = {
     "flutter_speed": "m/s, first p-k flutter crossing (empty: none in the velocity sweep)",
     "flutter_frequency": "Hz, at the flutter speed",
-    "flutter_mode": "index of the fluttering elastic mode",
+    "flutter_mode": "the fluttering elastic mode, numbered from 1 (rigid mode not counted)",
     "divergence_speed": "m/s, static divergence (steady GAF eigenproblem; empty: none)",
     "unstable_at_start": "the first speed of the velocity sweep is already unstable",
     "flight_speed": "m/s, M a at the analysed condition",
@@ -723,7 +725,7 @@ def _analyse(sweep: Sweep, factors: AicFactors, values: dict):
         div = divergence_speeds(model, db.Q[0, 0].real, cond.density)
         out.update({"flutter_speed": u_f,
                     "flutter_frequency": None if u_f is None else float(f.frequency_hz),
-                    "flutter_mode": None if u_f is None else int(f.mode),
+                    "flutter_mode": None if u_f is None else mode_number(f.mode, f.n_rigid),
                     "divergence_speed": float(div[0]) if div.size else None,
                     "unstable_at_start": bool(r.unstable_at_start), "flight_speed": u_fl})
         if "flutter_margin" in want or "flutter_inside" in want:

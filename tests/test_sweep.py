@@ -262,7 +262,7 @@ def test_a_sample_is_the_pipeline_on_the_edited_case(one_blas_thread):
     assert row["status"] == "ok" and row["flight.mach"] == 0.5
     assert row["flutter_speed"] == r.flutter.speed
     assert row["flutter_frequency"] == r.flutter.frequency_hz
-    assert row["flutter_mode"] == r.flutter.mode
+    assert row["flutter_mode"] == r.flutter.mode + 1        # user-facing: elastic modes from 1
     model = P.modal_model(case)
     div = divergence_speeds(model, P.gaf_at(db, 0.5).Q[0].real, cond.density)
     assert row["divergence_speed"] == div[0]

@@ -8,8 +8,9 @@
   the flutter equation by determinant iteration", J. Aircraft 8(11), 1971; the MSC Nastran PK
   method with linear interpolation of Q in k). Modes are tracked across airspeed and inside the
   k-iteration by eigenvector correlation (modal assurance criterion), not by frequency order.
-  Damping is reported as g = 2 Re(p)/|p| (Nastran's g = 2 gamma for oscillatory roots; +-2 for
-  real roots) and the decay rate sigma = Re(p) (1/s).
+  Damping is reported as g = 2 Re(p)/|Im(p)| (Nastran's g = 2 gamma, p = omega (gamma +- i);
+  g > 0 unstable; clipped to +-2, the value of real roots; docs/conventions.md) and the decay
+  rate sigma = Re(p) (1/s).
 * root locus (Section 3.3.2): eigenvalues of A_sys (Eq. 2.63) over airspeed; aeroelastic roots
   are continued from the structural roots (U -> 0) and separated from the aerodynamic lag roots
   by continuation with eigenvector correlation; damping ratio and frequency by Eq. (3.13).
@@ -37,6 +38,7 @@ import numpy as np
 from scipy import linalg, optimize
 
 from asekit.aeroelastic.statespace import ModalArrays, aeroelastic_matrices, modal_arrays
+from asekit.util.conventions import damping_ratio, mode_label, vg_damping
 from asekit.util.blas import small_dense
 from asekit.util.validate import positive, positive_array
 
@@ -163,8 +165,12 @@ class PkResult:
     """p-k solution over airspeed for each tracked mode.
 
     velocities (n_v,), p (n_v, n_t) complex roots, sigma = Re p (1/s), frequency_hz = Im p/2pi,
-    damping_g = 2 Re p/|p|, k (n_v, n_t), vectors (n_v, n_t, n) eigenvectors (modal
-    coordinates), converged (n_v, n_t) bool, structural_frequencies_hz (n_t,), density, mach.
+    damping_g = 2 Re p/|Im p| (V-g damping, > 0 unstable, :func:`asekit.util.conventions.vg_damping`),
+    k (n_v, n_t), vectors (n_v, n_t, n) eigenvectors (modal coordinates), converged (n_v, n_t)
+    bool, structural_frequencies_hz (n_t,), density, mach. ``modes`` (n_t,): the index of each
+    tracked column among the modes solved (None: column j is mode j); ``n_rigid``: rigid modes
+    among the modes solved (0 when the rigid mode is held, the default), so that column j is
+    named ``mode_labels[j]`` (docs/conventions.md: elastic modes 1, 2, ..., "rigid pitch").
     """
 
     velocities: np.ndarray
@@ -176,6 +182,8 @@ class PkResult:
     density: float
     mach: float | None = None
     b_ref: float = 1.0
+    modes: np.ndarray | None = None
+    n_rigid: int = 0
 
     @property
     def sigma(self) -> np.ndarray:
@@ -187,18 +195,30 @@ class PkResult:
 
     @property
     def damping_g(self) -> np.ndarray:
-        return 2 * self.p.real / np.maximum(np.abs(self.p), 1e-300)
+        """V-g damping g = 2 Re p / |Im p| (-), > 0 unstable (clipped to +-2)."""
+        return vg_damping(self.p)
 
     @property
     def damping_ratio(self) -> np.ndarray:
-        return -self.p.real / np.maximum(np.abs(self.p), 1e-300)
+        """Damping ratio zeta = -Re p / |p| (-), > 0 stable."""
+        return damping_ratio(self.p)
+
+    def mode_index(self, column: int) -> int:
+        """The index among the modes solved of tracked column ``column``."""
+        return int(column if self.modes is None else self.modes[column])
+
+    @property
+    def mode_labels(self) -> list[str]:
+        """User-facing names of the tracked columns ("mode 1", ..., "rigid pitch")."""
+        return [mode_label(self.mode_index(j), self.n_rigid) for j in range(self.p.shape[1])]
 
 
 @dataclass(frozen=True)
 class Instability:
     """A flutter or divergence point: ``kind`` ('flutter' or 'divergence'), tracked ``mode``
     index (0-based among the modes solved), ``speed`` (m/s), ``frequency_hz`` (0 for divergence),
-    ``vector`` (modal eigenvector at the point, if known), ``method``.
+    ``vector`` (modal eigenvector at the point, if known), ``method``; ``n_rigid``: rigid modes
+    among the modes solved (0 when held), so the user-facing name is :attr:`mode_name`.
 
     ``at_first_point`` marks the other result kind: the root is already unstable at the first
     airspeed of the sweep, so the instability is *at or below* ``speed`` (= U0, an upper bound,
@@ -213,11 +233,18 @@ class Instability:
     vector: np.ndarray | None = field(default=None, repr=False)
     method: str = ""
     at_first_point: bool = False
+    n_rigid: int = 0
+
+    @property
+    def mode_name(self) -> str:
+        """'mode 1', 'mode 2', ... (elastic modes from 1) or 'rigid pitch'
+        (:func:`asekit.util.conventions.mode_label`)."""
+        return mode_label(self.mode, self.n_rigid)
 
     def describe(self, unit: str = "m/s") -> str:
         """One-line description, e.g. 'flutter at 218.1 m/s, 140.9 Hz (mode 2, p-k)' or
         'unstable at the first point of the sweep: flutter at or below 250 m/s (mode 2, p-k)'."""
-        where = f"mode {self.mode + 1}" + (f", {self.method}" if self.method else "")
+        where = self.mode_name + (f", {self.method}" if self.method else "")
         if self.at_first_point:
             return (f"unstable at the first point of the sweep: {self.kind} at or below "
                     f"{self.speed:.6g} {unit} ({where})")
@@ -353,7 +380,9 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
             omega, ref = abs(p.imag), v
     if not conv.all():
         bad = np.argwhere(~conv)
-        listed = ", ".join(f"mode {modes[jt] + 1} at U = {U[i]:.6g}" for i, jt in bad[:8])
+        n_r = m.n_rigid if include_rigid else 0
+        listed = ", ".join(f"{mode_label(int(modes[jt]), n_r)} at U = {U[i]:.6g}"
+                           for i, jt in bad[:8])
         more = f" and {len(bad) - 8} more" if len(bad) > 8 else ""
         warnings.warn(f"p-k: the k-iteration did not converge within max_iter = {max_iter} "
                       f"(tol {tol:g}) at {len(bad)} of {conv.size} points: {listed}{more}; "
@@ -362,7 +391,8 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
                       FlutterConvergenceWarning, stacklevel=3)   # caller, past @small_dense
     return PkResult(velocities=U, p=P, k=KK, vectors=V, converged=conv,
                     structural_frequencies_hz=w[modes] / (2 * np.pi), density=rho,
-                    mach=gaf.mach, b_ref=gaf.b_ref)
+                    mach=gaf.mach, b_ref=gaf.b_ref, modes=modes,
+                    n_rigid=m.n_rigid if include_rigid else 0)
 
 
 def _crossings(U, sigma, freq_hz, real_mask, tol: float = 0.0):
@@ -416,9 +446,10 @@ def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = No
                                                 real_mask, tol):
             vec = result.vectors[i, jt]
             if first:
-                found.append(Instability(kind=kind, mode=jt, speed=float(us),
+                found.append(Instability(kind=kind, mode=result.mode_index(jt), speed=float(us),
                                          frequency_hz=0.0 if kind == "divergence" else float(f),
-                                         vector=vec, method="p-k", at_first_point=True))
+                                         vector=vec, method="p-k", at_first_point=True,
+                                         n_rigid=result.n_rigid))
                 continue
             if prob is not None:
                 # continue from the unstable side: at an undamped coalescence the sub-critical
@@ -437,9 +468,9 @@ def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = No
                         and f < 1e-6 else kind
                 except ValueError:
                     pass
-            found.append(Instability(kind=kind, mode=jt, speed=float(us),
+            found.append(Instability(kind=kind, mode=result.mode_index(jt), speed=float(us),
                                      frequency_hz=0.0 if kind == "divergence" else float(f),
-                                     vector=vec, method="p-k"))
+                                     vector=vec, method="p-k", n_rigid=result.n_rigid))
     return sorted(found, key=lambda s: s.speed)
 
 
@@ -590,8 +621,20 @@ class RootLocusResult:
 
     @property
     def damping_ratio(self) -> np.ndarray:
-        """xi of Eq. (3.13) for the aeroelastic roots."""
-        return -self.elastic.real / np.maximum(np.abs(self.elastic), 1e-300)
+        """Damping ratio xi = -Re lambda / |lambda| of Eq. (3.13) for the aeroelastic roots
+        (> 0 stable)."""
+        return damping_ratio(self.elastic)
+
+    @property
+    def damping_g(self) -> np.ndarray:
+        """V-g damping g = 2 Re lambda / |Im lambda| of the aeroelastic roots (> 0 unstable,
+        clipped to +-2; :func:`asekit.util.conventions.vg_damping`)."""
+        return vg_damping(self.elastic)
+
+    @property
+    def mode_labels(self) -> list[str]:
+        """'mode 1', 'mode 2', ...: the aeroelastic roots are the elastic modes'."""
+        return [mode_label(j) for j in range(self.elastic.shape[1])]
 
     @property
     def natural_frequency_hz(self) -> np.ndarray:

@@ -19,6 +19,7 @@ import numpy as np
 
 from asekit.aero.boxes import TrapezoidSurface, check_matrix_memory, mesh_surfaces
 from asekit.aero.gaf import GafDatabase, cached_gaf_database, default_reduced_frequencies
+from asekit.util.conventions import mode_label
 from asekit.atmosphere import standard_atmosphere
 from asekit.aeroelastic.flutter import (Instability, PkResult, TabulatedGaf, divergence_speeds,
                                         first_of)
@@ -359,7 +360,8 @@ class ConditionResult:
     pk : the sweep; instabilities : every crossing found; flutter / divergence : the first of
     each kind (None if none in the sweep); unstable_at_start : the lowest speed of the sweep is
     already unstable (flutter or divergence at or below it: the sweep must start lower);
-    start_mode : the index of the mode unstable there.
+    start_mode : the 0-based index (among the modes solved) of the mode unstable there (its
+    user-facing name: ``asekit.util.conventions.mode_label(start_mode, pk.n_rigid)``).
     """
 
     mach: float
@@ -478,8 +480,9 @@ def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -
     for r in results:
         if r.unstable_at_start:
             notes.append(f"M {r.mach:g}, rho {r.condition.density:.4g}: unstable at the first "
-                         f"point of the sweep ({case.flight.velocities[0]:g} m/s, mode "
-                         f"{r.start_mode}): flutter or divergence at or below it")
+                         f"point of the sweep ({case.flight.velocities[0]:g} m/s, "
+                         f"{mode_label(r.start_mode, r.pk.n_rigid)}): flutter or divergence "
+                         "at or below it")
     return FlutterAnalysis(tuple(results), tuple(div), tuple(matches), tuple(margins),
                            time.perf_counter() - t0, tuple(notes))
 

@@ -3,7 +3,12 @@ output), a plain-text table of it, and an HTML report with the figures a user ex
 (planform with FE and aero meshes, mode shapes, V-g and V-f with the flutter point marked,
 root locus; with an actuator also the FWTF Bode with its margins and the step responses).
 
-Units: SI in the JSON (m/s, Hz, kg/m^3, m); the same in the table.
+Conventions (docs/conventions.md): SI in the JSON and the table; every JSON key carries its
+unit as a suffix (``_ms`` m/s, ``_hz`` Hz, ``_m`` m, ``_s`` s, ``_deg`` deg, ``_pct`` %), and
+the document's ``units`` block (:data:`UNITS`) gives the unit of every numeric key;
+modes are named as the user reads them: elastic modes 1, 2, ... (the rigid mode not counted)
+and ``"rigid pitch"`` (:func:`asekit.util.conventions.mode_number`); every V-g axis is
+g = 2 Re p / |Im p|, > 0 unstable.
 """
 
 from __future__ import annotations
@@ -18,7 +23,30 @@ from pathlib import Path
 
 import numpy as np
 
+from asekit.util.conventions import mode_label, mode_number
 from asekit.case.schema import Case
+
+#: The unit of every numeric key of the summary (the JSON's ``units`` block; docs/conventions.md).
+#: Key suffixes name the unit too: ``_ms`` m/s, ``_hz`` Hz, ``_m`` m, ``_s`` s, ``_deg`` deg,
+#: ``_pct`` %; the keys without a suffix are dimensionless or listed here with theirs.
+UNITS = {
+    "frequencies_hz": "Hz", "frequency_hz": "Hz",
+    "altitude_m": "m",
+    "speed_ms": "m/s", "matched_speed_ms": "m/s", "envelope_speed_ms": "m/s",
+    "flutter_speed_ms": "m/s", "velocity_ms": "m/s",
+    "density": "kg/m^3",
+    "mach": "-", "matched_mach": "-", "envelope_mach": "-",
+    "margin": "- (U_f / U_envelope - 1)",
+    "flutter_speed_index": "- (U_f / (b_s omega_alpha sqrt(mu)))",
+    "frequency_ratio": "- (f_f / f_alpha)",
+    "mode": "elastic mode number from 1 (the rigid mode not counted) or 'rigid pitch'",
+    "labels": "mode names in array order: 'rigid pitch', then the elastic modes 1, 2, ...",
+    "n_rigid": "count", "boxes": "count",
+    "max_real_pole": "1/s (largest Re of the closed-loop poles, > 0 unstable)",
+    "settling_s": "s", "steady_error_pct": "%", "corner_overshoot_pct": "%",
+    "fwtf_phase_margin_deg": "deg",
+    "seconds": "s (wall-clock time per step)",
+}
 
 
 @dataclass(frozen=True)
@@ -67,7 +95,7 @@ def summary(a: Analysis) -> dict:
         row = {"mach": r.mach, "altitude_m": r.condition.altitude, "density": r.condition.density,
                "speed_ms": None if f is None else float(f.speed),
                "frequency_hz": None if f is None else float(f.frequency_hz),
-               "mode": None if f is None else int(f.mode),
+               "mode": None if f is None else mode_number(f.mode, f.n_rigid),
                "unstable_at_first_point": bool(r.unstable_at_start)}
         if r.unstable_at_start:
             row["note"] = (f"unstable at the first point of the sweep "
@@ -78,9 +106,12 @@ def summary(a: Analysis) -> dict:
             row["flutter_speed_index"] = float(f.speed / (fs.semichord * w_a * math.sqrt(fs.mass_ratio)))
             row["frequency_ratio"] = float(f.frequency_hz / fs.f_alpha)
         fl.append(row)
+    n_r = int(a.modal.n_rigid)
     out = {"case": c.name, "reference": c.reference,
+           "units": dict(UNITS),
            "modes": {"frequencies_hz": [float(v) for v in a.modal.frequencies_hz],
-                     "n_rigid": int(a.modal.n_rigid)},
+                     "n_rigid": n_r,
+                     "labels": [mode_number(j, n_r) for j in range(len(a.modal.frequencies_hz))]},
            "boxes": int(a.database.metadata.get("boxes", 0)) or None,
            "flutter": fl,
            "divergence": [{"mach": d["mach"], "altitude_m": d["altitude_m"],
@@ -93,7 +124,7 @@ def summary(a: Analysis) -> dict:
         s = a.ase
         out["ase"] = {"mach": s.mach, "altitude_m": s.altitude, "velocity_ms": s.velocity,
                       "stable": dict(s.stable), "max_real_pole": dict(s.max_real_pole),
-                      "settling_ms": {k: _f(v * 1e3) for k, v in s.settling_s.items()},
+                      "settling_s": {k: _f(v) for k, v in s.settling_s.items()},
                       "steady_error_pct": {k: _f(v * 100) for k, v in s.steady_error.items()},
                       "corner_overshoot_pct": {k: {c: _f(x * 100) for c, x in v.items()}
                                                for k, v in s.corner_overshoot.items()},
@@ -116,8 +147,9 @@ def format_summary(s: dict, width: int = 100) -> str:
                                                   else ""), width, subsequent_indent="  ")
     f = s["modes"]["frequencies_hz"]
     r = s["modes"]["n_rigid"]
-    lines.append("modes (Hz): " + ", ".join(f"{v:.4g}" for v in f[r:])
-                 + (f"  (+ {r} rigid)" if r else ""))
+    lines.append("modes (Hz): " + ", ".join(f"{mode_label(j, r)} {v:.4g}"
+                                            for j, v in enumerate(f) if j >= r)
+                 + (f"  (+ {mode_label(0, r)})" if r else ""))
     has_fsi = any("flutter_speed_index" in row for row in s["flutter"])
     head = f"{'Mach':>6} {'altitude m':>10} {'rho kg/m3':>10} {'U_f m/s':>9} {'f_f Hz':>8} {'mode':>4}"
     if has_fsi:
@@ -155,11 +187,11 @@ def format_summary(s: dict, width: int = 100) -> str:
         lines += ["", f"ASE loop at M {a['mach']:g}, {a['altitude_m']:g} m:"]
         for t in a["stable"]:
             ov = a["corner_overshoot_pct"][t]
-            st = a["settling_ms"][t]
+            st = a["settling_s"][t]
             lines += textwrap.wrap(
                 f"{t}: {'stable' if a['stable'][t] else 'UNSTABLE'} (max Re pole "
                 f"{a['max_real_pole'][t]:.3g} 1/s); fin root "
-                + ("never inside the 2 % band" if st is None else f"settles in {st:.1f} ms")
+                + ("never inside the 2 % band" if st is None else f"settles in {1e3 * st:.1f} ms")
                 + f", final error {_cell(a['steady_error_pct'][t], '{:.2f}')} %; corner "
                 f"overshoot {min(ov.values()):.0f}-{max(ov.values()):.0f} %", width,
                 initial_indent="  ", subsequent_indent="    ")
@@ -210,7 +242,7 @@ def fig_modes(a: Analysis, n: int = 4):
         w = m.shapes[:, 0, j]
         ax.tricontourf(m.nodes[:, 1], m.nodes[:, 0], tri, w / np.abs(w).max(), levels=15,
                        cmap="RdBu_r")
-        ax.set_title(f"mode {j - m.n_rigid + 1}: {m.frequencies_hz[j]:.4g} Hz")
+        ax.set_title(f"{mode_label(j, m.n_rigid)}: {m.frequencies_hz[j]:.4g} Hz")
         ax.set_xlabel("y (m)")
         ax.set_ylabel("x (m)")
         ax.invert_yaxis()
@@ -219,25 +251,22 @@ def fig_modes(a: Analysis, n: int = 4):
 
 
 def fig_vg(a: Analysis, result):
-    from asekit.util.plotting import new_figure
+    """V-g and V-f of the p-k roots at one condition (:func:`asekit.util.plotting.plot_vg`: g = 2 Re
+    p / |Im p|, > 0 unstable; modes named "mode 1", ...), the flutter point starred."""
+    from asekit.util.plotting import new_figure, plot_vg
     pk = result.pk
     alt = result.condition.altitude
     where = f"{alt:g} m" if alt is not None else f"rho {result.condition.density:.4g} kg/m^3"
     fig, (ax1, ax2) = new_figure(f"{a.case.name}: V-g and V-f, M {result.mach:g}, {where}",
                                  nrows=2, figsize=(6.4, 6.4), sharex=True)
-    for j in range(pk.p.shape[1]):
-        ax1.plot(pk.velocities, pk.damping_g[:, j], label=f"mode {j + 1}")
-        ax2.plot(pk.velocities, pk.frequency_hz[:, j])
+    plot_vg(ax1, ax2, pk.velocities, pk.p, pk.mode_labels, g_limits=None)
     f = result.flutter
     if f is not None:
-        ax1.plot(f.speed, 0.0, "r*", ms=12, label=f"flutter {f.speed:.1f} m/s")
+        ax1.plot(f.speed, 0.0, "r*", ms=12, label=f"flutter {f.speed:.1f} m/s ({f.mode_name})")
         ax2.plot(f.speed, f.frequency_hz, "r*", ms=12)
-    ax1.axhline(0.0, color="k", lw=0.8)
-    ax1.set_ylabel("damping g = 2 Re p / |Im p| (-)")
     ax1.set_ylim(-0.5, 0.3)
     ax1.legend(ncol=2)
     ax2.set_xlabel("airspeed U (m/s)")
-    ax2.set_ylabel("frequency (Hz)")
     return fig
 
 
@@ -245,14 +274,14 @@ def fig_root_locus(a: Analysis, result):
     from asekit.util.plotting import new_figure
     pk = result.pk
     fig, ax = new_figure(f"{a.case.name}: root locus of the p-k roots, M {result.mach:g}")
-    for j in range(pk.p.shape[1]):
-        ax.plot(pk.p[:, j].real, pk.p[:, j].imag / (2 * math.pi), ".-", ms=2)
+    for j, name in enumerate(pk.mode_labels):
+        ax.plot(pk.p[:, j].real, pk.p[:, j].imag / (2 * math.pi), ".-", ms=2, label=name)
     f = result.flutter
     if f is not None:
         ax.plot(0.0, f.frequency_hz, "r*", ms=12, label=f"flutter {f.speed:.1f} m/s")
-        ax.legend()
+    ax.legend(ncol=2, fontsize=8)
     ax.axvline(0.0, color="k", lw=0.8)
-    ax.set_xlabel("Re p (1/s)")
+    ax.set_xlabel("Re p (1/s), > 0 unstable")
     ax.set_ylabel("Im p / 2 pi (Hz)")
     return fig
 

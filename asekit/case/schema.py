@@ -88,8 +88,10 @@ class PointMass:
 
 @dataclass(frozen=True)
 class DampingSpec:
-    """Modal damping of the elastic modes: ``modal_damping_ratio`` (one value or one per
-    elastic mode) or ``structural_g``; both None = undamped (the thesis)."""
+    """Damping of the elastic modes (docs/conventions.md): ``modal_damping_ratio`` zeta (viscous,
+    C_ii = 2 zeta omega_i M_ii; one value or one per elastic mode) or ``structural_g``
+    (structural damping g of K (1 + i g), applied as its viscous equivalent at each mode's
+    natural frequency, zeta = g / 2); both None = undamped (the thesis)."""
 
     modal_damping_ratio: float | tuple[float, ...] | None = None
     structural_g: float | tuple[float, ...] | None = None

@@ -2,7 +2,8 @@
 case file (or a Nastran deck, :func:`asekit.io.bdf.read_bdf`) through
 the pipeline (modes -> GAF database -> p-k flutter -> match points and margins -> ASE loop when
 an actuator is given), print the summary table, and optionally write the JSON summary and an
-HTML report. A bad case file gets one line naming the key and exit status 2."""
+HTML report. A bad case file gets one line naming the key and exit status 2. Modes, damping
+and units follow docs/conventions.md (elastic modes from 1, "rigid pitch", g > 0 unstable)."""
 
 from __future__ import annotations
 

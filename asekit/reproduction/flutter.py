@@ -200,8 +200,9 @@ def run(figures: bool = False) -> ChapterResult:
                       + ", ".join(f"{100 * z:g}" for z in DAMPING_RATIOS) + " %"))
     q.append(Quantity("flutter.structural_g.pk.M075.h0.speed_ms",
                       [r["speed"] for r in damp if r["kind"] == "g"], "m/s",
-                      "6x7 model; g = " + ", ".join(f"{g:g}" for g in STRUCTURAL_G)
-                      + " (equivalent viscous at the flutter frequency)"))
+                      "6x7 model; structural damping g = "
+                      + ", ".join(f"{g:g}" for g in STRUCTURAL_G)
+                      + " (viscous equivalent g K / omega_f at the flutter frequency)"))
     if figures:
         figs.update(fin_figures(modal, db, fit, conds, rl, td))
         if ha is not None:
@@ -334,36 +335,34 @@ def _low_modes_ylim(freq_hz, n: int = 2):
     return (0.0, 1.15 * float(f.max())) if f.size else None
 
 
-def _damping_frequency_figure(title, thesis_figure, velocities, damping_ratio, frequency_hz,
-                              root: str, flutter, thesis_point, unit):
-    """Damping ratio and frequency of every tracked root vs airspeed (two panels), the flutter
-    point marked beside the thesis's; ``root`` names the eigenvalue in the axis label."""
-    from asekit.util.plotting import new_figure
+def _damping_frequency_figure(title, thesis_figure, velocities, roots, labels, root: str,
+                              flutter, thesis_point, unit):
+    """V-g damping g = 2 Re/|Im| (> 0 unstable, docs/conventions.md) and frequency of every
+    tracked root vs airspeed (two panels, :func:`asekit.util.plotting.plot_vg`), the flutter point
+    marked beside the thesis's; ``root`` names the eigenvalue in the axis label. (The thesis's
+    figures plot the damping ratio xi = -Re/|.| instead, ~ -g/2: its curves are mirrored and
+    halved; the zero crossing, the flutter point, is the same.)"""
+    from asekit.util.plotting import new_figure, plot_vg
     fig, (a1, a2) = new_figure(title, thesis_figure, nrows=2, figsize=(6.4, 6.5), sharex=True)
-    for j in range(damping_ratio.shape[1]):
-        a1.plot(velocities, damping_ratio[:, j], label=f"mode {j + 1}")
-        a2.plot(velocities, frequency_hz[:, j])
-    a1.axhline(0, color="k", lw=0.8)
-    a1.set_ylabel(f"damping ratio xi = -Re {root}/|{root}|\n(< 0: unstable)")
-    a1.set_ylim(max(a1.get_ylim()[0], -0.25), min(a1.get_ylim()[1], 0.5))
-    lim = _low_modes_ylim(frequency_hz)
+    plot_vg(a1, a2, velocities, roots, labels, root=root, g_limits=(-1.0, 0.5))
+    lim = _low_modes_ylim(np.abs(np.asarray(roots).imag) / (2 * np.pi))
     if lim:
         a2.set_ylim(*lim)
     _mark_flutter(a1, a2, flutter, thesis_point, unit)
     a1.legend(fontsize=8, ncol=2)
     a2.set_xlabel(f"airspeed ({unit})")
-    a2.set_ylabel("frequency (Hz)")
     return fig
 
 
 def fig_pk(res, title="p-k damping and frequency", thesis_figure="Figs 30-31", unit="m/s",
            flutter=None, thesis_point=None):
-    """Damping ratio xi = -Re p / |p| (Eq. 3.13, the sign used throughout: xi < 0 unstable) and
-    frequency vs airspeed of every tracked mode (Figs 30-31). ``flutter``: an
-    :class:`asekit.aeroelastic.flutter.Instability` to mark; ``thesis_point``: (speed, Hz) drawn beside it.
-    The frequency axis shows the first two modes, whose coalescence is the flutter."""
-    return _damping_frequency_figure(title, thesis_figure, res.velocities, res.damping_ratio,
-                                     res.frequency_hz, "p", flutter, thesis_point, unit)
+    """V-g damping g = 2 Re p / |Im p| (> 0 unstable; the thesis's Figs 30-31 plot the damping
+    ratio xi = -Re p / |p| of Eq. 3.13 instead) and frequency vs airspeed of every tracked mode.
+    ``flutter``: an :class:`asekit.aeroelastic.flutter.Instability` to mark; ``thesis_point``: (speed, Hz)
+    drawn beside it. The frequency axis shows the first two modes, whose coalescence is the
+    flutter."""
+    return _damping_frequency_figure(title, thesis_figure, res.velocities, res.p,
+                                     res.mode_labels, "p", flutter, thesis_point, unit)
 
 
 def _mark_flutter(a1, a2, flutter, thesis_point, unit):
@@ -388,9 +387,9 @@ def fig_root_locus(rl, thesis_figure="Figs 32, 35", flutter=None):
     marked when ``flutter`` is given."""
     from asekit.util.plotting import new_figure
     fig, ax = new_figure("Root locus of A_sys (aeroelastic roots)", thesis_figure)
-    for j in range(rl.elastic.shape[1]):
+    for j, name in enumerate(rl.mode_labels):
         ax.plot(rl.elastic[:, j].real, rl.elastic[:, j].imag / (2 * np.pi), ".-", ms=3,
-                label=f"mode {j + 1}")
+                label=name)
     ax.axvline(0, color="k", lw=0.8)
     if flutter is not None:
         ax.plot(0.0, flutter.frequency_hz, "*", color="C3", ms=12,
@@ -403,10 +402,11 @@ def fig_root_locus(rl, thesis_figure="Figs 32, 35", flutter=None):
 
 def fig_root_locus_damping(rl, thesis_figure="Figs 33-34", unit="m/s", flutter=None,
                            thesis_point=None):
-    """Damping ratio (Eq. 3.13, xi < 0 unstable) and natural frequency of the aeroelastic roots
-    vs airspeed, flutter point marked (asekit's and the thesis's)."""
-    return _damping_frequency_figure("Root locus: damping ratio and frequency", thesis_figure,
-                                     rl.velocities, rl.damping_ratio, rl.frequency_hz, "lambda",
+    """V-g damping g = 2 Re lambda / |Im lambda| (> 0 unstable; the thesis's Figs 33-34 plot
+    the damping ratio of Eq. 3.13) and frequency of the aeroelastic roots vs airspeed, flutter
+    point marked (asekit's and the thesis's)."""
+    return _damping_frequency_figure("Root locus: damping and frequency", thesis_figure,
+                                     rl.velocities, rl.elastic, rl.mode_labels, "lambda",
                                      flutter, thesis_point, unit)
 
 
@@ -485,21 +485,23 @@ def fig_growth(td, thesis_figure="Table 11", unit="m/s"):
         ax.axvline(td.onset_speed, color="C3", ls="--", label=f"onset {td.onset_speed:.1f}")
         ax.legend()
     ax.set_xlabel(f"airspeed ({unit})")
-    ax.set_ylabel("growth rate (1/s)")
+    ax.set_ylabel("growth rate (1/s), > 0 unstable")
     return fig
 
 
 def fig_damping_study(rows, thesis_speed: float | None = None):
-    """Flutter speed vs modal damping ratio and vs structural g (equivalent at g = 2 zeta)."""
+    """Flutter speed vs modal damping ratio zeta and vs structural damping g (its viscous
+    equivalent g K / omega_f at the flutter frequency; plotted at zeta = g / 2)."""
     from asekit.util.plotting import THESIS_COLOR, new_figure
     fig, ax = new_figure("Flutter speed vs structural damping, Mach 0.75, sea level, 6x7 model")
     z = [(r["value"], r["speed"]) for r in rows if r["kind"] == "zeta" and r["speed"]]
     g = [(r["value"], r["speed"]) for r in rows if r["kind"] == "g" and r["speed"]]
     ax.plot([100 * a for a, _ in z], [b for _, b in z], "o-", label="modal damping ratio zeta")
-    ax.plot([50 * a for a, _ in g], [b for _, b in g], "s--", label="structural g (plotted at g/2)")
+    ax.plot([50 * a for a, _ in g], [b for _, b in g], "s--",
+            label="structural damping g at the flutter frequency (plotted at g/2)")
     if thesis_speed:
         ax.axhline(thesis_speed, color=THESIS_COLOR, ls=":", label=f"thesis {thesis_speed} m/s")
-    ax.set_xlabel("damping ratio zeta = g/2 (%)")
+    ax.set_xlabel("modal damping ratio zeta = g/2 (%), > 0 stable")
     ax.set_ylabel("p-k flutter speed (m/s)")
     ax.legend(fontsize=8)
     return fig

@@ -24,6 +24,7 @@ import numpy as np
 from asekit.case import pipeline
 from asekit.case.schema import Case
 from asekit.case.variants import with_mesh, with_modes
+from asekit.util.conventions import mode_label
 from asekit.util.plotting import THESIS_COLOR, new_figure
 from asekit.reproduction.driver import ChapterResult, Quantity
 from asekit.structure.assembly import rigid_pitch_vector
@@ -232,7 +233,7 @@ def fig_mode_shapes(model: ModalModel, title: str = "FN2 mode shapes (w, contour
         # the thesis numbers its in-plane mode "elastic mode 1", so its out-of-plane modes used
         # (Table 6) are its elastic modes 2-6
         kind = ("rigid pitch, 1 rad" if rigid else
-                f"elastic mode {j - model.n_rigid + 1} (thesis {j - model.n_rigid + 2})")
+                f"{mode_label(j, model.n_rigid)} (thesis elastic {j - model.n_rigid + 2})")
         ax.set_title(f"{kind}: {model.frequencies_hz[j]:.1f} Hz", fontsize=9)
         ax.set_aspect("equal")
         ax.set_xlabel("x (mm)")
@@ -266,7 +267,7 @@ def fig_fn1_vs_fn2(ch: StructureChapter, mode: int = 1):
     a = ch.fn1_modes.fin[:, mode]
     b = ch.fn2_modes.fin[:, mode + 1]
     b = b * np.sign(a @ b)
-    fig, ax = new_figure(f"Elastic mode {mode + 1}: FN1 vs FN2 "
+    fig, ax = new_figure(f"Elastic {mode_label(mode)}: FN1 vs FN2 "
                          f"({ch.fn1_modes.frequencies_hz[mode]:.2f} Hz)", "Fig 19")
     dof = np.arange(a.size)
     ax.plot(dof, a, "o", mfc="none", color=THESIS_COLOR, ms=5, label="FN1 (spring to ground)")
@@ -290,7 +291,7 @@ def fig_convergence(meshes, single: np.ndarray, distributed: dict, n_modes: int 
             ax.semilogx(n_el, arr[:, j], "s-", color=f"C{k + 1}", label=f"distributed, {lab}")
         ax.axhline(thesis[j], color=THESIS_COLOR, ls="--", label="thesis (Nastran 6x7)")
         ax.set_xlabel("number of elements")
-        ax.set_ylabel(f"elastic mode {j + 1} frequency (Hz)")
+        ax.set_ylabel(f"elastic {mode_label(j)} frequency (Hz)")
         ax.set_xticks(n_el)
         ax.set_xticklabels([f"{a}x{b}" for a, b in meshes], rotation=30, fontsize=8)
     np.atleast_1d(axes)[0].legend(fontsize=8)

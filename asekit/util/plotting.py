@@ -1,7 +1,9 @@
 """One figure style for every asekit plot.
 
 Every chapter figure is made through :func:`new_figure`, so labels, fonts and sizes agree, and
-its title carries the thesis figure number it reproduces.
+its title carries the thesis figure number it reproduces. Every V-g / V-f figure draws its
+curves through :func:`plot_vg`, so the damping convention of docs/conventions.md (g = 2 Re p /
+|Im p|, > 0 unstable, stated on the axis; elastic modes named from 1) lives in one place.
 """
 
 from __future__ import annotations
@@ -9,8 +11,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import matplotlib
-
 import matplotlib.pyplot as plt
+import numpy as np
+
+from asekit.util.conventions import vg_damping, vg_damping_label
 
 STYLE = {
     "figure.dpi": 100,
@@ -70,3 +74,40 @@ def save_figure(fig, directory: str | Path, name: str) -> Path:
         fig.savefig(path)
     plt.close(fig)
     return path
+
+
+def plot_vg(ax_g, ax_f, velocities, roots, labels, root: str = "p", g_limits=(-1.0, 0.5)):
+    """V-g and V-f curves of tracked roots on two axes, in the convention of
+    docs/conventions.md.
+
+    Parameters
+    ----------
+    ax_g, ax_f : matplotlib axes for the damping g and the frequency (Hz).
+    velocities : (n_v,) airspeeds (any unit; the caller labels the x axis).
+    roots : (n_v, n_t) complex roots p = sigma + i omega (1/s), one column per tracked mode.
+    labels : n_t legend labels (use :func:`asekit.util.conventions.mode_label`, e.g.
+        ``PkResult.mode_labels``: "mode 1", "mode 2", ..., "rigid pitch").
+    root : the eigenvalue's symbol in the axis label ("p" for p-k, "lambda" for A_sys).
+    g_limits : (low, high) clip of the g axis to the data (None: matplotlib's limits).
+
+    Plotted: g = 2 Re p / |Im p| (:func:`asekit.util.conventions.vg_damping`, > 0 unstable) on
+    ``ax_g`` with the zero line, f = |Im p| / 2 pi on ``ax_f``; the g axis label says
+    "damping g = 2 Re p / |Im p| (-), > 0 unstable". Returns the g array (n_v, n_t).
+    """
+    p = np.asarray(roots, dtype=complex)
+    if p.ndim != 2 or p.shape[0] != np.size(velocities) or len(labels) != p.shape[1]:
+        raise ValueError(f"roots must be (n_v, n_t) with n_v = len(velocities) and n_t = "
+                         f"len(labels); got roots {p.shape}, {np.size(velocities)} velocities, "
+                         f"{len(labels)} labels")
+    g = vg_damping(p)
+    f = np.abs(p.imag) / (2 * np.pi)
+    for j, name in enumerate(labels):
+        ax_g.plot(velocities, g[:, j], label=name)
+        ax_f.plot(velocities, f[:, j])
+    ax_g.axhline(0.0, color="k", lw=0.8)
+    ax_g.set_ylabel(vg_damping_label(root))
+    ax_f.set_ylabel("frequency (Hz)")
+    if g_limits is not None:
+        lo, hi = ax_g.get_ylim()
+        ax_g.set_ylim(max(lo, g_limits[0]), min(hi, g_limits[1]))
+    return g
