@@ -14,15 +14,23 @@ case with :func:`asekit.case.case_from_dict`, so it is validated with the same k
 as a case file; a sample whose case is invalid (or whose analysis raises) becomes a failed row
 with its error message, never a dropped row.
 
-AIC reuse. The doublet-lattice normalwash matrices D(M, k) depend on the boxes, Mach and k only
-(:func:`asekit.aero.dlm.normalwash_matrices`). The sweep factors them once per (M, k) for the
-base box mesh (:func:`aic_factors`) and projects each sample's mode shapes:
-Q_ij(M, k) = h_i(lp)^T A D(M, k)^-1 (dh_j/dx + i k h_j / b) (thesis Eqs. 2.10-2.12, the same
-operations as :func:`asekit.aero.gaf.gaf_from_box_modes`, so the projected GAFs are bit-identical
-to a rebuilt database). A sample whose boxes, reduced frequencies or kernel settings differ from
-the base (a planform or ``aero`` key varied) gets its own factors (column ``aic_reused`` false).
-On Dask the factors are scattered to the workers once, on local processes they are passed once
-per process (pool initializer).
+AIC reuse. The sweep honours the base case's ``aero.method`` (:mod:`asekit.aero.methods`;
+``auto`` resolved per Mach). Every method of the registry has a structure-independent pressure
+operator (it depends on the boxes, Mach and k only): the DLM's normalwash matrices D(M, k)
+(:func:`asekit.aero.dlm.normalwash_matrices`), the Mach-box and piston pressure matrices. The
+sweep forms it once per (M, k) for the base box mesh (:func:`aic_factors`: the LU of D, or the
+matrix) and projects each sample's mode shapes:
+Q_ij(M, k) = h_i(lp)^T A Op(M, k) (dh_j/dx + i k h_j / b) (thesis Eqs. 2.10-2.12, the same
+operations as :func:`asekit.aero.gaf.gaf_from_box_modes`, so for the DLM and piston theory the
+projected GAFs are bit-identical to a rebuilt database). Where forming the operator costs more
+than the sweep's samples would (the Mach-box matrices of a sweep with few samples,
+:attr:`asekit.aero.methods.AeroMethod.reuse_break_even`), or a method's operator depends on the
+structure, each sample's GAFs are computed by the method itself, as the pipeline does. A sample
+whose boxes, reduced frequencies, method or kernel settings differ from the base (a planform or
+``aero`` key varied) gets its own (column ``aic_reused`` false). The analysed Mach must lie in
+the method's range: otherwise the sweep file is refused naming its key path and
+``aero.method``. On Dask the operators are scattered to the workers once, on local processes
+they are passed once per process (pool initializer).
 
 Determinism: the samples are drawn up front from ``numpy.random.SeedSequence(seed)`` (one
 child stream per parameter, inverse-CDF transforms, no rejection), every sample is evaluated by
@@ -48,11 +56,22 @@ import os
 import re
 import time
 import tomllib
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from asekit.aero.gaf import GafDatabase, gaf_from_box_modes
+from asekit.aero.methods import AERO_METHODS, TransonicWarning, method_spec, resolve_method
+from asekit.aero.spline import fe_spline, modal_forces
+from asekit.atmosphere import standard_atmosphere
+from asekit.util.blas import one_blas_thread
+from asekit.case import pipeline as P
+from asekit.case.schema import CaseError, _number, _Table, case_from_dict
+from asekit.aeroelastic.flutter import divergence_speeds
+from asekit.util.paths import CASES_DIR
+from asekit.util.validate import read_toml
 from asekit.util.conventions import mode_number
 
 
@@ -64,8 +83,11 @@ class SweepError(ValueError):
 # key paths into the parsed TOML dict
 # ---------------------------------------------------------------------------------------------
 _TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)")
-#: Parameters that are not case-file keys: the analysed flight condition of each sample.
-CONDITION_PATHS = ("flight.mach", "flight.altitude")
+#: Parameters that are not case-file keys: the analysed flight condition of each sample (Mach
+#: and either the altitude, 1976 standard atmosphere, or the density in kg/m^3).
+CONDITION_PATHS = ("flight.mach", "flight.altitude", "flight.density")
+#: Outputs that need the speed of sound of the analysed condition (not known for a density).
+SPEED_OF_SOUND_OUTPUTS = ("flight_speed", "flutter_margin", "flutter_inside")
 
 
 def parse_key_path(path: str) -> tuple:
@@ -166,81 +188,75 @@ class Parameter:
         raise SweepError(f"{self.path}: not a distribution ({self.kind})")
 
 
-def _num(where, v, positive=False):
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise SweepError(f"{where} must be a finite number, got {v!r}")
-    if positive and v <= 0:
-        raise SweepError(f"{where} must be > 0, got {v:g}")
-    return float(v)
+def _check_mach_value(where: str, v) -> float:
+    """A finite number for a Mach value of the sweep file (its range is the case's aero
+    method's, checked by :func:`_check_condition`)."""
+    return _number(where, v, None, None, True, False, "", SweepError)
+
+
+#: The keys of a [[parameter]] table that each kind reads (besides path).
+_DIST_KEYS = {"normal": ("mean", "std"), "uniform": ("low", "high"),
+              "lognormal": ("median", "sigma"),
+              "truncated_normal": ("mean", "std", "low", "high")}
+
+
+def _grid_values(t: _Table, where: str) -> tuple:
+    """The values of a grid parameter: ``values`` (a non-empty list) or ``range``
+    ({min, max, num} or {min, max, step})."""
+    if t.has("values") and t.has("range"):
+        raise SweepError(f"{where}: give values or range, not both")
+    if t.has("values"):
+        vals = t.raw("values")
+        if not isinstance(vals, list) or not vals:
+            raise SweepError(f"{where}.values must be a non-empty list, got {vals!r}")
+        return tuple(vals)
+    r = t.table("range")
+    if r.has("num") == r.has("step"):
+        raise SweepError(f"{r.path} must be {{min, max, num}} or {{min, max, step}}, got {r.d!r}")
+    lo, hi = r.number("min", required=True), r.number("max", required=True)
+    n = r.integer("num", low=1, high=100000)
+    st = r.number("step", low=0.0)
+    r.done()
+    if hi < lo:
+        raise SweepError(f"{r.path}: min ({lo:g}) must be <= max ({hi:g})")
+    if n is not None:
+        return tuple(float(v) for v in np.linspace(lo, hi, n))
+    n = int(math.floor((hi - lo) / st + 1e-9)) + 1
+    if n > 100000:
+        raise SweepError(f"{r.path} gives {n} values (> 100000)")
+    return tuple(float(v) for v in lo + st * np.arange(n))
 
 
 def _parameter(i: int, d, base: dict) -> Parameter:
-    where = f"parameter[{i}]"
-    if not isinstance(d, dict):
-        raise SweepError(f"{where} must be a table ([[parameter]]), got {d!r}")
-    known = {"path", "values", "range", "distribution", "mean", "std", "median", "sigma",
-             "low", "high"}
-    extra = sorted(set(d) - known)
-    if extra:
-        raise SweepError(f"{where}.{extra[0]} is not a known key "
-                         f"(known: {', '.join(sorted(known))})")
-    path = d.get("path")
+    """The ``i``-th [[parameter]] table (asekit.case.schema's _Table: typed getters naming the
+    key path ``parameter[i] (path).key``, unknown keys refused)."""
+    t = _Table(d, f"parameter[{i}]", SweepError)
+    path = t.raw("path")
     if not isinstance(path, str):
-        raise SweepError(f"{where}.path is missing (a case-file key path, e.g. "
+        raise SweepError(f"parameter[{i}].path is missing (a case-file key path, e.g. "
                          f"material.youngs_modulus)")
     parse_key_path(path)
-    where = f"parameter[{i}] ({path})"
-    grid = "values" in d or "range" in d
-    dist = d.get("distribution")
-    if grid and dist is not None:
+    t.path = where = f"parameter[{i}] ({path})"
+    grid = t.has("values") or t.has("range")
+    if grid and t.has("distribution"):
         raise SweepError(f"{where}: give values/range (a grid) or a distribution, not both")
     if grid:
-        if "values" in d and "range" in d:
-            raise SweepError(f"{where}: give values or range, not both")
-        if "values" in d:
-            vals = d["values"]
-            if not isinstance(vals, list) or not vals:
-                raise SweepError(f"{where}.values must be a non-empty list, got {vals!r}")
-            vals = tuple(vals)
-        else:
-            r = d["range"]
-            if not isinstance(r, dict) or set(r) - {"min", "max", "num", "step"} \
-                    or "min" not in r or "max" not in r or (("num" in r) == ("step" in r)):
-                raise SweepError(f"{where}.range must be {{min, max, num}} or {{min, max, step}}, "
-                                 f"got {r!r}")
-            lo, hi = _num(f"{where}.range.min", r["min"]), _num(f"{where}.range.max", r["max"])
-            if hi < lo:
-                raise SweepError(f"{where}.range: min ({lo:g}) must be <= max ({hi:g})")
-            if "num" in r:
-                n = r["num"]
-                if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 100000:
-                    raise SweepError(f"{where}.range.num must be an integer in [1, 100000], "
-                                     f"got {n!r}")
-                vals = tuple(float(v) for v in np.linspace(lo, hi, n))
-            else:
-                st = _num(f"{where}.range.step", r["step"], positive=True)
-                n = int(math.floor((hi - lo) / st + 1e-9)) + 1
-                if n > 100000:
-                    raise SweepError(f"{where}.range gives {n} values (> 100000)")
-                vals = tuple(float(v) for v in lo + st * np.arange(n))
+        vals = _grid_values(t, where)
+        t.done()
         return Parameter(path, "grid", values=vals)
-    if dist is None:
+    if not t.has("distribution"):
         raise SweepError(f"{where}: give values, range or distribution "
                          f"({', '.join(DISTRIBUTIONS)})")
-    if dist not in DISTRIBUTIONS:
-        raise SweepError(f"{where}.distribution must be one of {', '.join(DISTRIBUTIONS)}, "
-                         f"got {dist!r}")
-    allowed = {"normal": {"mean", "std"}, "uniform": {"low", "high"},
-               "lognormal": {"median", "sigma"},
-               "truncated_normal": {"mean", "std", "low", "high"}}[dist]
-    bad = sorted(set(d) - allowed - {"path", "distribution"})
+    dist = t.string("distribution", DISTRIBUTIONS)
+    allowed = _DIST_KEYS[dist]
+    bad = sorted(set(t.d) - set(allowed) - {"path", "distribution"})
     if bad:
         raise SweepError(f"{where}: {bad[0]} is not a parameter of the {dist} distribution "
                          f"(give {', '.join(sorted(allowed))})")
 
     def centre(key):
-        if key in d:
-            return _num(f"{where}.{key}", d[key])
+        if t.has(key):
+            return t.number(key)
         if path in CONDITION_PATHS:
             raise SweepError(f"{where}.{key} is missing")
         try:
@@ -248,43 +264,38 @@ def _parameter(i: int, d, base: dict) -> Parameter:
         except (KeyError, IndexError, TypeError):
             raise SweepError(f"{where}.{key} is missing and the base case has no value at "
                              f"{path}") from None
-        return _num(f"{where}.{key} (the base case's {path})", v)
+        return _number(f"{where}.{key} (the base case's {path})", v, None, None, True, False,
+                       "", SweepError)
+
+    def spread(key):
+        return t.number(key, required=True, low=0.0)
 
     def bounds():
-        for k in ("low", "high"):
-            if k not in d:
-                raise SweepError(f"{where}.{k} is missing ({dist})")
-        lo, hi = _num(f"{where}.low", d["low"]), _num(f"{where}.high", d["high"])
+        lo, hi = t.number("low", required=True), t.number("high", required=True)
         if not lo < hi:
             raise SweepError(f"{where}: low ({lo:g}) must be < high ({hi:g})")
         return lo, hi
 
     if dist == "normal":
-        return Parameter(path, dist, a=centre("mean"), b=_pos(where, d, "std"))
-    if dist == "uniform":
+        out = Parameter(path, dist, a=centre("mean"), b=spread("std"))
+    elif dist == "uniform":
         lo, hi = bounds()
-        return Parameter(path, dist, low=lo, high=hi)
-    if dist == "lognormal":
+        out = Parameter(path, dist, low=lo, high=hi)
+    elif dist == "lognormal":
         med = centre("median")
         if med <= 0:
             raise SweepError(f"{where}.median must be > 0, got {med:g}")
-        return Parameter(path, dist, a=med, b=_pos(where, d, "sigma"))
-    mean, std = centre("mean"), _pos(where, d, "std")
-    lo, hi = bounds()
-    from scipy.special import ndtr
-    if ndtr((hi - mean) / std) - ndtr((lo - mean) / std) < 1e-12:
-        raise SweepError(f"{where}: [low, high] = [{lo:g}, {hi:g}] holds no probability of "
-                         f"the normal(mean {mean:g}, std {std:g})")
-    return Parameter(path, dist, a=mean, b=std, low=lo, high=hi)
-
-
-def _pos(where, d, key):
-    if key not in d:
-        raise SweepError(f"{where}.{key} is missing")
-    v = d[key]
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
-        raise SweepError(f"{where}.{key} must be a finite number > 0, got {v!r}")
-    return float(v)
+        out = Parameter(path, dist, a=med, b=spread("sigma"))
+    else:
+        mean, std = centre("mean"), spread("std")
+        lo, hi = bounds()
+        from scipy.special import ndtr
+        if ndtr((hi - mean) / std) - ndtr((lo - mean) / std) < 1e-12:
+            raise SweepError(f"{where}: [low, high] = [{lo:g}, {hi:g}] holds no probability of "
+                             f"the normal(mean {mean:g}, std {std:g})")
+        out = Parameter(path, dist, a=mean, b=std, low=lo, high=hi)
+    t.done()
+    return out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -330,7 +341,9 @@ DEFAULT_OUTPUTS = ("flutter_speed", "flutter_frequency", "divergence_speed", "un
 class Sweep:
     """A checked sweep: ``base`` the parsed TOML dict of the base case (after the sweep's
     ``[case]`` overrides), ``parameters``, Monte Carlo ``samples`` and ``seed``, the analysed
-    condition defaults ``mach`` / ``altitude``, the ``outputs`` and the file it came from."""
+    condition defaults ``mach`` and ``altitude`` (m), or ``density`` (kg/m^3, then
+    ``altitude`` is unused: a sweep over a case with densities, e.g. a wind-tunnel case), the
+    ``outputs`` and the file it came from."""
 
     name: str
     base: dict = field(compare=False, hash=False)
@@ -341,6 +354,7 @@ class Sweep:
     samples: int = 1
     seed: int = 0
     source: str = field(default="", compare=False)
+    density: float | None = None
 
     @property
     def grid(self) -> tuple[Parameter, ...]:
@@ -357,17 +371,25 @@ class Sweep:
             n *= len(p.values)
         return n
 
+    @property
+    def condition_path(self) -> str:
+        """``"flight.density"`` when the samples are analysed at a density, else
+        ``"flight.altitude"``."""
+        return "flight.altitude" if self.density is None else "flight.density"
+
     def sweep_id(self) -> str:
         """Short SHA-256 of everything that defines the rows (base case, parameters, outputs,
         condition, samples, seed): the rows of a partial output file must carry it."""
         d = {"base": self.base, "parameters": [p.__dict__ for p in self.parameters],
              "outputs": list(self.outputs), "mach": self.mach, "altitude": self.altitude,
              "samples": self.samples if self.random else 1, "seed": self.seed}
+        if self.density is not None:
+            d["density"] = self.density
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=repr).encode()).hexdigest()[:16]
 
     def columns(self) -> tuple[str, ...]:
         params = [p.path for p in self.parameters if p.path not in CONDITION_PATHS]
-        return BASE_COLUMNS + ("flight.mach", "flight.altitude") + tuple(params) + self.outputs
+        return BASE_COLUMNS + ("flight.mach", self.condition_path) + tuple(params) + self.outputs
 
     def design(self) -> list[dict]:
         """The samples in order: one dict {key path: value} per row (grid-major, then the Monte
@@ -391,24 +413,26 @@ class Sweep:
         return out
 
     def case_dict(self, values: dict) -> tuple[dict, float, float]:
-        """The sample's case dict (base edited at the key paths) and its analysed Mach and
-        altitude."""
+        """The sample's case dict (base edited at the key paths), its analysed Mach and its
+        altitude (m), or its density (kg/m^3) when :attr:`density` is set."""
         d = copy.deepcopy(self.base)
-        mach, alt = self.mach, self.altitude
+        mach = self.mach
+        cond = self.altitude if self.density is None else self.density
         for path, v in values.items():
             if path == "flight.mach":
                 mach = float(v)
-            elif path == "flight.altitude":
-                alt = float(v)
+            elif path in ("flight.altitude", "flight.density"):
+                cond = float(v)
             else:
                 set_key(d, path, v)
-        return d, mach, alt
+        return d, mach, cond
 
 
-def _base_condition(case_dict: dict, case) -> tuple[float, float]:
-    """Default analysed condition: the envelope's top Mach at its lowest altitude (the
-    critical corner: highest flight speed at the highest density), else the case's highest
-    Mach at its first altitude."""
+def _base_condition(case_dict: dict, case) -> tuple[float, float, float | None]:
+    """Default analysed condition (mach, altitude m, density kg/m^3 or None): the envelope's
+    top Mach at its lowest altitude (the critical corner: highest flight speed at the highest
+    density), else the case's highest Mach at its first altitude; a case with densities
+    instead of altitudes: its highest Mach at its first density."""
     f = case.flight
     mach = f.envelope_mach[1] if f.envelope_mach is not None else case.aero.machs[-1]
     if f.envelope_altitude is not None:
@@ -417,37 +441,72 @@ def _base_condition(case_dict: dict, case) -> tuple[float, float]:
         alt = f.altitudes[0]
     else:
         alt = 0.0
-    return float(mach), float(alt)
+    dens = None if f.densities is None else float(f.densities[0])
+    return float(mach), float(alt), dens
 
 
-def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
-    """Build and check a :class:`Sweep` from a parsed sweep file (see ``data/sweeps/``)."""
-    from asekit.case import CaseError, case_from_dict
-    if not isinstance(d, dict):
-        raise SweepError("a sweep must be a table")
-    extra = sorted(set(d) - {"sweep", "case", "parameter"})
-    if extra:
-        raise SweepError(f"{extra[0]} is not a known key (known: sweep, case, parameter)")
-    s = d.get("sweep")
-    if not isinstance(s, dict):
-        raise SweepError("sweep is missing: a [sweep] table with case = \"path/to/case.toml\"")
-    known = {"name", "case", "samples", "seed", "outputs", "mach", "altitude"}
-    extra = sorted(set(s) - known)
-    if extra:
-        raise SweepError(f"sweep.{extra[0]} is not a known key (known: {', '.join(sorted(known))})")
-    name = s.get("name", "sweep")
-    if not isinstance(name, str) or not name:
-        raise SweepError(f"sweep.name must be a non-empty string, got {name!r}")
-    cpath = s.get("case")
-    if not isinstance(cpath, str) or not cpath:
-        raise SweepError("sweep.case is missing: the base case file (relative to the sweep file)")
+def _case_file(cpath: str, base_dir) -> Path:
+    """The base case file: ``cpath`` relative to the sweep file, else a shipped case."""
     p = Path(cpath)
     if not p.is_absolute():
         p = Path(base_dir) / p
         if not p.exists():
-            from asekit.util.paths import CASES_DIR
             if (CASES_DIR / cpath).exists():          # a shipped case by name
                 p = CASES_DIR / cpath
+    return p
+
+
+def _outputs(raw, base_case, density_condition: bool) -> tuple[str, ...]:
+    """``sweep.outputs`` checked against :data:`OUTPUTS` and what the base case provides."""
+    if raw is None:
+        return tuple(o for o in DEFAULT_OUTPUTS
+                     if not (density_condition and o in SPEED_OF_SOUND_OUTPUTS))
+    if not isinstance(raw, list) or not raw or not all(isinstance(o, str) for o in raw):
+        raise SweepError(f"sweep.outputs must be a non-empty list of names, got {raw!r}")
+    for o in raw:
+        if o not in OUTPUTS:
+            raise SweepError(f"sweep.outputs: {o!r} is not an output (known: "
+                             f"{', '.join(OUTPUTS)})")
+        if density_condition and o in SPEED_OF_SOUND_OUTPUTS:
+            raise SweepError(f"sweep.outputs: {o} needs the speed of sound of the analysed "
+                             f"condition, and the sweep analyses flight.density (kg/m^3; the "
+                             f"base case's flight.densities or the sweep's density): give "
+                             f"sweep.altitude or a flight.altitude parameter instead")
+    if len(set(raw)) != len(raw):
+        raise SweepError("sweep.outputs lists a name twice")
+    if any(o in ASE_OUTPUTS for o in raw) and base_case.actuator is None:
+        raise SweepError("sweep.outputs: the aem1_* / aem2_* outputs need an [actuator] in the "
+                         "base case")
+    if "envelope_margin" in raw and base_case.flight.envelope_mach is None:
+        raise SweepError("sweep.outputs: envelope_margin needs [flight.envelope] in the base case")
+    return tuple(raw)
+
+
+def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
+    """Build and check a :class:`Sweep` from a parsed sweep file (see ``data/sweeps/``); the
+    tables are read by :class:`asekit.case.schema._Table` (typed getters naming the key path,
+    unknown keys refused), raising :class:`SweepError`."""
+    top = _Table(d, "", SweepError)
+    if not top.has("sweep"):
+        raise SweepError("sweep is missing: a [sweep] table with case = \"path/to/case.toml\"")
+    s = top.table("sweep")
+    over = top.raw("case", {})
+    raw = top.raw("parameter", [])
+    top.done()
+    name = s.text("name", "sweep")
+    if not name:
+        raise SweepError("sweep.name must be a non-empty string, got ''")
+    cpath = s.text("case", "")
+    if not cpath:
+        raise SweepError("sweep.case is missing: the base case file (relative to the sweep file)")
+    samples = s.integer("samples", 1, low=1, high=10 ** 7)
+    seed = s.integer("seed", 0, low=0, high=2 ** 63 - 1)
+    outs = s.raw("outputs")
+    mach = None if not s.has("mach") else _check_mach_value("sweep.mach", s.raw("mach"))
+    alt = s.number("altitude")
+    dens = s.number("density", low=0.0, high=100.0, unit="kg/m^3")
+    s.done()
+    p = _case_file(cpath, base_dir)
     try:
         with open(p, "rb") as fh:
             base = tomllib.load(fh)
@@ -455,7 +514,6 @@ def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
         raise SweepError(f"sweep.case: case file {p} not found") from None
     except tomllib.TOMLDecodeError as exc:
         raise SweepError(f"sweep.case: {p.name} is not valid TOML: {exc}") from None
-    over = d.get("case", {})
     if not isinstance(over, dict):
         raise SweepError("case must be a table of overrides {key path = value}")
     for k, v in over.items():
@@ -464,47 +522,42 @@ def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
         base_case = case_from_dict(copy.deepcopy(base), source=str(p))
     except CaseError as exc:
         raise SweepError(f"base case ({p.name} with the sweep's [case] overrides): {exc}") from None
-    mach0, alt0 = _base_condition(base, base_case)
-    mach = _num("sweep.mach", s["mach"]) if "mach" in s else mach0
-    alt = _num("sweep.altitude", s["altitude"]) if "altitude" in s else alt0
-    _check_condition("sweep.mach", "flight.mach", mach)
-    _check_condition("sweep.altitude", "flight.altitude", alt)
-    samples = s.get("samples", 1)
-    if isinstance(samples, bool) or not isinstance(samples, int) or not 1 <= samples <= 10 ** 7:
-        raise SweepError(f"sweep.samples must be an integer in [1, 10000000], got {samples!r}")
-    seed = s.get("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise SweepError(f"sweep.seed must be an integer >= 0, got {seed!r}")
-    outs = s.get("outputs", list(DEFAULT_OUTPUTS))
-    if not isinstance(outs, list) or not outs or not all(isinstance(o, str) for o in outs):
-        raise SweepError(f"sweep.outputs must be a non-empty list of names, got {outs!r}")
-    for o in outs:
-        if o not in OUTPUTS:
-            raise SweepError(f"sweep.outputs: {o!r} is not an output (known: "
-                             f"{', '.join(OUTPUTS)})")
-    if len(set(outs)) != len(outs):
-        raise SweepError("sweep.outputs lists a name twice")
-    if any(o in ASE_OUTPUTS for o in outs) and base_case.actuator is None:
-        raise SweepError("sweep.outputs: the aem1_* / aem2_* outputs need an [actuator] in the "
-                         "base case")
-    if "envelope_margin" in outs and base_case.flight.envelope_mach is None:
-        raise SweepError("sweep.outputs: envelope_margin needs [flight.envelope] in the base case")
-    raw = d.get("parameter", [])
     if not isinstance(raw, list):
         raise SweepError("parameter must be an array of tables ([[parameter]])")
     params = tuple(_parameter(i, t, base) for i, t in enumerate(raw))
-    for i, q in enumerate(params):
-        if q.path in CONDITION_PATHS and q.is_grid:
-            for j, v in enumerate(q.values):
-                _check_condition(f"parameter[{i}] ({q.path}).values[{j}]", q.path,
-                                 _num(f"parameter[{i}] ({q.path}).values[{j}]", v))
     paths = [q.path for q in params]
     if len(set(paths)) != len(paths):
         dup = next(x for x in paths if paths.count(x) > 1)
         raise SweepError(f"parameter path {dup!r} is given twice")
-    if "samples" in s and not any(not q.is_grid for q in params):
+    # the analysed condition: altitude (standard atmosphere) or density
+    by_alt = alt is not None or "flight.altitude" in paths
+    by_dens = dens is not None or "flight.density" in paths
+    if by_alt and by_dens:
+        raise SweepError("give the analysed condition as flight.altitude (sweep.altitude or a "
+                         "parameter) or as flight.density (sweep.density or a parameter), "
+                         "not both")
+    mach0, alt0, dens0 = _base_condition(base, base_case)
+    density_condition = by_dens or (not by_alt and dens0 is not None)
+    mach = mach0 if mach is None else mach
+    alt = alt0 if alt is None else alt
+    dens = (dens if dens is not None else dens0) if density_condition else None
+    if density_condition and dens is None:
+        raise SweepError("sweep.density is missing (the flight.density parameter has no "
+                         "default: the base case gives altitudes)")
+    method = base_case.aero.method
+    _check_condition("sweep.mach", "flight.mach", mach, method)
+    _check_condition("sweep.altitude", "flight.altitude", alt)
+    if dens is not None:
+        _check_condition("sweep.density", "flight.density", dens)
+    outputs = _outputs(outs, base_case, density_condition)
+    for i, q in enumerate(params):
+        if q.path in CONDITION_PATHS and q.is_grid:
+            for j, v in enumerate(q.values):
+                where = f"parameter[{i}] ({q.path}).values[{j}]"
+                _check_condition(where, q.path, _check_mach_value(where, v), method)
+    if "samples" in s.d and not any(not q.is_grid for q in params):
         raise SweepError("sweep.samples needs at least one parameter with a distribution")
-    sweep = Sweep(name, base, params, tuple(outs), mach, alt, samples, seed, source)
+    sweep = Sweep(name, base, params, outputs, mach, alt, samples, seed, source, dens)
     # every parameter, alone at its first value, must give a case the schema accepts: an
     # unknown key path is an error of the sweep file, not of each sample
     first = sweep.design()[0] if sweep.n_samples else {}
@@ -513,7 +566,7 @@ def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
             continue
         dd, _, _ = sweep.case_dict({q.path: first[q.path]})
         try:
-            case_from_dict(dd)
+            _sample_case(dd)
         except CaseError as exc:
             msg = str(exc)
             if "is not a known key" in msg:
@@ -522,18 +575,37 @@ def sweep_from_dict(d: dict, base_dir=".", source: str = "") -> Sweep:
     return sweep
 
 
-def _check_condition(where: str, path: str, v: float) -> None:
-    """The analysed Mach must suit the doublet lattice (0 <= M < 1), the altitude the 1976
-    standard atmosphere (-1000 to 80000 m)."""
-    if path == "flight.mach" and not 0.0 <= v < 1.0:
-        raise SweepError(f"{where} must be a Mach number in [0, 1) (doublet lattice), got {v:g}")
+def _sample_case(d: dict):
+    """:func:`~asekit.case.case_from_dict` of a sample's dict without repeating the base
+    case's :class:`~asekit.aero.methods.TransonicWarning` (given once, when the sweep file is
+    read) for every sample."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TransonicWarning)
+        return case_from_dict(d)
+
+
+def _check_condition(where: str, path: str, v: float, method: str = "dlm") -> None:
+    """The analysed Mach must lie in the Mach range of the base case's ``aero.method``
+    (:func:`asekit.aero.methods.resolve_method`), the altitude in the 1976 standard atmosphere
+    (-1000 to 80000 m), the density in (0, 100] kg/m^3; SweepError naming the sweep-file key
+    path ``where`` and, for the Mach, the case key path ``aero.method``."""
+    if path == "flight.mach":
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", TransonicWarning)
+                resolve_method(method, v)
+        except ValueError as exc:
+            raise SweepError(f"{where} = {v:g} cannot be analysed with the base case's "
+                             f"aero.method = {method!r} ({method_spec(method).summary}): "
+                             f"{exc}") from None
     if path == "flight.altitude" and not -1000.0 <= v <= 80000.0:
         raise SweepError(f"{where} must be an altitude in [-1000, 80000] m, got {v:g}")
+    if path == "flight.density" and not 0.0 < v <= 100.0:
+        raise SweepError(f"{where} must be a density in (0, 100] kg/m^3, got {v:g}")
 
 
 def load_sweep(path) -> Sweep:
     """Read and check a sweep file (TOML); SweepError naming the key, or FileNotFoundError."""
-    from asekit.util.validate import read_toml
     path = Path(path)
     return sweep_from_dict(read_toml(path, SweepError), base_dir=path.parent, source=str(path))
 
@@ -543,94 +615,105 @@ def load_sweep(path) -> Sweep:
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class AicFactors:
-    """LU factors of the DLM normalwash matrices D(M, k) of one box mesh.
+    """The structure-independent aerodynamic operators of one box mesh, per Mach.
 
-    key : what the factors depend on (box corners, k, b_ref, kernel, symmetry);
-    k : (n_k,) reduced frequencies; b_ref : m; lu : {mach: ((n_k, n, n) LU, (n_k, n) pivots)},
-    the LAPACK factors of D^T (:class:`asekit.aero.dlm.AicFactor` with ``transposed=True``, the
-    in-place factorisation of the C-ordered D).
+    key : what the operators depend on (box corners, k, b_ref, method, kernel, symmetry);
+    k : (n_k,) reduced frequencies; b_ref : m; operators : {mach: one operator per k}, each
+    with ``pressures(w) -> DeltaCp`` (the DLM: :class:`asekit.aero.dlm.AicFactor`, the LU of
+    D(M, k); the Mach-box and piston methods: :class:`asekit.aero.methods.PressureMatrix`), as
+    built by the method's :data:`asekit.aero.methods.AERO_METHODS` entry. A Mach missing from
+    ``operators`` is computed per sample (:func:`projected_gaf`).
     """
 
     key: str
     k: np.ndarray
     b_ref: float
-    lu: dict
+    operators: dict
 
     @property
     def nbytes(self) -> int:
-        return sum(a.nbytes + p.nbytes for a, p in self.lu.values())
-
-
-def _one_blas_thread():
-    """A context in which BLAS / LAPACK run on one thread (threadpoolctl). Multithreaded BLAS
-    may sum in another order, so the same sample would differ in its last bits between a
-    serial run (the user's thread settings) and Dask workers (one thread each); pinning one
-    thread everywhere makes the executors bit-identical whatever OMP_NUM_THREADS says."""
-    from threadpoolctl import threadpool_limits
-    return threadpool_limits(limits=1)
+        return sum(sum(a.nbytes for a in vars(op).values() if isinstance(a, np.ndarray))
+                   for ops in self.operators.values() for op in ops)
 
 
 def aero_key(case) -> str:
-    """SHA-256 of what the AIC factors of ``case`` depend on besides Mach: its boxes (corners),
-    reduced frequencies, reference semichord, kernel and symmetry."""
-    from asekit.case import pipeline as P
+    """SHA-256 of what the aerodynamic operators of ``case`` depend on besides Mach: its boxes
+    (corners), reduced frequencies, reference semichord, method, kernel and symmetry."""
     a = case.aero
     boxes = P.box_mesh(case)
     h = hashlib.sha256(np.ascontiguousarray(boxes.corners).tobytes())
     h.update(np.ascontiguousarray(P.reduced_frequencies(case)).tobytes())
-    h.update(json.dumps([a.reference_semichord, a.kernel, a.symmetry]).encode())
+    h.update(json.dumps([a.reference_semichord, a.kernel, a.symmetry, a.method]).encode())
     return h.hexdigest()
 
 
-def aic_factors(case, machs) -> AicFactors:
-    """LU factors of D(M, k) (:func:`asekit.aero.dlm.normalwash_matrices`) for the case's
-    boxes at every Mach of ``machs`` and the case's reduced frequencies (BLAS on one thread)."""
-    from asekit.case import pipeline as P
+def _dlm_kernel(case) -> str:
+    """The DLM kernel the pipeline's database uses: ``aero.kernel`` for ``aero.method = "dlm"``,
+    the quartic kernel for ``"auto"`` (:func:`asekit.aero.gaf.gaf_from_box_modes`)."""
+    return case.aero.kernel if case.aero.method == "dlm" else "quartic"
+
+
+def _resolved(case, mach: float) -> str:
+    """The method the case uses at ``mach`` (its ``aero.method``, resolved per Mach for
+    ``auto``); ValueError naming ``flight.mach`` and ``aero.method`` if it cannot."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", TransonicWarning)
+            return resolve_method(case.aero.method, mach)
+    except ValueError as exc:
+        raise ValueError(f"flight.mach = {mach:g} cannot be analysed with aero.method = "
+                         f"{case.aero.method!r}: {exc}") from None
+
+
+def aic_factors(case, machs, n_columns: float = math.inf) -> AicFactors:
+    """The operators of the case's boxes at every Mach of ``machs`` and the case's reduced
+    frequencies (BLAS on one thread), for the methods whose operator is structure-independent
+    and worth forming for ``n_columns`` normalwash columns (samples x modes;
+    :attr:`asekit.aero.methods.AeroMethod.reuse_break_even`); the other Machs are left out
+    (computed per sample)."""
     boxes = P.box_mesh(case)
     ks = P.reduced_frequencies(case)
-    with _one_blas_thread():
-        return _factors(case, boxes, ks, machs)
-
-
-def _factors(case, boxes, ks, machs) -> AicFactors:
-    from asekit.aero.dlm import factor_normalwash_matrix, map_normalwash_matrices
     a = case.aero
-    lu = {}
-    for m in sorted({float(x) for x in machs}):
-        # streamed: the factors plus one batch of D in memory (not all D, their LU and a stack)
-        lus = np.empty((ks.size, boxes.n, boxes.n), complex)
-        pivs = np.empty((ks.size, boxes.n), np.int32)
-
-        def factor(i, _k, d, lus=lus, pivs=pivs):
-            f = factor_normalwash_matrix(d, overwrite=True)      # LU of D^T, in place
-            lus[i], pivs[i] = f.lu, f.piv
-
-        map_normalwash_matrices(boxes, m, ks, a.reference_semichord, factor, a.kernel,
-                                a.symmetry == "wall")
-        lu[m] = (lus, pivs)
-    return AicFactors(aero_key(case), ks, float(a.reference_semichord), lu)
+    ops = {}
+    with one_blas_thread(), warnings.catch_warnings():
+        warnings.simplefilter("ignore", TransonicWarning)       # the case file was warned
+        for m in sorted({float(x) for x in machs}):
+            spec = AERO_METHODS[_resolved(case, m)]
+            if not spec.structure_independent or n_columns < spec.reuse_break_even * boxes.n:
+                continue
+            ops[m] = spec.operators(boxes, m, ks, a.reference_semichord, a.symmetry == "wall",
+                                    _dlm_kernel(case))
+    return AicFactors(aero_key(case), ks, float(a.reference_semichord), ops)
 
 
 def projected_gaf(model, case, factors: AicFactors, mach: float) -> np.ndarray:
-    """Q(M, k) (n_k, n_modes, n_modes) of ``model`` from the factored D(M, k):
-    Q = H_lp^T diag(A) D^-1 (dH/dx + i k H / b) per k (Eqs. 2.10-2.12), the operations of
-    :func:`asekit.aero.gaf.gaf_from_box_modes` on precomputed factors."""
-    from asekit.aero.dlm import AicFactor
-    from asekit.aero.spline import fe_spline, modal_forces
-    from asekit.case import pipeline as P
+    """Q(M, k) (n_k, n_modes, n_modes) of ``model``: from the factored operators when
+    ``factors`` holds ``mach``, Q = H_lp^T diag(A) Op(M, k) (dH/dx + i k H / b) per k
+    (Eqs. 2.10-2.12, the operations of :func:`asekit.aero.gaf.gaf_from_box_modes`: for the
+    DLM bit-identical to a rebuilt database, for the Mach-box method equal to rounding), else
+    rebuilt for this sample by :func:`~asekit.aero.gaf.gaf_from_box_modes` with the case's
+    method."""
     boxes = P.box_mesh(case)
     bm = fe_spline(model, boxes)
-    lu, piv = factors.lu[float(mach)]
+    ops = factors.operators.get(float(mach))
+    if ops is None:
+        a = case.aero
+        method = a.kernel if a.method == "dlm" else a.method
+        _resolved(case, mach)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", TransonicWarning)
+            return gaf_from_box_modes(bm, boxes, mach, factors.k, factors.b_ref,
+                                      a.symmetry == "wall", method)
     n = bm.h_cp.shape[1]
     out = np.empty((factors.k.size, n, n), complex)
     for ik, kk in enumerate(factors.k):
-        cp = AicFactor(lu[ik], piv[ik], True).pressures(bm.normalwash(kk, factors.b_ref))
+        cp = ops[ik].pressures(bm.normalwash(kk, factors.b_ref))
         out[ik] = modal_forces(bm, cp, boxes.area)
     return out
 
 
 def needed_machs(sweep: Sweep) -> set:
-    """The Mach numbers the samples need factors at: their analysed Machs, and every
+    """The Mach numbers the samples need operators at: their analysed Machs, and every
     ``aero.machs`` when envelope or ASE outputs are asked for."""
     machs = {sweep.mach}
     for p in sweep.parameters:
@@ -642,16 +725,17 @@ def needed_machs(sweep: Sweep) -> set:
 
 
 def base_factors(sweep: Sweep) -> AicFactors:
-    """The factors of the base case at :func:`needed_machs` (computed once per sweep)."""
-    from asekit.case import case_from_dict
-    return aic_factors(case_from_dict(copy.deepcopy(sweep.base)), needed_machs(sweep))
+    """The operators of the base case at :func:`needed_machs` (computed once per sweep), for
+    the samples x modes of the base case's modal model."""
+    case = _sample_case(copy.deepcopy(sweep.base))
+    n_modes = len(P.modal_model(case).frequencies_hz)
+    return aic_factors(case, needed_machs(sweep), sweep.n_samples * n_modes)
 
 
 # ---------------------------------------------------------------------------------------------
 # one sample
 # ---------------------------------------------------------------------------------------------
 def _database(model, case, factors: AicFactors, machs):
-    from asekit.aero.gaf import GafDatabase
     ms = np.array(sorted({float(m) for m in machs}))
     Q = np.stack([projected_gaf(model, case, factors, m) for m in ms])
     return GafDatabase(ms, factors.k, Q, factors.b_ref, model.n_rigid, {})
@@ -660,24 +744,25 @@ def _database(model, case, factors: AicFactors, machs):
 def evaluate(sweep: Sweep, factors: AicFactors, index: int, values: dict) -> dict:
     """The row of sample ``index`` with parameter ``values`` (key path -> value): the case is
     rebuilt from the edited dict (:func:`~asekit.case.case_from_dict`), its modes projected on
-    the factored AICs, p-k at the analysed condition (and over the case for envelope outputs,
-    the ASE loop for aem outputs). Any exception gives ``status = "failed"`` and its message."""
+    the factored operators (or its GAFs rebuilt, :func:`projected_gaf`), p-k at the analysed
+    condition (and over the case for envelope outputs, the ASE loop for aem outputs). Any
+    exception gives ``status = "failed"`` and its message."""
     t0 = time.perf_counter()
     row = {c: None for c in sweep.columns()}
     row.update({"sample": int(index), "sweep_id": sweep.sweep_id(), "seed": sweep.seed})
     for k, v in values.items():
         row[k] = v
     try:
-        with _one_blas_thread():
-            out, reused, mach, alt = _analyse(sweep, factors, values)
+        with one_blas_thread():
+            out, reused, mach, cond = _analyse(sweep, factors, values)
         row.update(out)
         row["aic_reused"] = reused
         row["status"] = "ok"
     except Exception as exc:                 # recorded in the row, never dropped
         row["status"] = "failed"
         row["error"] = f"{type(exc).__name__}: {exc}".replace("\n", " ")
-        mach, alt = sweep.case_dict(values)[1:] if _safe(sweep, values) else (None, None)
-    row["flight.mach"], row["flight.altitude"] = mach, alt
+        mach, cond = sweep.case_dict(values)[1:] if _safe(sweep, values) else (None, None)
+    row["flight.mach"], row[sweep.condition_path] = mach, cond
     row["wall_s"] = time.perf_counter() - t0
     return row
 
@@ -690,23 +775,32 @@ def _safe(sweep, values):
         return False
 
 
+def _condition(sweep: Sweep, value: float) -> P.FlightCondition:
+    """The analysed flight condition: the standard atmosphere at the altitude, or the density
+    (no speed of sound)."""
+    if sweep.density is not None:
+        _check_condition("flight.density", "flight.density", value)
+        return P.FlightCondition(None, float(value), None)
+    _check_condition("flight.altitude", "flight.altitude", value)
+    atm = standard_atmosphere(value)
+    return P.FlightCondition(float(value), float(atm.density), float(atm.speed_of_sound))
+
+
 def _analyse(sweep: Sweep, factors: AicFactors, values: dict):
-    from asekit.atmosphere import standard_atmosphere
-    from asekit.case import case_from_dict
-    from asekit.case import pipeline as P
-    from asekit.aeroelastic.flutter import divergence_speeds
-    d, mach, alt = sweep.case_dict(values)
-    _check_condition("flight.mach", "flight.mach", mach)
-    _check_condition("flight.altitude", "flight.altitude", alt)
-    case = case_from_dict(d)
+    d, mach, cval = sweep.case_dict(values)
+    case = _sample_case(d)
+    _resolved(case, mach)
+    cond = _condition(sweep, cval)
     model = P.modal_model(case)
+    n_modes = len(model.frequencies_hz)                 # one sample's normalwash columns
     if aero_key(case) == factors.key:
         fac, reused = factors, True
     else:
-        fac, reused = aic_factors(case, needed_machs(sweep) | {mach}), False
-    if float(mach) not in fac.lu:
+        fac, reused = aic_factors(case, needed_machs(sweep) | {mach}, n_modes), False
+    if float(mach) not in fac.operators:
         fac = AicFactors(fac.key, fac.k, fac.b_ref,
-                         {**fac.lu, **aic_factors(case, [mach]).lu})
+                         {**fac.operators, **aic_factors(case, [mach], n_modes).operators})
+    reused = reused and float(mach) in factors.operators
     out = {}
     want = set(sweep.outputs)
     f_el = model.frequencies_hz[model.n_rigid:]
@@ -715,13 +809,11 @@ def _analyse(sweep: Sweep, factors: AicFactors, values: dict):
     if "f2_hz" in want:
         out["f2_hz"] = float(f_el[1]) if f_el.size > 1 else None
     if want & set(POINT_OUTPUTS) - {"f1_hz", "f2_hz"}:
-        atm = standard_atmosphere(alt)
-        cond = P.FlightCondition(float(alt), float(atm.density), float(atm.speed_of_sound))
         db = _database(model, case, fac, [mach])
         r = P.analyse_condition(case, db, mach, cond, model)
         f = r.flutter
         u_f = None if (f is None or r.unstable_at_start) else float(f.speed)
-        u_fl = float(mach) * cond.speed_of_sound
+        u_fl = None if cond.speed_of_sound is None else float(mach) * cond.speed_of_sound
         div = divergence_speeds(model, db.Q[0, 0].real, cond.density)
         out.update({"flutter_speed": u_f,
                     "flutter_frequency": None if u_f is None else float(f.frequency_hz),
@@ -763,7 +855,7 @@ def _analyse(sweep: Sweep, factors: AicFactors, values: dict):
                 out[f"{p}_settling_s"] = a.settling_s[t]
                 out[f"{p}_steady_error"] = a.steady_error[t]
                 out[f"{p}_corner_overshoot"] = max(a.corner_overshoot[t].values())
-    return {k: v for k, v in out.items() if k in want}, reused, float(mach), float(alt)
+    return {k: v for k, v in out.items() if k in want}, reused, float(mach), float(cval)
 
 
 # ---------------------------------------------------------------------------------------------

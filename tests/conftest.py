@@ -211,9 +211,10 @@ def ase_setup(case, modal, db, mach: float, altitude: float, n_lags: int = 4) ->
     from asekit.ase.loop import build_model
     from asekit.atmosphere import standard_atmosphere
     from asekit.case import pipeline
-    from asekit.rfa import gaf_at_mach, roger_fit
+    from asekit.rfa import roger_fit
 
-    k, q = gaf_at_mach(db, mach, interpolate=True)
+    g = db.at(mach, interpolate=True)
+    k, q = g.k, g.Q
     rfa = roger_fit(k, q, db.b_ref, n_lags=n_lags, mach=mach)
     atm = standard_atmosphere(altitude)
     rho, U = float(atm.density), mach * float(atm.speed_of_sound)

@@ -248,20 +248,14 @@ RFA = Target(
 
 
 def _gaf_at_mach(mach, interpolate):
-    from asekit.rfa import gaf_at_mach
-
-    @dataclass(frozen=True)
-    class Db:
-        machs: np.ndarray
-        k: np.ndarray
-        Q: np.ndarray
-
-    db = Db(np.array([0.4, 0.6, 0.75]), np.array([0.0, 0.5]), np.ones((3, 2, 1, 1), complex))
-    return gaf_at_mach(db, mach, interpolate=interpolate)
+    from asekit.aero.gaf import GafDatabase
+    db = GafDatabase(np.array([0.4, 0.6, 0.75]), np.array([0.0, 0.5]),
+                     np.ones((3, 2, 1, 1), complex), 1.0, 0, {})
+    return db.at(mach, interpolate=interpolate)
 
 
 GAF_AT_MACH = Target(
-    "gaf_at_mach",
+    "GafDatabase.at",
     st.fixed_dictionaries({"mach": reals(0.0, 1.0), "interpolate": st.booleans()}),
     _gaf_at_mach, ("mach",))
 

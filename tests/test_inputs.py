@@ -138,17 +138,13 @@ def test_simulate_bad_arguments_named():
         simulate(P, SYSTEM_3, 0.1, theta0=float("inf"))
 
 
-def test_gaf_at_mach_nan():
-    from asekit.rfa import gaf_at_mach
-
-    class Db:
-        machs = np.array([0.4, 0.6])
-        k = np.array([0.0, 1.0])
-        Q = np.zeros((2, 2, 1, 1), complex)
-
-    with pytest.raises(ValueError, match="mach"):
-        gaf_at_mach(Db, float("nan"), interpolate=True)
-    assert gaf_at_mach(Db, 0.5, interpolate=True)[1].shape == (2, 1, 1)
+def test_gaf_database_at_nan():
+    from asekit.aero.gaf import GafDatabase
+    db = GafDatabase(np.array([0.4, 0.6]), np.array([0.0, 1.0]), np.zeros((2, 2, 1, 1), complex),
+                     1.0, 0, {})
+    with pytest.raises(ValueError, match="mach must be a finite Mach number"):
+        db.at(float("nan"), interpolate=True)
+    assert db.at(0.5, interpolate=True).Q.shape == (2, 1, 1)
 
 
 # ---- OP4 ------------------------------------------------------------------------------------------

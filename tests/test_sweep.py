@@ -6,6 +6,7 @@ import copy
 import csv
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -34,7 +35,8 @@ def _cache(tmp_path, monkeypatch):
 def one_blas_thread():
     """The pipeline computations a test compares with run on one BLAS thread, as the sweep's
     samples do (multithreaded BLAS may differ in the last bits)."""
-    with S._one_blas_thread():
+    from asekit.util.blas import one_blas_thread as one
+    with one():
         yield
 
 
@@ -106,9 +108,18 @@ def test_unknown_key_path_is_a_sweep_error_naming_it():
 
 
 @pytest.mark.parametrize("param, message", [
-    ({"distribution": "normal", "mean": 1.0, "std": -0.1}, r"std must be a finite number > 0"),
+    ({"distribution": "normal", "mean": 1.0, "std": -0.1},
+     r"parameter\[0\] \(support.torsional_stiffness\).std must be > 0, got -0.1"),
     ({"distribution": "uniform", "low": 2.0, "high": 1.0}, r"low \(2\) must be < high \(1\)"),
-    ({"distribution": "lognormal", "median": 120.0, "sigma": 0.0}, r"sigma must be"),
+    ({"distribution": "lognormal", "median": 120.0, "sigma": 0.0},
+     r"\(support.torsional_stiffness\).sigma must be > 0, got 0"),
+    ({"distribution": "normal", "mean": "a", "std": 1.0},
+     r"\(support.torsional_stiffness\).mean must be a finite number, got 'a'"),
+    ({"distribution": "normal", "mean": 1.0}, r"\(support.torsional_stiffness\).std is missing"),
+    ({"range": {"min": 1.0, "max": 2.0, "num": 3, "stp": 1.0}},
+     r"\(support.torsional_stiffness\).range.stp is not a known key"),
+    ({"range": {"min": 1.0, "max": 2.0}}, r"\.range must be \{min, max, num\} or"),
+    ({"range": {"min": 1.0, "max": 2.0, "num": 0}}, r"\.range.num must be an integer in \[1, "),
     ({"distribution": "truncated_normal", "mean": 0.0, "std": 1.0, "low": 1.0, "high": 0.5},
      r"low \(1\) must be < high \(0.5\)"),
     ({"distribution": "truncated_normal", "mean": 0.0, "std": 1.0, "low": 50.0, "high": 60.0},
@@ -125,7 +136,9 @@ def test_invalid_distribution_parameters(param, message):
 
 
 def test_condition_out_of_range_is_a_sweep_error():
-    with pytest.raises(S.SweepError, match=r"values\[1\] must be a Mach number in \[0, 1\)"):
+    with pytest.raises(S.SweepError, match=r"parameter\[0\] \(flight.mach\).values\[1\] = 1.2 "
+                                           r"cannot be analysed with the base case's aero.method "
+                                           r"= 'dlm' .*mach must be < 1 for the DLM"):
         S.sweep_from_dict(sweep_dict([{"path": "flight.mach", "values": [0.5, 1.2]}]))
     with pytest.raises(S.SweepError, match="sweep.altitude must be an altitude"):
         S.sweep_from_dict(sweep_dict([], altitude=1e6))
@@ -264,7 +277,7 @@ def test_a_sample_is_the_pipeline_on_the_edited_case(one_blas_thread):
     assert row["flutter_frequency"] == r.flutter.frequency_hz
     assert row["flutter_mode"] == r.flutter.mode + 1        # user-facing: elastic modes from 1
     model = P.modal_model(case)
-    div = divergence_speeds(model, P.gaf_at(db, 0.5).Q[0].real, cond.density)
+    div = divergence_speeds(model, db.at(0.5).Q[0].real, cond.density)
     assert row["divergence_speed"] == div[0]
     assert row["flight_speed"] == 0.5 * cond.speed_of_sound
     assert row["flutter_margin"] == r.flutter.speed / (0.5 * cond.speed_of_sound) - 1
@@ -522,7 +535,8 @@ def _cli(args, tmp_path, timeout=120):
 @pytest.mark.parametrize("edit, message", [
     (lambda d: d["parameter"][0].update(path="material.youngs_modulos"),
      "'material.youngs_modulos' is not a case-file key"),
-    (lambda d: d["parameter"][0].update(sigma=-0.1), "sigma must be a finite number > 0"),
+    (lambda d: d["parameter"][0].update(sigma=-0.1),
+     r"parameter\[0\] \(support.torsional_stiffness\).sigma must be > 0, got -0.1"),
     (lambda d: d["parameter"][0].update(distribution="uniform", low=130.0, high=110.0),
      None),
     (lambda d: d["sweep"].update(outputs=["flutter_speed", "q_dyn"]), "'q_dyn' is not an output"),
@@ -555,3 +569,145 @@ def test_cli_unreachable_scheduler_fails_fast(tmp_path):
     assert r.returncode == 2
     assert r.stderr.strip().splitlines()[-1].startswith(
         "error: cannot reach the Dask scheduler at tcp://127.0.0.1:9 within 5 s")
+
+
+# ------------------------------------------------------------------------------------------
+# the aero method of the base case (issue 21): supersonic and piston sweeps
+# ------------------------------------------------------------------------------------------
+AGARD_SWEEP = ROOT / "data" / "sweeps" / "agard445_6_supersonic_stiffness.toml"
+
+
+def test_supersonic_sweep_runs_and_its_nominal_sample_is_the_pipeline():
+    """The shipped sweep over data/cases/agard445_6_supersonic.toml (aero.method = "supersonic",
+    M 1.072, a density case): every sample runs with the Mach-box method; the nominal sample
+    (E1 = 3.1511 GPa) has the flutter speed and frequency of the pipeline (its database and
+    its per-condition p-k, asekit.case.pipeline.analyse_condition, the step of
+    pipeline.flutter) on the unmodified case at (M 1.072, rho 0.055146 kg/m^3); the flutter
+    speed and the first (bending) frequency rise with the fibre-direction modulus E1."""
+    import warnings
+
+    from asekit.aero.methods import TransonicWarning
+    from asekit.case import load_case
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TransonicWarning)
+        sw = S.load_sweep(AGARD_SWEEP)
+        df = S.run_sweep(sw)
+        case = load_case(ROOT / "data" / "cases" / "agard445_6_supersonic.toml")
+        ref = P.analyse_condition(case, P.gaf_database(case, progress=False), 1.072,
+                                  P.flight_conditions(case)[1])
+    assert sw.density == 0.055146 and sw.condition_path == "flight.density"
+    assert (df["status"] == "ok").all(), df["error"].tolist()
+    assert not df["aic_reused"].any()           # 3 samples x 4 modes: rebuilt per sample
+    assert ref.condition.density == 0.055146
+    nominal = df[df["material.e1"] == 3.1511e9].iloc[0]
+    assert math.isclose(nominal["flutter_speed"], ref.flutter.speed, rel_tol=1e-12)
+    assert math.isclose(nominal["flutter_frequency"], ref.flutter.frequency_hz, rel_tol=1e-12)
+    assert np.all(np.diff(df["flutter_speed"]) > 0) and np.all(np.diff(df["f1_hz"]) > 0)
+    assert df["flight.density"].tolist() == [0.055146] * 3
+
+
+def _piston_plate(tmp_path):
+    """A clamped square aluminium plate with piston theory at M 2.5 (a small supersonic case)."""
+    case = tmp_path / "plate.toml"
+    case.write_text('''[case]
+name = "piston plate"
+[[panel]]
+root_leading_edge = [0.0, 0.0]
+root_chord = 0.3
+tip_leading_edge = [0.0, 0.3]
+tip_chord = 0.3
+n_chord = 8
+n_span = 8
+[thickness]
+root = 0.002
+tip = 0.002
+[material]
+youngs_modulus = 70.0e9
+poisson_ratio = 0.3
+density = 2700.0
+[support]
+kind = "clamped_root"
+[modes]
+count = 4
+[aero]
+method = "piston"
+machs = [2.5]
+reference_semichord = 0.15
+boxes = [{ n_chord = 8, n_span = 8 }]
+reduced_frequencies = [0.001, 0.05, 0.1, 0.2, 0.4, 0.8]
+[flight]
+densities = [0.4]
+velocities = { min = 100.0, max = 1500.0, step = 20.0 }
+''')
+    return case
+
+
+def _plate_sweep(tmp_path, case, **sweep):
+    f = tmp_path / "s.toml"
+    extra = "".join(f"{k} = {v!r}\n" for k, v in sweep.items())
+    extra += "" if "mach" in sweep else "mach = 2.5\n"
+    f.write_text(f'[sweep]\ncase = "{case.name}"\n{extra}'
+                 'outputs = ["flutter_speed", "flutter_frequency", "f1_hz"]\n'
+                 '[[parameter]]\npath = "thickness.root"\nvalues = [0.0018, 0.002, 0.0022]\n')
+    return S.load_sweep(f)
+
+
+def test_piston_sweep_reuses_its_matrices_and_equals_the_pipeline(tmp_path, monkeypatch,
+                                                                  one_blas_thread):
+    """Piston theory's pressure matrix depends on the boxes and Mach only (a local law): the
+    sweep forms it once and projects each sample's modes (aic_reused), bit-identical to the
+    pipeline's database; with the registry saying "structure-dependent" the GAFs are rebuilt
+    per sample, with the same numbers. A thicker root stiffens the plate: f1 and the flutter
+    speed rise."""
+    import asekit.aero.methods as M
+    import dataclasses
+    case = _piston_plate(tmp_path)
+    calls = []
+    real = M.piston_pressure_matrices
+    monkeypatch.setattr(M, "piston_pressure_matrices",
+                        lambda *a, **k: calls.append(a[1]) or real(*a, **k))
+    sw = _plate_sweep(tmp_path, case)
+    assert sw.condition_path == "flight.density" and sw.density == 0.4
+    df = S.run_sweep(sw)
+    assert calls == [2.5]                                   # one matrix for three samples
+    assert (df["status"] == "ok").all(), df["error"].tolist()
+    assert df["aic_reused"].all()
+    assert np.all(np.diff(df["f1_hz"]) > 0) and np.all(np.diff(df["flutter_speed"]) > 0)
+    d, mach, rho = sw.case_dict({"thickness.root": 0.0022})
+    c = case_from_dict(d)
+    r = P.analyse_condition(c, P.gaf_database(c, progress=False), mach,
+                            P.FlightCondition(None, rho, None))
+    assert df["flutter_speed"].iloc[2] == r.flutter.speed
+    monkeypatch.setitem(M.AERO_METHODS, "piston", dataclasses.replace(
+        M.AERO_METHODS["piston"], structure_independent=False))
+    calls.clear()
+    df2 = S.run_sweep(sw)
+    assert calls == [2.5, 2.5, 2.5] and not df2["aic_reused"].any()
+    assert df2["flutter_speed"].tolist() == df["flutter_speed"].tolist()
+
+
+def test_impossible_method_and_condition_name_both_key_paths(tmp_path):
+    case = _piston_plate(tmp_path)
+    with pytest.raises(S.SweepError, match=r"sweep.mach = 0.8 cannot be analysed with the base "
+                                           r"case's aero.method = 'piston' .*mach must be > 1"):
+        _plate_sweep(tmp_path, case, mach=0.8)
+    f = tmp_path / "m.toml"
+    f.write_text(f'[sweep]\ncase = "{case.name}"\n[[parameter]]\npath = "flight.mach"\n'
+                 'values = [2.0, 0.9]\n')
+    with pytest.raises(S.SweepError, match=r"parameter\[0\] \(flight.mach\).values\[1\] = 0.9 "
+                                           r"cannot be analysed .*aero.method = 'piston'"):
+        S.load_sweep(f)
+    with pytest.raises(S.SweepError, match=r"flight.altitude .* or as flight.density .*not both"):
+        _plate_sweep(tmp_path, case, altitude=0.0, density=0.4)
+    f.write_text(f'[sweep]\ncase = "{case.name}"\noutputs = ["flutter_margin"]\n')
+    with pytest.raises(S.SweepError, match=r"flutter_margin needs the speed of sound .*give "
+                                           r"sweep.altitude"):
+        S.load_sweep(f)
+    # a sample that varies the method itself into an impossible combination: a failed row
+    # naming the case key paths (the case file is valid, the sample's case is not)
+    f.write_text(f'[sweep]\ncase = "{case.name}"\noutputs = ["flutter_speed"]\n'
+                 '[[parameter]]\npath = "aero.method"\nvalues = ["piston", "dlm"]\n')
+    df = S.run_sweep(S.load_sweep(f))
+    assert df["status"].tolist() == ["ok", "failed"]
+    assert re.search(r"aero.machs\[0\] = 2.5 with aero.method = 'dlm': mach must be < 1 for the "
+                     r"DLM", df["error"].iloc[1]), df["error"].iloc[1]

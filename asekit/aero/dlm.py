@@ -88,6 +88,7 @@ import scipy.linalg as sla
 
 from asekit.aero.boxes import BoxMesh, check_matrix_memory
 from asekit.aero.kernels import check_kernel
+from asekit.aero.validity import check_k
 from asekit.aero.vlm import check_mach, vlm_normalwash_matrix, CHUNK_BYTES
 
 #: Laschka's approximation of u / sqrt(1 + u^2) ~ 1 - sum a_n exp(-n c u) ([R71] Eq. A.4;
@@ -122,14 +123,6 @@ COMPILED_POINTS_PER_CHUNK = 262144
 COMPILED_MIN_ROWS = 48
 #: Largest table of planar weights per (receiver group, sender group) (:class:`_PlanarWeights`).
 PLANAR_WEIGHT_TABLE_BYTES = 64 * 2**20
-
-
-def check_k(k) -> np.ndarray:
-    """Validate reduced frequencies: finite and >= 0 (raises ValueError). Returns a 1-D array."""
-    ks = np.atleast_1d(np.asarray(k, float))
-    if ks.ndim != 1 or ks.size == 0 or not np.all(np.isfinite(ks)) or np.any(ks < 0):
-        raise ValueError(f"k must be finite reduced frequencies >= 0, got {k!r}")
-    return ks
 
 
 def _check_bref(b_ref: float) -> float:

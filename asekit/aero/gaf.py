@@ -29,9 +29,10 @@ from asekit.util.blas import blas_threads_for
 from asekit.util.cache import CacheError, load_npz, save_npz
 from asekit.util.paths import DATA_DIR, user_cache_dir
 from asekit.aero.boxes import BoxMesh
-from asekit.aero.dlm import check_k, factor_normalwash_matrix, map_normalwash_matrices
+from asekit.aero.dlm import factor_normalwash_matrix, map_normalwash_matrices
+from asekit.aero.methods import DLM_KERNELS, check_mach, pressures, resolve_method
 from asekit.aero.spline import BoxModes, fe_spline, modal_forces
-from asekit.aero.vlm import check_mach
+from asekit.aero.validity import check_k
 
 #: The reference fin's database, shipped read-only with the repository (so CI does not rebuild
 #: it). Rebuilt databases go to the user cache directory (:func:`asekit.util.paths.user_cache_dir`).
@@ -40,6 +41,57 @@ GAF_FILE = DATA_DIR / "gaf_fin.npz"
 SHIPPED_DATABASES = (GAF_FILE,)
 #: Format version of the database file; bump when its layout or meaning changes.
 GAF_FORMAT = 1
+
+
+@dataclass(frozen=True)
+class TabulatedGaf:
+    """Complex GAFs Q (n_k, n, n) at reduced frequencies k (ascending, >= 0) of one Mach,
+    per unit dynamic pressure (F = q Q zeta), reference semi-chord ``b_ref`` (m); ``mach``
+    the Mach number they belong to (None: not stated). :meth:`GafDatabase.at` gives one from a
+    database; the flutter solvers (:mod:`asekit.aeroelastic.flutter`) read it."""
+
+    k: np.ndarray
+    Q: np.ndarray
+    b_ref: float
+    mach: float | None = None
+
+    def __post_init__(self):
+        k = np.asarray(self.k, dtype=float)
+        Q = np.asarray(self.Q, dtype=complex)
+        if k.ndim != 1 or Q.shape[0] != k.size or Q.ndim != 3 or Q.shape[1] != Q.shape[2]:
+            raise ValueError(f"Q must be (n_k, n, n) with n_k = len(k); got k {k.shape}, "
+                             f"Q {Q.shape}")
+        if k.size < 2 or np.any(np.diff(k) <= 0) or k[0] < 0:
+            raise ValueError(f"k must hold >= 2 ascending values >= 0, got {k}")
+        if not (np.isfinite(self.b_ref) and self.b_ref > 0):
+            raise ValueError(f"b_ref must be > 0, got {self.b_ref}")
+        object.__setattr__(self, "k", k)
+        object.__setattr__(self, "Q", Q)
+
+    def parts(self, k: float, method: str = "linear") -> tuple[np.ndarray, np.ndarray]:
+        """(Q^R(k), Q^I(k)/k): real part and imaginary part divided by k, interpolated in k.
+
+        Linear interpolation (Nastran's IMETH=L) or ``method="cubic"`` (not-a-knot spline).
+        Outside the table: Q^R and Q^I/k are held at the end values (k below the first point
+        uses Q^I(k_1)/k_1, the finite k -> 0 limit of a smooth Q^I).
+        """
+        kk = self.k
+        qi_over_k = self.Q.imag / np.where(kk > 0, kk, 1.0)[:, None, None]
+        if kk[0] == 0:
+            qi_over_k[0] = qi_over_k[1]
+        kq = float(np.clip(k, kk[0], kk[-1]))
+        if method == "linear":
+            j = int(np.clip(np.searchsorted(kk, kq) - 1, 0, kk.size - 2))
+            t = (kq - kk[j]) / (kk[j + 1] - kk[j])
+            qr = (1 - t) * self.Q.real[j] + t * self.Q.real[j + 1]
+            qik = (1 - t) * qi_over_k[j] + t * qi_over_k[j + 1]
+        elif method == "cubic":
+            from scipy.interpolate import CubicSpline
+            qr = CubicSpline(kk, self.Q.real, axis=0)(kq)
+            qik = CubicSpline(kk, qi_over_k, axis=0)(kq)
+        else:
+            raise ValueError(f"method must be 'linear' or 'cubic', got {method!r}")
+        return qr, qik
 
 
 @dataclass(frozen=True)
@@ -59,6 +111,57 @@ class GafDatabase:
     n_rigid: int
     metadata: dict
 
+    def at(self, mach: float, interpolate: bool = False, atol: float = 1e-9) -> TabulatedGaf:
+        """The tabulated GAFs at one Mach number.
+
+        Parameters
+        ----------
+        mach : Mach number (-), within ``atol`` of one of :attr:`machs`, or, with
+            ``interpolate``, inside [min(machs), max(machs)].
+        interpolate : False (default): an exact Mach of the database is required.
+            True: between two tabulated Machs M_0 < M < M_1, Q is interpolated linearly,
+            Q(M) = (1 - t) Q(M_0) + t Q(M_1), t = (M - M_0) / (M_1 - M_0) (never extrapolated).
+        atol : tolerance of an exact match.
+
+        Returns
+        -------
+        TabulatedGaf : k, Q (n_k, n, n) at ``mach``, :attr:`b_ref`, ``mach``.
+
+        Raises ValueError naming ``mach``, the database's Machs and its range otherwise.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> db = GafDatabase(np.array([0.5, 0.7]), np.array([0.0, 1.0]),
+        ...                  np.array([np.ones((2, 1, 1)), 3 * np.ones((2, 1, 1))]), 1.0, 0, {})
+        >>> db.at(0.7).Q[0, 0, 0]
+        np.complex128(3+0j)
+        >>> db.at(0.6, interpolate=True).Q[0, 0, 0]
+        np.complex128(2+0j)
+        """
+        machs = np.asarray(self.machs, dtype=float)
+        try:
+            m = float(mach)
+        except (TypeError, ValueError):
+            m = math.nan
+        if not math.isfinite(m) or m < 0:
+            raise ValueError(f"mach must be a finite Mach number >= 0, got {mach!r}")
+        hit = np.nonzero(np.abs(machs - m) <= atol)[0]
+        if hit.size:
+            return TabulatedGaf(self.k, self.Q[hit[0]], self.b_ref, mach=m)
+        if not interpolate or m < machs.min() or m > machs.max():
+            raise ValueError(f"mach {m} is not in the GAF database {machs.tolist()}"
+                             + ("" if interpolate else " (pass interpolate=True to interpolate "
+                                "between its Machs)")
+                             + f"; valid range [{machs.min()}, {machs.max()}]")
+        order = np.argsort(machs)
+        m_sorted = machs[order]
+        j = int(np.searchsorted(m_sorted, m))
+        m0, m1 = m_sorted[j - 1], m_sorted[j]
+        t = (m - m0) / (m1 - m0)
+        q = (1 - t) * self.Q[order[j - 1]] + t * self.Q[order[j]]
+        return TabulatedGaf(self.k, q, self.b_ref, mach=m)
+
 
 def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref: float,
                        symmetric: bool = False, method: str = "quartic",
@@ -76,8 +179,7 @@ def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref
     "parabolic" are the DLM kernels.
     """
     ks = check_k(k)
-    if method not in ("quartic", "parabolic"):
-        from asekit.aero.methods import pressures, resolve_method
+    if method not in DLM_KERNELS:
         if resolve_method(method, mach) != "dlm" or aero_options:
             cp = pressures(mesh, mach, ks, b_ref, lambda kk: box_modes.normalwash(kk, b_ref),
                            method, symmetric, **(aero_options or {}))
@@ -162,11 +264,13 @@ def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: flo
     """Compute Q over ``machs`` x ``ks`` (tqdm bar over Mach x k when ``progress``); ``method``
     and ``aero_options`` as in :func:`gaf_from_box_modes` (e.g. "auto" over subsonic and
     supersonic Mach numbers, refusing the transonic gap)."""
-    if method in ("quartic", "parabolic"):
-        machs = np.array([check_mach(m) for m in np.atleast_1d(machs)])
-    else:
-        from asekit.aero.methods import resolve_method
-        machs = np.array([float(m) for m in np.atleast_1d(machs) if resolve_method(method, m)])
+    # the Mach range of the method (asekit.aero.methods); an explicit method warns in the gap
+    machs = np.array([float(m) for m in np.atleast_1d(machs)])
+    for i, m in enumerate(machs):
+        if method in DLM_KERNELS:
+            check_mach(m, method, f"machs[{i}]")
+        else:
+            resolve_method(method, m, f"machs[{i}]")
     ks = check_k(ks)
     if np.any(np.diff(ks) <= 0):
         raise ValueError("ks must be strictly ascending")
@@ -276,7 +380,4 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
 
 def steady_hinge_coefficient(db: GafDatabase, mach: float) -> float:
     """Re Q_cc at the database's lowest k (0.001) and ``mach`` (m^3/rad; thesis Eq. 4.6)."""
-    i = int(np.argmin(np.abs(db.machs - mach)))
-    if not math.isclose(db.machs[i], mach, abs_tol=1e-9):
-        raise ValueError(f"mach {mach} is not in the database {db.machs.tolist()}")
-    return float(db.Q[i, 0, 0, 0].real)
+    return float(db.at(mach).Q[0, 0, 0].real)

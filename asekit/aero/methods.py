@@ -17,21 +17,41 @@ kernel (Prandtl-Glauert factor 1/sqrt(1 - M^2)) and the supersonic one (1/sqrt(M
 Mach cones that collapse onto the wing, kernel wavelength 2 pi b (M - 1)/(k M) -> 0) both
 diverge. Transonic unsteady loads need a nonlinear (transonic small-disturbance, Euler or
 Navier-Stokes) solution or test data; asekit does not extrapolate into the gap.
+
+The registry. :data:`AERO_METHODS` maps each method name to its :class:`AeroMethod`: its valid
+Mach range (:mod:`asekit.aero.validity`), its builder of the pressure-per-normalwash matrices
+and whether those matrices are structure-independent (they depend on the boxes, Mach and k
+only, so a sweep over the structure factors or forms them once per Mach and projects each
+sample's modes, :mod:`asekit.sweep`). The case schema (``aero.method``, ``aero.machs``), the
+pipeline and the sweep check a method and a Mach number here (:func:`check_method`,
+:func:`check_mach`, :func:`resolve_method`); an unknown method fails with the list of the known
+ones. Adding a method: its kernel module and one :data:`AERO_METHODS` entry.
 """
 
 from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
 from asekit.aero.boxes import BoxMesh
+from asekit.aero.dlm import factor_normalwash_matrix, map_normalwash_matrices, normalwash_matrices
+from asekit.aero.piston import piston_pressure_matrices
+from asekit.aero.supersonic import supersonic_pressure_matrices, supersonic_pressures
+from asekit.aero.validity import SUBSONIC, SUPERSONIC, MachRange, check_k
+from asekit.aero.validity import check_mach as _check_mach_range
+
+__all__ = ["AERO_METHODS", "AeroMethod", "DLM_KERNELS", "DLM_MACH_MAX", "METHODS",
+           "SUPERSONIC_MACH_MIN", "TransonicGapError", "TransonicWarning", "check_k",
+           "check_mach", "check_method", "method_spec", "pressure_matrices", "pressures",
+           "PressureMatrix", "resolve_method"]
 
 #: auto: highest Mach number given to the DLM, lowest given to the supersonic method.
 DLM_MACH_MAX = 0.9
 SUPERSONIC_MACH_MIN = 1.15
-METHODS = ("auto", "dlm", "supersonic", "piston")
 DLM_KERNELS = ("quartic", "parabolic")
 
 
@@ -43,71 +63,197 @@ class TransonicWarning(UserWarning):
     """An explicitly chosen linear method is used close to M = 1."""
 
 
-def check_method(method: str) -> str:
-    """Validate a method name (:data:`METHODS` or a DLM kernel name)."""
+def _dlm_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic", **options):
+    """A = D^-1 (n_k, n, n), the DLM's AIC formed explicitly (:mod:`asekit.aero.dlm`; it has
+    no aero options: ``options`` are ignored)."""
+    d = normalwash_matrices(mesh, mach, ks, b_ref, kernel, symmetric)
+    return np.linalg.solve(d, np.broadcast_to(np.eye(mesh.n), d.shape))
+
+
+def _supersonic_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic", **options):
+    """The Mach-box matrices (:func:`asekit.aero.supersonic.supersonic_pressure_matrices`)."""
+    return supersonic_pressure_matrices(mesh, mach, ks, b_ref, symmetric, **options)
+
+
+def _piston_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic", **options):
+    """Piston theory (:func:`asekit.aero.piston.piston_pressure_matrices`; a local law: the
+    wall image has no effect, ``symmetric`` is ignored)."""
+    return piston_pressure_matrices(mesh, mach, ks, b_ref, **options)
+
+
+@dataclass(frozen=True)
+class PressureMatrix:
+    """A pressure-per-normalwash matrix A (n, n) as an operator: DeltaCp = A (w/U), the
+    counterpart of :class:`asekit.aero.dlm.AicFactor` for the methods whose matrix is formed
+    explicitly."""
+
+    a: np.ndarray
+
+    def pressures(self, w: np.ndarray) -> np.ndarray:
+        """DeltaCp (n, m) = A w for normalwash columns ``w`` (n, m)."""
+        return self.a @ w
+
+
+def _dlm_operators(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic", **options):
+    """One :class:`asekit.aero.dlm.AicFactor` (LU of D(M, k), in place, streamed) per k: the
+    operations of :func:`asekit.aero.gaf.gaf_from_box_modes`, so pressures applied through
+    them are bit-identical to a database built from scratch."""
+    return tuple(map_normalwash_matrices(
+        mesh, mach, check_k(ks), b_ref, lambda i, kk, d: factor_normalwash_matrix(d, overwrite=True),
+        kernel, symmetric))
+
+
+def _matrix_operators(builder):
+    def operators(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic", **options):
+        a = builder(mesh, mach, ks, b_ref, symmetric, kernel, **options)
+        return tuple(PressureMatrix(np.ascontiguousarray(x)) for x in a)
+    operators.__doc__ = f"One :class:`PressureMatrix` per k of {builder.__name__}."
+    return operators
+
+
+@dataclass(frozen=True)
+class AeroMethod:
+    """One unsteady aerodynamic method of the registry.
+
+    name : the ``aero.method`` value; summary : one line; mach_range : its valid Mach numbers
+    (None for ``auto``, which picks a method per Mach); who : how error messages name it;
+    hint : what a message suggests outside the range.
+    structure_independent : its pressure operator depends on the boxes, Mach and k only (not
+    on the mode shapes or the thickness), so one operator per (M, k) serves every structure on
+    the same boxes (:mod:`asekit.sweep` forms it once per sweep).
+    pressure_matrices : builder ``(mesh, mach, ks, b_ref, symmetric, kernel, **options) ->
+    A (n_k, n, n)`` with DeltaCp = A (w/U) (None for ``auto``).
+    operators : builder with the same arguments of one operator per k, each with a
+    ``pressures(w) -> DeltaCp`` method (the DLM: LU factors of D; the others:
+    :class:`PressureMatrix`).
+    reuse_break_even : forming the operators costs about as much as computing the pressures of
+        ``reuse_break_even * n_boxes`` normalwash columns one sample at a time; a sweep forms
+        them once when its samples x modes reach that (0: always worth it). The Mach-box
+        method: 0.1, measured on the AGARD 445.6 case (256 boxes, 4 modes, 10 k, one BLAS
+        thread: the matrices 6.6 s at M 1.072 and 13.1 s at M 1.141, one sample's pressures
+        1.15 s and 2.26 s, so break-even near 6 samples = 24 columns).
+    """
+
+    name: str
+    summary: str
+    mach_range: MachRange | None
+    who: str
+    hint: str
+    structure_independent: bool
+    pressure_matrices: Callable | None
+    operators: Callable | None
+    reuse_break_even: float = 0.0
+
+
+#: The aero-method registry: ``aero.method`` name -> :class:`AeroMethod`.
+AERO_METHODS: dict[str, AeroMethod] = {
+    "auto": AeroMethod("auto", f"the DLM for M <= {DLM_MACH_MAX:g}, the Mach-box method for "
+                       f"M >= {SUPERSONIC_MACH_MIN:g}, refused in between", None, "auto", "",
+                       True, None, None),
+    "dlm": AeroMethod("dlm", "doublet lattice (Albano & Rodden), subsonic", SUBSONIC, "the DLM",
+                      "; use method='supersonic' or 'piston' above M 1", True, _dlm_matrices,
+                      _dlm_operators, 0.0),
+    "supersonic": AeroMethod("supersonic", "Mach-box lifting-surface method, supersonic",
+                             SUPERSONIC, "method='supersonic'", "; use method='dlm' below M 1",
+                             True, _supersonic_matrices, _matrix_operators(_supersonic_matrices),
+                             0.1),
+    "piston": AeroMethod("piston", "piston theory (Lighthill; Ashley & Zartarian), supersonic",
+                         SUPERSONIC, "method='piston'", "; use method='dlm' below M 1", True,
+                         _piston_matrices, _matrix_operators(_piston_matrices), 0.0),
+}
+#: The method names (the registry's keys).
+METHODS = tuple(AERO_METHODS)
+
+
+def check_method(method: str, name: str = "method") -> str:
+    """Validate a method name (a key of :data:`AERO_METHODS` or a DLM kernel name); ValueError
+    listing the known ones otherwise."""
     if method not in METHODS + DLM_KERNELS:
-        raise ValueError(f"method must be one of {list(METHODS + DLM_KERNELS)}, got {method!r}")
+        raise ValueError(f"{name} must be one of {list(METHODS + DLM_KERNELS)}, got {method!r}")
     return method
 
 
-def resolve_method(method: str, mach: float) -> str:
+def method_spec(method: str, mach: float | None = None) -> AeroMethod:
+    """The :class:`AeroMethod` of ``method`` (a DLM kernel name is the DLM); for ``auto`` with
+    a ``mach``, the method it resolves to there (:func:`resolve_method`)."""
+    check_method(method)
+    if method == "auto" and mach is not None:
+        return AERO_METHODS[resolve_method(method, mach)]
+    return AERO_METHODS["dlm" if method in DLM_KERNELS else method]
+
+
+def resolve_method(method: str, mach: float, name: str = "mach") -> str:
     """The method used at ``mach``: 'dlm', 'supersonic' or 'piston' (DLM kernel names map to
     'dlm'). ``auto`` raises :class:`TransonicGapError` for DLM_MACH_MAX < M <
-    SUPERSONIC_MACH_MIN; an explicit method outside its Mach range raises ValueError, and one
-    inside the gap warns (:class:`TransonicWarning`)."""
+    SUPERSONIC_MACH_MIN; an explicit method outside its Mach range raises ValueError (naming
+    ``name``, the argument or key path, and the method), and one inside the gap warns
+    (:class:`TransonicWarning`)."""
     check_method(method)
-    m = float(mach)
+    try:
+        m = float(mach)
+    except (TypeError, ValueError):
+        m = math.nan
     if not math.isfinite(m) or m < 0:
-        raise ValueError(f"mach must be a finite Mach number >= 0, got {mach!r}")
+        raise ValueError(f"{name} must be a finite Mach number >= 0, got {mach!r}")
     if method == "auto":
         if m <= DLM_MACH_MAX:
             return "dlm"
         if m >= SUPERSONIC_MACH_MIN:
             return "supersonic"
         raise TransonicGapError(
-            f"mach={m:g} lies in the transonic gap {DLM_MACH_MAX:g} < M < {SUPERSONIC_MACH_MIN:g}: "
+            f"{name}={m:g} lies in the transonic gap {DLM_MACH_MAX:g} < M < "
+            f"{SUPERSONIC_MACH_MIN:g} of method 'auto': "
             "linear potential theory is not trusted there (the linearised equation degenerates "
             "as M -> 1, shocks and their motion carry the unsteady loads, and both the subsonic "
             "and the supersonic kernels diverge); asekit does not extrapolate. Use Mach numbers "
             f"<= {DLM_MACH_MAX:g} or >= {SUPERSONIC_MACH_MIN:g}, or transonic loads from "
             "elsewhere")
-    name = "dlm" if method in DLM_KERNELS else method
-    if name == "dlm" and m >= 1.0:
-        raise ValueError(f"mach must be < 1 for the DLM (subsonic), got {mach!r}; use "
-                         "method='supersonic' or 'piston' above M 1")
-    if name in ("supersonic", "piston") and m <= 1.0:
-        raise ValueError(f"mach must be > 1 for method={name!r} (supersonic), got {mach!r}; use "
-                         "method='dlm' below M 1")
+    spec = AERO_METHODS["dlm" if method in DLM_KERNELS else method]
+    _check_mach_range(mach, spec.mach_range, spec.who, name, spec.hint)
     if DLM_MACH_MAX < m < SUPERSONIC_MACH_MIN:
-        warnings.warn(f"method={name!r} at mach={m:g}, inside the transonic gap "
+        warnings.warn(f"method={spec.name!r} at mach={m:g}, inside the transonic gap "
                       f"({DLM_MACH_MAX:g}, {SUPERSONIC_MACH_MIN:g}) where linear theory is not "
                       "trusted: shocks and their motion, not modelled, carry the unsteady loads "
                       "there, and linear theory usually overpredicts the flutter speed (the "
                       "transonic dip); treat the result as doubtful", TransonicWarning,
                       stacklevel=2)
-    return name
+    return spec.name
+
+
+def check_mach(mach: float, method: str = "dlm", name: str = "mach") -> float:
+    """``float(mach)`` if ``method`` can be used at ``mach`` (:func:`resolve_method`: the
+    method's Mach range, the transonic gap of ``auto``), else ValueError naming ``name`` (an
+    argument or a case-file key path), the method and its range.
+
+    Examples
+    --------
+    >>> check_mach(0.6)
+    0.6
+    >>> check_mach(1.2, "dlm", "aero.machs[0]")
+    Traceback (most recent call last):
+    ...
+    ValueError: aero.machs[0] must be < 1 for the DLM (subsonic: 0 <= M < 1), got 1.2; use \
+method='supersonic' or 'piston' above M 1
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TransonicWarning)
+        resolve_method(method, mach, name)
+    return float(mach)
 
 
 def pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, method: str = "auto",
                       symmetric: bool = False, dlm_kernel: str = "quartic",
                       **options) -> np.ndarray:
     """Pressure-per-normalwash matrices A (n_k, n, n) complex, DeltaCp = A (w/U), of the method
-    chosen by :func:`resolve_method` (for the DLM, A = D^-1, its AIC, formed explicitly: to
-    apply it to a few normalwash columns, :func:`pressures` is cheaper). ``options`` go to the
-    supersonic (``cells_per_box``, ...) or piston (``order``, ``thickness_slope``, ...)
-    function; ``symmetric`` is not available for piston theory (a local law: it has no images).
+    chosen by :func:`resolve_method` (its :data:`AERO_METHODS` builder; for the DLM, A = D^-1,
+    its AIC, formed explicitly: to apply it to a few normalwash columns, :func:`pressures` is
+    cheaper). ``options`` go to the supersonic (``cells_per_box``, ...) or piston (``order``,
+    ``thickness_slope``, ...) function; ``symmetric`` is not available for piston theory (a
+    local law: it has no images).
     """
-    name = resolve_method(method, mach)
-    if name == "dlm":
-        from asekit.aero.dlm import normalwash_matrices
-        kernel = method if method in DLM_KERNELS else dlm_kernel
-        d = normalwash_matrices(mesh, mach, k, b_ref, kernel, symmetric)
-        return np.linalg.solve(d, np.broadcast_to(np.eye(mesh.n), d.shape))
-    if name == "supersonic":
-        from asekit.aero.supersonic import supersonic_pressure_matrices
-        return supersonic_pressure_matrices(mesh, mach, k, b_ref, symmetric, **options)
-    from asekit.aero.piston import piston_pressure_matrices
-    return piston_pressure_matrices(mesh, mach, k, b_ref, **options)
+    spec = AERO_METHODS[resolve_method(method, mach)]
+    kernel = method if method in DLM_KERNELS else dlm_kernel
+    return spec.pressure_matrices(mesh, mach, k, b_ref, symmetric, kernel, **options)
 
 
 def pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash, method: str = "auto",
@@ -118,15 +264,13 @@ def pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash, method: s
     inverse (:class:`asekit.aero.dlm.AicFactor`, one LU per k, streamed)."""
     name = resolve_method(method, mach)
     if name == "supersonic":
-        from asekit.aero.supersonic import supersonic_pressures
         return supersonic_pressures(mesh, mach, k, b_ref, normalwash, symmetric, **options)
-    ks = np.atleast_1d(np.asarray(k, float))
+    ks = check_k(k)
 
     def wash(ik, kk):
         return np.asarray(normalwash(float(kk)) if callable(normalwash) else normalwash[ik])
 
     if name == "dlm":               # factor and solve per k, streamed (no explicit inverse)
-        from asekit.aero.dlm import factor_normalwash_matrix, map_normalwash_matrices
         kernel = method if method in DLM_KERNELS else dlm_kernel
         return np.stack(map_normalwash_matrices(
             mesh, mach, ks, b_ref,

@@ -51,6 +51,7 @@ import warnings
 import numpy as np
 
 from asekit.aero.boxes import BoxMesh
+from asekit.aero.validity import SUPERSONIC, check_k, check_mach
 
 #: Validity bound ([AZ56] Section II, asekit's choice of ">>"): M >= 2 or M k >= 2.
 PISTON_MACH_MIN = 2.0
@@ -62,18 +63,9 @@ class PistonValidityWarning(UserWarning):
 
 
 def check_supersonic_mach(mach: float, name: str = "mach") -> float:
-    """Finite Mach number > 1 (raises ValueError naming ``name`` otherwise)."""
-    m = float(mach)
-    if not math.isfinite(m) or m <= 1.0:
-        raise ValueError(f"{name} must be a finite supersonic Mach number > 1, got {mach!r}")
-    return m
-
-
-def _check_k(k) -> np.ndarray:
-    ks = np.atleast_1d(np.asarray(k, float))
-    if ks.ndim != 1 or ks.size == 0 or not np.all(np.isfinite(ks)) or np.any(ks < 0):
-        raise ValueError(f"k must be finite reduced frequencies >= 0, got {k!r}")
-    return ks
+    """Finite Mach number > 1 (:data:`asekit.aero.validity.SUPERSONIC`; raises ValueError
+    naming ``name`` otherwise)."""
+    return check_mach(mach, SUPERSONIC, "the supersonic methods", name)
 
 
 def piston_validity(mach: float, k: float, tau_max: float = 0.0, order: int = 1) -> bool:
@@ -178,7 +170,7 @@ def piston_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float, order:
     warn : :class:`PistonValidityWarning` naming M and k outside the bound.
     """
     m = check_supersonic_mach(mach)
-    ks = _check_k(k)
+    ks = check_k(k)
     if not (math.isfinite(float(b_ref)) and float(b_ref) > 0):
         raise ValueError(f"b_ref must be a finite reference semi-chord > 0 m, got {b_ref!r}")
     tau = _thickness(mesh, thickness_slope)

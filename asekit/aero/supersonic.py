@@ -98,7 +98,8 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from asekit.aero.boxes import BoxMesh, MeshRuleWarning
-from asekit.aero.piston import _check_k, check_supersonic_mach, piston_transfer, strip_interpolation
+from asekit.aero.piston import check_supersonic_mach, piston_transfer, strip_interpolation
+from asekit.aero.validity import check_k
 
 _GAUSS_PHI = np.polynomial.legendre.leggauss(12)
 _GAUSS_F = np.polynomial.legendre.leggauss(32)
@@ -681,7 +682,7 @@ def _transfer(mesh: BoxMesh, grid: MachGrid):
 def _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box, cells_per_wavelength, max_cells,
              bpw_min, warn):
     m = check_supersonic_mach(mach)
-    ks = _check_k(k)
+    ks = check_k(k)
     b = float(b_ref)
     if not (math.isfinite(b) and b > 0):
         raise ValueError(f"b_ref must be a finite reference semi-chord > 0 m, got {b_ref!r}")

@@ -27,6 +27,8 @@ import numpy as np
 from asekit.util.validate import positive
 from asekit.aero.boxes import BoxMesh, check_matrix_memory
 from asekit.aero.kernels import check_kernel
+from asekit.aero.validity import SUBSONIC
+from asekit.aero.validity import check_mach as _check_mach
 
 #: Upper bound (bytes) for the temporaries of one row chunk (VLM and DLM).
 CHUNK_BYTES = 256 * 2**20
@@ -35,11 +37,9 @@ VLM_PAIRS_PER_CHUNK = 32768
 
 
 def check_mach(mach: float) -> float:
-    """Validate a subsonic Mach number: finite and 0 <= M < 1 (raises ValueError)."""
-    m = float(mach)
-    if not math.isfinite(m) or m < 0.0 or m >= 1.0:
-        raise ValueError(f"mach must be a finite number with 0 <= mach < 1 (subsonic), got {mach!r}")
-    return m
+    """Validate a subsonic Mach number, 0 <= M < 1 (:data:`asekit.aero.validity.SUBSONIC`;
+    raises ValueError)."""
+    return _check_mach(mach, SUBSONIC, "the vortex and doublet lattices")
 
 
 def _senders(mesh: BoxMesh, symmetric: bool):

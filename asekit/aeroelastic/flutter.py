@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import linalg, optimize
 
+from asekit.aero.gaf import TabulatedGaf
 from asekit.aeroelastic.statespace import ModalArrays, aeroelastic_matrices, modal_arrays
 from asekit.util.conventions import damping_ratio, mode_label, vg_damping
 from asekit.util.blas import small_dense
@@ -89,58 +90,6 @@ def _count(name: str, value, low: int = 1) -> int:
     if value < low:
         raise ValueError(f"{name} must be an integer >= {low}, got {value}")
     return int(value)
-
-
-# --------------------------------------------------------------------------------------------
-# tabulated GAFs
-# --------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class TabulatedGaf:
-    """Complex GAFs Q (n_k, n, n) at reduced frequencies k (ascending, >= 0) of one Mach,
-    per unit dynamic pressure (F = q Q zeta), reference semi-chord ``b_ref``."""
-
-    k: np.ndarray
-    Q: np.ndarray
-    b_ref: float
-    mach: float | None = None
-
-    def __post_init__(self):
-        k = np.asarray(self.k, dtype=float)
-        Q = np.asarray(self.Q, dtype=complex)
-        if k.ndim != 1 or Q.shape[0] != k.size or Q.ndim != 3 or Q.shape[1] != Q.shape[2]:
-            raise ValueError(f"Q must be (n_k, n, n) with n_k = len(k); got k {k.shape}, "
-                             f"Q {Q.shape}")
-        if k.size < 2 or np.any(np.diff(k) <= 0) or k[0] < 0:
-            raise ValueError(f"k must hold >= 2 ascending values >= 0, got {k}")
-        if not (np.isfinite(self.b_ref) and self.b_ref > 0):
-            raise ValueError(f"b_ref must be > 0, got {self.b_ref}")
-        object.__setattr__(self, "k", k)
-        object.__setattr__(self, "Q", Q)
-
-    def parts(self, k: float, method: str = "linear") -> tuple[np.ndarray, np.ndarray]:
-        """(Q^R(k), Q^I(k)/k): real part and imaginary part divided by k, interpolated in k.
-
-        Linear interpolation (Nastran's IMETH=L) or ``method="cubic"`` (not-a-knot spline).
-        Outside the table: Q^R and Q^I/k are held at the end values (k below the first point
-        uses Q^I(k_1)/k_1, the finite k -> 0 limit of a smooth Q^I).
-        """
-        kk = self.k
-        qi_over_k = self.Q.imag / np.where(kk > 0, kk, 1.0)[:, None, None]
-        if kk[0] == 0:
-            qi_over_k[0] = qi_over_k[1]
-        kq = float(np.clip(k, kk[0], kk[-1]))
-        if method == "linear":
-            j = int(np.clip(np.searchsorted(kk, kq) - 1, 0, kk.size - 2))
-            t = (kq - kk[j]) / (kk[j + 1] - kk[j])
-            qr = (1 - t) * self.Q.real[j] + t * self.Q.real[j + 1]
-            qik = (1 - t) * qi_over_k[j] + t * qi_over_k[j + 1]
-        elif method == "cubic":
-            from scipy.interpolate import CubicSpline
-            qr = CubicSpline(kk, self.Q.real, axis=0)(kq)
-            qik = CubicSpline(kk, qi_over_k, axis=0)(kq)
-        else:
-            raise ValueError(f"method must be 'linear' or 'cubic', got {method!r}")
-        return qr, qik
 
 
 def _mac(a: np.ndarray, B: np.ndarray) -> np.ndarray:

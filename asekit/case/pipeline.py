@@ -21,11 +21,10 @@ from asekit.aero.boxes import TrapezoidSurface, check_matrix_memory, mesh_surfac
 from asekit.aero.gaf import GafDatabase, cached_gaf_database, default_reduced_frequencies
 from asekit.util.conventions import mode_label
 from asekit.atmosphere import standard_atmosphere
-from asekit.aeroelastic.flutter import (Instability, PkResult, TabulatedGaf, divergence_speeds,
+from asekit.aeroelastic.flutter import (Instability, PkResult, divergence_speeds,
                                         first_of)
 from asekit.aeroelastic.methods import flutter_method
 from asekit.rfa.methods import rfa_kind
-from asekit.rfa.roger import gaf_at_mach
 from asekit.structure.assembly import (SupportedSystem, assemble, plate_pitch_inertia,
                                        point_mass_matrix)
 from asekit.structure.mesh import PlateMesh, panels_mesh
@@ -315,14 +314,6 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True,
                                metadata={"case": case.name})
 
 
-def gaf_at(db: GafDatabase, mach: float) -> TabulatedGaf:
-    """The database's GAFs at one of its Mach numbers."""
-    i = int(np.argmin(np.abs(db.machs - mach)))
-    if not math.isclose(db.machs[i], mach, abs_tol=1e-9):
-        raise ValueError(f"mach {mach} is not in the database {db.machs.tolist()}")
-    return TabulatedGaf(db.k, db.Q[i], db.b_ref, mach=float(mach))
-
-
 # ---------------------------------------------------------------------------------------------
 # flutter
 # ---------------------------------------------------------------------------------------------
@@ -392,7 +383,8 @@ def rfa_at(case: Case, db: GafDatabase, mach: float):
     """The case's rational function approximation (``flutter.rfa`` with ``flutter.lags`` lag
     roots, :data:`asekit.rfa.methods.RFA_FITS`) of the GAFs at ``mach`` (interpolated linearly
     between the database's Mach numbers)."""
-    k, q = gaf_at_mach(db, mach, interpolate=True)
+    g = db.at(mach, interpolate=True)
+    k, q = g.k, g.Q
     return rfa_kind(case.flutter.rfa).fit(k, q, db.b_ref, mach, case.flutter.lags)
 
 
@@ -401,7 +393,7 @@ def analyse_condition(case: Case, db: GafDatabase, mach: float, cond: FlightCond
     """The case's flutter method (``flutter.method``, :data:`FLUTTER_METHODS`) at one Mach and
     flight condition: the tracked roots over ``flight.velocities`` and their instabilities."""
     model = modal_model(case) if model is None else model
-    gaf = gaf_at(db, mach)
+    gaf = db.at(mach)
     U = np.asarray(case.flight.velocities, float)
     method = flutter_method(case.flutter.method)
     rfa = rfa_at(case, db, mach) if method.needs_rfa else None
@@ -438,7 +430,7 @@ def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -
     results = [analyse_condition(case, db, m, c, model) for m in case.aero.machs for c in conds]
     div = []
     for m in case.aero.machs:
-        Q0 = gaf_at(db, m).Q[0].real
+        Q0 = db.at(m).Q[0].real
         for c in conds:
             sp = divergence_speeds(model, Q0, c.density)
             div.append({"mach": float(m), "altitude_m": c.altitude, "density": c.density,
@@ -623,7 +615,8 @@ def ase_condition(case: Case, mach: float | None = None, altitude: float | None 
     if not lo <= mach <= hi:
         raise ValueError(f"mach must lie within the GAF database's range [{lo}, {hi}], "
                          f"got {mach}")
-    k, q = gaf_at_mach(db, mach, interpolate=True)
+    g = db.at(mach, interpolate=True)
+    k, q = g.k, g.Q
     lags = case.flutter.lags if n_lags is None else n_lags
     rfa = (rfa_kind(case.flutter.rfa).fit(k, q, db.b_ref, mach, lags) if fit is None
            else fit(k, q, db.b_ref, mach))

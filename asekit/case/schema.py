@@ -18,6 +18,7 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
+from asekit.aero.methods import METHODS, resolve_method
 from asekit.aeroelastic.methods import FLUTTER_METHODS
 from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
 from asekit.rfa.methods import RFA_FITS
@@ -116,7 +117,9 @@ class AeroSpec:
     u_min (m/s) for the automatic k and the mesh rules (15 boxes per wavelength, 4 boxes per
     chord, aspect ratio < 3); boxes : per panel (n_chord, n_span), or None for automatic from
     the mesh rules; kernel "quartic" | "parabolic"; symmetry "none" | "wall" (a reflection plane
-    at the root); method "dlm" (doublet lattice, M < 1).
+    at the root); method: a key of :data:`asekit.aero.methods.AERO_METHODS` ("dlm" doublet
+    lattice M < 1, "supersonic" Mach boxes M > 1, "piston" M > 1, "auto" by Mach), each Mach of
+    ``machs`` inside its range.
     """
 
     machs: tuple[float, ...]
@@ -260,14 +263,16 @@ class Case:
 # ---------------------------------------------------------------------------------------------
 class _Table:
     """A TOML table being read: typed getters that name the key path, then :meth:`done` refuses
-    the keys nobody asked for."""
+    the keys nobody asked for. ``error`` is the exception class raised (:class:`CaseError` for
+    case files; the sweep file passes its :class:`asekit.sweep.SweepError`)."""
 
-    def __init__(self, data, path: str):
+    def __init__(self, data, path: str, error: type[ValueError] = CaseError):
         if not isinstance(data, dict):
-            raise CaseError(f"{path} must be a table, got {type(data).__name__}")
+            raise error(f"{path or 'the file'} must be a table, got {type(data).__name__}")
         self.d = data
         self.path = path
         self.used = set()
+        self.error = error
 
     def key(self, k):
         return f"{self.path}.{k}" if self.path else k
@@ -279,7 +284,7 @@ class _Table:
         self.used.add(k)
         if k not in self.d:
             if required:
-                raise CaseError(f"{self.key(k)} is missing")
+                raise self.error(f"{self.key(k)} is missing")
             return default
         return self.d[k]
 
@@ -288,16 +293,16 @@ class _Table:
         v = self.raw(k, default, required)
         if v is None:
             return None
-        return _number(self.key(k), v, low, high, low_open, high_open, unit)
+        return _number(self.key(k), v, low, high, low_open, high_open, unit, self.error)
 
     def integer(self, k, default=None, required=False, low=1, high=100000):
         v = self.raw(k, default, required)
         if v is None:
             return None
         if isinstance(v, bool) or not isinstance(v, int):
-            raise CaseError(f"{self.key(k)} must be an integer in [{low}, {high}], got {v!r}")
+            raise self.error(f"{self.key(k)} must be an integer in [{low}, {high}], got {v!r}")
         if not low <= v <= high:
-            raise CaseError(f"{self.key(k)} must be an integer in [{low}, {high}], got {v}")
+            raise self.error(f"{self.key(k)} must be an integer in [{low}, {high}], got {v}")
         return v
 
     def string(self, k, choices, default=None, required=False):
@@ -305,20 +310,20 @@ class _Table:
         if v is None:
             return None
         if v not in choices:
-            raise CaseError(f"{self.key(k)} must be one of {', '.join(map(repr, choices))}, "
-                            f"got {v!r}")
+            raise self.error(f"{self.key(k)} must be one of {', '.join(map(repr, choices))}, "
+                             f"got {v!r}")
         return v
 
     def text(self, k, default=""):
         v = self.raw(k, default)
         if not isinstance(v, str):
-            raise CaseError(f"{self.key(k)} must be a string, got {v!r}")
+            raise self.error(f"{self.key(k)} must be a string, got {v!r}")
         return v
 
     def boolean(self, k, default):
         v = self.raw(k, default)
         if not isinstance(v, bool):
-            raise CaseError(f"{self.key(k)} must be true or false, got {v!r}")
+            raise self.error(f"{self.key(k)} must be true or false, got {v!r}")
         return v
 
     def numbers(self, k, default=None, required=False, length=None, min_length=1, low=None,
@@ -329,37 +334,38 @@ class _Table:
         if isinstance(v, (int, float)) and not isinstance(v, bool) and length is None:
             v = [v]
         if not isinstance(v, (list, tuple)):
-            raise CaseError(f"{self.key(k)} must be a list of numbers, got {v!r}")
+            raise self.error(f"{self.key(k)} must be a list of numbers, got {v!r}")
         if length is not None and len(v) != length:
-            raise CaseError(f"{self.key(k)} must hold {length} numbers, got {len(v)}")
+            raise self.error(f"{self.key(k)} must hold {length} numbers, got {len(v)}")
         if len(v) < min_length:
-            raise CaseError(f"{self.key(k)} must hold at least {min_length} number(s), got {len(v)}")
-        out = tuple(_number(f"{self.key(k)}[{i}]", x, low, high, low_open, high_open, unit)
-                    for i, x in enumerate(v))
+            raise self.error(f"{self.key(k)} must hold at least {min_length} number(s), "
+                             f"got {len(v)}")
+        out = tuple(_number(f"{self.key(k)}[{i}]", x, low, high, low_open, high_open, unit,
+                            self.error) for i, x in enumerate(v))
         if ascending and any(b <= a for a, b in zip(out, out[1:])):
-            raise CaseError(f"{self.key(k)} must be strictly ascending, got {list(out)}")
+            raise self.error(f"{self.key(k)} must be strictly ascending, got {list(out)}")
         return out
 
     def table(self, k, required=False):
         v = self.raw(k, None, required)
-        return None if v is None else _Table(v, self.key(k))
+        return None if v is None else _Table(v, self.key(k), self.error)
 
     def done(self):
         extra = sorted(set(self.d) - self.used)
         if extra:
-            raise CaseError(f"{self.key(extra[0])} is not a known key"
-                            + (f" (also {', '.join(extra[1:])})" if len(extra) > 1 else ""))
+            raise self.error(f"{self.key(extra[0])} is not a known key"
+                             + (f" (also {', '.join(extra[1:])})" if len(extra) > 1 else ""))
 
 
-def _number(path, v, low, high, low_open, high_open, unit):
+def _number(path, v, low, high, low_open, high_open, unit, error=CaseError):
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise CaseError(f"{path} must be a finite number{_range(low, high, low_open, high_open, unit)}"
-                        f", got {v!r}")
+        raise error(f"{path} must be a finite number{_range(low, high, low_open, high_open, unit)}"
+                    f", got {v!r}")
     u = f" {unit}" if unit else ""
     if low is not None and (v <= low if low_open else v < low):
-        raise CaseError(f"{path} must be {'>' if low_open else '>='} {low:g}{u}, got {v:g}")
+        raise error(f"{path} must be {'>' if low_open else '>='} {low:g}{u}, got {v:g}")
     if high is not None and (v >= high if high_open else v > high):
-        raise CaseError(f"{path} must be {'<' if high_open else '<='} {high:g}{u}, got {v:g}")
+        raise error(f"{path} must be {'<' if high_open else '<='} {high:g}{u}, got {v:g}")
     return float(v)
 
 
@@ -503,11 +509,9 @@ def _modes(t: _Table | None, support: SupportSpec) -> ModesSpec:
 
 
 def _aero(t: _Table, panels) -> AeroSpec:
-    method = t.string("method", ("dlm", "auto", "supersonic", "piston"), default="dlm")
-    machs = t.numbers("machs", required=True, low=0.0, low_open=False,
-                      high=1.0 if method == "dlm" else 10.0, high_open=True, ascending=True)
-    from asekit.aero.methods import resolve_method
-    for i, m in enumerate(machs):
+    method = t.string("method", METHODS, default="dlm")     # the registry (aero.methods)
+    machs = t.numbers("machs", required=True, low=0.0, low_open=False, ascending=True)
+    for i, m in enumerate(machs):       # the method's Mach range, from the registry
         try:
             resolve_method(method, m)
         except ValueError as exc:
@@ -597,8 +601,8 @@ def _actuator(t: _Table | None) -> ActuatorSpec | None:
         ctl.done()
     cond = t.table("condition")
     if cond is not None:
-        vals["mach"] = cond.number("mach", default=0.5, low=0.0, low_open=False, high=1.0,
-                                   high_open=True)
+        # its range: within aero.machs (checked by case_from_dict), so within aero.method's
+        vals["mach"] = cond.number("mach", default=0.5, low=0.0, low_open=False)
         vals["altitude"] = cond.number("altitude", default=0.0, low=-1000.0, low_open=False,
                                        high=80000.0, unit="m")
         cond.done()

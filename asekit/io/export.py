@@ -123,10 +123,7 @@ def write_modal_op4(path, model, digits: int = 9) -> Path:
 def write_gaf_op4(path, db, mach: float, digits: int = 9) -> Path:
     """One Mach of a :class:`~asekit.aero.gaf.GafDatabase` as OP4: QHHL (n x n n_k complex,
     the Q(k) blocks side by side, per unit dynamic pressure) and KLIST (1 x n_k)."""
-    i = int(np.argmin(np.abs(np.asarray(db.machs) - mach)))
-    if abs(db.machs[i] - mach) > 1e-9:
-        raise ValueError(f"mach {mach} is not in the database {list(db.machs)}")
-    Q = np.asarray(db.Q[i])
+    Q = db.at(mach).Q
     qhhl = np.concatenate(list(Q), axis=1)
     return write_op4(path, {"QHHL": qhhl, "KLIST": np.asarray(db.k, float)[None, :]},
                      digits=digits)
@@ -147,7 +144,7 @@ def case_state_spaces(case, mach: float | None = None, altitude: float | None = 
     from asekit.aeroelastic.statespace import aeroelastic_model, fin_outputs
     from asekit.atmosphere import standard_atmosphere
     from asekit.case import pipeline as pl
-    from asekit.rfa import gaf_at_mach, roger_fit
+    from asekit.rfa import roger_fit
     a = case.actuator
     mach = (a.mach if a is not None else case.aero.machs[0]) if mach is None else mach
     if altitude is None:
@@ -157,8 +154,8 @@ def case_state_spaces(case, mach: float | None = None, altitude: float | None = 
     U = mach * float(atm.speed_of_sound) if velocity is None else float(velocity)
     model = pl.modal_model(case)
     db = pl.gaf_database(case, progress=False)
-    k, q = gaf_at_mach(db, mach, interpolate=True)
-    rfa = roger_fit(k, q, db.b_ref, n_lags=n_lags, mach=mach)
+    g = db.at(mach, interpolate=True)
+    rfa = roger_fit(g.k, g.Q, db.b_ref, n_lags=n_lags, mach=mach)
     corners = pl.corner_points(case)
     shaft = case.support.axis_point if case.support.kind == "shaft" else None
     rows = fin_outputs(model, np.array(list(corners.values())), names=list(corners),

@@ -389,10 +389,11 @@ def rfa_state_study(data=None, mach: float = 0.75, roger_lags=range(0, 8),
                     ms_states=(1, 2, 4, 6, 8, 10, 12, 16), max_iter: int = 2000) -> dict:
     """Fit error against the number of aerodynamic lag states: Roger (N lags -> N n states)
     and minimum-state (n_L states), unweighted, at ``mach``."""
-    from asekit.rfa import gaf_at_mach, minimum_state_fit, roger_fit
+    from asekit.rfa import minimum_state_fit, roger_fit
 
     db, _ = load() if data is None else data
-    k, Q = gaf_at_mach(db, mach)
+    g = db.at(mach)
+    k, Q = g.k, g.Q
     n = Q.shape[1]
     rg = [(N * n, roger_fit(k, Q, db.b_ref, n_lags=N).fit_error) for N in roger_lags]
     ms = [(s, minimum_state_fit(k, Q, db.b_ref, n_states=s, max_iter=max_iter).fit_error)
@@ -410,14 +411,13 @@ def states_for_error(table: np.ndarray, target: float = 0.01):
 def elastic_problem(data, mach):
     """The clamped (rigid mode held) flutter problem: (ModalArrays, k, Q_ss, b_ref)."""
     from asekit.aeroelastic.statespace import modal_arrays
-    from asekit.rfa import gaf_at_mach
 
     db, modal = data
     m = modal_arrays(modal)
     s = slice(m.n_rigid, m.n_modes)
     me = modal_arrays(M=m.M[s, s], K=m.K[s, s], C=m.C[s, s], n_rigid=0)
-    k, Q = gaf_at_mach(db, mach)
-    return me, k, Q[:, s, s], db.b_ref
+    g = db.at(mach)
+    return me, g.k, g.Q[:, s, s], db.b_ref
 
 
 def flutter_comparison(data=None, mach: float = 0.75, altitude: float = 0.0,

@@ -40,13 +40,6 @@ def load_fin_gafs():
     return (db, modal), ""
 
 
-def fin_gaf(db, mach: float) -> TabulatedGaf:
-    """The database's GAFs at one Mach as a :class:`TabulatedGaf` (exact Mach required)."""
-    from asekit.rfa import gaf_at_mach
-    k, q = gaf_at_mach(db, mach)
-    return TabulatedGaf(k, q, db.b_ref, mach=mach)
-
-
 def fin_rfa(db, mach: float, n_lags: int = N_LAGS, constrain_k0: bool = False, lag_roots=None):
     """Roger fit of the fin's GAFs at ``mach`` (default lag roots over the database's k)."""
     from asekit.rfa import roger_fit_database
@@ -58,7 +51,7 @@ def analyse_condition(modal, db, mach: float, altitude: float, velocities=VELOCI
                       density: float | None = None) -> dict:
     """p-k at one (Mach, altitude): result, instabilities, first flutter and first of any kind."""
     rho = float(standard_atmosphere(altitude).density) if density is None else density
-    gaf = fin_gaf(db, mach)
+    gaf = db.at(mach)
     res = pk_flutter(modal, gaf, rho, velocities)
     inst = pk_instabilities(res, modal, gaf)
     return {"density": rho, "gaf": gaf, "pk": res, "instabilities": inst,
@@ -621,7 +614,7 @@ def sensitivity_study(modal, db, mach: float = 0.75, altitude: float = 0.0,
     leaves open or states differently. Returns rows {label, speed, freq, first, first_kind}."""
     from asekit.aeroelastic.statespace import modal_arrays
     rho0 = float(standard_atmosphere(altitude).density)
-    gaf = fin_gaf(db, mach)
+    gaf = db.at(mach)
     base = modal_arrays(modal)
     J = float(base.M[0, 0]) if base.n_rigid else None
     variants = [
@@ -638,7 +631,7 @@ def sensitivity_study(modal, db, mach: float = 0.75, altitude: float = 0.0,
     ]
     other = [mm for mm in np.asarray(db.machs, float) if abs(mm - mach) > 1e-9]
     for mm in other:
-        variants.append((f"GAFs at Mach {mm:g}", base, fin_gaf(db, float(mm)), rho0, {}))
+        variants.append((f"GAFs at Mach {mm:g}", base, db.at(float(mm)), rho0, {}))
     rows = []
     for label, mod, g, rho, kw in variants:
         if mod is None:      # truncated modal basis
@@ -802,7 +795,7 @@ def damping_study(modal, db, mach: float = 0.75, altitude: float = 0.0,
     until it changes by < 0.1 % (at most 6 passes; starts from the undamped flutter frequency).
     """
     rho = float(standard_atmosphere(altitude).density)
-    gaf = fin_gaf(db, mach)
+    gaf = db.at(mach)
 
     def flutter(mod):
         res = pk_flutter(mod, gaf, rho, velocities)

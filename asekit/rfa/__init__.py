@@ -14,9 +14,8 @@ either.
 
 from asekit.rfa.minimum_state import (MinimumStateFit, default_ms_roots, minimum_state_fit,
                                       minimum_state_fit_database, reduced_frequency_weights)
-from asekit.rfa.roger import (RogerFit, default_lag_roots, design_rows, gaf_at_mach, roger_fit,
-                              roger_fit_database)
+from asekit.rfa.roger import RogerFit, default_lag_roots, design_rows, roger_fit, roger_fit_database
 
 __all__ = ["RogerFit", "MinimumStateFit", "default_lag_roots", "default_ms_roots",
-           "design_rows", "gaf_at_mach", "roger_fit", "roger_fit_database",
+           "design_rows", "roger_fit", "roger_fit_database",
            "minimum_state_fit", "minimum_state_fit_database", "reduced_frequency_weights"]

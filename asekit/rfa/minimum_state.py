@@ -51,7 +51,7 @@ import numpy as np
 
 from asekit.util.blas import small_dense
 from asekit.util.validate import positive
-from asekit.rfa.roger import check_gaf_table, default_lag_roots, fit_errors, gaf_at_mach
+from asekit.rfa.roger import check_gaf_table, default_lag_roots, fit_errors
 
 
 def default_ms_roots(k_max: float, n_states: int) -> np.ndarray:
@@ -458,7 +458,7 @@ def minimum_state_fit(k, Q, b_ref: float, n_states: int = 4, lag_roots=None, wei
 
 def minimum_state_fit_database(database, mach: float, interpolate: bool = False,
                                **kwargs) -> MinimumStateFit:
-    """:func:`minimum_state_fit` of a GafDatabase-like object at one Mach (see
-    :func:`asekit.rfa.gaf_at_mach`); ``kwargs`` go to :func:`minimum_state_fit`."""
-    k, q = gaf_at_mach(database, mach, interpolate=interpolate)
-    return minimum_state_fit(k, q, database.b_ref, mach=mach, **kwargs)
+    """:func:`minimum_state_fit` of a :class:`~asekit.aero.gaf.GafDatabase` at one Mach (see
+    :meth:`~asekit.aero.gaf.GafDatabase.at`); ``kwargs`` go to :func:`minimum_state_fit`."""
+    g = database.at(mach, interpolate=interpolate)
+    return minimum_state_fit(g.k, g.Q, database.b_ref, mach=mach, **kwargs)

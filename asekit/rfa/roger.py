@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from asekit.util.blas import small_dense
-from asekit.util.validate import in_range, positive
+from asekit.util.validate import positive
 
 
 def default_lag_roots(k_max: float, n_lags: int = 4) -> np.ndarray:
@@ -238,32 +238,8 @@ def roger_fit(k, Q, b_ref: float, lag_roots=None, n_lags: int = 4, weights=None,
                     mach=mach, weights=w)
 
 
-def gaf_at_mach(database, mach: float, interpolate: bool = False, atol: float = 1e-9):
-    """(k, Q (n_k, n, n)) of a GAF database (fields ``machs``, ``k``, ``Q`` (n_mach, n_k, n, n))
-    at ``mach``. An exact Mach of the database is required unless ``interpolate`` is True, in
-    which case Q is interpolated linearly between the neighbouring Machs (never extrapolated).
-
-    Raises ValueError naming ``mach`` and the database's range otherwise.
-    """
-    machs, mach = np.asarray(database.machs, dtype=float), in_range("mach", mach, 0.0, True)
-    hit = np.nonzero(np.abs(machs - mach) <= atol)[0]
-    if hit.size:
-        return np.asarray(database.k), np.asarray(database.Q[hit[0]])
-    if not interpolate or mach < machs.min() or mach > machs.max():
-        raise ValueError(f"mach {mach} is not in the GAF database {machs.tolist()}"
-                         + ("" if interpolate else " (pass interpolate=True to interpolate "
-                            "between its Machs)") + f"; valid range [{machs.min()}, {machs.max()}]")
-    order = np.argsort(machs)
-    m_sorted = machs[order]
-    j = int(np.searchsorted(m_sorted, mach))
-    m0, m1 = m_sorted[j - 1], m_sorted[j]
-    t = (mach - m0) / (m1 - m0)
-    q = (1 - t) * database.Q[order[j - 1]] + t * database.Q[order[j]]
-    return np.asarray(database.k), np.asarray(q)
-
-
 def roger_fit_database(database, mach: float, interpolate: bool = False, **kwargs) -> RogerFit:
-    """:func:`roger_fit` of a :class:`GafDatabase`-like object at one Mach (see
-    :func:`gaf_at_mach`); ``kwargs`` go to :func:`roger_fit`."""
-    k, q = gaf_at_mach(database, mach, interpolate=interpolate)
-    return roger_fit(k, q, database.b_ref, mach=mach, **kwargs)
+    """:func:`roger_fit` of a :class:`~asekit.aero.gaf.GafDatabase` at one Mach (see
+    :meth:`~asekit.aero.gaf.GafDatabase.at`); ``kwargs`` go to :func:`roger_fit`."""
+    g = database.at(mach, interpolate=interpolate)
+    return roger_fit(g.k, g.Q, database.b_ref, mach=mach, **kwargs)

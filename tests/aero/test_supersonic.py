@@ -592,3 +592,49 @@ def test_agard445_6_piston_theory_out_of_range():
         res[method] = None if r.flutter is None else r.flutter.speed
     assert res["supersonic"] is not None
     assert res["piston"] is None or res["piston"] > 1.4 * res["supersonic"]
+
+
+def test_aero_method_registry_is_the_one_mach_check():
+    """AERO_METHODS holds every method's Mach range; the kernels' own guards (vlm / dlm,
+    piston / supersonic), the front door (check_mach, resolve_method), the case schema and the
+    GAF builder all give the same range and message; an unknown method lists the known ones."""
+    import math
+
+    from asekit.aero import methods as M
+    from asekit.aero import validity as V
+    from asekit.aero.dlm import check_k as dlm_check_k
+    from asekit.aero.piston import check_supersonic_mach
+    from asekit.aero.vlm import check_mach as vlm_check_mach
+    assert set(M.AERO_METHODS) == {"auto", "dlm", "supersonic", "piston"} == set(M.METHODS)
+    assert M.AERO_METHODS["dlm"].mach_range is V.SUBSONIC
+    assert M.AERO_METHODS["supersonic"].mach_range is M.AERO_METHODS["piston"].mach_range \
+        is V.SUPERSONIC
+    assert all(s.structure_independent for s in M.AERO_METHODS.values())
+    assert V.SUBSONIC.contains(0.0) and not V.SUBSONIC.contains(1.0)
+    assert V.SUPERSONIC.contains(1.0 + 1e-12) and not V.SUPERSONIC.contains(1.0)
+    assert not V.SUPERSONIC.contains(math.nan)
+    for fn, arg in ((vlm_check_mach, 1.0), (lambda m: M.check_mach(m, "dlm"), 1.0)):
+        with pytest.raises(ValueError, match=r"mach must be < 1 for .*\(subsonic: 0 <= M < 1\), "
+                                             r"got 1.0"):
+            fn(arg)
+    with pytest.raises(ValueError, match=r"mach must be >= 0 .*got -0.1"):
+        vlm_check_mach(-0.1)
+    for fn in (check_supersonic_mach, lambda m: M.check_mach(m, "piston")):
+        with pytest.raises(ValueError, match=r"mach must be > 1 for .*\(supersonic: M > 1\)"):
+            fn(0.99)
+    with pytest.raises(ValueError, match=r"aero.machs\[2\] must be > 1 for method='supersonic'"):
+        M.check_mach(0.5, "supersonic", "aero.machs[2]")
+    with pytest.raises(ValueError, match=r"method must be one of \['auto', 'dlm', 'supersonic', "
+                                         r"'piston', 'quartic', 'parabolic'\], got 'mach_box'"):
+        M.check_mach(2.0, "mach_box")
+    assert M.check_mach(1.1, "supersonic") == 1.1           # in the gap: no warning at the door
+    assert M.method_spec("auto", 0.5).name == "dlm" and M.method_spec("quartic").name == "dlm"
+    for bad in (-0.1, math.inf, [[0.1]]):
+        with pytest.raises(ValueError, match="k must be finite reduced frequencies >= 0"):
+            V.check_k(bad)
+    assert dlm_check_k is V.check_k
+    np.testing.assert_array_equal(V.check_k(0.5), [0.5])
+    from asekit.aero.gaf import build_gaf_database
+    mesh = mesh_surfaces([TrapezoidSurface((0, 0, 0), 0.2, (0, 0.2, 0), 0.2, 2, 2)])
+    with pytest.raises(ValueError, match=r"machs\[1\] must be < 1 for the DLM"):
+        build_gaf_database(None, mesh, [0.5, 1.2], [0.0, 0.1], 0.1, 0, progress=False)

@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 
 from asekit.aeroelastic.statespace import modal_arrays
-from asekit.case import pipeline
 from asekit.aeroelastic.flutter import (FlutterConvergenceWarning, PkResult, RootLocusResult, TabulatedGaf,
                             crossing_tolerance, first_of, match_point_table, matched_mach,
                             pk_flutter, pk_instabilities, root_locus, root_locus_instabilities,
@@ -31,7 +30,7 @@ HA145B_FLUTTER_SPEED = 12672.0      # in/s, Nastran HA145B (see module docstring
 def fin(fin_modal, fin_gafs):
     """The fin (tests/conftest.py, via the case pipeline) at M 0.75: modal model, tabulated GAFs
     and their Roger fit with 4 lags."""
-    return (fin_modal, pipeline.gaf_at(fin_gafs, 0.75),
+    return (fin_modal, fin_gafs.at(0.75),
             roger_fit_database(fin_gafs, 0.75, n_lags=4))
 
 

@@ -15,7 +15,7 @@ from asekit.aeroelastic.statespace import fin_outputs
 from asekit.atmosphere import standard_atmosphere
 from asekit.case import load_case, pipeline
 from asekit.util.paths import FIN_FILE
-from asekit.rfa import gaf_at_mach, roger_fit
+from asekit.rfa import roger_fit
 from asekit.servo.actuator import SYSTEM_3
 
 
@@ -25,7 +25,8 @@ def fin_ase_model(mach: float = 0.5, altitude: float = 0.0):
     fin-root pitch and corner outputs."""
     case = load_case(FIN_FILE)
     modal, db = pipeline.modal_model(case), pipeline.gaf_database(case, progress=False)
-    k, q = gaf_at_mach(db, mach, interpolate=True)
+    g = db.at(mach, interpolate=True)
+    k, q = g.k, g.Q
     rfa = roger_fit(k, q, db.b_ref, n_lags=4, mach=mach)
     atm = standard_atmosphere(altitude)
     corners = pipeline.corner_points(case)

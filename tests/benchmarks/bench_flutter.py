@@ -46,8 +46,7 @@ def main():
         from asekit.util.paths import FIN_FILE
         case = load_case(FIN_FILE)
         db, modal = pipeline.gaf_database(case, progress=False), pipeline.modal_model(case)
-        i = int(np.argmin(np.abs(np.asarray(db.machs) - 0.75)))
-        gaf = TabulatedGaf(db.k, db.Q[i], db.b_ref, db.machs[i])
+        gaf = db.at(0.75)
         modal = modal_arrays(modal)
         label = "fin GAF database"
     except Exception as exc:  # noqa: BLE001

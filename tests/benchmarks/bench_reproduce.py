@@ -62,7 +62,7 @@ def main(argv):
     from asekit.reproduction import ase as rep
     from asekit.case import pipeline
     from asekit.reproduction.fin import distributed_case, fin_case
-    from asekit.rfa import gaf_at_mach, minimum_state as ms
+    from asekit.rfa import minimum_state as ms
     from asekit.servo.actuator import SYSTEM_3
     from asekit.servo.simulate import THESIS_LIMITS
     from asekit.structure import modes
@@ -135,7 +135,8 @@ def main(argv):
 
     # 4. the design chapter's minimum-state fit
     db = pipeline.gaf_database(fin_case(), progress=False)
-    k, q = gaf_at_mach(db, 0.6, interpolate=True)
+    g = db.at(0.6, interpolate=True)
+    k, q = g.k, g.Q
     kw = dict(n_states=6, constrain_k0=True, mach=0.6)
     init = ms._Als.__init__
 

@@ -118,7 +118,7 @@ def main(argv=None) -> int:
     t = time.perf_counter()
     fac = S.base_factors(sw)
     t_fac = time.perf_counter() - t
-    print(f"AIC factors (D(M, k) at M {sorted(fac.lu)}, {fac.k.size} k, LU): {t_fac:.2f} s, "
+    print(f"AIC factors (D(M, k) at M {sorted(fac.operators)}, {fac.k.size} k, LU): {t_fac:.2f} s, "
           f"{fac.nbytes / 1e6:.1f} MB")
 
     serial = None

@@ -44,7 +44,7 @@ def test_damped_modal_rejects_bad_input():
 def test_pk_roots_carry_the_modal_damping_at_zero_airspeed():
     db, modal = DATA
     zeta = 0.01
-    res = pk_flutter(rf.damped_modal(modal, zeta=zeta), rf.fin_gaf(db, 0.75), 1.225,
+    res = pk_flutter(rf.damped_modal(modal, zeta=zeta), db.at(0.75), 1.225,
                      [0.5, 1.0])
     # q = 0.15 Pa: the aerodynamic damping is negligible against 1 % structural damping
     assert np.allclose(res.damping_ratio[0], zeta, rtol=0.02)

@@ -8,7 +8,7 @@ import pytest
 from asekit.aeroelastic.statespace import aeroelastic_matrices, modal_arrays
 from asekit.aeroelastic.flutter import (TabulatedGaf, first_of, pk_flutter, pk_instabilities, root_locus,
                             root_locus_instabilities)
-from asekit.rfa import (MinimumStateFit, gaf_at_mach, minimum_state_fit,
+from asekit.rfa import (MinimumStateFit, minimum_state_fit,
                         reduced_frequency_weights, roger_fit)
 
 
@@ -94,7 +94,8 @@ def test_minimum_state_fits_the_fin_at_least_as_well_as_roger_with_as_many_state
     # Roger with N lags carries N n aerodynamic states (n = 6 modes of the fin, rigid pitch
     # first); the minimum-state fit with the same number of shared states fits better
     db, _ = fin
-    k, Q = gaf_at_mach(db, 0.75)
+    g = db.at(0.75)
+    k, Q = g.k, g.Q
     rg = roger_fit(k, Q, db.b_ref, n_lags=n_lags)
     ms = minimum_state_fit(k, Q, db.b_ref, n_states=rg.n_lag_states)
     assert ms.fit_error <= rg.fit_error
@@ -105,7 +106,8 @@ def test_aeroelastic_eigenvalues_solve_the_flutter_determinant(fin):
     # every root of A_sys built from a minimum-state fit solves
     # det(s^2 M_ss + s C_ss + K_ss - q Q~_ss(s)) = 0 (thesis Eq. 2.44 with the rigid mode held)
     db, modal = fin
-    k, Q = gaf_at_mach(db, 0.6)
+    g = db.at(0.6)
+    k, Q = g.k, g.Q
     fit = minimum_state_fit(k, Q, db.b_ref, n_states=5)
     m = modal_arrays(modal)
     rho, U = 1.225, 200.0
@@ -129,7 +131,8 @@ def _elastic(fin, mach):
     m = modal_arrays(modal)
     s = slice(m.n_rigid, m.n_modes)
     me = modal_arrays(M=m.M[s, s], K=m.K[s, s], C=m.C[s, s], n_rigid=0)
-    k, Q = gaf_at_mach(db, mach)
+    g = db.at(mach)
+    k, Q = g.k, g.Q
     return me, k, Q[:, s, s], db.b_ref
 
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from asekit.io.op4 import load_ha145b
-from asekit.rfa import default_lag_roots, gaf_at_mach, roger_fit
+from asekit.rfa import default_lag_roots, roger_fit
 
 
 def _synthetic(n=3, lags=(0.1, 0.5), seed=1, k=None):
@@ -95,14 +95,15 @@ def test_bad_input():
 
 
 def test_mach_selection():
-    class Db:
-        machs = np.array([0.5, 0.75])
-        k = np.array([0.0, 1.0])
-        Q = np.array([np.ones((2, 2, 2)), 3 * np.ones((2, 2, 2))]).astype(complex)
-        b_ref = 0.078
-    with pytest.raises(ValueError, match="mach"):
-        gaf_at_mach(Db, 0.6)
-    with pytest.raises(ValueError, match="mach"):
-        gaf_at_mach(Db, 0.9, interpolate=True)
-    _, q = gaf_at_mach(Db, 0.625, interpolate=True)
-    np.testing.assert_allclose(q, 2.0)
+    from asekit.aero.gaf import GafDatabase
+    db = GafDatabase(np.array([0.5, 0.75]), np.array([0.0, 1.0]),
+                     np.array([np.ones((2, 2, 2)), 3 * np.ones((2, 2, 2))]).astype(complex),
+                     0.078, 0, {})
+    with pytest.raises(ValueError, match="mach 0.6 is not in the GAF database"):
+        db.at(0.6)
+    with pytest.raises(ValueError, match=r"valid range \[0.5, 0.75\]"):
+        db.at(0.9, interpolate=True)
+    g = db.at(0.625, interpolate=True)
+    np.testing.assert_allclose(g.Q, 2.0)
+    assert g.mach == 0.625 and g.b_ref == 0.078
+    np.testing.assert_array_equal(db.at(0.75 + 1e-12).Q, db.Q[1])      # exact within atol
