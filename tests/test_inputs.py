@@ -100,9 +100,6 @@ def test_box_count_and_matrix_memory_bounds():
         steady_pressure("mesh", 0.5, np.zeros(3))
 
 
-@pytest.mark.xfail(strict=True, reason="issue 21: the pipeline's automatic boxes "
-                   "(asekit.case.pipeline._auto_boxes) do not name the knob; the removed "
-                   "asekit.reproduction.fin.fin_surface did (check_matrix_memory)")
 def test_automatic_box_count_refusal_names_the_case_keys():
     # issue 11: a resource bound refused up front names the estimate and the knob to turn
     big = case_from_dict(_fin_dict_with("aero", "f_max", 1e6))

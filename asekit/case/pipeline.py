@@ -271,17 +271,20 @@ def box_mesh(case: Case):
     if case.structure is not None:
         return imported_box_mesh(case)
     a = case.aero
+    counts = [a.boxes[i] if a.boxes is not None else auto_boxes(p.planform, a.u_min, a.f_max)
+              for i, p in enumerate(case.panels)]
+    n_boxes = sum(nc * ns for nc, ns in counts)
+    # refused before any box is made, naming the case keys that set the count
+    check_matrix_memory(n_boxes, 1, 16, f"one DLM matrix of case {case.name!r} ({n_boxes} boxes"
+                        f"{' from the mesh rules' if a.boxes is None else ''})",
+                        "lower aero.f_max, raise aero.u_min or give aero.boxes"
+                        if a.boxes is None else "lower aero.boxes")
     surfaces = []
-    for i, p in enumerate(case.panels):
+    for i, (p, (nc, ns)) in enumerate(zip(case.panels, counts)):
         pf = p.planform
-        nc, ns = a.boxes[i] if a.boxes is not None else auto_boxes(pf, a.u_min, a.f_max)
         surfaces.append(TrapezoidSurface(pf.root_le + (0.0,), pf.root_chord, pf.tip_le + (0.0,),
                                          pf.tip_chord, nc, ns,
                                          name=f"panel{i}" if len(case.panels) > 1 else "surface"))
-    n_boxes = sum(sf.n_chord * sf.n_span for sf in surfaces)
-    check_matrix_memory(n_boxes, 1, 16, f"one DLM matrix of case {case.name!r} ({n_boxes} boxes"
-                        f"{' from the mesh rules' if a.boxes is None else ''})",
-                        "give aero.boxes" if a.boxes is None else "lower aero.boxes")
     return mesh_surfaces(surfaces)
 
 

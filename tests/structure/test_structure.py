@@ -422,22 +422,20 @@ def test_mitc4_passes_the_constant_curvature_patch_test_on_a_distorted_mesh():
     np.testing.assert_allclose(ui, u[idof], rtol=0, atol=1e-10 * np.abs(u).max())
 
 
-@pytest.mark.xfail(strict=True, reason="issue 21: asekit.case.pipeline.modal_model is a bare "
-                   "lru_cache: it hands every caller the same arrays and warns on the first call "
-                   "only (the removed asekit.reproduction.fin.fin_modal_model handed out copies "
-                   "and re-issued the warnings, issue 12)")
-def test_memoised_modal_model_is_a_copy_and_warns_every_time(fin_variant):
-    # issue 12: a modal model is computed once per case in a process; every call must still get
-    # its own arrays (bit-identical to the first) and the warnings of the computation
+def test_memoised_modal_model_is_read_only_and_warns_every_time(fin_variant):
+    # issue 12, kept by issue 21's pipeline: a modal model is computed once per case in a
+    # process; every call gets the same bit-identical arrays, read-only so that a caller's edit
+    # cannot reach the next caller, and the warnings of the computation every time
     case = fin_variant(radius=0.005)                # a 5 mm shaft: "not resolved" on 6 x 7
     for _ in range(2):
         with pytest.warns(UserWarning, match="not resolved"):
             a = pipeline.modal_model(case)
     with pytest.warns(UserWarning, match="not resolved"):
         b = pipeline.modal_model(case)
-    assert a is not b and a.M is not b.M and a.shapes is not b.shapes
     for name in ("frequencies_hz", "M", "K", "C", "shapes", "nodes", "elements"):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
-    a.M[0, 0] = -1.0                       # a caller's edit does not reach the next caller
+        assert not getattr(b, name).flags.writeable, name
+    with pytest.raises(ValueError, match="read-only"):
+        a.M[0, 0] = -1.0
     with pytest.warns(UserWarning, match="not resolved"):
         assert pipeline.modal_model(case).M[0, 0] == b.M[0, 0] > 0
