@@ -65,14 +65,14 @@ import numpy as np
 from asekit.aero.gaf import GafDatabase, gaf_from_box_modes
 from asekit.aero.methods import AERO_METHODS, TransonicWarning, method_spec, resolve_method
 from asekit.aero.spline import fe_spline, modal_forces
+from asekit.aeroelastic.flutter import divergence_speeds
 from asekit.atmosphere import standard_atmosphere
-from asekit.util.blas import one_blas_thread
 from asekit.case import pipeline as P
 from asekit.case.schema import CaseError, _number, _Table, case_from_dict
-from asekit.aeroelastic.flutter import divergence_speeds
+from asekit.util.blas import one_blas_thread
+from asekit.util.conventions import mode_number
 from asekit.util.paths import CASES_DIR
 from asekit.util.validate import read_toml
-from asekit.util.conventions import mode_number
 
 
 class SweepError(ValueError):

@@ -265,8 +265,8 @@ def two_dof_coalescence(c):
     """The hand-derivable 2-dof quasi-steady coalescence model of tests/aeroelastic/test_flutter.py:
     (modal, gaf, fit) with stiffnesses 100^2, 150^2, coupling Q = [[0, 1], [-2, 0]] and modal
     damping c (also used by tests/aeroelastic/test_flutter_onset.py)."""
-    from asekit.aeroelastic.statespace import modal_arrays
     from asekit.aeroelastic.flutter import TabulatedGaf
+    from asekit.aeroelastic.statespace import modal_arrays
     from asekit.rfa import RogerFit
     k1, k2, a, d = TWO_DOF
     Q = np.array([[0.0, a], [d, 0.0]], complex)
@@ -306,8 +306,9 @@ def _unreported(result_sigma, velocities, instabilities):
 
 
 def _pk(c, density, velocities, max_iter, tol):
-    from asekit.aeroelastic.flutter import pk_flutter, pk_instabilities
     import warnings
+
+    from asekit.aeroelastic.flutter import pk_flutter, pk_instabilities
     modal, gaf, _ = two_dof_coalescence(c)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
@@ -383,8 +384,14 @@ SERVO_NAMES = ("resistance", "inductance", "torque_constant", "back_emf_constant
 
 
 def _servo(scale_l, scale_r, ratio, efficiency, gain, kp, kd, supply, current_limit):
-    from asekit.servo.actuator import (ActuatorParameters, DCMotor, PDController, Transmission,
-                              closed_loop_poles, open_loop_poles)
+    from asekit.servo.actuator import (
+        ActuatorParameters,
+        DCMotor,
+        PDController,
+        Transmission,
+        closed_loop_poles,
+        open_loop_poles,
+    )
     from asekit.servo.simulate import PowerLimits
     motor = DCMotor(resistance=5.78 * scale_r, inductance=550e-6 * scale_l)
     p = ActuatorParameters(motor=motor, transmission=Transmission(ratio, efficiency))

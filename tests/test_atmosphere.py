@@ -3,8 +3,14 @@
 import numpy as np
 import pytest
 
-from asekit.atmosphere import (density, equivalent_airspeed, mach_number, speed_of_sound,
-                               standard_atmosphere, true_airspeed)
+from asekit.atmosphere import (
+    density,
+    equivalent_airspeed,
+    mach_number,
+    speed_of_sound,
+    standard_atmosphere,
+    true_airspeed,
+)
 
 
 def test_sea_level():

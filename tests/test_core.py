@@ -6,9 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from asekit.util.cache import CacheError, load_npz, save_npz
 from asekit.case import pipeline
 from asekit.geometry import LinearThickness, Material, Planform
+from asekit.util.cache import CacheError, load_npz, save_npz
 
 
 def test_reference_fin_geometry_matches_fin_md(fin_case):

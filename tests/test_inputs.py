@@ -13,9 +13,9 @@ from asekit.aero.dlm import normalwash_matrix
 from asekit.aero.vlm import lift_curve_slope, steady_pressure
 from asekit.case import CaseError, case_from_dict, pipeline
 from asekit.io.op4 import read_op4, write_op4
-from asekit.util.paths import FIN_FILE
 from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, DCMotor, PDController
 from asekit.servo.simulate import simulate
+from asekit.util.paths import FIN_FILE
 
 
 def _plate(n_chord=4, n_span=4, y0=0.0):

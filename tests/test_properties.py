@@ -11,7 +11,6 @@ import os
 
 import pytest
 from hypothesis import HealthCheck, given, settings
-
 from property_targets import TARGETS, classify
 
 settings.register_profile("asekit-default", max_examples=12, deadline=None, database=None,

@@ -255,8 +255,8 @@ def test_structural_sweep_builds_the_dlm_once_per_mach(monkeypatch):
 def test_a_sample_is_the_pipeline_on_the_edited_case(one_blas_thread):
     """Row = asekit.case.pipeline on the case file edited by hand (same flutter speed,
     frequency, divergence speed and flags); flight.mach / flight.altitude pick the condition."""
-    from asekit.atmosphere import standard_atmosphere
     from asekit.aeroelastic.flutter import divergence_speeds
+    from asekit.atmosphere import standard_atmosphere
     ps = [{"path": "support.torsional_stiffness", "values": [100.0]},
           {"path": "damping.modal_damping_ratio", "values": [0.005]},
           {"path": "flight.mach", "values": [0.5]}, {"path": "flight.altitude", "values": [2500.0]}]
@@ -659,8 +659,9 @@ def test_piston_sweep_reuses_its_matrices_and_equals_the_pipeline(tmp_path, monk
     pipeline's database; with the registry saying "structure-dependent" the GAFs are rebuilt
     per sample, with the same numbers. A thicker root stiffens the plate: f1 and the flutter
     speed rise."""
-    import asekit.aero.methods as M
     import dataclasses
+
+    import asekit.aero.methods as M
     case = _piston_plate(tmp_path)
     calls = []
     real = M.piston_pressure_matrices

@@ -11,11 +11,25 @@ semi-chord b stated by the caller (the fin: root semi-chord 0.078 m); Delta Cp >
 along its normal (+z); normalwash w/U = dh/dx + i k h / b.
 """
 
-from asekit.aero.boxes import (BoxMesh, MeshRuleReport, MeshRuleWarning, TrapezoidSurface,
-                               check_mesh_rules, mesh_surfaces)
-from asekit.aero.dlm import (AicFactor, aic_matrix, factor_aic, factor_normalwash_matrix,
-                             iter_normalwash_matrices, map_normalwash_matrices,
-                             normalwash_matrices, normalwash_matrix, pressure_jump)
+from asekit.aero.boxes import (
+                               BoxMesh,
+                               MeshRuleReport,
+                               MeshRuleWarning,
+                               TrapezoidSurface,
+                               check_mesh_rules,
+                               mesh_surfaces,
+)
+from asekit.aero.dlm import (
+                               AicFactor,
+                               aic_matrix,
+                               factor_aic,
+                               factor_normalwash_matrix,
+                               iter_normalwash_matrices,
+                               map_normalwash_matrices,
+                               normalwash_matrices,
+                               normalwash_matrix,
+                               pressure_jump,
+)
 from asekit.aero.vlm import lift_curve_slope, steady_pressure, vlm_normalwash_matrix
 
 __all__ = ["BoxMesh", "MeshRuleReport", "MeshRuleWarning", "TrapezoidSurface", "check_mesh_rules",

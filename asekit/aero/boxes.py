@@ -27,7 +27,6 @@ import numpy as np
 
 from asekit.util.validate import positive
 
-
 #: largest dense aerodynamic matrix set a single call may allocate (bytes); calls that would need
 #: more are refused up front with the estimate and the setting to change.
 MAX_MATRIX_BYTES = 4 * 2 ** 30

@@ -89,7 +89,7 @@ import scipy.linalg as sla
 from asekit.aero.boxes import BoxMesh, check_matrix_memory
 from asekit.aero.kernels import check_kernel
 from asekit.aero.validity import check_k
-from asekit.aero.vlm import check_mach, vlm_normalwash_matrix, CHUNK_BYTES
+from asekit.aero.vlm import CHUNK_BYTES, check_mach, vlm_normalwash_matrix
 
 #: Laschka's approximation of u / sqrt(1 + u^2) ~ 1 - sum a_n exp(-n c u) ([R71] Eq. A.4;
 #: coefficients as tabulated by Blair 1992, WL-TR-92-3028, p. 89).

@@ -24,15 +24,15 @@ from pathlib import Path
 
 import numpy as np
 
-from asekit.util.version import __version__
-from asekit.util.blas import blas_threads_for
-from asekit.util.cache import CacheError, load_npz, save_npz
-from asekit.util.paths import DATA_DIR, user_cache_dir
 from asekit.aero.boxes import BoxMesh
 from asekit.aero.dlm import factor_normalwash_matrix, map_normalwash_matrices
 from asekit.aero.methods import DLM_KERNELS, check_mach, pressures, resolve_method
 from asekit.aero.spline import BoxModes, fe_spline, modal_forces
 from asekit.aero.validity import check_k
+from asekit.util.blas import blas_threads_for
+from asekit.util.cache import CacheError, load_npz, save_npz
+from asekit.util.paths import DATA_DIR, user_cache_dir
+from asekit.util.version import __version__
 
 #: The reference fin's database, shipped read-only with the repository (so CI does not rebuild
 #: it). Rebuilt databases go to the user cache directory (:func:`asekit.util.paths.user_cache_dir`).

@@ -24,11 +24,11 @@ import math
 
 import numpy as np
 
-from asekit.util.validate import positive
 from asekit.aero.boxes import BoxMesh, check_matrix_memory
 from asekit.aero.kernels import check_kernel
 from asekit.aero.validity import SUBSONIC
 from asekit.aero.validity import check_mach as _check_mach
+from asekit.util.validate import positive
 
 #: Upper bound (bytes) for the temporaries of one row chunk (VLM and DLM).
 CHUNK_BYTES = 256 * 2**20

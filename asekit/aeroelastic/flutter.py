@@ -39,8 +39,8 @@ from scipy import linalg, optimize
 
 from asekit.aero.gaf import TabulatedGaf
 from asekit.aeroelastic.statespace import ModalArrays, aeroelastic_matrices, modal_arrays
-from asekit.util.conventions import damping_ratio, mode_label, vg_damping
 from asekit.util.blas import small_dense
+from asekit.util.conventions import damping_ratio, mode_label, vg_damping
 from asekit.util.validate import positive, positive_array
 
 #: relative tolerance of the stability test: a root is unstable when Re p > RTOL_UNSTABLE * scale,

@@ -29,8 +29,13 @@ from typing import Callable
 
 import numpy as np
 
-from asekit.aeroelastic.flutter import (PkResult, pk_flutter, pk_instabilities, root_locus,
-                                        root_locus_instabilities)
+from asekit.aeroelastic.flutter import (
+    PkResult,
+    pk_flutter,
+    pk_instabilities,
+    root_locus,
+    root_locus_instabilities,
+)
 
 
 @dataclass(frozen=True)

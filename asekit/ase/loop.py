@@ -42,11 +42,16 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from asekit.aeroelastic.statespace import aeroelastic_matrices, aeroelastic_model
-from asekit.util.blas import small_dense
 from asekit.servo.actuator import ActuatorParameters, PDController, actuator_state_space
 from asekit.servo.piecewise import PiecewiseAffineLoop, propagate_exact, voltage_bounds
-from asekit.servo.simulate import (THESIS_LIMITS, PowerLimits, applied_voltage, controller_voltage,
-                             motor_rhs)
+from asekit.servo.simulate import (
+    THESIS_LIMITS,
+    PowerLimits,
+    applied_voltage,
+    controller_voltage,
+    motor_rhs,
+)
+from asekit.util.blas import small_dense
 from asekit.util.validate import finite, positive
 
 TOPOLOGIES = ("AEM1", "AEM2")

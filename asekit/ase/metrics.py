@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+
 # ---------------------------------------------------------------------------------------------
 def settling_time(t: np.ndarray, y: np.ndarray, target: float, step: float,
                   band: float = 0.02) -> float:

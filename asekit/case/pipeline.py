@@ -19,20 +19,23 @@ import numpy as np
 
 from asekit.aero.boxes import TrapezoidSurface, check_matrix_memory, mesh_surfaces
 from asekit.aero.gaf import GafDatabase, cached_gaf_database, default_reduced_frequencies
-from asekit.util.conventions import mode_label
-from asekit.atmosphere import standard_atmosphere
-from asekit.aeroelastic.flutter import (Instability, PkResult, divergence_speeds,
-                                        first_of)
+from asekit.aeroelastic.flutter import Instability, PkResult, divergence_speeds, first_of
 from asekit.aeroelastic.methods import flutter_method
+from asekit.atmosphere import standard_atmosphere
+from asekit.case.schema import Case, CaseError
 from asekit.rfa.methods import rfa_kind
-from asekit.structure.assembly import (SupportedSystem, assemble, plate_pitch_inertia,
-                                       point_mass_matrix)
+from asekit.structure.assembly import (
+    SupportedSystem,
+    assemble,
+    plate_pitch_inertia,
+    point_mass_matrix,
+)
 from asekit.structure.mesh import PlateMesh, panels_mesh
 from asekit.structure.modes import InPlaneModes, ModalModel, fixed_modal_model, with_damping
 from asekit.structure.modes import inplane_modes as _inplane_modes
 from asekit.structure.supports import support_kind
+from asekit.util.conventions import mode_label
 from asekit.util.validate import positive
-from asekit.case.schema import Case, CaseError
 
 
 # ---------------------------------------------------------------------------------------------
@@ -520,9 +523,9 @@ def actuator_setup(case: Case):
     """(ActuatorParameters, PDController, PowerLimits) of the case's ``[actuator]``: the keys
     it sets, asekit's defaults (thesis Tables 12, 16, 17) for the rest. The actuator's load
     inertia is 0: the fin's inertia enters through its modal model (:func:`asekit.ase.loop.build_model`)."""
+    from asekit.case.schema import MOTOR_KEYS, TRANSMISSION_KEYS
     from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, DCMotor, Transmission
     from asekit.servo.simulate import THESIS_LIMITS
-    from asekit.case.schema import MOTOR_KEYS, TRANSMISSION_KEYS
     a = case.actuator
     if a is None:
         raise CaseError("the case has no [actuator]")
@@ -603,8 +606,8 @@ def ase_condition(case: Case, mach: float | None = None, altitude: float | None 
     -------
     :class:`AseCondition`.
     """
-    from asekit.ase import loop as ase_mod
     from asekit.aeroelastic.statespace import fin_outputs
+    from asekit.ase import loop as ase_mod
     from asekit.util.validate import finite
 
     a = case.actuator

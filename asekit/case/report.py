@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from asekit.util.conventions import mode_label, mode_number
 from asekit.case.schema import Case
+from asekit.util.conventions import mode_label, mode_number
 
 #: The unit of every numeric key of the summary (the JSON's ``units`` block; docs/conventions.md).
 #: Key suffixes name the unit too: ``_ms`` m/s, ``_hz`` Hz, ``_m`` m, ``_s`` s, ``_deg`` deg,
@@ -209,8 +209,8 @@ def format_summary(s: dict, width: int = 100) -> str:
 # figures and the HTML report
 # ---------------------------------------------------------------------------------------------
 def fig_planform(a: Analysis):
-    from asekit.util.plotting import new_figure
     from asekit.case import pipeline as P
+    from asekit.util.plotting import new_figure
     fig, ax = new_figure(f"{a.case.name}: planform, FE mesh (black) and aerodynamic boxes (blue)")
     mesh = P.structural_mesh(a.case)
     for e in mesh.elements:

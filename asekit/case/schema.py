@@ -20,9 +20,9 @@ import numpy as np
 
 from asekit.aero.methods import METHODS, resolve_method
 from asekit.aeroelastic.methods import FLUTTER_METHODS
+from asekit.case.imported import ImportedModel
 from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
 from asekit.rfa.methods import RFA_FITS
-from asekit.case.imported import ImportedModel
 from asekit.structure.supports import SUPPORTS
 
 

@@ -36,6 +36,7 @@ def _error(msg: str) -> int:
 
 def run(args) -> int:
     import dataclasses
+
     from asekit import sweep as S
     if args.scheduler and args.executor != "dask":
         return _error("--scheduler needs --executor dask")

@@ -140,8 +140,8 @@ def case_state_spaces(case, mach: float | None = None, altitude: float | None = 
     defaults to ``[actuator.condition]`` (else the first Mach and altitude), at the speed
     M a unless ``velocity`` (m/s) is given.
     """
-    from asekit.ase import loop as ase_mod
     from asekit.aeroelastic.statespace import aeroelastic_model, fin_outputs
+    from asekit.ase import loop as ase_mod
     from asekit.atmosphere import standard_atmosphere
     from asekit.case import pipeline as pl
     from asekit.rfa import roger_fit

@@ -21,10 +21,10 @@ from asekit.aero.gaf import steady_hinge_coefficient
 from asekit.aero.vlm import lift_curve_slope, steady_pressure
 from asekit.case import pipeline
 from asekit.case.variants import with_boxes
-from asekit.util.plotting import THESIS_COLOR, new_figure
 from asekit.reproduction.driver import ChapterResult, Quantity
-from asekit.reproduction.thesis import thesis_value
 from asekit.reproduction.fin import fin_case
+from asekit.reproduction.thesis import thesis_value
+from asekit.util.plotting import THESIS_COLOR, new_figure
 
 #: Mach of the steady hinge-moment coefficient (thesis Eq. 4.6).
 STEADY_MACH = 0.6

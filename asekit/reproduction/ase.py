@@ -34,13 +34,13 @@ import numpy as np
 
 from asekit.ase import loop as ase
 from asekit.ase import metrics
-from asekit.case import pipeline
 from asekit.ase.margins import NyquistMargins, nyquist_margins
-from asekit.util.plotting import THESIS_COLOR, new_figure
+from asekit.case import pipeline
 from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.reproduction.fin import CORNERS, fin_case
 from asekit.servo.actuator import SYSTEM_3, PDController
 from asekit.servo.simulate import THESIS_LIMITS, SimulationResult, simulate
-from asekit.reproduction.fin import CORNERS, fin_case
+from asekit.util.plotting import THESIS_COLOR, new_figure
 
 #: Thesis Table 2 requirements checked on the elastic fin.
 SETTLING_REQUIREMENT = 0.05      # s

@@ -35,10 +35,10 @@ import numpy as np
 
 from asekit.ase import loop as ase
 from asekit.ase import metrics
-from asekit.servo.controllers import DigitalController, pd_controller, pid_filtered
-from asekit.reproduction.driver import ChapterResult, Quantity
 from asekit.case import pipeline
+from asekit.reproduction.driver import ChapterResult, Quantity
 from asekit.reproduction.fin import CORNERS, fin_case
+from asekit.servo.controllers import DigitalController, pd_controller, pid_filtered
 
 MACHS = (0.4, 0.5, 0.6)
 ALTITUDES = (0.0, 2500.0, 5000.0)
@@ -425,9 +425,15 @@ def flutter_comparison(data=None, mach: float = 0.75, altitude: float = 0.0,
                        order: int = 4, velocities=np.arange(150.0, 461.0, 5.0)) -> dict:
     """Flutter speed of the fin (rigid mode held) by p-k and by the root locus with Roger fits
     and minimum-state fits (unweighted and weighted to k <= ``band`` k_f, k_f from p-k)."""
+    from asekit.aeroelastic.flutter import (
+        TabulatedGaf,
+        first_of,
+        pk_flutter,
+        pk_instabilities,
+        root_locus,
+        root_locus_instabilities,
+    )
     from asekit.atmosphere import standard_atmosphere
-    from asekit.aeroelastic.flutter import (TabulatedGaf, first_of, pk_flutter, pk_instabilities, root_locus,
-                                root_locus_instabilities)
     from asekit.rfa import minimum_state_fit, reduced_frequency_weights, roger_fit
 
     data = load() if data is None else data

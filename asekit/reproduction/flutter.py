@@ -16,10 +16,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from asekit.aeroelastic.flutter import (
+    TabulatedGaf,
+    divergence_speeds,
+    first_of,
+    pk_flutter,
+    pk_instabilities,
+    root_locus,
+    root_locus_instabilities,
+    time_domain_sweep,
+)
 from asekit.atmosphere import standard_atmosphere
-from asekit.aeroelastic.flutter import (TabulatedGaf, divergence_speeds, first_of, pk_flutter,
-                            pk_instabilities, root_locus, root_locus_instabilities,
-                            time_domain_sweep)
 from asekit.reproduction.driver import ChapterResult, Quantity
 
 VELOCITIES = np.arange(100.0, 460.0 + 1e-9, 2.0)      # m/s
@@ -504,8 +511,8 @@ def free_responses(modal, fit, rho: float, onset: float | None, t_end: float = 0
     """Free responses (Eq. 3.15, unit initial zeta_2, RK45 with steps <= 1e-4 s) at the thesis's
     248 / 254 / 260 m/s (Figs 36-38) and at asekit's onset -6 / 0 / +6 m/s: a list of
     (label, speed, FreeResponse)."""
-    from asekit.aeroelastic.statespace import aeroelastic_matrices
     from asekit.aeroelastic.flutter import initial_state, simulate_free_response
+    from asekit.aeroelastic.statespace import aeroelastic_matrices
     cases = [("thesis Fig 36", 248.0), ("thesis Fig 37", 254.0), ("thesis Fig 38", 260.0)]
     if onset:
         cases += [("asekit onset - 6", onset - 6.0), ("asekit onset", onset),
@@ -557,6 +564,7 @@ def root_locus_panel(modal, db, mach: float = 0.75, n_lags: int = N_LAGS):
     except ImportError:
         return None
     import matplotlib.pyplot as plt
+
     from asekit.aeroelastic.statespace import aeroelastic_matrices
     fit = fin_rfa(db, mach, n_lags=n_lags)
     out = w.Output()
@@ -915,8 +923,8 @@ def converged_flutter_study(db, mach: float = 0.75, altitude: float = 0.0,
     the physics source, and reused while the fingerprint matches. With ``compute=False`` a
     missing or stale cache returns None instead of computing.
     """
-    from asekit.util.paths import user_cache_dir
     from asekit.util.cache import CacheError, load_npz, save_npz
+    from asekit.util.paths import user_cache_dir
     key = _study_fingerprint(db, mach, altitude, velocities, structure, aero)
     path = user_cache_dir() / f"flutter_convergence_{key[:16]}.npz"
     if cache:

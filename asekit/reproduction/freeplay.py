@@ -41,10 +41,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from asekit.aeroelastic.nonlinear import (
+    ConnectedSystem,
+    Connection,
+    biased_harmonic_balance,
+    bisect_onset,
+    equilibria,
+    growth_rate,
+    harmonic_balance,
+    simulate_exact,
+)
 from asekit.aeroelastic.statespace import aeroelastic_matrices, fin_outputs, modal_arrays
 from asekit.atmosphere import standard_atmosphere
-from asekit.aeroelastic.nonlinear import (Connection, ConnectedSystem, biased_harmonic_balance, bisect_onset,
-                              equilibria, growth_rate, harmonic_balance, simulate_exact)
 from asekit.reproduction.driver import ChapterResult, Quantity
 from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, PDController, actuator_state_space
 
@@ -524,8 +532,13 @@ def conner_study(delta_half_deg: float | None = None, velocities=np.arange(3.0, 
     from scipy.optimize import brentq
 
     from asekit.aeroelastic.nonlinear import multi_harmonic_balance, steady_oscillation
-    from asekit.aeroelastic.typical_section import (CONNER_FREEPLAY_HALF_WIDTH_DEG, conner_1997,
-                                        connected_system, flutter_speed, flutter_speed_exact)
+    from asekit.aeroelastic.typical_section import (
+        CONNER_FREEPLAY_HALF_WIDTH_DEG,
+        connected_system,
+        conner_1997,
+        flutter_speed,
+        flutter_speed_exact,
+    )
     sec = conner_1997()
     dl = math.radians(CONNER_FREEPLAY_HALF_WIDTH_DEG if delta_half_deg is None
                       else delta_half_deg)
@@ -618,7 +631,11 @@ def conner_path_following(velocities, delta_half_deg: float | None = None,
     from scipy.signal import find_peaks
 
     from asekit.aeroelastic.nonlinear import steady_oscillation
-    from asekit.aeroelastic.typical_section import CONNER_FREEPLAY_HALF_WIDTH_DEG, conner_1997, connected_system
+    from asekit.aeroelastic.typical_section import (
+        CONNER_FREEPLAY_HALF_WIDTH_DEG,
+        connected_system,
+        conner_1997,
+    )
     v = np.asarray(velocities, float)
     if v.size == 0 or np.any(np.diff(v) <= 0):
         raise ValueError("velocities must be a non-empty increasing sequence")

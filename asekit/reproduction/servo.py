@@ -24,14 +24,33 @@ from dataclasses import dataclass
 import control as ct
 import numpy as np
 
-from asekit.util.plotting import THESIS_COLOR, new_figure
 from asekit.reproduction.driver import ChapterResult, Quantity
-from asekit.servo.actuator import (NO_CONTROLLER, SYSTEM_1, SYSTEM_2, SYSTEM_3, ActuatorParameters, Margins,
-                          PDController, closed_loop, closed_loop_poles, forward_path, margins,
-                          open_loop_poles, root_locus_data, step_response)
-from asekit.servo.simulate import SimulationResult, THESIS_LIMITS, SteadyHingeMoment, simulate
-from asekit.servo.torque_requirement import (ProfileResponse, SecondOrderProfile, TorqueRequirement,
-                                       profile_step, required_stall_torque, tune_rate_limit)
+from asekit.servo.actuator import (
+    NO_CONTROLLER,
+    SYSTEM_1,
+    SYSTEM_2,
+    SYSTEM_3,
+    ActuatorParameters,
+    Margins,
+    PDController,
+    closed_loop,
+    closed_loop_poles,
+    forward_path,
+    margins,
+    open_loop_poles,
+    root_locus_data,
+    step_response,
+)
+from asekit.servo.simulate import THESIS_LIMITS, SimulationResult, SteadyHingeMoment, simulate
+from asekit.servo.torque_requirement import (
+    ProfileResponse,
+    SecondOrderProfile,
+    TorqueRequirement,
+    profile_step,
+    required_stall_torque,
+    tune_rate_limit,
+)
+from asekit.util.plotting import THESIS_COLOR, new_figure
 
 #: Thesis Table 2: the settling-time and steady-state error requirements.
 SETTLING_REQUIREMENT = 0.05      # s

@@ -24,13 +24,13 @@ import numpy as np
 from asekit.case import pipeline
 from asekit.case.schema import Case
 from asekit.case.variants import with_mesh, with_modes
-from asekit.util.conventions import mode_label
-from asekit.util.plotting import THESIS_COLOR, new_figure
 from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.reproduction.fin import distributed_case, fin_case, fn1_case
+from asekit.reproduction.thesis import thesis_value
 from asekit.structure.assembly import rigid_pitch_vector
 from asekit.structure.modes import ModalModel, NormalModes, normal_modes
-from asekit.reproduction.thesis import thesis_value
-from asekit.reproduction.fin import distributed_case, fin_case, fn1_case
+from asekit.util.conventions import mode_label
+from asekit.util.plotting import THESIS_COLOR, new_figure
 
 #: Mesh used for the distributed-shaft result (the 5 mm shaft radius of the fin case file is resolved
 #: by 23 nodes here; 192 x 224 changes modes 1-2 by a further +0.3 / +1.0 %).

@@ -28,17 +28,23 @@ from pathlib import Path
 
 import numpy as np
 
-from asekit.util.version import __version__
 from asekit.aero.boxes import MeshRuleWarning
 from asekit.aero.gaf import gaf_from_box_modes
 from asekit.aero.methods import DLM_MACH_MAX, SUPERSONIC_MACH_MIN, pressures
 from asekit.aero.spline import fe_spline
+from asekit.aeroelastic.flutter import (
+    TabulatedGaf,
+    divergence_speeds,
+    first_of,
+    pk_flutter,
+    pk_instabilities,
+)
 from asekit.atmosphere import standard_atmosphere
-from asekit.util.cache import CacheError, load_npz, save_npz
 from asekit.case import pipeline
-from asekit.aeroelastic.flutter import TabulatedGaf, divergence_speeds, first_of, pk_flutter, pk_instabilities
 from asekit.reproduction.driver import ChapterResult, Quantity
 from asekit.reproduction.fin import fin_case
+from asekit.util.cache import CacheError, load_npz, save_npz
+from asekit.util.version import __version__
 
 MACHS = (0.4, 0.5, 0.6, 0.75, 0.9, 1.15, 1.2, 1.5, 2.0, 2.5, 3.0)
 ALTITUDES = (0.0, 2500.0, 5000.0)

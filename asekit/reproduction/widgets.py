@@ -14,11 +14,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from asekit.servo.actuator import (SYSTEM_3, ActuatorParameters, Margins, PDController, closed_loop_poles,
-                          margins, step_response)
-from asekit.servo.simulate import PowerLimits, SimulationResult, SteadyHingeMoment, simulate
 from asekit.case import pipeline
 from asekit.reproduction.fin import CORNERS, fin_case
+from asekit.servo.actuator import (
+    SYSTEM_3,
+    ActuatorParameters,
+    Margins,
+    PDController,
+    closed_loop_poles,
+    margins,
+    step_response,
+)
+from asekit.servo.simulate import PowerLimits, SimulationResult, SteadyHingeMoment, simulate
 
 
 @dataclass(frozen=True)

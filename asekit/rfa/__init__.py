@@ -12,8 +12,13 @@ The aeroelastic state space (:mod:`asekit.aeroelastic.statespace`), the root loc
 either.
 """
 
-from asekit.rfa.minimum_state import (MinimumStateFit, default_ms_roots, minimum_state_fit,
-                                      minimum_state_fit_database, reduced_frequency_weights)
+from asekit.rfa.minimum_state import (
+                                      MinimumStateFit,
+                                      default_ms_roots,
+                                      minimum_state_fit,
+                                      minimum_state_fit_database,
+                                      reduced_frequency_weights,
+)
 from asekit.rfa.roger import RogerFit, default_lag_roots, design_rows, roger_fit, roger_fit_database
 
 __all__ = ["RogerFit", "MinimumStateFit", "default_lag_roots", "default_ms_roots",

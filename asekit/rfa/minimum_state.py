@@ -49,9 +49,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from asekit.rfa.roger import check_gaf_table, default_lag_roots, fit_errors
 from asekit.util.blas import small_dense
 from asekit.util.validate import positive
-from asekit.rfa.roger import check_gaf_table, default_lag_roots, fit_errors
 
 
 def default_ms_roots(k_max: float, n_states: int) -> np.ndarray:

@@ -54,12 +54,16 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from asekit.ase import metrics
-from asekit.util.blas import small_dense
 from asekit.servo.actuator import ActuatorParameters, PDController
 from asekit.servo.piecewise import propagate_exact, voltage_bounds
+from asekit.servo.torque_requirement import (
+    SEA_LEVEL_DENSITY,
+    SEA_LEVEL_SPEED_OF_SOUND,
+    THESIS_Q_CC,
+    dynamic_pressure,
+)
+from asekit.util.blas import small_dense
 from asekit.util.validate import in_range
-from asekit.servo.torque_requirement import (SEA_LEVEL_DENSITY, SEA_LEVEL_SPEED_OF_SOUND, THESIS_Q_CC,
-                                       dynamic_pressure)
 
 _CURRENT_MODELS = ("voltage_clip", "regulator")
 

@@ -35,9 +35,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from asekit.geometry import Material
-from asekit.util.validate import positive
 from asekit.structure.mesh import PlateMesh
 from asekit.structure.plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness
+from asekit.util.validate import positive
 
 
 def element_dofs(mesh: PlateMesh) -> np.ndarray:

@@ -25,10 +25,10 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from asekit.util.validate import positive
 from asekit.structure.assembly import SupportedSystem, rigid_pitch_vector, shaft_support
 from asekit.structure.mesh import PlateMesh
 from asekit.structure.plate import locate_points, membrane_matrices, shape_functions
+from asekit.util.validate import positive
 
 #: Modes whose share of kinetic energy in the out-of-plane translation w is below this are
 #: "modes with no out-of-plane motion" and are dropped (thesis Fig. 15/16: in-plane mode).

@@ -4,13 +4,13 @@ import copy
 
 import numpy as np
 import pytest
+from panelaero_grid import panelaero_grid
 from scipy.special import hankel2
 
 from asekit.aero import dlm
 from asekit.aero.boxes import BoxMesh, TrapezoidSurface, mesh_surfaces
 from asekit.aero.dlm import aic_matrix, normalwash_matrices, normalwash_matrix, pressure_jump
 from asekit.aero.vlm import vlm_normalwash_matrix
-from panelaero_grid import panelaero_grid
 
 
 def theodorsen(k):

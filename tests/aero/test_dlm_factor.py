@@ -9,16 +9,23 @@ import tracemalloc
 
 import numpy as np
 import pytest
+from test_dlm import _nonplanar, _planar  # the same planar and non-planar meshes
 
 from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
-from asekit.aero.dlm import (AicFactor, aic_matrix, factor_aic, factor_normalwash_matrix,
-                             iter_normalwash_matrices, map_normalwash_matrices,
-                             normalwash_matrices, normalwash_matrix, pressure_jump)
+from asekit.aero.dlm import (
+    AicFactor,
+    aic_matrix,
+    factor_aic,
+    factor_normalwash_matrix,
+    iter_normalwash_matrices,
+    map_normalwash_matrices,
+    normalwash_matrices,
+    normalwash_matrix,
+    pressure_jump,
+)
 from asekit.aero.gaf import gaf_from_box_modes
 from asekit.aero.methods import pressure_matrices, pressures
 from asekit.aero.spline import analytic_modes
-
-from test_dlm import _nonplanar, _planar          # the same planar and non-planar meshes
 
 
 def _modal_wash(mesh, k, b, n_modes=6):

@@ -7,8 +7,13 @@ import numpy as np
 import pytest
 
 from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
-from asekit.aero.gaf import (GAF_FILE, cached_gaf_database, gaf_from_box_modes, gaf_matrix,
-                             steady_hinge_coefficient)
+from asekit.aero.gaf import (
+    GAF_FILE,
+    cached_gaf_database,
+    gaf_from_box_modes,
+    gaf_matrix,
+    steady_hinge_coefficient,
+)
 from asekit.aero.spline import InfinitePlateSpline, analytic_modes, fe_spline, normalwash
 from asekit.case import pipeline
 

@@ -17,8 +17,12 @@ import numpy as np
 import pytest
 
 from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
-from asekit.aero.piston import (PistonValidityWarning, piston_coefficient,
-                                piston_pressure_matrices, piston_pressure_matrix)
+from asekit.aero.piston import (
+    PistonValidityWarning,
+    piston_coefficient,
+    piston_pressure_matrices,
+    piston_pressure_matrix,
+)
 
 C = 0.4            # chord (m)
 B = C / 2          # reference semi-chord (m)

@@ -27,8 +27,12 @@ from scipy.special import j0
 
 from asekit.aero.boxes import MeshRuleWarning, TrapezoidSurface, mesh_surfaces
 from asekit.aero.piston import piston_pressure_matrices
-from asekit.aero.supersonic import (cell_potential_integral, supersonic_pressure_matrices,
-                                    supersonic_pressure_matrix, supersonic_pressures)
+from asekit.aero.supersonic import (
+    cell_potential_integral,
+    supersonic_pressure_matrices,
+    supersonic_pressure_matrix,
+    supersonic_pressures,
+)
 
 
 def _rect(chord, span, n_chord, n_span):
@@ -456,6 +460,7 @@ def test_agard445_6_supersonic_method_choice():
     the Mach boxes explicitly and gets a warning; the wing's leading and trailing edges are
     subsonic at both Mach numbers (so diaphragm and wake are solved)."""
     import tomllib
+
     from asekit.aero.supersonic import has_subsonic_trailing_edge
     from asekit.case import CaseError, case_from_dict
     from asekit.case import pipeline as P
@@ -534,6 +539,7 @@ def test_agard445_6_supersonic_mach_box_convergence():
     the same refinements move the index by 1.7-7 % (0.344 -> 0.350-0.369): not asserted, that
     point lies in the transonic range anyway."""
     import tomllib
+
     from asekit.aero.gaf import build_gaf_database
     from asekit.aero.spline import fe_spline
     from asekit.case import case_from_dict
@@ -564,6 +570,7 @@ def test_agard445_6_piston_theory_out_of_range():
     says so naming Mach and k; its 2-D load 4/M per unit w/U is beta/M = 0.48 of Ackeret's
     4/beta, so it puts the flutter speed far too high: above 1.4x the Mach-box value."""
     import tomllib
+
     from asekit.aero.methods import TransonicWarning
     from asekit.aero.piston import PistonValidityWarning
     from asekit.case import case_from_dict

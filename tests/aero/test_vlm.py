@@ -6,10 +6,16 @@ import warnings
 
 import numpy as np
 import pytest
-
-from asekit.aero.boxes import BoxMesh, MeshRuleWarning, TrapezoidSurface, check_mesh_rules, mesh_surfaces
-from asekit.aero.vlm import lift_curve_slope, steady_pressure, vlm_normalwash_matrix
 from panelaero_grid import panelaero_grid
+
+from asekit.aero.boxes import (
+    BoxMesh,
+    MeshRuleWarning,
+    TrapezoidSurface,
+    check_mesh_rules,
+    mesh_surfaces,
+)
+from asekit.aero.vlm import lift_curve_slope, steady_pressure, vlm_normalwash_matrix
 
 
 def _swept_wing(n_chord, n_span):

@@ -4,8 +4,12 @@ U -> 0 limit, quasi-steady hand-derived case, static hinge moment, outputs, bad 
 import numpy as np
 import pytest
 
-from asekit.aeroelastic.statespace import (aeroelastic_matrices, aeroelastic_model, modal_arrays,
-                                rotation_rows)
+from asekit.aeroelastic.statespace import (
+    aeroelastic_matrices,
+    aeroelastic_model,
+    modal_arrays,
+    rotation_rows,
+)
 from asekit.rfa import RogerFit, roger_fit
 
 

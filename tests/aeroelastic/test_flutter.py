@@ -4,11 +4,19 @@ limits, static divergence, agreement of p-k / root locus / time domain, bad inpu
 import numpy as np
 import pytest
 
-from asekit.aeroelastic.statespace import modal_arrays
-from asekit.aeroelastic.flutter import (TabulatedGaf, divergence_speeds, first_of, pk_flutter,
-                            pk_instabilities, root_locus, root_locus_instabilities,
-                            simulate_free_response, time_domain_sweep, initial_state)
-from asekit.aeroelastic.statespace import aeroelastic_matrices
+from asekit.aeroelastic.flutter import (
+    TabulatedGaf,
+    divergence_speeds,
+    first_of,
+    initial_state,
+    pk_flutter,
+    pk_instabilities,
+    root_locus,
+    root_locus_instabilities,
+    simulate_free_response,
+    time_domain_sweep,
+)
+from asekit.aeroelastic.statespace import aeroelastic_matrices, modal_arrays
 from asekit.io.op4 import load_ha145b
 from asekit.rfa import RogerFit, roger_fit
 
@@ -153,8 +161,8 @@ def test_match_point_table_and_matched_mach():
     M, K, C, Q, q_f, _ = _coalescence_case()
     gaf = TabulatedGaf(np.array([0.0, 10.0]), np.array([Q, Q]), 1.0)
     modal = modal_arrays(M=M, K=K, C=C)
-    from asekit.atmosphere import speed_of_sound
     from asekit.aeroelastic.flutter import match_point_table, matched_mach
+    from asekit.atmosphere import speed_of_sound
     rho = 1.225
     U_f = np.sqrt(2 * q_f / rho)
     rows = match_point_table(modal, lambda mach: gaf, [0.01, 0.9], [0.0],

@@ -12,16 +12,28 @@ import warnings
 
 import numpy as np
 import pytest
+from property_targets import TWO_DOF, two_dof_coalescence
 
+from asekit.aeroelastic.flutter import (
+    FlutterConvergenceWarning,
+    PkResult,
+    RootLocusResult,
+    TabulatedGaf,
+    crossing_tolerance,
+    first_of,
+    growth_rate,
+    match_point_table,
+    matched_mach,
+    pk_flutter,
+    pk_instabilities,
+    root_locus,
+    root_locus_instabilities,
+    simulate_free_response,
+    time_domain_sweep,
+)
 from asekit.aeroelastic.statespace import modal_arrays
-from asekit.aeroelastic.flutter import (FlutterConvergenceWarning, PkResult, RootLocusResult, TabulatedGaf,
-                            crossing_tolerance, first_of, match_point_table, matched_mach,
-                            pk_flutter, pk_instabilities, root_locus, root_locus_instabilities,
-                            time_domain_sweep, growth_rate, simulate_free_response)
 from asekit.io.op4 import load_ha145b
 from asekit.rfa import roger_fit, roger_fit_database
-
-from property_targets import TWO_DOF, two_dof_coalescence
 
 HA145B_FLUTTER_SPEED = 12672.0      # in/s, Nastran HA145B (see module docstring)
 

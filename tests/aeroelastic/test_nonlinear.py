@@ -15,8 +15,16 @@ import pytest
 from scipy.integrate import quad
 from scipy.linalg import expm
 
-from asekit.aeroelastic.nonlinear import (Connection, ConnectedSystem, deadzone_gain, growth_rate,
-                              harmonic_balance, lco_curve, simulate, steady_oscillation)
+from asekit.aeroelastic.nonlinear import (
+    ConnectedSystem,
+    Connection,
+    deadzone_gain,
+    growth_rate,
+    harmonic_balance,
+    lco_curve,
+    simulate,
+    steady_oscillation,
+)
 
 K_CONN = (2 * math.pi * 8.0) ** 2
 

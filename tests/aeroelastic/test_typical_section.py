@@ -16,16 +16,31 @@ import math
 
 import numpy as np
 import pytest
-
 from scipy.optimize import brentq
 
-from asekit.aeroelastic.nonlinear import (Connection, growth_rate, harmonic_balance,
-                              multi_harmonic_balance, simulate, simulate_exact,
-                              steady_oscillation)
-from asekit.aeroelastic.typical_section import (CONNER_FREEPLAY_HALF_WIDTH_DEG, CONNER_SPAN, conner_1997,
-                                    connected_system, flutter_speed, flutter_speed_exact,
-                                    frequency_domain_matrix, jones_function, section_matrices,
-                                    state_matrix, theodorsen_function, theodorsen_t)
+from asekit.aeroelastic.nonlinear import (
+    Connection,
+    growth_rate,
+    harmonic_balance,
+    multi_harmonic_balance,
+    simulate,
+    simulate_exact,
+    steady_oscillation,
+)
+from asekit.aeroelastic.typical_section import (
+    CONNER_FREEPLAY_HALF_WIDTH_DEG,
+    CONNER_SPAN,
+    connected_system,
+    conner_1997,
+    flutter_speed,
+    flutter_speed_exact,
+    frequency_domain_matrix,
+    jones_function,
+    section_matrices,
+    state_matrix,
+    theodorsen_function,
+    theodorsen_t,
+)
 
 DELTA = math.radians(CONNER_FREEPLAY_HALF_WIDTH_DEG)   # Conner et al.: +-2.12 deg
 

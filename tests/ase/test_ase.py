@@ -11,7 +11,12 @@ import pytest
 from asekit.ase import loop as ase
 from asekit.ase import metrics
 from asekit.case import pipeline
-from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, PDController, actuator_transfer_function
+from asekit.servo.actuator import (
+    SYSTEM_3,
+    ActuatorParameters,
+    PDController,
+    actuator_transfer_function,
+)
 from asekit.servo.actuator import margins as servo_margins
 
 

@@ -196,6 +196,7 @@ def test_cli_missing_case_file(tmp_path, capsys):
 
 def test_cli_analyse_json(tmp_path):
     import json
+
     from asekit.cli.main import main
     out = tmp_path / "out.json"
     assert main(["analyse", str(FV16), "--json", str(out), "--quiet"]) == 0

@@ -11,8 +11,8 @@ import pytest
 from asekit.case import ImportedModel, SupportSpec, case_from_dict
 from asekit.case import pipeline as pl
 from asekit.case.schema import CaseError, PointMass
-from asekit.util.paths import DATA_DIR
 from asekit.structure.assembly import clamped_edge
+from asekit.util.paths import DATA_DIR
 
 
 @pytest.fixture(scope="module")

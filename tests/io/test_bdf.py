@@ -14,15 +14,15 @@ import pytest
 
 if os.environ.get("ASEKIT_REQUIRE_PYNASTRAN"):
     # .ci/run's Nastran environment (environment-nastran.txt): there a missing reader fails
-    import pyNastran                                            # noqa: F401
+    import pyNastran  # noqa: F401
 else:
     pytest.importorskip("pyNastran")
 
+from asekit.case import case_from_dict, load_case  # noqa: E402
+from asekit.case import pipeline as pl  # noqa: E402
+from asekit.case.schema import PointMass  # noqa: E402
 from asekit.io import bdf as B
-from asekit.case import case_from_dict, load_case               # noqa: E402
-from asekit.case import pipeline as pl                          # noqa: E402
-from asekit.case.schema import PointMass                        # noqa: E402
-from asekit.util.paths import DATA_DIR                               # noqa: E402
+from asekit.util.paths import DATA_DIR  # noqa: E402
 
 HA145E = DATA_DIR / "benchmarks" / "ha145e"
 
@@ -403,6 +403,7 @@ def test_analyse_cli_reads_a_deck(tmp_path, capsys):
     analyse road (JSON summary with the deck's flutter point); a deck without aero is refused
     with one line naming the file."""
     import json
+
     from asekit.cli.main import main
     out = tmp_path / "s.json"
     with warnings.catch_warnings():
@@ -421,8 +422,8 @@ def test_imported_case_state_space_flutters_where_pk_says():
     """The deck's aeroelastic state space (asekit.io.export.case_state_spaces: Roger RFA, the
     imported mesh's corners as outputs) at sea level is stable at 0.9 U_f and unstable at
     1.1 U_f, U_f the pipeline's p-k flutter speed at the same density."""
-    from asekit.io import export
     from asekit.atmosphere import standard_atmosphere
+    from asekit.io import export
     m = _read(HA145E / "ha145e.bdf", units="in-lbf-s")
     rho = float(standard_atmosphere(0.0).density)
     sea = dataclasses.replace(m, flight=dataclasses.replace(m.flight, densities=(rho,)))

@@ -3,13 +3,13 @@ case, and OP4 modal / GAF matrices read back by pyNastran's own OP4 reader."""
 
 import os
 
+import control as ct
 import numpy as np
 import pytest
-import control as ct
 
-from asekit.io import export
 from asekit.case import load_case
 from asekit.case import pipeline as pl
+from asekit.io import export
 from asekit.io.op4 import read_op4, split_qhhl
 from asekit.util.paths import DATA_DIR
 

@@ -8,10 +8,10 @@ import dataclasses
 import inspect
 
 from asekit.aero.gaf import GAF_FILE, database_settings, mode_set_fingerprint
-from asekit.util.cache import load_npz
 from asekit.case import load_case, pipeline
-from asekit.util.paths import FIN_FILE
 from asekit.reproduction import fin
+from asekit.util.cache import load_npz
+from asekit.util.paths import FIN_FILE
 
 
 def test_fin_module_defines_no_model_class():

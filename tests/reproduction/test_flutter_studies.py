@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import asekit.reproduction.flutter as rf
-from asekit.aeroelastic.statespace import modal_arrays
 from asekit.aeroelastic.flutter import pk_flutter
+from asekit.aeroelastic.statespace import modal_arrays
 from asekit.util.paths import user_cache_dir
 
 DATA, REASON = rf.load_fin_gafs()

@@ -13,9 +13,13 @@ import math
 import numpy as np
 import pytest
 
-from asekit.aeroelastic.nonlinear import Connection, growth_rate, harmonic_balance, steady_oscillation
+from asekit.aeroelastic.nonlinear import (
+    Connection,
+    growth_rate,
+    harmonic_balance,
+    steady_oscillation,
+)
 from asekit.aeroelastic.typical_section import conner_1997, flutter_speed, section_matrices
-
 
 # --------------------------------------------------------------------------------------------
 # the reference fin (FinFreeplayModel): FN2 Ritz basis, Mach 0.5, sea level
@@ -53,6 +57,7 @@ def test_fin_aem1_loop_matches_the_ase_model(fin_model):
     """The AEM1 loop built through the connection has the aeroelastic roots of
     asekit.ase.loop.closed_loop (thesis FN2 formulation) near the 140 Hz flutter mode."""
     import control as ct
+
     from asekit.ase import loop as ase
     from asekit.servo.actuator import SYSTEM_3
     m = fin_model
@@ -72,6 +77,7 @@ def test_fin_aem2_loop_matches_the_ase_model(fin_model):
     and the same least-damped roots as asekit.ase.loop.closed_loop (the thesis finds the linear
     AEM2 loop unstable, Fig 79)."""
     import control as ct
+
     from asekit.ase import loop as ase
     from asekit.servo.actuator import SYSTEM_3
     m = fin_model

@@ -6,9 +6,15 @@ import json
 
 import pytest
 
-from asekit.reproduction import driver as rp
 from asekit.cli.main import main
-from asekit.reproduction.driver import ChapterResult, Quantity, comparison_kind, format_table, verdict
+from asekit.reproduction import driver as rp
+from asekit.reproduction.driver import (
+    ChapterResult,
+    Quantity,
+    comparison_kind,
+    format_table,
+    verdict,
+)
 
 
 # ---- verdicts --------------------------------------------------------------------------------

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from asekit.util.conventions import vg_damping, vg_damping_label
 from asekit.aeroelastic.flutter import Instability, PkResult, RootLocusResult
+from asekit.util.conventions import vg_damping, vg_damping_label
 
 
 def _roots():

@@ -5,11 +5,16 @@ space with shared lag states, and the fin's flutter speed against p-k."""
 import numpy as np
 import pytest
 
+from asekit.aeroelastic.flutter import (
+    TabulatedGaf,
+    first_of,
+    pk_flutter,
+    pk_instabilities,
+    root_locus,
+    root_locus_instabilities,
+)
 from asekit.aeroelastic.statespace import aeroelastic_matrices, modal_arrays
-from asekit.aeroelastic.flutter import (TabulatedGaf, first_of, pk_flutter, pk_instabilities, root_locus,
-                            root_locus_instabilities)
-from asekit.rfa import (MinimumStateFit, minimum_state_fit,
-                        reduced_frequency_weights, roger_fit)
+from asekit.rfa import MinimumStateFit, minimum_state_fit, reduced_frequency_weights, roger_fit
 
 
 def _ms_data(n=3, roots=(0.1, 0.4, 1.2), seed=2):

@@ -11,8 +11,8 @@ import pytest
 
 from asekit.ase import loop as ase
 from asekit.ase import metrics
-from asekit.servo.controllers import lowpass, notch, pd_controller, pid_filtered
 from asekit.servo.actuator import SYSTEM_3
+from asekit.servo.controllers import lowpass, notch, pd_controller, pid_filtered
 
 
 @pytest.fixture(scope="module")

@@ -6,11 +6,27 @@ import control as ct
 import numpy as np
 import pytest
 
-from asekit.servo.actuator import (NO_CONTROLLER, SYSTEM_1, SYSTEM_2, SYSTEM_3, ActuatorParameters,
-                          DCMotor, PDController, Transmission, actuator_state_space,
-                          actuator_transfer_function, closed_loop, closed_loop_poles,
-                          forward_path, margins, motor_transfer_function, open_loop_poles,
-                          root_locus_data, stable_kp_range, step_response)
+from asekit.servo.actuator import (
+    NO_CONTROLLER,
+    SYSTEM_1,
+    SYSTEM_2,
+    SYSTEM_3,
+    ActuatorParameters,
+    DCMotor,
+    PDController,
+    Transmission,
+    actuator_state_space,
+    actuator_transfer_function,
+    closed_loop,
+    closed_loop_poles,
+    forward_path,
+    margins,
+    motor_transfer_function,
+    open_loop_poles,
+    root_locus_data,
+    stable_kp_range,
+    step_response,
+)
 
 P = ActuatorParameters()
 

@@ -7,9 +7,20 @@ import numpy as np
 import pytest
 
 from asekit.servo.actuator import SYSTEM_2, SYSTEM_3, ActuatorParameters, actuator_state_space
-from asekit.servo.simulate import (CURRENT_REGULATED_LIMITS, NO_LIMITS, THESIS_LIMITS, PowerLimits,
-                             SteadyHingeMoment, actuator_rhs, applied_voltage, holding_current,
-                             motor_rhs, motor_torque_at_fin, no_hinge_moment, simulate)
+from asekit.servo.simulate import (
+    CURRENT_REGULATED_LIMITS,
+    NO_LIMITS,
+    THESIS_LIMITS,
+    PowerLimits,
+    SteadyHingeMoment,
+    actuator_rhs,
+    applied_voltage,
+    holding_current,
+    motor_rhs,
+    motor_torque_at_fin,
+    no_hinge_moment,
+    simulate,
+)
 
 P = ActuatorParameters()
 DEG = math.pi / 180

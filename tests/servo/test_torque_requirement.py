@@ -5,8 +5,14 @@ import math
 import numpy as np
 import pytest
 
-from asekit.servo.torque_requirement import (SecondOrderProfile, dynamic_pressure, profile_rhs,
-                                       profile_step, required_stall_torque, tune_rate_limit)
+from asekit.servo.torque_requirement import (
+    SecondOrderProfile,
+    dynamic_pressure,
+    profile_rhs,
+    profile_step,
+    required_stall_torque,
+    tune_rate_limit,
+)
 
 STEP = math.radians(15.0)
 

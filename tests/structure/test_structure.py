@@ -9,8 +9,13 @@ import pytest
 from asekit.case import CaseError, pipeline
 from asekit.geometry import LinearThickness, Material, Planform
 from asekit.structure import ModalModel, mode_shapes_at
-from asekit.structure.assembly import (assemble, clamped_edge, pitch_inertia, rigid_pitch_vector,
-                                       shaft_support)
+from asekit.structure.assembly import (
+    assemble,
+    clamped_edge,
+    pitch_inertia,
+    rigid_pitch_vector,
+    shaft_support,
+)
 from asekit.structure.mesh import rectangular_mesh, structured_mesh
 from asekit.structure.modes import fictitious_mass_modal_model, normal_modes, select_modes
 from asekit.structure.plate import consistent_mass, mitc4_stiffness

@@ -13,10 +13,10 @@ import pytest
 
 from asekit.case import CaseError, case_from_dict, load_case, pipeline
 from asekit.case.variants import with_mesh, with_shaft
-from asekit.util.paths import FIN_FILE
 from asekit.structure import supports
 from asekit.structure.assembly import clamped_edge
 from asekit.structure.modes import fixed_modal_model
+from asekit.util.paths import FIN_FILE
 from asekit.util.validate import read_toml
 
 
