@@ -83,10 +83,10 @@ def _fin_dict_with(section, key, value):
 
 
 def test_box_count_and_matrix_memory_bounds():
-    # the fin's mesh rules at f_max = 1 MHz ask for 13001 x 9260 boxes: refused before any
-    # allocation (the case file is valid; the box mesh cannot be built)
+    # the fin's mesh rules at f_max = 1 MHz ask for 13001 x 9260 boxes: refused before any box
+    # or allocation, by the dense-matrix bound (the case file is valid; the mesh cannot be built)
     big = case_from_dict(_fin_dict_with("aero", "f_max", 1e6))
-    with pytest.raises(ValueError, match="boxes exceeds the limit"):
+    with pytest.raises(ValueError, match=r"GiB.*aero\.f_max"):
         pipeline.box_mesh(big)
     with pytest.raises(ValueError, match="MAX_BOXES"):
         TrapezoidSurface((0, 0, 0), 1.0, (0, 1, 0), 1.0, 1000, 1000)

@@ -29,6 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from asekit.structure.modes import mode_shapes_at
+
 
 def normalwash(h: np.ndarray, dh_dx: np.ndarray, k: float, b_ref: float) -> np.ndarray:
     """Normalwash w/U = dh/dx + i k h / b_ref of the motion h exp(i omega t) (any shape).
@@ -64,7 +66,6 @@ def fe_spline(model, mesh) -> BoxModes:
 
     The boxes must lie in the structure's plane (z = 0, horizontal); raises ValueError otherwise.
     """
-    from asekit.structure.modes import mode_shapes_at
     if np.any(np.abs(mesh.corners[:, :, 2]) > 1e-9) or np.any(np.abs(mesh.dihedral) > 1e-12):
         raise ValueError("fe_spline needs boxes in the structural plane z = 0; "
                          "use InfinitePlateSpline for other configurations")

@@ -39,6 +39,7 @@ from scipy import linalg, optimize
 
 from asekit.aero.gaf import TabulatedGaf
 from asekit.aeroelastic.statespace import ModalArrays, aeroelastic_matrices, modal_arrays
+from asekit.atmosphere import standard_atmosphere
 from asekit.util.blas import small_dense
 from asekit.util.conventions import damping_ratio, mode_label, vg_damping
 from asekit.util.validate import positive, positive_array
@@ -493,7 +494,6 @@ def match_point_table(modal, gaf_for_mach, machs, altitudes, velocities, kind="f
     'flutter', 'divergence' or None (first instability of any kind). A condition unstable at the
     first airspeed gives a row with ``at_first_point=True`` (and a warning naming it).
     """
-    from asekit.atmosphere import standard_atmosphere
 
     if kind not in ("flutter", "divergence", None):
         raise ValueError(f"kind must be 'flutter', 'divergence' or None, got {kind!r}")

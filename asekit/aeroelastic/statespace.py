@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from asekit.structure.modes import mode_shapes_at  # lazy: the structure module
 from asekit.util.validate import positive
 
 INPUT_NAMES = ("theta", "theta_dot", "theta_ddot")
@@ -264,7 +265,6 @@ def fin_outputs(modal_model, points, names=None, shaft_point=None) -> dict:
     elastic rotation) at each of ``points`` ((n, 2) x, y in m), and, when ``shaft_point`` is
     given, ``fin_root_pitch`` (rad) there. Uses ``asekit.structure.modes.mode_shapes_at``.
     """
-    from asekit.structure.modes import mode_shapes_at  # lazy: the structure module
 
     pts = np.atleast_2d(np.asarray(points, dtype=float))
     names = [f"p{i + 1}" for i in range(len(pts))] if names is None else list(names)

@@ -21,9 +21,14 @@ from asekit.aero.boxes import TrapezoidSurface, check_matrix_memory, mesh_surfac
 from asekit.aero.gaf import GafDatabase, cached_gaf_database, default_reduced_frequencies
 from asekit.aeroelastic.flutter import Instability, PkResult, divergence_speeds, first_of
 from asekit.aeroelastic.methods import flutter_method
+from asekit.aeroelastic.statespace import fin_outputs
+from asekit.ase import loop as ase_mod
+from asekit.ase import metrics
 from asekit.atmosphere import standard_atmosphere
-from asekit.case.schema import Case, CaseError
+from asekit.case.schema import MOTOR_KEYS, TRANSMISSION_KEYS, Case, CaseError
 from asekit.rfa.methods import rfa_kind
+from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, DCMotor, Transmission
+from asekit.servo.simulate import THESIS_LIMITS, SteadyHingeMoment
 from asekit.structure.assembly import (
     SupportedSystem,
     assemble,
@@ -35,7 +40,7 @@ from asekit.structure.modes import InPlaneModes, ModalModel, fixed_modal_model, 
 from asekit.structure.modes import inplane_modes as _inplane_modes
 from asekit.structure.supports import support_kind
 from asekit.util.conventions import mode_label
-from asekit.util.validate import positive
+from asekit.util.validate import finite, positive
 
 
 # ---------------------------------------------------------------------------------------------
@@ -523,9 +528,6 @@ def actuator_setup(case: Case):
     """(ActuatorParameters, PDController, PowerLimits) of the case's ``[actuator]``: the keys
     it sets, asekit's defaults (thesis Tables 12, 16, 17) for the rest. The actuator's load
     inertia is 0: the fin's inertia enters through its modal model (:func:`asekit.ase.loop.build_model`)."""
-    from asekit.case.schema import MOTOR_KEYS, TRANSMISSION_KEYS
-    from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, DCMotor, Transmission
-    from asekit.servo.simulate import THESIS_LIMITS
     a = case.actuator
     if a is None:
         raise CaseError("the case has no [actuator]")
@@ -572,7 +574,6 @@ class AseCondition:
     def steady_hinge_moment(self):
         """The Ch. 4 steady hinge moment q Q_cc theta at this flight condition
         (:class:`asekit.servo.simulate.SteadyHingeMoment`)."""
-        from asekit.servo.simulate import SteadyHingeMoment
         atm = standard_atmosphere(self.altitude)
         return SteadyHingeMoment(q_cc=self.q_cc, mach=self.mach, density=float(atm.density),
                                  speed_of_sound=float(atm.speed_of_sound))
@@ -606,9 +607,6 @@ def ase_condition(case: Case, mach: float | None = None, altitude: float | None 
     -------
     :class:`AseCondition`.
     """
-    from asekit.aeroelastic.statespace import fin_outputs
-    from asekit.ase import loop as ase_mod
-    from asekit.util.validate import finite
 
     a = case.actuator
     mach = finite("mach", (a.mach if a is not None else 0.5) if mach is None else mach)
@@ -641,8 +639,6 @@ def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
     """The Ch. 5 analysis of the case's actuator (None without ``[actuator]``)."""
     if case.actuator is None:
         return None
-    from asekit.ase import loop as ase_mod
-    from asekit.ase import metrics
 
     a = case.actuator
     act, ctl, lim = actuator_setup(case)

@@ -23,8 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
+from asekit.ase import loop as ase_mod
+from asekit.case import pipeline as P
 from asekit.case.schema import Case
 from asekit.util.conventions import mode_label, mode_number
+from asekit.util.plotting import new_figure, plot_vg, save_figure
 
 #: The unit of every numeric key of the summary (the JSON's ``units`` block; docs/conventions.md).
 #: Key suffixes name the unit too: ``_ms`` m/s, ``_hz`` Hz, ``_m`` m, ``_s`` s, ``_deg`` deg,
@@ -64,7 +67,6 @@ class Analysis:
 
 def run_analysis(case: Case, progress: bool = False) -> Analysis:
     """Run the whole pipeline of ``case`` and time each step."""
-    from asekit.case import pipeline as P
     sec = {}
     t = time.perf_counter()
     modal = P.modal_model(case)
@@ -209,8 +211,6 @@ def format_summary(s: dict, width: int = 100) -> str:
 # figures and the HTML report
 # ---------------------------------------------------------------------------------------------
 def fig_planform(a: Analysis):
-    from asekit.case import pipeline as P
-    from asekit.util.plotting import new_figure
     fig, ax = new_figure(f"{a.case.name}: planform, FE mesh (black) and aerodynamic boxes (blue)")
     mesh = P.structural_mesh(a.case)
     for e in mesh.elements:
@@ -231,7 +231,6 @@ def fig_planform(a: Analysis):
 
 
 def fig_modes(a: Analysis, n: int = 4):
-    from asekit.util.plotting import new_figure
     m = a.modal
     idx = list(range(m.n_rigid, min(len(m.frequencies_hz), m.n_rigid + n)))
     fig, axes = new_figure(f"{a.case.name}: mode shapes (w, contours)", ncols=len(idx),
@@ -253,7 +252,6 @@ def fig_modes(a: Analysis, n: int = 4):
 def fig_vg(a: Analysis, result):
     """V-g and V-f of the p-k roots at one condition (:func:`asekit.util.plotting.plot_vg`: g = 2 Re
     p / |Im p|, > 0 unstable; modes named "mode 1", ...), the flutter point starred."""
-    from asekit.util.plotting import new_figure, plot_vg
     pk = result.pk
     alt = result.condition.altitude
     where = f"{alt:g} m" if alt is not None else f"rho {result.condition.density:.4g} kg/m^3"
@@ -271,7 +269,6 @@ def fig_vg(a: Analysis, result):
 
 
 def fig_root_locus(a: Analysis, result):
-    from asekit.util.plotting import new_figure
     pk = result.pk
     fig, ax = new_figure(f"{a.case.name}: root locus of the p-k roots, M {result.mach:g}")
     for j, name in enumerate(pk.mode_labels):
@@ -287,8 +284,6 @@ def fig_root_locus(a: Analysis, result):
 
 
 def fig_ase_bode(a: Analysis):
-    from asekit.ase import loop as ase_mod
-    from asekit.util.plotting import new_figure
     s = a.ase
     f = np.logspace(0, 3.5, 800)
     fig, (ax1, ax2) = new_figure(f"{a.case.name}: forward paths FWTF 1-3, M {s.mach:g}",
@@ -310,7 +305,6 @@ def fig_ase_bode(a: Analysis):
 
 
 def fig_ase_steps(a: Analysis):
-    from asekit.util.plotting import new_figure
     s = a.ase
     fig, ax = new_figure(f"{a.case.name}: power-limited step, fin-root pitch")
     for t, sim in s.simulations.items():
@@ -341,7 +335,6 @@ def figures(a: Analysis) -> dict:
 def write_report(a: Analysis, directory) -> Path:
     """Write ``directory/index.html`` (summary table and figures) with the PNGs beside it and
     ``summary.json``; returns the index path."""
-    from asekit.util.plotting import save_figure
     d = Path(directory)
     d.mkdir(parents=True, exist_ok=True)
     s = summary(a)

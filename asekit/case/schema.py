@@ -24,6 +24,7 @@ from asekit.case.imported import ImportedModel
 from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
 from asekit.rfa.methods import RFA_FITS
 from asekit.structure.supports import SUPPORTS
+from asekit.util.validate import read_toml
 
 
 class CaseError(ValueError):
@@ -665,5 +666,4 @@ def case_from_dict(d: dict, source: str = "") -> Case:
 def load_case(path) -> Case:
     """Read and check a case file (TOML). Raises :class:`CaseError` (a ValueError) naming the
     offending key and its valid range, or FileNotFoundError."""
-    from asekit.util.validate import read_toml
     return case_from_dict(read_toml(path, CaseError), source=str(path))

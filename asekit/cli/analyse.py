@@ -11,6 +11,10 @@ import json
 import sys
 from pathlib import Path
 
+from asekit.case import CaseError, load_case
+from asekit.case.report import format_summary, run_analysis, summary, write_report
+from asekit.io import bdf
+
 
 def add_parser(sub) -> None:
     p = sub.add_parser("analyse", aliases=["analyze"],
@@ -45,14 +49,11 @@ DECK_SUFFIXES = (".bdf", ".dat", ".nas", ".blk")
 def _read_case(args, load_case):
     """The case of ``args.case``: a Nastran deck (by suffix) through asekit.io.bdf, else TOML."""
     if Path(args.case).suffix.lower() in DECK_SUFFIXES:
-        from asekit.io import bdf
         return bdf.read_bdf(args.case, units=getattr(args, "units", "SI"))
     return load_case(args.case)
 
 
 def run(args) -> int:
-    from asekit.case import CaseError, load_case
-    from asekit.case.report import format_summary, run_analysis, summary, write_report
     for opt, what in ((args.json, "--json"), (args.report, "--report")):
         if opt is not None and opt != "-" and (msg := _check_writable(Path(opt), what)):
             print(f"error: {msg}", file=sys.stderr)

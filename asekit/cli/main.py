@@ -17,9 +17,12 @@ import os
 import sys
 from pathlib import Path
 
+from asekit.cli.analyse import add_parser as add_analyse
+from asekit.cli.sweep import add_parser as add_sweep
+from asekit.reproduction.driver import CHAPTERS, ChapterFailed, reproduce
+
 
 def _chapter(name: str) -> str:
-    from asekit.reproduction.driver import CHAPTERS
     valid = [n for n, _ in CHAPTERS]
     if name not in valid:
         raise argparse.ArgumentTypeError(f"unknown chapter {name!r}; choose from "
@@ -66,7 +69,6 @@ def _reproduce(args) -> int:
         os.environ["ASEKIT_CONVERGED_STUDY"] = "1"
     import matplotlib
     matplotlib.use("Agg")
-    from asekit.reproduction.driver import ChapterFailed, reproduce
 
     to_stderr = args.json == "-"
 
@@ -100,7 +102,6 @@ def build_parser() -> argparse.ArgumentParser:
                                                     "standard output; the table goes to "
                                                     "standard error)")
     rep.add_argument("--figures", metavar="DIR", help="write every chapter figure as PNG")
-    from asekit.reproduction.driver import CHAPTERS
     rep.add_argument("--only", nargs="+", metavar="CHAPTER", type=_chapter,
                      help=f"run only these chapters ({', '.join(n for n, _ in CHAPTERS)})")
     rep.add_argument("--wide", action="store_true",
@@ -112,8 +113,6 @@ def build_parser() -> argparse.ArgumentParser:
                      help="also compute the fin's mesh-converged flutter study if it is not "
                           "cached (about 8 min and 7 GB of memory the first time)")
     rep.set_defaults(func=_reproduce, parser=rep)
-    from asekit.cli.analyse import add_parser as add_analyse
-    from asekit.cli.sweep import add_parser as add_sweep
     add_analyse(sub)
     add_sweep(sub)
     return parser

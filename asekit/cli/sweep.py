@@ -9,6 +9,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from asekit import sweep as S
+
 
 def add_parser(sub) -> None:
     p = sub.add_parser("sweep", help="run a flight-envelope / uncertainty sweep of a case file")
@@ -37,7 +39,6 @@ def _error(msg: str) -> int:
 def run(args) -> int:
     import dataclasses
 
-    from asekit import sweep as S
     if args.scheduler and args.executor != "dask":
         return _error("--scheduler needs --executor dask")
     if args.workers is not None and args.workers < 1:

@@ -26,7 +26,12 @@ import control as ct
 import numpy as np
 import scipy.io
 
+from asekit.aeroelastic.statespace import aeroelastic_model, fin_outputs
+from asekit.ase import loop as ase_mod
+from asekit.atmosphere import standard_atmosphere
+from asekit.case import pipeline as pl
 from asekit.io.op4 import write_op4
+from asekit.rfa import roger_fit
 
 
 def _as_statespace(sys, name: str) -> ct.StateSpace:
@@ -140,11 +145,6 @@ def case_state_spaces(case, mach: float | None = None, altitude: float | None = 
     defaults to ``[actuator.condition]`` (else the first Mach and altitude), at the speed
     M a unless ``velocity`` (m/s) is given.
     """
-    from asekit.aeroelastic.statespace import aeroelastic_model, fin_outputs
-    from asekit.ase import loop as ase_mod
-    from asekit.atmosphere import standard_atmosphere
-    from asekit.case import pipeline as pl
-    from asekit.rfa import roger_fit
     a = case.actuator
     mach = (a.mach if a is not None else case.aero.machs[0]) if mach is None else mach
     if altitude is None:

@@ -22,6 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
+from asekit.util.paths import DATA_DIR
+
 
 @dataclass(frozen=True)
 class Op4Matrix:
@@ -255,7 +257,6 @@ class NastranFlutterCase:
 def ha145b_path() -> Path:
     """Location of ``ha145b.op4``: the copy shipped in ``data/benchmarks/ha145b/`` (MSC
     Nastran's own output for its example HA145B, with its README)."""
-    from asekit.util.paths import DATA_DIR
     return DATA_DIR / "benchmarks" / "ha145b" / "ha145b.op4"
 
 

@@ -33,12 +33,25 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from asekit.aeroelastic.flutter import (
+    TabulatedGaf,
+    first_of,
+    pk_flutter,
+    pk_instabilities,
+    root_locus,
+    root_locus_instabilities,
+)
+from asekit.aeroelastic.statespace import fin_outputs, modal_arrays
 from asekit.ase import loop as ase
 from asekit.ase import metrics
+from asekit.atmosphere import standard_atmosphere
 from asekit.case import pipeline
 from asekit.reproduction.driver import ChapterResult, Quantity
 from asekit.reproduction.fin import CORNERS, fin_case
+from asekit.rfa import minimum_state_fit, reduced_frequency_weights, roger_fit
 from asekit.servo.controllers import DigitalController, pd_controller, pid_filtered
+from asekit.servo.controllers import lqg_integral as _lqg
+from asekit.util.plotting import new_figure
 
 MACHS = (0.4, 0.5, 0.6)
 ALTITUDES = (0.0, 2500.0, 5000.0)
@@ -73,7 +86,6 @@ def perturbed_modal(modal, shaft_scale: float = 1.0, freq_scales=(1.0, 1.0)):
     K_ss (Rayleigh-Ritz on the kept modes). Frequencies: K_ss -> S K_ss S with S = diag(s1,
     s2, 1, ...).
     """
-    from asekit.aeroelastic.statespace import fin_outputs
     if shaft_scale <= 0 or min(freq_scales) <= 0:
         raise ValueError("shaft_scale and freq_scales must be > 0")
     shaft = fin_case().support
@@ -92,7 +104,6 @@ def perturbed_modal(modal, shaft_scale: float = 1.0, freq_scales=(1.0, 1.0)):
 def ms_fit(n_states: int = 6):
     """A minimum-state fit factory for :func:`asekit.case.pipeline.ase_condition` (``n_states`` shared lag
     states, steady constraint)."""
-    from asekit.rfa import minimum_state_fit
 
     def fit(k, q, b_ref, mach):
         return minimum_state_fit(k, q, b_ref, n_states=n_states, constrain_k0=True, mach=mach)
@@ -295,7 +306,6 @@ def redesign_a(data=None, max_evaluations: int = 500, x0=None):
 
 def design_b(data=None, topology: str = "AEM2", **overrides) -> DigitalController:
     """Design (b), LQG + integral action on the minimum-state plant (:data:`DESIGN_B`)."""
-    from asekit.servo.controllers import lqg_integral as _lqg
 
     m = fin_model(*DESIGN_B_CONDITION, data=data, fit=ms_fit(DESIGN_B_STATES))
     plant = ase.sampled_plant(m, topology, SAMPLE_TIME)
@@ -307,7 +317,6 @@ def design_b_scheduled(data=None, **overrides):
     """Design (b) scheduled on the flight condition: a factory ``(mach, altitude) ->``
     LQG + integral designed (:data:`DESIGN_B` weights) on the minimum-state plant of that
     condition -- the missile's autopilot knows its Mach and altitude. Designs are cached."""
-    from asekit.servo.controllers import lqg_integral as _lqg
 
     data = load() if data is None else data
     cache = {}
@@ -389,7 +398,6 @@ def rfa_state_study(data=None, mach: float = 0.75, roger_lags=range(0, 8),
                     ms_states=(1, 2, 4, 6, 8, 10, 12, 16), max_iter: int = 2000) -> dict:
     """Fit error against the number of aerodynamic lag states: Roger (N lags -> N n states)
     and minimum-state (n_L states), unweighted, at ``mach``."""
-    from asekit.rfa import minimum_state_fit, roger_fit
 
     db, _ = load() if data is None else data
     g = db.at(mach)
@@ -410,7 +418,6 @@ def states_for_error(table: np.ndarray, target: float = 0.01):
 
 def elastic_problem(data, mach):
     """The clamped (rigid mode held) flutter problem: (ModalArrays, k, Q_ss, b_ref)."""
-    from asekit.aeroelastic.statespace import modal_arrays
 
     db, modal = data
     m = modal_arrays(modal)
@@ -425,16 +432,6 @@ def flutter_comparison(data=None, mach: float = 0.75, altitude: float = 0.0,
                        order: int = 4, velocities=np.arange(150.0, 461.0, 5.0)) -> dict:
     """Flutter speed of the fin (rigid mode held) by p-k and by the root locus with Roger fits
     and minimum-state fits (unweighted and weighted to k <= ``band`` k_f, k_f from p-k)."""
-    from asekit.aeroelastic.flutter import (
-        TabulatedGaf,
-        first_of,
-        pk_flutter,
-        pk_instabilities,
-        root_locus,
-        root_locus_instabilities,
-    )
-    from asekit.atmosphere import standard_atmosphere
-    from asekit.rfa import minimum_state_fit, reduced_frequency_weights, roger_fit
 
     data = load() if data is None else data
     me, k, Qe, b = elastic_problem(data, mach)
@@ -589,7 +586,6 @@ def format_envelope(checks, designs_order=None) -> str:
 
 
 def fig_fit_error(study):
-    from asekit.util.plotting import new_figure
     fig, ax = new_figure(f"RFA fit error vs aerodynamic lag states (fin, Mach {study['mach']})",
                          "beyond the thesis")
     rg, ms = study["roger"], study["minimum_state"]
@@ -603,7 +599,6 @@ def fig_fit_error(study):
 
 
 def fig_loop_bode(plant, design_set, f_hz=None):
-    from asekit.util.plotting import new_figure
     f = np.logspace(0, np.log10(480.0), 2000) if f_hz is None else f_hz
     fig, ax = new_figure(f"Loop gain at the voltage demand, {plant.topology}, sampled 1 kHz",
                          "beyond the thesis", nrows=2, sharex=True, figsize=(7.5, 6.5))
@@ -621,7 +616,6 @@ def fig_loop_bode(plant, design_set, f_hz=None):
 
 def fig_steps(model, design_set, limits=ase.THESIS_LIMITS, t_final=0.1):
     """Fin-root responses to 1 deg and 15 deg steps (normalised), voltage and current."""
-    from asekit.util.plotting import new_figure
     label = "power limited" if limits is not None else "linear"
     fig, ax = new_figure(f"Steps at the fin root, AEM2, {label}", "beyond the thesis", nrows=3,
                          sharex=True, figsize=(7.5, 8.0))

@@ -26,6 +26,7 @@ from pathlib import Path
 
 from asekit.reproduction.thesis import _load, is_number, thesis_value
 from asekit.util.paths import THESIS_FILE
+from asekit.util.plotting import save_figure
 
 #: Chapters in the thesis's order (its one-way data flow). A chapter whose module does not
 #: exist yet is skipped; a chapter whose module exists but fails raises.
@@ -371,7 +372,6 @@ def reproduce(chapters: list[str] | None = None, figures_dir: str | Path | None 
             if result.failures:
                 out["failures"][name] = list(result.failures)
             if figures_dir is not None:
-                from asekit.util.plotting import save_figure
                 for fig_name, fig in result.figures.items():
                     save_figure(fig, figures_dir, fig_name)
             if bar is not None:

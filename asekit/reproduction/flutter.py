@@ -16,18 +16,32 @@ from __future__ import annotations
 
 import numpy as np
 
+from asekit.aero.gaf import gaf_from_box_modes
+from asekit.aero.spline import InfinitePlateSpline, fe_spline
 from asekit.aeroelastic.flutter import (
     TabulatedGaf,
     divergence_speeds,
     first_of,
+    initial_state,
+    matched_mach,
     pk_flutter,
     pk_instabilities,
     root_locus,
     root_locus_instabilities,
+    simulate_free_response,
     time_domain_sweep,
 )
+from asekit.aeroelastic.statespace import ModalArrays, aeroelastic_matrices, modal_arrays
 from asekit.atmosphere import standard_atmosphere
+from asekit.case import pipeline
+from asekit.case.variants import with_boxes, with_mesh
+from asekit.io.op4 import ha145b_path, load_ha145b
 from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.reproduction.fin import distributed_case, fin_case
+from asekit.rfa import default_lag_roots, roger_fit, roger_fit_database
+from asekit.util.cache import CacheError, load_npz, save_npz
+from asekit.util.paths import FIN_FILE, user_cache_dir
+from asekit.util.plotting import THESIS_COLOR, new_figure, plot_vg
 
 VELOCITIES = np.arange(100.0, 460.0 + 1e-9, 2.0)      # m/s
 ALTITUDES = (0.0, 2500.0, 5000.0)                       # m
@@ -37,8 +51,6 @@ N_LAGS = 4
 
 def load_fin_gafs():
     """(GafDatabase, ModalModel) of the fin, or (None, reason) when not available."""
-    from asekit.case import pipeline
-    from asekit.reproduction.fin import fin_case
     try:
         case = fin_case()
         db, modal = pipeline.gaf_database(case, progress=False), pipeline.modal_model(case)
@@ -49,7 +61,6 @@ def load_fin_gafs():
 
 def fin_rfa(db, mach: float, n_lags: int = N_LAGS, constrain_k0: bool = False, lag_roots=None):
     """Roger fit of the fin's GAFs at ``mach`` (default lag roots over the database's k)."""
-    from asekit.rfa import roger_fit_database
     return roger_fit_database(db, mach, n_lags=n_lags, constrain_k0=constrain_k0,
                               lag_roots=lag_roots)
 
@@ -69,7 +80,6 @@ def analyse_condition(modal, db, mach: float, altitude: float, velocities=VELOCI
 def time_domain_first(modal, fit, rho: float, velocities=np.arange(100.0, 461.0, 10.0)):
     """Time-domain growth sweep and the onset kind (flutter if the A_sys root crossing near the
     onset is oscillatory, else divergence)."""
-    from asekit.aeroelastic.statespace import aeroelastic_matrices
     td = time_domain_sweep(modal, fit, rho, velocities, coordinate=1)
     kind = None
     if td.onset_speed is not None:
@@ -81,9 +91,6 @@ def time_domain_first(modal, fit, rho: float, velocities=np.arange(100.0, 461.0,
 
 def ha145b_check() -> dict | None:
     """p-k, root locus and time domain on Nastran's HA145B (None if the file is absent)."""
-    from asekit.aeroelastic.statespace import modal_arrays
-    from asekit.io.op4 import ha145b_path, load_ha145b
-    from asekit.rfa import roger_fit
     if not ha145b_path().exists():
         return None
     case = load_ha145b()
@@ -215,7 +222,6 @@ def run(figures: bool = False) -> ChapterResult:
 # --------------------------------------------------------------------------------------------
 def fig_rfa_element(fit, i: int, j: int, thesis_figure: str = "Fig 23"):
     """Data vs Roger fit of element Q_ij in the complex plane (Figs 23-24)."""
-    from asekit.util.plotting import new_figure
     fig, ax = new_figure(f"RFA fit of Q_{i + 1}{j + 1} (Mach {fit.mach})", thesis_figure)
     kk = np.geomspace(max(fit.k[0], 1e-4), fit.k[-1], 300)
     qf = fit.evaluate(kk)[:, i, j]
@@ -248,7 +254,6 @@ FLUTTER_MARGIN = 0.15
 
 def _envelope():
     """(u_min, u_max, h_max) of the analysis envelope in data/fin.toml (m/s, m/s, m)."""
-    from asekit.reproduction.fin import fin_case
     c = fin_case()
     return float(c.aero.u_min), float(c.flight.velocities[-1]), float(max(c.flight.altitudes))
 
@@ -256,7 +261,6 @@ def _envelope():
 def fig_mach_airspeed_altitude(points=(), thesis_figure: str = "Fig 25"):
     """Mach lines in the airspeed-altitude plane (Fig 25) with the analysis envelope of
     data/fin.toml shaded; optional (U, h, label) points, one marker style per label."""
-    from asekit.util.plotting import new_figure
     fig, ax = new_figure("Mach - airspeed - altitude (1976 standard atmosphere)", thesis_figure)
     h = np.linspace(0, 12000, 100)
     a = standard_atmosphere(h).speed_of_sound
@@ -289,7 +293,6 @@ def fig_match_points(table, thesis_figure: str = "Figs 26-28"):
     of the standard atmosphere and the p-k flutter speed at each analysis Mach (rows of
     :func:`asekit.aeroelastic.flutter.match_point_table`); where the two meet is the matched flutter point.
     The flight envelope's Mach band (Table 3) and the customary +15 % margin are drawn."""
-    from asekit.util.plotting import new_figure
     alts = sorted({r.altitude for r in table})
     fig, axes = new_figure("Match point: flutter speed per analysis Mach vs flight Mach",
                            thesis_figure, ncols=len(alts), figsize=(4.2 * len(alts), 4.2),
@@ -309,7 +312,6 @@ def fig_match_points(table, thesis_figure: str = "Figs 26-28"):
         for r in rows:
             ax.annotate(f"{r.speed:.0f}", (r.speed, r.mach), textcoords="offset points",
                         xytext=(5, -3), fontsize=7, color="C3")
-        from asekit.aeroelastic.flutter import matched_mach
         mm = matched_mach(table, h)
         if mm is not None:
             ax.plot(mm * a, mm, "*", color="C2", ms=12, label=f"matched M {mm:.3f}")
@@ -342,7 +344,6 @@ def _damping_frequency_figure(title, thesis_figure, velocities, roots, labels, r
     marked beside the thesis's; ``root`` names the eigenvalue in the axis label. (The thesis's
     figures plot the damping ratio xi = -Re/|.| instead, ~ -g/2: its curves are mirrored and
     halved; the zero crossing, the flutter point, is the same.)"""
-    from asekit.util.plotting import new_figure, plot_vg
     fig, (a1, a2) = new_figure(title, thesis_figure, nrows=2, figsize=(6.4, 6.5), sharex=True)
     plot_vg(a1, a2, velocities, roots, labels, root=root, g_limits=(-1.0, 0.5))
     lim = _low_modes_ylim(np.abs(np.asarray(roots).imag) / (2 * np.pi))
@@ -366,7 +367,6 @@ def fig_pk(res, title="p-k damping and frequency", thesis_figure="Figs 30-31", u
 
 
 def _mark_flutter(a1, a2, flutter, thesis_point, unit):
-    from asekit.util.plotting import THESIS_COLOR
     if flutter is not None:
         a1.plot(flutter.speed, 0.0, "*", color="C3", ms=12, zorder=5,
                 label=f"asekit {flutter.speed:.1f} {unit}")
@@ -385,7 +385,6 @@ def _mark_flutter(a1, a2, flutter, thesis_point, unit):
 def fig_root_locus(rl, thesis_figure="Figs 32, 35", flutter=None):
     """Aeroelastic roots over airspeed in the complex plane (Figs 32, 35); the flutter root
     marked when ``flutter`` is given."""
-    from asekit.util.plotting import new_figure
     fig, ax = new_figure("Root locus of A_sys (aeroelastic roots)", thesis_figure)
     for j, name in enumerate(rl.mode_labels):
         ax.plot(rl.elastic[:, j].real, rl.elastic[:, j].imag / (2 * np.pi), ".-", ms=3,
@@ -413,7 +412,6 @@ def fig_root_locus_damping(rl, thesis_figure="Figs 33-34", unit="m/s", flutter=N
 def fig_time_responses(responses, coordinate=1, thesis_figure="Figs 36-38"):
     """Free responses of one elastic coordinate, one panel per (label, speed, response), filled
     column by column (Figs 36-38: the thesis's speeds left, asekit's onset speeds right)."""
-    from asekit.util.plotting import new_figure
     n = len(responses)
     fig, axes = new_figure(f"Free response of zeta_{coordinate + 1} (Eq. 3.15)", thesis_figure,
                            nrows=(n + 1) // 2, ncols=2, figsize=(11, 2.6 * ((n + 1) // 2) + 0.8),
@@ -430,7 +428,6 @@ def fig_time_responses(responses, coordinate=1, thesis_figure="Figs 36-38"):
 
 def fig_time_response(resp, coordinate=1, speed=None, thesis_figure="Figs 36-38"):
     """Elastic coordinate history (Figs 36-38)."""
-    from asekit.util.plotting import new_figure
     fig, ax = new_figure(f"Free response, zeta_{coordinate + 1}"
                          + (f" at {speed:.0f} m/s" if speed else ""), thesis_figure)
     ax.plot(resp.t, resp.z[:, coordinate], lw=0.8)
@@ -441,7 +438,6 @@ def fig_time_response(resp, coordinate=1, speed=None, thesis_figure="Figs 36-38"
 
 def fig_step_sizes(resp, speed: float, thesis_figure="Fig 39"):
     """RK45 step sizes of one free-response run (Fig 39), as 1/step on a log axis."""
-    from asekit.util.plotting import new_figure
     fig, ax = new_figure(f"RK45 step sizes of the free response at {speed:.1f} m/s",
                          thesis_figure)
     ax.semilogy(np.cumsum(resp.steps), 1.0 / resp.steps, ".", ms=2)
@@ -455,7 +451,6 @@ def fig_step_sizes(resp, speed: float, thesis_figure="Fig 39"):
 def fig_flutter_mode(modal, flutter, thesis_figure="Fig 29"):
     """Flutter mode shape (Fig 29): magnitude and phase of the out-of-plane displacement of the
     flutter eigenvector expanded on the elastic mode shapes (normalised to its largest value)."""
-    from asekit.util.plotting import new_figure
     v = flutter.vector / flutter.vector[np.argmax(np.abs(flutter.vector))]
     w = modal.shapes[:, 0, modal.n_rigid:] @ v
     w = w / w[np.argmax(np.abs(w))]
@@ -477,7 +472,6 @@ def fig_flutter_mode(modal, flutter, thesis_figure="Fig 29"):
 
 def fig_growth(td, thesis_figure="Table 11", unit="m/s"):
     """Growth rate of the free response vs airspeed."""
-    from asekit.util.plotting import new_figure
     fig, ax = new_figure("Time domain: growth rate vs airspeed", thesis_figure)
     ax.plot(td.velocities, td.growth, "o-")
     ax.axhline(0, color="k", lw=0.8)
@@ -492,7 +486,6 @@ def fig_growth(td, thesis_figure="Table 11", unit="m/s"):
 def fig_damping_study(rows, thesis_speed: float | None = None):
     """Flutter speed vs modal damping ratio zeta and vs structural damping g (its viscous
     equivalent g K / omega_f at the flutter frequency; plotted at zeta = g / 2)."""
-    from asekit.util.plotting import THESIS_COLOR, new_figure
     fig, ax = new_figure("Flutter speed vs structural damping, Mach 0.75, sea level, 6x7 model")
     z = [(r["value"], r["speed"]) for r in rows if r["kind"] == "zeta" and r["speed"]]
     g = [(r["value"], r["speed"]) for r in rows if r["kind"] == "g" and r["speed"]]
@@ -511,8 +504,6 @@ def free_responses(modal, fit, rho: float, onset: float | None, t_end: float = 0
     """Free responses (Eq. 3.15, unit initial zeta_2, RK45 with steps <= 1e-4 s) at the thesis's
     248 / 254 / 260 m/s (Figs 36-38) and at asekit's onset -6 / 0 / +6 m/s: a list of
     (label, speed, FreeResponse)."""
-    from asekit.aeroelastic.flutter import initial_state, simulate_free_response
-    from asekit.aeroelastic.statespace import aeroelastic_matrices
     cases = [("thesis Fig 36", 248.0), ("thesis Fig 37", 254.0), ("thesis Fig 38", 260.0)]
     if onset:
         cases += [("asekit onset - 6", onset - 6.0), ("asekit onset", onset),
@@ -565,7 +556,6 @@ def root_locus_panel(modal, db, mach: float = 0.75, n_lags: int = N_LAGS):
         return None
     import matplotlib.pyplot as plt
 
-    from asekit.aeroelastic.statespace import aeroelastic_matrices
     fit = fin_rfa(db, mach, n_lags=n_lags)
     out = w.Output()
     speed = w.FloatSlider(value=250.0, min=100.0, max=460.0, step=2.0, description="U (m/s)")
@@ -605,7 +595,6 @@ def scaled_modal(modal, mass_scale: float = 1.0, elastic_hz=None):
     ``mass_scale`` (a different material density with the same mode shapes: M -> s M, K and
     the GAFs unchanged), and/or the elastic stiffnesses set so that the elastic frequencies
     become ``elastic_hz`` (same shapes, K_ss diagonal rescaled; assumes M_ss diagonal)."""
-    from asekit.aeroelastic.statespace import ModalArrays, modal_arrays
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
     M = m.M * mass_scale
     K = m.K.copy()
@@ -620,7 +609,6 @@ def sensitivity_study(modal, db, mach: float = 0.75, altitude: float = 0.0,
                       velocities=VELOCITIES) -> list[dict]:
     """p-k (and root-locus) flutter speed of the fin under modelling variants that the thesis
     leaves open or states differently. Returns rows {label, speed, freq, first, first_kind}."""
-    from asekit.aeroelastic.statespace import modal_arrays
     rho0 = float(standard_atmosphere(altitude).density)
     gaf = db.at(mach)
     base = modal_arrays(modal)
@@ -644,7 +632,6 @@ def sensitivity_study(modal, db, mach: float = 0.75, altitude: float = 0.0,
     for label, mod, g, rho, kw in variants:
         if mod is None:      # truncated modal basis
             n = base.n_rigid + 2
-            from asekit.aeroelastic.statespace import ModalArrays
             mod = ModalArrays(M=base.M[:n, :n], K=base.K[:n, :n], C=base.C[:n, :n],
                               n_rigid=base.n_rigid)
             g = TabulatedGaf(gaf.k, gaf.Q[:, :n, :n], gaf.b_ref, gaf.mach)
@@ -663,7 +650,6 @@ def rfa_sensitivity(modal, db, mach: float = 0.75, altitude: float = 0.0,
                     velocities=VELOCITIES) -> list[dict]:
     """Root-locus flutter speed for several Roger fits (lag count, lag spread, steady-load
     constraint): the RFA-side spread the thesis names in Section 3.3.4."""
-    from asekit.rfa import default_lag_roots
     rho = float(standard_atmosphere(altitude).density)
     kmax = float(np.max(db.k))
     cases = [("2 lags", {"n_lags": 2}), ("4 lags (default)", {"n_lags": 4}),
@@ -690,11 +676,6 @@ def aero_variant_gafs(modal, db, mach: float = 0.75, symmetric: bool = False,
     nodes instead of the finite-element shape functions, on the database's k and b_ref (uses
     asekit.aero; a few seconds per variant). ``modal`` is the ModalModel whose shapes are used.
     """
-    from asekit.aero.gaf import gaf_from_box_modes
-    from asekit.aero.spline import InfinitePlateSpline, fe_spline
-    from asekit.case import pipeline
-    from asekit.case.variants import with_boxes
-    from asekit.reproduction.fin import fin_case
     case = fin_case()
     boxes = pipeline.box_mesh(case if (n_chord, n_span) == (None, None)
                               else with_boxes(case, n_chord, n_span))
@@ -723,8 +704,6 @@ def structure_variant(n_chord: int | None = None, n_span: int | None = None,
     """The fin's case on an ``n_chord x n_span`` structural mesh (default the case's) with the
     ``"single_node"`` (thesis) or ``"distributed"`` shaft
     (:func:`asekit.reproduction.fin.distributed_case`)."""
-    from asekit.case.variants import with_mesh
-    from asekit.reproduction.fin import distributed_case, fin_case
     if shaft == "single_node":
         return with_mesh(fin_case(), n_chord, n_span)
     if shaft == "distributed":
@@ -737,8 +716,6 @@ def model_sensitivity(db, mach: float = 0.75, altitude: float = 0.0, velocities=
     """p-k flutter speed with the structure and/or GAFs rebuilt for modelling variants (support
     model, structural mesh, spline, symmetry plane, aerodynamic mesh) at one Mach and altitude.
     Rows: label, elastic frequencies (Hz), Q_cc(k_min), speed, freq, first, first_kind."""
-    from asekit.aeroelastic.statespace import modal_arrays
-    from asekit.case import pipeline
     rho = float(standard_atmosphere(altitude).density)
     rows = []
     for label, skw, akw in variants:
@@ -777,7 +754,6 @@ def damped_modal(modal, zeta: float = 0.0, g: float = 0.0, omega_ref: float | No
     (rad/s) — at the flutter point when omega_ref is the flutter frequency (p = i omega_f:
     p (g/omega_f) K = i g K). The rigid mode stays undamped. ``zeta`` in [0, 1), ``g`` >= 0.
     """
-    from asekit.aeroelastic.statespace import ModalArrays, modal_arrays
     if not (0.0 <= zeta < 1.0):
         raise ValueError(f"zeta must be in [0, 1), got {zeta!r}")
     if not (g >= 0.0 and np.isfinite(g)):
@@ -864,7 +840,6 @@ def _study_fingerprint(db, mach, altitude, velocities, structure, aero) -> str:
     import hashlib
     from pathlib import Path
 
-    from asekit.util.paths import FIN_FILE
     h = hashlib.sha256()
     h.update(f"v{_STUDY_VERSION} {mach!r} {altitude!r} {structure!r} {aero!r}".encode())
     h.update(np.ascontiguousarray(np.asarray(velocities, float)).tobytes())
@@ -885,7 +860,6 @@ def _distributed_model(structure):
     """The FN2 modal model with the distributed shaft region on a ``structure`` mesh."""
     import warnings
 
-    from asekit.case import pipeline
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")          # unresolved shaft region on the coarse meshes
         return pipeline.modal_model(structure_variant(structure[0], structure[1], "distributed"))
@@ -893,7 +867,6 @@ def _distributed_model(structure):
 
 def _mesh_flutter(model, db, mach, rho, velocities, aero):
     """(elastic Hz (first 3), speed, freq) of ``model`` with GAFs on the ``aero`` box mesh."""
-    from asekit.aeroelastic.statespace import modal_arrays
     g = aero_variant_gafs(model, db, mach, n_chord=aero[0], n_span=aero[1])
     m = modal_arrays(model)
     fl = first_of(pk_instabilities(pk_flutter(m, g, rho, velocities), m, g), "flutter")
@@ -923,8 +896,6 @@ def converged_flutter_study(db, mach: float = 0.75, altitude: float = 0.0,
     the physics source, and reused while the fingerprint matches. With ``compute=False`` a
     missing or stale cache returns None instead of computing.
     """
-    from asekit.util.cache import CacheError, load_npz, save_npz
-    from asekit.util.paths import user_cache_dir
     key = _study_fingerprint(db, mach, altitude, velocities, structure, aero)
     path = user_cache_dir() / f"flutter_convergence_{key[:16]}.npz"
     if cache:

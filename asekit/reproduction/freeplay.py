@@ -49,12 +49,24 @@ from asekit.aeroelastic.nonlinear import (
     equilibria,
     growth_rate,
     harmonic_balance,
+    multi_harmonic_balance,
     simulate_exact,
+    steady_oscillation,
 )
 from asekit.aeroelastic.statespace import aeroelastic_matrices, fin_outputs, modal_arrays
+from asekit.aeroelastic.typical_section import (
+    CONNER_FREEPLAY_HALF_WIDTH_DEG,
+    connected_system,
+    conner_1997,
+    flutter_speed,
+    flutter_speed_exact,
+)
 from asekit.atmosphere import standard_atmosphere
 from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.reproduction.fin import CORNERS, fin_case
+from asekit.reproduction.flutter import fin_rfa, load_fin_gafs
 from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, PDController, actuator_state_space
+from asekit.util.plotting import new_figure
 
 MACHS = {"M05": 0.5, "M075": 0.75}
 FREEPLAYS_DEG = (0.05, 0.1, 0.25, 0.5)
@@ -158,8 +170,6 @@ class FinFreeplayModel:
 def fin_freeplay_model(mach: float, data=None, n_lags: int = N_LAGS) -> FinFreeplayModel:
     """Build :class:`FinFreeplayModel` from the cached GAF database (``data`` = (db, modal) as
     :func:`asekit.reproduction.flutter.load_fin_gafs` returns; loaded when None)."""
-    from asekit.reproduction.fin import CORNERS, fin_case
-    from asekit.reproduction.flutter import fin_rfa, load_fin_gafs
 
     if data is None:
         data, reason = load_fin_gafs()
@@ -355,7 +365,6 @@ def run(figures: bool = False) -> ChapterResult:
     LCO onset speed and amplitude at 200 m/s (fin alone and AEM1), linear flutter speeds,
     the static offset at 200 m/s and the freeplay limit for a 0.1 deg excursion up to the
     matched flight speed."""
-    from asekit.reproduction.flutter import load_fin_gafs
 
     data, reason = load_fin_gafs()
     keys = ["freeplay.M05.h0.lco_onset_ms", "freeplay.M05.h0.amplitude_deg_at_200ms",
@@ -408,7 +417,6 @@ def run(figures: bool = False) -> ChapterResult:
 def fig_excursion(results: dict, label: str):
     """Fin-root LCO amplitude (biased LCO) and static offset (deg) vs airspeed for each
     ``(config, delta_deg) -> ConfigResult`` entry, with the linear flutter speeds."""
-    from asekit.util.plotting import new_figure
     fig, (a1, a2) = new_figure(f"Freeplay: fin-root motion, {label}, sea-level density", None,
                                nrows=2, figsize=(6.4, 6.5))
     for j, ((cfg, dd), res) in enumerate(sorted(results.items())):
@@ -433,7 +441,6 @@ def fig_fin_lco(results: dict, freeplays_deg=FREEPLAYS_DEG):
     """Biased-LCO fin-root amplitude (deg, top) and frequency (Hz, bottom) vs airspeed for
     ``{(label, config): ConfigResult}``, one line per freeplay (amplitude proportional to
     delta), with each configuration's linear flutter speed (vertical line)."""
-    from asekit.util.plotting import new_figure
     fig, (a1, a2) = new_figure("Freeplay LCO of the fin (dual-input DF), sea-level density",
                                None, nrows=2, figsize=(7.0, 7.0))
     styles = ["-", "--", ":", "-."]
@@ -461,7 +468,6 @@ def fig_fin_lco(results: dict, freeplays_deg=FREEPLAYS_DEG):
 def fig_history(sim, delta: float, title: str, t_window: float | None = None):
     """d / delta vs time of a :class:`asekit.aeroelastic.nonlinear.PiecewiseSimulation` (last
     ``t_window`` s, default all), band edges dashed."""
-    from asekit.util.plotting import new_figure
     fig, ax = new_figure(title, None, figsize=(7.0, 3.0))
     sel = sim.t >= (sim.t[-1] - t_window if t_window else 0.0)
     ax.plot(sim.t[sel], sim.d[sel] / delta, lw=0.6)
@@ -476,7 +482,6 @@ def fig_growth_map(system_at, k: float, velocities, kappas=np.linspace(0.0, 1.0,
                    title: str = "growth rate of the quasi-linear system"):
     """Largest real part of the oscillatory roots (1/s) over (airspeed, equivalent stiffness
     ratio N/k): the harmonic-balance LCOs lie on its zero contour."""
-    from asekit.util.plotting import new_figure
     fig, ax = new_figure(title, None, figsize=(6.4, 4.2))
     v = np.asarray(velocities, float)
     sig = np.array([[growth_rate(system_at(u), kp * k)[0] for u in v] for kp in kappas])
@@ -531,14 +536,6 @@ def conner_study(delta_half_deg: float | None = None, velocities=np.arange(3.0, 
     a flap freeplay of half-width ``delta_half_deg`` (default: Conner et al., +-2.12 deg)."""
     from scipy.optimize import brentq
 
-    from asekit.aeroelastic.nonlinear import multi_harmonic_balance, steady_oscillation
-    from asekit.aeroelastic.typical_section import (
-        CONNER_FREEPLAY_HALF_WIDTH_DEG,
-        connected_system,
-        conner_1997,
-        flutter_speed,
-        flutter_speed_exact,
-    )
     sec = conner_1997()
     dl = math.radians(CONNER_FREEPLAY_HALF_WIDTH_DEG if delta_half_deg is None
                       else delta_half_deg)
@@ -630,12 +627,6 @@ def conner_path_following(velocities, delta_half_deg: float | None = None,
     starts the LCO). Returns a tuple of :class:`PathPoint`."""
     from scipy.signal import find_peaks
 
-    from asekit.aeroelastic.nonlinear import steady_oscillation
-    from asekit.aeroelastic.typical_section import (
-        CONNER_FREEPLAY_HALF_WIDTH_DEG,
-        connected_system,
-        conner_1997,
-    )
     v = np.asarray(velocities, float)
     if v.size == 0 or np.any(np.diff(v) <= 0):
         raise ValueError("velocities must be a non-empty increasing sequence")
@@ -667,7 +658,6 @@ def conner_path_following(velocities, delta_half_deg: float | None = None,
 def fig_conner(cs: ConnerStudy):
     """Flap LCO amplitude / delta (DF; time domain first harmonic and half peak-to-peak) and
     frequency vs airspeed for the Conner et al. section."""
-    from asekit.util.plotting import new_figure
     fig, (a1, a2) = new_figure("Conner et al. (1997) section with flap freeplay", None,
                                nrows=2, figsize=(6.4, 6.5))
     for branch, mk in ((True, "-"), (False, ":")):

@@ -24,7 +24,10 @@ from dataclasses import dataclass
 import control as ct
 import numpy as np
 
+from asekit.aero.gaf import GAF_FILE, GafDatabase, steady_hinge_coefficient
+from asekit.case import pipeline
 from asekit.reproduction.driver import ChapterResult, Quantity
+from asekit.reproduction.fin import fin_case
 from asekit.servo.actuator import (
     NO_CONTROLLER,
     SYSTEM_1,
@@ -50,6 +53,7 @@ from asekit.servo.torque_requirement import (
     required_stall_torque,
     tune_rate_limit,
 )
+from asekit.util.cache import CacheError, load_npz
 from asekit.util.plotting import THESIS_COLOR, new_figure
 
 #: Thesis Table 2: the settling-time and steady-state error requirements.
@@ -122,15 +126,11 @@ def asekit_fin_inputs(mach: float = 0.6) -> FinInputs:
     notes = []
     j_fin = q_cc = None
     try:
-        from asekit.case import pipeline
-        from asekit.reproduction.fin import fin_case
         j_fin = pipeline.pitch_inertia_exact(fin_case())
         notes.append("J_fin: exact plate integral")
     except (ImportError, AttributeError, ValueError) as exc:      # structure not available
         notes.append(f"J_fin unavailable ({exc})")
     try:
-        from asekit.aero.gaf import GAF_FILE, GafDatabase, steady_hinge_coefficient
-        from asekit.util.cache import CacheError, load_npz
         try:
             arrays, meta = load_npz(GAF_FILE)
             db = GafDatabase(arrays["machs"], arrays["k"], arrays["Q"], float(meta["b_ref"]),

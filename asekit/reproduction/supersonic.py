@@ -43,7 +43,11 @@ from asekit.atmosphere import standard_atmosphere
 from asekit.case import pipeline
 from asekit.reproduction.driver import ChapterResult, Quantity
 from asekit.reproduction.fin import fin_case
+from asekit.servo.actuator import THESIS_FIN_INERTIA
+from asekit.servo.torque_requirement import profile_step, required_stall_torque, tune_rate_limit
 from asekit.util.cache import CacheError, load_npz, save_npz
+from asekit.util.paths import user_cache_dir
+from asekit.util.plotting import new_figure
 from asekit.util.version import __version__
 
 MACHS = (0.4, 0.5, 0.6, 0.75, 0.9, 1.15, 1.2, 1.5, 2.0, 2.5, 3.0)
@@ -55,7 +59,6 @@ CACHE_FORMAT = 3
 
 def cache_dir() -> Path:
     """The user cache directory (:func:`asekit.util.paths.user_cache_dir`, never the repository)."""
-    from asekit.util.paths import user_cache_dir
     return user_cache_dir()
 
 
@@ -121,7 +124,6 @@ def _compute(model, boxes, ks, b_ref) -> dict:
 
 def _peak_acceleration() -> float:
     """|theta''|_max of the Section 4.1.1 command profile (as in the servo chapter)."""
-    from asekit.servo.torque_requirement import profile_step, tune_rate_limit
     profile = tune_rate_limit(natural_frequency=157.0, damping_ratio=1.0,
                               step=math.radians(15.0), settling_time=0.05, band=0.02)
     return float(profile_step(profile, math.radians(15.0), t_final=0.08).peak_acceleration)
@@ -169,8 +171,6 @@ def torque_at_worst_supersonic(env: dict) -> dict:
     """Section 4.1.1 stall torque (Eqs. 4.1, 4.7, 4.10-4.12) re-evaluated with Q_cc(M) at the
     supersonic (Mach, altitude) of the largest steady hinge moment |q Q_cc| (q = rho (M a)^2/2);
     the command profile and fin inertia as in the servo chapter."""
-    from asekit.servo.actuator import THESIS_FIN_INERTIA
-    from asekit.servo.torque_requirement import required_stall_torque
     best = None
     for im, mach in enumerate(env["machs"]):
         if mach < SUPERSONIC_MACH_MIN:
@@ -238,7 +238,6 @@ def _gap(ax):
 
 def fig_flutter_vs_mach(env=None):
     """Flutter and divergence speed vs Mach at each altitude, with the flight speed M a(h)."""
-    from asekit.util.plotting import new_figure
     env = envelope() if env is None else env
     fig, ax = new_figure("Fin flutter and divergence across the envelope")
     m = env["machs"]
@@ -258,7 +257,6 @@ def fig_flutter_vs_mach(env=None):
 
 def fig_qcc_vs_mach(env=None):
     """Steady hinge coefficient Q_cc(M) and the centre of pressure."""
-    from asekit.util.plotting import new_figure
     env = envelope() if env is None else env
     fig, axes = new_figure("Steady hinge coefficient and centre of pressure vs Mach", ncols=2)
     m = env["machs"]

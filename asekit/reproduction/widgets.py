@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from asekit.ase import loop as ase
 from asekit.case import pipeline
 from asekit.reproduction.fin import CORNERS, fin_case
 from asekit.servo.actuator import (
@@ -26,6 +27,7 @@ from asekit.servo.actuator import (
     step_response,
 )
 from asekit.servo.simulate import PowerLimits, SimulationResult, SteadyHingeMoment, simulate
+from asekit.util.plotting import THESIS_COLOR, new_figure
 
 
 @dataclass(frozen=True)
@@ -64,7 +66,6 @@ def servo_snapshot(gain: float, kp: float, kd: float, supply_voltage: float = 24
 def _draw(snap: ServoSnapshot, supply_voltage: float):
     import matplotlib.pyplot as plt
 
-    from asekit.util.plotting import THESIS_COLOR, new_figure
     fig, (ax1, ax2) = new_figure(
         f"K_c {snap.controller.gain:g}, K_P {snap.controller.kp:g}, K_D {snap.controller.kd:g}",
         "Figs 50-54 (live)", ncols=2, figsize=(11, 4))
@@ -178,7 +179,6 @@ def ase_snapshot(gain: float, kp: float, kd: float, mach: float = 0.5, altitude:
     :func:`asekit.case.pipeline.ase_condition` on the fin's case)."""
     import control as ct
 
-    from asekit.ase import loop as ase
 
     ctrl = PDController(gain, kp, kd, name="panel")
     fin = pipeline.ase_condition(fin_case(), mach=mach, altitude=altitude) if fin is None else fin
@@ -197,8 +197,6 @@ def ase_snapshot(gain: float, kp: float, kd: float, mach: float = 0.5, altitude:
 def _draw_ase(snap: AseSnapshot):
     import matplotlib.pyplot as plt
 
-    from asekit.ase import loop as ase
-    from asekit.util.plotting import THESIS_COLOR, new_figure
 
     c = snap.controller
     fig, axes = new_figure(f"{snap.topology}, M {snap.mach:g}, h {snap.altitude:g} m, K_c {c.gain:g}"
@@ -234,7 +232,6 @@ def ase_panel(controller: PDController = SYSTEM_3, mach: float = 0.5, altitude: 
     builds without a front-end. Models are kept per (Mach, altitude) inside the panel."""
     import ipywidgets as w
 
-    from asekit.ase import loop as ase
 
     sliders = {
         **_pd_sliders(controller),

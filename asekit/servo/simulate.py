@@ -54,7 +54,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from asekit.ase import metrics
-from asekit.servo.actuator import ActuatorParameters, PDController
+from asekit.servo.actuator import ActuatorParameters, PDController, closed_loop_polynomial
 from asekit.servo.piecewise import propagate_exact, voltage_bounds
 from asekit.servo.torque_requirement import (
     SEA_LEVEL_DENSITY,
@@ -314,7 +314,6 @@ def estimate_steps(params: ActuatorParameters, controller: PDController, t_final
     4.18, :func:`asekit.servo.actuator.closed_loop_polynomial`) or of the open-loop motor (when the supply
     clips the voltage or between zero-order-hold samples). A zero-order-hold controller adds at
     least 6 steps per sample. Returns (steps, |lambda_max|)."""
-    from asekit.servo.actuator import closed_loop_polynomial
     cl = closed_loop_polynomial(params, controller)
     ol = closed_loop_polynomial(params, PDController(0.0, 0.0, 0.0))
     lam = 0.0

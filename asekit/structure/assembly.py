@@ -36,7 +36,13 @@ import scipy.sparse as sp
 
 from asekit.geometry import Material
 from asekit.structure.mesh import PlateMesh
-from asekit.structure.plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness
+from asekit.structure.plate import (
+    DOF_PER_NODE,
+    consistent_mass,
+    locate_points,
+    mitc4_stiffness,
+    shape_functions,
+)
 from asekit.util.validate import positive
 
 
@@ -271,7 +277,6 @@ def point_mass_matrix(mesh: PlateMesh, masses) -> sp.csr_matrix:
     (kinetic energy 1/2 m (N w)^2 + 1/2 I_xx (N theta_x)^2 + 1/2 I_yy (N theta_y)^2), so a
     mass need not sit on a node; at a node this is the usual lumped CONM2-like mass.
     """
-    from asekit.structure.plate import locate_points, shape_functions
     n = DOF_PER_NODE * mesh.n_nodes
     M = sp.csr_matrix((n, n))
     masses = list(masses)
