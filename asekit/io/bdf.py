@@ -1208,7 +1208,7 @@ def read_bdf(path, units: str = "SI", tol: float | None = None,
     --------
     The HA145E wing (needs pyNastran; tests/io/test_bdf.py runs it):
 
-    >>> from asekit import bdf                                    # doctest: +SKIP
+    >>> from asekit.io import bdf                                 # doctest: +SKIP
     >>> from asekit.case import pipeline                          # doctest: +SKIP
     >>> case = bdf.read_bdf("data/benchmarks/ha145e/ha145e.bdf",
     ...                     units="in-lbf-s")                     # doctest: +SKIP
