@@ -298,7 +298,16 @@ def box_mesh(case: Case):
 
 def reduced_frequencies(case: Case) -> np.ndarray:
     """``aero.reduced_frequencies`` or, automatically, :func:`default_reduced_frequencies` up
-    to k_max = 2 pi f_max b / u_min (thesis Sec. 3.2.1)."""
+    to k_max = 2 pi f_max b / u_min (thesis Sec. 3.2.1).
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import FIN_FILE
+    >>> k = reduced_frequencies(load_case(FIN_FILE))     # b = 0.078 m, 1000 Hz, 180 m/s
+    >>> k.size, round(float(k[-1]), 4)
+    (15, 2.7227)
+    """
     a = case.aero
     if a.reduced_frequencies is not None:
         return np.asarray(a.reduced_frequencies, float)
@@ -432,8 +441,35 @@ def _interp_speed(points: list[tuple[float, float]], mach: float,
 
 
 def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -> FlutterAnalysis:
-    """p-k flutter with mode tracking at every ``aero.machs`` x flight condition, divergence
-    speeds (Eq. 3.13 eigenproblem on the steady GAFs), match points and flutter margins."""
+    """Flutter at every ``aero.machs`` x flight condition by the case's ``flutter.method``
+    (p-k with mode tracking by default, :data:`asekit.aeroelastic.methods.FLUTTER_METHODS`),
+    divergence speeds (Eq. 3.13 eigenproblem on the steady GAFs), match points and flutter
+    margins.
+
+    Parameters
+    ----------
+    case : the case.
+    progress : show the GAF database's progress bar when it is computed.
+    db : a GAF database to use instead of :func:`gaf_database` (e.g. a sweep's).
+
+    Returns
+    -------
+    FlutterAnalysis
+        ``results`` (one :class:`ConditionResult` per Mach and condition: speeds m/s,
+        frequencies Hz), ``divergence``, ``match_points``, ``margins``, ``notes``.
+
+    Examples
+    --------
+    AGARD 445.6 weakened wing 3 at M 0.499 (Yates 1987 measured the flutter speed index 0.4459,
+    U_f = 0.4459 b_s omega_alpha sqrt(mu) = 172 m/s with the case's [flutter_speed_index]; the
+    linear doublet lattice lands 6 % above):
+
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import CASES_DIR
+    >>> (r,) = flutter(load_case(CASES_DIR / "agard445_6.toml")).results
+    >>> round(r.flutter.speed), r.flutter.mode_name
+    (182, 'mode 1')
+    """
     t0 = time.perf_counter()
     model = modal_model(case)
     db = gaf_database(case, progress=progress) if db is None else db

@@ -664,6 +664,28 @@ def case_from_dict(d: dict, source: str = "") -> Case:
 
 
 def load_case(path) -> Case:
-    """Read and check a case file (TOML). Raises :class:`CaseError` (a ValueError) naming the
-    offending key and its valid range, or FileNotFoundError."""
+    """Read and check a case file (TOML, ``docs/case-format.md``).
+
+    Parameters
+    ----------
+    path : str or Path of the case file.
+
+    Returns
+    -------
+    Case
+        The frozen, checked case (SI units).
+
+    Raises
+    ------
+    CaseError
+        (a ValueError) naming the offending key path and its valid range.
+    FileNotFoundError
+
+    Examples
+    --------
+    >>> from asekit.util.paths import CASES_DIR
+    >>> case = load_case(CASES_DIR / "agard445_6.toml")
+    >>> case.support.kind, case.aero.machs, case.flutter.method
+    ('clamped_root', (0.499,), 'pk')
+    """
     return case_from_dict(read_toml(path, CaseError), source=str(path))
