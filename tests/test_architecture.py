@@ -124,3 +124,32 @@ def test_imports_go_down_the_layers(module):
           if r != "asekit" and _layer(r) > mine]
     assert not up, (f"{module} ({LAYERS[mine][0]}) imports from a higher layer: "
                     + ", ".join(f"line {line}: {r} ({LAYERS[_layer(r)][0]})" for line, r in up))
+
+
+def test_optional_packages_are_not_imported_at_module_top():
+    """The wheel's dependencies are numpy, scipy, control, matplotlib, tqdm and threadpoolctl
+    (pyproject.toml); numba, pandas, dask, pyNastran, ipywidgets and the notebook tools are
+    optional, so no asekit module imports them at its top (a function imports them when
+    used)."""
+    import sys
+    allowed = {"numpy", "scipy", "control", "matplotlib", "tqdm", "threadpoolctl", "asekit"}
+    optional_only = {"asekit.aero._dlm_compiled"}        # the numba kernel itself
+    bad = []
+    for module, path in MODULES.items():
+        if module in optional_only:
+            continue
+        for node in ast.parse(path.read_text()).body:
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import) else
+                     [node.module] if isinstance(node, ast.ImportFrom) and node.level == 0
+                     else [])
+            for n in names:
+                top = n.split(".")[0]
+                if top not in allowed and top not in sys.stdlib_module_names and top != "__future__":
+                    bad.append(f"{module}: {n}")
+    assert not bad, f"optional packages imported at module top: {bad}"
+    # and the numba kernel is reached only from inside functions
+    for module in ("asekit.aero.dlm", "asekit.aero.vlm"):
+        top = [n for n in ast.parse(MODULES[module].read_text()).body
+               if isinstance(n, (ast.Import, ast.ImportFrom))
+               and "_dlm_compiled" in ast.unparse(n)]
+        assert not top, f"{module} imports the numba kernel at its top"

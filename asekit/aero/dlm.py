@@ -86,7 +86,6 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from asekit.aero import _dlm_compiled as C
 from asekit.aero.boxes import BoxMesh, check_matrix_memory
 from asekit.aero.kernels import check_kernel
 from asekit.aero.validity import check_k
@@ -1052,6 +1051,7 @@ def _compiled_planar(rec, pts: "_StationPoints", rows: slice, mach: float, t1w: 
     """One planar row chunk by the compiled kernel (:mod:`asekit.aero._dlm_compiled`): the
     geometry of :class:`_PlanarChunk` in one compiled pass, then per k ``add(ik, d1)``, or, if
     ``target`` is given, D1 added into the array ``target(ik)`` by the kernel itself."""
+    from asekit.aero import _dlm_compiled as C  # numba is optional: imported only here
     pr = np.ascontiguousarray(rec.control_point[rows])
     e1, sgn_r1sq, gc, r1, phase, neg2, k10 = C.planar_geometry(pr, pts.xyz, pts.e, mach,
                                                                float(p_n[0]))

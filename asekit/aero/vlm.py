@@ -24,7 +24,6 @@ import math
 
 import numpy as np
 
-from asekit.aero import _dlm_compiled
 from asekit.aero.boxes import BoxMesh, check_matrix_memory
 from asekit.aero.kernels import check_kernel
 from asekit.aero.validity import SUBSONIC
@@ -144,6 +143,7 @@ def vlm_normalwash_matrix(mesh: BoxMesh, mach: float, symmetric: bool = False,
         v, ia, ib = _distinct_vertices(a, b)
         half_chord = 0.5 * img.chord
         if compiled:
+            from asekit.aero import _dlm_compiled  # numba is optional: imported only here
             _dlm_compiled.horseshoe_normalwash(np.ascontiguousarray(p), np.ascontiguousarray(n_r),
                                                v, ia, ib, scale, half_chord, d)
             continue
