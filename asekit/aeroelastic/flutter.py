@@ -379,14 +379,15 @@ def _step_accepted(prev: _Roots, new: _Roots, fraction: float, min_mac: float) -
 
 
 def _reassign(prob: _PkProblem, u: float, prev: _Roots, new: _Roots, tol, max_iter) -> _Roots:
-    """Columns that hold the same root at ``u`` reassigned to distinct roots: the candidate
-    roots of their eigenproblem are assigned to the columns' previous roots by the Hungarian
-    method on the cost |p - p_prev| / spacing_prev + (1 - MAC), and each column is converged
-    again from its candidate."""
-    cols = sorted({c for pair in _same_root(new) for c in pair})
-    if not cols:
+    """Columns that hold the same root at ``u`` reassigned to distinct roots: the roots of the
+    eigenproblem at the shared root's k are assigned to every column's previous root by the
+    Hungarian method on the cost |p - p_prev| / spacing_prev + (1 - MAC), and each column is
+    converged again from its candidate (kept when fewer columns share a root than before)."""
+    dup = _same_root(new)
+    if not dup:
         return new
-    lam, vec = prob.eig(u, new.k[cols[0]])
+    cols = list(range(new.p.size))
+    lam, vec = prob.eig(u, new.k[dup[0][0]])
     up = lam.imag >= -1e-9 * np.maximum(np.abs(lam), 1.0)
     lam, vec = lam[up], vec[:, up]
     cost = np.array([np.abs(lam - prev.p[c]) / max(prev.spacing[c], 1e-300)
@@ -397,7 +398,8 @@ def _reassign(prob: _PkProblem, u: float, prev: _Roots, new: _Roots, tol, max_it
         j = cols[r]
         p[j], v[j], k[j], ok[j], sp[j] = prob.solve_root(u, abs(lam[c].imag), vec[:, c], tol,
                                                          max_iter)
-    return _Roots(p, v, k, ok, sp)
+    out = _Roots(p, v, k, ok, sp)
+    return out if len(_same_root(out)) < len(dup) else new
 
 
 def _continue(prob: _PkProblem, ua: float, prev: _Roots, ub: float, tol, max_iter,
