@@ -477,3 +477,34 @@ OP4 = Target(
 
 TARGETS = (ATMOSPHERE, AIRSPEEDS, SURFACE_VLM, MESH_OVERLAP, DLM, RFA, GAF_AT_MACH, PK,
            ROOT_LOCUS, TIME_DOMAIN, SERVO, SIMULATE, OP4)
+
+
+# ---- p-k continuation: the first flutter whatever the velocity grid (issue 22) ----------------
+#: AGARD 445.6 weakened wing 3 at M 0.499 (data/cases/agard445_6.toml): the first flutter of
+#: asekit's p-k on the case's own fine sweep (100-260 m/s, step 2), mode 1 (the issue's 182 m/s).
+AGARD_FIRST_FLUTTER = 181.9386809
+
+
+def agard_pk_model():
+    """(modal model, TabulatedGaf at M 0.499, density) of the AGARD 445.6 case (pipeline)."""
+    from asekit.case import load_case
+    from asekit.case import pipeline as P
+    from asekit.util.paths import CASES_DIR
+    case = load_case(CASES_DIR / "agard445_6.toml")
+    db = P.gaf_database(case, progress=False)
+    return P.modal_model(case), db.at(case.aero.machs[0]), float(case.flight.densities[0])
+
+
+def _grid(start, step, n, extra):
+    """An ascending grid: ``n`` points from ``start`` by ``step``, plus ``extra`` points; it
+    reaches past the flutter speed (a last point at 182.5 + its step when it would not)."""
+    U = np.unique(np.r_[start + step * np.arange(n), extra])
+    if U[-1] <= AGARD_FIRST_FLUTTER + 0.5:
+        U = np.r_[U, AGARD_FIRST_FLUTTER + 0.5 + step]
+    return [float(u) for u in U]
+
+
+#: random velocity grids starting below the flutter speed, at least 2 points.
+AGARD_GRIDS = st.builds(_grid, st.floats(1.0, 181.0), st.floats(0.5, 900.0),
+                        st.integers(2, 14),
+                        st.lists(st.floats(1.0, 3000.0), max_size=4))

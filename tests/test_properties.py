@@ -34,3 +34,40 @@ def _make(target):
 @pytest.mark.parametrize("target", TARGETS, ids=[t.name for t in TARGETS])
 def test_entry_point_never_lies(target):
     _make(target)()
+
+
+# ---- issue 22: the first flutter does not depend on the velocity grid -------------------------
+@pytest.fixture(scope="module")
+def agard():
+    from property_targets import agard_pk_model
+    return agard_pk_model()
+
+
+def test_first_flutter_does_not_depend_on_the_grid(agard):
+    """For random grids (start below the flutter speed, random step, number of points and extra
+    points) over the AGARD 445.6 model at M 0.499, the reported first flutter is the fine
+    sweep's 181.94 m/s (mode 1), crossed (not at the first point), to the refinement tolerance
+    (Instability.speed_tolerance) plus the k-iteration's noise (1e-6 relative), reported once."""
+    import warnings
+
+    from hypothesis import strategies as st
+    from property_targets import AGARD_FIRST_FLUTTER, AGARD_GRIDS
+
+    from asekit.aeroelastic.flutter import first_of, pk_flutter, pk_instabilities
+
+    modal, gaf, rho = agard
+
+    @given(st.one_of(AGARD_GRIDS))
+    def check(U):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            res = pk_flutter(modal, gaf, rho, U)
+            inst = pk_instabilities(res, modal, gaf)
+        f = first_of(inst, "flutter")
+        assert f is not None and not f.at_first_point, (U, inst)
+        assert f.mode == 0
+        assert abs(f.speed - AGARD_FIRST_FLUTTER) <= f.speed_tolerance + 1e-6 * f.speed, (U, f)
+        near = [i for i in inst if abs(i.speed - f.speed) <= 1e-3]
+        assert len(near) == 1, (U, inst)                   # one physical root, once
+
+    check()

@@ -49,6 +49,18 @@ from asekit.util.validate import positive, positive_array
 RTOL_UNSTABLE = 1e-9
 #: largest number of steps / samples a single call may ask for before it is refused.
 MAX_STEPS = 5_000_000
+#: p-k continuation (:func:`pk_flutter`): a step between two points of the path is split in two
+#: when a tracked root moves by more than ``STEP_FRACTION`` of its distance to the nearest other
+#: root of the previous point, when its eigenvector correlates with the previous point's by a
+#: MAC below ``MIN_MAC``, or when two tracked columns land on the same root.
+STEP_FRACTION = 0.5
+MIN_MAC = 0.8
+#: a step between two requested airspeeds is halved at most ``MAX_HALVINGS`` times: the shortest
+#: sub-step is (U[i] - U[i-1]) / 2**MAX_HALVINGS; a step that short is taken as it is (and
+#: counted in ``PkResult.forced_steps``), its columns assigned to distinct roots.
+MAX_HALVINGS = 8
+#: relative tolerance of the refined crossing speed (Brent's ``xtol = REFINE_RTOL * U``).
+REFINE_RTOL = 1e-6
 
 
 class FlutterConvergenceWarning(RuntimeWarning):
@@ -121,6 +133,15 @@ class PkResult:
     tracked column among the modes solved (None: column j is mode j); ``n_rigid``: rigid modes
     among the modes solved (0 when the rigid mode is held, the default), so that column j is
     named ``mode_labels[j]`` (docs/conventions.md: elastic modes 1, 2, ..., "rigid pitch").
+
+    How fine the search was: the roots are continued along ``path_velocities`` (n_path,), the
+    requested velocities plus the sub-steps the step control of :func:`pk_flutter` inserted
+    between them (``substeps`` of them), with ``path_p``, ``path_vectors`` and
+    ``path_converged`` the roots there; :func:`pk_instabilities` brackets every crossing on
+    this path. ``step_fraction`` and ``min_mac`` are the step control's thresholds,
+    ``forced_steps`` the number of sub-steps taken at the shortest length without meeting them
+    (0 when every step met them). The path fields are None for a result not made by
+    :func:`pk_flutter` (the path is then ``velocities``).
     """
 
     velocities: np.ndarray
@@ -134,6 +155,26 @@ class PkResult:
     b_ref: float = 1.0
     modes: np.ndarray | None = None
     n_rigid: int = 0
+    path_velocities: np.ndarray | None = None
+    path_p: np.ndarray | None = None
+    path_vectors: np.ndarray | None = None
+    path_converged: np.ndarray | None = None
+    step_fraction: float = STEP_FRACTION
+    min_mac: float = MIN_MAC
+    forced_steps: int = 0
+
+    @property
+    def substeps(self) -> int:
+        """Number of sub-steps inserted between the requested velocities."""
+        return 0 if self.path_velocities is None else int(self.path_velocities.size
+                                                          - self.velocities.size)
+
+    def path(self):
+        """(velocities, p, vectors, converged) along the continuation path (the requested
+        velocities when the result has no path)."""
+        if self.path_velocities is None:
+            return self.velocities, self.p, self.vectors, self.converged
+        return self.path_velocities, self.path_p, self.path_vectors, self.path_converged
 
     @property
     def sigma(self) -> np.ndarray:
@@ -174,6 +215,11 @@ class Instability:
     airspeed of the sweep, so the instability is *at or below* ``speed`` (= U0, an upper bound,
     not a crossing); ``frequency_hz`` is then the frequency at U0. Start the sweep lower to
     locate it.
+
+    ``speed_tolerance`` (m/s): how well ``speed`` is known. For a refined crossing, Brent's
+    tolerance on the bracketing sub-step (``REFINE_RTOL`` times the speed); for an
+    interpolated one, the length of the bracketing step; for an ``at_first_point`` result,
+    ``speed`` itself (the instability lies somewhere in [0, speed]); 0 when not stated.
     """
 
     kind: str
@@ -184,6 +230,7 @@ class Instability:
     method: str = ""
     at_first_point: bool = False
     n_rigid: int = 0
+    speed_tolerance: float = 0.0
 
     @property
     def mode_name(self) -> str:
@@ -245,6 +292,13 @@ class _PkProblem:
 
     def solve_mode(self, U, omega_guess, ref, tol=1e-7, max_iter=60):
         """Converge one root: returns (p, vector, k, converged)."""
+        return self.solve_root(U, omega_guess, ref, tol, max_iter)[:4]
+
+    def solve_root(self, U, omega_guess, ref, tol=1e-7, max_iter=60):
+        """Converge one root: returns (p, vector, k, converged, spacing), ``spacing`` the
+        distance (1/s) from p to the nearest other root of the last eigenproblem (other real
+        roots not counted when p is real: a real pair is one branch, reported by its least
+        stable root; inf when there is none)."""
         b = self.gaf.b_ref
         omega = max(float(omega_guess), 0.0)
         p_best, v_best = None, None
@@ -266,16 +320,160 @@ class _PkProblem:
             p_best, v_best = lam_u[j], vec_u[:, j]
             omega_new = abs(p_best.imag)
             if abs(omega_new - omega) <= tol * max(omega_new, 1e-6 * U / b, 1e-12):
-                return p_best, v_best, omega_new * b / U, True
+                return p_best, v_best, omega_new * b / U, True, _spacing(lam_u, real_roots, j)
             omega = omega_new
-        return p_best, v_best, abs(p_best.imag) * b / U, False
+        return (p_best, v_best, abs(p_best.imag) * b / U, False,
+                _spacing(lam_u, real_roots, j))
+
+
+def _spacing(lam_u: np.ndarray, real_roots: np.ndarray, j: int) -> float:
+    """Distance from root ``lam_u[j]`` to the nearest other root (other real roots not counted
+    when it is real); inf when there is none."""
+    other = np.ones(lam_u.size, bool)
+    other[j] = False
+    if real_roots[j]:
+        other &= ~real_roots
+    return float(np.min(np.abs(lam_u[other] - lam_u[j]))) if other.any() else np.inf
+
+
+@dataclass(frozen=True)
+class _Roots:
+    """The tracked roots at one point of the p-k path: p (n_t,), vectors (n_t, n), k (n_t,),
+    converged (n_t,), spacing (n_t,) (see :meth:`_PkProblem.solve_root`)."""
+
+    p: np.ndarray
+    v: np.ndarray
+    k: np.ndarray
+    ok: np.ndarray
+    spacing: np.ndarray
+
+
+def _solve_all(prob: _PkProblem, u: float, prev: _Roots, tol, max_iter) -> _Roots:
+    """Every tracked root at airspeed ``u``, each continued from its root at ``prev``."""
+    out = [prob.solve_root(u, abs(p.imag), v, tol, max_iter) for p, v in zip(prev.p, prev.v)]
+    p, v, k, ok, sp = zip(*out)
+    return _Roots(np.array(p), np.array(v), np.array(k), np.array(ok), np.array(sp))
+
+
+def _same_root(r: _Roots) -> list[tuple[int, int]]:
+    """Pairs of tracked columns that hold the same root (equal to 1e-6 of its magnitude, their
+    eigenvectors correlated above 0.99)."""
+    pairs = []
+    for i in range(r.p.size):
+        for j in range(i + 1, r.p.size):
+            close = abs(r.p[i] - r.p[j]) <= 1e-6 * max(abs(r.p[i]), abs(r.p[j]), 1e-12)
+            if close and _mac(r.v[i], r.v[j][:, None])[0] > 0.99:
+                pairs.append((i, j))
+    return pairs
+
+
+def _step_accepted(prev: _Roots, new: _Roots, fraction: float, min_mac: float) -> bool:
+    """The step control's test: every tracked root moved by at most ``fraction`` of its
+    spacing at ``prev``, its eigenvector's MAC with the previous one is >= ``min_mac``, and no
+    two columns hold the same root that did not at ``prev`` already (two columns may share a
+    real root for good: each reports the least stable real root it correlates with)."""
+    if np.any(np.abs(new.p - prev.p) > fraction * prev.spacing):
+        return False
+    macs = [_mac(a, b[:, None])[0] for a, b in zip(prev.v, new.v)]
+    return min(macs) >= min_mac and not set(_same_root(new)) - set(_same_root(prev))
+
+
+def _reassign(prob: _PkProblem, u: float, prev: _Roots, new: _Roots, tol, max_iter) -> _Roots:
+    """Columns that hold the same root at ``u`` reassigned to distinct roots: the roots of the
+    eigenproblem at the shared root's k are assigned to every column's previous root by the
+    Hungarian method on the cost |p - p_prev| / spacing_prev + (1 - MAC), and each column is
+    converged again from its candidate (kept when fewer columns share a root than before)."""
+    dup = _same_root(new)
+    if not dup:
+        return new
+    cols = list(range(new.p.size))
+    lam, vec = prob.eig(u, new.k[dup[0][0]])
+    up = lam.imag >= -1e-9 * np.maximum(np.abs(lam), 1.0)
+    lam, vec = lam[up], vec[:, up]
+    cost = np.array([np.abs(lam - prev.p[c]) / max(prev.spacing[c], 1e-300)
+                     + (1 - _mac(prev.v[c], vec)) for c in cols])
+    rows, cand = optimize.linear_sum_assignment(np.minimum(cost, 1e6))
+    p, v, k, ok, sp = (np.array(a) for a in (new.p, new.v, new.k, new.ok, new.spacing))
+    for r, c in zip(rows, cand):
+        j = cols[r]
+        p[j], v[j], k[j], ok[j], sp[j] = prob.solve_root(u, abs(lam[c].imag), vec[:, c], tol,
+                                                         max_iter)
+    out = _Roots(p, v, k, ok, sp)
+    return out if len(_same_root(out)) < len(dup) else new
+
+
+def _continue(prob: _PkProblem, ua: float, prev: _Roots, ub: float, tol, max_iter,
+              fraction: float, min_mac: float, max_halvings: int):
+    """Continue the tracked roots from ``prev`` at ``ua`` to ``ub`` with step control.
+
+    The first trial is the whole step; a step that fails :func:`_step_accepted` is halved, at
+    most ``max_halvings`` times (a step of (ub - ua) / 2**max_halvings is taken as it is, its
+    columns made distinct by :func:`_reassign`); after an accepted step the next trial is twice
+    as long. Returns the accepted points [(u, roots), ...] ending at ``ub`` and the number of
+    forced steps.
+    """
+    points, forced, direct = [], 0, None
+    h_min = (ub - ua) / 2.0 ** max_halvings
+    u, h = ua, ub - ua
+    while u < ub:
+        un = ub if u + h >= ub else u + h
+        new = _solve_all(prob, un, prev, tol, max_iter)
+        if direct is None:
+            direct = new                  # the whole step, as a sweep without step control
+        if not _step_accepted(prev, new, fraction, min_mac):
+            if h > h_min * (1 + 1e-9):
+                h *= 0.5
+                continue
+            new = _reassign(prob, un, prev, new, tol, max_iter)
+            forced += 1
+        points.append((un, new))
+        u, prev, h = un, new, 2 * h
+    if len(points) > 1:
+        points[-1] = (ub, _prefer_direct(points[-1][1], direct))
+    return points, forced
+
+
+def _prefer_direct(cont: _Roots, direct: _Roots) -> _Roots:
+    """The roots at the end of a split step: each column's root of the whole (direct) step
+    where it is the continued root too (equal to 1e-5 of its magnitude, MAC > 0.999), else the
+    continued root. Where the direct step did not jump, the result is bit for bit that of a
+    sweep without step control; the same converged root either way, to the k-iteration's
+    tolerance."""
+    same = np.array([abs(c - d) <= 1e-5 * max(abs(c), 1e-12)
+                     and _mac(vc, vd[:, None])[0] > 0.999
+                     for c, d, vc, vd in zip(cont.p, direct.p, cont.v, direct.v)])
+    if not same.any():
+        return cont
+    pick = [np.where(same if a.ndim == 1 else same[:, None], b, a)
+            for a, b in ((cont.p, direct.p), (cont.v, direct.v), (cont.k, direct.k),
+                         (cont.ok, direct.ok), (cont.spacing, direct.spacing))]
+    out = _Roots(*pick)
+    return cont if set(_same_root(out)) - set(_same_root(cont)) else out
 
 
 @small_dense
 def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
                include_rigid: bool = False, interpolation: str = "linear", tol: float = 1e-7,
-               max_iter: int = 60) -> PkResult:
-    """p-k solution of Eq. (3.12) over a list of airspeeds.
+               max_iter: int = 60, step_fraction: float = STEP_FRACTION,
+               min_mac: float = MIN_MAC, max_halvings: int = MAX_HALVINGS) -> PkResult:
+    """p-k solution of Eq. (3.12) over a list of airspeeds, the roots continued with step
+    control so that a tracked root never jumps to another branch between two airspeeds.
+
+    Each tracked root is continued from its structural root (U = 0: p = i omega_j, the
+    undamped mode shape) through the requested airspeeds; at each new airspeed it is
+    converged from its root at the previous point (Hassig's k-iteration, roots picked by
+    eigenvector correlation, :class:`_PkProblem`). A step from U_a to U_b is accepted when,
+    for every tracked root j,
+
+        |p_j(U_b) - p_j(U_a)| <= step_fraction * s_j(U_a),   MAC(phi_j(U_a), phi_j(U_b)) >= min_mac
+
+    (s_j the distance from p_j to the nearest other root at U_a) and no two tracked columns
+    hold the same root; otherwise it is halved, at most ``max_halvings`` times, and the next
+    trial after an accepted step is twice as long. On a fine sweep every step is accepted as
+    it is (no extra work); the sub-steps land in ``PkResult.path_velocities``, where
+    :func:`pk_instabilities` brackets the crossings. A step still failing at the shortest
+    length is taken, its columns assigned to distinct roots by the Hungarian method on
+    |p - p_prev| / s_prev + (1 - MAC) (``PkResult.forced_steps`` counts them).
 
     Parameters
     ----------
@@ -288,10 +486,15 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
     include_rigid : solve with the rigid modes free too.
     interpolation : "linear" (Nastran's default) or "cubic" in k.
     tol, max_iter : k-iteration convergence (relative frequency change) and limit.
+    step_fraction : largest root movement per step as a fraction of its spacing, in (0, 1].
+    min_mac : smallest eigenvector correlation (MAC) between consecutive points, in [0, 1).
+    max_halvings : integer >= 0, most halvings of a step (0: no sub-steps, the requested
+        velocities only).
 
     Returns
     -------
-    :class:`PkResult`
+    :class:`PkResult` at the requested velocities, with the path and the step control's
+    thresholds.
     """
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
     rho = positive("density", density)
@@ -299,6 +502,11 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
     _pressure_ok(rho, U)
     max_iter = _count("max_iter", max_iter)
     tol = positive("tol", tol)
+    step_fraction = _fraction("step_fraction", step_fraction, 0.0, 1.0, low_open=True)
+    min_mac = _fraction("min_mac", min_mac, 0.0, 1.0, high_open=True)
+    max_halvings = _count("max_halvings", max_halvings, 0)
+    if max_halvings > 30:
+        raise ValueError(f"max_halvings must be an integer in [0, 30], got {max_halvings}")
     if interpolation not in ("linear", "cubic"):
         raise ValueError(f"interpolation must be 'linear' or 'cubic', got {interpolation!r}")
     if not isinstance(gaf, TabulatedGaf):
@@ -317,32 +525,83 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
     modes = np.arange(M.shape[0]) if modes is None else np.atleast_1d(np.asarray(modes, int))
     if np.any(modes < 0) or np.any(modes >= M.shape[0]):
         raise ValueError(f"modes must be indices in [0, {M.shape[0] - 1}], got {modes}")
-    nv, nt, n = U.size, modes.size, M.shape[0]
-    P = np.zeros((nv, nt), complex)
-    KK = np.zeros((nv, nt))
-    V = np.zeros((nv, nt, n), complex)
-    conv = np.zeros((nv, nt), bool)
-    for jt, jm in enumerate(modes):
-        omega, ref = w[jm], phi[:, jm].astype(complex)
-        for i, u in enumerate(U):
-            p, v, k, ok = prob.solve_mode(u, omega, ref, tol, max_iter)
-            P[i, jt], V[i, jt], KK[i, jt], conv[i, jt] = p, v, k, ok
-            omega, ref = abs(p.imag), v
-    if not conv.all():
-        bad = np.argwhere(~conv)
-        n_r = m.n_rigid if include_rigid else 0
-        listed = ", ".join(f"{mode_label(int(modes[jt]), n_r)} at U = {U[i]:.6g}"
-                           for i, jt in bad[:8])
-        more = f" and {len(bad) - 8} more" if len(bad) > 8 else ""
-        warnings.warn(f"p-k: the k-iteration did not converge within max_iter = {max_iter} "
-                      f"(tol {tol:g}) at {len(bad)} of {conv.size} points: {listed}{more}; "
-                      "their roots are the last iterate (PkResult.converged is False there). "
-                      "Raise max_iter or check those points.",
-                      FlutterConvergenceWarning, stacklevel=3)   # caller, past @small_dense
-    return PkResult(velocities=U, p=P, k=KK, vectors=V, converged=conv,
+    path_u, path, forced = _pk_path(prob, U, _structural_roots(w, phi, modes), tol, max_iter,
+                                    step_fraction, min_mac, max_halvings)
+    at = np.searchsorted(path_u, U)                       # the requested points on the path
+    P = np.array([r.p for r in path])
+    V = np.array([r.v for r in path])
+    conv = np.array([r.ok for r in path])
+    KK = np.array([r.k for r in path])
+    n_r = m.n_rigid if include_rigid else 0
+    _warn_unconverged(U, conv[at], modes, n_r, max_iter, tol, int((~conv).sum()))
+    return PkResult(velocities=U, p=P[at], k=KK[at], vectors=V[at], converged=conv[at],
                     structural_frequencies_hz=w[modes] / (2 * np.pi), density=rho,
-                    mach=gaf.mach, b_ref=gaf.b_ref, modes=modes,
-                    n_rigid=m.n_rigid if include_rigid else 0)
+                    mach=gaf.mach, b_ref=gaf.b_ref, modes=modes, n_rigid=n_r,
+                    path_velocities=path_u, path_p=P, path_vectors=V, path_converged=conv,
+                    step_fraction=step_fraction, min_mac=min_mac, forced_steps=forced)
+
+
+def _fraction(name: str, value, lo: float, hi: float, low_open: bool = False,
+              high_open: bool = False) -> float:
+    """A real number in the interval lo..hi (ends open as asked), else TypeError/ValueError
+    naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name} must be a real number, got {value!r}")
+    v = float(value)
+    ok = (lo < v if low_open else lo <= v) and (v < hi if high_open else v <= hi)
+    if not ok:
+        raise ValueError(f"{name} must be in {'(' if low_open else '['}{lo:g}, {hi:g}"
+                         f"{')' if high_open else ']'}, got {value!r}")
+    return v
+
+
+def _structural_roots(w: np.ndarray, phi: np.ndarray, modes: np.ndarray) -> _Roots:
+    """The start of the continuation, U = 0: p = i omega_j and the mode shapes of the tracked
+    modes; the spacing is the distance to the nearest other structural root (floored at 1e-9
+    of the largest, so that repeated frequencies still allow a step)."""
+    n = w.size
+    d = np.abs(w[:, None] - w[None, :]) + np.diag(np.full(n, np.inf))
+    spacing = np.maximum(d.min(axis=1), 1e-9 * max(float(w.max()), 1e-300))
+    nt = modes.size
+    return _Roots(1j * w[modes], phi[:, modes].T.astype(complex), np.zeros(nt),
+                  np.ones(nt, bool), spacing[modes])
+
+
+def _pk_path(prob, U, start: _Roots, tol, max_iter, fraction, min_mac, max_halvings):
+    """The continuation from U = 0 through every requested airspeed: (path airspeeds,
+    [roots per path point], forced steps). Points below U[0] (the way from the structural
+    roots) are not kept."""
+    path_u, path, forced = [], [], 0
+    ua, prev = 0.0, start
+    for u in U:
+        points, nf = _continue(prob, ua, prev, float(u), tol, max_iter, fraction, min_mac,
+                               max_halvings)
+        forced += nf
+        if ua == 0.0:
+            points = points[-1:]
+        path_u += [p[0] for p in points]
+        path += [p[1] for p in points]
+        ua, prev = float(u), points[-1][1]
+    path_u = np.array(path_u)
+    return path_u, path, forced
+
+
+def _warn_unconverged(U, conv, modes, n_r, max_iter, tol, n_path_bad):
+    """FlutterConvergenceWarning naming the (mode, airspeed) points whose k-iteration did not
+    converge (``conv`` at the requested points; ``n_path_bad`` counts the whole path)."""
+    if conv.all() and n_path_bad == 0:
+        return
+    bad = np.argwhere(~conv)
+    listed = ", ".join(f"{mode_label(int(modes[jt]), n_r)} at U = {U[i]:.6g}"
+                       for i, jt in bad[:8])
+    more = f" and {len(bad) - 8} more" if len(bad) > 8 else ""
+    sub = n_path_bad - len(bad)
+    sub_text = f" (and {sub} sub-step points of the continuation)" if sub > 0 else ""
+    warnings.warn(f"p-k: the k-iteration did not converge within max_iter = {max_iter} "
+                  f"(tol {tol:g}) at {len(bad)} of {conv.size} requested points{sub_text}: "
+                  f"{listed}{more}; their roots are the last iterate (PkResult.converged is "
+                  "False there). Raise max_iter or check those points.",
+                  FlutterConvergenceWarning, stacklevel=4)   # caller, past @small_dense
 
 
 def _crossings(U, sigma, freq_hz, real_mask, tol: float = 0.0):
@@ -370,16 +629,20 @@ def _crossings(U, sigma, freq_hz, real_mask, tol: float = 0.0):
 def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = None,
                      refine: bool = True, include_rigid: bool = False,
                      interpolation: str = "linear") -> list[Instability]:
-    """All flutter / divergence onsets of a p-k sweep, sorted by speed.
+    """All flutter / divergence onsets of a p-k sweep, sorted by speed; one per physical root.
 
-    Linear interpolation of Re(p) to zero between sweep points; with ``refine`` (needs the
-    ``modal`` and ``gaf`` of the sweep) the crossing is refined by Brent's method on Re(p)(U) of
-    the tracked root, continued from the sub-critical sweep point. A root unstable at the first
-    airspeed (Re p > :func:`crossing_tolerance`) is returned with ``at_first_point=True`` and
-    ``speed = velocities[0]`` (flutter or divergence at or below U0).
+    The crossings are bracketed on the continuation path (``PkResult.path_velocities``: the
+    requested velocities and the step control's sub-steps), interpolated linearly to Re p = 0
+    and, with ``refine`` (needs the ``modal`` and ``gaf`` of the sweep), refined by Brent's
+    method on Re(p)(U) of the tracked root inside the bracketing sub-step, continued from its
+    unstable end (``xtol = REFINE_RTOL * U``, stated in ``Instability.speed_tolerance``). A
+    root unstable at the first airspeed (Re p > :func:`crossing_tolerance`) is returned with
+    ``at_first_point=True`` and ``speed = velocities[0]`` (flutter or divergence at or below
+    U0). Two tracked columns that report the same crossing (same speed within tolerance, same
+    frequency, correlated eigenvectors) give one instability, the lower column's.
     """
     found = []
-    U = result.velocities
+    U, Pp, Vp, _ = result.path()
     prob = None
     if refine and modal is not None and gaf is not None:
         m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
@@ -389,39 +652,93 @@ def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = No
         prob = _PkProblem(M, K, C, TabulatedGaf(gaf.k, gaf.Q[:, sel, sel], gaf.b_ref),
                           result.density, interpolation)
     tol = crossing_tolerance(result.p)
-    for jt in range(result.p.shape[1]):
-        p = result.p[:, jt]
+    for jt in range(Pp.shape[1]):
+        p = Pp[:, jt]
         real_mask = np.abs(p.imag) <= 1e-6 * np.maximum(np.abs(p), 1e-12)
         for i, us, f, kind, first in _crossings(U, p.real, np.abs(p.imag) / (2 * np.pi),
                                                 real_mask, tol):
-            vec = result.vectors[i, jt]
+            vec = Vp[i, jt]
             if first:
                 found.append(Instability(kind=kind, mode=result.mode_index(jt), speed=float(us),
                                          frequency_hz=0.0 if kind == "divergence" else float(f),
                                          vector=vec, method="p-k", at_first_point=True,
-                                         n_rigid=result.n_rigid))
+                                         n_rigid=result.n_rigid, speed_tolerance=float(us)))
                 continue
+            spread = float(U[i] - U[i - 1])
             if prob is not None:
-                # continue from the unstable side: at an undamped coalescence the sub-critical
-                # vector correlates equally with the stable and the unstable partner
-                w0, ref0 = abs(result.p[i, jt].imag), result.vectors[i, jt]
-
-                def re_p(u, w0=w0, ref0=ref0):
-                    # Re p - tol: an undamped sub-critical root (Re = 0 +- rounding) stays < 0
-                    return prob.solve_mode(u, w0, ref0)[0].real - tol
-
-                try:
-                    us = optimize.brentq(re_p, U[i - 1], U[i], xtol=1e-6 * U[i])
-                    pz, vec, _, _ = prob.solve_mode(us, w0, ref0)
-                    f = abs(pz.imag) / (2 * np.pi)
-                    kind = "divergence" if abs(pz.imag) <= 1e-6 * max(abs(pz), 1e-9) \
-                        and f < 1e-6 else kind
-                except ValueError:
-                    pass
+                refined = _refine_on_path(prob, result, U, i, jt, tol)
+                if refined is not None:
+                    us, f, vec, divergent, spread = refined
+                    kind = "divergence" if divergent else kind
             found.append(Instability(kind=kind, mode=result.mode_index(jt), speed=float(us),
                                      frequency_hz=0.0 if kind == "divergence" else float(f),
-                                     vector=vec, method="p-k", n_rigid=result.n_rigid))
-    return sorted(found, key=lambda s: s.speed)
+                                     vector=vec, method="p-k", n_rigid=result.n_rigid,
+                                     speed_tolerance=spread))
+    return _one_per_root(sorted(found, key=lambda s: s.speed))
+
+
+def _refine_on_path(prob: _PkProblem, result: PkResult, U: np.ndarray, i: int, jt: int,
+                    tol: float):
+    """The crossing of column ``jt`` bracketed by path points i-1 and i, refined
+    (:func:`_refine_crossing`). When the bracket is a sub-step, the refinement over the whole
+    requested step that holds it (from the requested end, as a sweep without sub-steps does) is
+    tried first and kept when it lands inside the sub-step bracket: the same crossing, and the
+    same number bit for bit as without step control; else the sub-step bracket is refined."""
+    _, Pp, Vp, _ = result.path()
+    Ur = result.velocities
+    r = int(np.searchsorted(Ur, U[i]))
+    if r > 0 and not (U[i - 1] == Ur[r - 1] and U[i] == Ur[r]):
+        wide = _refine_crossing(prob, Ur[r - 1], Ur[r], result.p[r, jt], result.vectors[r, jt],
+                                tol)
+        if wide is not None and U[i - 1] - wide[4] <= wide[0] <= U[i] + wide[4]:
+            return wide
+    return _refine_crossing(prob, U[i - 1], U[i], Pp[i, jt], Vp[i, jt], tol)
+
+
+def _refine_crossing(prob: _PkProblem, ua: float, ub: float, p_b: complex, v_b: np.ndarray,
+                     tol: float):
+    """Brent's method on Re p(U) - tol in [ua, ub], the root continued from its unstable end
+    (p_b, v_b at ub: at an undamped coalescence the sub-critical vector correlates equally with
+    the stable and the unstable partner). Returns (U*, f* Hz, vector, divergence?, xtol) or
+    None when Re p does not change sign in the bracket."""
+    w0 = abs(p_b.imag)
+    xtol = REFINE_RTOL * ub
+
+    def re_p(u):
+        # Re p - tol: an undamped sub-critical root (Re = 0 +- rounding) stays < 0
+        return prob.solve_mode(u, w0, v_b)[0].real - tol
+
+    try:
+        us = optimize.brentq(re_p, ua, ub, xtol=xtol)
+    except ValueError:
+        return None
+    pz, vec, _, _ = prob.solve_mode(us, w0, v_b)
+    f = abs(pz.imag) / (2 * np.pi)
+    divergent = abs(pz.imag) <= 1e-6 * max(abs(pz), 1e-9) and f < 1e-6
+    return float(us), f, vec, divergent, float(xtol + 4 * np.finfo(float).eps * abs(us))
+
+
+def _one_per_root(found: list[Instability]) -> list[Instability]:
+    """Drop an instability that repeats an earlier one of the list: same kind and start flag,
+    speeds within their tolerances, frequencies within 1e-6 relative, eigenvectors correlated
+    above 0.99 (two tracked columns on one physical root)."""
+    out = []
+    for s in found:
+        if not any(_same_instability(s, t) for t in out):
+            out.append(s)
+    return out
+
+
+def _same_instability(a: Instability, b: Instability) -> bool:
+    if a.kind != b.kind or a.at_first_point != b.at_first_point:
+        return False
+    if abs(a.speed - b.speed) > a.speed_tolerance + b.speed_tolerance + 1e-12 * abs(a.speed):
+        return False
+    if abs(a.frequency_hz - b.frequency_hz) > 1e-6 * max(a.frequency_hz, b.frequency_hz, 1e-12):
+        return False
+    if a.vector is None or b.vector is None or a.vector.size == 0 or b.vector.size == 0:
+        return True
+    return bool(_mac(a.vector, b.vector[:, None])[0] > 0.99)
 
 
 def first_of(instabilities: list[Instability], kind: str | None = None) -> Instability | None:

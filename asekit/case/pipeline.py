@@ -426,6 +426,131 @@ def analyse_condition(case: Case, db: GafDatabase, mach: float, cond: FlightCond
                            start[0].mode if start else None)
 
 
+def _start_kind(r: ConditionResult) -> str:
+    """'flutter', 'divergence' or 'flutter or divergence': what is unstable at the first point
+    of the sweep of ``r``."""
+    kinds = sorted({i.kind for i in r.instabilities if i.at_first_point})
+    return " or ".join(kinds) if kinds else "flutter or divergence"
+
+
+def _start_note(r: ConditionResult, velocities) -> str:
+    """The note of a condition unstable at the first point of the sweep."""
+    return (f"M {r.mach:g}, rho {r.condition.density:.4g}: {_start_kind(r)} at or below "
+            f"{velocities[0]:g} m/s (the first point of the sweep, "
+            f"{mode_label(r.start_mode, r.pk.n_rigid)}): start the sweep lower to locate it")
+
+
+def _flutter_points(here: list[ConditionResult], velocities) -> list[tuple[float, float, str]]:
+    """(Mach, speed m/s, bound) of the flutter speed at each analysed Mach of one condition:
+    bound "value" (a crossing), "upper" (flutter at or below the first point of the sweep:
+    U_f <= speed) or "lower" (no flutter in the sweep: U_f > speed, its last point). A Mach
+    whose sweep starts with divergence only gives no point (its flutter speed is unknown)."""
+    pts = []
+    for r in sorted(here, key=lambda r: r.mach):
+        if r.unstable_at_start:
+            if "flutter" in _start_kind(r):
+                pts.append((r.mach, float(velocities[0]), "upper"))
+        elif r.flutter is not None:
+            pts.append((r.mach, float(r.flutter.speed), "value"))
+        else:
+            pts.append((r.mach, float(velocities[-1]), "lower"))
+    return pts
+
+
+def _machs(pts) -> str:
+    return ", ".join(f"{m:g}" for m, _, _ in pts)
+
+
+def _match_point(c: FlightCondition, pts) -> dict:
+    """The match point at one altitude: the Mach where U_f(M) = M a, interpolated between
+    consecutive Machs with flutter crossings; otherwise None with the reason, which states
+    what the bounds say (flutter at or below the first point of the sweep, no flutter up to
+    its last point) against the flight speed M a."""
+    a = c.speed_of_sound
+    d = [(m, u / a - m) for m, u, kind in pts if kind == "value"]
+    mm = None
+    for (m0, d0), (m1, d1) in zip(d[:-1], d[1:]):
+        if d0 == 0 or d0 * d1 < 0:
+            mm = m0 + (m1 - m0) * d0 / (d0 - d1)
+            break
+    upper = [p for p in pts if p[2] == "upper"]
+    why = None
+    if mm is None:
+        parts = []
+        inside = [p for p in upper if p[1] < p[0] * a]
+        unknown = [p for p in upper if p[1] >= p[0] * a]
+        if inside:
+            parts.append(f"flutter at or below {inside[0][1]:g} m/s (the first point of the "
+                         f"sweep) at M {_machs(inside)}, below the flight speed M a: inside "
+                         "the envelope")
+        if unknown:
+            parts.append(f"flutter at or below {unknown[0][1]:g} m/s (the first point of the "
+                         f"sweep) at M {_machs(unknown)}, the flight speed M a below it: not "
+                         "located, start the sweep lower")
+        if d and all(v > 0 for _, v in d):
+            parts.append(f"U_f > M a at every analysed Mach with a crossing: no match up to "
+                         f"M {d[-1][0]:g} (flutter-free there)")
+        elif d and all(v < 0 for _, v in d):
+            parts.append(f"U_f < M a at every analysed Mach with a crossing: the match lies "
+                         f"below M {d[0][0]:g}")
+        if not parts:
+            parts.append("no flutter in the sweep at any analysed Mach")
+        why = "; ".join(parts)
+        if not upper and len(d) == len(pts) and d:      # every Mach a crossing: as before
+            why = why.replace(" with a crossing", "")
+    return {"altitude_m": c.altitude, "matched_mach": mm,
+            "matched_speed_ms": None if mm is None else mm * a,
+            "flutter_at_or_below_ms": upper[0][1] if upper else None,
+            "no_match": why}
+
+
+def _interp_bounded(pts, mach: float, reach: float = 0.05):
+    """U_f at ``mach`` from (Mach, speed, bound) points (:func:`_interp_speed` on all of
+    them) and its bound: "value" when every point it uses is a value, "upper" / "lower" when
+    the used points are values and upper (lower) bounds, interpolated (not extrapolated);
+    (None, None) otherwise."""
+    u = _interp_speed([(m, s) for m, s, _ in pts], mach, reach)
+    if u is None:
+        return None, None
+    ms = [m for m, _, _ in pts]
+    if len(pts) == 1:
+        return u, pts[0][2]
+    i = int(np.clip(np.searchsorted(ms, mach) - 1, 0, len(ms) - 2))
+    t = (mach - ms[i]) / (ms[i + 1] - ms[i])
+    used = {kind for kind, w in ((pts[i][2], 1 - t), (pts[i + 1][2], t)) if w != 0}
+    bounds = used - {"value"}
+    if not bounds:
+        return u, "value"
+    if len(bounds) > 1 or not 0 <= t <= 1:
+        return None, None
+    return u, bounds.pop()
+
+
+def _margin(c: FlightCondition, pts, env_mach: float) -> dict:
+    """The flutter margin U_f / U_env - 1 at the envelope's top Mach, or its bound: at most
+    (U_f at or below the first point of the sweep) or at least (no flutter up to its last
+    point), with a note saying which."""
+    u_env = env_mach * c.speed_of_sound
+    uf, kind = _interp_bounded(pts, env_mach)
+    out = {"altitude_m": c.altitude, "envelope_mach": env_mach, "envelope_speed_ms": u_env,
+           "flutter_speed_ms": uf if kind == "value" else None,
+           "margin": uf / u_env - 1.0 if kind == "value" else None,
+           "margin_upper_bound": uf / u_env - 1.0 if kind == "upper" else None,
+           "margin_lower_bound": uf / u_env - 1.0 if kind == "lower" else None,
+           "flutter_speed_upper_bound_ms": uf if kind == "upper" else None,
+           "flutter_speed_lower_bound_ms": uf if kind == "lower" else None, "note": None}
+    if kind == "upper":
+        out["note"] = (f"flutter at or below {uf:.4g} m/s (the first point of the sweep)"
+                       + (": inside the envelope" if uf < u_env else
+                          ": the margin is at most this; start the sweep lower"))
+    elif kind == "lower":
+        out["note"] = f"no flutter up to {uf:.4g} m/s (the last point of the sweep)"
+    elif kind is None:
+        out["note"] = (f"U_f not known at M {env_mach:g}: no analysed Mach within 0.05, or "
+                       "bounds of both kinds around it")
+    return out
+
+
 def _interp_speed(points: list[tuple[float, float]], mach: float,
                   reach: float = 0.05) -> float | None:
     """U_f at ``mach`` from (Mach, U_f) points: linear between them, linear extrapolation of
@@ -482,46 +607,18 @@ def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -
             sp = divergence_speeds(model, Q0, c.density)
             div.append({"mach": float(m), "altitude_m": c.altitude, "density": c.density,
                         "speed_ms": float(sp[0]) if sp.size else None})
-    matches, margins, notes = [], [], []
+    matches, margins = [], []
     env_m, env_h = case.flight.envelope_mach, case.flight.envelope_altitude
+    U = case.flight.velocities
     for c in conds:
         if c.speed_of_sound is None:
             continue
-        here = [r for r in results if r.condition == c]
-        pts = [(r.mach, r.flutter.speed) for r in here
-               if r.flutter is not None and not r.unstable_at_start]
-        # matched Mach: M_f(M) = U_f(M) / a crosses M
-        d = [(m, u / c.speed_of_sound - m) for m, u in sorted(pts)]
-        mm = None
-        for (m0, d0), (m1, d1) in zip(d[:-1], d[1:]):
-            if d0 == 0 or d0 * d1 < 0:
-                mm = m0 + (m1 - m0) * d0 / (d0 - d1)
-                break
-        why = None
-        if mm is None:
-            if not d:
-                why = "no flutter in the sweep at any analysed Mach"
-            elif all(v > 0 for _, v in d):
-                why = (f"U_f > M a at every analysed Mach: no match up to M {d[-1][0]:g} "
-                       f"(flutter-free there)")
-            else:
-                why = (f"U_f < M a at every analysed Mach: the match lies below M {d[0][0]:g}")
-        matches.append({"altitude_m": c.altitude, "matched_mach": mm,
-                        "matched_speed_ms": None if mm is None else mm * c.speed_of_sound,
-                        "no_match": why})
+        pts = _flutter_points([r for r in results if r.condition == c], U)
+        matches.append(_match_point(c, pts))
         if env_m is not None and (env_h is None or c.altitude is None
                                   or env_h[0] <= c.altitude <= env_h[1]):
-            u_env = env_m[1] * c.speed_of_sound
-            uf = _interp_speed(pts, env_m[1])
-            margins.append({"altitude_m": c.altitude, "envelope_mach": env_m[1],
-                            "envelope_speed_ms": u_env, "flutter_speed_ms": uf,
-                            "margin": None if uf is None else uf / u_env - 1.0})
-    for r in results:
-        if r.unstable_at_start:
-            notes.append(f"M {r.mach:g}, rho {r.condition.density:.4g}: unstable at the first "
-                         f"point of the sweep ({case.flight.velocities[0]:g} m/s, "
-                         f"{mode_label(r.start_mode, r.pk.n_rigid)}): flutter or divergence "
-                         "at or below it")
+            margins.append(_margin(c, pts, env_m[1]))
+    notes = [_start_note(r, U) for r in results if r.unstable_at_start]
     return FlutterAnalysis(tuple(results), tuple(div), tuple(matches), tuple(margins),
                            time.perf_counter() - t0, tuple(notes))
 

@@ -36,7 +36,11 @@ UNITS = {
     "frequencies_hz": "Hz", "frequency_hz": "Hz",
     "altitude_m": "m",
     "speed_ms": "m/s", "matched_speed_ms": "m/s", "envelope_speed_ms": "m/s",
-    "flutter_speed_ms": "m/s", "velocity_ms": "m/s",
+    "flutter_speed_ms": "m/s", "velocity_ms": "m/s", "speed_upper_bound_ms": "m/s",
+    "flutter_at_or_below_ms": "m/s", "flutter_speed_upper_bound_ms": "m/s",
+    "flutter_speed_lower_bound_ms": "m/s",
+    "margin_upper_bound": "- (U_f / U_envelope - 1 is at most this)",
+    "margin_lower_bound": "- (U_f / U_envelope - 1 is at least this)",
     "density": "kg/m^3",
     "mach": "-", "matched_mach": "-", "envelope_mach": "-",
     "margin": "- (U_f / U_envelope - 1)",
@@ -98,10 +102,14 @@ def summary(a: Analysis) -> dict:
                "speed_ms": None if f is None else float(f.speed),
                "frequency_hz": None if f is None else float(f.frequency_hz),
                "mode": None if f is None else mode_number(f.mode, f.n_rigid),
-               "unstable_at_first_point": bool(r.unstable_at_start)}
+               "unstable_at_first_point": bool(r.unstable_at_start),
+               "speed_upper_bound_ms": None}
         if r.unstable_at_start:
-            row["note"] = (f"unstable at the first point of the sweep "
-                           f"({c.flight.velocities[0]:g} m/s): flutter at or below it")
+            kind = P._start_kind(r)
+            row["speed_upper_bound_ms"] = float(c.flight.velocities[0])
+            row["mode"] = mode_number(r.start_mode, r.pk.n_rigid)
+            row["note"] = (f"unstable at the first point of the sweep: {kind} at or below "
+                           f"{c.flight.velocities[0]:g} m/s")
         if c.flutter_index is not None and f is not None:
             fs = c.flutter_index
             w_a = 2 * math.pi * fs.f_alpha
@@ -143,6 +151,30 @@ def _cell(v, fmt="{:.4g}"):
     return str(v)
 
 
+def _speed_cell(row: dict) -> str:
+    """The U_f cell of a flutter row: the speed, '<=U0' when unstable at the first point."""
+    if row.get("speed_upper_bound_ms") is not None:
+        return f"<={row['speed_upper_bound_ms']:.2f}"
+    return _cell(row["speed_ms"], "{:.2f}")
+
+
+def _margin_text(m: dict) -> str:
+    """A margin line's value: the margin, its bound ('at most' / 'at least') or '-', with the
+    note."""
+    env = m["envelope_speed_ms"]
+    if m["margin"] is not None:
+        return f"{100 * m['margin']:+.1f} % (U_f {m['flutter_speed_ms']:.1f} vs {env:.1f} m/s)"
+    if m.get("margin_upper_bound") is not None:
+        u = m["flutter_speed_upper_bound_ms"]
+        return (f"at most {100 * m['margin_upper_bound']:+.1f} % (flutter at or below {u:.1f} "
+                f"m/s, the first point of the sweep, vs {env:.1f} m/s"
+                + (": inside the envelope)" if u < env else "; start the sweep lower)"))
+    if m.get("margin_lower_bound") is not None:
+        return (f"at least {100 * m['margin_lower_bound']:+.1f} % (no flutter up to "
+                f"{m['flutter_speed_lower_bound_ms']:.1f} m/s vs {env:.1f} m/s)")
+    return "-" + (f" ({m['note']})" if m.get("note") else "")
+
+
 def format_summary(s: dict, width: int = 100) -> str:
     """A plain-text summary of :func:`summary` that fits ``width`` columns."""
     lines = textwrap.wrap(f"case {s['case']}" + (f"  ({s['reference']})" if s.get("reference")
@@ -160,7 +192,7 @@ def format_summary(s: dict, width: int = 100) -> str:
     lines += ["", "flutter (p-k, rigid modes held)", head]
     for row in s["flutter"]:
         ln = (f"{row['mach']:>6.3g} {_cell(row['altitude_m'], '{:.0f}'):>10} "
-              f"{row['density']:>10.4g} {_cell(row['speed_ms'], '{:.2f}'):>9} "
+              f"{row['density']:>10.4g} {_speed_cell(row):>9} "
               f"{_cell(row['frequency_hz'], '{:.2f}'):>8} {_cell(row['mode']):>4}")
         if has_fsi:
             ln += (f" {_cell(row.get('flutter_speed_index'), '{:.4f}'):>7}"
@@ -181,9 +213,7 @@ def format_summary(s: dict, width: int = 100) -> str:
                         f"M {m['matched_mach']:.3f} ({m['matched_speed_ms']:.1f} m/s)"))
     for m in s["flutter_margins"]:
         lines.append(f"flutter margin at {_cell(m['altitude_m'], '{:.0f}')} m, envelope top "
-                     f"M {m['envelope_mach']:g}: "
-                     + ("-" if m["margin"] is None else f"{100 * m['margin']:+.1f} % "
-                        f"(U_f {m['flutter_speed_ms']:.1f} vs {m['envelope_speed_ms']:.1f} m/s)"))
+                     f"M {m['envelope_mach']:g}: " + _margin_text(m))
     if "ase" in s:
         a = s["ase"]
         lines += ["", f"ASE loop at M {a['mach']:g}, {a['altitude_m']:g} m:"]
