@@ -86,11 +86,15 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from asekit.aero import _dlm_compiled as C
 from asekit.aero.boxes import BoxMesh, check_matrix_memory
 from asekit.aero.kernels import check_kernel
 from asekit.aero.validity import check_k
 from asekit.aero.vlm import CHUNK_BYTES, check_mach, vlm_normalwash_matrix
+
+try:            # numba is optional (asekit.aero.kernels.numba_available chooses the kernel)
+    from asekit.aero import _dlm_compiled as C
+except ImportError:                                               # pragma: no cover
+    C = None
 
 #: Laschka's approximation of u / sqrt(1 + u^2) ~ 1 - sum a_n exp(-n c u) ([R71] Eq. A.4;
 #: coefficients as tabulated by Blair 1992, WL-TR-92-3028, p. 89).

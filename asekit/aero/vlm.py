@@ -24,12 +24,16 @@ import math
 
 import numpy as np
 
-from asekit.aero import _dlm_compiled
 from asekit.aero.boxes import BoxMesh, check_matrix_memory
 from asekit.aero.kernels import check_kernel
 from asekit.aero.validity import SUBSONIC
 from asekit.aero.validity import check_mach as _check_mach
 from asekit.util.validate import positive
+
+try:            # numba is optional (asekit.aero.kernels.numba_available chooses the kernel)
+    from asekit.aero import _dlm_compiled
+except ImportError:                                               # pragma: no cover
+    _dlm_compiled = None
 
 #: Upper bound (bytes) for the temporaries of one row chunk (VLM and DLM).
 CHUNK_BYTES = 256 * 2**20
