@@ -164,8 +164,8 @@ def test_op4_bad_files(tmp_path):
     with pytest.raises(ValueError, match="format"):
         read_op4(p)
     p.write_text("       1       1       2       2A       1P,5E16.9\n       1       1       1\n"
-                 "      garbage!!\n       2       1       1\n 1.000000000E+00\n")
-    with pytest.raises(ValueError, match="not a number"):
+                 "       garbage!!\n       2       1       1\n 1.000000000E+00\n")
+    with pytest.raises(ValueError, match="line 3: value 'garbage!!' is not a number"):
         read_op4(p)
 
 

@@ -12,6 +12,13 @@ Format (MSC Nastran DMAP Programmer's Guide, module OUTPUT4, formatted non-spars
 Columns not listed are zero. The sparse "BIGMAT" form (negative NW or row-index strings) is not
 supported and raises a ValueError naming the matrix. Values are parsed by fixed field width
 read from the format string, so adjacent negative numbers without spaces read correctly.
+
+The fixed-width records are read strictly (issue 22): a data line must hold exactly its
+fields (``min(per_line, remaining words) * width`` characters, trailing blanks allowed), every
+field a number; a header or column record may hold nothing after its fields. A line one
+character short, whose last field would otherwise still parse with one digit of its exponent
+lost (``2.743123126E+01`` read as ``2.743123126E+0``, ten times too small), and a stray token
+after a record are errors naming the file, the matrix and the 1-based line.
 """
 
 from __future__ import annotations
@@ -37,14 +44,16 @@ class Op4Matrix:
     data: np.ndarray
 
 
-_FMT = re.compile(r"(\d+)\s*[EeDd]\s*(\d+)\.(\d+)")
+_FMT = re.compile(r"(?:\d*P,)?(\d+)[EeDd](\d+)\.(\d+)")
 
 
 def _field_width(fmt: str) -> tuple[int, int]:
-    """(values per line, field width) from a Fortran format like ``1P,5E16.9``."""
-    m = _FMT.search(fmt)
+    """(values per line, field width) from a Fortran format like ``1P,5E16.9``: the whole
+    format field must be that one token (an optional scale factor ``kP,``, then ``nEw.d``)."""
+    m = _FMT.fullmatch(fmt)
     if m is None:
-        raise ValueError(f"unsupported OP4 number format {fmt!r} (expected like '1P,5E16.9')")
+        raise ValueError(f"unsupported OP4 number format {fmt!r} (expected one token like "
+                         "'1P,5E16.9')")
     per_line, width, digits = int(m.group(1)), int(m.group(2)), int(m.group(3))
     if per_line < 1 or width < 2 or digits >= width:
         raise ValueError(f"OP4 number format {fmt!r} must have >= 1 value per line and a field "
@@ -64,20 +73,126 @@ def _to_float(field: str) -> float:
     try:
         return float(f)
     except ValueError:
-        raise ValueError(f"OP4 value {field!r} is not a number") from None
+        raise ValueError(f"value {field!r} is not a number") from None
 
 
-def _parse_values(lines: list[str], nwords: int, width: int) -> np.ndarray:
+def _parse_line(s: str, n_fields: int, width: int, lineno: int) -> list[float]:
+    """The ``n_fields`` fixed-width fields of one data line, read strictly.
+
+    A line must hold exactly ``n_fields * width`` characters (blanks after them are allowed,
+    nothing else), and every field must be a number: a line one character short would
+    otherwise shift its last field by a digit (``2.743123126E+01`` read as ``2.743123126E+0``,
+    a value ten times too small) and still parse.
+    """
+    need = n_fields * width
+    if len(s) < need:
+        raise ValueError(f"line {lineno} holds {len(s)} characters; its {n_fields} value(s) "
+                         f"of field width {width} need exactly {need} (a truncated line)")
+    if s[need:].strip():
+        raise ValueError(f"line {lineno} has unexpected text {s[need:].strip()!r} after its "
+                         f"{n_fields} value(s) of field width {width}")
     vals = []
-    for line in lines:
-        s = line.rstrip("\n")
-        for j in range(0, len(s), width):
-            field = s[j:j + width].strip()
-            if field:
-                vals.append(_to_float(field))
-    if len(vals) != nwords:
-        raise ValueError(f"OP4 column record expected {nwords} words, read {len(vals)}")
+    for j in range(0, need, width):
+        field = s[j:j + width]
+        if not field.strip():
+            raise ValueError(f"line {lineno}: field {j // width + 1} (columns {j + 1}-"
+                             f"{j + width}) is blank")
+        try:
+            vals.append(_to_float(field.strip()))
+        except ValueError as exc:
+            raise ValueError(f"line {lineno}: {exc}") from None
+    return vals
+
+
+def _parse_values(lines: list[str], nwords: int, width: int, per_line: int,
+                  first_lineno: int) -> np.ndarray:
+    """The ``nwords`` values of one column record, ``per_line`` to a line (the last line holds
+    the remainder); ``first_lineno`` is the 1-based line number of ``lines[0]``."""
+    n_lines = -(-nwords // per_line)
+    if len(lines) < n_lines:
+        raise ValueError(f"the record needs {n_lines} data line(s) for its {nwords} words; the "
+                         f"file ends after {len(lines)}")
+    vals: list[float] = []
+    for r, line in enumerate(lines[:n_lines]):
+        n_fields = min(per_line, nwords - r * per_line)
+        vals.extend(_parse_line(line, n_fields, width, first_lineno + r))
     return np.asarray(vals)
+
+
+def _int_fields(line: str, n: int, what: str, lineno: int) -> tuple[int, ...]:
+    """The first ``n`` integer fields (I8) of a header or column record."""
+    try:
+        return tuple(int(line[j:j + 8]) for j in range(0, 8 * n, 8))
+    except ValueError:
+        raise ValueError(f"line {lineno} is not an OP4 {what}: {line!r}") from None
+
+
+def _read_header(line: str, lineno: int) -> tuple[int, int, int, int, str, int, int]:
+    """``(ncol, nrow, form, ntype, name, per_line, width)`` of a matrix header record
+    ``NCOL NROW NFORM NTYPE NAME FORMAT`` (4I8, the name in 8 columns, the format)."""
+    ncol, nrow, form, ntype = _int_fields(line, 4, "header", lineno)
+    rest = line[32:]
+    name = rest[:8].strip()
+    fmt = rest[8:].strip()
+    if not name or " " in name:
+        raise ValueError(f"line {lineno}: matrix name {rest[:8]!r} (columns 33-40) must be "
+                         "1-8 characters without blanks")
+    if ntype not in (1, 2, 3, 4):
+        raise ValueError(f"matrix {name!r} has unsupported type {ntype} (1..4)")
+    if ncol <= 0 or nrow <= 0:
+        raise ValueError(f"matrix {name!r} has a sparse/BIGMAT header "
+                         f"(ncol={ncol}, nrow={nrow}); not supported")
+    try:
+        per_line, width = _field_width(fmt)
+    except ValueError as exc:
+        raise ValueError(f"matrix {name!r}, header line {lineno}: {exc}") from None
+    return ncol, nrow, form, ntype, name, per_line, width
+
+
+def _read_column_record(line: str, lineno: int) -> tuple[int, int, int]:
+    """``(icol, irow, nw)`` of a column record (3I8); any other text on the line is an error."""
+    icol, irow, nw = _int_fields(line, 3, "column record (ICOL IROW NW, 3I8)", lineno)
+    if line[24:].strip():
+        raise ValueError(f"line {lineno}: unexpected text {line[24:].strip()!r} after the "
+                         "column record ICOL IROW NW (3I8)")
+    if nw < 0 or irow < 0:
+        raise ValueError(f"line {lineno}: the sparse (BIGMAT) layout is not supported")
+    return icol, irow, nw
+
+
+def _read_matrix(lines: list[str], i: int) -> tuple[Op4Matrix, int]:
+    """The matrix whose header is ``lines[i]``, and the index of the line after it."""
+    ncol, nrow, form, ntype, name, per_line, width = _read_header(lines[i], i + 1)
+    is_complex = ntype in (3, 4)
+    data = np.zeros((nrow, ncol), dtype=complex if is_complex else float)
+    i += 1
+    while True:
+        if i >= len(lines):
+            raise ValueError(f"matrix {name!r} ends without its terminating record")
+        try:
+            icol, irow, nw = _read_column_record(lines[i], i + 1)
+            nlines = -(-nw // per_line)
+            vals = _parse_values(lines[i + 1:i + 1 + nlines], nw, width, per_line, i + 2)
+        except ValueError as exc:
+            raise ValueError(f"matrix {name!r}: {exc}") from None
+        i += 1 + nlines
+        if icol > ncol:
+            break
+        if icol < 1 or irow < 1:
+            raise ValueError(f"matrix {name!r}, line {i - nlines}: column/row index < 1")
+        if is_complex:
+            if nw % 2:
+                raise ValueError(f"complex matrix {name!r} has an odd word count at line "
+                                 f"{i - nlines}")
+            col = vals[0::2] + 1j * vals[1::2]
+        else:
+            col = vals
+        if irow - 1 + len(col) > nrow:
+            raise ValueError(f"matrix {name!r} column {icol} overruns {nrow} rows")
+        data[irow - 1:irow - 1 + len(col), icol - 1] = col
+    if not np.all(np.isfinite(data)):
+        raise ValueError(f"matrix {name!r} holds non-finite values")
+    return Op4Matrix(name=name, form=form, ntype=ntype, data=data), i
 
 
 def read_op4(path: str | Path) -> dict[str, Op4Matrix]:
@@ -95,70 +210,29 @@ def read_op4(path: str | Path) -> dict[str, Op4Matrix]:
     Raises
     ------
     ValueError
-        On a malformed header or column record, an unsupported (sparse/BIGMAT) layout or a file
-        holding no matrix.
+        Naming the file, the matrix and the 1-based line: on a malformed header or column
+        record, unexpected text after a record's fields, a data line shorter than its fields
+        (a truncated line) or with a blank or misaligned field, an unsupported (sparse/BIGMAT)
+        layout, a matrix named twice, or a file holding no matrix.
     """
     lines = Path(path).read_text().splitlines()
     if not any(line.strip() for line in lines):
         raise ValueError(f"{path}: the OP4 file holds no matrix (it is empty)")
     out: dict[str, Op4Matrix] = {}
     i = 0
-    n = len(lines)
-    while i < n:
-        head = lines[i]
-        if not head.strip():
+    while i < len(lines):
+        if not lines[i].strip():
             i += 1
             continue
         try:
-            ncol, nrow, form, ntype = (int(head[j:j + 8]) for j in range(0, 32, 8))
+            mat, i_next = _read_matrix(lines, i)
         except ValueError as exc:
-            raise ValueError(f"{path}: line {i + 1} is not an OP4 header: {head!r}") from exc
-        rest = head[32:]
-        name = rest[:8].strip()
-        fmt = rest[8:].strip()
-        if ntype not in (1, 2, 3, 4):
-            raise ValueError(f"{path}: matrix {name!r} has unsupported type {ntype}")
-        if ncol <= 0 or nrow <= 0:
-            raise ValueError(f"{path}: matrix {name!r} has a sparse/BIGMAT header "
-                             f"(ncol={ncol}, nrow={nrow}); not supported")
-        per_line, width = _field_width(fmt)
-        is_complex = ntype in (3, 4)
-        data = np.zeros((nrow, ncol), dtype=complex if is_complex else float)
-        i += 1
-        while True:
-            if i >= n:
-                raise ValueError(f"{path}: matrix {name!r} ends without its terminating record")
-            rec = lines[i]
-            try:
-                icol, irow, nw = (int(rec[j:j + 8]) for j in range(0, 24, 8))
-            except ValueError as exc:
-                raise ValueError(f"{path}: line {i + 1}: bad column record {rec!r}") from exc
-            if nw < 0 or irow < 0:
-                raise ValueError(f"{path}: matrix {name!r} uses the sparse (BIGMAT) layout, "
-                                 "not supported")
-            nlines = -(-nw // per_line)
-            try:
-                vals = _parse_values(lines[i + 1:i + 1 + nlines], nw, width)
-            except ValueError as exc:
-                raise ValueError(f"{path}: matrix {name!r}, record at line {i + 1}: {exc}") \
-                    from None
-            i += 1 + nlines
-            if icol > ncol:
-                break
-            if icol < 1 or irow < 1:
-                raise ValueError(f"{path}: matrix {name!r}: column/row index < 1")
-            if is_complex:
-                if nw % 2:
-                    raise ValueError(f"{path}: complex matrix {name!r} has an odd word count")
-                col = vals[0::2] + 1j * vals[1::2]
-            else:
-                col = vals
-            if irow - 1 + len(col) > nrow:
-                raise ValueError(f"{path}: matrix {name!r} column {icol} overruns {nrow} rows")
-            data[irow - 1:irow - 1 + len(col), icol - 1] = col
-        if not np.all(np.isfinite(data)):
-            raise ValueError(f"{path}: matrix {name!r} holds non-finite values")
-        out[name] = Op4Matrix(name=name, form=form, ntype=ntype, data=data)
+            raise ValueError(f"{path}: {exc}") from None
+        if mat.name in out:
+            raise ValueError(f"{path}: matrix {mat.name!r} at line {i + 1} is already in the "
+                             "file (names must be unique)")
+        out[mat.name] = mat
+        i = i_next
     return out
 
 

@@ -6,16 +6,33 @@ interrupted write never leaves a half-written file; temporary files orphaned by 
 removed by the next :func:`save_npz` / :func:`load_npz` of that path.
 
 The metadata stores a SHA-256 (``"sha256"``, ``"digest_version": 2``) over every array's name,
-dtype, shape and bytes *and* over the metadata itself, so editing ``b_ref`` or ``n_rigid`` in the
-metadata, or changing a shape, fails the check. ``load_npz`` recomputes it and raises
-:class:`CacheError` -- the signal to rebuild -- for a missing, unreadable, malformed or
-mismatching file. A digest is no defence against a file rewritten *consistently* (reordered
-``machs`` with the digest recomputed): for that the caller passes what it expects
-(``expect_metadata``, ``expect_arrays``, ``expect_shapes``), and every mismatch is a CacheError.
+dtype, shape and bytes *and* over the metadata itself (the caller's fingerprint of the inputs
+included), so editing ``b_ref`` or ``n_rigid`` in the metadata, or changing a shape, fails the
+check. ``load_npz`` recomputes it and raises :class:`CacheError` -- the signal to rebuild -- for
+a missing, unreadable, malformed or mismatching file.
 
-Files written before digest version 2 (array-only digest) are still read when
-``allow_legacy=True`` (the default, so a shipped database stays usable); their metadata is then
-covered only by the caller's expectations.
+What the digest protects against, and what it does not
+------------------------------------------------------
+It is an integrity check, not an authentication (there is no secret: anyone who can write the
+cache folder can run :func:`save_npz`). It catches
+
+* accidental corruption: a flipped bit, a truncated or half-copied file, a zip member lost;
+* an edit by any tool that does not recompute the version-2 digest: an array changed alone
+  (``Q`` doubled, ``machs`` reordered), a metadata value changed alone, or an array changed with
+  an *array-only* digest recomputed next to the old metadata (version 2 covers both, so the old
+  fingerprint no longer matches the new arrays);
+* a legacy file (digest version 1: arrays only, the metadata unprotected), refused unless the
+  caller asks for it (``allow_legacy=True``; :func:`upgrade_legacy` re-stamps one explicitly);
+* together with the caller's checks, a stale cache from other inputs: the caller stores a
+  fingerprint of its inputs in the metadata and passes what it expects (``expect_metadata``,
+  ``expect_arrays``, ``expect_shapes``); every mismatch is a CacheError.
+
+It does **not** protect against a deliberate, consistent rewrite: arrays changed (``Q`` x 2)
+and the file written again through :func:`save_npz` (or the digest recomputed by hand) with the
+old fingerprint passes every check and is used as is. Guarding that needs a secret the writer
+does not have, which a local cache cannot keep from its own user; the remedy is not to trust a
+cache folder others can write, and to rebuild (``pipeline.gaf_database(case, cache=False)``, or
+delete the file) when in doubt.
 """
 
 from __future__ import annotations
@@ -159,9 +176,29 @@ def _same(a, b) -> bool:
     return a == b
 
 
+def _check_digest(path: Path, arrays: dict, meta: dict, stored: str, allow_legacy: bool) -> None:
+    """Raise CacheError unless ``stored`` is the digest of the arrays and metadata (version
+    2), or of the arrays alone for a legacy file when ``allow_legacy``."""
+    version = meta.get("digest_version")
+    if version == DIGEST_VERSION:
+        ok = stored == _digest(arrays, meta)
+    elif version is None and allow_legacy:
+        ok = stored == _digest(arrays)
+    elif version is None:
+        raise CacheError(f"cache file {path} has a legacy digest version None (arrays only, its "
+                         f"metadata unprotected), expected {DIGEST_VERSION}: refused unless "
+                         f"allow_legacy=True; rebuild it or re-stamp it with "
+                         f"asekit.util.cache.upgrade_legacy")
+    else:
+        raise CacheError(f"cache file {path} has digest version {version!r}, expected "
+                         f"{DIGEST_VERSION}")
+    if not ok:
+        raise CacheError(f"cache file {path} fails its checksum")
+
+
 def load_npz(path: str | Path, expect_metadata: dict | None = None,
              expect_arrays: dict | None = None, expect_shapes: dict | None = None,
-             allow_legacy: bool = True) -> tuple[dict[str, np.ndarray], dict]:
+             allow_legacy: bool = False) -> tuple[dict[str, np.ndarray], dict]:
     """Read a file written by :func:`save_npz`, verify its digest and the caller's expectations.
 
     Parameters
@@ -173,13 +210,18 @@ def load_npz(path: str | Path, expect_metadata: dict | None = None,
         1e-12 relative), e.g. ``{"machs": [0.4, 0.5, 0.6, 0.75], "k": ks}``.
     expect_shapes : ``name -> shape`` with ``None`` for a free axis, e.g.
         ``{"Q": (4, 15, None, None)}``; the array must exist with that number of axes.
-    allow_legacy : accept files with an array-only digest (written before version 2).
+    allow_legacy : accept a file with an array-only digest (digest version 1, written before
+        version 2, its metadata unprotected). Default False: such a file is a CacheError (the
+        rebuild signal) unless the caller asks for it explicitly; :func:`upgrade_legacy`
+        re-stamps one with a version-2 digest.
 
     Raises
     ------
     CacheError
-        If the file is missing, unreadable, its metadata malformed, its digest does not match,
-        or an expectation fails (the message names the key).
+        If the file is missing, unreadable, its metadata malformed, its digest does not match
+        (or is a legacy digest and ``allow_legacy`` is False), or an expectation fails (the
+        message names the key). What the digest does and does not protect against: the module
+        docstring (a consistent rewrite through :func:`save_npz` is *not* detected).
     """
     path = Path(path)
     clean_orphans(path)
@@ -200,16 +242,7 @@ def load_npz(path: str | Path, expect_metadata: dict | None = None,
     stored = meta.get("sha256")
     if not isinstance(stored, str):
         raise CacheError(f"cache file {path} has no digest in its metadata")
-    version = meta.get("digest_version")
-    if version == DIGEST_VERSION:
-        ok = stored == _digest(arrays, meta)
-    elif version is None and allow_legacy:
-        ok = stored == _digest(arrays)
-    else:
-        raise CacheError(f"cache file {path} has digest version {version!r}, expected "
-                         f"{DIGEST_VERSION}")
-    if not ok:
-        raise CacheError(f"cache file {path} fails its checksum")
+    _check_digest(path, arrays, meta, stored, allow_legacy)
     for key, want in (expect_metadata or {}).items():
         if key not in meta:
             raise CacheError(f"cache file {path}: metadata {key!r} is missing")
@@ -234,3 +267,27 @@ def load_npz(path: str | Path, expect_metadata: dict | None = None,
             raise CacheError(f"cache file {path}: array {key!r} has shape {got.shape}, "
                              f"expected {tuple(shape)}")
     return arrays, meta
+
+
+def upgrade_legacy(path: str | Path, target: str | Path | None = None) -> Path:
+    """Re-stamp a legacy cache file (array-only digest) with a version-2 digest.
+
+    The legacy digest is verified first (a corrupt file is a CacheError), then the same arrays,
+    bit for bit, and the same metadata are written through :func:`save_npz` to ``target``
+    (default: ``path`` itself, replaced atomically). This is the explicit "I trust this legacy
+    file" step: from then on its metadata is covered by the digest too. A file that already has
+    a version-2 digest is verified and rewritten unchanged in content.
+
+    Parameters
+    ----------
+    path : the legacy ``.npz``.
+    target : where to write the re-stamped file (default ``path``).
+
+    Returns
+    -------
+    Path
+        The re-stamped file.
+    """
+    arrays, meta = load_npz(path, allow_legacy=True)
+    body = {k: v for k, v in meta.items() if k not in _DIGEST_KEYS}
+    return save_npz(Path(path) if target is None else Path(target), arrays, body)

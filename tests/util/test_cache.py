@@ -1,6 +1,8 @@
-"""Caches that cannot lie (issue 11): the digest covers metadata and shapes; a consistently
-rewritten file is refused by the caller's expectations; malformed metadata is a CacheError (the
-rebuild signal), never a crash; orphaned temporary files are cleaned."""
+"""Caches that cannot lie (issues 11, 22): the digest covers metadata and shapes; a consistently
+rewritten file is refused by the caller's expectations where it can be (a deliberate consistent
+rewrite through save_npz is not detected: documented, and asserted below); legacy array-only
+digests are refused unless asked for; malformed metadata is a CacheError (the rebuild signal),
+never a crash; orphaned temporary files are cleaned."""
 
 import json
 import os
@@ -9,7 +11,14 @@ import time
 import numpy as np
 import pytest
 
-from asekit.util.cache import CacheError, _digest, clean_orphans, load_npz, save_npz
+from asekit.util.cache import (
+    CacheError,
+    _digest,
+    clean_orphans,
+    load_npz,
+    save_npz,
+    upgrade_legacy,
+)
 from asekit.util.paths import DATA_DIR
 
 MACHS = np.array([0.4, 0.5, 0.6, 0.75])
@@ -107,24 +116,89 @@ def test_unknown_digest_version_and_legacy(tmp_path):
     p = tmp_path / "legacy.npz"
     arrays = {"machs": MACHS}
     _rewrite(p, arrays, {"b_ref": 0.05, "sha256": _digest(arrays)})      # pre-v2 file
-    assert load_npz(p)[1]["b_ref"] == 0.05
-    with pytest.raises(CacheError, match="digest version"):
-        load_npz(p, allow_legacy=False)
+    with pytest.raises(CacheError, match="legacy digest version None .* refused unless "
+                                         "allow_legacy=True"):
+        load_npz(p)                                                     # issue 22: the default
+    assert load_npz(p, allow_legacy=True)[1]["b_ref"] == 0.05           # asked for explicitly
     _rewrite(p, arrays, {"sha256": _digest(arrays), "digest_version": 7})
-    with pytest.raises(CacheError, match="digest version"):
+    with pytest.raises(CacheError, match="digest version 7"):
+        load_npz(p, allow_legacy=True)
+
+
+# ---- issue 22: what the digest does and does not protect against -----------------------------
+def _shipped():
+    """The arrays and metadata (digest keys dropped) of the shipped data/gaf_fin.npz."""
+    path = DATA_DIR / "gaf_fin.npz"
+    with np.load(path) as raw:
+        arrays = {k: raw[k] for k in ("machs", "k", "Q")}
+        meta = json.loads(bytes(raw["__metadata__"]).decode())
+    return arrays, {k: v for k, v in meta.items() if k not in ("sha256", "digest_version")}
+
+
+def test_issue22_legacy_rewrite_of_q_is_refused_by_default(tmp_path):
+    """Q x 2 with an array-only (legacy) digest recomputed next to the old metadata: accepted
+    before issue 22 (allow_legacy=True was the default), refused now."""
+    arrays, meta = _shipped()
+    bad = dict(arrays, Q=2 * arrays["Q"])
+    p = tmp_path / "gaf.npz"
+    _rewrite(p, bad, dict(meta, sha256=_digest(bad)))
+    with pytest.raises(CacheError, match="legacy digest"):
         load_npz(p)
 
 
+def test_issue22_array_digest_with_old_fingerprint_fails_the_checksum(tmp_path):
+    """Q x 2, an array-only digest recomputed, the version-2 stamp and the old fingerprint kept:
+    the version-2 digest binds the arrays to the metadata, so it fails."""
+    arrays, meta = _shipped()
+    bad = dict(arrays, Q=2 * arrays["Q"])
+    p = tmp_path / "gaf.npz"
+    _rewrite(p, bad, dict(meta, sha256=_digest(bad), digest_version=2))
+    with pytest.raises(CacheError, match="fails its checksum"):
+        load_npz(p)
+    _rewrite(p, bad, dict(meta, sha256=_digest(arrays, dict(meta, digest_version=2)),
+                          digest_version=2))                   # the original file's digest
+    with pytest.raises(CacheError, match="fails its checksum"):
+        load_npz(p)
+
+
+def test_issue22_consistent_rewrite_is_not_detected(tmp_path):
+    """The documented limit (module docstring of asekit.util.cache): Q x 2 written again through
+    save_npz with the old metadata passes every check. The digest is an integrity check, not an
+    authentication; if this ever starts failing, update the documentation with it."""
+    arrays, meta = _shipped()
+    p = save_npz(tmp_path / "gaf.npz", dict(arrays, Q=2 * arrays["Q"]), meta)
+    got, _ = load_npz(p, expect_metadata={"fingerprint": meta["fingerprint"]},
+                      expect_arrays={"machs": arrays["machs"], "k": arrays["k"]})
+    np.testing.assert_array_equal(got["Q"], 2 * arrays["Q"])
+
+
+def test_upgrade_legacy_keeps_the_numbers_bit_for_bit(tmp_path):
+    arrays, meta = _shipped()
+    p = tmp_path / "legacy.npz"
+    _rewrite(p, arrays, dict(meta, sha256=_digest(arrays)))
+    assert upgrade_legacy(p) == p
+    got, m = load_npz(p)
+    assert m["digest_version"] == 2 and {k: m[k] for k in meta} == meta
+    for k, a in arrays.items():
+        assert got[k].dtype == a.dtype and got[k].tobytes() == a.tobytes()
+    q = tmp_path / "corrupt.npz"                        # a legacy file failing its own digest
+    _rewrite(q, dict(arrays, Q=2 * arrays["Q"]), dict(meta, sha256=_digest(arrays)))
+    with pytest.raises(CacheError, match="fails its checksum"):
+        upgrade_legacy(q)
+
+
 def test_shipped_database_still_loads():
-    """The committed data/gaf_fin.npz (array-only digest) stays readable, unmodified."""
+    """The committed data/gaf_fin.npz (re-stamped with a version-2 digest in issue 22, its
+    arrays and metadata unchanged) is readable without allow_legacy, and left unmodified."""
     path = DATA_DIR / "gaf_fin.npz"
-    if not path.exists():
-        pytest.skip("no shipped database")
     before = path.stat().st_mtime_ns
     with np.load(path) as raw:
         machs = raw["machs"]
     arrays, meta = load_npz(path, expect_arrays={"machs": machs},
                             expect_shapes={"Q": (machs.size, None, None, None)})
+    assert meta["digest_version"] == 2
+    assert meta["fingerprint"] == ("f412431191d9e1c4cc7167130b0993aae341f65e15a1efe2695093e6e3057"
+                                   "a3c")                         # the fin's, as before issue 22
     assert arrays["Q"].shape[2] == arrays["Q"].shape[3] == len(meta["frequencies_hz"])
     assert path.stat().st_mtime_ns == before
 
