@@ -91,11 +91,6 @@ from asekit.aero.kernels import check_kernel
 from asekit.aero.validity import check_k
 from asekit.aero.vlm import CHUNK_BYTES, check_mach, vlm_normalwash_matrix
 
-try:            # numba is optional (asekit.aero.kernels.numba_available chooses the kernel)
-    from asekit.aero import _dlm_compiled as C
-except ImportError:                                               # pragma: no cover
-    C = None
-
 #: Laschka's approximation of u / sqrt(1 + u^2) ~ 1 - sum a_n exp(-n c u) ([R71] Eq. A.4;
 #: coefficients as tabulated by Blair 1992, WL-TR-92-3028, p. 89).
 LASCHKA_C = 0.372

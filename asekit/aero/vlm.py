@@ -30,11 +30,6 @@ from asekit.aero.validity import SUBSONIC
 from asekit.aero.validity import check_mach as _check_mach
 from asekit.util.validate import positive
 
-try:            # numba is optional (asekit.aero.kernels.numba_available chooses the kernel)
-    from asekit.aero import _dlm_compiled
-except ImportError:                                               # pragma: no cover
-    _dlm_compiled = None
-
 #: Upper bound (bytes) for the temporaries of one row chunk (VLM and DLM).
 CHUNK_BYTES = 256 * 2**20
 #: Receiver-sender pairs per row chunk of the vortex lattice (cache-sized).
