@@ -28,7 +28,7 @@ from asekit.aero.boxes import BoxMesh
 from asekit.aero.dlm import factor_normalwash_matrix, map_normalwash_matrices
 from asekit.aero.methods import DLM_KERNELS, check_mach, pressures, resolve_method
 from asekit.aero.spline import BoxModes, fe_spline, modal_forces
-from asekit.aero.validity import check_k
+from asekit.aero.validity import check_k, mach_number
 from asekit.util.blas import blas_threads_for
 from asekit.util.cache import CacheError, load_npz, save_npz
 from asekit.util.paths import DATA_DIR, user_cache_dir
@@ -140,12 +140,7 @@ class GafDatabase:
         np.complex128(2+0j)
         """
         machs = np.asarray(self.machs, dtype=float)
-        try:
-            m = float(mach)
-        except (TypeError, ValueError):
-            m = math.nan
-        if not math.isfinite(m) or m < 0:
-            raise ValueError(f"mach must be a finite Mach number >= 0, got {mach!r}")
+        m = mach_number(mach)
         hit = np.nonzero(np.abs(machs - m) <= atol)[0]
         if hit.size:
             return TabulatedGaf(self.k, self.Q[hit[0]], self.b_ref, mach=m)

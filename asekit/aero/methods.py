@@ -30,7 +30,6 @@ ones. Adding a method: its kernel module and one :data:`AERO_METHODS` entry.
 
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass
 from typing import Callable
@@ -41,7 +40,7 @@ from asekit.aero.boxes import BoxMesh
 from asekit.aero.dlm import factor_normalwash_matrix, map_normalwash_matrices, normalwash_matrices
 from asekit.aero.piston import piston_pressure_matrices
 from asekit.aero.supersonic import supersonic_pressure_matrices, supersonic_pressures
-from asekit.aero.validity import SUBSONIC, SUPERSONIC, MachRange, check_k
+from asekit.aero.validity import SUBSONIC, SUPERSONIC, MachRange, check_k, mach_number
 from asekit.aero.validity import check_mach as _check_mach_range
 
 __all__ = ["AERO_METHODS", "AeroMethod", "DLM_KERNELS", "DLM_MACH_MAX", "METHODS",
@@ -189,12 +188,7 @@ def resolve_method(method: str, mach: float, name: str = "mach") -> str:
     ``name``, the argument or key path, and the method), and one inside the gap warns
     (:class:`TransonicWarning`)."""
     check_method(method)
-    try:
-        m = float(mach)
-    except (TypeError, ValueError):
-        m = math.nan
-    if not math.isfinite(m) or m < 0:
-        raise ValueError(f"{name} must be a finite Mach number >= 0, got {mach!r}")
+    m = mach_number(mach, name)
     if method == "auto":
         if m <= DLM_MACH_MAX:
             return "dlm"

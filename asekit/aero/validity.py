@@ -56,6 +56,23 @@ SUBSONIC = MachRange(0.0, 1.0, True, False, "subsonic")
 SUPERSONIC = MachRange(1.0, math.inf, False, False, "supersonic")
 
 
+def mach_number(mach, name: str = "mach") -> float:
+    """``float(mach)`` if it is a finite Mach number >= 0, else ValueError naming ``name``.
+
+    Examples
+    --------
+    >>> mach_number(0.75)
+    0.75
+    """
+    try:
+        m = float(mach)
+    except (TypeError, ValueError):
+        m = math.nan
+    if not math.isfinite(m) or m < 0:
+        raise ValueError(f"{name} must be a finite Mach number >= 0, got {mach!r}")
+    return m
+
+
 def check_mach(mach, mach_range: MachRange, who: str = "", name: str = "mach",
                hint: str = "") -> float:
     """``float(mach)`` if it lies in ``mach_range``, else ValueError
