@@ -23,3 +23,30 @@ def user_cache_dir() -> Path:
         return Path(env).expanduser()
     xdg = os.environ.get("XDG_CACHE_HOME")
     return (Path(xdg).expanduser() if xdg else Path.home() / ".cache") / "asekit"
+
+
+def shipped_cases() -> dict[str, Path]:
+    """The case files shipped with asekit (``data/cases/*.toml``), by name (the file stem).
+
+    Examples
+    --------
+    >>> "agard445_6" in shipped_cases()
+    True
+    """
+    return {p.stem: p for p in sorted(CASES_DIR.glob("*.toml"))}
+
+
+def shipped_case(name: str) -> Path | None:
+    """The shipped case file called ``name`` (with or without ``.toml``), or None.
+
+    Examples
+    --------
+    >>> shipped_case("agard445_6.toml").name
+    'agard445_6.toml'
+    >>> shipped_case("no_such_case") is None
+    True
+    """
+    stem = name[:-5] if name.endswith(".toml") else name
+    if "/" in stem or "\\" in stem:
+        return None
+    return shipped_cases().get(stem)
