@@ -468,9 +468,12 @@ def _match_point(c: FlightCondition, pts) -> dict:
     its last point) against the flight speed M a."""
     a = c.speed_of_sound
     d = [(m, u / a - m) for m, u, kind in pts if kind == "value"]
-    mm = None
+    mm, across = None, None
     for (m0, d0), (m1, d1) in zip(d[:-1], d[1:]):
         if d0 == 0 or d0 * d1 < 0:
+            if _across_sonic(m0, m1):       # never interpolated through the transonic range
+                across = across or (m0, m1)
+                continue
             mm = m0 + (m1 - m0) * d0 / (d0 - d1)
             break
     upper = [p for p in pts if p[2] == "upper"]
@@ -493,6 +496,10 @@ def _match_point(c: FlightCondition, pts) -> dict:
         elif d and all(v < 0 for _, v in d):
             parts.append(f"U_f < M a at every analysed Mach with a crossing: the match lies "
                          f"below M {d[0][0]:g}")
+        if across:
+            parts.append(f"U_f - M a changes sign between M {across[0]:g} and M "
+                         f"{across[1]:g}, across M 1: the match lies in the transonic range, "
+                         "which is not interpolated (analyse Machs nearer M 1 on each side)")
         if not parts:
             parts.append("no flutter in the sweep at any analysed Mach")
         why = "; ".join(parts)
@@ -500,6 +507,7 @@ def _match_point(c: FlightCondition, pts) -> dict:
             why = why.replace(" with a crossing", "")
     return {"altitude_m": c.altitude, "matched_mach": mm,
             "matched_speed_ms": None if mm is None else mm * a,
+            "match_across_sonic": None if across is None or mm is not None else list(across),
             "flutter_at_or_below_ms": upper[0][1] if upper else None,
             "no_match": why}
 
@@ -509,6 +517,7 @@ def _interp_bounded(pts, mach: float, reach: float = 0.05):
     them) and its bound: "value" when every point it uses is a value, "upper" / "lower" when
     the used points are values and upper (lower) bounds, interpolated (not extrapolated);
     (None, None) otherwise."""
+    pts = sorted(p for p in pts if not _across_sonic(p[0], mach))
     u = _interp_speed([(m, s) for m, s, _ in pts], mach, reach)
     if u is None:
         return None, None
@@ -546,16 +555,33 @@ def _margin(c: FlightCondition, pts, env_mach: float) -> dict:
     elif kind == "lower":
         out["note"] = f"no flutter up to {uf:.4g} m/s (the last point of the sweep)"
     elif kind is None:
-        out["note"] = (f"U_f not known at M {env_mach:g}: no analysed Mach within 0.05, or "
-                       "bounds of both kinds around it")
+        out["note"] = (f"U_f not known at M {env_mach:g}: no analysed Mach within 0.05 on "
+                       "the same side of M 1, or bounds of both kinds around it")
     return out
+
+
+def _across_sonic(m0: float, m1: float) -> bool:
+    """Whether M 1 lies between (or at) two Mach numbers that are not both on one side of it.
+
+    Flutter speeds are never interpolated or extrapolated through the transonic range: linear
+    theory changes character at M 1 (subsonic DLM below, supersonic theory above, the gap
+    :data:`asekit.aero.methods.DLM_MACH_MAX` < M < :data:`asekit.aero.methods.SUPERSONIC_MACH_MIN`
+    unanalysed by ``aero.method = "auto"``) and the transonic dip lies there.
+
+    Examples
+    --------
+    >>> _across_sonic(0.9, 1.5), _across_sonic(0.6, 0.9), _across_sonic(1.2, 2.0)
+    (True, False, False)
+    """
+    return (m0 - 1.0) * (m1 - 1.0) <= 0.0
 
 
 def _interp_speed(points: list[tuple[float, float]], mach: float,
                   reach: float = 0.05) -> float | None:
-    """U_f at ``mach`` from (Mach, U_f) points: linear between them, linear extrapolation of
-    the end segment at most ``reach`` in Mach beyond them; None farther out."""
-    pts = sorted(points)
+    """U_f at ``mach`` from (Mach, U_f) points on its side of M 1 (:func:`_across_sonic`):
+    linear between them, linear extrapolation of the end segment at most ``reach`` in Mach
+    beyond them; None farther out."""
+    pts = sorted(p for p in points if not _across_sonic(p[0], mach))
     if not pts or not pts[0][0] - reach <= mach <= pts[-1][0] + reach:
         return None
     ms, us = np.array(pts).T

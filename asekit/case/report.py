@@ -163,7 +163,10 @@ def _margin_text(m: dict) -> str:
     note."""
     env = m["envelope_speed_ms"]
     if m["margin"] is not None:
-        return f"{100 * m['margin']:+.1f} % (U_f {m['flutter_speed_ms']:.1f} vs {env:.1f} m/s)"
+        where = ("flutter inside the envelope by" if m["margin"] < 0 else
+                 "flutter outside the envelope by")
+        return (f"{100 * m['margin']:+.1f} % ({where} {abs(100 * m['margin']):.1f} %: U_f "
+                f"{m['flutter_speed_ms']:.1f} vs {env:.1f} m/s)")
     if m.get("margin_upper_bound") is not None:
         u = m["flutter_speed_upper_bound_ms"]
         return (f"at most {100 * m['margin_upper_bound']:+.1f} % (flutter at or below {u:.1f} "
