@@ -919,16 +919,65 @@ def read_table(path):
 # executors
 # ---------------------------------------------------------------------------------------------
 EXECUTORS = ("serial", "processes", "dask")
-_WORKER: dict = {}        # per worker process of the "processes" executor: (sweep, factors)
+#: A sample whose worker process dies this many times while computing it (killed by a signal,
+#: out of memory, a crash in compiled code) is a failed row (:class:`WorkerLost` naming it).
+MAX_WORKER_DEATHS = 3
+#: Worker processes replaced in one run of the "processes" executor at most; the samples not
+#: computed after that are failed rows (:class:`WorkerLost`) that a resume runs again.
+MAX_WORKER_RESTARTS = 12
+#: s between two checks of a worker's watchdog that its parent (the sweep) is alive.
+WATCHDOG_INTERVAL = 0.5
 
 
-def _init_worker(sweep, factors):
-    _WORKER["job"] = (sweep, factors)
+class WorkerLost(RuntimeError):
+    """The process computing a sample died (killed by a signal, out of memory, a crash in
+    compiled code): the error of its failed row, naming the sample."""
 
 
-def _worker_evaluate(index, values):
-    sweep, factors = _WORKER["job"]
-    return evaluate(sweep, factors, index, values)
+def _die_with_parent(parent_pid: int) -> None:
+    """Make this worker process end when the sweep's process ``parent_pid`` is gone (killed
+    with SIGKILL, it cannot clean up): on Linux the kernel kills it on the parent's death
+    (prctl PR_SET_PDEATHSIG = SIGKILL), and on every POSIX system a daemon thread exits the
+    process once it has been re-parented (os.getppid() != parent_pid, polled every
+    :data:`WATCHDOG_INTERVAL` s)."""
+    import signal
+    import sys
+    import threading
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)           # 1 = PR_SET_PDEATHSIG
+        except (OSError, AttributeError):                        # no libc prctl: the watchdog
+            pass
+    if os.name != "posix":
+        return
+    if os.getppid() != parent_pid:                    # the parent died before prctl took hold
+        os._exit(1)
+
+    def watch():
+        while os.getppid() == parent_pid:
+            time.sleep(WATCHDOG_INTERVAL)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="asekit-sweep-watchdog", daemon=True).start()
+
+
+def _worker_main(conn, sweep, factors, parent_pid: int) -> None:
+    """One worker process of the "processes" executor: receives (index, values) on ``conn``,
+    sends back the row (:func:`evaluate`), until None or the pipe closes. Ctrl-C is left to
+    the parent, which ends its workers."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _die_with_parent(parent_pid)
+    while True:
+        try:
+            job = conn.recv()
+        except (EOFError, OSError):
+            return
+        if job is None:
+            return
+        conn.send(evaluate(sweep, factors, *job))
 
 
 def connect(scheduler: str | None, workers: int | None, timeout: float = 5.0):
@@ -953,7 +1002,7 @@ def connect(scheduler: str | None, workers: int | None, timeout: float = 5.0):
 
 def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | None = None,
               scheduler: str | None = None, client=None, progress: bool = False,
-              factors: AicFactors | None = None, retry_failed: bool = False):
+              factors: AicFactors | None = None, retry_failed: bool = True):
     """Run every sample not yet in ``out`` and return the whole table (pandas DataFrame,
     sorted by sample).
 
@@ -966,12 +1015,14 @@ def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | N
         (``client`` if given, else ``scheduler`` address, else a LocalCluster of ``workers``).
     progress : tqdm bar.
     factors : precomputed :func:`base_factors` (else computed here, once).
-    retry_failed : on resume, run the failed rows of ``out`` again (e.g. after a lost worker)
-        instead of keeping them.
+    retry_failed : on resume, run the failed rows of ``out`` again (a lost worker, a sample
+        stopped by :data:`MAX_WORKER_RESTARTS`; the default) or, False, keep them.
 
     The "processes" executor starts its workers with the ``spawn`` method: a script that calls
     it must guard its entry point with ``if __name__ == "__main__":`` (Python's multiprocessing
-    rule); notebooks and ``python -m asekit sweep`` need nothing.
+    rule); notebooks and ``python -m asekit sweep`` need nothing. A worker that dies is
+    replaced and its sample run again (:func:`_run_processes`); the workers end with the
+    process (and, on Linux, the thread) that called ``run_sweep``.
     """
     if executor not in EXECUTORS:
         raise SweepError(f"executor must be one of {', '.join(EXECUTORS)}, got {executor!r}")
@@ -1060,19 +1111,127 @@ def _failed_row(sweep: Sweep, index: int, values: dict, exc: BaseException) -> d
     return row
 
 
-def _run_processes(sweep, factors, todo, workers, record):
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-    ctx = mp.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
-                             initargs=(sweep, factors)) as pool:
-        futs = {pool.submit(_worker_evaluate, i, v): (i, v) for i, v in todo}
-        for f in as_completed(futs):
-            i, v = futs[f]
+class _Workers:
+    """The worker processes of one "processes" run: each has its own pipe, so the sample a
+    dead process was computing is known exactly and only that process is replaced (the others
+    keep computing; no row is lost, recomputed or duplicated)."""
+
+    def __init__(self, sweep, factors):
+        import multiprocessing as mp
+        self.ctx = mp.get_context("spawn")
+        self.args = (sweep, factors, os.getpid())
+        self.procs: dict = {}                 # pipe -> process
+        self.busy: dict = {}                  # pipe -> sample index, or None (idle)
+
+    def start(self) -> None:
+        here, there = self.ctx.Pipe()
+        p = self.ctx.Process(target=_worker_main, args=(there,) + self.args, daemon=True,
+                             name="asekit-sweep-worker")
+        p.start()
+        there.close()
+        self.procs[here], self.busy[here] = p, None
+
+    def remove(self, conn) -> int | None:
+        """Forget a dead worker; the sample it was computing (None if idle)."""
+        p = self.procs.pop(conn)
+        p.join(1.0)
+        conn.close()
+        return self.busy.pop(conn)
+
+    def close(self) -> None:
+        """End every worker: idle ones are told to stop, busy ones (an interrupted sweep) are
+        terminated."""
+        for conn, p in self.procs.items():
             try:
-                record(f.result())
-            except Exception as exc:          # a worker that died: recorded, not dropped
-                record(_failed_row(sweep, i, v, exc))
+                if self.busy[conn] is None:
+                    conn.send(None)
+                else:
+                    p.terminate()
+            except OSError:
+                pass
+        for conn, p in self.procs.items():
+            p.join(5.0)
+            if p.is_alive():
+                p.kill()
+                p.join(1.0)
+            conn.close()
+        self.procs.clear()
+        self.busy.clear()
+
+
+def _receive(workers: _Workers, conn, record) -> bool:
+    """Record the row waiting on ``conn``; False if the worker is gone (EOF, a cut message)."""
+    try:
+        row = conn.recv()
+    except Exception:                     # EOFError, OSError, a message cut by the death
+        return False
+    workers.busy[conn] = None
+    record(row)
+    return True
+
+
+def _lost(sweep, i: int, values: dict, deaths: int) -> dict:
+    return _failed_row(sweep, i, values, WorkerLost(
+        f"sample {i}: its worker process died {deaths} times while computing it (killed by a "
+        f"signal, out of memory or a crash in compiled code); the other samples are not "
+        f"affected"))
+
+
+def _run_processes(sweep, factors, todo, workers, record):
+    """The "processes" executor: ``workers`` spawned processes, one sample each at a time. A
+    process that dies is replaced and its sample run again (at most :data:`MAX_WORKER_DEATHS`
+    deaths per sample, then a failed :class:`WorkerLost` row; at most
+    :data:`MAX_WORKER_RESTARTS` replacements per run, then the samples left are failed rows
+    that a resume runs again). Workers die with the sweep's process (:func:`_die_with_parent`).
+    """
+    from multiprocessing.connection import wait
+    values = dict(todo)
+    queue = [i for i, _ in todo]
+    deaths: dict[int, int] = {}
+    restarts = 0
+    pool = _Workers(sweep, factors)
+    try:
+        for _ in range(min(workers, len(queue))):
+            pool.start()
+        while queue or any(i is not None for i in pool.busy.values()):
+            for conn in [c for c, i in pool.busy.items() if i is None and queue]:
+                i = pool.busy[conn] = queue.pop(0)
+                try:
+                    conn.send((i, values[i]))
+                except OSError:               # died idle: its sentinel below
+                    pass
+            sentinels = {p.sentinel: c for c, p in pool.procs.items()}
+            ready = wait(list(pool.procs) + list(sentinels))
+            for conn in [c for c in ready if c in pool.procs]:
+                _receive(pool, conn, record)
+            for conn in [sentinels[s] for s in ready if s in sentinels]:
+                while pool.busy.get(conn) is not None and conn.poll() and _receive(pool, conn,
+                                                                                   record):
+                    pass                      # a row sent just before the death is kept
+                i = pool.remove(conn)
+                if i is not None:
+                    deaths[i] = deaths.get(i, 0) + 1
+                    if deaths[i] >= MAX_WORKER_DEATHS:
+                        record(_lost(sweep, i, values[i], deaths[i]))
+                    else:
+                        queue.insert(0, i)
+                restarts += 1
+                if restarts > MAX_WORKER_RESTARTS:
+                    _give_up(sweep, queue, values, record)
+                elif queue and len(pool.procs) < workers:
+                    pool.start()
+    finally:
+        pool.close()
+
+
+def _give_up(sweep, queue: list, values: dict, record) -> None:
+    """After :data:`MAX_WORKER_RESTARTS`: the samples not started are failed rows (the busy
+    workers finish theirs)."""
+    for i in queue:
+        record(_failed_row(sweep, i, values[i], WorkerLost(
+            f"sample {i}: not computed: {MAX_WORKER_RESTARTS + 1} worker processes died in "
+            f"this run; run the sweep again to retry")))
+    queue.clear()
 
 
 def _run_dask(client, sweep, factors, todo, record):
