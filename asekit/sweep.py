@@ -1194,7 +1194,7 @@ def _run_processes(sweep, factors, todo, workers, record):
         for _ in range(min(workers, len(queue))):
             pool.start()
         while queue or any(i is not None for i in pool.busy.values()):
-            for conn in [c for c, i in pool.busy.items() if i is None and queue]:
+            for conn in [c for c, i in pool.busy.items() if i is None][:len(queue)]:
                 i = pool.busy[conn] = queue.pop(0)
                 try:
                     conn.send((i, values[i]))

@@ -4,6 +4,7 @@ bit, a failing task and a worker killed by PID mid-sweep."""
 
 import copy
 import csv
+import dataclasses
 import math
 import os
 import re
@@ -356,10 +357,11 @@ def test_resume_keeps_or_retries_failed_rows(tmp_path):
     cells[cols.index("status")], cells[cols.index("error")] = "failed", "KilledWorker: lost"
     cells[cols.index("f1_hz")] = ""
     out.write_text(lines[0] + lines[1] + ",".join(cells) + "\n")
-    kept = S.run_sweep(sw, out=out)
+    kept = S.run_sweep(sw, out=out, retry_failed=False)
     assert kept["status"].tolist() == ["ok", "failed"]           # a finished row is kept
-    again = S.run_sweep(sw, out=out, retry_failed=True)
+    again = S.run_sweep(sw, out=out)                             # the default: rerun failed
     assert_identical(full, again)
+    assert again["wall_s"][0] == full["wall_s"][0]               # the ok row was not rerun
 
 
 # ------------------------------------------------------------------------------------------
@@ -712,3 +714,162 @@ def test_impossible_method_and_condition_name_both_key_paths(tmp_path):
     assert df["status"].tolist() == ["ok", "failed"]
     assert re.search(r"aero.machs\[0\] = 2.5 with aero.method = 'dlm': mach must be < 1 for the "
                      r"DLM", df["error"].iloc[1]), df["error"].iloc[1]
+
+
+# ------------------------------------------------------------------------------------------
+# the processes executor with dying workers (issue 22)
+# ------------------------------------------------------------------------------------------
+CHEAP = {"aero.boxes": [{"n_chord": 4, "n_span": 4}]}     # 16 boxes: factors in ~1 s
+K_GRID = [100.0, 110.0, 120.0, 130.0]
+
+
+@dataclasses.dataclass(frozen=True)
+class KillingSweep(S.Sweep):
+    """A sweep whose sample with support.torsional_stiffness = ``kill_value`` SIGKILLs the
+    worker process computing it (never the test's process ``parent``): once if ``marker`` is a
+    file path (created before the kill, so the rerun computes the row), every time if it is
+    empty. Each kill appends a line to ``log``. Pickled to the spawned workers by reference
+    (this module is on their sys.path)."""
+
+    kill_value: float = 0.0
+    marker: str = ""
+    log: str = ""
+    parent: int = 0
+
+    def case_dict(self, values):
+        if (values.get("support.torsional_stiffness") == self.kill_value
+                and os.getpid() != self.parent
+                and not (self.marker and os.path.exists(self.marker))):
+            if self.marker:
+                Path(self.marker).touch()
+            with open(self.log, "a") as fh:
+                fh.write(f"{os.getpid()}\n")
+            os.kill(os.getpid(), signal.SIGKILL)
+        return super().case_dict(values)
+
+
+def killing_sweep(tmp_path, once: bool):
+    d = sweep_dict([{"path": "support.torsional_stiffness", "values": K_GRID}],
+                   outputs=["f1_hz"])
+    d["case"].update(CHEAP)
+    sw = S.sweep_from_dict(d)
+    ks = KillingSweep(**{f.name: getattr(sw, f.name) for f in dataclasses.fields(sw)},
+                      kill_value=K_GRID[1], marker=str(tmp_path / "killed") if once else "",
+                      log=str(tmp_path / "kills.log"), parent=os.getpid())
+    return sw, ks
+
+
+def test_worker_killed_by_its_sample_is_replaced_and_the_sample_rerun(tmp_path):
+    """Sample 1 SIGKILLs its worker once: the worker is replaced, sample 1 computed again, and
+    the table (4 rows, each sample journaled once) equals the serial one."""
+    sw, ks = killing_sweep(tmp_path, once=True)
+    out = tmp_path / "o.csv"
+    df = S.run_sweep(ks, out=out, executor="processes", workers=2)
+    assert (tmp_path / "killed").exists(), "the worker was never killed"
+    assert len((tmp_path / "kills.log").read_text().split()) == 1
+    assert df["status"].tolist() == ["ok"] * 4
+    samples = [r["sample"] for r in csv.DictReader(out.open())]
+    assert samples == ["0", "1", "2", "3"]
+    assert_identical(df, S.run_sweep(sw))
+
+
+def test_sample_that_always_kills_its_worker_fails_with_exit_1(tmp_path, monkeypatch, capsys):
+    """Sample 1 SIGKILLs every worker that computes it: it is tried MAX_WORKER_DEATHS times,
+    then a failed WorkerLost row naming it; the other rows are ok, and the CLI exits 1 with one
+    line giving the count and how to retry."""
+    from asekit.cli.main import main
+    _, ks = killing_sweep(tmp_path, once=False)
+    monkeypatch.setattr(S, "load_sweep", lambda path: ks)
+    rc = main(["sweep", "k.toml", "--out", str(tmp_path / "o.csv"), "--executor", "processes",
+               "--workers", "2", "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 1
+    assert len(err) == 1 and err[0].startswith("error: 1 of 4 samples failed"), err
+    assert "run the same command again to retry" in err[0]
+    kills = (tmp_path / "kills.log").read_text().split()
+    assert len(kills) == S.MAX_WORKER_DEATHS == 3 and len(set(kills)) == 3   # 3 processes
+    df = S.read_table(tmp_path / "o.csv")
+    assert df["status"].tolist() == ["ok", "failed", "ok", "ok"]
+    assert df["error"][1].startswith("WorkerLost: sample 1: its worker process died 3 times")
+
+
+def test_a_plain_resume_retries_failed_rows_and_keep_failed_keeps_them(tmp_path, monkeypatch,
+                                                                       capsys):
+    """A journal with a failed row (a worker lost): `sweep --keep-failed` keeps it (exit 1),
+    the plain command reruns it (exit 0), and the table is the serial one."""
+    from asekit.cli.main import main
+    sw = S.sweep_from_dict(sweep_dict([{"path": "support.torsional_stiffness",
+                                        "values": [100.0, 120.0]}], outputs=["f1_hz"]))
+    out = tmp_path / "r.csv"
+    full = S.run_sweep(sw, out=out)
+    lines = out.read_text().splitlines(keepends=True)
+    cols = next(csv.reader([lines[0]]))
+    cells = next(csv.reader([lines[2]]))
+    cells[cols.index("status")], cells[cols.index("error")] = "failed", "WorkerLost: lost"
+    cells[cols.index("f1_hz")] = ""
+    out.write_text(lines[0] + lines[1] + ",".join(cells) + "\n")
+    monkeypatch.setattr(S, "load_sweep", lambda path: sw)
+    args = ["sweep", "s.toml", "--out", str(out), "--quiet"]
+    assert main(args + ["--keep-failed"]) == 1
+    assert "error: 1 of 2 samples failed" in capsys.readouterr().err
+    assert S.read_table(out)["status"].tolist() == ["ok", "failed"]
+    assert main(args) == 0
+    assert capsys.readouterr().err.strip() == f"2 samples (0 failed) -> {out}"
+    assert_identical(S.read_table(out), full)
+
+
+def _children(pid: int) -> list[int]:
+    """The live (not zombie) processes whose parent is ``pid``, from /proc."""
+    out = []
+    for p in Path("/proc").iterdir():
+        if p.name.isdigit():
+            try:
+                stat = (p / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(stat[1]) == pid and stat[0] != "Z":
+                out.append(int(p.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_parent_killed_leaves_no_worker_alive(tmp_path):
+    """`sweep --executor processes` SIGKILLed mid-sweep: its worker processes (and the
+    multiprocessing resource tracker) are gone within 5 s (PR_SET_PDEATHSIG, the watchdog)."""
+    d = sweep_dict([{"path": "support.torsional_stiffness", "values": K_GRID * 10}],
+                   outputs=["f1_hz", "flutter_speed"])
+    d["parameter"][0]["values"] = [100.0 + i for i in range(40)]
+    d["case"].update(CHEAP)
+    f = tmp_path / "s.toml"
+    f.write_text(_toml(d))
+    out = tmp_path / "o.csv"
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    proc = subprocess.Popen([sys.executable, "-m", "asekit", "sweep", str(f), "--out", str(out),
+                             "--executor", "processes", "--workers", "2", "--quiet"], env=env,
+                            cwd=tmp_path, stderr=subprocess.DEVNULL)
+    try:
+        t0 = time.time()
+        while time.time() - t0 < 120 and proc.poll() is None:
+            if out.exists() and len(out.read_text().splitlines()) >= 2:
+                break
+            time.sleep(0.02)
+        kids = _children(proc.pid)
+    finally:
+        proc.kill()
+        proc.wait()
+    assert len(kids) >= 2, kids                       # two workers (and the resource tracker)
+    t0 = time.time()
+    while time.time() - t0 < 5 and any(_alive(k) for k in kids):
+        time.sleep(0.05)
+    left = [k for k in kids if _alive(k)]
+    for k in left:
+        os.kill(k, signal.SIGKILL)
+    assert not left, f"alive {time.time() - t0:.1f} s after the parent's SIGKILL: {left}"
