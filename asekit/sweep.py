@@ -316,9 +316,16 @@ POINT_OUTPUTS = {
 }
 #: Outputs over the whole case (every aero.machs x flight altitude; the analyse pipeline).
 ENVELOPE_OUTPUTS = {
-    "min_flutter_speed": "m/s, lowest flutter speed over aero.machs x flight conditions",
+    "min_flutter_speed": "m/s, lowest flutter speed over aero.machs x flight conditions (empty "
+                         "when only bounded: a condition unstable at the sweep's first speed)",
+    "min_flutter_speed_upper_bound": "m/s, the lowest flutter speed is at most this (a "
+                                     "condition unstable at the first speed of the sweep)",
     "envelope_margin": "smallest flutter margin U_f / U_envelope - 1 over the altitudes "
-                       "(needs [flight.envelope])",
+                       "(needs [flight.envelope]; empty when only bounded)",
+    "envelope_margin_upper_bound": "the smallest flutter margin is at most this (the case "
+                                   "summary's margin_upper_bound at an altitude)",
+    "envelope_margin_lower_bound": "the smallest flutter margin is at least this (no flutter "
+                                   "up to the last speed of the sweep at an altitude)",
     "matched_mach": "lowest match-point Mach over the altitudes (empty: no match)",
 }
 #: Outputs of the ASE loop (needs [actuator]): thesis Ch. 5 / Table 2 metrics.
@@ -477,8 +484,9 @@ def _outputs(raw, base_case, density_condition: bool) -> tuple[str, ...]:
     if any(o in ASE_OUTPUTS for o in raw) and base_case.actuator is None:
         raise SweepError("sweep.outputs: the aem1_* / aem2_* outputs need an [actuator] in the "
                          "base case")
-    if "envelope_margin" in raw and base_case.flight.envelope_mach is None:
-        raise SweepError("sweep.outputs: envelope_margin needs [flight.envelope] in the base case")
+    for o in ("envelope_margin", "envelope_margin_upper_bound", "envelope_margin_lower_bound"):
+        if o in raw and base_case.flight.envelope_mach is None:
+            raise SweepError(f"sweep.outputs: {o} needs [flight.envelope] in the base case")
     return tuple(raw)
 
 
@@ -786,6 +794,67 @@ def _condition(sweep: Sweep, value: float) -> P.FlightCondition:
     return P.FlightCondition(float(value), float(atm.density), float(atm.speed_of_sound))
 
 
+def bounded_minimum(items) -> tuple[float | None, float | None, float | None]:
+    """The minimum of quantities each known as ("value", x), ("upper", x) (at most x),
+    ("lower", x) (at least x) or (None, None) (unknown): (value, upper bound, lower bound),
+    the value when it is determined (then no bounds), else the bounds that hold (None where
+    none). min <= every value and upper bound; min >= the least value or lower bound unless a
+    quantity is only bounded above or unknown."""
+    vals = [x for k, x in items if k == "value"]
+    ups = [x for k, x in items if k == "upper"]
+    lows = [x for k, x in items if k == "lower"]
+    above = vals + ups
+    upper = float(min(above)) if above else None
+    open_below = bool(ups) or any(k is None for k, _ in items)
+    lower = None if open_below or not vals + lows else float(min(vals + lows))
+    if upper is not None and upper == lower:
+        return upper, None, None
+    return None, upper, lower
+
+
+_MARGIN_KEYS = (("value", "margin"), ("upper", "margin_upper_bound"),
+                ("lower", "margin_lower_bound"))
+
+
+def _envelope_outputs(case, fa) -> dict:
+    """min_flutter_speed, envelope_margin (each the value or its bounds, from the flutter
+    points and margins of the case summary, :func:`asekit.case.pipeline.flutter`) and
+    matched_mach of one sample."""
+    speeds = [(k, u) for _, u, k in P._flutter_points(list(fa.results), case.flight.velocities)]
+    if any(r.unstable_at_start and "flutter" not in P._start_kind(r) for r in fa.results):
+        speeds.append((None, None))              # divergence at the first speed: U_f unknown
+    u, u_up, _ = bounded_minimum(speeds)
+    margins = [next(((k, m[key]) for k, key in _MARGIN_KEYS if m[key] is not None),
+                    (None, None)) for m in fa.margins]
+    e, e_up, e_low = bounded_minimum(margins)
+    mm = [m["matched_mach"] for m in fa.match_points if m["matched_mach"] is not None]
+    return {"min_flutter_speed": u, "min_flutter_speed_upper_bound": u_up,
+            "envelope_margin": e, "envelope_margin_upper_bound": e_up,
+            "envelope_margin_lower_bound": e_low,
+            "matched_mach": float(min(mm)) if mm else None}
+
+
+def _inside(case, r, u_f: float | None, u_fl: float) -> tuple[float | None, bool]:
+    """(flutter_margin, flutter_inside) at the flight speed ``u_fl`` = M a (m/s) from the p-k
+    result ``r`` and its flutter speed ``u_f``; ValueError when the velocity sweep cannot
+    decide: it starts unstable above M a (the instability may lie above or below M a), or it
+    ends below M a without flutter."""
+    u0, u_max = case.flight.velocities[0], case.flight.velocities[-1]
+    if r.unstable_at_start:
+        if u0 > u_fl:
+            raise ValueError(f"flutter_inside: unstable at {u0:g} m/s, the first speed of "
+                             f"flight.velocities, above the flight speed M a = {u_fl:g} m/s: "
+                             f"start the velocity sweep lower")
+        return None, True
+    if u_f is not None:
+        return u_f / u_fl - 1.0, bool(u_f <= u_fl)
+    if u_max >= u_fl:
+        return None, False
+    raise ValueError(f"flutter_inside: no flutter up to {u_max:g} m/s, the end of "
+                     f"flight.velocities, below the flight speed M a = {u_fl:g} "
+                     f"m/s: extend the velocity sweep")
+
+
 def _analyse(sweep: Sweep, factors: AicFactors, values: dict):
     d, mach, cval = sweep.case_dict(values)
     case = _sample_case(d)
@@ -821,31 +890,11 @@ def _analyse(sweep: Sweep, factors: AicFactors, values: dict):
                     "divergence_speed": float(div[0]) if div.size else None,
                     "unstable_at_start": bool(r.unstable_at_start), "flight_speed": u_fl})
         if "flutter_margin" in want or "flutter_inside" in want:
-            u_max = case.flight.velocities[-1]
-            if r.unstable_at_start:
-                inside, margin = True, None
-            elif u_f is not None:
-                inside, margin = u_f <= u_fl, u_f / u_fl - 1.0
-            elif u_max >= u_fl:
-                inside, margin = False, None
-            else:
-                raise ValueError(f"flutter_inside: no flutter up to {u_max:g} m/s, the end of "
-                                 f"flight.velocities, below the flight speed M a = {u_fl:g} "
-                                 f"m/s: extend the velocity sweep")
-            out["flutter_margin"], out["flutter_inside"] = margin, bool(inside)
+            out["flutter_margin"], out["flutter_inside"] = _inside(case, r, u_f, u_fl)
     if want & set(ENVELOPE_OUTPUTS) or want & set(ASE_OUTPUTS):
         db = _database(model, case, fac, case.aero.machs)
         if want & set(ENVELOPE_OUTPUTS):
-            fa = P.flutter(case, db=db)
-            speeds = [r.flutter.speed for r in fa.results
-                      if r.flutter is not None and not r.unstable_at_start]
-            if any(r.unstable_at_start for r in fa.results):
-                speeds.append(case.flight.velocities[0])
-            out["min_flutter_speed"] = float(min(speeds)) if speeds else None
-            ms = [m["margin"] for m in fa.margins if m["margin"] is not None]
-            out["envelope_margin"] = float(min(ms)) if ms else None
-            mm = [m["matched_mach"] for m in fa.match_points if m["matched_mach"] is not None]
-            out["matched_mach"] = float(min(mm)) if mm else None
+            out.update(_envelope_outputs(case, P.flutter(case, db=db)))
         if want & set(ASE_OUTPUTS):
             a = P.ase(case, db=db)
             for t in ("AEM1", "AEM2"):

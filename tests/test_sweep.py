@@ -301,6 +301,9 @@ def test_envelope_and_ase_outputs_are_the_pipeline(one_blas_thread):
     fa = P.flutter(case, db=db)
     assert row["min_flutter_speed"] == min(r.flutter.speed for r in fa.results)
     assert row["envelope_margin"] == min(m["margin"] for m in fa.margins)
+    for bound in ("min_flutter_speed_upper_bound", "envelope_margin_upper_bound",
+                  "envelope_margin_lower_bound"):
+        assert math.isnan(row[bound])                            # the values are known
     mm = [m["matched_mach"] for m in fa.match_points if m["matched_mach"] is not None]
     assert (math.isnan(row["matched_mach"]) and not mm) or row["matched_mach"] == min(mm)
     a = P.ase(case, db=db)
@@ -873,3 +876,49 @@ def test_parent_killed_leaves_no_worker_alive(tmp_path):
     for k in left:
         os.kill(k, signal.SIGKILL)
     assert not left, f"alive {time.time() - t0:.1f} s after the parent's SIGKILL: {left}"
+
+
+# ------------------------------------------------------------------------------------------
+# sweeps that start above the flutter speed: the case summary's bounds (issue 22)
+# ------------------------------------------------------------------------------------------
+def test_bounded_minimum_gives_the_value_only_when_it_is_determined():
+    """min over quantities known as a value, an upper or a lower bound, or unknown."""
+    bm = S.bounded_minimum
+    assert bm([("value", 0.3), ("value", 0.1)]) == (0.1, None, None)
+    assert bm([("value", 0.3), ("lower", 0.5)]) == (0.3, None, None)   # 0.5 < x: not the min
+    assert bm([("value", 0.3), ("lower", 0.2)]) == (None, 0.3, 0.2)    # min in [0.2, 0.3]
+    assert bm([("value", 0.3), ("upper", 0.5)]) == (None, 0.3, None)   # the other may be lower
+    assert bm([("value", 0.3), ("upper", 0.1)]) == (None, 0.1, None)
+    assert bm([("value", 0.3), (None, None)]) == (None, 0.3, None)     # one unknown
+    assert bm([("lower", 0.4), ("lower", 0.2)]) == (None, None, 0.2)
+    assert bm([]) == (None, None, None)
+
+
+def test_sweep_above_flutter_gives_the_case_summary_bounds(one_blas_thread):
+    """flight.velocities from 230 m/s, above the sea-level flutter speed of the 16-box fin: the
+    envelope outputs are the bounds of asekit.case.pipeline.flutter's summary (its
+    margin_upper_bound, flutter at or below 230 m/s), not a value taken from the other
+    altitude; flutter_inside is True where M a >= 230 m/s (M 0.75: 255 m/s) and a failed row
+    where M a < 230 m/s (M 0.6: 204 m/s), which the sweep cannot decide."""
+    outs = list(S.ENVELOPE_OUTPUTS) + ["unstable_at_start", "flutter_margin", "flutter_inside"]
+    d = sweep_dict([{"path": "flight.mach", "values": [0.6, 0.75]}], outputs=outs)
+    d["case"].update({**CHEAP, "aero.machs": [0.5, 0.6], "flight.altitudes": [0.0, 5000.0],
+                      "flight.velocities": {"min": 230.0, "max": 400.0, "step": 10.0}})
+    sw = S.sweep_from_dict(d)
+    df = S.run_sweep(sw)
+    case = case_from_dict(sw.case_dict({})[0])
+    fa = P.flutter(case, db=P.gaf_database(case, progress=False))
+    sea = next(m for m in fa.margins if m["altitude_m"] == 0.0)
+    assert sea["margin"] is None and sea["margin_upper_bound"] is not None      # the setup
+    assert fa.match_points[0]["flutter_at_or_below_ms"] == 230.0
+    bounds = [m["margin"] if m["margin"] is not None else m["margin_upper_bound"]
+              for m in fa.margins]
+    assert df["status"].tolist() == ["failed", "ok"]
+    assert "unstable at 230 m/s, the first speed of flight.velocities, above the flight " \
+           "speed M a = 204.176 m/s: start the velocity sweep lower" in df["error"][0]
+    row = df.iloc[1]
+    assert math.isnan(row["envelope_margin"]) and math.isnan(row["envelope_margin_lower_bound"])
+    assert row["envelope_margin_upper_bound"] == min(bounds)
+    assert math.isnan(row["min_flutter_speed"]) and row["min_flutter_speed_upper_bound"] == 230.0
+    assert row["unstable_at_start"] and row["flutter_inside"]
+    assert math.isnan(row["flutter_margin"])
