@@ -40,7 +40,9 @@ bit-identical tables serially, with processes and on Dask (except the timing col
 
 Results: one row per sample (:data:`BASE_COLUMNS`, every parameter value, every output), journaled
 row by row to the output CSV as samples finish, so an interrupted sweep resumes from its partial
-output file (rows of another sweep are refused by their ``sweep_id``).
+output file (rows of another sweep are refused by their ``sweep_id``; its failed rows are run
+again unless ``retry_failed=False``). A worker process that dies is replaced and its sample run
+again, a bounded number of times (:func:`_run_processes`); workers die with the sweep's process.
 """
 
 from __future__ import annotations
