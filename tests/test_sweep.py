@@ -751,11 +751,15 @@ class KillingSweep(S.Sweep):
         return super().case_dict(values)
 
 
-def killing_sweep(tmp_path, once: bool):
+def killing_sweep_dict():
     d = sweep_dict([{"path": "support.torsional_stiffness", "values": K_GRID}],
                    outputs=["f1_hz"])
     d["case"].update(CHEAP)
-    sw = S.sweep_from_dict(d)
+    return d
+
+
+def killing_sweep(tmp_path, once: bool):
+    sw = S.sweep_from_dict(killing_sweep_dict())
     ks = KillingSweep(**{f.name: getattr(sw, f.name) for f in dataclasses.fields(sw)},
                       kill_value=K_GRID[1], marker=str(tmp_path / "killed") if once else "",
                       log=str(tmp_path / "kills.log"), parent=os.getpid())
@@ -782,8 +786,10 @@ def test_sample_that_always_kills_its_worker_fails_with_exit_1(tmp_path, monkeyp
     line giving the count and how to retry."""
     from asekit.cli.main import main
     _, ks = killing_sweep(tmp_path, once=False)
+    f = tmp_path / "k.toml"                       # the file the CLI reads: the sweep without
+    f.write_text(_toml(killing_sweep_dict()))     # its killer, which load_sweep returns
     monkeypatch.setattr(S, "load_sweep", lambda path: ks)
-    rc = main(["sweep", "k.toml", "--out", str(tmp_path / "o.csv"), "--executor", "processes",
+    rc = main(["sweep", str(f), "--out", str(tmp_path / "o.csv"), "--executor", "processes",
                "--workers", "2", "--quiet"])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 1
@@ -796,23 +802,23 @@ def test_sample_that_always_kills_its_worker_fails_with_exit_1(tmp_path, monkeyp
     assert df["error"][1].startswith("WorkerLost: sample 1: its worker process died 3 times")
 
 
-def test_a_plain_resume_retries_failed_rows_and_keep_failed_keeps_them(tmp_path, monkeypatch,
-                                                                       capsys):
+def test_a_plain_resume_retries_failed_rows_and_keep_failed_keeps_them(tmp_path, capsys):
     """A journal with a failed row (a worker lost): `sweep --keep-failed` keeps it (exit 1),
     the plain command reruns it (exit 0), and the table is the serial one."""
     from asekit.cli.main import main
-    sw = S.sweep_from_dict(sweep_dict([{"path": "support.torsional_stiffness",
-                                        "values": [100.0, 120.0]}], outputs=["f1_hz"]))
+    d = sweep_dict([{"path": "support.torsional_stiffness", "values": [100.0, 120.0]}],
+                   outputs=["f1_hz"])
+    f = tmp_path / "s.toml"
+    f.write_text(_toml(d))
     out = tmp_path / "r.csv"
-    full = S.run_sweep(sw, out=out)
+    full = S.run_sweep(S.sweep_from_dict(d), out=out)
     lines = out.read_text().splitlines(keepends=True)
     cols = next(csv.reader([lines[0]]))
     cells = next(csv.reader([lines[2]]))
     cells[cols.index("status")], cells[cols.index("error")] = "failed", "WorkerLost: lost"
     cells[cols.index("f1_hz")] = ""
     out.write_text(lines[0] + lines[1] + ",".join(cells) + "\n")
-    monkeypatch.setattr(S, "load_sweep", lambda path: sw)
-    args = ["sweep", "s.toml", "--out", str(out), "--quiet"]
+    args = ["sweep", str(f), "--out", str(out), "--quiet"]
     assert main(args + ["--keep-failed"]) == 1
     assert "error: 1 of 2 samples failed" in capsys.readouterr().err
     assert S.read_table(out)["status"].tolist() == ["ok", "failed"]
