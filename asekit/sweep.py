@@ -40,7 +40,9 @@ bit-identical tables serially, with processes and on Dask (except the timing col
 
 Results: one row per sample (:data:`BASE_COLUMNS`, every parameter value, every output), journaled
 row by row to the output CSV as samples finish, so an interrupted sweep resumes from its partial
-output file (rows of another sweep are refused by their ``sweep_id``).
+output file (rows of another sweep are refused by their ``sweep_id``; its failed rows are run
+again unless ``retry_failed=False``). A worker process that dies is replaced and its sample run
+again, a bounded number of times (:func:`_run_processes`); workers die with the sweep's process.
 """
 
 from __future__ import annotations
@@ -316,9 +318,16 @@ POINT_OUTPUTS = {
 }
 #: Outputs over the whole case (every aero.machs x flight altitude; the analyse pipeline).
 ENVELOPE_OUTPUTS = {
-    "min_flutter_speed": "m/s, lowest flutter speed over aero.machs x flight conditions",
+    "min_flutter_speed": "m/s, lowest flutter speed over aero.machs x flight conditions (empty "
+                         "when only bounded: a condition unstable at the sweep's first speed)",
+    "min_flutter_speed_upper_bound": "m/s, the lowest flutter speed is at most this (a "
+                                     "condition unstable at the first speed of the sweep)",
     "envelope_margin": "smallest flutter margin U_f / U_envelope - 1 over the altitudes "
-                       "(needs [flight.envelope])",
+                       "(needs [flight.envelope]; empty when only bounded)",
+    "envelope_margin_upper_bound": "the smallest flutter margin is at most this (the case "
+                                   "summary's margin_upper_bound at an altitude)",
+    "envelope_margin_lower_bound": "the smallest flutter margin is at least this (no flutter "
+                                   "up to the last speed of the sweep at an altitude)",
     "matched_mach": "lowest match-point Mach over the altitudes (empty: no match)",
 }
 #: Outputs of the ASE loop (needs [actuator]): thesis Ch. 5 / Table 2 metrics.
@@ -477,8 +486,9 @@ def _outputs(raw, base_case, density_condition: bool) -> tuple[str, ...]:
     if any(o in ASE_OUTPUTS for o in raw) and base_case.actuator is None:
         raise SweepError("sweep.outputs: the aem1_* / aem2_* outputs need an [actuator] in the "
                          "base case")
-    if "envelope_margin" in raw and base_case.flight.envelope_mach is None:
-        raise SweepError("sweep.outputs: envelope_margin needs [flight.envelope] in the base case")
+    for o in ("envelope_margin", "envelope_margin_upper_bound", "envelope_margin_lower_bound"):
+        if o in raw and base_case.flight.envelope_mach is None:
+            raise SweepError(f"sweep.outputs: {o} needs [flight.envelope] in the base case")
     return tuple(raw)
 
 
@@ -786,6 +796,67 @@ def _condition(sweep: Sweep, value: float) -> P.FlightCondition:
     return P.FlightCondition(float(value), float(atm.density), float(atm.speed_of_sound))
 
 
+def bounded_minimum(items) -> tuple[float | None, float | None, float | None]:
+    """The minimum of quantities each known as ("value", x), ("upper", x) (at most x),
+    ("lower", x) (at least x) or (None, None) (unknown): (value, upper bound, lower bound),
+    the value when it is determined (then no bounds), else the bounds that hold (None where
+    none). min <= every value and upper bound; min >= the least value or lower bound unless a
+    quantity is only bounded above or unknown."""
+    vals = [x for k, x in items if k == "value"]
+    ups = [x for k, x in items if k == "upper"]
+    lows = [x for k, x in items if k == "lower"]
+    above = vals + ups
+    upper = float(min(above)) if above else None
+    open_below = bool(ups) or any(k is None for k, _ in items)
+    lower = None if open_below or not vals + lows else float(min(vals + lows))
+    if upper is not None and upper == lower:
+        return upper, None, None
+    return None, upper, lower
+
+
+_MARGIN_KEYS = (("value", "margin"), ("upper", "margin_upper_bound"),
+                ("lower", "margin_lower_bound"))
+
+
+def _envelope_outputs(case, fa) -> dict:
+    """min_flutter_speed, envelope_margin (each the value or its bounds, from the flutter
+    points and margins of the case summary, :func:`asekit.case.pipeline.flutter`) and
+    matched_mach of one sample."""
+    speeds = [(k, u) for _, u, k in P._flutter_points(list(fa.results), case.flight.velocities)]
+    if any(r.unstable_at_start and "flutter" not in P._start_kind(r) for r in fa.results):
+        speeds.append((None, None))              # divergence at the first speed: U_f unknown
+    u, u_up, _ = bounded_minimum(speeds)
+    margins = [next(((k, m[key]) for k, key in _MARGIN_KEYS if m[key] is not None),
+                    (None, None)) for m in fa.margins]
+    e, e_up, e_low = bounded_minimum(margins)
+    mm = [m["matched_mach"] for m in fa.match_points if m["matched_mach"] is not None]
+    return {"min_flutter_speed": u, "min_flutter_speed_upper_bound": u_up,
+            "envelope_margin": e, "envelope_margin_upper_bound": e_up,
+            "envelope_margin_lower_bound": e_low,
+            "matched_mach": float(min(mm)) if mm else None}
+
+
+def _inside(case, r, u_f: float | None, u_fl: float) -> tuple[float | None, bool]:
+    """(flutter_margin, flutter_inside) at the flight speed ``u_fl`` = M a (m/s) from the p-k
+    result ``r`` and its flutter speed ``u_f``; ValueError when the velocity sweep cannot
+    decide: it starts unstable above M a (the instability may lie above or below M a), or it
+    ends below M a without flutter."""
+    u0, u_max = case.flight.velocities[0], case.flight.velocities[-1]
+    if r.unstable_at_start:
+        if u0 > u_fl:
+            raise ValueError(f"flutter_inside: unstable at {u0:g} m/s, the first speed of "
+                             f"flight.velocities, above the flight speed M a = {u_fl:g} m/s: "
+                             f"start the velocity sweep lower")
+        return None, True
+    if u_f is not None:
+        return u_f / u_fl - 1.0, bool(u_f <= u_fl)
+    if u_max >= u_fl:
+        return None, False
+    raise ValueError(f"flutter_inside: no flutter up to {u_max:g} m/s, the end of "
+                     f"flight.velocities, below the flight speed M a = {u_fl:g} "
+                     f"m/s: extend the velocity sweep")
+
+
 def _analyse(sweep: Sweep, factors: AicFactors, values: dict):
     d, mach, cval = sweep.case_dict(values)
     case = _sample_case(d)
@@ -821,31 +892,11 @@ def _analyse(sweep: Sweep, factors: AicFactors, values: dict):
                     "divergence_speed": float(div[0]) if div.size else None,
                     "unstable_at_start": bool(r.unstable_at_start), "flight_speed": u_fl})
         if "flutter_margin" in want or "flutter_inside" in want:
-            u_max = case.flight.velocities[-1]
-            if r.unstable_at_start:
-                inside, margin = True, None
-            elif u_f is not None:
-                inside, margin = u_f <= u_fl, u_f / u_fl - 1.0
-            elif u_max >= u_fl:
-                inside, margin = False, None
-            else:
-                raise ValueError(f"flutter_inside: no flutter up to {u_max:g} m/s, the end of "
-                                 f"flight.velocities, below the flight speed M a = {u_fl:g} "
-                                 f"m/s: extend the velocity sweep")
-            out["flutter_margin"], out["flutter_inside"] = margin, bool(inside)
+            out["flutter_margin"], out["flutter_inside"] = _inside(case, r, u_f, u_fl)
     if want & set(ENVELOPE_OUTPUTS) or want & set(ASE_OUTPUTS):
         db = _database(model, case, fac, case.aero.machs)
         if want & set(ENVELOPE_OUTPUTS):
-            fa = P.flutter(case, db=db)
-            speeds = [r.flutter.speed for r in fa.results
-                      if r.flutter is not None and not r.unstable_at_start]
-            if any(r.unstable_at_start for r in fa.results):
-                speeds.append(case.flight.velocities[0])
-            out["min_flutter_speed"] = float(min(speeds)) if speeds else None
-            ms = [m["margin"] for m in fa.margins if m["margin"] is not None]
-            out["envelope_margin"] = float(min(ms)) if ms else None
-            mm = [m["matched_mach"] for m in fa.match_points if m["matched_mach"] is not None]
-            out["matched_mach"] = float(min(mm)) if mm else None
+            out.update(_envelope_outputs(case, P.flutter(case, db=db)))
         if want & set(ASE_OUTPUTS):
             a = P.ase(case, db=db)
             for t in ("AEM1", "AEM2"):
@@ -919,16 +970,65 @@ def read_table(path):
 # executors
 # ---------------------------------------------------------------------------------------------
 EXECUTORS = ("serial", "processes", "dask")
-_WORKER: dict = {}        # per worker process of the "processes" executor: (sweep, factors)
+#: A sample whose worker process dies this many times while computing it (killed by a signal,
+#: out of memory, a crash in compiled code) is a failed row (:class:`WorkerLost` naming it).
+MAX_WORKER_DEATHS = 3
+#: Worker processes replaced in one run of the "processes" executor at most; the samples not
+#: computed after that are failed rows (:class:`WorkerLost`) that a resume runs again.
+MAX_WORKER_RESTARTS = 12
+#: s between two checks of a worker's watchdog that its parent (the sweep) is alive.
+WATCHDOG_INTERVAL = 0.5
 
 
-def _init_worker(sweep, factors):
-    _WORKER["job"] = (sweep, factors)
+class WorkerLost(RuntimeError):
+    """The process computing a sample died (killed by a signal, out of memory, a crash in
+    compiled code): the error of its failed row, naming the sample."""
 
 
-def _worker_evaluate(index, values):
-    sweep, factors = _WORKER["job"]
-    return evaluate(sweep, factors, index, values)
+def _die_with_parent(parent_pid: int) -> None:
+    """Make this worker process end when the sweep's process ``parent_pid`` is gone (killed
+    with SIGKILL, it cannot clean up): on Linux the kernel kills it on the parent's death
+    (prctl PR_SET_PDEATHSIG = SIGKILL), and on every POSIX system a daemon thread exits the
+    process once it has been re-parented (os.getppid() != parent_pid, polled every
+    :data:`WATCHDOG_INTERVAL` s)."""
+    import signal
+    import sys
+    import threading
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)           # 1 = PR_SET_PDEATHSIG
+        except (OSError, AttributeError):                        # no libc prctl: the watchdog
+            pass
+    if os.name != "posix":
+        return
+    if os.getppid() != parent_pid:                    # the parent died before prctl took hold
+        os._exit(1)
+
+    def watch():
+        while os.getppid() == parent_pid:
+            time.sleep(WATCHDOG_INTERVAL)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="asekit-sweep-watchdog", daemon=True).start()
+
+
+def _worker_main(conn, sweep, factors, parent_pid: int) -> None:
+    """One worker process of the "processes" executor: receives (index, values) on ``conn``,
+    sends back the row (:func:`evaluate`), until None or the pipe closes. Ctrl-C is left to
+    the parent, which ends its workers."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _die_with_parent(parent_pid)
+    while True:
+        try:
+            job = conn.recv()
+        except (EOFError, OSError):
+            return
+        if job is None:
+            return
+        conn.send(evaluate(sweep, factors, *job))
 
 
 def connect(scheduler: str | None, workers: int | None, timeout: float = 5.0):
@@ -953,7 +1053,7 @@ def connect(scheduler: str | None, workers: int | None, timeout: float = 5.0):
 
 def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | None = None,
               scheduler: str | None = None, client=None, progress: bool = False,
-              factors: AicFactors | None = None, retry_failed: bool = False):
+              factors: AicFactors | None = None, retry_failed: bool = True):
     """Run every sample not yet in ``out`` and return the whole table (pandas DataFrame,
     sorted by sample).
 
@@ -966,12 +1066,14 @@ def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | N
         (``client`` if given, else ``scheduler`` address, else a LocalCluster of ``workers``).
     progress : tqdm bar.
     factors : precomputed :func:`base_factors` (else computed here, once).
-    retry_failed : on resume, run the failed rows of ``out`` again (e.g. after a lost worker)
-        instead of keeping them.
+    retry_failed : on resume, run the failed rows of ``out`` again (a lost worker, a sample
+        stopped by :data:`MAX_WORKER_RESTARTS`; the default) or, False, keep them.
 
     The "processes" executor starts its workers with the ``spawn`` method: a script that calls
     it must guard its entry point with ``if __name__ == "__main__":`` (Python's multiprocessing
-    rule); notebooks and ``python -m asekit sweep`` need nothing.
+    rule); notebooks and ``python -m asekit sweep`` need nothing. A worker that dies is
+    replaced and its sample run again (:func:`_run_processes`); the workers end with the
+    process (and, on Linux, the thread) that called ``run_sweep``.
     """
     if executor not in EXECUTORS:
         raise SweepError(f"executor must be one of {', '.join(EXECUTORS)}, got {executor!r}")
@@ -1060,19 +1162,127 @@ def _failed_row(sweep: Sweep, index: int, values: dict, exc: BaseException) -> d
     return row
 
 
-def _run_processes(sweep, factors, todo, workers, record):
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-    ctx = mp.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
-                             initargs=(sweep, factors)) as pool:
-        futs = {pool.submit(_worker_evaluate, i, v): (i, v) for i, v in todo}
-        for f in as_completed(futs):
-            i, v = futs[f]
+class _Workers:
+    """The worker processes of one "processes" run: each has its own pipe, so the sample a
+    dead process was computing is known exactly and only that process is replaced (the others
+    keep computing; no row is lost, recomputed or duplicated)."""
+
+    def __init__(self, sweep, factors):
+        import multiprocessing as mp
+        self.ctx = mp.get_context("spawn")
+        self.args = (sweep, factors, os.getpid())
+        self.procs: dict = {}                 # pipe -> process
+        self.busy: dict = {}                  # pipe -> sample index, or None (idle)
+
+    def start(self) -> None:
+        here, there = self.ctx.Pipe()
+        p = self.ctx.Process(target=_worker_main, args=(there,) + self.args, daemon=True,
+                             name="asekit-sweep-worker")
+        p.start()
+        there.close()
+        self.procs[here], self.busy[here] = p, None
+
+    def remove(self, conn) -> int | None:
+        """Forget a dead worker; the sample it was computing (None if idle)."""
+        p = self.procs.pop(conn)
+        p.join(1.0)
+        conn.close()
+        return self.busy.pop(conn)
+
+    def close(self) -> None:
+        """End every worker: idle ones are told to stop, busy ones (an interrupted sweep) are
+        terminated."""
+        for conn, p in self.procs.items():
             try:
-                record(f.result())
-            except Exception as exc:          # a worker that died: recorded, not dropped
-                record(_failed_row(sweep, i, v, exc))
+                if self.busy[conn] is None:
+                    conn.send(None)
+                else:
+                    p.terminate()
+            except OSError:
+                pass
+        for conn, p in self.procs.items():
+            p.join(5.0)
+            if p.is_alive():
+                p.kill()
+                p.join(1.0)
+            conn.close()
+        self.procs.clear()
+        self.busy.clear()
+
+
+def _receive(workers: _Workers, conn, record) -> bool:
+    """Record the row waiting on ``conn``; False if the worker is gone (EOF, a cut message)."""
+    try:
+        row = conn.recv()
+    except Exception:                     # EOFError, OSError, a message cut by the death
+        return False
+    workers.busy[conn] = None
+    record(row)
+    return True
+
+
+def _lost(sweep, i: int, values: dict, deaths: int) -> dict:
+    return _failed_row(sweep, i, values, WorkerLost(
+        f"sample {i}: its worker process died {deaths} times while computing it (killed by a "
+        f"signal, out of memory or a crash in compiled code); the other samples are not "
+        f"affected"))
+
+
+def _run_processes(sweep, factors, todo, workers, record):
+    """The "processes" executor: ``workers`` spawned processes, one sample each at a time. A
+    process that dies is replaced and its sample run again (at most :data:`MAX_WORKER_DEATHS`
+    deaths per sample, then a failed :class:`WorkerLost` row; at most
+    :data:`MAX_WORKER_RESTARTS` replacements per run, then the samples left are failed rows
+    that a resume runs again). Workers die with the sweep's process (:func:`_die_with_parent`).
+    """
+    from multiprocessing.connection import wait
+    values = dict(todo)
+    queue = [i for i, _ in todo]
+    deaths: dict[int, int] = {}
+    restarts = 0
+    pool = _Workers(sweep, factors)
+    try:
+        for _ in range(min(workers, len(queue))):
+            pool.start()
+        while queue or any(i is not None for i in pool.busy.values()):
+            for conn in [c for c, i in pool.busy.items() if i is None][:len(queue)]:
+                i = pool.busy[conn] = queue.pop(0)
+                try:
+                    conn.send((i, values[i]))
+                except OSError:               # died idle: its sentinel below
+                    pass
+            sentinels = {p.sentinel: c for c, p in pool.procs.items()}
+            ready = wait(list(pool.procs) + list(sentinels))
+            for conn in [c for c in ready if c in pool.procs]:
+                _receive(pool, conn, record)
+            for conn in [sentinels[s] for s in ready if s in sentinels]:
+                while pool.busy.get(conn) is not None and conn.poll() and _receive(pool, conn,
+                                                                                   record):
+                    pass                      # a row sent just before the death is kept
+                i = pool.remove(conn)
+                if i is not None:
+                    deaths[i] = deaths.get(i, 0) + 1
+                    if deaths[i] >= MAX_WORKER_DEATHS:
+                        record(_lost(sweep, i, values[i], deaths[i]))
+                    else:
+                        queue.insert(0, i)
+                restarts += 1
+                if restarts > MAX_WORKER_RESTARTS:
+                    _give_up(sweep, queue, values, record)
+                elif queue and len(pool.procs) < workers:
+                    pool.start()
+    finally:
+        pool.close()
+
+
+def _give_up(sweep, queue: list, values: dict, record) -> None:
+    """After :data:`MAX_WORKER_RESTARTS`: the samples not started are failed rows (the busy
+    workers finish theirs)."""
+    for i in queue:
+        record(_failed_row(sweep, i, values[i], WorkerLost(
+            f"sample {i}: not computed: {MAX_WORKER_RESTARTS + 1} worker processes died in "
+            f"this run; run the sweep again to retry")))
+    queue.clear()
 
 
 def _run_dask(client, sweep, factors, todo, record):

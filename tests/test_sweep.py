@@ -4,6 +4,7 @@ bit, a failing task and a worker killed by PID mid-sweep."""
 
 import copy
 import csv
+import dataclasses
 import math
 import os
 import re
@@ -300,6 +301,9 @@ def test_envelope_and_ase_outputs_are_the_pipeline(one_blas_thread):
     fa = P.flutter(case, db=db)
     assert row["min_flutter_speed"] == min(r.flutter.speed for r in fa.results)
     assert row["envelope_margin"] == min(m["margin"] for m in fa.margins)
+    for bound in ("min_flutter_speed_upper_bound", "envelope_margin_upper_bound",
+                  "envelope_margin_lower_bound"):
+        assert math.isnan(row[bound])                            # the values are known
     mm = [m["matched_mach"] for m in fa.match_points if m["matched_mach"] is not None]
     assert (math.isnan(row["matched_mach"]) and not mm) or row["matched_mach"] == min(mm)
     a = P.ase(case, db=db)
@@ -356,10 +360,11 @@ def test_resume_keeps_or_retries_failed_rows(tmp_path):
     cells[cols.index("status")], cells[cols.index("error")] = "failed", "KilledWorker: lost"
     cells[cols.index("f1_hz")] = ""
     out.write_text(lines[0] + lines[1] + ",".join(cells) + "\n")
-    kept = S.run_sweep(sw, out=out)
+    kept = S.run_sweep(sw, out=out, retry_failed=False)
     assert kept["status"].tolist() == ["ok", "failed"]           # a finished row is kept
-    again = S.run_sweep(sw, out=out, retry_failed=True)
+    again = S.run_sweep(sw, out=out)                             # the default: rerun failed
     assert_identical(full, again)
+    assert again["wall_s"][0] == full["wall_s"][0]               # the ok row was not rerun
 
 
 # ------------------------------------------------------------------------------------------
@@ -712,3 +717,214 @@ def test_impossible_method_and_condition_name_both_key_paths(tmp_path):
     assert df["status"].tolist() == ["ok", "failed"]
     assert re.search(r"aero.machs\[0\] = 2.5 with aero.method = 'dlm': mach must be < 1 for the "
                      r"DLM", df["error"].iloc[1]), df["error"].iloc[1]
+
+
+# ------------------------------------------------------------------------------------------
+# the processes executor with dying workers (issue 22)
+# ------------------------------------------------------------------------------------------
+CHEAP = {"aero.boxes": [{"n_chord": 4, "n_span": 4}]}     # 16 boxes: factors in ~1 s
+K_GRID = [100.0, 110.0, 120.0, 130.0]
+
+
+@dataclasses.dataclass(frozen=True)
+class KillingSweep(S.Sweep):
+    """A sweep whose sample with support.torsional_stiffness = ``kill_value`` SIGKILLs the
+    worker process computing it (never the test's process ``parent``): once if ``marker`` is a
+    file path (created before the kill, so the rerun computes the row), every time if it is
+    empty. Each kill appends a line to ``log``. Pickled to the spawned workers by reference
+    (this module is on their sys.path)."""
+
+    kill_value: float = 0.0
+    marker: str = ""
+    log: str = ""
+    parent: int = 0
+
+    def case_dict(self, values):
+        if (values.get("support.torsional_stiffness") == self.kill_value
+                and os.getpid() != self.parent
+                and not (self.marker and os.path.exists(self.marker))):
+            if self.marker:
+                Path(self.marker).touch()
+            with open(self.log, "a") as fh:
+                fh.write(f"{os.getpid()}\n")
+            os.kill(os.getpid(), signal.SIGKILL)
+        return super().case_dict(values)
+
+
+def killing_sweep_dict():
+    d = sweep_dict([{"path": "support.torsional_stiffness", "values": K_GRID}],
+                   outputs=["f1_hz"])
+    d["case"].update(CHEAP)
+    return d
+
+
+def killing_sweep(tmp_path, once: bool):
+    sw = S.sweep_from_dict(killing_sweep_dict())
+    ks = KillingSweep(**{f.name: getattr(sw, f.name) for f in dataclasses.fields(sw)},
+                      kill_value=K_GRID[1], marker=str(tmp_path / "killed") if once else "",
+                      log=str(tmp_path / "kills.log"), parent=os.getpid())
+    return sw, ks
+
+
+def test_worker_killed_by_its_sample_is_replaced_and_the_sample_rerun(tmp_path):
+    """Sample 1 SIGKILLs its worker once: the worker is replaced, sample 1 computed again, and
+    the table (4 rows, each sample journaled once) equals the serial one."""
+    sw, ks = killing_sweep(tmp_path, once=True)
+    out = tmp_path / "o.csv"
+    df = S.run_sweep(ks, out=out, executor="processes", workers=2)
+    assert (tmp_path / "killed").exists(), "the worker was never killed"
+    assert len((tmp_path / "kills.log").read_text().split()) == 1
+    assert df["status"].tolist() == ["ok"] * 4
+    samples = [r["sample"] for r in csv.DictReader(out.open())]
+    assert samples == ["0", "1", "2", "3"]
+    assert_identical(df, S.run_sweep(sw))
+
+
+def test_sample_that_always_kills_its_worker_fails_with_exit_1(tmp_path, monkeypatch, capsys):
+    """Sample 1 SIGKILLs every worker that computes it: it is tried MAX_WORKER_DEATHS times,
+    then a failed WorkerLost row naming it; the other rows are ok, and the CLI exits 1 with one
+    line giving the count and how to retry."""
+    from asekit.cli.main import main
+    _, ks = killing_sweep(tmp_path, once=False)
+    f = tmp_path / "k.toml"                       # the file the CLI reads: the sweep without
+    f.write_text(_toml(killing_sweep_dict()))     # its killer, which load_sweep returns
+    monkeypatch.setattr(S, "load_sweep", lambda path: ks)
+    rc = main(["sweep", str(f), "--out", str(tmp_path / "o.csv"), "--executor", "processes",
+               "--workers", "2", "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 1
+    assert len(err) == 1 and err[0].startswith("error: 1 of 4 samples failed"), err
+    assert "run the same command again to retry" in err[0]
+    kills = (tmp_path / "kills.log").read_text().split()
+    assert len(kills) == S.MAX_WORKER_DEATHS == 3 and len(set(kills)) == 3   # 3 processes
+    df = S.read_table(tmp_path / "o.csv")
+    assert df["status"].tolist() == ["ok", "failed", "ok", "ok"]
+    assert df["error"][1].startswith("WorkerLost: sample 1: its worker process died 3 times")
+
+
+def test_a_plain_resume_retries_failed_rows_and_keep_failed_keeps_them(tmp_path, capsys):
+    """A journal with a failed row (a worker lost): `sweep --keep-failed` keeps it (exit 1),
+    the plain command reruns it (exit 0), and the table is the serial one."""
+    from asekit.cli.main import main
+    d = sweep_dict([{"path": "support.torsional_stiffness", "values": [100.0, 120.0]}],
+                   outputs=["f1_hz"])
+    f = tmp_path / "s.toml"
+    f.write_text(_toml(d))
+    out = tmp_path / "r.csv"
+    full = S.run_sweep(S.sweep_from_dict(d), out=out)
+    lines = out.read_text().splitlines(keepends=True)
+    cols = next(csv.reader([lines[0]]))
+    cells = next(csv.reader([lines[2]]))
+    cells[cols.index("status")], cells[cols.index("error")] = "failed", "WorkerLost: lost"
+    cells[cols.index("f1_hz")] = ""
+    out.write_text(lines[0] + lines[1] + ",".join(cells) + "\n")
+    args = ["sweep", str(f), "--out", str(out), "--quiet"]
+    assert main(args + ["--keep-failed"]) == 1
+    assert "error: 1 of 2 samples failed" in capsys.readouterr().err
+    assert S.read_table(out)["status"].tolist() == ["ok", "failed"]
+    assert main(args) == 0
+    assert capsys.readouterr().err.strip() == f"2 samples (0 failed) -> {out}"
+    assert_identical(S.read_table(out), full)
+
+
+def _children(pid: int) -> list[int]:
+    """The live (not zombie) processes whose parent is ``pid``, from /proc."""
+    out = []
+    for p in Path("/proc").iterdir():
+        if p.name.isdigit():
+            try:
+                stat = (p / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(stat[1]) == pid and stat[0] != "Z":
+                out.append(int(p.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_parent_killed_leaves_no_worker_alive(tmp_path):
+    """`sweep --executor processes` SIGKILLed mid-sweep: its worker processes (and the
+    multiprocessing resource tracker) are gone within 5 s (PR_SET_PDEATHSIG, the watchdog)."""
+    d = sweep_dict([{"path": "support.torsional_stiffness", "values": K_GRID * 10}],
+                   outputs=["f1_hz", "flutter_speed"])
+    d["parameter"][0]["values"] = [100.0 + i for i in range(40)]
+    d["case"].update(CHEAP)
+    f = tmp_path / "s.toml"
+    f.write_text(_toml(d))
+    out = tmp_path / "o.csv"
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    proc = subprocess.Popen([sys.executable, "-m", "asekit", "sweep", str(f), "--out", str(out),
+                             "--executor", "processes", "--workers", "2", "--quiet"], env=env,
+                            cwd=tmp_path, stderr=subprocess.DEVNULL)
+    try:
+        t0 = time.time()
+        while time.time() - t0 < 120 and proc.poll() is None:
+            if out.exists() and len(out.read_text().splitlines()) >= 2:
+                break
+            time.sleep(0.02)
+        kids = _children(proc.pid)
+    finally:
+        proc.kill()
+        proc.wait()
+    assert len(kids) >= 2, kids                       # two workers (and the resource tracker)
+    t0 = time.time()
+    while time.time() - t0 < 5 and any(_alive(k) for k in kids):
+        time.sleep(0.05)
+    left = [k for k in kids if _alive(k)]
+    for k in left:
+        os.kill(k, signal.SIGKILL)
+    assert not left, f"alive {time.time() - t0:.1f} s after the parent's SIGKILL: {left}"
+
+
+# ------------------------------------------------------------------------------------------
+# sweeps that start above the flutter speed: the case summary's bounds (issue 22)
+# ------------------------------------------------------------------------------------------
+def test_bounded_minimum_gives_the_value_only_when_it_is_determined():
+    """min over quantities known as a value, an upper or a lower bound, or unknown."""
+    bm = S.bounded_minimum
+    assert bm([("value", 0.3), ("value", 0.1)]) == (0.1, None, None)
+    assert bm([("value", 0.3), ("lower", 0.5)]) == (0.3, None, None)   # 0.5 < x: not the min
+    assert bm([("value", 0.3), ("lower", 0.2)]) == (None, 0.3, 0.2)    # min in [0.2, 0.3]
+    assert bm([("value", 0.3), ("upper", 0.5)]) == (None, 0.3, None)   # the other may be lower
+    assert bm([("value", 0.3), ("upper", 0.1)]) == (None, 0.1, None)
+    assert bm([("value", 0.3), (None, None)]) == (None, 0.3, None)     # one unknown
+    assert bm([("lower", 0.4), ("lower", 0.2)]) == (None, None, 0.2)
+    assert bm([]) == (None, None, None)
+
+
+def test_sweep_above_flutter_gives_the_case_summary_bounds(one_blas_thread):
+    """flight.velocities from 230 m/s, above the sea-level flutter speed of the 16-box fin: the
+    envelope outputs are the bounds of asekit.case.pipeline.flutter's summary (its
+    margin_upper_bound, flutter at or below 230 m/s), not a value taken from the other
+    altitude; flutter_inside is True where M a >= 230 m/s (M 0.75: 255 m/s) and a failed row
+    where M a < 230 m/s (M 0.6: 204 m/s), which the sweep cannot decide."""
+    outs = list(S.ENVELOPE_OUTPUTS) + ["unstable_at_start", "flutter_margin", "flutter_inside"]
+    d = sweep_dict([{"path": "flight.mach", "values": [0.6, 0.75]}], outputs=outs)
+    d["case"].update({**CHEAP, "aero.machs": [0.5, 0.6], "flight.altitudes": [0.0, 5000.0],
+                      "flight.velocities": {"min": 230.0, "max": 400.0, "step": 10.0}})
+    sw = S.sweep_from_dict(d)
+    df = S.run_sweep(sw)
+    case = case_from_dict(sw.case_dict({})[0])
+    fa = P.flutter(case, db=P.gaf_database(case, progress=False))
+    sea = next(m for m in fa.margins if m["altitude_m"] == 0.0)
+    assert sea["margin"] is None and sea["margin_upper_bound"] is not None      # the setup
+    assert fa.match_points[0]["flutter_at_or_below_ms"] == 230.0
+    bounds = [m["margin"] if m["margin"] is not None else m["margin_upper_bound"]
+              for m in fa.margins]
+    assert df["status"].tolist() == ["failed", "ok"]
+    assert "unstable at 230 m/s, the first speed of flight.velocities, above the flight " \
+           "speed M a = 204.176 m/s: start the velocity sweep lower" in df["error"][0]
+    row = df.iloc[1]
+    assert math.isnan(row["envelope_margin"]) and math.isnan(row["envelope_margin_lower_bound"])
+    assert row["envelope_margin_upper_bound"] == min(bounds)
+    assert math.isnan(row["min_flutter_speed"]) and row["min_flutter_speed_upper_bound"] == 230.0
+    assert row["unstable_at_start"] and row["flutter_inside"]
+    assert math.isnan(row["flutter_margin"])

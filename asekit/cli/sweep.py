@@ -2,10 +2,12 @@
 [--scheduler tcp://HOST:8786] [--workers N]``: run a sweep file (:mod:`asekit.sweep`) and
 write one row per sample. An existing partial output file of the same sweep is resumed. Bad
 input (unknown key path, invalid distribution, unknown output, unreachable scheduler) gets one
-line and exit status 2."""
+line and exit status 2; samples that fail (their rows say why) give exit status 1 and one line
+with their count, and the same command run again retries them."""
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
@@ -25,8 +27,10 @@ def add_parser(sub) -> None:
                    help="local processes or LocalCluster workers (default 2)")
     p.add_argument("--samples", type=int, metavar="N",
                    help="override sweep.samples (the Monte Carlo sample count)")
-    p.add_argument("--retry-failed", action="store_true",
-                   help="on resume, run the failed rows of --out again instead of keeping them")
+    p.add_argument("--keep-failed", dest="retry_failed", action="store_false",
+                   help="on resume, keep the failed rows of --out (default: run them again)")
+    p.add_argument("--retry-failed", dest="retry_failed", action="store_true",
+                   help=argparse.SUPPRESS)     # the default since issue 22; still accepted
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
@@ -79,12 +83,24 @@ def run(args) -> int:
         return _error(str(exc))
     except ValueError as exc:            # a base case the pipeline refuses (e.g. its DLM)
         return _error(f"{Path(args.sweep).name}: {type(exc).__name__}: {exc}")
-    if parquet:
+    return _summary(df, out, journal if parquet else None)
+
+
+def _summary(df, out: Path, journal: Path | None) -> int:
+    """Write the Parquet table (keeping its journal while rows failed, so that a rerun resumes
+    from it) and print one line: exit 0 if every sample is ok, else 1 with the count, the
+    first error and how to run the failed samples again."""
+    failed = df[df["status"] != "ok"]
+    if journal is not None:
         df.to_parquet(out, index=False)
-        journal.unlink()
-    failed = int((df["status"] != "ok").sum())
-    print(f"{len(df)} samples ({failed} failed) -> {out}", file=sys.stderr)
-    if failed:
-        first = df[df["status"] != "ok"].iloc[0]
-        print(f"first failure, sample {int(first['sample'])}: {first['error']}", file=sys.stderr)
-    return 0
+        if failed.empty:
+            journal.unlink()
+    if failed.empty:
+        print(f"{len(df)} samples (0 failed) -> {out}", file=sys.stderr)
+        return 0
+    first = failed.iloc[0]
+    print(f"error: {len(failed)} of {len(df)} samples failed -> {out} (first, sample "
+          f"{int(first['sample'])}: {first['error']}); run the same command again to retry "
+          f"them (the finished rows are kept; --keep-failed keeps the failed ones)",
+          file=sys.stderr)
+    return 1
