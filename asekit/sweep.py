@@ -73,6 +73,7 @@ from asekit.case import pipeline as P
 from asekit.case.schema import CaseError, _number, _Table, case_from_dict
 from asekit.util.blas import one_blas_thread
 from asekit.util.conventions import mode_number
+from asekit.util.extras import require
 from asekit.util.paths import CASES_DIR
 from asekit.util.validate import read_toml
 
@@ -961,7 +962,7 @@ def read_journal(path: Path, sweep: Sweep) -> dict[int, str]:
 
 def read_table(path):
     """The output CSV as a pandas DataFrame (floats read back bit-exactly)."""
-    import pandas as pd
+    pd = require("pandas", "asekit sweep (the results table)")
     df = pd.read_csv(path)
     return df
 
@@ -1035,11 +1036,8 @@ def connect(scheduler: str | None, workers: int | None, timeout: float = 5.0):
     """A dask.distributed Client: to ``scheduler`` (SweepError if it is not reachable within
     ``timeout`` s), else to a new LocalCluster of ``workers`` single-threaded worker processes.
     Returns (client, cluster or None)."""
-    try:
-        from dask.distributed import Client, LocalCluster
-    except ImportError:
-        raise SweepError("--executor dask needs dask[distributed]: pip install "
-                         "'asekit[sweep]'") from None
+    distributed = require("dask.distributed", "--executor dask")
+    Client, LocalCluster = distributed.Client, distributed.LocalCluster
     if scheduler:
         try:
             return Client(scheduler, timeout=f"{timeout}s"), None
@@ -1080,6 +1078,7 @@ def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | N
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
                                 or workers < 1):
         raise SweepError(f"workers must be an integer >= 1, got {workers!r}")
+    pd = require("pandas", "asekit sweep (the results table)")     # before any work
     cols = sweep.columns()
     design = sweep.design()
     path = None if out is None else Path(out)
@@ -1140,7 +1139,6 @@ def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | N
     text = ",".join(cols) + "\n" + "".join(rows_mem[i] for i in sorted(rows_mem))
     if path is not None:
         _atomic_write(path, text)
-    import pandas as pd
     return pd.read_csv(io.StringIO(text))
 
 

@@ -40,13 +40,31 @@ def _error(msg: str) -> int:
     return 2
 
 
+def _missing_extra(args) -> str | None:
+    """The one-line reason (with its pip install) when an extra the run needs is missing."""
+    from asekit.util.extras import MissingExtra, require
+    try:
+        require("pandas", "asekit sweep (the results table)")
+        if args.executor == "dask":
+            require("dask.distributed", "--executor dask")
+    except MissingExtra as exc:
+        return str(exc)
+    return None
+
+
+def _argument_error(args) -> str | None:
+    """Why the executor options cannot run (or an extra is missing), else None."""
+    if args.scheduler and args.executor != "dask":
+        return "--scheduler needs --executor dask"
+    if args.workers is not None and args.workers < 1:
+        return f"--workers must be >= 1, got {args.workers}"
+    return _missing_extra(args)
+
+
 def run(args) -> int:
     import dataclasses
-
-    if args.scheduler and args.executor != "dask":
-        return _error("--scheduler needs --executor dask")
-    if args.workers is not None and args.workers < 1:
-        return _error(f"--workers must be >= 1, got {args.workers}")
+    if (why := _argument_error(args)) is not None:
+        return _error(why)
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".parquet"):
         return _error(f"--out {out}: give a .csv or .parquet path")

@@ -31,3 +31,18 @@ def test_progress_on_stderr_and_quiet():
     q = _run("reproduce", "--only", "servo", "--quiet")
     assert q.returncode == 0 and "chapter" not in q.stderr
     assert max(len(line) for line in q.stdout.splitlines()) <= 100
+
+
+def test_sweep_without_pandas_names_the_pip_install_before_any_work(tmp_path):
+    """issue 30: `sweep` without its extra printed a raw ModuleNotFoundError."""
+    from pathlib import Path
+    code = ("import sys; sys.modules['pandas'] = None; from asekit.cli.main import main; "
+            "sys.exit(main(['sweep', 'data/sweeps/fin_envelope.toml', '--out', "
+            f"{str(tmp_path / 'o.csv')!r}]))")
+    root = Path(__file__).resolve().parents[2]
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=root,
+                       timeout=120)
+    assert r.returncode == 2
+    assert r.stderr.strip().splitlines() == [
+        "error: asekit sweep (the results table) needs pandas: pip install 'asekit-aero[sweep]'"]
+    assert not (tmp_path / "o.csv").exists()
