@@ -66,7 +66,8 @@ from asekit.case.schema import AeroSpec, Case, FlightSpec, ModesSpec, SupportSpe
 from asekit.geometry import Material, OrthotropicMaterial
 from asekit.structure.assembly import SupportedSystem, element_dofs, pitch_inertia
 from asekit.structure.mesh import PlateMesh
-from asekit.structure.plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness
+from asekit.structure.plate import (DOF_PER_NODE, consistent_mass, mitc4_stiffness,
+                                    shape_functions)
 from asekit.structure.supports import planform_edge_supports
 
 #: length, mass and time of one deck unit in SI (m, kg, s).
@@ -268,17 +269,249 @@ class _Deck:
         return DOF_PER_NODE * self.index[int(nid)] + comp
 
 
+#: Cards whose ids share one name space (Nastran: an element id is unique over all elements,
+#: CONM2 and rigid elements included); a second card with an id already given is an error
+#: unless it repeats the first exactly (an identical repeat is dropped, as Nastran does).
+#: SPC / SPC1 (sets of several cards) and MKAERO1 (no id) are not listed.
+ID_SPACES = {"GRID": "GRID", "CQUAD4": "element", "CTRIA3": "element", "CELAS1": "element",
+             "CELAS2": "element", "CONM2": "element", "RBE2": "element",
+             "PSHELL": "property", "PELAS": "property", "MAT1": "material", "MAT8": "material",
+             "CORD2R": "coordinate system", "CORD1R": "coordinate system",
+             "CORD2C": "coordinate system", "CORD2S": "coordinate system",
+             "CAERO1": "CAERO", "PAERO1": "PAERO", "AEFACT": "AEFACT", "SPLINE1": "spline",
+             "SPLINE4": "spline", "SET1": "SET1", "AELIST": "AELIST", "FLFACT": "FLFACT",
+             "FLUTTER": "FLUTTER", "EIGR": "method", "EIGRL": "method", "TABDMP1": "TABDMP1",
+             "AERO": "AERO", "AEROS": "AEROS", "PARAM": "PARAM", "SUPORT": None}
+
+
+class BdfWarning(UserWarning):
+    """A deck asekit reads but whose model looks unintended (e.g. grids that touch nothing)."""
+
+
+def _number(v):
+    """A Nastran field as a float (``1.5``, ``1.-7``, ``2+3``) or None (blank, not a number)."""
+    if v is None:
+        return None
+    if isinstance(v, (int, float)):
+        return float(v)
+    s = str(v).strip().upper().replace("D", "E")
+    try:
+        return float(s)
+    except ValueError:
+        pass
+    for i in range(len(s) - 1, 0, -1):
+        if s[i] in "+-" and s[i - 1] not in "E+-":
+            try:
+                return float(s[:i] + "E" + s[i:])
+            except ValueError:
+                return None
+    return None
+
+
+def _norm_fields(fields) -> tuple:
+    """The fields of a card compared for a repeat: numbers as floats, text upper-case, the
+    trailing blanks dropped."""
+    out = []
+    for v in fields:
+        x = _number(v)
+        out.append(x if x is not None else (None if v is None or str(v).strip() == ""
+                                            else str(v).strip().upper()))
+    while out and out[-1] is None:
+        out.pop()
+    return tuple(out)
+
+
+def _first_line(exc: BaseException) -> str:
+    """The first non-empty line of an exception's message (pyNastran's are multi-line)."""
+    text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+    lines = [ln.strip() for ln in text.strip("'\" \n").splitlines() if ln.strip()]
+    return (lines[0] if lines else type(exc).__name__)[:300]
+
+
+@dataclass
+class _CardTrace:
+    """The cards pyNastran parses, seen one by one through ``BDF.add_card``: each card's
+    normalised fields by (id space, id), for the duplicate check; the number of identical
+    repeats; the raw fields of every MAT1 (its MAT1 rules need what was given)."""
+
+    name: str
+    seen: dict = field(default_factory=dict)
+    repeats: int = 0
+    mat1: dict = field(default_factory=dict)
+
+    def record(self, card: str, fields: list) -> None:
+        space = ID_SPACES.get(card, None)
+        if card not in ID_SPACES or space is None or len(fields) < 2:
+            return
+        key = "-" if card in ("AERO", "AEROS") else _norm_fields(fields[1:2])
+        key = key[0] if isinstance(key, tuple) and key else key
+        norm = (card, _norm_fields(fields))
+        old = self.seen.get((space, key))
+        if old is None:
+            self.seen[(space, key)] = norm
+            if card == "MAT1":
+                self.mat1[key] = norm[1]
+                _check_mat1_fields(norm[1])
+            return
+        if old == norm:
+            self.repeats += 1
+            return
+        what = card if card in ("AERO", "AEROS") else f"{card} {_fmt_id(key)}"
+        raise BdfError(f"{self.name}: {what}: a second card with the {space} id of "
+                       f"{old[0]} {_fmt_id(key)} and other fields: duplicate ids are errors "
+                       f"(give each card its own id)")
+
+
+def _fmt_id(key) -> str:
+    return f"{key:g}" if isinstance(key, float) else str(key)
+
+
+def _traced_add_card(model, trace: _CardTrace):
+    """``model.add_card`` that records each card in ``trace`` and turns pyNastran's errors
+    into a :class:`BdfError` naming the card and its id (pyNastran's message, with the field,
+    after it)."""
+    orig = model.add_card
+
+    def add_card(card_lines, card_name, comment="", ifile=None, is_list=True, has_none=True):
+        name = str(card_name).upper()
+        try:
+            card_obj, _ = model.create_card_object(card_lines, name, is_list=is_list,
+                                                   has_none=has_none)
+            fields = list(card_obj.card)
+        except Exception as exc:
+            raise BdfError(f"{trace.name}: {name} card unreadable: {_first_line(exc)}") from None
+        ident = f"{name} {fields[1]}" if len(fields) > 1 and fields[1] is not None else name
+        trace.record(name, fields)
+        try:
+            return orig(card_lines, card_name, comment=comment, ifile=ifile, is_list=is_list,
+                        has_none=has_none)
+        except BdfError:
+            raise
+        except Exception as exc:
+            raise BdfError(f"{trace.name}: {ident}: {_first_line(exc)}") from None
+    return add_card
+
+
 def _open_deck(path: Path, BDF):
     """The pyNastran model of ``path`` (cross-referenced; a file without BEGIN BULK is read as
-    bulk data only)."""
+    bulk data only) and its :class:`_CardTrace`. Every pyNastran error is a
+    :class:`BdfError`: a card's error names the card, its id and (pyNastran's words) the
+    field; a reference to a missing card names the card that refers; otherwise the file."""
     model = BDF(debug=None)
-    punch = "BEGIN BULK" not in path.read_text(errors="replace").upper()
-    model.read_bdf(str(path), punch=punch, xref=True)
-    return model
+    try:
+        punch = "BEGIN BULK" not in path.read_text(errors="replace").upper()
+    except OSError as exc:
+        raise BdfError(f"{path}: cannot read the deck ({exc.strerror or exc})") from None
+    trace = _CardTrace(path.name)
+    model.add_card = _traced_add_card(model, trace)
+    try:
+        model.read_bdf(str(path), punch=punch, xref=False)
+    except BdfError:
+        raise
+    except Exception as exc:
+        raise BdfError(f"{path.name}: pyNastran cannot read the deck "
+                       f"({type(exc).__name__}: {_first_line(exc)})") from None
+    try:
+        model.cross_reference()
+    except Exception as exc:
+        raise BdfError(f"{path.name}: a card refers to one the deck does not hold: "
+                       f"{_xref_message(exc)}") from None
+    return model, trace
 
 
-def _read_param_wtmass(model) -> float:
-    """PARAM WTMASS: the factor from the deck's mass input to its mass unit (default 1).
+def _xref_message(exc) -> str:
+    """pyNastran's cross-reference error in one line (its long id lists cut)."""
+    text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+    lines = [ln.strip() for ln in text.strip("'\" \n").splitlines() if ln.strip()]
+    lines = [ln for ln in lines if not ln.startswith(("There are cross-reference errors",
+                                                      "nids=", "allowed", "Allowed"))]
+    msg = (lines[0] if lines else _first_line(exc))
+    return msg.replace("\\n", " ")[:300]
+
+
+# ---------------------------------------------------------------------------------------------
+# physical ranges (SI) of the fields asekit reads
+# ---------------------------------------------------------------------------------------------
+#: The range (SI, low, high, whether low is allowed) each kind of field must lie in: wide
+#: plausibility bounds (any aircraft or wind-tunnel model lies well inside), so that a typo
+#: of a few orders of magnitude or 1e30 is refused with its card and field instead of giving
+#: a structure of another scale and "no flutter".
+RANGES = {
+    "coordinate": (-1.0e4, 1.0e4, True, "m"),
+    "length": (0.0, 1.0e4, False, "m"),
+    "thickness": (0.0, 10.0, False, "m"),
+    "modulus": (1.0e3, 1.0e13, True, "Pa"),
+    "density": (0.0, 1.0e5, True, "kg/m^3"),
+    "areal mass": (0.0, 1.0e5, True, "kg/m^2"),
+    "mass": (0.0, 1.0e7, True, "kg"),
+    "inertia": (0.0, 1.0e9, True, "kg m^2"),
+    "spring": (0.0, 1.0e20, True, "N/m or N m/rad"),
+    "fluid density": (0.0, 2.0e3, False, "kg/m^3"),
+    "velocity": (0.0, 1.0e4, False, "m/s"),
+    "reduced frequency": (0.0, 100.0, False, ""),
+    "damping": (0.0, 1.0, True, ""),
+    "frequency": (0.0, 1.0e6, True, "Hz"),
+    "factor": (0.0, 1.0e30, False, ""),
+}
+
+
+def _si_factor(deck, kind: str) -> float:
+    """SI value of one deck unit of a field of ``kind`` (WTMASS on structural masses)."""
+    L, Mu, T, w = deck.L, deck.Mu, deck.T, deck.wtmass
+    return {"coordinate": L, "length": L, "thickness": L, "modulus": Mu / (L * T * T),
+            "density": w * Mu / L**3, "areal mass": w * Mu / L**2, "mass": w * Mu,
+            "inertia": w * Mu * L * L, "fluid density": Mu / L**3, "velocity": L / T,
+            "frequency": 1.0 / T}.get(kind, 1.0)
+
+
+def _check_range(deck, what: str, value, kind: str, si: float | None = None) -> float:
+    """``value`` (deck units; ``si`` its SI value if already converted) of the field ``what``
+    (card, id and field) checked against :data:`RANGES`; returns the SI value."""
+    lo, hi, lo_ok, unit = RANGES[kind]
+    v = float(value)
+    s = v * _si_factor(deck, kind) if si is None else float(si)
+    if not (math.isfinite(s) and (s > lo or (lo_ok and s == lo)) and s <= hi):
+        shown = f"{v:g}" + ("" if si is None and _si_factor(deck, kind) == 1.0
+                            else f" (= {s:g} {unit})")
+        raise BdfError(f"{deck.name}: {what} = {shown} is outside the physical range "
+                       f"{lo:g} {'<=' if lo_ok else '<'} {kind} <= {hi:g} {unit}".rstrip())
+    return s
+
+
+def _check_mat1_fields(f: tuple) -> None:
+    """The MAT1 rules on the fields as given (MSC Nastran QRG, MAT1): two of E, G, NU
+    determine the third (G = E / (2 (1 + NU))); E > 0, G > 0 and -1 < NU <= 0.5, given or
+    derived. asekit needs two of them (Nastran's "E alone: G = NU = 0" has no shear)."""
+    mid = _fmt_id(f[1])
+    E, G, nu = (f[i] if len(f) > i else None for i in (2, 3, 4))
+    if any(isinstance(v, str) for v in (E, G, nu)):
+        return                                   # pyNastran names the bad field
+    given = [n for n, v in zip(("E", "G", "NU"), (E, G, nu)) if v is not None]
+    if len(given) < 2:
+        raise BdfError(f"MAT1 {mid}: {' and '.join(given) or 'none of E, G, NU'} given: "
+                       f"asekit needs two of E, G, NU (the third is G = E / (2 (1 + NU)))")
+    for n, v in (("E", E), ("G", G)):
+        if v is not None and not v > 0:
+            raise BdfError(f"MAT1 {mid}: {n} = {v:g} must be > 0")
+    derived = nu is None
+    nu = E / (2.0 * G) - 1.0 if derived else nu
+    if not -1.0 < nu <= 0.5:
+        how = f" (from E = {E:g} and G = {G:g}: NU = E / (2 G) - 1)" if derived else ""
+        raise BdfError(f"MAT1 {mid}: NU = {nu:g}{how} is outside -1 < NU <= 0.5")
+
+
+def _check_grid_ranges(deck) -> None:
+    """GRID X1-X3 (basic) within :data:`RANGES` ``coordinate``."""
+    bad = np.flatnonzero(~np.all(np.abs(deck.xyz * deck.L) <= RANGES["coordinate"][1], axis=1))
+    if bad.size:
+        i = int(bad[0])
+        j = int(np.argmax(~(np.abs(deck.xyz[i] * deck.L) <= RANGES["coordinate"][1])))
+        _check_range(deck, f"GRID {deck.nids[i]} X{j + 1} (basic)", deck.xyz[i, j],
+                     "coordinate")
+
+
+def _read_param_wtmass(model, name: str = "") -> float:
+    """PARAM WTMASS: the factor from the deck's mass input to its mass unit (default 1; > 0).
 
     +-------+--------+--------+
     |   1   |   2    |   3    |
@@ -287,7 +520,13 @@ def _read_param_wtmass(model) -> float:
     +-------+--------+--------+
     """
     wt = model.params.get("WTMASS")
-    return float(wt.values[0]) if wt is not None else 1.0
+    if wt is None:
+        return 1.0
+    v = _number(wt.values[0] if wt.values else None)
+    if v is None or not (math.isfinite(v) and 0.0 < v < 1.0e30):
+        raise BdfError(f"{name}: PARAM WTMASS = {wt.values[0] if wt.values else None} must be "
+                       f"a number > 0 (the deck's mass input x WTMASS = its mass unit)")
+    return v
 
 
 def _shell_elements(model, name: str) -> list:
@@ -318,6 +557,7 @@ def _read_grids(deck: _Deck, quads, tol: float | None) -> None:
     xyz = np.array([model.nodes[n].get_position() for n in nids], float)
     deck.nids, deck.xyz = nids, xyz
     deck.index = {int(n): i for i, n in enumerate(nids)}
+    _check_grid_ranges(deck)
     size = float(np.ptp(xyz[:, :2], axis=0).max())
     tol = 1e-6 * size if tol is None else float(tol)
     plate_nodes = sorted({n for e in quads for n in e.node_ids})
@@ -354,6 +594,43 @@ def _read_pshell(p, e) -> None:
         raise BdfError(f"{e.type} {e.eid}: ZOFFS = {e.zoffset} is not supported")
 
 
+def _check_shell_ranges(deck: _Deck, quads, th, props) -> None:
+    """PSHELL T (> 0) and NSM, and each element's corner thicknesses (deck units): all >= 0,
+    the largest > 0 (an element of zero thickness has no stiffness), within :data:`RANGES`."""
+    for p in props.values():
+        if p.t is not None:
+            _check_range(deck, f"PSHELL {p.pid} T", p.t, "thickness")
+        _check_range(deck, f"PSHELL {p.pid} NSM", p.nsm or 0.0, "areal mass")
+    bad = np.flatnonzero(~((th >= 0).all(axis=1) & (th.max(axis=1) > 0)
+                           & (th.max(axis=1) * deck.L <= RANGES["thickness"][1])))
+    if bad.size:
+        e = quads[int(bad[0])]
+        raise BdfError(f"{deck.name}: {e.type} {e.eid}: corner thicknesses T1-T4 = "
+                       f"{[float(v) for v in th[bad[0]]]} (with PSHELL {e.pid} T for blanks): "
+                       f"each must be >= 0, the largest > 0 and <= "
+                       f"{RANGES['thickness'][1] / deck.L:g} (10 m)")
+
+
+def _check_element_shapes(deck: _Deck, quads, conn) -> None:
+    """Every element's Jacobian positive at its 2 x 2 Gauss points (after :func:`_orient`): a
+    degenerate (collinear, coincident grids) or non-convex quadrilateral is refused by id."""
+    xy = deck.nodes[conn]
+    g = 1.0 / math.sqrt(3.0)
+    worst = np.full(len(conn), np.inf)
+    for r, s in ((-g, -g), (g, -g), (g, g), (-g, g)):
+        _, dNr, dNs = shape_functions(r, s)
+        J = np.stack([dNr @ xy, dNs @ xy], axis=1)
+        worst = np.minimum(worst, J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0])
+    area = np.abs(worst) + 1e-300
+    scale = np.ptp(deck.nodes, axis=0).max() ** 2
+    bad = np.flatnonzero(~(worst > 1e-12 * scale) | ~np.isfinite(area))
+    if bad.size:
+        e = quads[int(bad[0])]
+        raise BdfError(f"{deck.name}: {e.type} {e.eid} (grids {list(e.node_ids)}) is degenerate "
+                       f"or not convex in the plate's plane (Jacobian <= 0): its grids must "
+                       f"make a convex polygon of non-zero area")
+
+
 def _shell_thickness(e, p, tri: bool) -> list[float]:
     """Corner thicknesses (deck units) of a CQUAD4 (T1-T4) or CTRIA3 (T1-T3, T3 repeated for
     the degenerated MITC4): blank or negative -> PSHELL T; TFLAG = 1 -> multiples of T.
@@ -375,6 +652,9 @@ def _shell_thickness(e, p, tri: bool) -> list[float]:
     +--------+-------+-------+----+----+----+------------+-------+
     """
     t = [e.T1, e.T2, e.T3, e.T3] if tri else [e.T1, e.T2, e.T3, e.T4]
+    if p.t is None and (getattr(e, "tflag", 0) == 1 or any(v is None or v < 0 for v in t)):
+        raise BdfError(f"{e.type} {e.eid}: a corner thickness is blank and PSHELL {p.pid} T "
+                       f"is blank too: give T")
     if getattr(e, "tflag", 0) == 1:
         t = [(v if v is not None else 1.0) * p.t for v in t]
     return [p.t if v is None or v < 0 else v for v in t]
@@ -426,7 +706,9 @@ def _read_shells(deck: _Deck, quads):
         th[j] = _shell_thickness(e, p, bool(is_tri[j]))
         angles[j] = _element_angle(e, lambda g: deck.xyz[deck.index[g]], e.node_ids[0],
                                    e.node_ids[1], deck.model)
+    _check_shell_ranges(deck, quads, th, props)
     _orient(deck, conn, th, is_tri)
+    _check_element_shapes(deck, quads, conn)
     if is_tri.any():
         deck.notes.append(f"{int(is_tri.sum())} CTRIA3 modelled as degenerated MITC4 (G3 "
                           f"repeated; Bathe, Finite Element Procedures, 1996, Ch. 5: collapsed "
@@ -448,17 +730,16 @@ def _read_mat1(mat, deck: _Deck, pid: int) -> Material:
     | MAT1 | MID | E | G | NU | RHO | A | TREF | GE |
     +------+-----+---+---+----+-----+---+------+----+
     """
-    stress, dens = deck.Mu / (deck.L * deck.T * deck.T), deck.Mu / deck.L**3
+    _check_mat1_fields((mat.type, mat.mid, mat.e, mat.g, mat.nu))   # after pyNastran's fill
     E, G, nu = mat.e, mat.g, mat.nu
-    if E is None or E <= 0:
-        raise BdfError(f"MAT1 {mat.mid} (PSHELL {pid}): E must be > 0, got {E}")
-    if nu is None:
-        nu = E / (2 * G) - 1.0
-    elif G is not None and abs(G - E / (2 * (1 + nu))) > 1e-3 * G:
+    if abs(G - E / (2 * (1 + nu))) > 1e-3 * G:
         raise BdfError(f"MAT1 {mat.mid}: E, G and NU all given and G = {G:g} differs from "
                        f"E / (2 (1 + NU)) = {E / (2 * (1 + nu)):g}: asekit's isotropic "
                        f"material takes E and NU (give two of the three)")
-    return Material(E * stress, nu, mat.rho * deck.wtmass * dens, name=f"MAT1 {mat.mid}")
+    what = f"MAT1 {mat.mid} (PSHELL {pid})"
+    return Material(_check_range(deck, f"{what} E", E, "modulus"), nu,
+                    _check_range(deck, f"{what} RHO", mat.rho or 0.0, "density"),
+                    name=f"MAT1 {mat.mid}")
 
 
 def _read_mat8(mat, deck: _Deck, angle: float) -> OrthotropicMaterial:
@@ -470,12 +751,19 @@ def _read_mat8(mat, deck: _Deck, angle: float) -> OrthotropicMaterial:
     | MAT8 | MID | E1  |  E2  | NU12 | G12 | G1Z | G2Z | RHO |
     +------+-----+-----+------+------+-----+-----+-----+-----+
     """
-    stress, dens = deck.Mu / (deck.L * deck.T * deck.T), deck.Mu / deck.L**3
+    what = f"MAT8 {mat.mid}"
     g1z = mat.g1z if mat.g1z else mat.g12
     g2z = mat.g2z if mat.g2z else mat.g12
-    return OrthotropicMaterial(mat.e11 * stress, mat.e22 * stress, mat.g12 * stress,
-                               mat.nu12, mat.rho * deck.wtmass * dens, g1z * stress,
-                               g2z * stress, angle, name=f"MAT8 {mat.mid}")
+    mod = {n: _check_range(deck, f"{what} {n}", v, "modulus")
+           for n, v in (("E1", mat.e11), ("E2", mat.e22), ("G12", mat.g12), ("G1Z", g1z),
+                        ("G2Z", g2z))}
+    nu12 = float(mat.nu12 or 0.0)
+    if not abs(nu12) < math.sqrt(mod["E1"] / mod["E2"]):
+        raise BdfError(f"{what}: NU12 = {nu12:g} is outside |NU12| < sqrt(E1 / E2) = "
+                       f"{math.sqrt(mod['E1'] / mod['E2']):g} (a positive definite lamina)")
+    return OrthotropicMaterial(mod["E1"], mod["E2"], mod["G12"], nu12,
+                               _check_range(deck, f"{what} RHO", mat.rho or 0.0, "density"),
+                               mod["G1Z"], mod["G2Z"], angle, name=f"MAT8 {mat.mid}")
 
 
 def _material(deck: _Deck, mat, angle: float, pid: int):
@@ -578,6 +866,8 @@ def _read_celas(deck: _Deck):
         if lost:
             dropped.append(e.eid)
         k *= deck.Mu * deck.L**2 / deck.T**2 if rot else deck.Mu / deck.T**2
+        _check_range(deck, f"{e.type} {e.eid} K" if e.type == "CELAS2" else
+                     f"PELAS {e.pid} K (CELAS1 {e.eid})", k, "spring", si=k)
         if a is None:
             a, b = b, None
         if a is None:
@@ -612,16 +902,13 @@ def _read_conm2(deck: _Deck):
     n = deck.n_dof
     Mx = sp.lil_matrix((n, n))
     masses = []
-    sm, si = deck.wtmass * deck.Mu, deck.wtmass * deck.Mu * deck.L**2
     for m in deck.model.masses.values():
         if m.type != "CONM2":
             continue
         if m.cid not in (0, -1, None):
             raise BdfError(f"CONM2 {m.eid}: CID = {m.cid} is not supported (basic only)")
         i = deck.index[m.nid]
-        mass = float(m.mass) * sm
-        X = np.asarray(m.X if m.X is not None else np.zeros(3), float) * deck.L
-        I = np.asarray(m.I, float) * si
+        mass, X, I = _conm2_values(deck, m)
         masses.append((i, mass, X.copy(), (float(I[0]), float(I[1]), float(I[2]))))
         d = DOF_PER_NODE * i
         r = np.array([1.0, X[1], -X[0]])
@@ -631,6 +918,23 @@ def _read_conm2(deck: _Deck):
         Mx[d + 1, d + 2] -= I[1]
         Mx[d + 2, d + 1] -= I[1]
     return tuple(masses), Mx.tocsr()
+
+
+def _conm2_values(deck: _Deck, m):
+    """(mass kg, offset (3,) m, (I11, I21, I22, ...) kg m^2) of a CONM2, checked: mass and
+    offsets within :data:`RANGES`, I11, I22 >= 0 and I21^2 <= I11 I22."""
+    what = f"CONM2 {m.eid}"
+    mass = _check_range(deck, f"{what} M", float(m.mass or 0.0), "mass")
+    X = np.asarray(m.X if m.X is not None else np.zeros(3), float)
+    for j, x in enumerate(X):
+        _check_range(deck, f"{what} X{j + 1}", x, "coordinate")
+    I = np.asarray(m.I, float) * deck.wtmass * deck.Mu * deck.L**2
+    for j, n in ((0, "I11"), (2, "I22")):
+        _check_range(deck, f"{what} {n}", I[j], "inertia", si=I[j])
+    if not I[1] ** 2 <= I[0] * I[2] * (1 + 1e-12):
+        raise BdfError(f"{deck.name}: {what}: I21^2 > I11 I22 (I11, I21, I22 = "
+                       f"{list(map(float, np.asarray(m.I)[:3]))}): not a positive inertia")
+    return mass, X * deck.L, I
 
 
 def _read_grid_ps(deck: _Deck) -> set:
@@ -740,7 +1044,7 @@ def _reduction(n: int, fixed: set, dep: dict, K, M) -> sp.csr_matrix:
     return Tm[:, np.flatnonzero(~empty)].tocsr() if empty.any() else Tm
 
 
-def _read_eigen_method(model, T: float):
+def _read_eigen_method(model, deck: _Deck):
     """EIGRL (or EIGR) of the case control's METHOD (else the first): (ND number of modes or
     None, V2 / F2 upper frequency Hz or None).
 
@@ -759,10 +1063,16 @@ def _read_eigen_method(model, T: float):
     mth = methods.get(meth) if meth in methods else methods[min(methods)]
     nd = getattr(mth, "nd", None)
     v2 = getattr(mth, "v2", None) if mth.type == "EIGRL" else getattr(mth, "f2", None)
-    return (int(nd) if nd else None), (float(v2) / T if v2 else None)
+    if nd is not None and not 1 <= nd <= 100000:
+        raise BdfError(f"{deck.name}: {mth.type} {mth.sid} ND = {nd} must be an integer "
+                       f"1 <= ND <= 100000 (the number of modes)")
+    if v2 is not None:
+        _check_range(deck, f"{mth.type} {mth.sid} {'V2' if mth.type == 'EIGRL' else 'F2'}",
+                     v2, "frequency")
+    return (int(nd) if nd else None), (float(v2) / deck.T if v2 else None)
 
 
-def _read_tabdmp1(model, T: float):
+def _read_tabdmp1(model, deck: _Deck):
     """TABDMP1 (the first): modal damping vs frequency as ((f Hz, g), ...); TYPE G as given,
     CRIT (fraction of critical) as g = 2 zeta.
 
@@ -780,8 +1090,11 @@ def _read_tabdmp1(model, T: float):
     tab = tables[min(tables)]
     if tab.Type not in ("G", "CRIT"):
         raise BdfError(f"TABDMP1 {tab.tid}: TYPE {tab.Type} is not supported (G, CRIT)")
+    for j, (f, v) in enumerate(zip(tab.x, tab.y)):
+        _check_range(deck, f"TABDMP1 {tab.tid} f{j + 1}", f, "frequency")
+        _check_range(deck, f"TABDMP1 {tab.tid} {tab.Type.lower()}{j + 1}", v, "damping")
     g = np.asarray(tab.y, float) * (2.0 if tab.Type == "CRIT" else 1.0)
-    return tuple((float(f) / T, float(v)) for f, v in zip(tab.x, g))
+    return tuple((float(f) / deck.T, float(v)) for f, v in zip(tab.x, g))
 
 
 def _read_aero_card(deck: _Deck):
@@ -802,12 +1115,14 @@ def _read_aero_card(deck: _Deck):
         raise BdfError("CAERO1 without AERO / AEROS: the reference chord is unknown")
     if int(getattr(aero, "sym_xy", 0) or 0) != 0:
         raise BdfError("SYMXY (ground effect) is not supported")
-    rho_ref = (float(model.aero.rho_ref) * deck.Mu / deck.L**3 if model.aero is not None
-               else None)
-    return 0.5 * float(aero.cref) * deck.L, rho_ref, int(aero.sym_xz or 0) == 1
+    card = "AERO" if model.aero is not None else "AEROS"
+    rho_ref = (_check_range(deck, "AERO RHOREF", model.aero.rho_ref, "fluid density")
+               if model.aero is not None else None)
+    refc = _check_range(deck, f"{card} REFC", aero.cref, "length")
+    return 0.5 * refc, rho_ref, int(aero.sym_xz or 0) == 1
 
 
-def _read_mkaero1(model):
+def _read_mkaero1(model, deck=None):
     """MKAERO1: the Mach numbers and reduced frequencies of the GAF database (all pairs of
     all cards; subsonic only, asekit's doublet lattice).
 
@@ -824,6 +1139,9 @@ def _read_mkaero1(model):
         if mk.type != "MKAERO1":
             raise BdfError(f"{mk.type} is not supported (MKAERO1)")
         pairs += [(float(m), float(k)) for m in mk.machs for k in mk.reduced_freqs]
+    for k in sorted({p[1] for p in pairs}):
+        if deck is not None:
+            _check_range(deck, "MKAERO1 k", k, "reduced frequency")
     machs = tuple(sorted({p[0] for p in pairs}))
     for m in machs:                 # the deck's CAERO1 boxes are run with the doublet lattice
         try:
@@ -841,11 +1159,13 @@ def _read_aero(deck: _Deck) -> dict:
         if model.flutters:
             raise BdfError("FLUTTER without CAERO1 boxes")
         return {}
+    for c in model.caeros.values():
+        _check_caero1(deck, c)
     boxes, box_ids = _boxes(model, deck.L, deck.z0 * deck.L)
     _check_splines(model, box_ids, deck.notes)
     b_ref, rho_ref, symmetric = _read_aero_card(deck)
-    machs, ks = _read_mkaero1(model)
-    flut = [_flutter(model, f, rho_ref, deck.L, deck.Mu, deck.T)
+    machs, ks = _read_mkaero1(model, deck)
+    flut = [_flutter(model, f, rho_ref, deck)
             for f in model.flutters.values()]
     fm = _case_value(model, "FMETHOD")
     flut.sort(key=lambda r: r.sid != fm)          # the case control's FMETHOD first
@@ -917,6 +1237,32 @@ def _caero1_boxes(c, L):
     return box * L, (bid[::-1] if flip else bid).ravel(), ns, nc
 
 
+#: The most boxes one CAERO1 may have (the doublet-lattice matrix of n boxes holds n^2
+#: complex numbers per Mach and k: 10000 boxes are 1.6 GB).
+MAX_BOXES_PER_CAERO1 = 10000
+
+
+def _check_caero1(deck: _Deck, c) -> None:
+    """CAERO1 corners P1, P4 and chords X12, X43 within :data:`RANGES` (chords >= 0, one of
+    them > 0), NSPAN x NCHORD <= :data:`MAX_BOXES_PER_CAERO1`."""
+    if c.type != "CAERO1":
+        return
+    for name, p in (("P1", c.p1), ("P4", c.p4)):
+        for j, x in enumerate(np.asarray(p, float)):
+            _check_range(deck, f"CAERO1 {c.eid} {name} X{j + 1}", x, "coordinate")
+    for name, x in (("X12", c.x12), ("X43", c.x43)):
+        if x != 0.0:
+            _check_range(deck, f"CAERO1 {c.eid} {name}", x, "length")
+    if not (c.x12 > 0 or c.x43 > 0):
+        raise BdfError(f"{deck.name}: CAERO1 {c.eid}: both chords X12 and X43 are zero")
+    ns = c.nspan or (len(c.lspan_ref.fractions) - 1 if c.lspan else 1)
+    nc = c.nchord or (len(c.lchord_ref.fractions) - 1 if c.lchord else 1)
+    if ns * nc > MAX_BOXES_PER_CAERO1:
+        raise BdfError(f"{deck.name}: CAERO1 {c.eid}: NSPAN x NCHORD = {ns} x {nc} = "
+                       f"{ns * nc} boxes, more than {MAX_BOXES_PER_CAERO1} (the doublet-lattice "
+                       f"matrix would need {16 * (ns * nc) ** 2 / 2**30:.3g} GiB per Mach and k)")
+
+
 def _boxes(model, L, z0):
     """Every CAERO1 as one :class:`BoxMesh` (in the structure's plane, z = 0 in asekit) and
     the Nastran box ids."""
@@ -976,7 +1322,7 @@ def _check_splines(model, box_ids, notes):
                      "modes with its finite-element shape functions, not the surface spline")
 
 
-def _flutter(model, f, rho_ref, L, Mu, T) -> FlutterRequest:
+def _flutter(model, f, rho_ref, deck) -> FlutterRequest:
     """A FLUTTER request with its FLFACT lists in SI (densities x RHOREF, |velocities|).
 
     +---------+-----+--------+------+------+-------+-------+-------+------+
@@ -993,12 +1339,16 @@ def _flutter(model, f, rho_ref, L, Mu, T) -> FlutterRequest:
     if rho_ref is None:
         raise BdfError(f"FLUTTER {f.sid} needs AERO (RHOREF)")
 
-    def fl(v):
+    def fl(v, name, kind=None, scale=1.0):
         sid = v if isinstance(v, (int, np.integer)) else v.sid
-        return np.asarray(model.flfacts[int(sid)].factors, float)
-    dens = fl(f.density) * rho_ref
-    mach = fl(f.mach)
-    vel = np.abs(fl(f.reduced_freq_velocity)) * L / T
+        vals = np.asarray(model.flfacts[int(sid)].factors, float) * scale
+        for j, x in enumerate(vals if kind else ()):  # PK: a negative V asks for vectors
+            _check_range(deck, f"FLFACT {sid} (FLUTTER {f.sid} {name}) F{j + 1}", x / scale,
+                         kind, si=abs(x) if kind == "velocity" else x)
+        return vals
+    dens = fl(f.density, "DENS", "fluid density", rho_ref)
+    mach = fl(f.mach, "MACH")                # checked on the MKAERO1 grid (_aero_of)
+    vel = np.abs(fl(f.reduced_freq_velocity, "RFREQ", "velocity", deck.L / deck.T))
     if method == "PKNL" and not len(dens) == len(mach) == len(vel):
         raise BdfError(f"FLUTTER {f.sid} PKNL: FLFACT lists must have equal lengths")
     return FlutterRequest(int(f.sid), method, tuple(map(float, dens)), tuple(map(float, mach)),
@@ -1057,9 +1407,14 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"BDF not found: {path}")
-    model = _open_deck(path, BDF)
+    if not path.is_file():
+        raise BdfError(f"{path}: not a file (give the deck's .bdf file)")
+    model, trace = _open_deck(path, BDF)
     ignored = _check_cards(model, path.name)
-    deck = _Deck(model, path.name, *UNITS[units], wtmass=_read_param_wtmass(model))
+    deck = _Deck(model, path.name, *UNITS[units], wtmass=_read_param_wtmass(model, path.name))
+    if trace.repeats:
+        deck.notes.append(f"{trace.repeats} cards repeated exactly (same id, same fields): "
+                          f"each read once")
     quads = _shell_elements(model, path.name)
     _read_grids(deck, quads, tol)
     conn, th, angles, pids, props = _read_shells(deck, quads)
@@ -1076,13 +1431,13 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
                              shaft_nodes=np.array([], dtype=np.int64), mesh=mesh,
                              label=f"BDF {path.name}: {len(quads)} CQUAD4, {len(deck.nids)} "
                                    f"GRID")
-    n_modes, f_max = _read_eigen_method(model, deck.T)
+    n_modes, f_max = _read_eigen_method(model, deck)
     aero = _read_aero(deck)
     if ignored:
         warnings.warn(f"{path.name}: cards read but not represented by asekit: "
                       f"{_fmt(ignored)}", UnsupportedCardWarning, stacklevel=2)
     return BdfModel(mesh=mesh, node_ids=deck.nids, K=K, M=M, system=system, **aero,
-                    n_modes=n_modes, f_max_hz=f_max, damping_g=_read_tabdmp1(model, deck.T),
+                    n_modes=n_modes, f_max_hz=f_max, damping_g=_read_tabdmp1(model, deck),
                     materials=materials, element_pids=pids.copy(),
                     element_angles=_angles(keys, len(quads)), springs=springs, masses=masses,
                     fixed=tuple(sorted(fixed)), rigid=rigid, ignored=tuple(ignored),
