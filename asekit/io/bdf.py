@@ -259,6 +259,7 @@ class _Deck:
     nodes: np.ndarray | None = None
     z0: float = 0.0
     notes: list = field(default_factory=list)
+    missing: list = field(default_factory=list)
 
     @property
     def n_dof(self) -> int:
@@ -339,10 +340,12 @@ class _CardTrace:
     repeats: int = 0
     mat1: dict = field(default_factory=dict)
 
-    def record(self, card: str, fields: list) -> None:
+    def record(self, card: str, fields: list) -> bool:
+        """Record a card; True for an exact repeat of a card already read (to be dropped);
+        BdfError for a second card with the same id and other fields."""
         space = ID_SPACES.get(card, None)
         if card not in ID_SPACES or space is None or len(fields) < 2:
-            return
+            return False
         key = "-" if card in ("AERO", "AEROS") else _norm_fields(fields[1:2])
         key = key[0] if isinstance(key, tuple) and key else key
         norm = (card, _norm_fields(fields))
@@ -352,10 +355,10 @@ class _CardTrace:
             if card == "MAT1":
                 self.mat1[key] = norm[1]
                 _check_mat1_fields(norm[1])
-            return
+            return False
         if old == norm:
             self.repeats += 1
-            return
+            return True
         what = card if card in ("AERO", "AEROS") else f"{card} {_fmt_id(key)}"
         raise BdfError(f"{self.name}: {what}: a second card with the {space} id of "
                        f"{old[0]} {_fmt_id(key)} and other fields: duplicate ids are errors "
@@ -374,14 +377,20 @@ def _traced_add_card(model, trace: _CardTrace):
 
     def add_card(card_lines, card_name, comment="", ifile=None, is_list=True, has_none=True):
         name = str(card_name).upper()
+        count = model.card_count.get(name)
         try:
             card_obj, _ = model.create_card_object(card_lines, name, is_list=is_list,
                                                    has_none=has_none)
             fields = list(card_obj.card)
+            if count is None:                     # the card is counted once, by orig
+                model.card_count.pop(name, None)
+            else:
+                model.card_count[name] = count
         except Exception as exc:
             raise BdfError(f"{trace.name}: {name} card unreadable: {_first_line(exc)}") from None
         ident = f"{name} {fields[1]}" if len(fields) > 1 and fields[1] is not None else name
-        trace.record(name, fields)
+        if trace.record(name, fields):
+            return card_obj                       # an exact repeat: read once
         try:
             return orig(card_lines, card_name, comment=comment, ifile=ifile, is_list=is_list,
                         has_none=has_none)
@@ -423,10 +432,13 @@ def _xref_message(exc) -> str:
     """pyNastran's cross-reference error in one line (its long id lists cut)."""
     text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
     lines = [ln.strip() for ln in text.strip("'\" \n").splitlines() if ln.strip()]
-    lines = [ln for ln in lines if not ln.startswith(("There are cross-reference errors",
-                                                      "nids=", "allowed", "Allowed"))]
-    msg = (lines[0] if lines else _first_line(exc))
-    return msg.replace("\\n", " ")[:300]
+    hits = [ln for ln in lines if "required by" in ln or "not found" in ln]
+    msg = hits[0] if hits else (lines[0] if lines else type(exc).__name__)
+    msg = msg.split("Error: ", 1)[1] if msg.startswith(("KeyError: ", "CrossReferenceError: ")) \
+        else msg
+    for cut in (". Allowed", "; allowed", "\\n"):
+        msg = msg.split(cut)[0]
+    return msg.strip("'\" ")[:300]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -950,6 +962,14 @@ def _spc_set_ids(deck: _Deck) -> list:
     cc = _case_value(model, "SPC")
     if cc is not None and cc in model.spcs:
         return [cc]
+    adds = (getattr(model, "spcadds", {}) or {}).get(cc) if cc is not None else None
+    if adds:
+        adds = adds if isinstance(adds, list) else [adds]
+        return [s for a in adds for s in getattr(a, "spc_ids", a.sets) if s in model.spcs]
+    if cc is not None:
+        deck.missing.append(f"the case control's SPC = {cc} is not a set of the deck "
+                            f"(SPC sets: {ids or 'none'})")
+        return []
     if len(ids) > 1:
         deck.notes.append(f"several SPC sets {ids} and no SPC = in the case control: all "
                           f"applied")
@@ -1355,6 +1375,153 @@ def _flutter(model, f, rho_ref, deck) -> FlutterRequest:
                           tuple(map(float, vel)))
 
 
+# ---------------------------------------------------------------------------------------------
+# what holds the structure: connectivity and rigid-body modes
+# ---------------------------------------------------------------------------------------------
+def _components_of(n: int, links) -> np.ndarray:
+    """Connected components (a label per node) of ``n`` nodes joined by ``links`` (node index
+    arrays, each joining all its nodes)."""
+    parent = np.arange(n)
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+    for group in links:
+        r0 = root(int(group[0]))
+        for j in group[1:]:
+            r = root(int(j))
+            if r != r0:
+                parent[r] = r0
+    return np.array([root(i) for i in range(n)])
+
+
+def _check_connectivity(deck: _Deck, conn, quads, springs, masses, rigid) -> np.ndarray:
+    """Warn (:class:`BdfWarning`) about GRIDs that no element, spring, mass or rigid link uses
+    (ignored) and about plate elements in pieces that share no grid, rigid link or spring with
+    the largest piece; returns the component label of each node (elements and RBE2 joined)."""
+    n = len(deck.nids)
+    links = [np.unique(c) for c in conn] + [np.array([gi, *dep]) for gi, _, dep in rigid]
+    comp = _components_of(n, links)
+    used = np.zeros(n, bool)
+    used[np.unique(conn)] = True
+    for gi, _, dep in rigid:
+        used[[gi, *dep]] = True
+    for a, b, _ in springs:
+        used[[a // DOF_PER_NODE] + ([b // DOF_PER_NODE] if b >= 0 else [])] = True
+    used[[m[0] for m in masses]] = True
+    idle = deck.nids[~used]
+    if idle.size:
+        off = [int(g) for g in idle if abs(deck.xyz[deck.index[int(g)], 2] - deck.z0)
+               > 1e-6 * max(float(np.ptp(deck.xyz[:, :2])), 1.0)]
+        warnings.warn(f"{deck.name}: GRIDs {idle[:10].tolist()}{'...' if idle.size > 10 else ''}"
+                      f" touch no element, spring, mass or rigid link: ignored"
+                      + (f" (off the plate's plane: {off[:10]})" if off else ""),
+                      BdfWarning, stacklevel=4)
+    joined = _components_of(n, links + [np.array([a // 3, b // 3]) for a, b, _ in springs
+                                        if b >= 0])
+    pieces = joined[conn[:, 0]]
+    labels, counts = np.unique(pieces, return_counts=True)
+    if labels.size > 1:
+        loose = [int(quads[j].eid) for j in np.flatnonzero(pieces != labels[np.argmax(counts)])]
+        warnings.warn(f"{deck.name}: the plate is in {labels.size} pieces that share no grid, "
+                      f"spring or rigid link: elements {loose[:10]}"
+                      f"{'...' if len(loose) > 10 else ''} do not touch the largest piece",
+                      BdfWarning, stacklevel=4)
+    return comp
+
+
+def _rigid_vectors(deck: _Deck, comp: np.ndarray):
+    """The rigid out-of-plane motions of each component (3 per component: w = 1; w = y - y_c,
+    theta_x = 1; w = -(x - x_c), theta_y = 1, lengths scaled by the component's size), as an
+    (n_dof, 3 n_comp) array, and the component of each column."""
+    labels = np.unique(comp[comp >= 0])
+    R = np.zeros((deck.n_dof, 3 * labels.size))
+    for k, lab in enumerate(labels):
+        idx = np.flatnonzero(comp == lab)
+        xy = deck.nodes[idx]
+        c = xy.mean(axis=0)
+        ell = max(float(np.ptp(xy, axis=0).max()), 1e-12 * max(float(np.ptp(deck.nodes)), 1.0))
+        d = DOF_PER_NODE * idx
+        R[d, 3 * k] = 1.0
+        R[d, 3 * k + 1], R[d + 1, 3 * k + 1] = (xy[:, 1] - c[1]) / ell, 1.0 / ell
+        R[d, 3 * k + 2], R[d + 2, 3 * k + 2] = -(xy[:, 0] - c[0]) / ell, 1.0 / ell
+    return R, np.repeat(labels, 3)
+
+
+def _free_rigid_modes(deck: _Deck, comp, fixed: set, Ks, K, M):
+    """The rigid-body modes the supports leave: combinations c of the components' rigid
+    motions R that every constraint allows (R c = 0 on the fixed DOFs; an RBE2 moves
+    rigidly anyway), that no spring resists (c^T R^T K_s R c = 0; the plate elements carry
+    no strain energy in a rigid motion) and that carry mass. Returns (number of modes,
+    component label with the largest share of the first one or None)."""
+    node_mass = np.abs(M).sum(axis=1).A1.reshape(-1, DOF_PER_NODE).sum(axis=1)
+    labels, inv = np.unique(comp, return_inverse=True)
+    heavy = np.bincount(inv, weights=node_mass) > 0
+    comp = np.where(heavy[inv], comp, -1)           # a massless piece has no mode
+    R, col_comp = _rigid_vectors(deck, comp)
+    rows = R[sorted(fixed)] if fixed else np.zeros((0, R.shape[1]))
+    rows = rows[np.abs(rows).max(axis=1) > 0] if rows.size else rows
+    rows = rows / np.abs(rows).max(axis=1, keepdims=True) if rows.size else rows
+    tau = max(float(np.abs(K.diagonal()).max()), 1e-300)
+    E = R.T @ (Ks @ R) / tau
+    w, V = np.linalg.eigh(0.5 * (E + E.T))
+    A = np.vstack([rows, (np.sqrt(np.clip(w, 0.0, None))[:, None] * V.T)])
+    _, s, Vt = np.linalg.svd(A, full_matrices=True) if A.size else (None, np.zeros(0),
+                                                                     np.eye(R.shape[1]))
+    s = np.concatenate([s, np.zeros(R.shape[1] - s.size)])
+    N = Vt[s <= 1e-6].T                                    # the unrestrained combinations
+    if not N.shape[1]:
+        return 0, None
+    G = N.T @ (R.T @ (M @ R)) @ N
+    g, U = np.linalg.eigh(0.5 * (G + G.T))
+    keep = g > 1e-10 * max(float(g.max()), 1e-300)
+    if not keep.any():
+        return 0, None
+    first = N @ U[:, np.flatnonzero(keep)[-1]]
+    return int(keep.sum()), int(col_comp[np.argmax(np.abs(first))])
+
+
+def _suport_dofs(model) -> int:
+    """The number of out-of-plane DOFs (components 3, 4, 5) SUPORT / SUPORT1 declare free."""
+    cards = list(getattr(model, "suport", []) or []) + list(
+        (getattr(model, "suport1", {}) or {}).values())
+    return sum(len(_components(c)) for s in cards for c in getattr(s, "Cs", []))
+
+
+def _holding_words(deck: _Deck, fixed: set, springs) -> str:
+    """What the deck holds the structure with (for the rigid-body error)."""
+    parts = [f"SPC / SPC1 / GRID PS fix {len(fixed)} out-of-plane DOFs" if fixed else
+             "no SPC / SPC1 set applies and no GRID PS holds a T3, R1 or R2 DOF"]
+    grounded = sum(1 for _, b, _ in springs if b < 0)
+    parts.append(f"{grounded} CELAS to ground" if grounded else "no CELAS to ground")
+    parts += deck.missing
+    return "; ".join(parts)
+
+
+def _check_rigid_modes(deck: _Deck, comp, fixed, springs, Ks, K, M) -> None:
+    """Refuse a structure with rigid-body modes (zero strain energy, some mass) the deck does
+    not explain; with as many SUPORT DOFs as modes (a free-free model declared) warn."""
+    n, where = _free_rigid_modes(deck, comp, fixed, Ks, K, M)
+    if not n:
+        return
+    idx = np.flatnonzero(comp == where)
+    grids = [int(g) for g in deck.nids[idx][:8]]
+    piece = ("the whole plate" if idx.size == len(deck.nids)
+             else f"the piece of GRIDs {grids}{'...' if idx.size > 8 else ''}")
+    n_sup = _suport_dofs(deck.model)
+    if n_sup and n <= n_sup:
+        warnings.warn(f"{deck.name}: {n} rigid-body modes (free-free, SUPORT on {n_sup} "
+                      f"DOFs): asekit keeps them as 0 Hz modes among the elastic ones",
+                      BdfWarning, stacklevel=4)
+        return
+    raise BdfError(f"{deck.name}: the structure has {n} rigid-body mode{'s' * (n > 1)} (zero "
+                   f"strain energy; {piece} moves freely): {_holding_words(deck, fixed, springs)}"
+                   f"{f'; SUPORT declares {n_sup}' if n_sup else ''}: add the SPC / SPC1 of "
+                   f"its supports (and SPC = n in the case control) or GRID PS")
+
+
 def _angles(keys, n):
     out = np.zeros(n)
     for (pid, ang), idx in keys.items():
@@ -1426,6 +1593,8 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
     fixed = _read_spcs(deck)
     dep, rigid = _read_rbe2(deck, fixed)
     Tm = _reduction(deck.n_dof, fixed, dep, K, M)
+    comp = _check_connectivity(deck, conn, quads, springs, masses, rigid)
+    _check_rigid_modes(deck, comp, fixed, springs, Ks, K, M)
     system = SupportedSystem(K=(Tm.T @ K @ Tm).tocsr(), M=(Tm.T @ M @ Tm).tocsr(), T=Tm,
                              shaft_index=None, ground_index=None, fictitious_inertia=0.0,
                              shaft_nodes=np.array([], dtype=np.int64), mesh=mesh,
