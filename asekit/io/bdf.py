@@ -66,8 +66,7 @@ from asekit.case.schema import AeroSpec, Case, FlightSpec, ModesSpec, SupportSpe
 from asekit.geometry import Material, OrthotropicMaterial
 from asekit.structure.assembly import SupportedSystem, element_dofs, pitch_inertia
 from asekit.structure.mesh import PlateMesh
-from asekit.structure.plate import (DOF_PER_NODE, consistent_mass, mitc4_stiffness,
-                                    shape_functions)
+from asekit.structure.plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness, shape_functions
 from asekit.structure.supports import planform_edge_supports
 
 #: length, mass and time of one deck unit in SI (m, kg, s).
@@ -414,7 +413,9 @@ def _open_deck(path: Path, BDF):
     trace = _CardTrace(path.name)
     model.add_card = _traced_add_card(model, trace)
     try:
-        model.read_bdf(str(path), punch=punch, xref=False)
+        model.read_bdf(str(path), punch=punch, xref=False, validate=False)
+        _validate_cards(model, path.name)
+        model.validate()                          # the rest of pyNastran's checks
     except BdfError:
         raise
     except Exception as exc:
@@ -426,6 +427,28 @@ def _open_deck(path: Path, BDF):
         raise BdfError(f"{path.name}: a card refers to one the deck does not hold: "
                        f"{_xref_message(exc)}") from None
     return model, trace
+
+
+#: The pyNastran tables whose cards :func:`_validate_cards` checks one by one.
+_VALIDATED = ("nodes", "coords", "elements", "properties", "rigid_elements", "masses",
+              "materials", "caeros", "paeros", "splines", "aefacts", "sets", "aelists",
+              "flfacts", "flutters", "methods", "tables_sdamping", "mkaeros", "spcs")
+
+
+def _validate_cards(model, name: str) -> None:
+    """pyNastran's own card checks (``card.validate()``), card by card, so that a failure
+    names the card and its id."""
+    for attr in _VALIDATED:
+        table = getattr(model, attr, None) or {}
+        cards = table.values() if isinstance(table, dict) else table
+        for c in [x for v in cards for x in (v if isinstance(v, list) else [v])]:
+            try:
+                c.validate()
+            except Exception as exc:
+                ident = next((getattr(c, a) for a in ("eid", "nid", "pid", "mid", "sid", "cid",
+                                                      "tid", "conid") if hasattr(c, a)), "")
+                raise BdfError(f"{name}: {getattr(c, 'type', attr)} {ident}: "
+                               f"{_first_line(exc)}".replace("  ", " ")) from None
 
 
 def _xref_message(exc) -> str:
