@@ -43,6 +43,13 @@ Kirchhoff); ASET1 (Guyan reduction) is ignored, so asekit solves the full model;
 interpolates the modes onto the boxes with its finite-element shape functions, not with the
 deck's SPLINE1/SPLINE4 surface spline.
 
+Checks (issue 22): every pyNastran error is a :class:`BdfError` naming the card, its id and
+field; duplicate ids are errors (:data:`ID_SPACES`); values outside the physical ranges
+:data:`RANGES` (checked in SI) and broken MAT1 rules are refused with the card and field; a
+structure with rigid-body modes its SPC / GRID PS / CELAS do not hold is refused (declared
+free-free by SUPORT: warned); GRIDs and plate pieces that touch nothing are warned about
+(:class:`BdfWarning`).
+
 Units: a BDF has no units. ``units`` names the deck's consistent system and every quantity is
 converted to SI on import: ``"SI"`` (m, kg, s, N), ``"mm-t-s"`` (mm, tonne, s, N) and
 ``"in-lbf-s"`` (in, lbf s^2/in, s, lbf; PARAM WTMASS converts the deck's mass input to it).
@@ -331,13 +338,12 @@ def _first_line(exc: BaseException) -> str:
 @dataclass
 class _CardTrace:
     """The cards pyNastran parses, seen one by one through ``BDF.add_card``: each card's
-    normalised fields by (id space, id), for the duplicate check; the number of identical
-    repeats; the raw fields of every MAT1 (its MAT1 rules need what was given)."""
+    normalised fields by (id space, id), for the duplicate check, and the number of identical
+    repeats; each MAT1 is checked on its fields as given (:func:`_check_mat1_fields`)."""
 
     name: str
     seen: dict = field(default_factory=dict)
     repeats: int = 0
-    mat1: dict = field(default_factory=dict)
 
     def record(self, card: str, fields: list) -> bool:
         """Record a card; True for an exact repeat of a card already read (to be dropped);
@@ -345,14 +351,12 @@ class _CardTrace:
         space = ID_SPACES.get(card, None)
         if card not in ID_SPACES or space is None or len(fields) < 2:
             return False
-        key = "-" if card in ("AERO", "AEROS") else _norm_fields(fields[1:2])
-        key = key[0] if isinstance(key, tuple) and key else key
         norm = (card, _norm_fields(fields))
+        key = "-" if card in ("AERO", "AEROS") else (norm[1][1] if len(norm[1]) > 1 else None)
         old = self.seen.get((space, key))
         if old is None:
             self.seen[(space, key)] = norm
             if card == "MAT1":
-                self.mat1[key] = norm[1]
                 _check_mat1_fields(norm[1])
             return False
         if old == norm:
@@ -388,6 +392,7 @@ def _traced_add_card(model, trace: _CardTrace):
         except Exception as exc:
             raise BdfError(f"{trace.name}: {name} card unreadable: {_first_line(exc)}") from None
         ident = f"{name} {fields[1]}" if len(fields) > 1 and fields[1] is not None else name
+        _check_thru(trace.name, name, fields)
         if trace.record(name, fields):
             return card_obj                       # an exact repeat: read once
         try:
@@ -398,6 +403,22 @@ def _traced_add_card(model, trace: _CardTrace):
         except Exception as exc:
             raise BdfError(f"{trace.name}: {ident}: {_first_line(exc)}") from None
     return add_card
+
+
+#: The most ids a "THRU" range of one card may hold (pyNastran expands every range).
+MAX_THRU_IDS = 10**6
+
+
+def _check_thru(name: str, card: str, fields: list) -> None:
+    """A ``id1 THRU id2`` range of more than :data:`MAX_THRU_IDS` ids is refused before
+    pyNastran expands it (a typo such as 24000000 for 24 would take minutes and gigabytes)."""
+    for j in range(1, len(fields) - 1):
+        if str(fields[j]).strip().upper() == "THRU":
+            lo, hi = _number(fields[j - 1]), _number(fields[j + 1])
+            if lo is not None and hi is not None and hi - lo > MAX_THRU_IDS:
+                raise BdfError(f"{name}: {card} {fields[1]}: {fields[j - 1]} THRU "
+                               f"{fields[j + 1]} (fields {j}-{j + 2}) holds {hi - lo + 1:.0f} "
+                               f"ids, more than {MAX_THRU_IDS}")
 
 
 def _open_deck(path: Path, BDF):
@@ -647,18 +668,19 @@ def _check_shell_ranges(deck: _Deck, quads, th, props) -> None:
 
 
 def _check_element_shapes(deck: _Deck, quads, conn) -> None:
-    """Every element's Jacobian positive at its 2 x 2 Gauss points (after :func:`_orient`): a
-    degenerate (collinear, coincident grids) or non-convex quadrilateral is refused by id."""
+    """Every element's Jacobian positive inside it (after :func:`_orient`): det J of the
+    bilinear map is affine in r and s, so it is > 0 everywhere inside iff it is >= 0 at the
+    four corners and > 0 at the centre (a CTRIA3, G3 repeated, has det J = 0 at that corner).
+    A degenerate (collinear, coincident grids) or non-convex element is refused by id."""
     xy = deck.nodes[conn]
-    g = 1.0 / math.sqrt(3.0)
-    worst = np.full(len(conn), np.inf)
-    for r, s in ((-g, -g), (g, -g), (g, g), (-g, g)):
+    tol = 1e-12 * max(float(np.ptp(deck.nodes, axis=0).max()), 1e-300) ** 2
+
+    def det(r, s):
         _, dNr, dNs = shape_functions(r, s)
         J = np.stack([dNr @ xy, dNs @ xy], axis=1)
-        worst = np.minimum(worst, J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0])
-    area = np.abs(worst) + 1e-300
-    scale = np.ptp(deck.nodes, axis=0).max() ** 2
-    bad = np.flatnonzero(~(worst > 1e-12 * scale) | ~np.isfinite(area))
+        return J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
+    corners = np.min([det(r, s) for r, s in ((-1, -1), (1, -1), (1, 1), (-1, 1))], axis=0)
+    bad = np.flatnonzero(~((corners >= -tol) & (det(0.0, 0.0) > tol)))
     if bad.size:
         e = quads[int(bad[0])]
         raise BdfError(f"{deck.name}: {e.type} {e.eid} (grids {list(e.node_ids)}) is degenerate "
@@ -1010,6 +1032,9 @@ def _read_spc_card(deck: _Deck, sid: int, c) -> set:
     | SPC  | SID | G1 | C1 |  D1  | G2 | C2 | D2 |
     +------+-----+----+----+------+----+----+----+
     """
+    if any(nid in (None, 0) for nid in c.node_ids):
+        raise BdfError(f"{deck.name}: {c.type} {sid}: a grid id is 0 or blank "
+                       f"(grids {list(c.node_ids)[:10]}): each G must be a GRID id > 0")
     if c.type == "SPC1":
         return {deck.dof(nid, k) for nid in c.node_ids for k in _components(c.components)}
     if c.type != "SPC":
@@ -1587,9 +1612,17 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
     Returns
     -------
     BdfModel
-        Raises :class:`BdfError` (a ValueError) for a deck asekit cannot represent (refused
-        cards listed); warns :class:`UnsupportedCardWarning` once, listing every card read
-        but not represented (name, count, first id).
+        Raises :class:`BdfError` (a ValueError, one line) for a deck asekit cannot represent
+        (refused cards listed) or that is wrong: any error of pyNastran's (the card, its id
+        and the field in pyNastran's words; a reference to a missing card names the card
+        that refers), a second card with an id already given (:data:`ID_SPACES`; an exact
+        repeat is read once), a value outside :data:`RANGES` (card, id, field, value in
+        deck and SI units), the MAT1 rules broken, a degenerate element, or rigid-body
+        modes that no SPC / SPC1 / GRID PS / CELAS holds (the missing support named; with
+        as many SUPORT DOFs it is a :class:`BdfWarning`). Warns :class:`BdfWarning` for
+        GRIDs that touch nothing and for plate pieces that touch nothing else, and
+        :class:`UnsupportedCardWarning` once, listing every card read but not represented
+        (name, count, first id).
     """
     if units not in UNITS:
         raise ValueError(f"units must be one of {sorted(UNITS)}, got {units!r}")

@@ -121,7 +121,7 @@ def mutate(rng: random.Random, cards: list[list[str]]) -> tuple[list[list[str]],
     return cards, f"{kind} {name}"
 
 
-def outcome(path: Path, timeout: float) -> tuple[str, str]:
+def outcome(path: Path, timeout: float, units: str = "in-lbf-s") -> tuple[str, str]:
     """(class, detail) of reading ``path`` and computing its modes."""
     from asekit.case import pipeline
     from asekit.io import bdf
@@ -129,7 +129,7 @@ def outcome(path: Path, timeout: float) -> tuple[str, str]:
     try:
         with warnings.catch_warnings(record=True) as rec:
             warnings.simplefilter("always")
-            case = bdf.read_bdf(path, units="in-lbf-s")
+            case = bdf.read_bdf(path, units=units)
             pipeline.modal_model(case)
         mine = [w for w in rec if not issubclass(w.category, bdf.UnsupportedCardWarning)
                 and w.category.__module__.startswith("asekit")]
@@ -145,10 +145,11 @@ def outcome(path: Path, timeout: float) -> tuple[str, str]:
         signal.setitimer(signal.ITIMER_REAL, 0)
 
 
-def run(decks: int, seed: int, timeout: float, show: int) -> Counter:
+def run(decks: int, seed: int, timeout: float, show: int, deck: Path = DECK,
+        units: str = "in-lbf-s") -> Counter:
     import contextlib
     import io
-    head, cards, tail = split_cards(inlined_deck())
+    head, cards, tail = split_cards(inlined_deck(Path(deck)))
     seen: Counter = Counter()
     samples: dict[str, list] = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -161,14 +162,14 @@ def run(decks: int, seed: int, timeout: float, show: int) -> Counter:
                 what.append(w)
             path.write_text("\n".join(head + [ln for c in mutated for ln in c] + tail) + "\n")
             with contextlib.redirect_stdout(io.StringIO()):   # pyNastran prints its errors
-                kind, detail = outcome(path, timeout)
+                kind, detail = outcome(path, timeout, units)
             seen[kind] += 1
             if kind not in ("ok", "BdfError") or len(samples.get(kind, [])) < 1:
                 if len(samples.setdefault(kind, [])) < show:
                     samples[kind].append(f"deck {n} ({', '.join(what)}): {detail}")
     order = ["ok", "ok+warning", "BdfError"]
     keys = order + sorted(k for k in seen if k not in order)
-    print(f"{decks} mutated decks (seed {seed}):")
+    print(f"{decks} mutated decks of {Path(deck).name} (seed {seed}):")
     for k in keys:
         print(f"  {k:24s}{seen.get(k, 0):6d}")
     print("samples:")
@@ -184,11 +185,13 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=22)
     ap.add_argument("--timeout", type=float, default=20.0)
     ap.add_argument("--show", type=int, default=3, help="samples printed per class")
+    ap.add_argument("--deck", type=Path, default=DECK, help="the deck mutated (default HA145E)")
+    ap.add_argument("--units", default="in-lbf-s", help="its units (read_bdf's units)")
     args = ap.parse_args(argv)
     import asekit.case.pipeline  # noqa: F401  (imported before any alarm)
     import asekit.io.bdf  # noqa: F401
     signal.signal(signal.SIGALRM, _alarm)
-    run(args.decks, args.seed, args.timeout, args.show)
+    run(args.decks, args.seed, args.timeout, args.show, args.deck, args.units)
     return 0
 
 
