@@ -73,6 +73,7 @@ from asekit.case.schema import AeroSpec, Case, FlightSpec, ModesSpec, SupportSpe
 from asekit.geometry import Material, OrthotropicMaterial
 from asekit.structure.assembly import SupportedSystem, element_dofs, pitch_inertia
 from asekit.structure.mesh import PlateMesh
+from asekit.structure.modes import MIN_OUT_OF_PLANE
 from asekit.structure.plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness, shape_functions
 from asekit.structure.supports import planform_edge_supports
 
@@ -1481,16 +1482,17 @@ def _check_connectivity(deck: _Deck, conn, quads, springs, masses, rigid) -> np.
 
 
 def _rigid_vectors(deck: _Deck, comp: np.ndarray):
-    """The rigid out-of-plane motions of each component (3 per component: w = 1; w = y - y_c,
-    theta_x = 1; w = -(x - x_c), theta_y = 1, lengths scaled by the component's size), as an
-    (n_dof, 3 n_comp) array, and the component of each column."""
+    """The rigid out-of-plane motions of each component with a label >= 0 (3 per component:
+    w = 1; w = y - y_c, theta_x = 1; w = -(x - x_c), theta_y = 1, lengths in units of the
+    model's size, so that every column has entries of order 1), as an (n_dof, 3 n_comp)
+    array, and the component of each column."""
     labels = np.unique(comp[comp >= 0])
     R = np.zeros((deck.n_dof, 3 * labels.size))
+    ell = max(float(np.ptp(deck.nodes, axis=0).max()), 1e-300)
     for k, lab in enumerate(labels):
         idx = np.flatnonzero(comp == lab)
         xy = deck.nodes[idx]
         c = xy.mean(axis=0)
-        ell = max(float(np.ptp(xy, axis=0).max()), 1e-12 * max(float(np.ptp(deck.nodes)), 1.0))
         d = DOF_PER_NODE * idx
         R[d, 3 * k] = 1.0
         R[d, 3 * k + 1], R[d + 1, 3 * k + 1] = (xy[:, 1] - c[1]) / ell, 1.0 / ell
@@ -1498,37 +1500,53 @@ def _rigid_vectors(deck: _Deck, comp: np.ndarray):
     return R, np.repeat(labels, 3)
 
 
+def _unrestrained(R, fixed: set, Ks, K) -> np.ndarray:
+    """Basis (columns) of the combinations c of the rigid motions R that every constraint
+    allows (R c = 0 on the fixed DOFs; an RBE2 moves rigidly anyway) and that no spring
+    resists (c^T R^T K_s R c = 0; plate elements carry no strain energy in a rigid motion)."""
+    rows = R[sorted(fixed)] if fixed else np.zeros((0, R.shape[1]))
+    rows = rows[np.abs(rows).max(axis=1) > 0] if rows.size else rows
+    rows = rows / np.abs(rows).max(axis=1, keepdims=True) if rows.size else rows
+    tau = max(float(np.abs(K.diagonal()).max()), 1e-300)
+    w, V = np.linalg.eigh(0.5 * (R.T @ (Ks @ R) + (R.T @ (Ks @ R)).T) / tau)
+    A = np.vstack([rows, np.sqrt(np.clip(w, 0.0, None))[:, None] * V.T])
+    if not A.size:
+        return np.eye(R.shape[1])
+    _, s, Vt = np.linalg.svd(A, full_matrices=True)
+    s = np.concatenate([s, np.zeros(R.shape[1] - s.size)])
+    return Vt[s <= 1e-6].T
+
+
 def _free_rigid_modes(deck: _Deck, comp, fixed: set, Ks, K, M):
-    """The rigid-body modes the supports leave: combinations c of the components' rigid
-    motions R that every constraint allows (R c = 0 on the fixed DOFs; an RBE2 moves
-    rigidly anyway), that no spring resists (c^T R^T K_s R c = 0; the plate elements carry
-    no strain energy in a rigid motion) and that carry mass. Returns (number of modes,
-    component label with the largest share of the first one or None)."""
+    """The rigid-body modes the supports leave: the unrestrained rigid motions
+    (:func:`_unrestrained`) that carry mass, split as the mode selection of the pipeline
+    does (:data:`asekit.structure.modes.MIN_OUT_OF_PLANE`): those with an out-of-plane (w)
+    kinetic-energy share of at least that reach the analysis as 0 Hz modes; the others (the
+    fictitious pitch inertia of an FN2 export: a grounded grid's R2 inertia) are dropped by
+    it. Returns (modes kept, modes dropped, component with the largest share of the first
+    kept one or None)."""
     node_mass = np.abs(M).sum(axis=1).A1.reshape(-1, DOF_PER_NODE).sum(axis=1)
     labels, inv = np.unique(comp, return_inverse=True)
     heavy = np.bincount(inv, weights=node_mass) > 0
     comp = np.where(heavy[inv], comp, -1)           # a massless piece has no mode
     R, col_comp = _rigid_vectors(deck, comp)
-    rows = R[sorted(fixed)] if fixed else np.zeros((0, R.shape[1]))
-    rows = rows[np.abs(rows).max(axis=1) > 0] if rows.size else rows
-    rows = rows / np.abs(rows).max(axis=1, keepdims=True) if rows.size else rows
-    tau = max(float(np.abs(K.diagonal()).max()), 1e-300)
-    E = R.T @ (Ks @ R) / tau
-    w, V = np.linalg.eigh(0.5 * (E + E.T))
-    A = np.vstack([rows, (np.sqrt(np.clip(w, 0.0, None))[:, None] * V.T)])
-    _, s, Vt = np.linalg.svd(A, full_matrices=True) if A.size else (None, np.zeros(0),
-                                                                     np.eye(R.shape[1]))
-    s = np.concatenate([s, np.zeros(R.shape[1] - s.size)])
-    N = Vt[s <= 1e-6].T                                    # the unrestrained combinations
+    N = _unrestrained(R, fixed, Ks, K)
     if not N.shape[1]:
-        return 0, None
-    G = N.T @ (R.T @ (M @ R)) @ N
-    g, U = np.linalg.eigh(0.5 * (G + G.T))
-    keep = g > 1e-10 * max(float(g.max()), 1e-300)
-    if not keep.any():
-        return 0, None
-    first = N @ U[:, np.flatnonzero(keep)[-1]]
-    return int(keep.sum()), int(col_comp[np.argmax(np.abs(first))])
+        return 0, 0, None
+    U = R @ N
+    MU = M @ U
+    b, Vb = np.linalg.eigh(0.5 * (U.T @ MU + MU.T @ U))
+    massive = b > 1e-10 * max(float(b.max()), 1e-300)
+    if not massive.any():
+        return 0, 0, None
+    W = Vb[:, massive] / np.sqrt(b[massive])          # M-orthonormal unrestrained motions
+    Aw = (U @ W)[0::DOF_PER_NODE].T @ (MU @ W)[0::DOF_PER_NODE]
+    share, S = np.linalg.eigh(0.5 * (Aw + Aw.T))
+    kept = share >= MIN_OUT_OF_PLANE
+    if not kept.any():
+        return 0, int(massive.sum()), None
+    first = N @ (W @ S[:, np.flatnonzero(kept)[-1]])
+    return int(kept.sum()), int((~kept).sum()), int(col_comp[np.argmax(np.abs(first))])
 
 
 def _suport_dofs(model) -> int:
@@ -1551,7 +1569,11 @@ def _holding_words(deck: _Deck, fixed: set, springs) -> str:
 def _check_rigid_modes(deck: _Deck, comp, fixed, springs, Ks, K, M) -> None:
     """Refuse a structure with rigid-body modes (zero strain energy, some mass) the deck does
     not explain; with as many SUPORT DOFs as modes (a free-free model declared) warn."""
-    n, where = _free_rigid_modes(deck, comp, fixed, Ks, K, M)
+    n, dropped, where = _free_rigid_modes(deck, comp, fixed, Ks, K, M)
+    if dropped:
+        deck.notes.append(f"{dropped} zero-frequency mode{'s' * (dropped > 1)} with less than "
+                          f"{MIN_OUT_OF_PLANE:.0%} of its kinetic energy out of plane (e.g. an "
+                          f"FN2 fictitious pitch inertia): left out by the mode selection")
     if not n:
         return
     idx = np.flatnonzero(comp == where)

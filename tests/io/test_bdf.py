@@ -503,6 +503,21 @@ def test_a_single_clamped_point_or_a_grounded_spring_holds_the_plate(tmp_path):
               units="in-lbf-s")
 
 
+def test_fn2_fictitious_pitch_inertia_is_noted_not_refused(fin, tmp_path):
+    """The fin's FN2 export holds a zero-frequency rigid pitch: the plate turning with the
+    ground GRID that carries the fictitious inertia (CONM2 I22) through the torsion spring.
+    Nearly all its kinetic energy is that inertia's rotation, so the mode selection leaves it
+    out (as the case's own pipeline does): a note, no error; the FN1 variant (spring to
+    ground) has no such mode."""
+    notes = _read(B.write_case_bdf(fin, tmp_path / "fn2.bdf")).structure.deck.notes
+    assert any(n.startswith("1 zero-frequency mode with less than 1%") for n in notes)
+    fn1 = _variant(DATA_DIR / "cases" / "nalci2013_fin.toml",
+                   support={"kind": "shaft", "axis_point": [0.078, 0.0],
+                            "torsional_stiffness": 120.0, "model": "FN1"})
+    notes = _read(B.write_case_bdf(fn1, tmp_path / "fn1.bdf")).structure.deck.notes
+    assert not any("zero-frequency" in n for n in notes)
+
+
 def test_free_mass_and_loose_plate_piece_are_refused_or_warned(tmp_path):
     """A CONM2 on a grid that no element, spring or rigid link touches is a free mass (a 0 Hz
     mode): refused, naming the grid. A second plate piece sharing nothing with the wing is
