@@ -364,7 +364,7 @@ class _CardTrace:
             self.repeats += 1
             return True
         what = card if card in ("AERO", "AEROS") else f"{card} {_fmt_id(key)}"
-        raise BdfError(f"{self.name}: {what}: a second card with the {space} id of "
+        raise BdfError(f"{what}: a second card with the {space} id of "
                        f"{old[0]} {_fmt_id(key)} and other fields: duplicate ids are errors "
                        f"(give each card its own id)")
 
@@ -391,7 +391,7 @@ def _traced_add_card(model, trace: _CardTrace):
             else:
                 model.card_count[name] = count
         except Exception as exc:
-            raise BdfError(f"{trace.name}: {name} card unreadable: {_first_line(exc)}") from None
+            raise BdfError(f"{name} card unreadable: {_first_line(exc)}") from None
         ident = f"{name} {fields[1]}" if len(fields) > 1 and fields[1] is not None else name
         _check_thru(trace.name, name, fields)
         if trace.record(name, fields):
@@ -402,8 +402,18 @@ def _traced_add_card(model, trace: _CardTrace):
         except BdfError:
             raise
         except Exception as exc:
-            raise BdfError(f"{trace.name}: {ident}: {_first_line(exc)}") from None
+            raise BdfError(f"{ident}{_include_of(model, ifile, trace.name)}: "
+                           f"{_first_line(exc)}") from None
     return add_card
+
+
+def _include_of(model, ifile, main: str) -> str:
+    """`` (in NAME)`` when card ``ifile`` of pyNastran comes from an INCLUDE file."""
+    try:
+        name = Path(model.active_filenames[ifile]).name
+    except (AttributeError, IndexError, TypeError):
+        return ""
+    return "" if name == main else f" (in {name})"
 
 
 #: The most ids a "THRU" range of one card may hold (pyNastran expands every range).
@@ -417,7 +427,7 @@ def _check_thru(name: str, card: str, fields: list) -> None:
         if str(fields[j]).strip().upper() == "THRU":
             lo, hi = _number(fields[j - 1]), _number(fields[j + 1])
             if lo is not None and hi is not None and hi - lo > MAX_THRU_IDS:
-                raise BdfError(f"{name}: {card} {fields[1]}: {fields[j - 1]} THRU "
+                raise BdfError(f"{card} {fields[1]}: {fields[j - 1]} THRU "
                                f"{fields[j + 1]} (fields {j}-{j + 2}) holds {hi - lo + 1:.0f} "
                                f"ids, more than {MAX_THRU_IDS}")
 
@@ -441,12 +451,12 @@ def _open_deck(path: Path, BDF):
     except BdfError:
         raise
     except Exception as exc:
-        raise BdfError(f"{path.name}: pyNastran cannot read the deck "
+        raise BdfError(f"pyNastran cannot read the deck "
                        f"({type(exc).__name__}: {_first_line(exc)})") from None
     try:
         model.cross_reference()
     except Exception as exc:
-        raise BdfError(f"{path.name}: a card refers to one the deck does not hold: "
+        raise BdfError(f"a card refers to one the deck does not hold: "
                        f"{_xref_message(exc)}") from None
     return model, trace
 
@@ -469,7 +479,7 @@ def _validate_cards(model, name: str) -> None:
             except Exception as exc:
                 ident = next((getattr(c, a) for a in ("eid", "nid", "pid", "mid", "sid", "cid",
                                                       "tid", "conid") if hasattr(c, a)), "")
-                raise BdfError(f"{name}: {getattr(c, 'type', attr)} {ident}: "
+                raise BdfError(f"{getattr(c, 'type', attr)} {ident}: "
                                f"{_first_line(exc)}".replace("  ", " ")) from None
 
 
@@ -530,7 +540,7 @@ def _check_range(deck, what: str, value, kind: str, si: float | None = None) -> 
     if not (math.isfinite(s) and (s > lo or (lo_ok and s == lo)) and s <= hi):
         shown = f"{v:g}" + ("" if si is None and _si_factor(deck, kind) == 1.0
                             else f" (= {s:g} {unit})")
-        raise BdfError(f"{deck.name}: {what} = {shown} is outside the physical range "
+        raise BdfError(f"{what} = {shown} is outside the physical range "
                        f"{lo:g} {'<=' if lo_ok else '<'} {kind} <= {hi:g} {unit}".rstrip())
     return s
 
@@ -581,7 +591,7 @@ def _read_param_wtmass(model, name: str = "") -> float:
         return 1.0
     v = _number(wt.values[0] if wt.values else None)
     if v is None or not (math.isfinite(v) and 0.0 < v < 1.0e30):
-        raise BdfError(f"{name}: PARAM WTMASS = {wt.values[0] if wt.values else None} must be "
+        raise BdfError(f"PARAM WTMASS = {wt.values[0] if wt.values else None} must be "
                        f"a number > 0 (the deck's mass input x WTMASS = its mass unit)")
     return v
 
@@ -662,7 +672,7 @@ def _check_shell_ranges(deck: _Deck, quads, th, props) -> None:
                            & (th.max(axis=1) * deck.L <= RANGES["thickness"][1])))
     if bad.size:
         e = quads[int(bad[0])]
-        raise BdfError(f"{deck.name}: {e.type} {e.eid}: corner thicknesses T1-T4 = "
+        raise BdfError(f"{e.type} {e.eid}: corner thicknesses T1-T4 = "
                        f"{[float(v) for v in th[bad[0]]]} (with PSHELL {e.pid} T for blanks): "
                        f"each must be >= 0, the largest > 0 and <= "
                        f"{RANGES['thickness'][1] / deck.L:g} (10 m)")
@@ -684,7 +694,7 @@ def _check_element_shapes(deck: _Deck, quads, conn) -> None:
     bad = np.flatnonzero(~((corners >= -tol) & (det(0.0, 0.0) > tol)))
     if bad.size:
         e = quads[int(bad[0])]
-        raise BdfError(f"{deck.name}: {e.type} {e.eid} (grids {list(e.node_ids)}) is degenerate "
+        raise BdfError(f"{e.type} {e.eid} (grids {list(e.node_ids)}) is degenerate "
                        f"or not convex in the plate's plane (Jacobian <= 0): its grids must "
                        f"make a convex polygon of non-zero area")
 
@@ -990,7 +1000,7 @@ def _conm2_values(deck: _Deck, m):
     for j, n in ((0, "I11"), (2, "I22")):
         _check_range(deck, f"{what} {n}", I[j], "inertia", si=I[j])
     if not I[1] ** 2 <= I[0] * I[2] * (1 + 1e-12):
-        raise BdfError(f"{deck.name}: {what}: I21^2 > I11 I22 (I11, I21, I22 = "
+        raise BdfError(f"{what}: I21^2 > I11 I22 (I11, I21, I22 = "
                        f"{list(map(float, np.asarray(m.I)[:3]))}): not a positive inertia")
     return mass, X * deck.L, I
 
@@ -1034,7 +1044,7 @@ def _read_spc_card(deck: _Deck, sid: int, c) -> set:
     +------+-----+----+----+------+----+----+----+
     """
     if any(nid in (None, 0) for nid in c.node_ids):
-        raise BdfError(f"{deck.name}: {c.type} {sid}: a grid id is 0 or blank "
+        raise BdfError(f"{c.type} {sid}: a grid id is 0 or blank "
                        f"(grids {list(c.node_ids)[:10]}): each G must be a GRID id > 0")
     if c.type == "SPC1":
         return {deck.dof(nid, k) for nid in c.node_ids for k in _components(c.components)}
@@ -1133,7 +1143,7 @@ def _read_eigen_method(model, deck: _Deck):
     nd = getattr(mth, "nd", None)
     v2 = getattr(mth, "v2", None) if mth.type == "EIGRL" else getattr(mth, "f2", None)
     if nd is not None and not 1 <= nd <= 100000:
-        raise BdfError(f"{deck.name}: {mth.type} {mth.sid} ND = {nd} must be an integer "
+        raise BdfError(f"{mth.type} {mth.sid} ND = {nd} must be an integer "
                        f"1 <= ND <= 100000 (the number of modes)")
     if v2 is not None:
         _check_range(deck, f"{mth.type} {mth.sid} {'V2' if mth.type == 'EIGRL' else 'F2'}",
@@ -1323,11 +1333,11 @@ def _check_caero1(deck: _Deck, c) -> None:
         if x != 0.0:
             _check_range(deck, f"CAERO1 {c.eid} {name}", x, "length")
     if not (c.x12 > 0 or c.x43 > 0):
-        raise BdfError(f"{deck.name}: CAERO1 {c.eid}: both chords X12 and X43 are zero")
+        raise BdfError(f"CAERO1 {c.eid}: both chords X12 and X43 are zero")
     ns = c.nspan or (len(c.lspan_ref.fractions) - 1 if c.lspan else 1)
     nc = c.nchord or (len(c.lchord_ref.fractions) - 1 if c.lchord else 1)
     if ns * nc > MAX_BOXES_PER_CAERO1:
-        raise BdfError(f"{deck.name}: CAERO1 {c.eid}: NSPAN x NCHORD = {ns} x {nc} = "
+        raise BdfError(f"CAERO1 {c.eid}: NSPAN x NCHORD = {ns} x {nc} = "
                        f"{ns * nc} boxes, more than {MAX_BOXES_PER_CAERO1} (the doublet-lattice "
                        f"matrix would need {16 * (ns * nc) ** 2 / 2**30:.3g} GiB per Mach and k)")
 
@@ -1586,7 +1596,7 @@ def _check_rigid_modes(deck: _Deck, comp, fixed, springs, Ks, K, M) -> None:
                       f"DOFs): asekit keeps them as 0 Hz modes among the elastic ones",
                       BdfWarning, stacklevel=4)
         return
-    raise BdfError(f"{deck.name}: the structure has {n} rigid-body mode{'s' * (n > 1)} (zero "
+    raise BdfError(f"the structure has {n} rigid-body mode{'s' * (n > 1)} (zero "
                    f"strain energy; {piece} moves freely): {_holding_words(deck, fixed, springs)}"
                    f"{f'; SUPORT declares {n_sup}' if n_sup else ''}: add the SPC / SPC1 of "
                    f"its supports (and SPC = n in the case control) or GRID PS")

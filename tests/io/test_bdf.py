@@ -528,7 +528,8 @@ def test_free_mass_and_loose_plate_piece_are_refused_or_warned(tmp_path):
     piece = [_card("GRID", 101 + i, None, x, y, 0.0)
              for i, (x, y) in enumerate([(10.0, 0.0), (11.0, 0.0), (11.0, 1.0), (10.0, 1.0)])]
     piece.append(_card("CQUAD4", 200, 1, 101, 102, 103, 104))
-    with pytest.raises(B.BdfError, match=r"3 rigid-body modes .*GRIDs \[101, 102, 103, 104\]"):
+    with pytest.raises(B.BdfError, match=r"3 rigid-body modes .*GRIDs \[101, 102, 103, 104\]"), \
+            pytest.warns(B.BdfWarning, match="2 pieces"):
         _read(_ha145e_deck(tmp_path, add=piece, name="p.bdf"), units="in-lbf-s")
     held = piece + [_card("SPC1", 1, 345, 101, 102)]
     with pytest.warns(B.BdfWarning, match=r"2 pieces .*elements \[200\]"):
@@ -671,12 +672,20 @@ def test_pynastran_errors_are_bdf_errors_naming_the_card(tmp_path, old, new, mat
         _read(_ha145e_deck(tmp_path, replace=[(old, new)]), units="in-lbf-s")
 
 
-def test_a_directory_or_unreadable_deck_is_a_bdf_error(tmp_path):
+def test_a_directory_a_missing_include_and_an_included_card_are_named(tmp_path):
+    """A directory, a missing INCLUDE and a bad card of an INCLUDE file are BdfErrors naming
+    them (the CLI puts the deck's name in front)."""
     with pytest.raises(B.BdfError, match="not a file"):
         B.read_bdf(tmp_path)
     p = tmp_path / "bad.bdf"
     p.write_text("BEGIN BULK\nINCLUDE 'missing.bdf'\nENDDATA\n")
-    with pytest.raises(B.BdfError, match="bad.bdf"):
+    with pytest.raises(B.BdfError, match="missing.bdf"):
+        B.read_bdf(p)
+    s = (HA145E / "ha145e_structure.bdf").read_text().replace("CQUAD4  9       1",
+                                                              "CQUAD4  9.0     1")
+    (tmp_path / "s.bdf").write_text(s)
+    p.write_text((HA145E / "ha145e.bdf").read_text().replace("ha145e_structure.bdf", "s.bdf"))
+    with pytest.raises(B.BdfError, match=r"^CQUAD4 9.0 \(in s.bdf\): eid .*field #1"):
         B.read_bdf(p)
 
 
