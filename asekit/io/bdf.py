@@ -432,6 +432,18 @@ def _check_thru(name: str, card: str, fields: list) -> None:
                                f"ids, more than {MAX_THRU_IDS}")
 
 
+def _check_includes(path: Path, text: str) -> None:
+    """Every one-line ``INCLUDE 'file'`` of the deck names a file (relative to the deck's
+    folder), checked before pyNastran (which would leave a pyNastran_crash.bdf behind)."""
+    for n, line in enumerate(text.splitlines(), 1):
+        head = line.split("$")[0].strip()
+        if not head.upper().startswith("INCLUDE") or head.count("'") != 2:
+            continue
+        name = head.split("'")[1]
+        if not (path.parent / name).expanduser().is_file():
+            raise BdfError(f"line {n}: INCLUDE '{name}': no such file (in {path.parent})")
+
+
 def _open_deck(path: Path, BDF):
     """The pyNastran model of ``path`` (cross-referenced; a file without BEGIN BULK is read as
     bulk data only) and its :class:`_CardTrace`. Every pyNastran error is a
@@ -439,9 +451,11 @@ def _open_deck(path: Path, BDF):
     field; a reference to a missing card names the card that refers; otherwise the file."""
     model = BDF(debug=None)
     try:
-        punch = "BEGIN BULK" not in path.read_text(errors="replace").upper()
+        text = path.read_text(errors="replace")
     except OSError as exc:
         raise BdfError(f"{path}: cannot read the deck ({exc.strerror or exc})") from None
+    punch = "BEGIN BULK" not in text.upper()
+    _check_includes(path, text)
     trace = _CardTrace(path.name)
     model.add_card = _traced_add_card(model, trace)
     try:
