@@ -819,6 +819,7 @@ def _read_mat1(mat, deck: _Deck, pid: int) -> Material:
                        f"E / (2 (1 + NU)) = {E / (2 * (1 + nu)):g}: asekit's isotropic "
                        f"material takes E and NU (give two of the three)")
     what = f"MAT1 {mat.mid} (PSHELL {pid})"
+    _check_range(deck, f"{what} G", G, "modulus")
     return Material(_check_range(deck, f"{what} E", E, "modulus"), nu,
                     _check_range(deck, f"{what} RHO", mat.rho or 0.0, "density"),
                     name=f"MAT1 {mat.mid}")
@@ -947,9 +948,10 @@ def _read_celas(deck: _Deck):
         (a, b), rot, lost = _celas_dofs(deck, e)
         if lost:
             dropped.append(e.eid)
+        k_deck = k
         k *= deck.Mu * deck.L**2 / deck.T**2 if rot else deck.Mu / deck.T**2
         _check_range(deck, f"{e.type} {e.eid} K" if e.type == "CELAS2" else
-                     f"PELAS {e.pid} K (CELAS1 {e.eid})", k, "spring", si=k)
+                     f"PELAS {e.pid} K (CELAS1 {e.eid})", k_deck, "spring", si=k)
         if a is None:
             a, b = b, None
         if a is None:
