@@ -819,8 +819,9 @@ def _read_mat1(mat, deck: _Deck, pid: int) -> Material:
                        f"E / (2 (1 + NU)) = {E / (2 * (1 + nu)):g}: asekit's isotropic "
                        f"material takes E and NU (give two of the three)")
     what = f"MAT1 {mat.mid} (PSHELL {pid})"
+    E_si = _check_range(deck, f"{what} E", E, "modulus")
     _check_range(deck, f"{what} G", G, "modulus")
-    return Material(_check_range(deck, f"{what} E", E, "modulus"), nu,
+    return Material(E_si, nu,
                     _check_range(deck, f"{what} RHO", mat.rho or 0.0, "density"),
                     name=f"MAT1 {mat.mid}")
 
