@@ -279,7 +279,7 @@ class _Deck:
 
 #: Cards whose ids share one name space (Nastran: an element id is unique over all elements,
 #: CONM2 and rigid elements included); a second card with an id already given is an error
-#: unless it repeats the first exactly (an identical repeat is dropped, as Nastran does).
+#: unless it repeats the first exactly (an identical repeat is read once, with a note).
 #: SPC / SPC1 (sets of several cards) and MKAERO1 (no id) are not listed.
 ID_SPACES = {"GRID": "GRID", "CQUAD4": "element", "CTRIA3": "element", "CELAS1": "element",
              "CELAS2": "element", "CONM2": "element", "RBE2": "element",
