@@ -43,6 +43,13 @@ Kirchhoff); ASET1 (Guyan reduction) is ignored, so asekit solves the full model;
 interpolates the modes onto the boxes with its finite-element shape functions, not with the
 deck's SPLINE1/SPLINE4 surface spline.
 
+Checks (issue 22): every pyNastran error is a :class:`BdfError` naming the card, its id and
+field; duplicate ids are errors (:data:`ID_SPACES`); values outside the physical ranges
+:data:`RANGES` (checked in SI) and broken MAT1 rules are refused with the card and field; a
+structure with rigid-body modes its SPC / GRID PS / CELAS do not hold is refused (declared
+free-free by SUPORT: warned); GRIDs and plate pieces that touch nothing are warned about
+(:class:`BdfWarning`).
+
 Units: a BDF has no units. ``units`` names the deck's consistent system and every quantity is
 converted to SI on import: ``"SI"`` (m, kg, s, N), ``"mm-t-s"`` (mm, tonne, s, N) and
 ``"in-lbf-s"`` (in, lbf s^2/in, s, lbf; PARAM WTMASS converts the deck's mass input to it).
@@ -66,7 +73,8 @@ from asekit.case.schema import AeroSpec, Case, FlightSpec, ModesSpec, SupportSpe
 from asekit.geometry import Material, OrthotropicMaterial
 from asekit.structure.assembly import SupportedSystem, element_dofs, pitch_inertia
 from asekit.structure.mesh import PlateMesh
-from asekit.structure.plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness
+from asekit.structure.modes import MIN_OUT_OF_PLANE
+from asekit.structure.plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness, shape_functions
 from asekit.structure.supports import planform_edge_supports
 
 #: length, mass and time of one deck unit in SI (m, kg, s).
@@ -258,6 +266,7 @@ class _Deck:
     nodes: np.ndarray | None = None
     z0: float = 0.0
     notes: list = field(default_factory=list)
+    missing: list = field(default_factory=list)
 
     @property
     def n_dof(self) -> int:
@@ -268,17 +277,322 @@ class _Deck:
         return DOF_PER_NODE * self.index[int(nid)] + comp
 
 
+#: Cards whose ids share one name space (Nastran: an element id is unique over all elements,
+#: CONM2 and rigid elements included); a second card with an id already given is an error
+#: unless it repeats the first exactly (an identical repeat is read once, with a note).
+#: SPC / SPC1 (sets of several cards) and MKAERO1 (no id) are not listed.
+ID_SPACES = {"GRID": "GRID", "CQUAD4": "element", "CTRIA3": "element", "CELAS1": "element",
+             "CELAS2": "element", "CONM2": "element", "RBE2": "element",
+             "PSHELL": "property", "PELAS": "property", "MAT1": "material", "MAT8": "material",
+             "CORD2R": "coordinate system", "CORD1R": "coordinate system",
+             "CORD2C": "coordinate system", "CORD2S": "coordinate system",
+             "CAERO1": "CAERO", "PAERO1": "PAERO", "AEFACT": "AEFACT", "SPLINE1": "spline",
+             "SPLINE4": "spline", "SET1": "SET1", "AELIST": "AELIST", "FLFACT": "FLFACT",
+             "FLUTTER": "FLUTTER", "EIGR": "method", "EIGRL": "method", "TABDMP1": "TABDMP1",
+             "AERO": "AERO", "AEROS": "AEROS", "PARAM": "PARAM", "SUPORT": None}
+
+
+class BdfWarning(UserWarning):
+    """A deck asekit reads but whose model looks unintended (e.g. grids that touch nothing)."""
+
+
+def _number(v):
+    """A Nastran field as a float (``1.5``, ``1.-7``, ``2+3``) or None (blank, not a number)."""
+    if v is None:
+        return None
+    if isinstance(v, (int, float)):
+        return float(v)
+    s = str(v).strip().upper().replace("D", "E")
+    try:
+        return float(s)
+    except ValueError:
+        pass
+    for i in range(len(s) - 1, 0, -1):
+        if s[i] in "+-" and s[i - 1] not in "E+-":
+            try:
+                return float(s[:i] + "E" + s[i:])
+            except ValueError:
+                return None
+    return None
+
+
+def _norm_fields(fields) -> tuple:
+    """The fields of a card compared for a repeat: numbers as floats, text upper-case, the
+    trailing blanks dropped."""
+    out = []
+    for v in fields:
+        x = _number(v)
+        out.append(x if x is not None else (None if v is None or str(v).strip() == ""
+                                            else str(v).strip().upper()))
+    while out and out[-1] is None:
+        out.pop()
+    return tuple(out)
+
+
+def _first_line(exc: BaseException) -> str:
+    """The first non-empty line of an exception's message (pyNastran's are multi-line)."""
+    text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+    lines = [ln.strip() for ln in text.strip("'\" \n").splitlines() if ln.strip()]
+    return (lines[0] if lines else type(exc).__name__)[:300]
+
+
+@dataclass
+class _CardTrace:
+    """The cards pyNastran parses, seen one by one through ``BDF.add_card``: each card's
+    normalised fields by (id space, id), for the duplicate check, and the number of identical
+    repeats; each MAT1 is checked on its fields as given (:func:`_check_mat1_fields`)."""
+
+    name: str
+    seen: dict = field(default_factory=dict)
+    repeats: int = 0
+
+    def record(self, card: str, fields: list) -> bool:
+        """Record a card; True for an exact repeat of a card already read (to be dropped);
+        BdfError for a second card with the same id and other fields."""
+        space = ID_SPACES.get(card, None)
+        if card not in ID_SPACES or space is None or len(fields) < 2:
+            return False
+        norm = (card, _norm_fields(fields))
+        key = "-" if card in ("AERO", "AEROS") else (norm[1][1] if len(norm[1]) > 1 else None)
+        old = self.seen.get((space, key))
+        if old is None:
+            self.seen[(space, key)] = norm
+            if card == "MAT1":
+                _check_mat1_fields(norm[1])
+            return False
+        if old == norm:
+            self.repeats += 1
+            return True
+        what = card if card in ("AERO", "AEROS") else f"{card} {_fmt_id(key)}"
+        raise BdfError(f"{what}: a second card with the {space} id of "
+                       f"{old[0]} {_fmt_id(key)} and other fields: duplicate ids are errors "
+                       f"(give each card its own id)")
+
+
+def _fmt_id(key) -> str:
+    return f"{key:g}" if isinstance(key, float) else str(key)
+
+
+def _traced_add_card(model, trace: _CardTrace):
+    """``model.add_card`` that records each card in ``trace`` and turns pyNastran's errors
+    into a :class:`BdfError` naming the card and its id (pyNastran's message, with the field,
+    after it)."""
+    orig = model.add_card
+
+    def add_card(card_lines, card_name, comment="", ifile=None, is_list=True, has_none=True):
+        name = str(card_name).upper()
+        count = model.card_count.get(name)
+        try:
+            card_obj, _ = model.create_card_object(card_lines, name, is_list=is_list,
+                                                   has_none=has_none)
+            fields = list(card_obj.card)
+            if count is None:                     # the card is counted once, by orig
+                model.card_count.pop(name, None)
+            else:
+                model.card_count[name] = count
+        except Exception as exc:
+            raise BdfError(f"{name} card unreadable: {_first_line(exc)}") from None
+        ident = f"{name} {fields[1]}" if len(fields) > 1 and fields[1] is not None else name
+        _check_thru(trace.name, name, fields)
+        if trace.record(name, fields):
+            return card_obj                       # an exact repeat: read once
+        try:
+            return orig(card_lines, card_name, comment=comment, ifile=ifile, is_list=is_list,
+                        has_none=has_none)
+        except BdfError:
+            raise
+        except Exception as exc:
+            raise BdfError(f"{ident}{_include_of(model, ifile, trace.name)}: "
+                           f"{_first_line(exc)}") from None
+    return add_card
+
+
+def _include_of(model, ifile, main: str) -> str:
+    """`` (in NAME)`` when card ``ifile`` of pyNastran comes from an INCLUDE file."""
+    try:
+        name = Path(model.active_filenames[ifile]).name
+    except (AttributeError, IndexError, TypeError):
+        return ""
+    return "" if name == main else f" (in {name})"
+
+
+#: The most ids a "THRU" range of one card may hold (pyNastran expands every range).
+MAX_THRU_IDS = 10**6
+
+
+def _check_thru(name: str, card: str, fields: list) -> None:
+    """A ``id1 THRU id2`` range of more than :data:`MAX_THRU_IDS` ids is refused before
+    pyNastran expands it (a typo such as 24000000 for 24 would take minutes and gigabytes)."""
+    for j in range(1, len(fields) - 1):
+        if str(fields[j]).strip().upper() == "THRU":
+            lo, hi = _number(fields[j - 1]), _number(fields[j + 1])
+            if lo is not None and hi is not None and hi - lo > MAX_THRU_IDS:
+                raise BdfError(f"{card} {fields[1]}: {fields[j - 1]} THRU "
+                               f"{fields[j + 1]} (fields {j}-{j + 2}) holds {hi - lo + 1:.0f} "
+                               f"ids, more than {MAX_THRU_IDS}")
+
+
+def _check_includes(path: Path, text: str) -> None:
+    """Every one-line ``INCLUDE 'file'`` of the deck names a file (relative to the deck's
+    folder), checked before pyNastran (which would leave a pyNastran_crash.bdf behind)."""
+    for n, line in enumerate(text.splitlines(), 1):
+        head = line.split("$")[0].strip()
+        if not head.upper().startswith("INCLUDE") or head.count("'") != 2:
+            continue
+        name = head.split("'")[1]
+        if not (path.parent / name).expanduser().is_file():
+            raise BdfError(f"line {n}: INCLUDE '{name}': no such file (in {path.parent})")
+
+
 def _open_deck(path: Path, BDF):
     """The pyNastran model of ``path`` (cross-referenced; a file without BEGIN BULK is read as
-    bulk data only)."""
+    bulk data only) and its :class:`_CardTrace`. Every pyNastran error is a
+    :class:`BdfError`: a card's error names the card, its id and (pyNastran's words) the
+    field; a reference to a missing card names the card that refers; otherwise the file."""
     model = BDF(debug=None)
-    punch = "BEGIN BULK" not in path.read_text(errors="replace").upper()
-    model.read_bdf(str(path), punch=punch, xref=True)
-    return model
+    try:
+        text = path.read_text(errors="replace")
+    except OSError as exc:
+        raise BdfError(f"{path}: cannot read the deck ({exc.strerror or exc})") from None
+    punch = "BEGIN BULK" not in text.upper()
+    _check_includes(path, text)
+    trace = _CardTrace(path.name)
+    model.add_card = _traced_add_card(model, trace)
+    try:
+        model.read_bdf(str(path), punch=punch, xref=False, validate=False)
+        _validate_cards(model, path.name)
+        model.validate()                          # the rest of pyNastran's checks
+    except BdfError:
+        raise
+    except Exception as exc:
+        raise BdfError(f"pyNastran cannot read the deck "
+                       f"({type(exc).__name__}: {_first_line(exc)})") from None
+    try:
+        model.cross_reference()
+    except Exception as exc:
+        raise BdfError(f"a card refers to one the deck does not hold: "
+                       f"{_xref_message(exc)}") from None
+    return model, trace
 
 
-def _read_param_wtmass(model) -> float:
-    """PARAM WTMASS: the factor from the deck's mass input to its mass unit (default 1).
+#: The pyNastran tables whose cards :func:`_validate_cards` checks one by one.
+_VALIDATED = ("nodes", "coords", "elements", "properties", "rigid_elements", "masses",
+              "materials", "caeros", "paeros", "splines", "aefacts", "sets", "aelists",
+              "flfacts", "flutters", "methods", "tables_sdamping", "mkaeros", "spcs")
+
+
+def _validate_cards(model, name: str) -> None:
+    """pyNastran's own card checks (``card.validate()``), card by card, so that a failure
+    names the card and its id."""
+    for attr in _VALIDATED:
+        table = getattr(model, attr, None) or {}
+        cards = table.values() if isinstance(table, dict) else table
+        for c in [x for v in cards for x in (v if isinstance(v, list) else [v])]:
+            try:
+                c.validate()
+            except Exception as exc:
+                ident = next((getattr(c, a) for a in ("eid", "nid", "pid", "mid", "sid", "cid",
+                                                      "tid", "conid") if hasattr(c, a)), "")
+                raise BdfError(f"{getattr(c, 'type', attr)} {ident}: "
+                               f"{_first_line(exc)}".replace("  ", " ")) from None
+
+
+def _xref_message(exc) -> str:
+    """pyNastran's cross-reference error in one line (its long id lists cut)."""
+    text = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+    lines = [ln.strip() for ln in text.strip("'\" \n").splitlines() if ln.strip()]
+    hits = [ln for ln in lines if "required by" in ln or "not found" in ln]
+    msg = hits[0] if hits else (lines[0] if lines else type(exc).__name__)
+    msg = msg.split("Error: ", 1)[1] if msg.startswith(("KeyError: ", "CrossReferenceError: ")) \
+        else msg
+    for cut in (". Allowed", "; allowed", "\\n"):
+        msg = msg.split(cut)[0]
+    return msg.strip("'\" ")[:300]
+
+
+# ---------------------------------------------------------------------------------------------
+# physical ranges (SI) of the fields asekit reads
+# ---------------------------------------------------------------------------------------------
+#: The range (SI, low, high, whether low is allowed) each kind of field must lie in: wide
+#: plausibility bounds (any aircraft or wind-tunnel model lies well inside), so that a typo
+#: of a few orders of magnitude or 1e30 is refused with its card and field instead of giving
+#: a structure of another scale and "no flutter".
+RANGES = {
+    "coordinate": (-1.0e4, 1.0e4, True, "m"),
+    "length": (0.0, 1.0e4, False, "m"),
+    "thickness": (0.0, 10.0, False, "m"),
+    "modulus": (1.0e3, 1.0e13, True, "Pa"),
+    "density": (0.0, 1.0e5, True, "kg/m^3"),
+    "areal mass": (0.0, 1.0e5, True, "kg/m^2"),
+    "mass": (0.0, 1.0e7, True, "kg"),
+    "inertia": (0.0, 1.0e9, True, "kg m^2"),
+    "spring": (0.0, 1.0e20, True, "N/m or N m/rad"),
+    "fluid density": (0.0, 2.0e3, False, "kg/m^3"),
+    "velocity": (0.0, 1.0e4, False, "m/s"),
+    "reduced frequency": (0.0, 100.0, False, ""),
+    "damping": (0.0, 1.0, True, ""),
+    "frequency": (0.0, 1.0e6, True, "Hz"),
+    "factor": (0.0, 1.0e30, False, ""),
+}
+
+
+def _si_factor(deck, kind: str) -> float:
+    """SI value of one deck unit of a field of ``kind`` (WTMASS on structural masses)."""
+    L, Mu, T, w = deck.L, deck.Mu, deck.T, deck.wtmass
+    return {"coordinate": L, "length": L, "thickness": L, "modulus": Mu / (L * T * T),
+            "density": w * Mu / L**3, "areal mass": w * Mu / L**2, "mass": w * Mu,
+            "inertia": w * Mu * L * L, "fluid density": Mu / L**3, "velocity": L / T,
+            "frequency": 1.0 / T}.get(kind, 1.0)
+
+
+def _check_range(deck, what: str, value, kind: str, si: float | None = None) -> float:
+    """``value`` (deck units; ``si`` its SI value if already converted) of the field ``what``
+    (card, id and field) checked against :data:`RANGES`; returns the SI value."""
+    lo, hi, lo_ok, unit = RANGES[kind]
+    v = float(value)
+    s = v * _si_factor(deck, kind) if si is None else float(si)
+    if not (math.isfinite(s) and (s > lo or (lo_ok and s == lo)) and s <= hi):
+        shown = f"{v:g}" + ("" if si is None and _si_factor(deck, kind) == 1.0
+                            else f" (= {s:g} {unit})")
+        raise BdfError(f"{what} = {shown} is outside the physical range "
+                       f"{lo:g} {'<=' if lo_ok else '<'} {kind} <= {hi:g} {unit}".rstrip())
+    return s
+
+
+def _check_mat1_fields(f: tuple) -> None:
+    """The MAT1 rules on the fields as given (MSC Nastran QRG, MAT1): two of E, G, NU
+    determine the third (G = E / (2 (1 + NU))); E > 0, G > 0 and -1 < NU <= 0.5, given or
+    derived. asekit needs two of them (Nastran's "E alone: G = NU = 0" has no shear)."""
+    mid = _fmt_id(f[1])
+    E, G, nu = (f[i] if len(f) > i else None for i in (2, 3, 4))
+    if any(isinstance(v, str) for v in (E, G, nu)):
+        return                                   # pyNastran names the bad field
+    given = [n for n, v in zip(("E", "G", "NU"), (E, G, nu)) if v is not None]
+    if len(given) < 2:
+        raise BdfError(f"MAT1 {mid}: {' and '.join(given) or 'none of E, G, NU'} given: "
+                       f"asekit needs two of E, G, NU (the third is G = E / (2 (1 + NU)))")
+    for n, v in (("E", E), ("G", G)):
+        if v is not None and not v > 0:
+            raise BdfError(f"MAT1 {mid}: {n} = {v:g} must be > 0")
+    derived = nu is None
+    nu = E / (2.0 * G) - 1.0 if derived else nu
+    if not -1.0 < nu <= 0.5:
+        how = f" (from E = {E:g} and G = {G:g}: NU = E / (2 G) - 1)" if derived else ""
+        raise BdfError(f"MAT1 {mid}: NU = {nu:g}{how} is outside -1 < NU <= 0.5")
+
+
+def _check_grid_ranges(deck) -> None:
+    """GRID X1-X3 (basic) within :data:`RANGES` ``coordinate``."""
+    bad = np.flatnonzero(~np.all(np.abs(deck.xyz * deck.L) <= RANGES["coordinate"][1], axis=1))
+    if bad.size:
+        i = int(bad[0])
+        j = int(np.argmax(~(np.abs(deck.xyz[i] * deck.L) <= RANGES["coordinate"][1])))
+        _check_range(deck, f"GRID {deck.nids[i]} X{j + 1} (basic)", deck.xyz[i, j],
+                     "coordinate")
+
+
+def _read_param_wtmass(model, name: str = "") -> float:
+    """PARAM WTMASS: the factor from the deck's mass input to its mass unit (default 1; > 0).
 
     +-------+--------+--------+
     |   1   |   2    |   3    |
@@ -287,7 +601,13 @@ def _read_param_wtmass(model) -> float:
     +-------+--------+--------+
     """
     wt = model.params.get("WTMASS")
-    return float(wt.values[0]) if wt is not None else 1.0
+    if wt is None:
+        return 1.0
+    v = _number(wt.values[0] if wt.values else None)
+    if v is None or not (math.isfinite(v) and 0.0 < v < 1.0e30):
+        raise BdfError(f"PARAM WTMASS = {wt.values[0] if wt.values else None} must be "
+                       f"a number > 0 (the deck's mass input x WTMASS = its mass unit)")
+    return v
 
 
 def _shell_elements(model, name: str) -> list:
@@ -318,6 +638,7 @@ def _read_grids(deck: _Deck, quads, tol: float | None) -> None:
     xyz = np.array([model.nodes[n].get_position() for n in nids], float)
     deck.nids, deck.xyz = nids, xyz
     deck.index = {int(n): i for i, n in enumerate(nids)}
+    _check_grid_ranges(deck)
     size = float(np.ptp(xyz[:, :2], axis=0).max())
     tol = 1e-6 * size if tol is None else float(tol)
     plate_nodes = sorted({n for e in quads for n in e.node_ids})
@@ -354,6 +675,44 @@ def _read_pshell(p, e) -> None:
         raise BdfError(f"{e.type} {e.eid}: ZOFFS = {e.zoffset} is not supported")
 
 
+def _check_shell_ranges(deck: _Deck, quads, th, props) -> None:
+    """PSHELL T (> 0) and NSM, and each element's corner thicknesses (deck units): all >= 0,
+    the largest > 0 (an element of zero thickness has no stiffness), within :data:`RANGES`."""
+    for p in props.values():
+        if p.t is not None:
+            _check_range(deck, f"PSHELL {p.pid} T", p.t, "thickness")
+        _check_range(deck, f"PSHELL {p.pid} NSM", p.nsm or 0.0, "areal mass")
+    bad = np.flatnonzero(~((th >= 0).all(axis=1) & (th.max(axis=1) > 0)
+                           & (th.max(axis=1) * deck.L <= RANGES["thickness"][1])))
+    if bad.size:
+        e = quads[int(bad[0])]
+        raise BdfError(f"{e.type} {e.eid}: corner thicknesses T1-T4 = "
+                       f"{[float(v) for v in th[bad[0]]]} (with PSHELL {e.pid} T for blanks): "
+                       f"each must be >= 0, the largest > 0 and <= "
+                       f"{RANGES['thickness'][1] / deck.L:g} (10 m)")
+
+
+def _check_element_shapes(deck: _Deck, quads, conn) -> None:
+    """Every element's Jacobian positive inside it (after :func:`_orient`): det J of the
+    bilinear map is affine in r and s, so it is > 0 everywhere inside iff it is >= 0 at the
+    four corners and > 0 at the centre (a CTRIA3, G3 repeated, has det J = 0 at that corner).
+    A degenerate (collinear, coincident grids) or non-convex element is refused by id."""
+    xy = deck.nodes[conn]
+    tol = 1e-12 * max(float(np.ptp(deck.nodes, axis=0).max()), 1e-300) ** 2
+
+    def det(r, s):
+        _, dNr, dNs = shape_functions(r, s)
+        J = np.stack([dNr @ xy, dNs @ xy], axis=1)
+        return J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
+    corners = np.min([det(r, s) for r, s in ((-1, -1), (1, -1), (1, 1), (-1, 1))], axis=0)
+    bad = np.flatnonzero(~((corners >= -tol) & (det(0.0, 0.0) > tol)))
+    if bad.size:
+        e = quads[int(bad[0])]
+        raise BdfError(f"{e.type} {e.eid} (grids {list(e.node_ids)}) is degenerate "
+                       f"or not convex in the plate's plane (Jacobian <= 0): its grids must "
+                       f"make a convex polygon of non-zero area")
+
+
 def _shell_thickness(e, p, tri: bool) -> list[float]:
     """Corner thicknesses (deck units) of a CQUAD4 (T1-T4) or CTRIA3 (T1-T3, T3 repeated for
     the degenerated MITC4): blank or negative -> PSHELL T; TFLAG = 1 -> multiples of T.
@@ -375,6 +734,9 @@ def _shell_thickness(e, p, tri: bool) -> list[float]:
     +--------+-------+-------+----+----+----+------------+-------+
     """
     t = [e.T1, e.T2, e.T3, e.T3] if tri else [e.T1, e.T2, e.T3, e.T4]
+    if p.t is None and (getattr(e, "tflag", 0) == 1 or any(v is None or v < 0 for v in t)):
+        raise BdfError(f"{e.type} {e.eid}: a corner thickness is blank and PSHELL {p.pid} T "
+                       f"is blank too: give T")
     if getattr(e, "tflag", 0) == 1:
         t = [(v if v is not None else 1.0) * p.t for v in t]
     return [p.t if v is None or v < 0 else v for v in t]
@@ -426,7 +788,9 @@ def _read_shells(deck: _Deck, quads):
         th[j] = _shell_thickness(e, p, bool(is_tri[j]))
         angles[j] = _element_angle(e, lambda g: deck.xyz[deck.index[g]], e.node_ids[0],
                                    e.node_ids[1], deck.model)
+    _check_shell_ranges(deck, quads, th, props)
     _orient(deck, conn, th, is_tri)
+    _check_element_shapes(deck, quads, conn)
     if is_tri.any():
         deck.notes.append(f"{int(is_tri.sum())} CTRIA3 modelled as degenerated MITC4 (G3 "
                           f"repeated; Bathe, Finite Element Procedures, 1996, Ch. 5: collapsed "
@@ -448,17 +812,18 @@ def _read_mat1(mat, deck: _Deck, pid: int) -> Material:
     | MAT1 | MID | E | G | NU | RHO | A | TREF | GE |
     +------+-----+---+---+----+-----+---+------+----+
     """
-    stress, dens = deck.Mu / (deck.L * deck.T * deck.T), deck.Mu / deck.L**3
+    _check_mat1_fields((mat.type, mat.mid, mat.e, mat.g, mat.nu))   # after pyNastran's fill
     E, G, nu = mat.e, mat.g, mat.nu
-    if E is None or E <= 0:
-        raise BdfError(f"MAT1 {mat.mid} (PSHELL {pid}): E must be > 0, got {E}")
-    if nu is None:
-        nu = E / (2 * G) - 1.0
-    elif G is not None and abs(G - E / (2 * (1 + nu))) > 1e-3 * G:
+    if abs(G - E / (2 * (1 + nu))) > 1e-3 * G:
         raise BdfError(f"MAT1 {mat.mid}: E, G and NU all given and G = {G:g} differs from "
                        f"E / (2 (1 + NU)) = {E / (2 * (1 + nu)):g}: asekit's isotropic "
                        f"material takes E and NU (give two of the three)")
-    return Material(E * stress, nu, mat.rho * deck.wtmass * dens, name=f"MAT1 {mat.mid}")
+    what = f"MAT1 {mat.mid} (PSHELL {pid})"
+    E_si = _check_range(deck, f"{what} E", E, "modulus")
+    _check_range(deck, f"{what} G", G, "modulus")
+    return Material(E_si, nu,
+                    _check_range(deck, f"{what} RHO", mat.rho or 0.0, "density"),
+                    name=f"MAT1 {mat.mid}")
 
 
 def _read_mat8(mat, deck: _Deck, angle: float) -> OrthotropicMaterial:
@@ -470,12 +835,19 @@ def _read_mat8(mat, deck: _Deck, angle: float) -> OrthotropicMaterial:
     | MAT8 | MID | E1  |  E2  | NU12 | G12 | G1Z | G2Z | RHO |
     +------+-----+-----+------+------+-----+-----+-----+-----+
     """
-    stress, dens = deck.Mu / (deck.L * deck.T * deck.T), deck.Mu / deck.L**3
+    what = f"MAT8 {mat.mid}"
     g1z = mat.g1z if mat.g1z else mat.g12
     g2z = mat.g2z if mat.g2z else mat.g12
-    return OrthotropicMaterial(mat.e11 * stress, mat.e22 * stress, mat.g12 * stress,
-                               mat.nu12, mat.rho * deck.wtmass * dens, g1z * stress,
-                               g2z * stress, angle, name=f"MAT8 {mat.mid}")
+    mod = {n: _check_range(deck, f"{what} {n}", v, "modulus")
+           for n, v in (("E1", mat.e11), ("E2", mat.e22), ("G12", mat.g12), ("G1Z", g1z),
+                        ("G2Z", g2z))}
+    nu12 = float(mat.nu12 or 0.0)
+    if not abs(nu12) < math.sqrt(mod["E1"] / mod["E2"]):
+        raise BdfError(f"{what}: NU12 = {nu12:g} is outside |NU12| < sqrt(E1 / E2) = "
+                       f"{math.sqrt(mod['E1'] / mod['E2']):g} (a positive definite lamina)")
+    return OrthotropicMaterial(mod["E1"], mod["E2"], mod["G12"], nu12,
+                               _check_range(deck, f"{what} RHO", mat.rho or 0.0, "density"),
+                               mod["G1Z"], mod["G2Z"], angle, name=f"MAT8 {mat.mid}")
 
 
 def _material(deck: _Deck, mat, angle: float, pid: int):
@@ -577,7 +949,10 @@ def _read_celas(deck: _Deck):
         (a, b), rot, lost = _celas_dofs(deck, e)
         if lost:
             dropped.append(e.eid)
+        k_deck = k
         k *= deck.Mu * deck.L**2 / deck.T**2 if rot else deck.Mu / deck.T**2
+        _check_range(deck, f"{e.type} {e.eid} K" if e.type == "CELAS2" else
+                     f"PELAS {e.pid} K (CELAS1 {e.eid})", k_deck, "spring", si=k)
         if a is None:
             a, b = b, None
         if a is None:
@@ -612,16 +987,13 @@ def _read_conm2(deck: _Deck):
     n = deck.n_dof
     Mx = sp.lil_matrix((n, n))
     masses = []
-    sm, si = deck.wtmass * deck.Mu, deck.wtmass * deck.Mu * deck.L**2
     for m in deck.model.masses.values():
         if m.type != "CONM2":
             continue
         if m.cid not in (0, -1, None):
             raise BdfError(f"CONM2 {m.eid}: CID = {m.cid} is not supported (basic only)")
         i = deck.index[m.nid]
-        mass = float(m.mass) * sm
-        X = np.asarray(m.X if m.X is not None else np.zeros(3), float) * deck.L
-        I = np.asarray(m.I, float) * si
+        mass, X, I = _conm2_values(deck, m)
         masses.append((i, mass, X.copy(), (float(I[0]), float(I[1]), float(I[2]))))
         d = DOF_PER_NODE * i
         r = np.array([1.0, X[1], -X[0]])
@@ -631,6 +1003,23 @@ def _read_conm2(deck: _Deck):
         Mx[d + 1, d + 2] -= I[1]
         Mx[d + 2, d + 1] -= I[1]
     return tuple(masses), Mx.tocsr()
+
+
+def _conm2_values(deck: _Deck, m):
+    """(mass kg, offset (3,) m, (I11, I21, I22, ...) kg m^2) of a CONM2, checked: mass and
+    offsets within :data:`RANGES`, I11, I22 >= 0 and I21^2 <= I11 I22."""
+    what = f"CONM2 {m.eid}"
+    mass = _check_range(deck, f"{what} M", float(m.mass or 0.0), "mass")
+    X = np.asarray(m.X if m.X is not None else np.zeros(3), float)
+    for j, x in enumerate(X):
+        _check_range(deck, f"{what} X{j + 1}", x, "coordinate")
+    I = np.asarray(m.I, float) * deck.wtmass * deck.Mu * deck.L**2
+    for j, n in ((0, "I11"), (2, "I22")):
+        _check_range(deck, f"{what} {n}", I[j], "inertia", si=I[j])
+    if not I[1] ** 2 <= I[0] * I[2] * (1 + 1e-12):
+        raise BdfError(f"{what}: I21^2 > I11 I22 (I11, I21, I22 = "
+                       f"{list(map(float, np.asarray(m.I)[:3]))}): not a positive inertia")
+    return mass, X * deck.L, I
 
 
 def _read_grid_ps(deck: _Deck) -> set:
@@ -646,6 +1035,14 @@ def _spc_set_ids(deck: _Deck) -> list:
     cc = _case_value(model, "SPC")
     if cc is not None and cc in model.spcs:
         return [cc]
+    adds = (getattr(model, "spcadds", {}) or {}).get(cc) if cc is not None else None
+    if adds:
+        adds = adds if isinstance(adds, list) else [adds]
+        return [s for a in adds for s in getattr(a, "spc_ids", a.sets) if s in model.spcs]
+    if cc is not None:
+        deck.missing.append(f"the case control's SPC = {cc} is not a set of the deck "
+                            f"(SPC sets: {ids or 'none'})")
+        return []
     if len(ids) > 1:
         deck.notes.append(f"several SPC sets {ids} and no SPC = in the case control: all "
                           f"applied")
@@ -663,6 +1060,9 @@ def _read_spc_card(deck: _Deck, sid: int, c) -> set:
     | SPC  | SID | G1 | C1 |  D1  | G2 | C2 | D2 |
     +------+-----+----+----+------+----+----+----+
     """
+    if any(nid in (None, 0) for nid in c.node_ids):
+        raise BdfError(f"{c.type} {sid}: a grid id is 0 or blank "
+                       f"(grids {list(c.node_ids)[:10]}): each G must be a GRID id > 0")
     if c.type == "SPC1":
         return {deck.dof(nid, k) for nid in c.node_ids for k in _components(c.components)}
     if c.type != "SPC":
@@ -740,7 +1140,7 @@ def _reduction(n: int, fixed: set, dep: dict, K, M) -> sp.csr_matrix:
     return Tm[:, np.flatnonzero(~empty)].tocsr() if empty.any() else Tm
 
 
-def _read_eigen_method(model, T: float):
+def _read_eigen_method(model, deck: _Deck):
     """EIGRL (or EIGR) of the case control's METHOD (else the first): (ND number of modes or
     None, V2 / F2 upper frequency Hz or None).
 
@@ -759,10 +1159,16 @@ def _read_eigen_method(model, T: float):
     mth = methods.get(meth) if meth in methods else methods[min(methods)]
     nd = getattr(mth, "nd", None)
     v2 = getattr(mth, "v2", None) if mth.type == "EIGRL" else getattr(mth, "f2", None)
-    return (int(nd) if nd else None), (float(v2) / T if v2 else None)
+    if nd is not None and not 1 <= nd <= 100000:
+        raise BdfError(f"{mth.type} {mth.sid} ND = {nd} must be an integer "
+                       f"1 <= ND <= 100000 (the number of modes)")
+    if v2 is not None:
+        _check_range(deck, f"{mth.type} {mth.sid} {'V2' if mth.type == 'EIGRL' else 'F2'}",
+                     v2, "frequency")
+    return (int(nd) if nd else None), (float(v2) / deck.T if v2 else None)
 
 
-def _read_tabdmp1(model, T: float):
+def _read_tabdmp1(model, deck: _Deck):
     """TABDMP1 (the first): modal damping vs frequency as ((f Hz, g), ...); TYPE G as given,
     CRIT (fraction of critical) as g = 2 zeta.
 
@@ -780,8 +1186,11 @@ def _read_tabdmp1(model, T: float):
     tab = tables[min(tables)]
     if tab.Type not in ("G", "CRIT"):
         raise BdfError(f"TABDMP1 {tab.tid}: TYPE {tab.Type} is not supported (G, CRIT)")
+    for j, (f, v) in enumerate(zip(tab.x, tab.y)):
+        _check_range(deck, f"TABDMP1 {tab.tid} f{j + 1}", f, "frequency")
+        _check_range(deck, f"TABDMP1 {tab.tid} {tab.Type.lower()}{j + 1}", v, "damping")
     g = np.asarray(tab.y, float) * (2.0 if tab.Type == "CRIT" else 1.0)
-    return tuple((float(f) / T, float(v)) for f, v in zip(tab.x, g))
+    return tuple((float(f) / deck.T, float(v)) for f, v in zip(tab.x, g))
 
 
 def _read_aero_card(deck: _Deck):
@@ -802,12 +1211,14 @@ def _read_aero_card(deck: _Deck):
         raise BdfError("CAERO1 without AERO / AEROS: the reference chord is unknown")
     if int(getattr(aero, "sym_xy", 0) or 0) != 0:
         raise BdfError("SYMXY (ground effect) is not supported")
-    rho_ref = (float(model.aero.rho_ref) * deck.Mu / deck.L**3 if model.aero is not None
-               else None)
-    return 0.5 * float(aero.cref) * deck.L, rho_ref, int(aero.sym_xz or 0) == 1
+    card = "AERO" if model.aero is not None else "AEROS"
+    rho_ref = (_check_range(deck, "AERO RHOREF", model.aero.rho_ref, "fluid density")
+               if model.aero is not None else None)
+    refc = _check_range(deck, f"{card} REFC", aero.cref, "length")
+    return 0.5 * refc, rho_ref, int(aero.sym_xz or 0) == 1
 
 
-def _read_mkaero1(model):
+def _read_mkaero1(model, deck=None):
     """MKAERO1: the Mach numbers and reduced frequencies of the GAF database (all pairs of
     all cards; subsonic only, asekit's doublet lattice).
 
@@ -824,6 +1235,9 @@ def _read_mkaero1(model):
         if mk.type != "MKAERO1":
             raise BdfError(f"{mk.type} is not supported (MKAERO1)")
         pairs += [(float(m), float(k)) for m in mk.machs for k in mk.reduced_freqs]
+    for k in sorted({p[1] for p in pairs}):
+        if deck is not None:
+            _check_range(deck, "MKAERO1 k", k, "reduced frequency")
     machs = tuple(sorted({p[0] for p in pairs}))
     for m in machs:                 # the deck's CAERO1 boxes are run with the doublet lattice
         try:
@@ -841,11 +1255,13 @@ def _read_aero(deck: _Deck) -> dict:
         if model.flutters:
             raise BdfError("FLUTTER without CAERO1 boxes")
         return {}
+    for c in model.caeros.values():
+        _check_caero1(deck, c)
     boxes, box_ids = _boxes(model, deck.L, deck.z0 * deck.L)
     _check_splines(model, box_ids, deck.notes)
     b_ref, rho_ref, symmetric = _read_aero_card(deck)
-    machs, ks = _read_mkaero1(model)
-    flut = [_flutter(model, f, rho_ref, deck.L, deck.Mu, deck.T)
+    machs, ks = _read_mkaero1(model, deck)
+    flut = [_flutter(model, f, rho_ref, deck)
             for f in model.flutters.values()]
     fm = _case_value(model, "FMETHOD")
     flut.sort(key=lambda r: r.sid != fm)          # the case control's FMETHOD first
@@ -917,6 +1333,32 @@ def _caero1_boxes(c, L):
     return box * L, (bid[::-1] if flip else bid).ravel(), ns, nc
 
 
+#: The most boxes one CAERO1 may have (the doublet-lattice matrix of n boxes holds n^2
+#: complex numbers per Mach and k: 10000 boxes are 1.6 GB).
+MAX_BOXES_PER_CAERO1 = 10000
+
+
+def _check_caero1(deck: _Deck, c) -> None:
+    """CAERO1 corners P1, P4 and chords X12, X43 within :data:`RANGES` (chords >= 0, one of
+    them > 0), NSPAN x NCHORD <= :data:`MAX_BOXES_PER_CAERO1`."""
+    if c.type != "CAERO1":
+        return
+    for name, p in (("P1", c.p1), ("P4", c.p4)):
+        for j, x in enumerate(np.asarray(p, float)):
+            _check_range(deck, f"CAERO1 {c.eid} {name} X{j + 1}", x, "coordinate")
+    for name, x in (("X12", c.x12), ("X43", c.x43)):
+        if x != 0.0:
+            _check_range(deck, f"CAERO1 {c.eid} {name}", x, "length")
+    if not (c.x12 > 0 or c.x43 > 0):
+        raise BdfError(f"CAERO1 {c.eid}: both chords X12 and X43 are zero")
+    ns = c.nspan or (len(c.lspan_ref.fractions) - 1 if c.lspan else 1)
+    nc = c.nchord or (len(c.lchord_ref.fractions) - 1 if c.lchord else 1)
+    if ns * nc > MAX_BOXES_PER_CAERO1:
+        raise BdfError(f"CAERO1 {c.eid}: NSPAN x NCHORD = {ns} x {nc} = "
+                       f"{ns * nc} boxes, more than {MAX_BOXES_PER_CAERO1} (the doublet-lattice "
+                       f"matrix would need {16 * (ns * nc) ** 2 / 2**30:.3g} GiB per Mach and k)")
+
+
 def _boxes(model, L, z0):
     """Every CAERO1 as one :class:`BoxMesh` (in the structure's plane, z = 0 in asekit) and
     the Nastran box ids."""
@@ -976,7 +1418,7 @@ def _check_splines(model, box_ids, notes):
                      "modes with its finite-element shape functions, not the surface spline")
 
 
-def _flutter(model, f, rho_ref, L, Mu, T) -> FlutterRequest:
+def _flutter(model, f, rho_ref, deck) -> FlutterRequest:
     """A FLUTTER request with its FLFACT lists in SI (densities x RHOREF, |velocities|).
 
     +---------+-----+--------+------+------+-------+-------+-------+------+
@@ -993,16 +1435,188 @@ def _flutter(model, f, rho_ref, L, Mu, T) -> FlutterRequest:
     if rho_ref is None:
         raise BdfError(f"FLUTTER {f.sid} needs AERO (RHOREF)")
 
-    def fl(v):
+    def fl(v, name, kind=None, scale=1.0):
         sid = v if isinstance(v, (int, np.integer)) else v.sid
-        return np.asarray(model.flfacts[int(sid)].factors, float)
-    dens = fl(f.density) * rho_ref
-    mach = fl(f.mach)
-    vel = np.abs(fl(f.reduced_freq_velocity)) * L / T
+        vals = np.asarray(model.flfacts[int(sid)].factors, float) * scale
+        for j, x in enumerate(vals if kind else ()):  # PK: a negative V asks for vectors
+            _check_range(deck, f"FLFACT {sid} (FLUTTER {f.sid} {name}) F{j + 1}", x / scale,
+                         kind, si=abs(x) if kind == "velocity" else x)
+        return vals
+    dens = fl(f.density, "DENS", "fluid density", rho_ref)
+    mach = fl(f.mach, "MACH")                # checked on the MKAERO1 grid (_aero_of)
+    vel = np.abs(fl(f.reduced_freq_velocity, "RFREQ", "velocity", deck.L / deck.T))
     if method == "PKNL" and not len(dens) == len(mach) == len(vel):
         raise BdfError(f"FLUTTER {f.sid} PKNL: FLFACT lists must have equal lengths")
     return FlutterRequest(int(f.sid), method, tuple(map(float, dens)), tuple(map(float, mach)),
                           tuple(map(float, vel)))
+
+
+# ---------------------------------------------------------------------------------------------
+# what holds the structure: connectivity and rigid-body modes
+# ---------------------------------------------------------------------------------------------
+def _components_of(n: int, links) -> np.ndarray:
+    """Connected components (a label per node) of ``n`` nodes joined by ``links`` (node index
+    arrays, each joining all its nodes)."""
+    parent = np.arange(n)
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+    for group in links:
+        r0 = root(int(group[0]))
+        for j in group[1:]:
+            r = root(int(j))
+            if r != r0:
+                parent[r] = r0
+    return np.array([root(i) for i in range(n)])
+
+
+def _check_connectivity(deck: _Deck, conn, quads, springs, masses, rigid) -> np.ndarray:
+    """Warn (:class:`BdfWarning`) about GRIDs that no element, spring, mass or rigid link uses
+    (ignored) and about plate elements in pieces that share no grid, rigid link or spring with
+    the largest piece; returns the component label of each node (elements and RBE2 joined)."""
+    n = len(deck.nids)
+    links = [np.unique(c) for c in conn] + [np.array([gi, *dep]) for gi, _, dep in rigid]
+    comp = _components_of(n, links)
+    used = np.zeros(n, bool)
+    used[np.unique(conn)] = True
+    for gi, _, dep in rigid:
+        used[[gi, *dep]] = True
+    for a, b, _ in springs:
+        used[[a // DOF_PER_NODE] + ([b // DOF_PER_NODE] if b >= 0 else [])] = True
+    used[[m[0] for m in masses]] = True
+    idle = deck.nids[~used]
+    if idle.size:
+        off = [int(g) for g in idle if abs(deck.xyz[deck.index[int(g)], 2] - deck.z0)
+               > 1e-6 * max(float(np.ptp(deck.xyz[:, :2])), 1.0)]
+        warnings.warn(f"{deck.name}: GRIDs {idle[:10].tolist()}{'...' if idle.size > 10 else ''}"
+                      f" touch no element, spring, mass or rigid link: ignored"
+                      + (f" (off the plate's plane: {off[:10]})" if off else ""),
+                      BdfWarning, stacklevel=4)
+    joined = _components_of(n, links + [np.array([a // 3, b // 3]) for a, b, _ in springs
+                                        if b >= 0])
+    pieces = joined[conn[:, 0]]
+    labels, counts = np.unique(pieces, return_counts=True)
+    if labels.size > 1:
+        loose = [int(quads[j].eid) for j in np.flatnonzero(pieces != labels[np.argmax(counts)])]
+        warnings.warn(f"{deck.name}: the plate is in {labels.size} pieces that share no grid, "
+                      f"spring or rigid link: elements {loose[:10]}"
+                      f"{'...' if len(loose) > 10 else ''} do not touch the largest piece",
+                      BdfWarning, stacklevel=4)
+    return comp
+
+
+def _rigid_vectors(deck: _Deck, comp: np.ndarray):
+    """The rigid out-of-plane motions of each component with a label >= 0 (3 per component:
+    w = 1; w = y - y_c, theta_x = 1; w = -(x - x_c), theta_y = 1, lengths in units of the
+    model's size, so that every column has entries of order 1), as an (n_dof, 3 n_comp)
+    array, and the component of each column."""
+    labels = np.unique(comp[comp >= 0])
+    R = np.zeros((deck.n_dof, 3 * labels.size))
+    ell = max(float(np.ptp(deck.nodes, axis=0).max()), 1e-300)
+    for k, lab in enumerate(labels):
+        idx = np.flatnonzero(comp == lab)
+        xy = deck.nodes[idx]
+        c = xy.mean(axis=0)
+        d = DOF_PER_NODE * idx
+        R[d, 3 * k] = 1.0
+        R[d, 3 * k + 1], R[d + 1, 3 * k + 1] = (xy[:, 1] - c[1]) / ell, 1.0 / ell
+        R[d, 3 * k + 2], R[d + 2, 3 * k + 2] = -(xy[:, 0] - c[0]) / ell, 1.0 / ell
+    return R, np.repeat(labels, 3)
+
+
+def _unrestrained(R, fixed: set, Ks, K) -> np.ndarray:
+    """Basis (columns) of the combinations c of the rigid motions R that every constraint
+    allows (R c = 0 on the fixed DOFs; an RBE2 moves rigidly anyway) and that no spring
+    resists (c^T R^T K_s R c = 0; plate elements carry no strain energy in a rigid motion)."""
+    rows = R[sorted(fixed)] if fixed else np.zeros((0, R.shape[1]))
+    rows = rows[np.abs(rows).max(axis=1) > 0] if rows.size else rows
+    rows = rows / np.abs(rows).max(axis=1, keepdims=True) if rows.size else rows
+    tau = max(float(np.abs(K.diagonal()).max()), 1e-300)
+    w, V = np.linalg.eigh(0.5 * (R.T @ (Ks @ R) + (R.T @ (Ks @ R)).T) / tau)
+    A = np.vstack([rows, np.sqrt(np.clip(w, 0.0, None))[:, None] * V.T])
+    if not A.size:
+        return np.eye(R.shape[1])
+    _, s, Vt = np.linalg.svd(A, full_matrices=True)
+    s = np.concatenate([s, np.zeros(R.shape[1] - s.size)])
+    return Vt[s <= 1e-6].T
+
+
+def _free_rigid_modes(deck: _Deck, comp, fixed: set, Ks, K, M):
+    """The rigid-body modes the supports leave: the unrestrained rigid motions
+    (:func:`_unrestrained`) that carry mass, split as the mode selection of the pipeline
+    does (:data:`asekit.structure.modes.MIN_OUT_OF_PLANE`): those with an out-of-plane (w)
+    kinetic-energy share of at least that reach the analysis as 0 Hz modes; the others (the
+    fictitious pitch inertia of an FN2 export: a grounded grid's R2 inertia) are dropped by
+    it. Returns (modes kept, modes dropped, component with the largest share of the first
+    kept one or None)."""
+    node_mass = np.abs(M).sum(axis=1).A1.reshape(-1, DOF_PER_NODE).sum(axis=1)
+    labels, inv = np.unique(comp, return_inverse=True)
+    heavy = np.bincount(inv, weights=node_mass) > 0
+    comp = np.where(heavy[inv], comp, -1)           # a massless piece has no mode
+    R, col_comp = _rigid_vectors(deck, comp)
+    N = _unrestrained(R, fixed, Ks, K)
+    if not N.shape[1]:
+        return 0, 0, None
+    U = R @ N
+    MU = M @ U
+    b, Vb = np.linalg.eigh(0.5 * (U.T @ MU + MU.T @ U))
+    massive = b > 1e-10 * max(float(b.max()), 1e-300)
+    if not massive.any():
+        return 0, 0, None
+    W = Vb[:, massive] / np.sqrt(b[massive])          # M-orthonormal unrestrained motions
+    Aw = (U @ W)[0::DOF_PER_NODE].T @ (MU @ W)[0::DOF_PER_NODE]
+    share, S = np.linalg.eigh(0.5 * (Aw + Aw.T))
+    kept = share >= MIN_OUT_OF_PLANE
+    if not kept.any():
+        return 0, int(massive.sum()), None
+    first = N @ (W @ S[:, np.flatnonzero(kept)[-1]])
+    return int(kept.sum()), int((~kept).sum()), int(col_comp[np.argmax(np.abs(first))])
+
+
+def _suport_dofs(model) -> int:
+    """The number of out-of-plane DOFs (components 3, 4, 5) SUPORT / SUPORT1 declare free."""
+    cards = list(getattr(model, "suport", []) or []) + list(
+        (getattr(model, "suport1", {}) or {}).values())
+    return sum(len(_components(c)) for s in cards for c in getattr(s, "Cs", []))
+
+
+def _holding_words(deck: _Deck, fixed: set, springs) -> str:
+    """What the deck holds the structure with (for the rigid-body error)."""
+    parts = [f"SPC / SPC1 / GRID PS fix {len(fixed)} out-of-plane DOFs" if fixed else
+             "no SPC / SPC1 set applies and no GRID PS holds a T3, R1 or R2 DOF"]
+    grounded = sum(1 for _, b, _ in springs if b < 0)
+    parts.append(f"{grounded} CELAS to ground" if grounded else "no CELAS to ground")
+    parts += deck.missing
+    return "; ".join(parts)
+
+
+def _check_rigid_modes(deck: _Deck, comp, fixed, springs, Ks, K, M) -> None:
+    """Refuse a structure with rigid-body modes (zero strain energy, some mass) the deck does
+    not explain; with as many SUPORT DOFs as modes (a free-free model declared) warn."""
+    n, dropped, where = _free_rigid_modes(deck, comp, fixed, Ks, K, M)
+    if dropped:
+        deck.notes.append(f"{dropped} zero-frequency mode{'s' * (dropped > 1)} with less than "
+                          f"{MIN_OUT_OF_PLANE:.0%} of its kinetic energy out of plane (e.g. an "
+                          f"FN2 fictitious pitch inertia): left out by the mode selection")
+    if not n:
+        return
+    idx = np.flatnonzero(comp == where)
+    grids = [int(g) for g in deck.nids[idx][:8]]
+    piece = ("the whole plate" if idx.size == len(deck.nids)
+             else f"the piece of GRIDs {grids}{'...' if idx.size > 8 else ''}")
+    n_sup = _suport_dofs(deck.model)
+    if n_sup and n <= n_sup:
+        warnings.warn(f"{deck.name}: {n} rigid-body modes (free-free, SUPORT on {n_sup} "
+                      f"DOFs): asekit keeps them as 0 Hz modes among the elastic ones",
+                      BdfWarning, stacklevel=4)
+        return
+    raise BdfError(f"the structure has {n} rigid-body mode{'s' * (n > 1)} (zero "
+                   f"strain energy; {piece} moves freely): {_holding_words(deck, fixed, springs)}"
+                   f"{f'; SUPORT declares {n_sup}' if n_sup else ''}: add the SPC / SPC1 of "
+                   f"its supports (and SPC = n in the case control) or GRID PS")
 
 
 def _angles(keys, n):
@@ -1047,9 +1661,17 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
     Returns
     -------
     BdfModel
-        Raises :class:`BdfError` (a ValueError) for a deck asekit cannot represent (refused
-        cards listed); warns :class:`UnsupportedCardWarning` once, listing every card read
-        but not represented (name, count, first id).
+        Raises :class:`BdfError` (a ValueError, one line) for a deck asekit cannot represent
+        (refused cards listed) or that is wrong: any error of pyNastran's (the card, its id
+        and the field in pyNastran's words; a reference to a missing card names the card
+        that refers), a second card with an id already given (:data:`ID_SPACES`; an exact
+        repeat is read once), a value outside :data:`RANGES` (card, id, field, value in
+        deck and SI units), the MAT1 rules broken, a degenerate element, or rigid-body
+        modes that no SPC / SPC1 / GRID PS / CELAS holds (the missing support named; with
+        as many SUPORT DOFs it is a :class:`BdfWarning`). Warns :class:`BdfWarning` for
+        GRIDs that touch nothing and for plate pieces that touch nothing else, and
+        :class:`UnsupportedCardWarning` once, listing every card read but not represented
+        (name, count, first id).
     """
     if units not in UNITS:
         raise ValueError(f"units must be one of {sorted(UNITS)}, got {units!r}")
@@ -1057,9 +1679,14 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"BDF not found: {path}")
-    model = _open_deck(path, BDF)
+    if not path.is_file():
+        raise BdfError(f"{path}: not a file (give the deck's .bdf file)")
+    model, trace = _open_deck(path, BDF)
     ignored = _check_cards(model, path.name)
-    deck = _Deck(model, path.name, *UNITS[units], wtmass=_read_param_wtmass(model))
+    deck = _Deck(model, path.name, *UNITS[units], wtmass=_read_param_wtmass(model, path.name))
+    if trace.repeats:
+        deck.notes.append(f"{trace.repeats} cards repeated exactly (same id, same fields): "
+                          f"each read once")
     quads = _shell_elements(model, path.name)
     _read_grids(deck, quads, tol)
     conn, th, angles, pids, props = _read_shells(deck, quads)
@@ -1071,18 +1698,20 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
     fixed = _read_spcs(deck)
     dep, rigid = _read_rbe2(deck, fixed)
     Tm = _reduction(deck.n_dof, fixed, dep, K, M)
+    comp = _check_connectivity(deck, conn, quads, springs, masses, rigid)
+    _check_rigid_modes(deck, comp, fixed, springs, Ks, K, M)
     system = SupportedSystem(K=(Tm.T @ K @ Tm).tocsr(), M=(Tm.T @ M @ Tm).tocsr(), T=Tm,
                              shaft_index=None, ground_index=None, fictitious_inertia=0.0,
                              shaft_nodes=np.array([], dtype=np.int64), mesh=mesh,
                              label=f"BDF {path.name}: {len(quads)} CQUAD4, {len(deck.nids)} "
                                    f"GRID")
-    n_modes, f_max = _read_eigen_method(model, deck.T)
+    n_modes, f_max = _read_eigen_method(model, deck)
     aero = _read_aero(deck)
     if ignored:
         warnings.warn(f"{path.name}: cards read but not represented by asekit: "
                       f"{_fmt(ignored)}", UnsupportedCardWarning, stacklevel=2)
     return BdfModel(mesh=mesh, node_ids=deck.nids, K=K, M=M, system=system, **aero,
-                    n_modes=n_modes, f_max_hz=f_max, damping_g=_read_tabdmp1(model, deck.T),
+                    n_modes=n_modes, f_max_hz=f_max, damping_g=_read_tabdmp1(model, deck),
                     materials=materials, element_pids=pids.copy(),
                     element_angles=_angles(keys, len(quads)), springs=springs, masses=masses,
                     fixed=tuple(sorted(fixed)), rigid=rigid, ignored=tuple(ignored),

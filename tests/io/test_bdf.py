@@ -438,3 +438,270 @@ def test_imported_case_state_space_flutters_where_pk_says():
         assert "w_tip_te" in ss.output_labels
         growth.append(np.linalg.eigvals(np.asarray(ss.A)).real.max())
     assert growth[0] < 0 < growth[1], growth
+
+
+# ---------------------------------------------------------------------------------------------
+# issue 22: no silent wrong answer from a deck (reproducers of the independent check)
+# ---------------------------------------------------------------------------------------------
+def _card(*fields) -> str:
+    """One small-field (8-character) bulk data card: None is a blank field."""
+    return "".join(("" if f is None else str(f))[:8].ljust(8) for f in fields).rstrip()
+
+
+def _ha145e_deck(tmp_path, replace=(), add=(), drop=(), name="deck.bdf"):
+    """HA145E with its structure include inlined, lines starting with a prefix in ``drop``
+    removed, each (old, new) of ``replace`` applied once (old must be there) and the cards of
+    ``add`` before ENDDATA."""
+    text = (HA145E / "ha145e.bdf").read_text()
+    text = text.replace("INCLUDE 'ha145e_structure.bdf'",
+                        (HA145E / "ha145e_structure.bdf").read_text().strip())
+    for old, new in replace:
+        assert old in text, old
+        text = text.replace(old, new, 1)
+    text = "\n".join(ln for ln in text.splitlines() if not ln.startswith(tuple(drop))) + "\n"
+    text = text.replace("ENDDATA", "".join(a + "\n" for a in add) + "ENDDATA")
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+def test_inlined_ha145e_deck_reads_as_the_shipped_one(tmp_path):
+    """The helper's inlined deck is the shipped deck (same modes), so the reproducers below
+    change only what they say."""
+    ref = _modes(_read(HA145E / "ha145e.bdf", units="in-lbf-s")).frequencies_hz
+    f = _modes(_read(_ha145e_deck(tmp_path), units="in-lbf-s")).frequencies_hz
+    np.testing.assert_allclose(f, ref, rtol=1e-12)
+
+
+def test_deck_without_spc_is_refused_as_free_free(tmp_path):
+    """Issue 22: without its SPC1 cards HA145E is a free-free plate (three rigid-body modes:
+    heave, roll, pitch) that asekit imported silently and reported "no flutter" for. It is
+    refused, naming what is missing (no SPC set, and the case control's SPC = 1 names none);
+    declared free-free (SUPORT on three DOFs) it reads with a warning, and its first three
+    frequencies are zero (to 1e-4 of the first elastic one)."""
+    p = _ha145e_deck(tmp_path, drop=["SPC1"])
+    with pytest.raises(B.BdfError, match=r"3 rigid-body modes .*no SPC / SPC1 set applies.*"
+                                         r"SPC = 1 is not a set of the deck"):
+        _read(p, units="in-lbf-s")
+    sup = _ha145e_deck(tmp_path, drop=["SPC1"], add=[_card("SUPORT", 17, 345)], name="s.bdf")
+    with pytest.warns(B.BdfWarning, match="3 rigid-body modes .*SUPORT"):
+        case = _read(sup, units="in-lbf-s")
+    f = _modes(case, n_modes=4).frequencies_hz
+    assert np.all(f[:3] < 1e-4 * f[3]) and f[3] > 1.0
+
+
+def test_a_single_clamped_point_or_a_grounded_spring_holds_the_plate(tmp_path):
+    """The rigid-body check counts what the supports really hold: T3 R1 R2 fixed at one grid
+    (SPC1 345) or one grid held by CELAS2 springs to ground on T3, R1, R2 leave no rigid
+    mode; springs on T3 alone leave two (roll and pitch about that grid)."""
+    _read(_ha145e_deck(tmp_path, drop=["SPC1"], add=[_card("SPC1", 1, 345, 9)]),
+          units="in-lbf-s")
+    springs = [_card("CELAS2", 900 + c, 1.0e4, 9, c) for c in (3, 4, 5)]
+    _read(_ha145e_deck(tmp_path, drop=["SPC1"], add=springs, name="k.bdf"), units="in-lbf-s")
+    with pytest.raises(B.BdfError, match="2 rigid-body modes.*1 CELAS to ground"):
+        _read(_ha145e_deck(tmp_path, drop=["SPC1"], add=springs[:1], name="k1.bdf"),
+              units="in-lbf-s")
+
+
+def test_fn2_fictitious_pitch_inertia_is_noted_not_refused(fin, tmp_path):
+    """The fin's FN2 export holds a zero-frequency rigid pitch: the plate turning with the
+    ground GRID that carries the fictitious inertia (CONM2 I22) through the torsion spring.
+    Nearly all its kinetic energy is that inertia's rotation, so the mode selection leaves it
+    out (as the case's own pipeline does): a note, no error; the FN1 variant (spring to
+    ground) has no such mode."""
+    notes = _read(B.write_case_bdf(fin, tmp_path / "fn2.bdf")).structure.deck.notes
+    assert any(n.startswith("1 zero-frequency mode with less than 1%") for n in notes)
+    fn1 = _variant(DATA_DIR / "cases" / "nalci2013_fin.toml",
+                   support={"kind": "shaft", "axis_point": [0.078, 0.0],
+                            "torsional_stiffness": 120.0, "model": "FN1"})
+    notes = _read(B.write_case_bdf(fn1, tmp_path / "fn1.bdf")).structure.deck.notes
+    assert not any("zero-frequency" in n for n in notes)
+
+
+def test_free_mass_and_loose_plate_piece_are_refused_or_warned(tmp_path):
+    """A CONM2 on a grid that no element, spring or rigid link touches is a free mass (a 0 Hz
+    mode): refused, naming the grid. A second plate piece sharing nothing with the wing is
+    warned about; left unsupported it is refused as a rigid-body mode of that piece."""
+    iso = [_card("GRID", 99, None, 10.0, 10.0, 0.0), _card("CONM2", 500, 99, None, 0.1)]
+    with pytest.raises(B.BdfError, match=r"1 rigid-body mode .*GRIDs \[99\]"):
+        _read(_ha145e_deck(tmp_path, add=iso), units="in-lbf-s")
+    piece = [_card("GRID", 101 + i, None, x, y, 0.0)
+             for i, (x, y) in enumerate([(10.0, 0.0), (11.0, 0.0), (11.0, 1.0), (10.0, 1.0)])]
+    piece.append(_card("CQUAD4", 200, 1, 101, 102, 103, 104))
+    with pytest.raises(B.BdfError, match=r"3 rigid-body modes .*GRIDs \[101, 102, 103, 104\]"), \
+            pytest.warns(B.BdfWarning, match="2 pieces"):
+        _read(_ha145e_deck(tmp_path, add=piece, name="p.bdf"), units="in-lbf-s")
+    held = piece + [_card("SPC1", 1, 345, 101, 102)]
+    with pytest.warns(B.BdfWarning, match=r"2 pieces .*elements \[200\]"):
+        _read(_ha145e_deck(tmp_path, add=held, name="h.bdf"), units="in-lbf-s")
+
+
+def test_unconnected_off_plane_grid_is_warned(tmp_path):
+    """Issue 22: a GRID that no card connects to the structure (here 5 in off the plate's
+    plane) was accepted without a word; it is now named in a BdfWarning (and ignored: the
+    modes are those of the deck without it)."""
+    p = _ha145e_deck(tmp_path, add=[_card("GRID", 99, None, 1.0, 1.0, 5.0)])
+    with pytest.warns(B.BdfWarning, match=r"GRIDs \[99\] touch no element.*off the plate's "
+                                          r"plane: \[99\]"):
+        case = _read(p, units="in-lbf-s")
+    ref = _modes(_read(HA145E / "ha145e.bdf", units="in-lbf-s")).frequencies_hz
+    np.testing.assert_allclose(_modes(case).frequencies_hz, ref, rtol=1e-10)
+
+
+@pytest.mark.parametrize("extra", [
+    _card("FLFACT", 1, 2.0),                                  # pyNastran keeps the last one
+    _card("SET1", 100, 2, 4),                                 # pyNastran merges the two
+    _card("PARAM", "WTMASS", 1.0),                            # pyNastran warns, keeps the last
+    _card("GRID", 40, None, 3.6, 5.5251, 0.0),
+    _card("CQUAD4", 1, 1, 3, 4, 12, 11),
+    _card("CONM2", 1, 20, None, 0.01),                        # an element id of a CQUAD4
+    _card("PSHELL", 1, 1, 0.05, 1, None, 1),
+    _card("MAT1", 1, 1.0e7, None, 0.3, 0.1),
+    _card("CAERO1", 101, 1, None, 5, 4, None, None, 1) + "\n" + _card(
+        "", 0.0, 0.0, 0.0, 2.07055, 1.48044, 5.5251, 0.0, 2.07055),
+    _card("SPLINE1", 100, 101, 101, 110, 100),
+    _card("EIGR", 10, "MGIV", None, None, None, 5),
+    _card("TABDMP1", 2000, "G") + "\n" + _card("", 0.0, 0.02, 1000.0, 0.02, "ENDT"),
+    _card("AERO", 0, None, 3.0, "1.0726-7", 1),
+])
+def test_duplicate_ids_are_errors(tmp_path, extra):
+    """Issue 22: a second card with an id already given (here the HA145E deck's own ids, or an
+    element id of another element type) is refused with the card and id; before, a second
+    FLFACT silently replaced the first, a second SET1 was merged and PARAM WTMASS kept the
+    last value, while pyNastran refused others with its own errors."""
+    card = extra.split()[0]
+    with pytest.raises(B.BdfError, match=f"{card} .*duplicate ids are errors"):
+        _read(_ha145e_deck(tmp_path, add=[extra]), units="in-lbf-s")
+
+
+def test_exact_repeat_of_a_card_is_read_once(tmp_path):
+    """A card repeated field for field (an INCLUDE given twice, say) is no contradiction: read
+    once, with a note; even where pyNastran refuses identical cards (FLUTTER, CAERO1)."""
+    p = _ha145e_deck(tmp_path, add=[_card("FLUTTER", 30, "PK", 1, 2, 3, "L"),
+                                    _card("GRID", 40, None, 3.55099, 5.5251, 0.0)])
+    case = _read(p, units="in-lbf-s")
+    assert any("2 cards repeated exactly" in n for n in case.structure.deck.notes)
+    assert len(case.structure.deck.flutter) == 1
+
+
+@pytest.mark.parametrize("old, new, match", [
+    # issue 22: GRID x = 1e30 and RHOREF = 1e30 gave "no flutter"
+    (_card("GRID", 8, None, 1.48044, 5.5251), _card("GRID", 8, None, "1.+30", 5.5251),
+     r"GRID 8 X1 \(basic\) = 1e\+30 .*coordinate"),
+    ("1.0726-71", "1.+30   1", r"AERO RHOREF = 1e\+30 .*fluid density"),
+    ("9.2418+63.4993+6", "9.2418+93.4993+9", r"MAT1 1 \(PSHELL 1\) E = 9.2418e\+09 \(= "
+                                             r"6.37.*e\+13 Pa\) .*modulus <= 1e\+13"),
+    ("0.097464", "-1.0    ", r"MAT1 1 \(PSHELL 1\) RHO = -1 .*density"),
+    ("PSHELL  1       1       .041", "PSHELL  1       1       1000.0", r"PSHELL 1 T = 1000"),
+    ("        5400.   5600.", "        0.0     5600.", r"FLFACT 3 \(FLUTTER 30 RFREQ\) F8 = 0"),
+    ("        5400.   5600.", "        1.+30   5600.", r"FLFACT 3 .* velocity <= 10000 m/s"),
+    ("FLFACT  1       1.0", "FLFACT  1       -1.0", r"FLFACT 1 \(FLUTTER 30 DENS\) F1 = -1"),
+    ("        .18     .20", "        .18     1.+30", r"MKAERO1 k = 1e\+30 .*reduced frequency"),
+    ("0.0     0.01    1000.   0.01", "0.0     0.01    1000.   5.0 ", r"TABDMP1 2000 g2 = 5"),
+    ("PARAM   WTMASS  .0025901", "PARAM   WTMASS  -1.0", r"PARAM WTMASS = -1.0 must be"),
+])
+def test_values_outside_physical_ranges_are_refused(tmp_path, old, new, match):
+    """Issue 22: values far outside any physical range are refused with the card, its id, the
+    field, the value in deck and SI units and the range (asekit.io.bdf.RANGES); the ranges
+    are wide (a deck value is checked after conversion to SI: MAT1 E = 9.2418e9 psi is
+    6.4e13 Pa, beyond any material)."""
+    with pytest.raises(B.BdfError, match=match):
+        _read(_ha145e_deck(tmp_path, replace=[(old, new)]), units="in-lbf-s")
+
+
+def test_conm2_values_are_checked(tmp_path):
+    """CONM2: a negative mass, an offset of 1e30 and an inertia tensor that is not positive
+    (I21^2 > I11 I22) are refused by id and field."""
+    for cards, match in (([_card("CONM2", 500, 20, None, -1.0)], r"CONM2 500.*-1"),
+                         ([_card("CONM2", 500, 20, None, 1.0, "1.+30")], r"CONM2 500 X1"),
+                         ([_card("CONM2", 500, 20, None, 1.0) + "\n"
+                           + _card("", 1.0, 5.0, 1.0)], r"CONM2 500: I21\^2 > I11 I22")):
+        with pytest.raises(B.BdfError, match=match):
+            _read(_ha145e_deck(tmp_path, add=cards), units="in-lbf-s")
+
+
+@pytest.mark.parametrize("mat1, match", [
+    # issue 22: these were a ZeroDivisionError in asekit.io.bdf._material
+    (_card("MAT1", 1, "9.2418+6", "1.+30", None, 0.097464),
+     r"MAT1 1: NU = -1 \(from E = 9.2418e\+06 and G = 1e\+30: NU = E / \(2 G\) - 1\) is "
+     r"outside -1 < NU <= 0.5"),
+    (_card("MAT1", 1, "9.2418+6", None, -1.0, 0.097464), r"MAT1 1: NU = -1 is outside"),
+    (_card("MAT1", 1, "9.2418+6", None, 0.7, 0.097464), r"MAT1 1: NU = 0.7 is outside"),
+    (_card("MAT1", 1, "9.2418+6", None, None, 0.097464), r"MAT1 1: E given: .*two of E, G, NU"),
+    (_card("MAT1", 1, "-9.24+6", None, 0.3, 0.097464), r"MAT1 1: E = -9.24e\+06 must be > 0"),
+])
+def test_mat1_rules_named_with_their_range(tmp_path, mat1, match):
+    with pytest.raises(B.BdfError, match=match):
+        _read(_ha145e_deck(tmp_path, drop=["MAT1"], add=[mat1]), units="in-lbf-s")
+
+
+def test_mat1_g_and_nu_give_e(tmp_path):
+    """MAT1 with G and NU (E blank) is E = 2 (1 + NU) G: the deck's E = 9.2418e6 and G =
+    3.4993e6 (NU = E / (2 G) - 1 = 0.32052...) written as G and NU give the same modes."""
+    nu = 9.2418e6 / (2 * 3.4993e6) - 1
+    p = _ha145e_deck(tmp_path, drop=["MAT1"],
+                     add=[_card("MAT1", 1, None, "3.4993+6", f"{nu:.6f}", 0.097464)])
+    ref = _modes(_read(HA145E / "ha145e.bdf", units="in-lbf-s")).frequencies_hz
+    np.testing.assert_allclose(_modes(_read(p, units="in-lbf-s")).frequencies_hz, ref,
+                               rtol=1e-6)     # NU written with 6 decimals
+
+
+@pytest.mark.parametrize("old, new, match", [
+    (_card("CQUAD4", 9), _card("CQUAD4", "9.0"), r"CQUAD4 9.0: eid .*field #1"),
+    ("CQUAD4  10      1       11      12      20      19",
+     "CQUAD4  10      1       11      12      20      999", r"nid=999 .*required by CQUAD4 eid=10"),
+    ("CQUAD4  10      1       11      12      20      19",
+     "CQUAD4  10      7       11      12      20      19", r"pid=7 .*required by CQUAD4 eid=10"),
+    ("SPLINE1 100     101", "SPLINE1 100     555", r"required by SPLINE1 eid=100"),
+    ("CQUAD4  10      1       11      12      20      19",
+     "CQUAD4  10      1       11      20      12      19", r"CQUAD4 10 \(grids \[11, 20, 12, 19\]\) "
+                                                           r"is degenerate or not convex"),
+    # a re-entrant quadrilateral (found by the fuzzer): det J > 0 at the 2 x 2 Gauss points,
+    # < 0 at a corner and at the 3 x 3 points of the mass matrix (was a plain ValueError)
+    ("CQUAD4  11      1       12      13      21      20",
+     "CQUAD4  11      1       12      13      1       20", r"CQUAD4 11 .*not convex"),
+    ("SPC1    1       12345   9", "SPC1    1       12345   9       0", r"SPC1 1: a grid id is 0"),
+    ("ASET1   3       18      THRU    24", "ASET1   3       18      THRU    24000000",
+     r"ASET1 3: 18 THRU 24000000 \(fields 3-5\) holds 23999983 ids"),
+])
+def test_pynastran_errors_are_bdf_errors_naming_the_card(tmp_path, old, new, match):
+    """Issue 22: 271 of 400 mutated decks ended in pyNastran's own SyntaxError, KeyError,
+    AssertionError or RuntimeError; every one is now a BdfError naming the card, its id and
+    (in pyNastran's words) the field, or the card that refers to a missing one."""
+    with pytest.raises(B.BdfError, match=match):
+        _read(_ha145e_deck(tmp_path, replace=[(old, new)]), units="in-lbf-s")
+
+
+def test_a_directory_a_missing_include_and_an_included_card_are_named(tmp_path):
+    """A directory, a missing INCLUDE and a bad card of an INCLUDE file are BdfErrors naming
+    them (the CLI puts the deck's name in front)."""
+    with pytest.raises(B.BdfError, match="not a file"):
+        B.read_bdf(tmp_path)
+    p = tmp_path / "bad.bdf"
+    p.write_text("BEGIN BULK\nINCLUDE 'missing.bdf'\nENDDATA\n")
+    with pytest.raises(B.BdfError, match=r"line 2: INCLUDE 'missing.bdf': no such file"):
+        B.read_bdf(p)
+    s = (HA145E / "ha145e_structure.bdf").read_text().replace("CQUAD4  9       1",
+                                                              "CQUAD4  9.0     1")
+    (tmp_path / "s.bdf").write_text(s)
+    p.write_text((HA145E / "ha145e.bdf").read_text().replace("ha145e_structure.bdf", "s.bdf"))
+    with pytest.raises(B.BdfError, match=r"^CQUAD4 9.0 \(in s.bdf\): eid .*field #1"):
+        B.read_bdf(p)
+
+
+def test_mutated_decks_end_ok_or_in_a_bdf_error():
+    """The mutation fuzzer (tests/benchmarks/fuzz_bdf.py) on 60 of its decks: every outcome is
+    a read deck (ok, perhaps with an asekit warning) or a BdfError, never another exception
+    (before issue 22: 46 of these 60 ended in pyNastran's or asekit's plain exceptions)."""
+    import contextlib
+    import importlib.util
+    import io
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "fuzz_bdf.py"
+    spec = importlib.util.spec_from_file_location("fuzz_bdf", path)
+    fuzz = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(fuzz)
+    with contextlib.redirect_stdout(io.StringIO()):
+        seen = fuzz.run(60, 22, 60.0, 1)
+    assert set(seen) <= {"ok", "ok+warning", "BdfError"}, seen
+    assert seen["BdfError"] > 20 and seen["ok"] > 5          # both kinds are exercised
