@@ -111,7 +111,7 @@ def _need_pynastran():
     try:
         from pyNastran.bdf.bdf import BDF
     except ImportError as exc:                                    # pragma: no cover
-        raise ImportError("asekit.io.bdf needs pyNastran: pip install 'asekit[nastran]' "
+        raise ImportError("asekit.io.bdf needs pyNastran: pip install pyNastran "
                           "(see environment.txt)") from exc
     return BDF
 
