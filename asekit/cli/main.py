@@ -145,21 +145,57 @@ def error_line(exc: BaseException, command: str = "") -> tuple[str, int]:
             f"{type(exc).__name__}: {text[:300]}; rerun with --debug for the traceback"), 1
 
 
+class _Interrupts:
+    """Remembers a SIGINT while a command runs: a library that turns the KeyboardInterrupt into
+    an error of its own (matplotlib: "Invalid bounding box") is still reported as interrupted."""
+
+    def __init__(self):
+        self.seen = False
+
+    def __enter__(self):
+        import signal
+        self.previous = signal.getsignal(signal.SIGINT)
+        if self.previous is signal.default_int_handler:     # not when SIGINT is ignored
+            try:
+                signal.signal(signal.SIGINT, self._handler)
+            except ValueError:                              # not the main thread
+                self.previous = None
+        return self
+
+    def _handler(self, signum, frame):
+        self.seen = True
+        raise KeyboardInterrupt
+
+    def __exit__(self, *exc):
+        import signal
+        if self.previous is signal.default_int_handler:
+            signal.signal(signal.SIGINT, self.previous)
+        return False
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    try:
-        return args.func(args)
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return 130
-    except Exception as exc:            # one line, never a traceback (unless --debug)
-        if getattr(args, "debug", False):
-            import traceback
-            traceback.print_exc()
-        line, code = error_line(exc, args.command)
-        print(line, file=sys.stderr)
-        return code
+    with _Interrupts() as interrupts:
+        try:
+            code = args.func(args)
+            if code and interrupts.seen:    # the command reported the error it was turned into
+                print("interrupted", file=sys.stderr)
+                return 130
+            return code
+        except KeyboardInterrupt:
+            print("interrupted", file=sys.stderr)
+            return 130
+        except Exception as exc:            # one line, never a traceback (unless --debug)
+            if interrupts.seen:
+                print("interrupted", file=sys.stderr)
+                return 130
+            if getattr(args, "debug", False):
+                import traceback
+                traceback.print_exc()
+            line, code = error_line(exc, args.command)
+            print(line, file=sys.stderr)
+            return code
 
 
 if __name__ == "__main__":

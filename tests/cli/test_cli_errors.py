@@ -149,6 +149,30 @@ def test_keyboard_interrupt_is_130(monkeypatch, capsys):
     assert capsys.readouterr().err.strip() == "interrupted"
 
 
+def test_interrupt_turned_into_another_error_is_still_130(monkeypatch, capsys):
+    """Seen with a real SIGINT during --report: matplotlib turned it into "ValueError: Invalid
+    bounding box" (exit 2, a wrong reason)."""
+    import signal
+
+    def figures_interrupted(*a, **k):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)
+        except KeyboardInterrupt:
+            raise ValueError("Invalid bounding box") from None
+        pytest.fail("no KeyboardInterrupt")
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        pytest.skip("SIGINT is not Python's default handler here")
+    monkeypatch.setattr(R, "run_analysis", figures_interrupted)      # analyse reports it
+    assert main(["analyse", str(FV16), "--quiet"]) == 130
+    assert capsys.readouterr().err.strip().splitlines()[-1] == "interrupted"
+    monkeypatch.setattr(R, "run_analysis", lambda *a, **k: None)      # main sees it
+    monkeypatch.setattr(R, "summary", figures_interrupted)
+    assert main(["analyse", str(FV16), "--quiet"]) == 130
+    assert capsys.readouterr().err.strip() == "interrupted"
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler     # restored
+
+
 # ---- output paths ----------------------------------------------------------------------------
 def test_json_into_a_missing_folder_is_created(tmp_path, capsys):
     """Reproducer: `analyse ... --json nodir/o.json` ran the analysis, then a traceback."""
