@@ -14,9 +14,8 @@ import numpy as np
 import pytest
 
 from asekit.atmosphere import MAX_ALTITUDE, standard_atmosphere
-from asekit.case import CaseError, SolverError, case_from_dict, load_case
+from asekit.case import CaseError, SolverError, case_from_dict, load_case, schema
 from asekit.case import pipeline as P
-from asekit.case import schema
 from asekit.geometry import Material, Planform
 from asekit.util.paths import CASES_DIR
 
