@@ -21,8 +21,17 @@ Examples
 'nalci2013_fin'
 """
 
-from asekit.case import Case, CaseError, load_case, pipeline
+from asekit.case import Case, CaseError, load_case
 from asekit.util.paths import CASES_DIR, FIN_FILE
 from asekit.util.version import __version__
 
 __all__ = ["CASES_DIR", "Case", "CaseError", "FIN_FILE", "load_case", "pipeline", "__version__"]
+
+
+def __getattr__(name):
+    """``asekit.pipeline`` imported on first use (PEP 562): ``python -m asekit`` then reports a
+    refused input before the pipeline's imports (python-control, matplotlib) are paid for."""
+    if name == "pipeline":
+        from asekit.case import pipeline
+        return pipeline
+    raise AttributeError(f"module 'asekit' has no attribute {name!r}")

@@ -29,7 +29,12 @@ RHO0 = P0 / (R_AIR * T0)  # 1.2250 kg/m^3
 #: Layer bases (geopotential m) and temperature lapse rates (K/m), Table 4 up to 47 km.
 _H_BASE = np.array([0.0, 11000.0, 20000.0, 32000.0, 47000.0])
 _LAPSE = np.array([-0.0065, 0.0, 0.0010, 0.0028, 0.0])
-MAX_ALTITUDE = 47000.0  # m geometric-ish upper limit of the layers implemented
+#: The geometric altitudes (m) this model covers: the 1976 standard's tables start at -5 km and
+#: the layers implemented end at 47 km. The one source of the altitude range: the case file
+#: (``flight.altitudes``, ``flight.envelope.altitude``, ``actuator.condition.altitude``) and
+#: the sweep file (``flight.altitude``) refuse altitudes outside it.
+MIN_ALTITUDE = -5000.0
+MAX_ALTITUDE = 47000.0
 
 
 def _layer_bases():
@@ -68,8 +73,9 @@ class AtmosphereState:
 
 def _altitude(h) -> np.ndarray:
     h = np.asarray(h, dtype=float)
-    if not np.all(np.isfinite(h)) or np.any(h < -5000.0) or np.any(h > MAX_ALTITUDE):
-        raise ValueError(f"altitude must be finite and within [-5000, {MAX_ALTITUDE:.0f}] m, "
+    if not np.all(np.isfinite(h)) or np.any(h < MIN_ALTITUDE) or np.any(h > MAX_ALTITUDE):
+        raise ValueError(f"altitude must be finite and within [{MIN_ALTITUDE:.0f}, "
+                         f"{MAX_ALTITUDE:.0f}] m, "
                          f"got {h}")
     return h
 

@@ -598,8 +598,9 @@ def _sample_case(d: dict):
 def _check_condition(where: str, path: str, v: float, method: str = "dlm") -> None:
     """The analysed Mach must lie in the Mach range of the base case's ``aero.method``
     (:func:`asekit.aero.methods.resolve_method`), the altitude in the 1976 standard atmosphere
-    (-1000 to 80000 m), the density in (0, 100] kg/m^3; SweepError naming the sweep-file key
-    path ``where`` and, for the Mach, the case key path ``aero.method``."""
+    (:data:`asekit.atmosphere.MIN_ALTITUDE` to :data:`~asekit.atmosphere.MAX_ALTITUDE`, -5000
+    to 47000 m), the density in (0, 100] kg/m^3; SweepError naming the sweep-file key path
+    ``where`` and, for the Mach, the case key path ``aero.method``."""
     if path == "flight.mach":
         try:
             with warnings.catch_warnings():
@@ -609,8 +610,10 @@ def _check_condition(where: str, path: str, v: float, method: str = "dlm") -> No
             raise SweepError(f"{where} = {v:g} cannot be analysed with the base case's "
                              f"aero.method = {method!r} ({method_spec(method).summary}): "
                              f"{exc}") from None
-    if path == "flight.altitude" and not -1000.0 <= v <= 80000.0:
-        raise SweepError(f"{where} must be an altitude in [-1000, 80000] m, got {v:g}")
+    from asekit.atmosphere import MAX_ALTITUDE, MIN_ALTITUDE
+    if path == "flight.altitude" and not MIN_ALTITUDE <= v <= MAX_ALTITUDE:
+        raise SweepError(f"{where} must be an altitude in [{MIN_ALTITUDE:g}, {MAX_ALTITUDE:g}] m "
+                         f"(the 1976 standard atmosphere's layers implemented), got {v:g}")
     if path == "flight.density" and not 0.0 < v <= 100.0:
         raise SweepError(f"{where} must be a density in (0, 100] kg/m^3, got {v:g}")
 

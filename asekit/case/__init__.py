@@ -15,6 +15,7 @@ from asekit.case.schema import (
                                 ModesSpec,
                                 PanelSpec,
                                 PointMass,
+                                SolverError,
                                 SupportSpec,
                                 case_from_dict,
                                 load_case,
@@ -22,5 +23,5 @@ from asekit.case.schema import (
 
 __all__ = ["ActuatorSpec", "AeroSpec", "Case", "CaseError", "DampingSpec", "FlightSpec",
            "FlutterIndexSpec", "FlutterSpec", "ImportedModel", "ModesSpec", "PanelSpec",
-           "PointMass", "SupportSpec",
+           "PointMass", "SolverError", "SupportSpec",
            "case_from_dict", "load_case"]

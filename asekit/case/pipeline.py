@@ -25,7 +25,14 @@ from asekit.aeroelastic.statespace import fin_outputs
 from asekit.ase import loop as ase_mod
 from asekit.ase import metrics
 from asekit.atmosphere import standard_atmosphere
-from asekit.case.schema import MOTOR_KEYS, TRANSMISSION_KEYS, Case, CaseError
+from asekit.case.schema import (
+    MOTOR_KEYS,
+    TRANSMISSION_KEYS,
+    Case,
+    CaseError,
+    SolverError,
+    auto_boxes,
+)
 from asekit.rfa.methods import rfa_kind
 from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, DCMotor, Transmission
 from asekit.servo.simulate import THESIS_LIMITS, SteadyHingeMoment
@@ -40,13 +47,47 @@ from asekit.structure.modes import InPlaneModes, ModalModel, fixed_modal_model, 
 from asekit.structure.modes import inplane_modes as _inplane_modes
 from asekit.structure.supports import support_kind
 from asekit.util.conventions import mode_label
-from asekit.util.validate import finite, positive
+from asekit.util.validate import finite
+
+# ---------------------------------------------------------------------------------------------
+# the door: a numerical failure of a checked case becomes a SolverError saying what to change
+# ---------------------------------------------------------------------------------------------
+_STRUCTURE = ("check material (moduli, density), thickness, support stiffness and "
+              "panel[*].n_chord / n_span, or give modes.count / lower modes.f_max")
+_AERO = "check aero.boxes, aero.machs and aero.reduced_frequencies"
+_FLUTTER = ("check flight.velocities and the flight conditions (altitudes or densities), "
+            "flutter.method, flutter.rfa and flutter.lags")
+_ASE = "check [actuator] (its motor, transmission, controller and condition)"
+
+
+def _door(step: str, change: str):
+    """Decorator of the pipeline's public functions: a numerical failure inside (ARPACK or
+    SuperLU's RuntimeError, LinAlgError, MemoryError, SystemError) is re-raised as a one-line
+    :class:`~asekit.case.schema.SolverError` naming ``step``, the solver's message and
+    ``change`` (what to change in the case). CaseError, SolverError and the other ValueErrors
+    (bad arguments) pass unchanged."""
+    def decorate(fn):
+        @functools.wraps(fn)
+        def wrapper(*args, **kw):
+            try:
+                return fn(*args, **kw)
+            except (SolverError, CaseError, NotImplementedError, RecursionError):
+                raise
+            except (np.linalg.LinAlgError, RuntimeError, MemoryError, SystemError) as exc:
+                what = " ".join(str(exc).split()) or "no message"
+                if isinstance(exc, MemoryError):
+                    what = "out of memory" + (f" ({what})" if str(exc) else "")
+                raise SolverError(f"{step} failed ({type(exc).__name__}: {what[:300]}): "
+                                  f"{change}") from exc
+        return wrapper
+    return decorate
 
 
 # ---------------------------------------------------------------------------------------------
 # structure
 # ---------------------------------------------------------------------------------------------
 @lru_cache(maxsize=16)
+@_door("the structural mesh", _STRUCTURE)
 def structural_mesh(case: Case) -> PlateMesh:
     """The plate mesh of all panels (``panel[i].n_chord x n_span`` elements each), or the
     imported model's mesh (``case.structure``)."""
@@ -56,6 +97,7 @@ def structural_mesh(case: Case) -> PlateMesh:
                        case.panels[0].n_chord, [p.n_span for p in case.panels])
 
 
+@_door("assembling K and M", _STRUCTURE)
 def mass_and_stiffness(case: Case):
     """Global sparse K (plate) and M (plate + point masses) of the case's mesh (the imported
     model's K and M when ``case.structure`` is given, plus the case's point masses)."""
@@ -97,6 +139,7 @@ def _memo_with_warnings(fn):
     return wrapper
 
 
+@_door("the supported structure", _STRUCTURE)
 def supported_system(case: Case) -> SupportedSystem:
     """The case's supported structure (its ``support.kind`` of
     :data:`asekit.structure.supports.SUPPORTS`; for a shaft, the FN1 or FN2 system as
@@ -111,6 +154,7 @@ def supported_system(case: Case) -> SupportedSystem:
 
 
 @_memo_with_warnings
+@_door("the modal model (plate eigenproblem: ARPACK with SuperLU)", _STRUCTURE)
 def modal_model(case: Case) -> ModalModel:
     """The case's modal model (thesis Eqs. 2.45-2.46): for a shaft with ``model = "FN2"`` and
     ``modes.keep_rigid`` the rigid pitch mode first (n_rigid = 1), otherwise the elastic modes
@@ -158,6 +202,7 @@ def _shaft(case: Case, what: str):
     return case.support
 
 
+@_door("the pitch inertia", _STRUCTURE)
 def pitch_inertia_exact(case: Case) -> float:
     """Pitch inertia (kg m^2) of a one-panel flat case about its shaft axis by exact integration
     (:func:`asekit.structure.assembly.plate_pitch_inertia`; no point masses)."""
@@ -169,6 +214,7 @@ def pitch_inertia_exact(case: Case) -> float:
         raise CaseError(f"thickness / material: {exc}") from None
 
 
+@_door("the in-plane modes", _STRUCTURE)
 def inplane_modes(case: Case, n_modes: int = 4) -> InPlaneModes:
     """In-plane modes of a shaft-supported case held only at the shaft node
     (:func:`asekit.structure.modes.inplane_modes` on :func:`structural_mesh`)."""
@@ -184,6 +230,8 @@ def _imported_matrices(case: Case):
     return case.structure.K.tocsr(), case.structure.M.tocsr()
 
 
+@_door("the modal model of the imported structure",
+       "check the deck's materials, properties and constraints, or give modes.count")
 def imported_modal_model(case: Case) -> ModalModel:
     """The modal model (n_rigid = 0) of a case with an imported structure.
 
@@ -217,6 +265,7 @@ def imported_modal_model(case: Case) -> ModalModel:
         raise CaseError(str(exc)) from None
 
 
+@_door("the imported mesh's corners", "check the deck's GRIDs")
 def imported_corner_points(case: Case) -> dict:
     """The imported mesh's four corners: the nodes of least and greatest x on its root
     (least y) and tip (greatest y) stations, (x, y) m."""
@@ -231,6 +280,7 @@ def imported_corner_points(case: Case) -> dict:
     return {k: out[k] for k in ("root_le", "root_te", "tip_le", "tip_te")}
 
 
+@_door("the imported boxes", "check the deck's CAERO1 cards")
 def imported_box_mesh(case: Case):
     """The imported structure's boxes; CaseError if it has none."""
     if case.structure.boxes is None:
@@ -242,35 +292,8 @@ def imported_box_mesh(case: Case):
 # ---------------------------------------------------------------------------------------------
 # aerodynamics
 # ---------------------------------------------------------------------------------------------
-def auto_boxes(planform, u_min: float, f_max: float, n_chord: int | None = None,
-               n_span: int | None = None, bpw_min: float = 15.0,
-               ar_max: float = 3.0) -> tuple[int, int]:
-    """Box counts (n_chord, n_span) of one panel from the mesh rules (thesis Sec. 3.2.1).
-
-    n_chord (unless given): the smallest n_chord >= 4 with boxes per wavelength
-    U_min / (f_max dx) > ``bpw_min`` (strictly) on the root strip, dx = root chord / n_chord
-    (Eq. 3.5); n_span (unless given): the smallest keeping the tip boxes' aspect ratio
-    span / (n_span dx_tip) below 0.9 ``ar_max`` (a 10 % margin), dx_tip = tip chord / n_chord.
-    u_min in m/s, f_max in Hz.
-
-    Examples
-    --------
-    >>> from asekit.geometry import Planform
-    >>> auto_boxes(Planform((0.0, 0.0), 0.156, (0.078, 0.15), 0.078), 180.0, 1000.0)
-    (14, 10)
-    """
-    u_min, f_max = positive("aero.u_min", u_min), positive("aero.f_max", f_max)
-    bpw_min, ar_max = positive("bpw_min", bpw_min), positive("ar_max", ar_max)
-    if n_chord is None:
-        dx_max = u_min / (bpw_min * f_max)
-        n_chord = max(4, math.floor(planform.root_chord / dx_max) + 1)
-    if n_span is None:
-        dx_tip = planform.tip_chord / n_chord
-        n_span = max(1, math.ceil(planform.span / (0.9 * ar_max * dx_tip)))
-    return int(n_chord), int(n_span)
-
-
 @lru_cache(maxsize=16)
+@_door("the aerodynamic boxes", _AERO)
 def box_mesh(case: Case):
     """The doublet-lattice boxes, per panel ``aero.boxes`` or automatic (:func:`auto_boxes`),
     or the imported structure's boxes; the surfaces are named ``"surface"`` (one panel) or
@@ -296,6 +319,7 @@ def box_mesh(case: Case):
     return mesh_surfaces(surfaces)
 
 
+@_door("the reduced frequencies", _AERO)
 def reduced_frequencies(case: Case) -> np.ndarray:
     """``aero.reduced_frequencies`` or, automatically, :func:`default_reduced_frequencies` up
     to k_max = 2 pi f_max b / u_min (thesis Sec. 3.2.1).
@@ -314,6 +338,7 @@ def reduced_frequencies(case: Case) -> np.ndarray:
     return default_reduced_frequencies(2 * math.pi * a.f_max * a.reference_semichord / a.u_min)
 
 
+@_door("the GAF database (doublet lattice, Mach box or piston theory)", _AERO)
 def gaf_database(case: Case, progress: bool = True, cache: bool = True,
                  path=None) -> GafDatabase:
     """Q_mm(M, k) over ``aero.machs`` x the reduced frequencies of :func:`modal_model` on
@@ -347,6 +372,7 @@ class FlightCondition:
     speed_of_sound: float | None
 
 
+@_door("the flight conditions", _FLUTTER)
 def flight_conditions(case: Case) -> list[FlightCondition]:
     """The analysed conditions: per altitude (standard atmosphere) or per density."""
     f = case.flight
@@ -399,6 +425,7 @@ class FlutterAnalysis:
     notes: tuple[str, ...] = field(default_factory=tuple)
 
 
+@_door("the rational function approximation", _FLUTTER)
 def rfa_at(case: Case, db: GafDatabase, mach: float):
     """The case's rational function approximation (``flutter.rfa`` with ``flutter.lags`` lag
     roots, :data:`asekit.rfa.methods.RFA_FITS`) of the GAFs at ``mach`` (interpolated linearly
@@ -408,6 +435,7 @@ def rfa_at(case: Case, db: GafDatabase, mach: float):
     return rfa_kind(case.flutter.rfa).fit(k, q, db.b_ref, mach, case.flutter.lags)
 
 
+@_door("the flutter solution", _FLUTTER)
 def analyse_condition(case: Case, db: GafDatabase, mach: float, cond: FlightCondition,
                       model: ModalModel | None = None) -> ConditionResult:
     """The case's flutter method (``flutter.method``, :data:`FLUTTER_METHODS`) at one Mach and
@@ -591,6 +619,7 @@ def _interp_speed(points: list[tuple[float, float]], mach: float,
     return float(us[i] + (us[i + 1] - us[i]) * (mach - ms[i]) / (ms[i + 1] - ms[i]))
 
 
+@_door("the flutter analysis", _FLUTTER)
 def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -> FlutterAnalysis:
     """Flutter at every ``aero.machs`` x flight condition by the case's ``flutter.method``
     (p-k with mode tracking by default, :data:`asekit.aeroelastic.methods.FLUTTER_METHODS`),
@@ -673,6 +702,7 @@ class AseResult:
     corner_overshoot: dict
 
 
+@_door("the corner points", _STRUCTURE)
 def corner_points(case: Case) -> dict:
     """The surface's four corners (root LE/TE of the first panel, tip LE/TE of the last; of an
     imported structure: :func:`imported_corner_points`)."""
@@ -683,6 +713,7 @@ def corner_points(case: Case) -> dict:
             "tip_le": t.tip_le, "tip_te": (t.tip_le[0] + t.tip_chord, t.tip_le[1])}
 
 
+@_door("the actuator", _ASE)
 def actuator_setup(case: Case):
     """(ActuatorParameters, PDController, PowerLimits) of the case's ``[actuator]``: the keys
     it sets, asekit's defaults (thesis Tables 12, 16, 17) for the rest. The actuator's load
@@ -738,6 +769,7 @@ class AseCondition:
                                  speed_of_sound=float(atm.speed_of_sound))
 
 
+@_door("the aeroservoelastic model", _ASE)
 def ase_condition(case: Case, mach: float | None = None, altitude: float | None = None,
                   actuator=None, count_fin_inertia_twice: bool = False, n_lags: int | None = None,
                   fit=None, db: GafDatabase | None = None,
@@ -794,6 +826,7 @@ def ase_condition(case: Case, mach: float | None = None, altitude: float | None 
                         mach=mach, altitude=altitude, density=rho, velocity=mach * sos)
 
 
+@_door("the ASE loop", _ASE)
 def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
     """The Ch. 5 analysis of the case's actuator (None without ``[actuator]``)."""
     if case.actuator is None:

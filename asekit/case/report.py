@@ -365,21 +365,67 @@ def figures(a: Analysis) -> dict:
     return figs
 
 
-def write_report(a: Analysis, directory) -> Path:
-    """Write ``directory/index.html`` (summary table and figures) with the PNGs beside it and
-    ``summary.json``; returns the index path."""
-    d = Path(directory)
-    d.mkdir(parents=True, exist_ok=True)
-    s = summary(a)
-    (d / "summary.json").write_text(json.dumps(s, indent=2))
-    names = [save_figure(f, d, n).name for n, f in figures(a).items()]
+def write_text_atomic(path, text: str) -> Path:
+    """Write ``text`` to ``path`` through a temporary file in the same folder and
+    :func:`os.replace`: a reader (or an interrupted run) sees the old file or the new one,
+    never half of it."""
+    import os
+    import tempfile
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _report_page(s: dict, names) -> str:
     body = "\n".join(f'<figure><img src="{html.escape(n)}" alt="{html.escape(n)}"></figure>'
                      for n in names)
-    page = (f"<!doctype html><html><head><meta charset='utf-8'><title>asekit: "
+    return (f"<!doctype html><html><head><meta charset='utf-8'><title>asekit: "
             f"{html.escape(s['case'])}</title><style>body{{font-family:sans-serif;max-width:70em;"
             f"margin:auto}} img{{max-width:100%}} pre{{background:#f4f4f4;padding:1em}}</style>"
             f"</head><body><h1>{html.escape(s['case'])}</h1><pre>"
             f"{html.escape(format_summary(s, width=120))}</pre>{body}</body></html>")
-    index = d / "index.html"
-    index.write_text(page)
-    return index
+
+
+def write_report(a: Analysis, directory) -> Path:
+    """Write ``directory/index.html`` (summary table and figures) with the PNGs beside it and
+    ``summary.json``; returns the index path.
+
+    The report is written into a temporary folder next to ``directory`` and moved into place
+    when complete (an existing report there is replaced), so an interrupted run (SIGINT) leaves
+    the previous report or none, never PNGs without their ``index.html``."""
+    import os
+    import shutil
+    import tempfile
+    d = Path(directory)
+    d.parent.mkdir(parents=True, exist_ok=True)
+    if d.exists() and not d.is_dir():
+        raise NotADirectoryError(f"--report {d}: exists and is not a directory")
+    tmp = Path(tempfile.mkdtemp(prefix=f".{d.name}.", suffix=".partial", dir=d.parent))
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o777 & ~umask)           # mkdtemp's folder is private (0700)
+    old = None
+    try:
+        s = summary(a)
+        (tmp / "summary.json").write_text(json.dumps(s, indent=2))
+        names = [save_figure(f, tmp, n).name for n, f in figures(a).items()]
+        (tmp / "index.html").write_text(_report_page(s, names))
+        if d.exists():
+            old = d.with_name(f".{d.name}.{os.getpid()}.old")
+            os.replace(d, old)
+        os.replace(tmp, d)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        if old is not None and not d.exists():
+            os.replace(old, d)              # put the previous report back
+        raise
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+    return d / "index.html"

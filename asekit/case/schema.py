@@ -18,17 +18,80 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
+from asekit.aero.boxes import MAX_MATRIX_BYTES
 from asekit.aero.methods import METHODS, resolve_method
 from asekit.aeroelastic.methods import FLUTTER_METHODS
+from asekit.atmosphere import MAX_ALTITUDE, MIN_ALTITUDE
 from asekit.case.imported import ImportedModel
 from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
 from asekit.rfa.methods import RFA_FITS
 from asekit.structure.supports import SUPPORTS
-from asekit.util.validate import read_toml
+from asekit.util.validate import positive, read_toml
 
 
 class CaseError(ValueError):
     """A case file or case definition that cannot be analysed; the message names the key."""
+
+
+class SolverError(RuntimeError):
+    """A numerical failure (ARPACK, SuperLU, LinAlgError, out of memory) of a case that passed
+    the loader's checks, raised at the door of :mod:`asekit.case.pipeline`: the message names
+    the step that failed, the solver's own message and what to change in the case."""
+
+
+#: Largest leading- or trailing-edge sweep (deg) of a panel: beyond it the plate elements'
+#: smallest angle (90 deg - the sweep) is below 5 deg and the plate's rigid-body modes carry
+#: strain energy (the planform is all but folded over itself).
+MAX_EDGE_SWEEP_DEG = 85.0
+#: Largest estimated sparse LU factor (bytes) of the structural eigenproblem (K - sigma M, one
+#: per modal model): refused by the loader before SuperLU runs out of memory.
+MAX_STRUCTURAL_BYTES = 2 * 2 ** 30
+#: Ranges of the engineering materials (Pa for moduli, kg/m^3 for density): foams and soft
+#: elastomers (10 kPa, 1 kg/m^3) to ten times diamond's modulus and four times osmium's density.
+#: Values many orders of magnitude outside are typing errors (and make ARPACK fail).
+MODULUS_RANGE = (1e4, 1e13)
+DENSITY_RANGE = (1.0, 1e5)
+
+
+def structural_factor_bytes(n_dof: int) -> float:
+    """Estimated memory (bytes) of the sparse LU factor of K - sigma M for ``n_dof`` plate
+    degrees of freedom: nnz(L + U) = 10.4 n_dof^1.294 entries of 12 bytes (value and row
+    index), the fit of SuperLU's MMD_AT_PLUS_A fill on square plate meshes from 20 x 20 to
+    160 x 160 elements (1260 to 77280 dof, within 3 %; measured for issue 22)."""
+    return 12.0 * 10.4 * float(n_dof) ** 1.294
+
+
+def _max_dof(max_bytes: float) -> int:
+    """The largest n_dof whose :func:`structural_factor_bytes` fits in ``max_bytes``."""
+    return int((max_bytes / (12.0 * 10.4)) ** (1.0 / 1.294))
+
+
+def auto_boxes(planform, u_min: float, f_max: float, n_chord: int | None = None,
+               n_span: int | None = None, bpw_min: float = 15.0,
+               ar_max: float = 3.0) -> tuple[int, int]:
+    """Box counts (n_chord, n_span) of one panel from the mesh rules (thesis Sec. 3.2.1).
+
+    n_chord (unless given): the smallest n_chord >= 4 with boxes per wavelength
+    U_min / (f_max dx) > ``bpw_min`` (strictly) on the root strip, dx = root chord / n_chord
+    (Eq. 3.5); n_span (unless given): the smallest keeping the tip boxes' aspect ratio
+    span / (n_span dx_tip) below 0.9 ``ar_max`` (a 10 % margin), dx_tip = tip chord / n_chord.
+    u_min in m/s, f_max in Hz.
+
+    Examples
+    --------
+    >>> from asekit.geometry import Planform
+    >>> auto_boxes(Planform((0.0, 0.0), 0.156, (0.078, 0.15), 0.078), 180.0, 1000.0)
+    (14, 10)
+    """
+    u_min, f_max = positive("aero.u_min", u_min), positive("aero.f_max", f_max)
+    bpw_min, ar_max = positive("bpw_min", bpw_min), positive("ar_max", ar_max)
+    if n_chord is None:
+        dx_max = u_min / (bpw_min * f_max)
+        n_chord = max(4, math.floor(planform.root_chord / dx_max) + 1)
+    if n_span is None:
+        dx_tip = planform.tip_chord / n_chord
+        n_span = max(1, math.ceil(planform.span / (0.9 * ar_max * dx_tip)))
+    return int(n_chord), int(n_span)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -418,8 +481,25 @@ def _panels(raw) -> tuple[PanelSpec, ...]:
             if nc != panels[0].n_chord:
                 raise CaseError(f"panel[{i}].n_chord must equal panel[0].n_chord = "
                                 f"{panels[0].n_chord} (a conforming structural mesh), got {nc}")
+        _check_sweep(i, rle, rc, tle, tc)
         panels.append(PanelSpec(_wrap(f"panel[{i}]", Planform, rle, rc, tle, tc), nc, ns))
     return tuple(panels)
+
+
+def _check_sweep(i, rle, rc, tle, tc) -> None:
+    """Refuse a panel whose leading or trailing edge is swept beyond :data:`MAX_EDGE_SWEEP_DEG`
+    (its elements' smallest angle 90 deg - sweep: a planform folded onto itself)."""
+    span = tle[1] - rle[1]
+    for edge, dx, keys in (("leading", tle[0] - rle[0], "tip_leading_edge x"),
+                           ("trailing", tle[0] + tc - rle[0] - rc,
+                            "tip_leading_edge x + tip_chord")):
+        sweep = math.degrees(math.atan2(abs(dx), span))
+        if sweep > MAX_EDGE_SWEEP_DEG:
+            raise CaseError(f"panel[{i}]: the {edge} edge is swept {sweep:.2f} deg ({keys} moves "
+                            f"{dx:g} m over a span of {span:g} m), the planform folds onto "
+                            f"itself; the edge sweeps must be within +-{MAX_EDGE_SWEEP_DEG:g} "
+                            f"deg (|dx| <= {span * math.tan(math.radians(MAX_EDGE_SWEEP_DEG)):.4g}"
+                            f" m)")
 
 
 def _thickness(t: _Table) -> Thickness:
@@ -439,6 +519,7 @@ def _material(t: _Table):
         nu = t.number("poisson_ratio", required=True, low=-1.0, high=0.5, high_open=True)
         rho = t.number("density", required=True, low=0.0, high=1e6, unit="kg/m^3")
         t.done()
+        _engineering("material", {"youngs_modulus": e}, rho)
         return _wrap("material", Material, e, nu, rho, name)
     vals = {k: t.number(k, required=True, low=0.0, high=big, unit="Pa") for k in ("e1", "e2", "g12")}
     nu12 = t.number("nu12", required=True, low=-10.0, high=10.0)
@@ -448,8 +529,20 @@ def _material(t: _Table):
     angle = t.number("fibre_angle_deg", default=0.0, low=-360.0, high=360.0, low_open=False,
                      unit="deg")
     t.done()
+    _engineering("material", dict(vals, g13=g13, g23=g23), rho)
     return _wrap("material", OrthotropicMaterial, vals["e1"], vals["e2"], vals["g12"], nu12, rho,
                  g13, g23, math.radians(angle), name)
+
+
+def _engineering(path: str, moduli: dict, density: float) -> None:
+    """Refuse moduli (Pa) and a density (kg/m^3) outside :data:`MODULUS_RANGE` /
+    :data:`DENSITY_RANGE` (engineering materials), naming the key."""
+    for k, v in list(moduli.items()) + [("density", density)]:
+        lo, hi, unit = (DENSITY_RANGE + ("kg/m^3",) if k == "density"
+                        else MODULUS_RANGE + ("Pa",))
+        if v is not None and not lo <= v <= hi:
+            raise CaseError(f"{path}.{k} = {v:g} {unit} is outside the range of engineering "
+                            f"materials [{lo:g}, {hi:g}] {unit} (SI units: Pa and kg/m^3)")
 
 
 def _support(t: _Table, panels) -> SupportSpec:
@@ -468,7 +561,23 @@ def _support(t: _Table, panels) -> SupportSpec:
                        **{k: v for k, v in fields.items() if k in known})
 
 
-def _point_masses(raw) -> tuple[PointMass, ...]:
+def _on_planform(panels, x: float, y: float) -> bool:
+    """Whether (x, y) lies on one of the panels (edges included, to 1e-9 of the size)."""
+    for p in panels:
+        pf = p.planform
+        tol = 1e-9 * max(pf.span, pf.root_chord, pf.tip_chord)
+        eta = (y - pf.root_le[1]) / pf.span
+        if not -tol / pf.span <= eta <= 1 + tol / pf.span:
+            continue
+        e = min(max(eta, 0.0), 1.0)
+        x_le = pf.root_le[0] + e * (pf.tip_le[0] - pf.root_le[0])
+        c = pf.root_chord + e * (pf.tip_chord - pf.root_chord)
+        if x_le - tol <= x <= x_le + c + tol:
+            return True
+    return False
+
+
+def _point_masses(raw, panels=()) -> tuple[PointMass, ...]:
     if raw is None:
         return ()
     if not isinstance(raw, list):
@@ -481,6 +590,12 @@ def _point_masses(raw) -> tuple[PointMass, ...]:
         inertia = t.numbers("inertia", default=[0.0, 0.0], length=2, low=0.0, low_open=False,
                             high=1e9, unit="kg m^2")
         t.done()
+        if panels and not _on_planform(panels, *pos):
+            c = panels[0].planform.corners.tolist() + panels[-1].planform.corners.tolist()
+            lo, hi = np.min(c, axis=0), np.max(c, axis=0)
+            raise CaseError(f"point_mass[{i}].position {list(pos)} m is off the planform (the "
+                            f"panels span x {lo[0]:g} to {hi[0]:g} m, y {lo[1]:g} to {hi[1]:g} "
+                            f"m): a point mass must lie on a panel")
         out.append(PointMass(pos, m, inertia))
     return tuple(out)
 
@@ -551,8 +666,44 @@ def _aero(t: _Table, panels) -> AeroSpec:
     return AeroSpec(machs, b, ks, f_max, u_min, boxes, kernel, symmetry, method)
 
 
+def _check_memory(panels, aero: AeroSpec) -> None:
+    """Refuse, before any computation, a case whose dense DLM matrix (16 n_boxes^2 bytes, one
+    at a time: :func:`asekit.aero.dlm.iter_normalwash_matrices`) exceeds
+    :data:`asekit.aero.boxes.MAX_MATRIX_BYTES`, or whose structural LU factor
+    (:func:`structural_factor_bytes`) exceeds :data:`MAX_STRUCTURAL_BYTES`; the error names
+    the keys that set the size and the largest size that fits."""
+    if aero.boxes is None:
+        counts = [auto_boxes(p.planform, aero.u_min, aero.f_max) for p in panels]
+    else:
+        counts = list(aero.boxes)
+    n = sum(nc * ns for nc, ns in counts)
+    need = 16.0 * n * n
+    if need > MAX_MATRIX_BYTES:
+        fit = math.isqrt(int(MAX_MATRIX_BYTES // 16))
+        what = (" ".join(f"{nc} x {ns}" for nc, ns in counts) + f" = {n} boxes" +
+                (" from the mesh rules" if aero.boxes is None else ""))
+        knob = ("lower aero.f_max, raise aero.u_min or give aero.boxes" if aero.boxes is None
+                else "lower aero.boxes")
+        raise CaseError(f"aero.boxes: {what} need a {need / 2 ** 30:.3g} GiB DLM matrix (limit "
+                        f"{MAX_MATRIX_BYTES / 2 ** 30:.3g} GiB, asekit.aero.boxes."
+                        f"MAX_MATRIX_BYTES): at most {fit} boxes fit (e.g. "
+                        f"{math.isqrt(fit)} x {math.isqrt(fit)}); {knob}")
+    nc = panels[0].n_chord
+    ns = sum(p.n_span for p in panels)
+    dof = 3 * (nc + 1) * (ns + 1)
+    need = structural_factor_bytes(dof)
+    if need > MAX_STRUCTURAL_BYTES:
+        side = int(math.isqrt(_max_dof(MAX_STRUCTURAL_BYTES) // 3)) - 1
+        raise CaseError(f"panel[*].n_chord x n_span: {nc} x {ns} elements ({dof} dof) need about "
+                        f"{need / 2 ** 30:.3g} GiB for the structural eigenproblem's sparse LU "
+                        f"factor (limit {MAX_STRUCTURAL_BYTES / 2 ** 30:.3g} GiB, asekit.case."
+                        f"schema.MAX_STRUCTURAL_BYTES): at most {_max_dof(MAX_STRUCTURAL_BYTES)}"
+                        f" dof fit (e.g. {side} x {side} elements); lower n_chord or n_span")
+
+
 def _flight(t: _Table) -> FlightSpec:
-    alts = t.numbers("altitudes", low=-1000.0, high=80000.0, low_open=False, unit="m")
+    alts = t.numbers("altitudes", low=MIN_ALTITUDE, high=MAX_ALTITUDE, low_open=False,
+                     unit="m (the 1976 standard atmosphere's layers)")
     dens = t.numbers("densities", low=0.0, high=100.0, unit="kg/m^3")
     sos = t.numbers("speeds_of_sound", low=0.0, high=1e4, unit="m/s")
     vt = t.table("velocities", required=True)
@@ -564,7 +715,8 @@ def _flight(t: _Table) -> FlightSpec:
     em = ea = None
     if env is not None:
         em = env.numbers("mach", length=2, low=0.0, low_open=False, high=10.0)
-        ea = env.numbers("altitude", length=2, low=-1000.0, low_open=False, high=80000.0, unit="m")
+        ea = env.numbers("altitude", length=2, low=MIN_ALTITUDE, low_open=False,
+                         high=MAX_ALTITUDE, unit="m")
         env.done()
         for nm, r in (("mach", em), ("altitude", ea)):
             if r is not None and r[1] < r[0]:
@@ -604,8 +756,8 @@ def _actuator(t: _Table | None) -> ActuatorSpec | None:
     if cond is not None:
         # its range: within aero.machs (checked by case_from_dict), so within aero.method's
         vals["mach"] = cond.number("mach", default=0.5, low=0.0, low_open=False)
-        vals["altitude"] = cond.number("altitude", default=0.0, low=-1000.0, low_open=False,
-                                       high=80000.0, unit="m")
+        vals["altitude"] = cond.number("altitude", default=0.0, low=MIN_ALTITUDE,
+                                       low_open=False, high=MAX_ALTITUDE, unit="m")
         cond.done()
     t.done()
     return ActuatorSpec(**vals)
@@ -634,10 +786,11 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     thickness = _thickness(top.table("thickness", required=True))
     material = _material(top.table("material", required=True))
     support = _support(top.table("support", required=True), panels)
-    masses = _point_masses(top.raw("point_mass"))
+    masses = _point_masses(top.raw("point_mass"), panels)
     damping = _damping(top.table("damping"))
     modes = _modes(top.table("modes"), support)
     aero = _aero(top.table("aero", required=True), panels)
+    _check_memory(panels, aero)
     flight = _flight(top.table("flight", required=True))
     actuator = _actuator(top.table("actuator"))
     flutter = _flutter(top.table("flutter"))

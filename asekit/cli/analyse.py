@@ -11,9 +11,7 @@ import json
 import sys
 from pathlib import Path
 
-from asekit.case import CaseError, load_case
-from asekit.case.report import format_summary, run_analysis, summary, write_report
-from asekit.io import bdf
+from asekit.cli import outputs
 
 
 def add_parser(sub) -> None:
@@ -30,18 +28,6 @@ def add_parser(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _check_writable(path: Path, what: str) -> str | None:
-    target = path if path.is_dir() else path.parent
-    target = target if str(target) else Path(".")
-    probe = target
-    while not probe.exists():
-        probe = probe.parent
-    import os
-    if not os.access(probe, os.W_OK):
-        return f"{what} {path}: folder {probe} is not writable"
-    return None
-
-
 #: File suffixes read as Nastran bulk data.
 DECK_SUFFIXES = (".bdf", ".dat", ".nas", ".blk")
 
@@ -49,34 +35,54 @@ DECK_SUFFIXES = (".bdf", ".dat", ".nas", ".blk")
 def _read_case(args, load_case):
     """The case of ``args.case``: a Nastran deck (by suffix) through asekit.io.bdf, else TOML."""
     if Path(args.case).suffix.lower() in DECK_SUFFIXES:
+        from asekit.io import bdf
         return bdf.read_bdf(args.case, units=getattr(args, "units", "SI"))
     return load_case(args.case)
 
 
+def _error(msg: str) -> int:
+    print(f"error: {msg}", file=sys.stderr)
+    return 2
+
+
+def _named(name: str, exc: BaseException) -> str:
+    """``exc``'s message prefixed with the case file's name (unless it starts with it)."""
+    text = " ".join(str(exc).split())
+    return text if text.startswith(name) else f"{name}: {text}"
+
+
 def run(args) -> int:
-    for opt, what in ((args.json, "--json"), (args.report, "--report")):
-        if opt is not None and opt != "-" and (msg := _check_writable(Path(opt), what)):
-            print(f"error: {msg}", file=sys.stderr)
-            return 2
-        if opt == "" :
-            print(f"error: {what} needs a path", file=sys.stderr)
-            return 2
+    """The command: output paths first, then the case (the loader's checks), then the
+    pipeline; an input error or a numerical failure of the case is one line and exit 2 (other
+    exceptions reach :func:`asekit.cli.main.main`: one line, exit 1)."""
+    for reason in (outputs.check_file("--json", args.json),
+                   outputs.check_dir("--report", args.report, "the HTML report")):
+        if reason:
+            return _error(reason)
+    from asekit.case import CaseError, load_case
+    from asekit.case.schema import SolverError
+    name = Path(args.case).name
     try:
         case = _read_case(args, load_case)
     except ImportError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+        return _error(str(exc))
     except FileNotFoundError:
-        print(f"error: case file {args.case} not found", file=sys.stderr)
-        return 2
+        return _error(f"case file {args.case} not found")
     except (CaseError, ValueError) as exc:
-        print(f"error: {Path(args.case).name}: {exc}", file=sys.stderr)
-        return 2
+        return _error(_named(name, exc))
+    except OSError as exc:
+        return _error(f"{name}: cannot read the case file ({exc.strerror or exc})")
+    from asekit.case.report import (
+        format_summary,
+        run_analysis,
+        summary,
+        write_report,
+        write_text_atomic,
+    )
     try:
         analysis = run_analysis(case, progress=not args.quiet)
-    except CaseError as exc:
-        print(f"error: {Path(args.case).name}: {exc}", file=sys.stderr)
-        return 2
+    except (ValueError, SolverError) as exc:
+        return _error(_named(name, exc))
     s = summary(analysis)
     to_stdout = args.json == "-"
     print(format_summary(s), file=sys.stderr if to_stdout else sys.stdout)
@@ -85,7 +91,7 @@ def run(args) -> int:
         if to_stdout:
             print(text)
         else:
-            Path(args.json).write_text(text + "\n")
+            write_text_atomic(args.json, text + "\n")
     if args.report:
         import matplotlib
         matplotlib.use("Agg")

@@ -4,10 +4,19 @@ Commands (argparse subcommands; each sets ``func(args) -> exit code``, so more c
 
 * ``reproduce [--json PATH|-] [--figures DIR] [--only CHAPTER ...] [--wide] [--quiet]
   [--keep-going]``: the thesis reproduction table (see :mod:`asekit.reproduction.driver`);
-* ``analyse CASE.toml [--json PATH] [--report DIR]``: a case file (see :mod:`asekit.cli.analyse`).
+* ``analyse CASE.toml [--json PATH] [--report DIR]``: a case file (see :mod:`asekit.cli.analyse`);
+* ``sweep SWEEP.toml --out PATH``: a sweep file (see :mod:`asekit.cli.sweep`).
 
-Exit codes: 0 success, 1 a chapter's inputs failed (without ``--keep-going``), 2 bad arguments
-(argparse), 130 interrupted.
+Output paths are checked (and their missing folders made) before any work
+(:mod:`asekit.cli.outputs`). Every error is one line on standard error, never a traceback
+(``--debug`` shows it). Exit codes: 0 success; 2 bad input (arguments, a case, sweep or deck
+file the loader refuses -- a ValueError such as CaseError or BdfError --, a numerical failure
+of a case, :class:`asekit.case.SolverError`, or an unusable file); 1 a chapter of ``reproduce``
+failed (without ``--keep-going``) or an internal error (a bug: one line saying so; rerun with
+``--debug``); 130 interrupted.
+
+The heavy modules (the pipeline, the reproduction, matplotlib) are imported by the command
+that needs them, so that a refused input is reported within a second or two.
 """
 
 from __future__ import annotations
@@ -15,52 +24,40 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from pathlib import Path
 
+from asekit.cli import outputs
 from asekit.cli.analyse import add_parser as add_analyse
 from asekit.cli.sweep import add_parser as add_sweep
-from asekit.reproduction.driver import CHAPTERS, ChapterFailed, reproduce
+
+
+def _chapter_names() -> list[str]:
+    from asekit.reproduction.driver import CHAPTERS
+    return [n for n, _ in CHAPTERS]
+
+
+class _ChapterList:
+    """The chapter names for the ``--only`` help, read when the help is printed (so that
+    building the parser does not import the reproduction)."""
+
+    def __str__(self) -> str:
+        return ", ".join(_chapter_names())
 
 
 def _chapter(name: str) -> str:
-    valid = [n for n, _ in CHAPTERS]
+    valid = _chapter_names()
     if name not in valid:
         raise argparse.ArgumentTypeError(f"unknown chapter {name!r}; choose from "
                                          f"{', '.join(valid)}")
     return name
 
 
-def _writable_dir(path: Path) -> str | None:
-    """None if ``path`` is (or can be made) a writable directory, else the reason."""
-    if path.exists() and not path.is_dir():
-        return f"{path} exists and is not a directory"
-    probe = path
-    while not probe.exists():
-        probe = probe.parent
-    if not probe.is_dir():
-        return f"{probe} is not a directory"
-    if not os.access(probe, os.W_OK | os.X_OK):
-        return f"{probe} is not writable"
-    return None
-
-
 def _check_outputs(parser: argparse.ArgumentParser, args) -> None:
-    """Refuse unusable --json / --figures paths before any chapter runs."""
-    if args.json is not None and args.json != "-":
-        j = Path(args.json)
-        if args.json == "" or j.is_dir():
-            parser.error(f"--json {args.json!r}: give a file path (or '-' for standard output)")
-        if j.exists() and not os.access(j, os.W_OK):
-            parser.error(f"--json {args.json}: the file is not writable")
-        reason = _writable_dir(j.parent if str(j.parent) else Path("."))
+    """Refuse unusable --json / --figures paths before any chapter runs (argparse's error,
+    exit 2); their missing folders are made."""
+    for reason in (outputs.check_file("--json", args.json),
+                   outputs.check_dir("--figures", args.figures, "the PNG figures")):
         if reason:
-            parser.error(f"--json {args.json}: {reason}")
-    if args.figures is not None:
-        if not args.figures.strip():
-            parser.error("--figures '': give a directory for the PNG figures")
-        reason = _writable_dir(Path(args.figures))
-        if reason:
-            parser.error(f"--figures {args.figures}: {reason}")
+            parser.error(reason)
 
 
 def _reproduce(args) -> int:
@@ -69,6 +66,7 @@ def _reproduce(args) -> int:
         os.environ["ASEKIT_CONVERGED_STUDY"] = "1"
     import matplotlib
     matplotlib.use("Agg")
+    from asekit.reproduction.driver import ChapterFailed, reproduce
 
     to_stderr = args.json == "-"
 
@@ -102,8 +100,9 @@ def build_parser() -> argparse.ArgumentParser:
                                                     "standard output; the table goes to "
                                                     "standard error)")
     rep.add_argument("--figures", metavar="DIR", help="write every chapter figure as PNG")
-    rep.add_argument("--only", nargs="+", metavar="CHAPTER", type=_chapter,
-                     help=f"run only these chapters ({', '.join(n for n, _ in CHAPTERS)})")
+    only = rep.add_argument("--only", nargs="+", metavar="CHAPTER", type=_chapter,
+                            help="run only these chapters (%(chapters)s)")
+    only.chapters = _ChapterList()
     rep.add_argument("--wide", action="store_true",
                      help="one line per row with its note at the end (wider than 100 columns)")
     rep.add_argument("--quiet", action="store_true", help="no progress bar on standard error")
@@ -115,17 +114,88 @@ def build_parser() -> argparse.ArgumentParser:
     rep.set_defaults(func=_reproduce, parser=rep)
     add_analyse(sub)
     add_sweep(sub)
+    parser.add_argument("--debug", action="store_true", help=_DEBUG_HELP)
+    seen = set()
+    for p in sub.choices.values():              # also after the command (aliases: once)
+        if id(p) not in seen:
+            seen.add(id(p))
+            p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                           help=_DEBUG_HELP)
     return parser
+
+
+_DEBUG_HELP = "show the traceback of an error (for a bug report)"
+
+
+def _input_error(exc: BaseException) -> bool:
+    """Whether ``exc`` is the user's to fix (exit 2): a refused input (ValueError: CaseError,
+    BdfError, SweepError, ...), a numerical failure of a checked case (SolverError) or a file
+    the system refuses (OSError)."""
+    from asekit.case.schema import SolverError
+    return isinstance(exc, (ValueError, SolverError, OSError))
+
+
+def error_line(exc: BaseException, command: str = "") -> tuple[str, int]:
+    """(the one line printed for ``exc``, the exit code): 2 for an input error, 1 for a bug."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    where = f"asekit {command}: " if command else ""
+    if _input_error(exc):
+        return f"error: {where}{text}", 2
+    return (f"internal error (a bug in asekit, please report it): {where}"
+            f"{type(exc).__name__}: {text[:300]}; rerun with --debug for the traceback"), 1
+
+
+class _Interrupts:
+    """Remembers a SIGINT while a command runs: a library that turns the KeyboardInterrupt into
+    an error of its own (matplotlib: "Invalid bounding box") is still reported as interrupted."""
+
+    def __init__(self):
+        self.seen = False
+
+    def __enter__(self):
+        import signal
+        self.previous = signal.getsignal(signal.SIGINT)
+        if self.previous is signal.default_int_handler:     # not when SIGINT is ignored
+            try:
+                signal.signal(signal.SIGINT, self._handler)
+            except ValueError:                              # not the main thread
+                self.previous = None
+        return self
+
+    def _handler(self, signum, frame):
+        self.seen = True
+        raise KeyboardInterrupt
+
+    def __exit__(self, *exc):
+        import signal
+        if self.previous is signal.default_int_handler:
+            signal.signal(signal.SIGINT, self.previous)
+        return False
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    try:
-        return args.func(args)
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return 130
+    with _Interrupts() as interrupts:
+        try:
+            code = args.func(args)
+            if code and interrupts.seen:    # the command reported the error it was turned into
+                print("interrupted", file=sys.stderr)
+                return 130
+            return code
+        except KeyboardInterrupt:
+            print("interrupted", file=sys.stderr)
+            return 130
+        except Exception as exc:            # one line, never a traceback (unless --debug)
+            if interrupts.seen:
+                print("interrupted", file=sys.stderr)
+                return 130
+            if getattr(args, "debug", False):
+                import traceback
+                traceback.print_exc()
+            line, code = error_line(exc, args.command)
+            print(line, file=sys.stderr)
+            return code
 
 
 if __name__ == "__main__":

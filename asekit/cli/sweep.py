@@ -11,7 +11,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from asekit import sweep as S
+from asekit.cli import outputs
 
 
 def add_parser(sub) -> None:
@@ -74,12 +74,11 @@ def run(args) -> int:
             import pyarrow  # noqa: F401
         except ImportError:
             return _error("--out *.parquet needs pyarrow (pip install pyarrow); or write .csv")
-    probe = out.parent if str(out.parent) else Path(".")
-    while not probe.exists():
-        probe = probe.parent
-    import os
-    if not os.access(probe, os.W_OK):
-        return _error(f"--out {out}: folder {probe} is not writable")
+    reason = outputs.check_file("--out", args.out, dash=False)
+    if reason:
+        return _error(reason)
+    from asekit import sweep as S
+    from asekit.case.schema import SolverError
     try:
         sw = S.load_sweep(args.sweep)
         if args.samples is not None:
@@ -99,7 +98,7 @@ def run(args) -> int:
                          retry_failed=args.retry_failed)
     except S.SweepError as exc:
         return _error(str(exc))
-    except ValueError as exc:            # a base case the pipeline refuses (e.g. its DLM)
+    except (ValueError, SolverError) as exc:   # a base case the pipeline refuses (e.g. its DLM)
         return _error(f"{Path(args.sweep).name}: {type(exc).__name__}: {exc}")
     return _summary(df, out, journal if parquet else None)
 

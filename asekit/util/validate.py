@@ -64,13 +64,22 @@ def positive_array(name: str, values) -> np.ndarray:
 
 
 def read_toml(path, error: type[Exception] = ValueError) -> dict:
-    """Parse the TOML file ``path``; a syntax error becomes ``error`` naming the file (a missing
-    file raises FileNotFoundError)."""
+    """Parse the TOML file ``path`` as UTF-8, with or without a byte-order mark; a file that is
+    not UTF-8, a directory or a syntax error becomes ``error`` naming the file in one line (a
+    missing file raises FileNotFoundError)."""
     import tomllib
     from pathlib import Path
     path = Path(path)
-    with open(path, "rb") as fh:
-        try:
-            return tomllib.load(fh)
-        except tomllib.TOMLDecodeError as exc:
-            raise error(f"{path.name} is not valid TOML: {exc}") from None
+    if path.is_dir():
+        raise error(f"{path} is a directory, not a TOML file")
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8-sig")           # a leading BOM (EF BB BF) is dropped
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise error(f"{path.name} is not UTF-8 (byte 0x{raw[exc.start]:02x} on line {line}): "
+                    f"save it as UTF-8") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{path.name} is not valid TOML: {exc}") from None
