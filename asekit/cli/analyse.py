@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 from asekit.cli import outputs
+from asekit.cli.cases import resolve_case
 
 
 def add_parser(sub) -> None:
@@ -33,11 +34,14 @@ DECK_SUFFIXES = (".bdf", ".dat", ".nas", ".blk")
 
 
 def _read_case(args, load_case):
-    """The case of ``args.case``: a Nastran deck (by suffix) through asekit.io.bdf, else TOML."""
-    if Path(args.case).suffix.lower() in DECK_SUFFIXES:
+    """The case of ``args.case``: a Nastran deck (by suffix) through asekit.io.bdf, else TOML;
+    a path that does not exist may name a shipped case (:func:`asekit.cli.cases.resolve_case`:
+    ``asekit analyse agard445_6`` from any directory)."""
+    path = resolve_case(args.case)
+    if path.suffix.lower() in DECK_SUFFIXES:
         from asekit.io import bdf
-        return bdf.read_bdf(args.case, units=getattr(args, "units", "SI"))
-    return load_case(args.case)
+        return bdf.read_bdf(path, units=getattr(args, "units", "SI"))
+    return load_case(path)
 
 
 def _error(msg: str) -> int:
@@ -66,8 +70,9 @@ def run(args) -> int:
         case = _read_case(args, load_case)
     except ImportError as exc:
         return _error(str(exc))
-    except FileNotFoundError:
-        return _error(f"case file {args.case} not found")
+    except FileNotFoundError as exc:
+        return _error(f"case file {exc}" if str(exc).startswith(args.case) else
+                      f"case file {args.case} not found")
     except (CaseError, ValueError) as exc:
         return _error(_named(name, exc))
     except OSError as exc:

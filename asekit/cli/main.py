@@ -5,7 +5,9 @@ Commands (argparse subcommands; each sets ``func(args) -> exit code``, so more c
 * ``reproduce [--json PATH|-] [--figures DIR] [--only CHAPTER ...] [--wide] [--quiet]
   [--keep-going]``: the thesis reproduction table (see :mod:`asekit.reproduction.driver`);
 * ``analyse CASE.toml [--json PATH] [--report DIR]``: a case file (see :mod:`asekit.cli.analyse`);
-* ``sweep SWEEP.toml --out PATH``: a sweep file (see :mod:`asekit.cli.sweep`).
+* ``sweep SWEEP.toml --out PATH``: a sweep file (see :mod:`asekit.cli.sweep`);
+* ``cases [--copy NAME DIR]``: the shipped case files (see :mod:`asekit.cli.cases`);
+* ``--version``.
 
 Output paths are checked (and their missing folders made) before any work
 (:mod:`asekit.cli.outputs`). Every error is one line on standard error, never a traceback
@@ -27,7 +29,9 @@ import sys
 
 from asekit.cli import outputs
 from asekit.cli.analyse import add_parser as add_analyse
+from asekit.cli.cases import add_parser as add_cases
 from asekit.cli.sweep import add_parser as add_sweep
+from asekit.util.version import __version__
 
 
 def _chapter_names() -> list[str]:
@@ -89,8 +93,10 @@ def _reproduce(args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with its subcommands (each sets ``func``)."""
-    parser = argparse.ArgumentParser(prog="python -m asekit",
+    prog = "asekit" if os.path.basename(sys.argv[0]) == "asekit" else "python -m asekit"
+    parser = argparse.ArgumentParser(prog=prog,
                                      description="asekit: aeroservoelastic workbench")
+    parser.add_argument("--version", action="version", version=f"asekit {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     rep = sub.add_parser("reproduce", help="run the thesis reproduction and print the "
                                            "thesis-vs-asekit table",
@@ -114,6 +120,7 @@ def build_parser() -> argparse.ArgumentParser:
     rep.set_defaults(func=_reproduce, parser=rep)
     add_analyse(sub)
     add_sweep(sub)
+    add_cases(sub)
     parser.add_argument("--debug", action="store_true", help=_DEBUG_HELP)
     seen = set()
     for p in sub.choices.values():              # also after the command (aliases: once)

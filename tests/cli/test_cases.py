@@ -1,6 +1,7 @@
 """`asekit cases`: the shipped case files by name (asekit/cli/cases.py, asekit/util/paths.py)."""
 
 import argparse
+import json
 import tomllib
 
 import pytest
@@ -44,3 +45,28 @@ def test_copy_writes_an_editable_case_and_never_overwrites(tmp_path, capsys):
     assert "not overwritten" in capsys.readouterr().err
     assert _run(["--copy", "nope", str(tmp_path)]) == 2
     assert "choose from" in capsys.readouterr().err
+
+
+def test_version_and_a_shipped_case_by_name_from_any_directory(tmp_path):
+    """`asekit --version`; `asekit analyse agard445_6` run outside the checkout (issue 30: a
+    wheel user got "not found"); an unknown name says where shipped cases live."""
+    import subprocess
+    import sys
+
+    from asekit.util.version import __version__
+
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "asekit", *args], capture_output=True,
+                              text=True, cwd=tmp_path, timeout=300)
+
+    r = run("--version")
+    assert r.returncode == 0 and r.stdout.strip() == f"asekit {__version__}"
+    r = run("analyse", "no_such_case")
+    assert r.returncode == 2
+    assert r.stderr.strip().splitlines() == [
+        f"error: case file no_such_case: no such file, and no shipped case of that name "
+        f"(`asekit cases` lists them; they live in {CASES_DIR})"]
+    r = run("analyse", "agard445_6", "--quiet", "--json", "out/o.json")
+    assert r.returncode == 0, r.stderr
+    summary = json.loads((tmp_path / "out" / "o.json").read_text())
+    assert summary["case"] == "agard445_6_weakened_3"
