@@ -32,7 +32,7 @@ from asekit.aero.validity import check_k, mach_number
 from asekit.util.blas import blas_threads_for
 from asekit.util.cache import CacheError, load_npz, save_npz
 from asekit.util.paths import DATA_DIR, user_cache_dir
-from asekit.util.validate import finite_array, positive
+from asekit.util.validate import finite_array, positive, real
 from asekit.util.version import __version__
 
 #: The reference fin's database, shipped read-only with the repository (so CI does not rebuild
@@ -97,7 +97,7 @@ class TabulatedGaf:
         qi_over_k = self.Q.imag / np.where(kk > 0, kk, 1.0)[:, None, None]
         if kk[0] == 0:
             qi_over_k[0] = qi_over_k[1]
-        kq = float(np.clip(k, kk[0], kk[-1]))
+        kq = float(np.clip(real("k", k), kk[0], kk[-1]))
         if method == "linear":
             j = int(np.clip(np.searchsorted(kk, kq) - 1, 0, kk.size - 2))
             t = (kq - kk[j]) / (kk[j + 1] - kk[j])

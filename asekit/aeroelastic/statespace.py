@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from asekit.structure.modes import mode_shapes_at  # lazy: the structure module
-from asekit.util.validate import finite_array, finite_result, positive
+from asekit.util.validate import finite_array, finite_result, integer, positive
 
 INPUT_NAMES = ("theta", "theta_dot", "theta_ddot")
 
@@ -74,7 +74,7 @@ def modal_arrays(model=None, *, M=None, K=None, C=None, n_rigid=None) -> ModalAr
     M = np.atleast_2d(np.asarray(M, dtype=float))
     K = np.atleast_2d(np.asarray(K, dtype=float))
     C = np.zeros_like(M) if C is None else np.atleast_2d(np.asarray(C, dtype=float))
-    n_rigid = 0 if n_rigid is None else int(n_rigid)
+    n_rigid = 0 if n_rigid is None else integer("n_rigid", n_rigid, low=0, high=1)
     n = M.shape[0]
     for name, a in (("M", M), ("K", K), ("C", C)):
         if a.shape != (n, n):

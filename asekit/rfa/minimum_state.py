@@ -51,7 +51,7 @@ import numpy as np
 
 from asekit.rfa.roger import check_coefficients, check_gaf_table, default_lag_roots, fit_errors
 from asekit.util.blas import small_dense
-from asekit.util.validate import finite_array, finite_result, integer, positive
+from asekit.util.validate import finite_array, finite_result, integer, positive, real_array
 
 
 def default_ms_roots(k_max: float, n_states: int) -> np.ndarray:
@@ -139,7 +139,7 @@ class MinimumStateFit:
 
     def evaluate(self, k) -> np.ndarray:
         """Q~ at reduced frequencies ``k``: (n, n) or (len(k), n, n) complex."""
-        k_arr = np.atleast_1d(np.asarray(k, dtype=float))
+        k_arr = np.atleast_1d(real_array("k", k))
         out = self._eval_p(1j * k_arr)
         return out[0] if np.ndim(k) == 0 else out
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from asekit.util.blas import small_dense
-from asekit.util.validate import finite_array, finite_result, integer, positive
+from asekit.util.validate import finite_array, finite_result, integer, positive, real_array
 
 
 def default_lag_roots(k_max: float, n_lags: int = 4) -> np.ndarray:
@@ -124,7 +124,7 @@ class RogerFit:
     def evaluate(self, k) -> np.ndarray:
         """Q~ at reduced frequencies ``k`` (scalar or array): (n, n) or (len(k), n, n) complex,
         Eq. (2.13)."""
-        k_arr = np.atleast_1d(np.asarray(k, dtype=float))
+        k_arr = np.atleast_1d(real_array("k", k))
         ik = 1j * k_arr
         terms = [np.ones_like(ik), ik, ik ** 2] + [ik / (ik + b) for b in self.lag_roots]
         basis = np.stack(terms, axis=1)                       # (n_k, N+3)
