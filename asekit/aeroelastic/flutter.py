@@ -42,7 +42,13 @@ from asekit.aeroelastic.statespace import ModalArrays, aeroelastic_matrices, mod
 from asekit.atmosphere import standard_atmosphere
 from asekit.util.blas import small_dense
 from asekit.util.conventions import damping_ratio, mode_label, vg_damping
-from asekit.util.validate import finite_array, integer, positive, positive_array
+from asekit.util.validate import (
+    ArgumentTypeError,
+    finite_array,
+    integer,
+    positive,
+    positive_array,
+)
 
 #: relative tolerance of the stability test: a root is unstable when Re p > RTOL_UNSTABLE * scale,
 #: ``scale`` the largest root magnitude of the sweep (rounding of eigenvalues is ~1e-16 of it).
@@ -757,8 +763,8 @@ def divergence_speeds(modal, Q0: np.ndarray, density: float, include_rigid: bool
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
     rho = float(positive_array("density", density)[0])
     if Q0 is None:
-        raise TypeError(f"Q0 must be the ({m.n_modes}, {m.n_modes}) GAF matrix at k = 0 "
-                        "(e.g. TabulatedGaf.Q[0]), got None")
+        raise ArgumentTypeError(f"Q0 must be the ({m.n_modes}, {m.n_modes}) GAF matrix at "
+                                "k = 0 (e.g. TabulatedGaf.Q[0]), got None")
     Q0 = finite_array("Q0", Q0, complex_values=True)
     if Q0.shape != (m.n_modes, m.n_modes):
         raise ValueError(f"Q0 must be ({m.n_modes}, {m.n_modes}) like the modal model, got "

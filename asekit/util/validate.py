@@ -8,23 +8,31 @@ import math
 import numpy as np
 
 
+class ArgumentTypeError(TypeError, ValueError):
+    """An argument of the wrong type (a string, bool, complex or float where a real number or a
+    count belongs): a TypeError, and a ValueError like every other user-input error of asekit,
+    so that one ``except ValueError`` catches every refusal."""
+
+
 def _float(name: str, value) -> float:
     """``float(value)``, or TypeError/ValueError naming ``name`` (never a bare conversion
     error). Booleans and complex numbers are refused."""
     if isinstance(value, (str, bytes)):
         raise ValueError(f"{name} must be a real number, got the string {value!r}")
     if isinstance(value, (bool, np.bool_, complex, np.complexfloating)):
-        raise TypeError(f"{name} must be a real number, got {value!r}")
+        raise ArgumentTypeError(f"{name} must be a real number, got {value!r}")
     try:
         return float(value)
     except (TypeError, ValueError) as exc:
-        raise type(exc)(f"{name} must be a real number, got {value!r}") from exc
+        raise (ArgumentTypeError if isinstance(exc, TypeError) else ValueError)(
+            f"{name} must be a real number, got {value!r}") from exc
 
 
 def integer(name: str, value, low: int | None = None, high: int | None = None) -> int:
     """``int(value)`` for an integer (Python or numpy) within [low, high] (None: unbounded);
-    a bool, a float (even 4.0), a string or anything else is a TypeError naming ``name``, an
-    integer outside the range a ValueError naming ``name`` and the range.
+    a bool, a float (even 4.0), a string or anything else is an :class:`ArgumentTypeError`
+    (a TypeError and a ValueError) naming ``name``, an integer outside the range a ValueError
+    naming ``name`` and the range.
 
     Examples
     --------
@@ -33,7 +41,7 @@ def integer(name: str, value, low: int | None = None, high: int | None = None) -
     >>> integer("n_states", 4.5, low=1)
     Traceback (most recent call last):
     ...
-    TypeError: n_states must be an integer >= 1, got 4.5
+    asekit.util.validate.ArgumentTypeError: n_states must be an integer >= 1, got 4.5
     """
     if low is not None and high is not None:
         valid = f"an integer in [{low}, {high}]"
@@ -44,7 +52,7 @@ def integer(name: str, value, low: int | None = None, high: int | None = None) -
     else:
         valid = "an integer"
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{name} must be {valid}, got {value!r}")
+        raise ArgumentTypeError(f"{name} must be {valid}, got {value!r}")
     if (low is not None and value < low) or (high is not None and value > high):
         raise ValueError(f"{name} must be {valid}, got {value!r}")
     return int(value)
@@ -72,22 +80,23 @@ def real_array(name: str, values) -> np.ndarray:
     try:
         a = np.asarray(values)
     except (TypeError, ValueError) as exc:      # ragged nesting
-        raise TypeError(f"{name} must be an array of real numbers, got {values!r}") from exc
+        raise ArgumentTypeError(f"{name} must be an array of real numbers, got "
+                                f"{values!r}") from exc
     if a.dtype.kind == "O":
         if not all(isinstance(v, (int, float, complex, np.number))
                    and not isinstance(v, (bool, np.bool_)) for v in a.ravel()):
-            raise TypeError(f"{name} must be real numbers, got {values!r}")
+            raise ArgumentTypeError(f"{name} must be real numbers, got {values!r}")
         a = np.asarray(a.tolist())
     if a.dtype.kind in "US":
         raise ValueError(f"{name} must be real numbers, got strings {values!r}")
     if a.dtype.kind == "c":
         imag = np.flatnonzero(a.imag != 0)
         if imag.size:
-            raise TypeError(f"{name} must be real numbers, got the complex value "
+            raise ArgumentTypeError(f"{name} must be real numbers, got the complex value "
                             f"{a.ravel()[imag[0]].item()!r} at {name}{_index(a, imag[0])}")
         a = a.real
     if a.dtype.kind not in "iuf":
-        raise TypeError(f"{name} must be real numbers, got {values!r}")
+        raise ArgumentTypeError(f"{name} must be real numbers, got {values!r}")
     return a.astype(float)
 
 
@@ -104,7 +113,7 @@ def finite_array(name: str, values, complex_values: bool = False) -> np.ndarray:
                 isinstance(v, (int, float, complex, np.number))
                 and not isinstance(v, (bool, np.bool_)) for v in a.ravel()) else a
         if a.dtype.kind not in "iufc":
-            raise TypeError(f"{name} must be numbers, got {values!r}")
+            raise ArgumentTypeError(f"{name} must be numbers, got {values!r}")
         a = a.astype(complex)
     else:
         a = real_array(name, values)

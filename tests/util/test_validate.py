@@ -107,3 +107,14 @@ def test_existing_scalar_checks_refuse_strings_and_complex():
         positive("b_ref", "1.0")
     with pytest.raises(TypeError, match="rho must be a real number"):
         in_range("rho", np.complex128(1.2 + 1j))
+
+
+def test_type_refusals_are_value_errors_too():
+    """Project convention: every user-input error is a ValueError subclass; a wrong type is
+    also a TypeError (ArgumentTypeError), so both ``except`` clauses catch it."""
+    from asekit.util.validate import ArgumentTypeError
+    for call in (lambda: integer("n", 2.5), lambda: real("x", 1j),
+                 lambda: real_array("k", [1j]), lambda: finite_array("Q", [None], True)):
+        with pytest.raises(ArgumentTypeError) as info:
+            call()
+        assert isinstance(info.value, ValueError) and isinstance(info.value, TypeError)
