@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from asekit.util.validate import real_array
+
 #: Constants of the 1976 standard (Table 2 of NOAA-S/T 76-1562).
 G0 = 9.80665            # m/s^2
 R_AIR = 287.05287       # J/(kg K), R* / M0 = 8314.32 / 28.9644
@@ -72,7 +74,7 @@ class AtmosphereState:
 
 
 def _altitude(h) -> np.ndarray:
-    h = np.asarray(h, dtype=float)
+    h = real_array("altitude", h)
     if not np.all(np.isfinite(h)) or np.any(h < MIN_ALTITUDE) or np.any(h > MAX_ALTITUDE):
         raise ValueError(f"altitude must be finite and within [{MIN_ALTITUDE:.0f}, "
                          f"{MAX_ALTITUDE:.0f}] m, "
@@ -112,7 +114,7 @@ def speed_of_sound(altitude) -> np.ndarray:
 
 def equivalent_airspeed(true_airspeed, altitude) -> np.ndarray:
     """Equivalent airspeed U_eq = U sqrt(rho(h)/rho_0) (m/s), thesis Eq. (3.10)."""
-    u = np.asarray(true_airspeed, dtype=float)
+    u = real_array("true_airspeed", true_airspeed)
     if np.any(u < 0) or not np.all(np.isfinite(u)):
         raise ValueError(f"true_airspeed must be finite and >= 0 m/s, got {u}")
     return u * np.sqrt(density(altitude) / RHO0)
@@ -120,7 +122,7 @@ def equivalent_airspeed(true_airspeed, altitude) -> np.ndarray:
 
 def true_airspeed(mach, altitude) -> np.ndarray:
     """True airspeed (m/s) of Mach number ``mach`` at ``altitude`` (m): U = M a(h) (Fig 25)."""
-    m = np.asarray(mach, dtype=float)
+    m = real_array("mach", mach)
     if np.any(m < 0) or not np.all(np.isfinite(m)):
         raise ValueError(f"mach must be finite and >= 0, got {m}")
     with np.errstate(over="ignore"):
@@ -132,7 +134,7 @@ def true_airspeed(mach, altitude) -> np.ndarray:
 
 def mach_number(true_airspeed_ms, altitude) -> np.ndarray:
     """Mach number of ``true_airspeed_ms`` (m/s) at ``altitude`` (m)."""
-    u = np.asarray(true_airspeed_ms, dtype=float)
+    u = real_array("true_airspeed_ms", true_airspeed_ms)
     if np.any(u < 0) or not np.all(np.isfinite(u)):
         raise ValueError(f"true_airspeed_ms must be finite and >= 0 m/s, got {u}")
     return u / speed_of_sound(altitude)
@@ -140,7 +142,7 @@ def mach_number(true_airspeed_ms, altitude) -> np.ndarray:
 
 def dynamic_pressure(true_airspeed_ms, altitude) -> np.ndarray:
     """Dynamic pressure q = rho U^2 / 2 (Pa)."""
-    u = np.asarray(true_airspeed_ms, dtype=float)
+    u = real_array("true_airspeed_ms", true_airspeed_ms)
     if np.any(u < 0) or not np.all(np.isfinite(u)):
         raise ValueError(f"true_airspeed_ms must be finite and >= 0 m/s, got {u}")
     with np.errstate(over="ignore"):

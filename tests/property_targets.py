@@ -508,3 +508,283 @@ def _grid(start, step, n, extra):
 AGARD_GRIDS = st.builds(_grid, st.floats(1.0, 181.0), st.floats(0.5, 900.0),
                         st.integers(2, 14),
                         st.lists(st.floats(1.0, 3000.0), max_size=4))
+
+
+# ---- silent NaN and loose types (issue 22) ------------------------------------------------------
+#: a refusal that names the argument it is about (word-bounded): :func:`_expect` marks it so
+NAMED = "<named>"
+
+
+def _expect(arg: str, thunk):
+    """Call ``thunk``; a ValueError/TypeError whose message names ``arg`` (as a word, or the
+    file name for a file) comes back marked :data:`NAMED`, any other passes unchanged (so it
+    counts as ``unnamed``)."""
+    import re
+    try:
+        return thunk()
+    except (ValueError, TypeError) as exc:
+        if re.search(rf"(?<![\w.]){re.escape(arg)}(?!\w)", str(exc)):
+            raise type(exc)(f"{NAMED} {exc}") from exc
+        raise
+
+
+def _loose(label, arg, thunk):
+    """One loose-typed call: ``thunk`` must refuse the value of ``arg``; returning is a silent
+    coercion (``implausible``)."""
+    return (label, arg, thunk)
+
+
+def _call_loose(case):
+    label, arg, thunk = case
+    return label, _expect(arg, thunk)
+
+
+def _loose_check(kw, out):
+    return f"{out[0]}: accepted silently"
+
+
+def _loose_cases():
+    """Strings, floats and bools where counts belong, complex values with an imaginary part:
+    each must be refused naming its argument (issue 22's reproducers and their siblings)."""
+    def dlm(**kw):
+        from asekit.aero.dlm import normalwash_matrix
+        a = {"mach": 0.5, "k": 0.1, "b_ref": 1.0} | kw
+        return normalwash_matrix(_plate(2, 2), a["mach"], a["k"], a["b_ref"])
+
+    def gaf(**kw):
+        from asekit.aero.gaf import TabulatedGaf
+        a = {"k": np.array([0.0, 0.5, 1.0]), "Q": np.ones((3, 2, 2), complex), "b_ref": 1.0}
+        a |= kw
+        return TabulatedGaf(a["k"], a["Q"], a["b_ref"])
+
+    def roger(**kw):
+        from asekit.rfa import roger_fit
+        rng = np.random.default_rng(0)
+        a = {"k": np.linspace(0.0, 1.0, 8), "Q": rng.normal(size=(8, 2, 2)) + 0j,
+             "b_ref": 1.0} | kw
+        return roger_fit(a.pop("k"), a.pop("Q"), a.pop("b_ref"), **a)
+
+    def ms(**kw):
+        from asekit.rfa import minimum_state_fit
+        rng = np.random.default_rng(0)
+        a = {"k": np.linspace(0.0, 1.0, 8), "Q": rng.normal(size=(8, 2, 2)) + 0j,
+             "b_ref": 1.0} | kw
+        return minimum_state_fit(a.pop("k"), a.pop("Q"), a.pop("b_ref"), max_iter=5, **a)
+
+    def pk(**kw):
+        from asekit.aeroelastic.flutter import pk_flutter
+        modal, g, _ = two_dof_coalescence(1.0)
+        a = {"density": 1.2, "velocities": [10.0, 20.0]} | kw
+        return pk_flutter(modal, g, a.pop("density"), a.pop("velocities"), **a)
+
+    def atm(altitude):
+        from asekit.atmosphere import standard_atmosphere
+        return standard_atmosphere(altitude)
+
+    def tas(mach):
+        from asekit.atmosphere import true_airspeed
+        return true_airspeed(mach, 0.0)
+
+    def step(**kw):
+        from asekit.servo.actuator import ActuatorParameters, PDController, step_response
+        return step_response(ActuatorParameters(), PDController(10.0, 275.0, 1.0), **kw)
+
+    def section(**kw):
+        from asekit.aeroelastic.typical_section import conner_1997, flutter_speed
+        return flutter_speed(conner_1997(), 5.0, 40.0, **kw)
+
+    def statespace(**kw):
+        from asekit.aeroelastic.statespace import aeroelastic_matrices
+        modal, _, fit = two_dof_coalescence(1.0)
+        a = {"rho": 1.2, "velocity": 50.0} | kw
+        return aeroelastic_matrices(modal, fit, a["rho"], a["velocity"])
+
+    cz = np.array([0.0, 0.5, 1.0 + 0.5j])
+    return [
+        _loose("dlm b_ref str", "b_ref", lambda: dlm(b_ref="1.0")),
+        _loose("dlm k complex", "k", lambda: dlm(k=0.1 + 0.5j)),
+        _loose("dlm k complex numpy", "k", lambda: dlm(k=np.complex128(0.1 + 0.5j))),
+        _loose("dlm mach str", "mach", lambda: dlm(mach="0.5")),
+        _loose("dlm mach complex", "mach", lambda: dlm(mach=np.complex128(0.5 + 1j))),
+        _loose("TabulatedGaf b_ref str", "b_ref", lambda: gaf(b_ref="1.0")),
+        _loose("TabulatedGaf k complex", "k", lambda: gaf(k=cz)),
+        _loose("TabulatedGaf k str", "k", lambda: gaf(k=["0", "0.5", "1"])),
+        _loose("roger_fit b_ref str", "b_ref", lambda: roger(b_ref="1.0")),
+        _loose("roger_fit n_lags float", "n_lags", lambda: roger(n_lags=2.5)),
+        _loose("roger_fit n_lags bool", "n_lags", lambda: roger(n_lags=True)),
+        _loose("roger_fit n_lags str", "n_lags", lambda: roger(n_lags="2")),
+        _loose("roger_fit k complex", "k", lambda: roger(k=np.linspace(0, 1, 8) + 0.1j)),
+        _loose("minimum_state_fit n_states float", "n_states", lambda: ms(n_states=4.5)),
+        _loose("minimum_state_fit n_states bool", "n_states", lambda: ms(n_states=True)),
+        _loose("minimum_state_fit k complex", "k", lambda: ms(k=np.linspace(0, 1, 8) + 0.1j)),
+        _loose("minimum_state_fit max_iter float", "max_iter", lambda: ms(max_iter=2.5)),
+        _loose("pk velocities complex", "velocities",
+               lambda: pk(velocities=np.array([10.0, 20.0 + 1j]))),
+        _loose("pk density complex", "density", lambda: pk(density=np.complex128(1.2 + 1j))),
+        _loose("pk density str", "density", lambda: pk(density="1.2")),
+        _loose("pk max_iter float", "max_iter", lambda: pk(max_iter=3.5)),
+        _loose("atmosphere altitude complex", "altitude",
+               lambda: atm(np.array([1000.0 + 5j]))),
+        _loose("atmosphere altitude str", "altitude", lambda: atm("1000")),
+        _loose("atmosphere altitude str list", "altitude", lambda: atm(["1000", "2000"])),
+        _loose("true_airspeed mach complex", "mach", lambda: tas(np.array([0.5 + 1j]))),
+        _loose("statespace velocity complex", "velocity",
+               lambda: statespace(velocity=np.complex128(50 + 1j))),
+        _loose("step_response n float", "n", lambda: step(n=2001.0)),
+        _loose("step_response t_final str", "t_final", lambda: step(t_final="0.05")),
+        _loose("step_response amplitude str", "amplitude", lambda: step(amplitude="1")),
+        _loose("step_response amplitude complex", "amplitude", lambda: step(amplitude=1 + 1j)),
+        _loose("flutter_speed n float", "n", lambda: section(n=10.5)),
+        _loose("flutter_speed n bool", "n", lambda: section(n=True)),
+    ]
+
+
+LOOSE_TYPES = Target("loose_types", st.fixed_dictionaries({"case": st.sampled_from(
+    _loose_cases())}), _call_loose, (NAMED,), _loose_check)
+
+
+def _step(t_final, n, gain):
+    from asekit.servo.actuator import ActuatorParameters, PDController, step_response
+    return step_response(ActuatorParameters(), PDController(gain, 275.0, 1.0), t_final=t_final,
+                         n=n)
+
+
+STEP_RESPONSE = Target(
+    "step_response",
+    st.fixed_dictionaries({
+        "t_final": st.one_of(reals(1e-4, 1.0), st.sampled_from([10.0, 1e3, 1e6, 1e12, 1e100,
+                                                                  1e300])),
+        "n": st.one_of(st.integers(2, 3000), st.sampled_from([0, 1, 2001])),
+        "gain": st.sampled_from([10.0, 1.0, 0.1, -5.0])}),
+    _step, (NAMED, "t_final", "n", "time step", "gain"))
+
+_BAD = st.sampled_from([math.nan, math.inf, -math.inf, complex(0, math.inf),
+                        complex(math.nan, 0), None])
+
+
+def _gaf_pk(bad, where, velocities):
+    """The 2-dof coalescence model of :func:`two_dof_coalescence` with one entry of its GAF table
+    (3 reduced frequencies) replaced by ``bad`` (None: unchanged), through p-k."""
+    import warnings
+
+    from asekit.aero.gaf import TabulatedGaf
+    from asekit.aeroelastic.flutter import pk_flutter, pk_instabilities
+    modal, g, _ = two_dof_coalescence(1.0)
+    Q = np.array([g.Q[0], g.Q[0] * 1.01, g.Q[0] * 1.02])
+    if bad is not None:
+        Q[where] = bad
+    gaf = TabulatedGaf(np.array([0.0, 1.0, 10.0]), Q, 1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        res = pk_flutter(modal, gaf, 1.2, velocities)
+    return res, pk_instabilities(res, modal, gaf)
+
+
+_ENTRY = st.tuples(st.integers(0, 2), st.integers(0, 1), st.integers(0, 1))
+
+GAF_TABLE = Target(
+    "TabulatedGaf",
+    st.fixed_dictionaries({"bad": _BAD, "where": _ENTRY,
+                           "velocities": st.sampled_from([[10.0, 50.0, 100.0, 150.0],
+                                                          [20.0, 40.0]])}),
+    _gaf_pk, ("Q", "k", "b_ref", "velocities"), _pk_check)
+
+
+def _statespace(bad, where, lag_bad, rho, velocity):
+    """aeroelastic_matrices of the 2-dof model from a Roger fit whose A (one lag root) holds one
+    bad entry; and a Roger fit of a table holding it."""
+    import dataclasses as dc
+
+    from asekit.aeroelastic.statespace import aeroelastic_matrices
+    from asekit.rfa import roger_fit
+    modal, _, fit = two_dof_coalescence(1.0)
+    A = np.concatenate([fit.A, fit.A[:1] * 0.1])
+    if bad is not None and not lag_bad:
+        A[where] = np.real(bad)
+    roots = np.array([math.nan if lag_bad and bad is not None else 0.5])
+    fit = dc.replace(fit, A=A, lag_roots=roots)
+    k = np.linspace(0.0, 1.0, 6)
+    Q = np.array([fit.A[0] + 1j * kk * fit.A[0] for kk in k]).astype(complex)
+    if bad is not None and lag_bad:
+        Q[2, 0, 1] = bad
+    return aeroelastic_matrices(modal, fit, rho, velocity), roger_fit(k, Q, 1.0, n_lags=1)
+
+
+STATESPACE = Target(
+    "statespace",
+    st.fixed_dictionaries({"bad": _BAD, "where": _ENTRY, "lag_bad": st.booleans(),
+                           "rho": reals(0.01, 3.0), "velocity": reals(1.0, 300.0)}),
+    _statespace, ("A", "rfa", "lag_roots", "rho", "velocity", "Q"))
+
+
+def _damaged_mat(kind):
+    """A file written by save_mat, damaged by ``kind``, read by load_mat."""
+    import control as ct
+
+    from asekit.io.export import load_mat, save_mat
+    with tempfile.TemporaryDirectory() as d:
+        p = save_mat(Path(d) / "sys.mat", {"g": ct.ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]])})
+        raw = bytearray(p.read_bytes())
+        if kind == "truncated":
+            raw = raw[:len(raw) * 2 // 3]
+        elif kind == "flipped":
+            for i in range(200, len(raw), 7):
+                raw[i] ^= 0x5A
+        elif kind == "header only":
+            raw = raw[:128]
+        elif kind == "empty":
+            raw = bytearray()
+        elif kind == "text":
+            raw = bytearray(b"not a MATLAB file\n" * 20)
+        p.write_bytes(bytes(raw))
+        return _expect("sys.mat", lambda: load_mat(p))
+
+
+def _misc_cases():
+    """The issue's bare exceptions: divergence_speeds without Q0, flutter_speed with n < 2, a
+    Mach number of 1e300, a damaged .mat file."""
+    def div(Q0):
+        from asekit.aeroelastic.flutter import divergence_speeds
+        modal, _, _ = two_dof_coalescence(1.0)
+        return divergence_speeds(modal, Q0, 1.2)
+
+    def section(n):
+        from asekit.aeroelastic.typical_section import conner_1997, flutter_speed
+        return flutter_speed(conner_1997(), 5.0, 40.0, n=n)
+
+    def piston(mach, order):
+        from asekit.aero.piston import piston_pressure_matrices
+        return piston_pressure_matrices(_plate(2, 2), mach, [0.1], 1.0, order=order,
+                                        thickness_slope=0.05)
+
+    def mach_box(mach):
+        from asekit.aero.supersonic import supersonic_pressure_matrices
+        return supersonic_pressure_matrices(_plate(2, 2), mach, [0.1], 1.0)
+
+    cases = [("divergence_speeds Q0 None", "Q0", lambda: div(None)),
+             ("divergence_speeds Q0 3x3", "Q0", lambda: div(np.eye(3))),
+             ("divergence_speeds Q0 nan", "Q0", lambda: div(np.full((2, 2), math.nan))),
+             ("divergence_speeds Q0 str", "Q0", lambda: div("Q0")),
+             ("flutter_speed n 0", "n", lambda: section(0)),
+             ("flutter_speed n 1", "n", lambda: section(1)),
+             ("flutter_speed n -3", "n", lambda: section(-3))]
+    cases += [(f"piston mach {m:g} order {o}", "mach", (lambda m=m, o=o: piston(m, o)))
+              for m in (1e300, 1e160, 1e20) for o in (1, 2, 3)]
+    cases += [(f"mach box mach {m:g}", "mach", (lambda m=m: mach_box(m))) for m in (1e300, 1e20)]
+    cases += [(f"load_mat {kind}", "sys.mat", (lambda kind=kind: _damaged_mat(kind)))
+              for kind in ("truncated", "flipped", "header only", "empty", "text")]
+    return cases
+
+
+def _call_misc(case):
+    label, arg, thunk = case
+    return _expect(arg, thunk)
+
+
+MISC = Target("bare_errors", st.fixed_dictionaries({"case": st.sampled_from(_misc_cases())}),
+              _call_misc, (NAMED,))
+
+#: the targets of issue 22's "silent NaN and loose types"
+TYPE_TARGETS = (LOOSE_TYPES, STEP_RESPONSE, GAF_TABLE, STATESPACE, MISC)
+#: everything the fuzz counter (tests/benchmarks/fuzz_count.py) runs
+ALL_TARGETS = TARGETS + TYPE_TARGETS

@@ -68,3 +68,30 @@ def test_bad_altitude(bad):
 def test_bad_speed():
     with pytest.raises(ValueError, match="true_airspeed"):
         equivalent_airspeed(-1.0, 0.0)
+
+
+# ---- issue 22: strict types -------------------------------------------------------------------
+@pytest.mark.parametrize("altitude, error, word", [
+    (np.array([1000.0 + 5j]), TypeError, r"altitude must be real numbers.*altitude\[0\]"),
+    (1000.0 + 5j, TypeError, "altitude must be real numbers"),
+    ("1000", ValueError, "altitude must be real numbers, got the string"),
+    (["1000", "2000"], ValueError, "altitude must be real numbers, got strings"),
+    ([1000.0, None], TypeError, "altitude must be real numbers"),
+])
+def test_altitude_must_be_real_numbers(altitude, error, word):
+    """Issue 22: a complex altitude lost its imaginary part and "1000" was parsed silently."""
+    with pytest.raises(error, match=word):
+        standard_atmosphere(altitude)
+
+
+def test_mach_and_airspeed_must_be_real_numbers():
+    from asekit.atmosphere import dynamic_pressure, true_airspeed
+    with pytest.raises(TypeError, match=r"mach must be real numbers.*mach\[0\]"):
+        true_airspeed(np.array([0.5 + 1j]), 0.0)
+    with pytest.raises(ValueError, match="true_airspeed_ms must be real numbers"):
+        dynamic_pressure("100", 0.0)
+
+
+def test_numpy_real_altitudes_are_accepted():
+    s = standard_atmosphere(np.float32(0.0))
+    assert float(s.density) == pytest.approx(1.225, rel=1e-4)   # sea level, US 1976 Table 1

@@ -11,7 +11,15 @@ import os
 
 import pytest
 from hypothesis import HealthCheck, given, settings
-from property_targets import TARGETS, classify
+from property_targets import (
+    LOOSE_TYPES,
+    MISC,
+    TARGETS,
+    TYPE_TARGETS,
+    _loose_cases,
+    _misc_cases,
+    classify,
+)
 
 settings.register_profile("asekit-default", max_examples=12, deadline=None, database=None,
                           derandomize=True,
@@ -71,3 +79,29 @@ def test_first_flutter_does_not_depend_on_the_grid(agard):
         assert len(near) == 1, (U, inst)                   # one physical root, once
 
     check()
+
+
+# ---- issue 22: silent NaN and loose types ------------------------------------------------------
+@pytest.mark.parametrize("target", TYPE_TARGETS, ids=[t.name for t in TYPE_TARGETS])
+def test_no_unnamed_nan_or_crash(target):
+    """The issue-22 targets (loose-typed arguments, step_response horizons, non-finite GAF
+    tables and Roger fits, the bare exceptions): every call returns finite results or is
+    refused naming its argument -- no 'unnamed', 'nan', 'implausible' or 'crash' outcome."""
+    _make(target)()
+
+
+@pytest.mark.parametrize("case", _loose_cases(), ids=[c[0] for c in _loose_cases()])
+def test_loose_type_is_refused_naming_the_argument(case):
+    """Each loose-typed call of issue 22 (a string, a float or bool count, a complex value) is
+    refused with a message naming its argument; before, most were coerced silently."""
+    outcome = classify(LOOSE_TYPES, {"case": case})
+    assert outcome.kind == "refused", outcome
+
+
+@pytest.mark.parametrize("case", _misc_cases(), ids=[c[0] for c in _misc_cases()])
+def test_bare_exception_is_now_named(case):
+    """divergence_speeds(Q0=None) (AttributeError), flutter_speed(n=0) (IndexError), Mach 1e300
+    (OverflowError), a damaged .mat file (scipy/zlib errors): refused naming the argument or
+    the file, or (a huge but finite Mach at first order) a finite result."""
+    outcome = classify(MISC, {"case": case})
+    assert outcome.kind in ("refused", "ok"), outcome

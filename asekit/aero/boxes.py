@@ -25,7 +25,7 @@ from functools import cached_property
 
 import numpy as np
 
-from asekit.util.validate import positive
+from asekit.util.validate import integer, positive
 
 #: largest dense aerodynamic matrix set a single call may allocate (bytes); calls that would need
 #: more are refused up front with the estimate and the setting to change.
@@ -85,10 +85,7 @@ class TrapezoidSurface:
         for nm in ("root_chord", "tip_chord"):
             object.__setattr__(self, nm, positive(nm, getattr(self, nm)))
         for nm in ("n_chord", "n_span"):
-            v = getattr(self, nm)
-            if int(v) != v or int(v) < 1:
-                raise ValueError(f"{nm} must be an integer >= 1, got {v!r}")
-            object.__setattr__(self, nm, int(v))
+            object.__setattr__(self, nm, integer(nm, getattr(self, nm), low=1))
         if self.n_chord * self.n_span > MAX_BOXES:
             raise ValueError(f"n_chord x n_span = {self.n_chord} x {self.n_span} = "
                              f"{self.n_chord * self.n_span} boxes exceeds the limit {MAX_BOXES} "

@@ -90,6 +90,7 @@ from asekit.aero.boxes import BoxMesh, check_matrix_memory
 from asekit.aero.kernels import check_kernel
 from asekit.aero.validity import check_k
 from asekit.aero.vlm import CHUNK_BYTES, check_mach, vlm_normalwash_matrix
+from asekit.util.validate import real
 
 #: Laschka's approximation of u / sqrt(1 + u^2) ~ 1 - sum a_n exp(-n c u) ([R71] Eq. A.4;
 #: coefficients as tabulated by Blair 1992, WL-TR-92-3028, p. 89).
@@ -126,7 +127,7 @@ PLANAR_WEIGHT_TABLE_BYTES = 64 * 2**20
 
 
 def _check_bref(b_ref: float) -> float:
-    b = float(b_ref)
+    b = real("b_ref", b_ref)
     if not math.isfinite(b) or b <= 0:
         raise ValueError(f"b_ref must be a finite reference semi-chord > 0 m, got {b_ref!r}")
     return b

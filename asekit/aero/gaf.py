@@ -32,6 +32,7 @@ from asekit.aero.validity import check_k, mach_number
 from asekit.util.blas import blas_threads_for
 from asekit.util.cache import CacheError, load_npz, save_npz
 from asekit.util.paths import DATA_DIR, user_cache_dir
+from asekit.util.validate import finite_array, positive, real
 from asekit.util.version import __version__
 
 #: The reference fin's database, shipped read-only with the repository (so CI does not rebuild
@@ -41,6 +42,22 @@ GAF_FILE = DATA_DIR / "gaf_fin.npz"
 SHIPPED_DATABASES = (GAF_FILE,)
 #: Format version of the database file; bump when its layout or meaning changes.
 GAF_FORMAT = 1
+
+
+def _finite_table(Q, k: np.ndarray) -> np.ndarray:
+    """Q (n_k, n, n) as a complex array, every entry finite, else ValueError naming the first
+    bad (mode, k) entry: ``Q[i, r, c]`` at k = k[i], row mode r, column mode c (0-based)."""
+    try:
+        return finite_array("Q", Q, complex_values=True)
+    except ValueError:
+        a = np.asarray(Q)
+        if a.ndim != 3 or a.dtype.kind not in "iufc":
+            raise
+        a = a.astype(complex)
+    i, r, c = (int(j) for j in np.argwhere(~np.isfinite(a))[0])
+    kk = f"k = {k[i]:g}" if k.ndim == 1 and i < k.size else f"k index {i}"
+    raise ValueError(f"Q must be finite: Q[{i}, {r}, {c}] = {a[i, r, c].item()!r} at {kk}, modes "
+                     f"({r}, {c}) (0-based; {int(np.sum(~np.isfinite(a)))} non-finite entries)")
 
 
 @dataclass(frozen=True)
@@ -56,15 +73,16 @@ class TabulatedGaf:
     mach: float | None = None
 
     def __post_init__(self):
-        k = np.asarray(self.k, dtype=float)
-        Q = np.asarray(self.Q, dtype=complex)
+        k = finite_array("k", self.k)
+        Q = _finite_table(self.Q, k)
         if k.ndim != 1 or Q.shape[0] != k.size or Q.ndim != 3 or Q.shape[1] != Q.shape[2]:
             raise ValueError(f"Q must be (n_k, n, n) with n_k = len(k); got k {k.shape}, "
                              f"Q {Q.shape}")
         if k.size < 2 or np.any(np.diff(k) <= 0) or k[0] < 0:
             raise ValueError(f"k must hold >= 2 ascending values >= 0, got {k}")
-        if not (np.isfinite(self.b_ref) and self.b_ref > 0):
-            raise ValueError(f"b_ref must be > 0, got {self.b_ref}")
+        object.__setattr__(self, "b_ref", positive("b_ref", self.b_ref))
+        if self.mach is not None:
+            object.__setattr__(self, "mach", mach_number(self.mach))
         object.__setattr__(self, "k", k)
         object.__setattr__(self, "Q", Q)
 
@@ -79,7 +97,7 @@ class TabulatedGaf:
         qi_over_k = self.Q.imag / np.where(kk > 0, kk, 1.0)[:, None, None]
         if kk[0] == 0:
             qi_over_k[0] = qi_over_k[1]
-        kq = float(np.clip(k, kk[0], kk[-1]))
+        kq = float(np.clip(real("k", k), kk[0], kk[-1]))
         if method == "linear":
             j = int(np.clip(np.searchsorted(kk, kq) - 1, 0, kk.size - 2))
             t = (kq - kk[j]) / (kk[j + 1] - kk[j])

@@ -136,10 +136,20 @@ def piston_coefficient(mach: float, order: int = 1, thickness_slope=0.0,
     if not (math.isfinite(gamma) and gamma > 1.0):
         raise ValueError(f"gamma must be a finite ratio of specific heats > 1, got {gamma!r}")
     tau = np.asarray(thickness_slope, float)
-    c2 = 1.0 if order >= 2 else 0.0
-    c3 = 1.0 if order >= 3 else 0.0
-    return -(4.0 / m) * (1.0 + c2 * 0.5 * (gamma + 1.0) * m * tau
-                         + c3 * 0.25 * (gamma + 1.0) * m**2 * tau**2)
+    m = np.float64(m)
+    with np.errstate(over="ignore", invalid="ignore"):
+        c = 1.0 + 0.0 * tau
+        if order >= 2:
+            c = c + 0.5 * (gamma + 1.0) * m * tau
+        if order >= 3:
+            c = c + 0.25 * (gamma + 1.0) * m**2 * tau**2
+        c = -(4.0 / m) * c
+    if not np.all(np.isfinite(c)):
+        raise ValueError(f"mach = {float(m):g} with thickness_slope up to "
+                         f"{float(np.max(np.abs(tau))):g} overflows the order-{order} piston "
+                         "coefficient: mach must be a physical Mach number (piston theory: "
+                         "M >= 2, M |tau| <= 1)")
+    return c
 
 
 def piston_transfer(mesh: BoxMesh) -> tuple[np.ndarray, np.ndarray]:

@@ -337,6 +337,12 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     edges = np.unique(np.round(np.concatenate([ylo, yhi]), 12))
     y_wmin, y_wmax = float(edges[0]), float(edges[-1])
     widths = np.diff(edges)
+    spanwise = beta * (y_wmax - y_wmin) / (MACH_BOX_RATIO * dx)       # <= ny (Mach boxes)
+    if not spanwise <= 4 * max_cells:                                  # NaN or inf too
+        raise ValueError(f"the supersonic grid would need more than {spanwise:.3g} cells "
+                         f"(> {max_cells} relevant cells, max_cells) at mach={m:g}, "
+                         f"k={k_max:g}: mach must be a physical Mach number (beta = "
+                         f"sqrt(M^2 - 1) = {beta:.3g} sets the Mach boxes' width)")
     if widths.size and np.allclose(widths, widths[0], rtol=1e-6):
         width = float(widths[0])
         dy = width / max(1, math.ceil(beta * width / (MACH_BOX_RATIO * dx) - 1e-9))

@@ -5,7 +5,7 @@ This module is the leaf that the kernels (:mod:`asekit.aero.vlm`, :mod:`asekit.a
 :mod:`asekit.aero.piston`, :mod:`asekit.aero.supersonic`) and the method registry
 (:mod:`asekit.aero.methods`, the front door that the schema, the pipeline and the sweep use)
 share, so that each range is written once and every Mach or k error reads the same. It imports
-no other asekit module (no import cycle with the kernels it serves).
+no asekit module but :mod:`asekit.util.validate` (no import cycle with the kernels it serves).
 
 - :data:`SUBSONIC`: 0 <= M < 1, the doublet lattice and the vortex lattice (Prandtl-Glauert
   factor beta = sqrt(1 - M^2) > 0);
@@ -20,6 +20,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from asekit.util.validate import real, real_array
 
 
 @dataclass(frozen=True)
@@ -64,10 +66,7 @@ def mach_number(mach, name: str = "mach") -> float:
     >>> mach_number(0.75)
     0.75
     """
-    try:
-        m = float(mach)
-    except (TypeError, ValueError):
-        m = math.nan
+    m = real(name, mach)
     if not math.isfinite(m) or m < 0:
         raise ValueError(f"{name} must be a finite Mach number >= 0, got {mach!r}")
     return m
@@ -99,10 +98,7 @@ def check_mach(mach, mach_range: MachRange, who: str = "", name: str = "mach",
     ...
     ValueError: mach must be < 1 for the DLM (subsonic: 0 <= M < 1), got 1.2
     """
-    try:
-        m = float(mach)
-    except (TypeError, ValueError):
-        m = math.nan
+    m = real(name, mach)
     if mach_range.contains(m):
         return m
     r = mach_range
@@ -130,7 +126,7 @@ def check_k(k, name: str = "k") -> np.ndarray:
     ...
     ValueError: k must be finite reduced frequencies >= 0, got [0.0, -0.1]
     """
-    ks = np.atleast_1d(np.asarray(k, float))
+    ks = np.atleast_1d(real_array(name, k))
     if ks.ndim != 1 or ks.size == 0 or not np.all(np.isfinite(ks)) or np.any(ks < 0):
         raise ValueError(f"{name} must be finite reduced frequencies >= 0, got {k!r}")
     return ks

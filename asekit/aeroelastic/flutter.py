@@ -42,7 +42,13 @@ from asekit.aeroelastic.statespace import ModalArrays, aeroelastic_matrices, mod
 from asekit.atmosphere import standard_atmosphere
 from asekit.util.blas import small_dense
 from asekit.util.conventions import damping_ratio, mode_label, vg_damping
-from asekit.util.validate import positive, positive_array
+from asekit.util.validate import (
+    ArgumentTypeError,
+    finite_array,
+    integer,
+    positive,
+    positive_array,
+)
 
 #: relative tolerance of the stability test: a root is unstable when Re p > RTOL_UNSTABLE * scale,
 #: ``scale`` the largest root magnitude of the sweep (rounding of eigenvalues is ~1e-16 of it).
@@ -97,12 +103,9 @@ def _pressure_ok(rho: float, U: np.ndarray) -> None:
 
 
 def _count(name: str, value, low: int = 1) -> int:
-    """An integer >= low (bool refused), else TypeError/ValueError naming ``name``."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{name} must be an integer >= {low}, got {value!r}")
-    if value < low:
-        raise ValueError(f"{name} must be an integer >= {low}, got {value}")
-    return int(value)
+    """An integer >= low (bool refused), else TypeError/ValueError naming ``name``
+    (:func:`asekit.util.validate.integer`)."""
+    return integer(name, value, low=low)
 
 
 def _mac(a: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -759,7 +762,13 @@ def divergence_speeds(modal, Q0: np.ndarray, density: float, include_rigid: bool
     """
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
     rho = float(positive_array("density", density)[0])
-    Q0 = np.asarray(Q0)
+    if Q0 is None:
+        raise ArgumentTypeError(f"Q0 must be the ({m.n_modes}, {m.n_modes}) GAF matrix at "
+                                "k = 0 (e.g. TabulatedGaf.Q[0]), got None")
+    Q0 = finite_array("Q0", Q0, complex_values=True)
+    if Q0.shape != (m.n_modes, m.n_modes):
+        raise ValueError(f"Q0 must be ({m.n_modes}, {m.n_modes}) like the modal model, got "
+                         f"shape {Q0.shape}")
     _, K, _, Qs = _elastic_part(m, Q0[None], include_rigid)
     mu = linalg.eigvals(Qs[0].real, K)                # Q x = mu K x, q = 1/mu
     mu = mu[np.abs(mu.imag) <= 1e-9 * np.maximum(np.abs(mu), 1e-300)].real

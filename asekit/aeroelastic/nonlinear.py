@@ -108,7 +108,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from asekit.util.blas import small_dense
-from asekit.util.validate import finite, in_range, positive
+from asekit.util.validate import finite, in_range, integer, positive
 
 # ---------------------------------------------------------------------------------------------
 # the connection law and its describing function
@@ -376,9 +376,7 @@ def harmonic_balance(system: ConnectedSystem, connection: Connection, n_grid: in
     if connection.freeplay <= 0 or connection.is_linear:
         raise ValueError("harmonic balance needs a nonlinear connection: freeplay > 0 and "
                          "inner_stiffness < stiffness")
-    n_grid = int(n_grid)
-    if n_grid < 4:
-        raise ValueError(f"n_grid must be >= 4, got {n_grid}")
+    n_grid = integer("n_grid", n_grid, low=4)
     k, k1, dl = connection.stiffness, connection.inner_stiffness, connection.freeplay
     if amplitude_range is None:
         a_lo, a_hi = dl, math.inf
@@ -760,10 +758,8 @@ def multi_harmonic_balance(system: ConnectedSystem, connection: Connection, ampl
     a0 = positive("amplitude", amplitude)
     w0 = 2 * math.pi * positive("frequency_hz", frequency_hz)
     b0 = finite("bias", bias)
-    N = int(n_harmonics)
-    if N < 1:
-        raise ValueError(f"n_harmonics must be >= 1, got {n_harmonics}")
-    M = int(n_samples)
+    N = integer("n_harmonics", n_harmonics, low=1)
+    M = integer("n_samples", n_samples, low=1)
     if M < 8 * N:
         raise ValueError(f"n_samples must be >= 8 n_harmonics = {8 * N}, got {n_samples}")
     th = 2 * math.pi * np.arange(M) / M
@@ -1033,7 +1029,7 @@ def simulate(system: ConnectedSystem, connection: Connection, x0, t_final: float
         evs.append(big)
         return evs
 
-    t_out = np.linspace(0.0, t_final, int(n_out))
+    t_out = np.linspace(0.0, t_final, integer("n_out", n_out, low=2, high=10_000_000))
     X = np.full((n, t_out.size), np.nan)
     switches, switch_d = [], []
     t0 = 0.0

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from asekit.structure.modes import mode_shapes_at  # lazy: the structure module
-from asekit.util.validate import positive
+from asekit.util.validate import finite_array, finite_result, integer, positive
 
 INPUT_NAMES = ("theta", "theta_dot", "theta_ddot")
 
@@ -74,7 +74,7 @@ def modal_arrays(model=None, *, M=None, K=None, C=None, n_rigid=None) -> ModalAr
     M = np.atleast_2d(np.asarray(M, dtype=float))
     K = np.atleast_2d(np.asarray(K, dtype=float))
     C = np.zeros_like(M) if C is None else np.atleast_2d(np.asarray(C, dtype=float))
-    n_rigid = 0 if n_rigid is None else int(n_rigid)
+    n_rigid = 0 if n_rigid is None else integer("n_rigid", n_rigid, low=0, high=1)
     n = M.shape[0]
     for name, a in (("M", M), ("K", K), ("C", C)):
         if a.shape != (n, n):
@@ -133,11 +133,15 @@ def aeroelastic_matrices(modal, rfa, rho: float, velocity: float) -> Aeroelastic
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
     rho = positive("rho", rho)
     U = positive("velocity", velocity)
-    if rfa.A.shape[1] != m.n_modes:
-        raise ValueError(f"rfa has {rfa.A.shape[1]} modes, the modal model {m.n_modes}")
-    b = rfa.b_ref
-    q = 0.5 * rho * U ** 2
-    A = rfa.A
+    A = finite_array("rfa.A", rfa.A)
+    if A.shape[1] != m.n_modes:
+        raise ValueError(f"rfa has {A.shape[1]} modes, the modal model {m.n_modes}")
+    b = positive("rfa.b_ref", rfa.b_ref)
+    with np.errstate(over="ignore"):
+        q = 0.5 * rho * np.float64(U) ** 2
+    if not np.isfinite(q):
+        raise ValueError(f"rho = {rho:g} and velocity = {U:g} give an infinite dynamic pressure "
+                         "(rho U^2 / 2 must be finite)")
     Mb = m.M - 0.5 * rho * b ** 2 * A[2]                    # Eq. (2.60) definitions
     Cb = m.C - 0.5 * rho * b * U * A[1]
     Kb = m.K - q * A[0]
@@ -146,8 +150,13 @@ def aeroelastic_matrices(modal, rfa, rho: float, velocity: float) -> Aeroelastic
     # lag terms as D (p I + diag(beta))^-1 E p: Roger's (Eqs. 2.61-2.63, D a 0/1 selection) or
     # the minimum-state fit's (Karpel 1982), x_a' = -(U/b) diag(beta) x_a + E zeta'
     Dl, El, roots, lag_names = rfa.lag_realization(nc)
+    roots = finite_array("rfa.lag_roots", roots)
     nL = roots.size
-    Mss_inv = np.linalg.inv(Mb[s, s])
+    try:
+        Mss_inv = np.linalg.inv(Mb[s, s])
+    except np.linalg.LinAlgError:
+        raise ValueError(f"M - rho b^2 / 2 A2 is singular at rho = {rho:g}: the apparent mass "
+                         "cancels the structural mass; check rho and the fit's A2") from None
     nz = 2 * ns + nL
     Asys = np.zeros((nz, nz))
     Bsys = np.zeros((nz, 3))
@@ -174,6 +183,10 @@ def aeroelastic_matrices(modal, rfa, rho: float, velocity: float) -> Aeroelastic
         D_h = np.zeros((0, 0))
     names = ([f"zeta{j + 1}" for j in range(ns)] + [f"zeta{j + 1}_dot" for j in range(ns)]
              + list(lag_names))
+    hint = (f"rho = {rho:g} kg/m^3 and velocity = {U:g} m/s overflow the model; give a "
+            "physical flight condition")
+    for what, a in (("A_sys", Asys), ("B_sys", Bsys), ("C_hinge", C_h), ("D_hinge", D_h)):
+        finite_result(f"the aeroelastic {what}", a, hint)
     return AeroelasticMatrices(A=Asys, B=Bsys, C_hinge=C_h, D_hinge=D_h,
                                state_names=tuple(names), n_elastic=ns, n_lags=rfa.n_lags,
                                n_rigid=nc, velocity=U, density=rho, n_lag_states=nL)

@@ -46,7 +46,7 @@ from scipy.optimize import brentq
 from scipy.special import hankel2
 
 from asekit.aeroelastic.nonlinear import ConnectedSystem
-from asekit.util.validate import in_range, positive
+from asekit.util.validate import in_range, integer, positive
 
 JONES_A = (0.165, 0.335)
 JONES_EPS = (0.0455, 0.3)
@@ -241,15 +241,17 @@ def connected_system(sec: TypicalSection, velocity: float) -> ConnectedSystem:
 def flutter_speed(sec: TypicalSection, u_lo: float, u_hi: float, n: int = 60):
     """(U_F (m/s), f_F (Hz)) of the linear section: the lowest airspeed in [u_lo, u_hi] at
     which a root of :func:`state_matrix` crosses into the right half-plane (scan of n speeds,
-    then Brent); None if none in the range. Raises ValueError if it is unstable at u_lo."""
+    then Brent; ``n`` an integer in [2, 1e6]); None if none in the range. Raises ValueError if
+    it is unstable at u_lo."""
     u_lo, u_hi = positive("u_lo", u_lo), positive("u_hi", u_hi)
     if u_hi <= u_lo:
         raise ValueError(f"u_hi must exceed u_lo, got {u_lo}, {u_hi}")
+    n = integer("n", n, low=2, high=1_000_000)
 
     def sig(u):
         ev = np.linalg.eigvals(state_matrix(sec, u))
         return float(np.max(ev.real))
-    us = np.linspace(u_lo, u_hi, int(n))
+    us = np.linspace(u_lo, u_hi, n)
     s = np.array([sig(u) for u in us])
     if s[0] > 0:
         raise ValueError(f"the section is already unstable at u_lo = {u_lo:g} m/s")

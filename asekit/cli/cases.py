@@ -44,7 +44,7 @@ def resolve_case(arg: str) -> Path:
     shipped = shipped_case(arg)
     if shipped is not None:
         return shipped
-    raise FileNotFoundError(f"{arg}: no such file, and no shipped case of that name (`asekit "
+    raise FileNotFoundError(f"{arg} not found, and no shipped case of that name (`asekit "
                             f"cases` lists them; they live in {CASES_DIR})")
 
 

@@ -92,28 +92,60 @@ def _names(cell) -> list[str]:
     return [str(np.asarray(x).item() if np.ndim(x) else x) for x in a.ravel()]
 
 
+class MatFileError(ValueError):
+    """A ``.mat`` file that :func:`load_mat` cannot read (damaged, truncated, not a MATLAB
+    file, or not written by :func:`save_mat`); the message names the file."""
+
+
+def _system(key: str, rec) -> ct.StateSpace:
+    """One struct of :func:`save_mat` as a named StateSpace."""
+    f = {n: rec[n] for n in rec.dtype.names}
+    A, B, C, D = (np.atleast_2d(np.asarray(f[k], float)) for k in "ABCD")
+    nx, nu, ny = A.shape[0], len(_names(f["inputs"])), len(_names(f["outputs"]))
+    A, B = A.reshape(nx, nx), B.reshape(nx, nu)
+    C, D = C.reshape(ny, nx), D.reshape(ny, nu)
+    for name, a in (("A", A), ("B", B), ("C", C), ("D", D)):
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"{key}.{name} holds non-finite values")
+    dt = float(np.squeeze(f["dt"]))
+    return ct.ss(A, B, C, D, dt if dt else 0, inputs=_names(f["inputs"]),
+                 outputs=_names(f["outputs"]), states=_names(f["states"]),
+                 name=str(np.squeeze(f["name"])))
+
+
 def load_mat(path) -> dict[str, ct.StateSpace]:
     """Read a file written by :func:`save_mat` back into ``{name: StateSpace}`` with its
     input, output and state names (the ``meta`` struct, if any, is returned under
-    ``"meta"`` as a dict)."""
-    raw = scipy.io.loadmat(str(path), squeeze_me=False, struct_as_record=True)
-    out = {}
-    for key, val in raw.items():
-        if key.startswith("__"):
-            continue
-        rec = val[0, 0]
-        if key == "meta":
-            out["meta"] = {n: np.squeeze(rec[n]).tolist() for n in rec.dtype.names}
-            continue
-        f = {n: rec[n] for n in rec.dtype.names}
-        A, B, C, D = (np.atleast_2d(np.asarray(f[k], float)) for k in "ABCD")
-        nx, nu, ny = A.shape[0], len(_names(f["inputs"])), len(_names(f["outputs"]))
-        A, B = A.reshape(nx, nx), B.reshape(nx, nu)
-        C, D = C.reshape(ny, nx), D.reshape(ny, nu)
-        dt = float(np.squeeze(f["dt"]))
-        out[key] = ct.ss(A, B, C, D, dt if dt else 0, inputs=_names(f["inputs"]),
-                         outputs=_names(f["outputs"]), states=_names(f["states"]),
-                         name=str(np.squeeze(f["name"])))
+    ``"meta"`` as a dict).
+
+    Raises FileNotFoundError for a missing file and :class:`MatFileError` (a ValueError)
+    naming the file when it is damaged, truncated, not a MATLAB file or holds no system
+    written by :func:`save_mat` (fields A, B, C, D, inputs, outputs, states, name, dt)."""
+    import zlib
+
+    path = Path(path)
+    if not path.is_file():
+        if not path.exists():
+            raise FileNotFoundError(f"{path}: no such .mat file")
+        raise MatFileError(f"{path} is not a file (a .mat file written by save_mat)")
+    try:
+        raw = scipy.io.loadmat(str(path), squeeze_me=False, struct_as_record=True)
+        out = {}
+        for key, val in raw.items():
+            if key.startswith("__"):
+                continue
+            rec = val[0, 0]
+            if key == "meta":
+                out["meta"] = {n: np.squeeze(rec[n]).tolist() for n in rec.dtype.names}
+                continue
+            out[key] = _system(key, rec)
+    except (ValueError, TypeError, KeyError, IndexError, AttributeError, OSError, EOFError,
+            MemoryError, zlib.error, NotImplementedError, scipy.io.matlab.MatReadError) as exc:
+        raise MatFileError(f"{path.name} cannot be read as a .mat file of save_mat (damaged or "
+                           f"not written by asekit): {type(exc).__name__}: "
+                           f"{str(exc).splitlines()[0] if str(exc) else ''}") from exc
+    if not any(k != "meta" for k in out):
+        raise MatFileError(f"{path.name} holds no state space written by save_mat")
     return out
 
 

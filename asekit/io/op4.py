@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from asekit.util.paths import DATA_DIR
+from asekit.util.validate import integer
 
 
 @dataclass(frozen=True)
@@ -253,9 +254,7 @@ def write_op4(path: str | Path, matrices: dict[str, np.ndarray], digits: int = 9
     (``1.000000000+100``), so every field keeps its width. ``matrices``: name (1-8 characters,
     no spaces) -> finite 1-D or 2-D real or complex array; ``digits`` an integer in [1, 16].
     """
-    if isinstance(digits, bool) or not isinstance(digits, (int, np.integer)) or \
-            not 1 <= digits <= 16:
-        raise ValueError(f"digits must be an integer in [1, 16], got {digits!r}")
+    digits = integer("digits", digits, low=1, high=16)
     if not isinstance(matrices, dict) or not matrices:
         raise ValueError("matrices must be a non-empty dict of name -> array")
     width = digits + 7

@@ -49,9 +49,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from asekit.rfa.roger import check_gaf_table, default_lag_roots, fit_errors
+from asekit.rfa.roger import check_coefficients, check_gaf_table, default_lag_roots, fit_errors
 from asekit.util.blas import small_dense
-from asekit.util.validate import positive
+from asekit.util.validate import finite_array, finite_result, integer, positive, real_array
 
 
 def default_ms_roots(k_max: float, n_states: int) -> np.ndarray:
@@ -115,6 +115,9 @@ class MinimumStateFit:
     error_history: np.ndarray = field(default=None, repr=False)
     weights: np.ndarray = field(default=None, repr=False)
 
+    def __post_init__(self):
+        check_coefficients(self, ("A", "D", "E"))
+
     @property
     def n_lags(self) -> int:
         """Number of lag roots = number of aerodynamic lag states n_L."""
@@ -136,7 +139,7 @@ class MinimumStateFit:
 
     def evaluate(self, k) -> np.ndarray:
         """Q~ at reduced frequencies ``k``: (n, n) or (len(k), n, n) complex."""
-        k_arr = np.atleast_1d(np.asarray(k, dtype=float))
+        k_arr = np.atleast_1d(real_array("k", k))
         out = self._eval_p(1j * k_arr)
         return out[0] if np.ndim(k) == 0 else out
 
@@ -379,11 +382,12 @@ def minimum_state_fit(k, Q, b_ref: float, n_states: int = 4, lag_roots=None, wei
     positive("b_ref", b_ref)
     k, Q = check_gaf_table(k, Q)
     n_k, n = Q.shape[0], Q.shape[1]
+    n_states = integer("n_states", n_states, low=1)
+    max_iter = integer("max_iter", max_iter, low=1)
+    max_root_evaluations = integer("max_root_evaluations", max_root_evaluations, low=1)
     if lag_roots is None:
-        if int(n_states) < 1:
-            raise ValueError(f"n_states must be >= 1, got {n_states}")
-        lag_roots = default_ms_roots(float(k.max()), int(n_states))
-    roots = np.atleast_1d(np.asarray(lag_roots, dtype=float))
+        lag_roots = default_ms_roots(float(k.max()), n_states)
+    roots = np.atleast_1d(finite_array("lag_roots", lag_roots))
     if roots.size < 1 or np.any(~np.isfinite(roots)) or np.any(roots <= 0):
         raise ValueError(f"lag_roots must be >= 1 finite values > 0, got {roots}")
     nL = roots.size
@@ -446,6 +450,9 @@ def minimum_state_fit(k, Q, b_ref: float, n_states: int = 4, lag_roots=None, wei
                                 "fatol": 1e-12})
         roots = np.sort(np.exp(res.x))
     als, (A, D, E, hist, it, conv) = solve(roots)
+    for name, a in (("A", A), ("D", D), ("E", E)):
+        finite_result(f"the minimum-state fit's {name}", a, "check the scale of Q and the "
+                      "lag_roots (finite, > 0, of the order of k) or give initial_D")
     elem, overall = fit_errors(Q, als.evaluate(A, D, E))
     ref = float(np.sum(np.abs(W * Q) ** 2))
     return MinimumStateFit(

@@ -26,17 +26,28 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from asekit.util.blas import small_dense
-from asekit.util.validate import positive
+from asekit.util.validate import finite_array, finite_result, integer, positive, real_array
 
 
 def default_lag_roots(k_max: float, n_lags: int = 4) -> np.ndarray:
     """Lag roots spread over the reduced-frequency range, beta_n = 1.7 k_max (n/(N+1))^2
     (Tiffany & Adams, NASA TP-2776, 1988, recommended spacing). Returns (n_lags,) > 0."""
     positive("k_max", k_max)
-    if int(n_lags) < 0:
-        raise ValueError(f"n_lags must be >= 0, got {n_lags}")
-    n = np.arange(1, int(n_lags) + 1)
-    return 1.7 * k_max * (n / (int(n_lags) + 1)) ** 2
+    n_lags = integer("n_lags", n_lags, low=0)
+    n = np.arange(1, n_lags + 1)
+    return 1.7 * k_max * (n / (n_lags + 1)) ** 2
+
+
+def check_coefficients(fit, names=("A",)) -> None:
+    """Refuse a fit (RogerFit, MinimumStateFit) whose coefficient arrays ``names`` or lag roots
+    are not finite, or whose b_ref is not a finite number > 0 (ValueError naming the field)."""
+    for name in names:
+        object.__setattr__(fit, name, finite_array(name, getattr(fit, name)))
+    roots = np.atleast_1d(finite_array("lag_roots", fit.lag_roots))
+    if np.any(roots <= 0):
+        raise ValueError(f"lag_roots must all be > 0, got {roots}")
+    object.__setattr__(fit, "lag_roots", roots)
+    object.__setattr__(fit, "b_ref", positive("b_ref", fit.b_ref))
 
 
 @dataclass(frozen=True)
@@ -69,6 +80,9 @@ class RogerFit:
     constrained_k0: bool = False
     mach: float | None = None
     weights: np.ndarray = field(default=None, repr=False)
+
+    def __post_init__(self):
+        check_coefficients(self, ("A",))
 
     @property
     def n_lags(self) -> int:
@@ -110,7 +124,7 @@ class RogerFit:
     def evaluate(self, k) -> np.ndarray:
         """Q~ at reduced frequencies ``k`` (scalar or array): (n, n) or (len(k), n, n) complex,
         Eq. (2.13)."""
-        k_arr = np.atleast_1d(np.asarray(k, dtype=float))
+        k_arr = np.atleast_1d(real_array("k", k))
         ik = 1j * k_arr
         terms = [np.ones_like(ik), ik, ik ** 2] + [ik / (ik + b) for b in self.lag_roots]
         basis = np.stack(terms, axis=1)                       # (n_k, N+3)
@@ -143,8 +157,8 @@ def fit_errors(Q: np.ndarray, Q_fit: np.ndarray) -> tuple[np.ndarray, float]:
 def check_gaf_table(k, Q) -> tuple[np.ndarray, np.ndarray]:
     """Validate a GAF table: k (n_k,) finite, >= 0, strictly ascending; Q (n_k, n, n) finite
     complex. Returns (k, Q) as float and complex arrays; ValueError otherwise."""
-    k = np.asarray(k, dtype=float)
-    Q = np.asarray(Q, dtype=complex)
+    k = finite_array("k", k)
+    Q = finite_array("Q", Q, complex_values=True)
     if k.ndim != 1 or Q.ndim != 3 or Q.shape[0] != k.size or Q.shape[1] != Q.shape[2]:
         raise ValueError(f"Q must have shape (n_k, n, n) with n_k = len(k) = {k.size}; "
                          f"got Q {Q.shape}")
@@ -197,9 +211,10 @@ def roger_fit(k, Q, b_ref: float, lag_roots=None, n_lags: int = 4, weights=None,
     """
     positive("b_ref", b_ref)
     k, Q = check_gaf_table(k, Q)
+    n_lags = integer("n_lags", n_lags, low=0)
     if lag_roots is None:
         lag_roots = default_lag_roots(float(k.max()), n_lags)
-    lag_roots = np.atleast_1d(np.asarray(lag_roots, dtype=float))
+    lag_roots = np.atleast_1d(finite_array("lag_roots", lag_roots))
     if np.any(~np.isfinite(lag_roots)) or np.any(lag_roots <= 0):
         raise ValueError(f"lag_roots must all be finite and > 0, got {lag_roots}")
     n_coef = 3 + lag_roots.size
@@ -228,7 +243,8 @@ def roger_fit(k, Q, b_ref: float, lag_roots=None, n_lags: int = 4, weights=None,
         coef = sol[:n_coef]
     else:
         coef = np.linalg.lstsq(G, rhs, rcond=None)[0]          # Eq. (2.24)
-    A = coef.reshape(n_coef, n, n)
+    A = finite_result("the Roger fit's coefficients A", coef.reshape(n_coef, n, n),
+                      "check the scale of Q and the lag_roots (finite, > 0, of the order of k)")
     fit = RogerFit(A=A, lag_roots=lag_roots, b_ref=float(b_ref), k=k, Q=Q,
                    element_error=np.zeros((n, n)), fit_error=0.0,
                    constrained_k0=bool(constrain_k0), mach=mach, weights=w)

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import control as ct
 import numpy as np
 
-from asekit.util.validate import in_range
+from asekit.util.validate import finite, finite_result, in_range, integer
 
 
 @dataclass(frozen=True)
@@ -391,14 +391,50 @@ def root_locus_data(params: ActuatorParameters, controller: PDController | None 
     return gains, poles
 
 
+#: largest time step x fastest closed-loop pole |p| dt of :func:`step_response`: the matrix
+#: exponential e^{A dt} of the sampled response loses all accuracy (NaN from about 1e50 on;
+#: 1e20 still exact) far beyond any useful sampling.
+MAX_STEP_POLE_PRODUCT = 1e12
+#: largest growth sigma t_final of an unstable loop's response (e^700 ~ 1e304, near the
+#: largest double).
+MAX_GROWTH_EXPONENT = 700.0
+
+
+def _step_horizon(poles: np.ndarray, n: int) -> float:
+    """The longest t_final (s) of :func:`step_response` with ``n`` samples whose response is
+    representable: (n - 1) MAX_STEP_POLE_PRODUCT / max|p|, and MAX_GROWTH_EXPONENT / max Re p
+    for an unstable loop."""
+    fastest = float(np.max(np.abs(poles))) if poles.size else 0.0
+    limit = (n - 1) * MAX_STEP_POLE_PRODUCT / fastest if fastest > 0 else np.inf
+    growth = float(np.max(poles.real)) if poles.size else 0.0
+    if growth > 0:
+        limit = min(limit, MAX_GROWTH_EXPONENT / growth)
+    return limit
+
+
 def step_response(params: ActuatorParameters, controller: PDController, t_final: float = 0.05,
                   amplitude: float = 1.0, n: int = 2001) -> tuple[np.ndarray, np.ndarray]:
     """Linear closed-loop step response of Eq. (4.18) (Figs 49, 51, 52, 53).
 
-    Returns (t in s, theta in the unit of ``amplitude``)."""
-    in_range("t_final", t_final)
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 2 <= n <= 10_000_000:
-        raise ValueError(f"n must be an integer in [2, 1e7], got {n!r}")
+    ``t_final`` (s) > 0 at most the representable horizon: the time step t_final / (n - 1)
+    times the fastest closed-loop pole |p| at most :data:`MAX_STEP_POLE_PRODUCT`, and for an
+    unstable loop (max Re p > 0) the growth max Re p t_final at most
+    :data:`MAX_GROWTH_EXPONENT` (ValueError naming t_final, n and the range otherwise);
+    ``n`` an integer in [2, 1e7]; ``amplitude`` a finite real number.
+
+    Returns (t in s, theta in the unit of ``amplitude``), both finite."""
+    t_final = in_range("t_final", t_final)
+    amplitude = finite("amplitude", amplitude)
+    n = integer("n", n, low=2, high=10_000_000)
+    loop = closed_loop(params, controller, require_stable=False)
+    horizon = _step_horizon(np.asarray(ct.poles(loop)), n)
+    if t_final > horizon:
+        raise ValueError(f"t_final must be in (0, {horizon:.4g}] s with n = {n} samples (time "
+                         f"step t_final / (n - 1) <= {horizon / (n - 1):.4g} s; an unstable "
+                         f"loop grows past the float range beyond it), got {t_final:g}")
     t = np.linspace(0.0, t_final, n)
-    resp = ct.step_response(closed_loop(params, controller, require_stable=False), T=t)
-    return resp.time, amplitude * np.squeeze(resp.outputs)
+    resp = ct.step_response(loop, T=t)
+    theta = finite_result("the step response", amplitude * np.squeeze(resp.outputs),
+                          f"t_final = {t_final:g} s with n = {n} samples is too coarse or too "
+                          "long for this loop; shorten t_final or give more samples")
+    return resp.time, theta

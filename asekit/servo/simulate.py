@@ -63,7 +63,7 @@ from asekit.servo.torque_requirement import (
     dynamic_pressure,
 )
 from asekit.util.blas import small_dense
-from asekit.util.validate import in_range
+from asekit.util.validate import in_range, integer
 
 _CURRENT_MODELS = ("voltage_clip", "regulator")
 
@@ -372,9 +372,7 @@ def simulate(params: ActuatorParameters, controller: PDController,
     in_range("max_step", max_step)
     if sample_time is not None:
         in_range("sample_time", sample_time)
-    if isinstance(n_out, bool) or not isinstance(n_out, (int, np.integer)) or not \
-            2 <= n_out <= 10_000_000:
-        raise ValueError(f"n_out must be an integer in [2, 1e7], got {n_out!r}")
+    n_out = integer("n_out", n_out, low=2, high=10_000_000)
     steps, lam = estimate_steps(params, controller, t_final, max_step, sample_time)
     if steps > MAX_SIM_STEPS:
         raise ValueError(

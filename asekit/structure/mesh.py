@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from asekit.geometry import LinearThickness, Planform, Thickness, ThicknessField
-from asekit.util.validate import positive
+from asekit.util.validate import integer, positive
 
 
 @dataclass(frozen=True)
@@ -86,9 +86,8 @@ class PlateMesh:
 
 
 def _check_count(name: str, value) -> int:
-    if isinstance(value, bool) or int(value) != value or int(value) < 1:
-        raise ValueError(f"{name} must be an integer >= 1 (elements per direction), got {value!r}")
-    return int(value)
+    """Elements per direction: an integer >= 1 (:func:`asekit.util.validate.integer`)."""
+    return integer(name, value, low=1)
 
 
 def structured_mesh(planform: Planform, thickness: LinearThickness, n_chord: int,

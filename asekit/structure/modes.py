@@ -28,7 +28,7 @@ import scipy.sparse.linalg as spla
 from asekit.structure.assembly import SupportedSystem, rigid_pitch_vector, shaft_support
 from asekit.structure.mesh import PlateMesh
 from asekit.structure.plate import locate_points, membrane_matrices, shape_functions
-from asekit.util.validate import positive
+from asekit.util.validate import integer, positive
 
 #: Modes whose share of kinetic energy in the out-of-plane translation w is below this are
 #: "modes with no out-of-plane motion" and are dropped (thesis Fig. 15/16: in-plane mode).
@@ -116,9 +116,7 @@ def normal_modes(system: SupportedSystem, n_modes: int = 10, M_fin=None,
     opinv : a :func:`shift_invert_operator` of this system and shift (default: made here).
     """
     n_q = system.K.shape[0]
-    if int(n_modes) != n_modes or n_modes < 1:
-        raise ValueError(f"n_modes must be an integer >= 1, got {n_modes!r}")
-    n_modes = int(min(n_modes, n_q))
+    n_modes = min(integer("n_modes", n_modes, low=1), n_q)
     sigma = -(2 * math.pi * shift_hz) ** 2
     if n_modes >= n_q - 1:
         # tiny systems: dense solve (less accurate for a near-zero rigid mode next to a huge
@@ -268,9 +266,7 @@ def _keep_modes(f_hz, share, f_max_hz, n_modes):
 def _solve_modes(system, M_fin, f_max_hz, n_modes, extra: int = 0) -> NormalModes:
     if n_modes is None:
         return modes_up_to(system, f_max_hz, M_fin=M_fin)
-    n = int(n_modes)
-    if n < 1:
-        raise ValueError(f"modes.count must be an integer >= 1, got {n_modes!r}")
+    n = integer("modes.count", n_modes, low=1)
     return normal_modes(system, min(system.K.shape[0], 2 * n + 4 + extra), M_fin=M_fin)
 
 
@@ -455,9 +451,7 @@ def inplane_modes(mesh: PlateMesh, material, pinned_point, n_modes: int = 4) -> 
     -------
     :class:`InPlaneModes`.
     """
-    if int(n_modes) != n_modes or n_modes < 1:
-        raise ValueError(f"n_modes must be an integer >= 1, got {n_modes!r}")
-    n_modes = int(n_modes)
+    n_modes = integer("n_modes", n_modes, low=1)
     Ke, Me = membrane_matrices(mesh, material)
     dofs = (2 * mesh.elements[:, :, None] + np.arange(2)).reshape(-1, 8)
     rows, cols = np.repeat(dofs, 8, axis=1).ravel(), np.tile(dofs, (1, 8)).ravel()

@@ -157,3 +157,48 @@ def test_bad_input(fin_db, fin_case, boxes_of):
     with pytest.raises(ValueError, match="line"):
         InfinitePlateSpline(np.array([[0, 0], [1, 0], [2, 0.0]]))
     assert pipeline.reduced_frequencies(fin_case)[0] == 0.001
+
+
+# ---- issue 22: TabulatedGaf refuses non-finite and loosely typed tables -----------------------
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf, complex(0, math.inf),
+                                 complex(math.nan, 0)])
+def test_tabulated_gaf_refuses_non_finite_q_naming_the_entry(bad):
+    """Issue 22's reproducer: a NaN/inf in Q was accepted (p-k then ignored it or raised a bare
+    LinAlgError). Now refused at construction, naming Q, the entry, its k and its modes."""
+    from asekit.aero.gaf import TabulatedGaf
+    Q = np.ones((3, 2, 2), complex)
+    Q[1, 0, 1] = bad
+    with pytest.raises(ValueError, match=r"Q must be finite: Q\[1, 0, 1\] = .* at k = 0\.5, "
+                                         r"modes \(0, 1\)"):
+        TabulatedGaf(np.array([0.0, 0.5, 1.0]), Q, 1.0)
+
+
+@pytest.mark.parametrize("kw, word, error", [
+    ({"b_ref": "1.0"}, "b_ref must be a real number", ValueError),
+    ({"b_ref": math.nan}, "b_ref must be a finite number > 0", ValueError),
+    ({"k": np.array([0.0, 0.5, 1.0 + 0.5j])}, r"k must be real numbers.*k\[2\]", TypeError),
+    ({"k": ["0", "0.5", "1"]}, "k must be real numbers", ValueError),
+    ({"k": np.array([0.0, math.nan, 1.0])}, r"k must be finite, got k\[1\] = nan", ValueError),
+    ({"mach": "0.5"}, "mach must be a real number", ValueError),
+])
+def test_tabulated_gaf_strict_types(kw, word, error):
+    from asekit.aero.gaf import TabulatedGaf
+    a = {"k": np.array([0.0, 0.5, 1.0]), "Q": np.ones((3, 2, 2), complex), "b_ref": 1.0} | kw
+    with pytest.raises(error, match=word):
+        TabulatedGaf(**a)
+
+
+def test_tabulated_gaf_accepts_numpy_reals():
+    from asekit.aero.gaf import TabulatedGaf
+    g = TabulatedGaf([0, 1], np.ones((2, 1, 1)), np.float32(0.5), mach=np.float64(0.7))
+    assert g.b_ref == 0.5 and g.mach == 0.7 and g.Q.dtype == complex and g.k.dtype == float
+
+
+def test_pk_with_a_nan_gaf_no_longer_reaches_the_solver():
+    """Before issue 22, pk_flutter on such a table raised LinAlgError("Array must not contain
+    infs or NaNs"); the table is now refused before any flutter computation."""
+    from asekit.aero.gaf import TabulatedGaf
+    Q = np.ones((3, 2, 2), complex)
+    Q[2, 1, 1] = math.nan
+    with pytest.raises(ValueError, match=r"Q\[2, 1, 1\]"):
+        TabulatedGaf(np.array([0.0, 1.0, 10.0]), Q, 1.0)

@@ -117,3 +117,18 @@ def test_bad_input(kwargs, match):
     args.update(kwargs)
     with pytest.raises(ValueError, match=match):
         piston_pressure_matrices(_wing(), **args)
+
+
+# ---- issue 22: an absurd Mach number is refused, not an OverflowError ---------------------------
+@pytest.mark.parametrize("mach, order", [(1e300, 3), (1e160, 3)])
+def test_overflowing_coefficient_names_mach(mach, order):
+    """Issue 22's reproducer: Mach 1e300 raised OverflowError (34, 'Numerical result out of
+    range') from M^2 tau^2."""
+    with pytest.raises(ValueError, match=r"mach = 1e\+\d+ with thickness_slope up to 0\.05 "
+                                         r"overflows the order-3 piston coefficient"):
+        piston_coefficient(mach, order=order, thickness_slope=0.05)
+
+
+def test_first_order_coefficient_at_huge_mach_is_the_finite_limit():
+    """First order: c = -4 / M exactly (no M^2 term to overflow, before: 0 * inf = nan)."""
+    assert piston_coefficient(1e160, order=1, thickness_slope=0.05) == pytest.approx(-4e-160)

@@ -645,3 +645,16 @@ def test_aero_method_registry_is_the_one_mach_check():
     mesh = mesh_surfaces([TrapezoidSurface((0, 0, 0), 0.2, (0, 0.2, 0), 0.2, 2, 2)])
     with pytest.raises(ValueError, match=r"machs\[1\] must be < 1 for the DLM"):
         build_gaf_database(None, mesh, [0.5, 1.2], [0.0, 0.1], 0.1, 0, progress=False)
+
+
+# ---- issue 22: an absurd Mach number is refused, not an OverflowError ---------------------------
+@pytest.mark.parametrize("mach", [1e300, 1e20])
+def test_huge_mach_is_refused_by_the_cell_count(mach):
+    """Issue 22: Mach 1e300 raised OverflowError ("cannot convert float infinity to integer")
+    in the grid; beta = sqrt(M^2 - 1) makes the Mach boxes ~1/beta wide, so the grid is refused
+    by its cell count, naming mach."""
+    from asekit.aero.supersonic import supersonic_pressure_matrices
+    mesh = _rect(1.0, 1.0, 2, 2)
+    with pytest.raises(ValueError, match=r"supersonic grid would need more than .* cells .* "
+                                         r"mach must be a physical Mach number"):
+        supersonic_pressure_matrices(mesh, mach, [0.1], 0.5)

@@ -192,3 +192,31 @@ def test_tracking_follows_eigenvectors_through_a_frequency_crossing():
     np.testing.assert_allclose(res.frequency_hz[ok, 1], w1[ok] / (2 * np.pi), rtol=1e-9)
     assert np.all(np.abs(res.vectors[:, 0, 1]) < 1e-9 * np.abs(res.vectors[:, 0, 0]))
     assert np.all(np.abs(res.vectors[ok, 1, 0]) < 1e-9 * np.abs(res.vectors[ok, 1, 1]))
+
+
+# ---- issue 22: divergence_speeds names a missing or bad Q0 -------------------------------------
+@pytest.mark.parametrize("Q0, word, error", [
+    (None, r"Q0 must be the \(2, 2\) GAF matrix at k = 0", TypeError),
+    (np.eye(3), r"Q0 must be \(2, 2\) like the modal model, got shape \(3, 3\)", ValueError),
+    (np.full((2, 2), np.nan), r"Q0 must be finite, got Q0\[0, 0\]", ValueError),
+    ("Q0", "Q0 must be numbers", ValueError),
+])
+def test_divergence_speeds_bad_q0_is_named(Q0, word, error):
+    """Issue 22's reproducer: divergence_speeds(Q0=None) was an AttributeError ('NoneType' has
+    no attribute 'real'); a wrong shape or NaN gave scipy's unnamed errors."""
+    modal = modal_arrays(M=np.eye(2), K=np.diag([100.0, 400.0]))
+    with pytest.raises(error, match=word):
+        divergence_speeds(modal, Q0, 1.2)
+
+
+def test_pk_refuses_complex_velocities_and_float_counts():
+    """Issue 22: velocities with an imaginary part were cast to float (imaginary part dropped)
+    and max_iter = 3.5 was a bare TypeError."""
+    from property_targets import two_dof_coalescence
+    modal, gaf, _ = two_dof_coalescence(1.0)
+    with pytest.raises(TypeError, match=r"velocities must be real numbers.*velocities\[1\]"):
+        pk_flutter(modal, gaf, 1.2, np.array([10.0, 20.0 + 1j]))
+    with pytest.raises(TypeError, match="density must be a real number"):
+        pk_flutter(modal, gaf, np.complex128(1.2 + 1j), [10.0, 20.0])
+    with pytest.raises(TypeError, match="max_iter must be an integer >= 1"):
+        pk_flutter(modal, gaf, 1.2, [10.0, 20.0], max_iter=3.5)

@@ -475,3 +475,14 @@ def test_conner_flap_stiffness_flutter_against_tang_1998():
     assert u_zero[0] == pytest.approx(6.80, abs=0.02)
     assert all(6.4 < u < 7.1 for u in u_zero), u_zero
     assert max(u_zero) < 0.83 * 8.6
+
+
+# ---- issue 22: the scan count is an integer >= 2 ------------------------------------------------
+@pytest.mark.parametrize("n, error", [(0, ValueError), (1, ValueError), (-3, ValueError),
+                                      (10.5, TypeError), (True, TypeError), ("60", TypeError)])
+def test_flutter_speed_scan_count_is_checked(n, error):
+    """Issue 22's reproducer: flutter_speed(n=0) was an IndexError (an empty scan), n = 10.5 was
+    truncated silently."""
+    from asekit.aeroelastic.typical_section import flutter_speed
+    with pytest.raises(error, match=r"n must be an integer in \[2, 1000000\]"):
+        flutter_speed(conner_1997(), 5.0, 40.0, n=n)

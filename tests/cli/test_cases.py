@@ -64,7 +64,7 @@ def test_version_and_a_shipped_case_by_name_from_any_directory(tmp_path):
     r = run("analyse", "no_such_case")
     assert r.returncode == 2
     assert r.stderr.strip().splitlines() == [
-        f"error: case file no_such_case: no such file, and no shipped case of that name "
+        f"error: case file no_such_case not found, and no shipped case of that name "
         f"(`asekit cases` lists them; they live in {CASES_DIR})"]
     r = run("analyse", "agard445_6", "--quiet", "--json", "out/o.json")
     assert r.returncode == 0, r.stderr

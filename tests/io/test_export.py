@@ -87,3 +87,44 @@ def test_op4_modal_and_gaf_read_by_pynastran(fin, tmp_path):
     ours = read_op4(p2)
     np.testing.assert_allclose(np.asarray(ours["QHHL"].data if hasattr(ours["QHHL"], "data")
                                           else ours["QHHL"]), qhhl, rtol=1e-12)
+
+
+# ---- issue 22: a damaged .mat file is a named error ---------------------------------------------
+def _damage(raw: bytes, kind: str) -> bytes:
+    raw = bytearray(raw)
+    if kind == "truncated":
+        return bytes(raw[:len(raw) * 2 // 3])
+    if kind == "flipped":                       # corrupts the zlib stream of the struct
+        for i in range(200, len(raw), 7):
+            raw[i] ^= 0x5A
+        return bytes(raw)
+    if kind == "header only":
+        return bytes(raw[:128])
+    if kind == "empty":
+        return b""
+    return b"not a MATLAB file\n" * 20
+
+
+@pytest.mark.parametrize("kind", ["truncated", "flipped", "header only", "empty", "text"])
+def test_load_mat_damaged_file_names_the_file(tmp_path, kind):
+    """Issue 22's reproducer: load_mat on a damaged file raised scipy's MatReadError, OSError
+    ("could not read bytes") or zlib.error; now MatFileError (a ValueError) naming the file."""
+    p = export.save_mat(tmp_path / "fin.mat", {"g": ct.ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]])})
+    p.write_bytes(_damage(p.read_bytes(), kind))
+    with pytest.raises(export.MatFileError, match=r"^fin\.mat "):
+        export.load_mat(p)
+    assert issubclass(export.MatFileError, ValueError)
+
+
+def test_load_mat_missing_file_and_directory(tmp_path):
+    with pytest.raises(FileNotFoundError, match="no such .mat file"):
+        export.load_mat(tmp_path / "none.mat")
+    with pytest.raises(export.MatFileError, match="is not a file"):
+        export.load_mat(tmp_path)
+
+
+def test_load_mat_round_trip_still_reads(tmp_path):
+    g = ct.ss([[-2.0]], [[1.0]], [[3.0]], [[0.5]], inputs=["u"], outputs=["y"], states=["x"])
+    back = export.load_mat(export.save_mat(tmp_path / "g.mat", {"g": g}))["g"]
+    np.testing.assert_array_equal(back.A, g.A) and np.testing.assert_array_equal(back.D, g.D)
+    assert back.input_labels == ["u"] and back.state_labels == ["x"]

@@ -205,3 +205,35 @@ def test_batched_column_solves_equal_the_column_by_column_solves(con):
     if con["k0_con"]:                # the steady constraint holds: A0 + D (g(0)) E = Q(k0)
         Qt = als.evaluate(A_b, D, E_b)
         np.testing.assert_allclose(Qt[0].real, Q[0].real, atol=1e-10)
+
+
+# ---- issue 22: strict types ----------------------------------------------------------------------
+@pytest.mark.parametrize("kw, word, error", [
+    ({"n_states": 4.5}, "n_states must be an integer >= 1", TypeError),
+    ({"n_states": True}, "n_states must be an integer >= 1", TypeError),
+    ({"n_states": 0}, "n_states must be an integer >= 1", ValueError),
+    ({"max_iter": 2.5}, "max_iter must be an integer >= 1", TypeError),
+    ({"max_root_evaluations": 1e3}, "max_root_evaluations must be an integer", TypeError),
+])
+def test_minimum_state_fit_strict_types(kw, word, error):
+    """Issue 22's reproducer: n_states = 4.5 was truncated to 4 silently."""
+    rng = np.random.default_rng(0)
+    k = np.linspace(0.0, 1.0, 8)
+    Q = rng.normal(size=(8, 2, 2)) + 0j
+    with pytest.raises(error, match=word):
+        minimum_state_fit(k, Q, 1.0, **kw)
+
+
+def test_minimum_state_fit_refuses_complex_k_and_nan_coefficients():
+    import dataclasses
+
+    rng = np.random.default_rng(0)
+    k = np.linspace(0.0, 1.0, 8)
+    Q = rng.normal(size=(8, 2, 2)) + 0j
+    with pytest.raises(TypeError, match=r"k must be real numbers"):
+        minimum_state_fit(k + 0.1j, Q, 1.0)
+    fit = minimum_state_fit(k, Q, 1.0, n_states=2, max_iter=5)
+    E = fit.E.copy()
+    E[1, 0] = np.inf
+    with pytest.raises(ValueError, match=r"E must be finite, got E\[1, 0\] = inf"):
+        dataclasses.replace(fit, E=E)

@@ -107,3 +107,49 @@ def test_mach_selection():
     np.testing.assert_allclose(g.Q, 2.0)
     assert g.mach == 0.625 and g.b_ref == 0.078
     np.testing.assert_array_equal(db.at(0.75 + 1e-12).Q, db.Q[1])      # exact within atol
+
+
+# ---- issue 22: strict types and finite coefficients --------------------------------------------
+def _table():
+    rng = np.random.default_rng(0)
+    return np.linspace(0.0, 1.0, 8), rng.normal(size=(8, 2, 2)) + 1j * rng.normal(size=(8, 2, 2))
+
+
+@pytest.mark.parametrize("kw, word, error", [
+    ({"n_lags": 2.5}, "n_lags must be an integer >= 0", TypeError),
+    ({"n_lags": True}, "n_lags must be an integer >= 0", TypeError),
+    ({"n_lags": "2"}, "n_lags must be an integer >= 0", TypeError),
+    ({"b_ref": "1.0"}, "b_ref must be a real number", ValueError),
+    ({"lag_roots": [0.1, np.nan]}, r"lag_roots must be finite, got lag_roots\[1\]", ValueError),
+])
+def test_roger_fit_strict_types(kw, word, error):
+    k, Q = _table()
+    a = {"b_ref": 1.0} | kw
+    with pytest.raises(error, match=word):
+        roger_fit(k, Q, a.pop("b_ref"), **a)
+
+
+def test_roger_fit_refuses_complex_k_and_non_finite_q():
+    k, Q = _table()
+    with pytest.raises(TypeError, match=r"k must be real numbers.*k\[0\]"):
+        roger_fit(k + 0.1j, Q, 1.0)
+    Q[3, 1, 0] = np.nan
+    with pytest.raises(ValueError, match=r"Q must be finite, got Q\[3, 1, 0\]"):
+        roger_fit(k, Q, 1.0)
+
+
+def test_roger_fit_holding_nan_is_refused_at_construction():
+    """Issue 22's reproducer: a RogerFit holding NaN (e.g. dataclasses.replace of a fit) gave
+    NaN state-space matrices; the fit itself now refuses non-finite coefficients."""
+    import dataclasses
+
+    k, Q = _table()
+    fit = roger_fit(k, Q, 1.0, n_lags=2)
+    A = fit.A.copy()
+    A[4, 0, 1] = np.nan
+    with pytest.raises(ValueError, match=r"A must be finite, got A\[4, 0, 1\] = nan"):
+        dataclasses.replace(fit, A=A)
+    with pytest.raises(ValueError, match="lag_roots"):
+        dataclasses.replace(fit, lag_roots=np.array([0.1, -1.0]))
+    with pytest.raises(ValueError, match="b_ref"):
+        dataclasses.replace(fit, b_ref=np.inf)

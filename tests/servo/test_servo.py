@@ -204,3 +204,52 @@ def test_interconnected_state_space_loop_has_the_design_poles():
     # a constant hinge moment T gives the analytic offset R T / (N eta K_t K_c K_P)
     kckp = SYSTEM_3.gain * SYSTEM_3.kp
     assert dc[2] == pytest.approx(5.78 / (66 * 0.7 * 34.6e-3 * kckp), rel=1e-9)
+
+
+# ---- issue 22: no silent NaN from the step response -------------------------------------------
+def test_step_response_t_final_1e100_is_refused_naming_the_horizon():
+    """Issue 22's reproducer: t_final = 1e100 s returned 2000 NaN of 2001 samples (the matrix
+    exponential of a 5e97 s step). Now refused, naming t_final, n and the valid range."""
+    with pytest.raises(ValueError, match=r"t_final must be in \(0, .*\] s with n = 2001"):
+        step_response(P, SYSTEM_3, t_final=1e100)
+
+
+def test_step_response_long_stable_horizon_is_computed_and_finite():
+    """A long but representable horizon (|p| dt ~ 5e9, far below MAX_STEP_POLE_PRODUCT) is
+    computed: a stable loop of unity DC gain (closed_loop's K_c K_P K_t / K_c K_P K_t) settles
+    at 1."""
+    t, y = step_response(P, SYSTEM_3, t_final=1e6)
+    assert np.all(np.isfinite(y)) and y[-1] == pytest.approx(1.0, abs=1e-6)
+
+
+def test_step_response_unstable_loop_refused_past_its_growth_horizon():
+    """An unstable loop grows as e^(sigma t): past sigma t_final = 700 (e^700 ~ 1e304) it is not
+    representable (before: 1662 NaN of 2001 at t_final = 10 s); up to it the response is
+    finite."""
+    bad = PDController(-5.0, 275.0, 1.0)
+    sigma = float(np.max(closed_loop_poles(P, bad, require_stable=False).real))
+    assert sigma > 0
+    with pytest.raises(ValueError, match="t_final must be in"):
+        step_response(P, bad, t_final=10.0)
+    t, y = step_response(P, bad, t_final=0.9 * 700.0 / sigma)
+    assert np.all(np.isfinite(y)) and abs(y[-1]) > 1e100
+
+
+@pytest.mark.parametrize("kw, word, error", [
+    ({"n": 2001.0}, "n must be an integer", TypeError),
+    ({"n": True}, "n must be an integer", TypeError),
+    ({"n": 1}, r"n must be an integer in \[2, 10000000\]", ValueError),
+    ({"t_final": "0.05"}, "t_final must be a real number", ValueError),
+    ({"amplitude": "1"}, "amplitude must be a real number", ValueError),
+    ({"amplitude": 1 + 1j}, "amplitude must be a real number", TypeError),
+    ({"amplitude": float("nan")}, "amplitude must be a finite number", ValueError),
+])
+def test_step_response_strict_types(kw, word, error):
+    with pytest.raises(error, match=word):
+        step_response(P, SYSTEM_3, **kw)
+
+
+def test_step_response_accepts_numpy_scalars():
+    t, y = step_response(P, SYSTEM_3, t_final=np.float32(0.05), n=np.int64(101),
+                         amplitude=np.float64(2.0))
+    assert t.size == 101 and y[-1] == pytest.approx(2.0, abs=2e-3)
