@@ -11,6 +11,7 @@ from dataclasses import replace
 
 from asekit.case.pipeline import auto_boxes
 from asekit.case.schema import Case, CaseError
+from asekit.structure.mesh import Grading, Stations, check_stations, station_array
 
 
 def _one_panel(case: Case, what: str):
@@ -25,22 +26,55 @@ def _count(name: str, v) -> int:
     return int(v)
 
 
-def with_mesh(case: Case, n_chord: int | None = None, n_span: int | None = None) -> Case:
+#: "Keep the case's spacing" (the default of :func:`with_mesh`; None means equal spacing).
+KEEP = "keep"
+
+
+def _spacing(name: str, spacing, n: int):
+    """``spacing`` as the case holds it (None, :class:`Stations` or :class:`Grading`; a plain
+    list of stations becomes a :class:`Stations`), checked against ``n`` elements."""
+    try:
+        if spacing is not None and not isinstance(spacing, (Stations, Grading)):
+            spacing = Stations(tuple(check_stations(name, spacing)))
+        station_array(spacing, n, name)
+    except ValueError as exc:
+        raise CaseError(str(exc)) from None
+    return spacing
+
+
+def with_mesh(case: Case, n_chord: int | None = None, n_span: int | None = None,
+              chord_spacing=KEEP, span_spacing=KEEP) -> Case:
     """The one-panel ``case`` on an ``n_chord x n_span`` structural mesh (``panel[0].n_chord``,
-    ``panel[0].n_span``; None keeps the case's).
+    ``panel[0].n_span``; None keeps the case's), its nodes at ``chord_spacing`` /
+    ``span_spacing`` (``panel[0].chord_stations`` or ``chord_grading``, ...): None for equal
+    spacing, a :class:`~asekit.structure.mesh.Grading`, a
+    :class:`~asekit.structure.mesh.Stations` or a list of stations; :data:`KEEP` (default)
+    keeps the case's, so a graded case refines on its own grading (explicit stations refine
+    by splitting each interval: the count must be a multiple of theirs).
 
     Examples
     --------
     >>> from asekit.case import load_case
+    >>> from asekit.structure.mesh import Grading
     >>> from asekit.util.paths import FIN_FILE
     >>> p = with_mesh(load_case(FIN_FILE), 12, 14).panels[0]
     >>> p.n_chord, p.n_span
     (12, 14)
+    >>> g = with_mesh(load_case(FIN_FILE), 24, 16, Grading(0.5, 8.0), Grading(0.0, 8.0))
+    >>> g.panels[0].span_spacing
+    Grading(toward=(0.0,), ratio=8.0, width=0.0, ramp=None)
     """
     p = _one_panel(case, "with_mesh")
     nc = p.n_chord if n_chord is None else _count("panel[0].n_chord", n_chord)
     ns = p.n_span if n_span is None else _count("panel[0].n_span", n_span)
-    return replace(case, panels=(replace(p, n_chord=nc, n_span=ns),))
+    cs = p.chord_spacing if isinstance(chord_spacing, str) and chord_spacing == KEEP \
+        else chord_spacing
+    ss = p.span_spacing if isinstance(span_spacing, str) and span_spacing == KEEP \
+        else span_spacing
+    cs = _spacing("panel[0].chord_spacing", cs, nc)
+    ss = _spacing("panel[0].span_spacing", ss, ns)
+    return replace(case, panels=(replace(p, n_chord=nc, n_span=ns, chord_spacing=cs,
+                                         span_spacing=ss),))
 
 
 def with_boxes(case: Case, n_chord: int | None = None, n_span: int | None = None) -> Case:
