@@ -30,6 +30,25 @@ included), peak resident memory (MB) per mesh; the order and the Richardson limi
 sequence; the two-mesh extrapolation (order 1, the graded sequences' observed order) of the
 cheapest graded pair; and the goal check against 253.1 m/s (the limit issue 23 quotes for the
 uniform study) and against the graded sequence's own limit.
+
+Measured 2026-12-02 (2 shared cores; speed m/s / CPU s / peak MB, cold):
+
+=========== ======================= =======================
+mesh        boxes 14 x 10           boxes 28 x 20
+=========== ======================= =======================
+u 96x112    246.06 / 11.8 / 335     248.16 / 12.5 / 363
+g 48x32     250.90 /  6.1 / 273     253.00 /  7.6 / 348
+g 64x48     252.81 /  7.6 / 274     254.89 /  8.0 / 349
+g 96x64     253.31 /  9.9 / 278     255.39 / 12.1 / 350
+g 192x128   254.59 / 23.2 / 558     256.64 / 24.2 / 549
+=========== ======================= =======================
+
+Graded order 0.91 (0.93), limit 256.0 (258.0) m/s; the uniform 96/192/384 speeds of issue 23
+(246.1, 250.7, 252.3 at 14 x 10) give order 1.52, limit 253.1. The two disagree because the
+flutter speed follows the shaft region's effective radius (about 18 m/s per mm: 244.6 and 262.5
+m/s for r = 4.5 and 5.5 mm on one graded mesh) and a uniform mesh's node rows under-resolve
+it irregularly (the last row inside the region at the axis is 4.02, 4.69, 4.69 mm up on
+96x112, 192x224, 384x448), so the uniform sequence is not in its asymptotic range.
 """
 
 from __future__ import annotations
