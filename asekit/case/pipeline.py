@@ -94,7 +94,8 @@ def structural_mesh(case: Case) -> PlateMesh:
     if case.structure is not None:
         return case.structure.mesh
     return panels_mesh([p.planform for p in case.panels], case.thickness,
-                       case.panels[0].n_chord, [p.n_span for p in case.panels])
+                       case.panels[0].n_chord, [p.n_span for p in case.panels],
+                       case.panels[0].chord_spacing, [p.span_spacing for p in case.panels])
 
 
 @_door("assembling K and M", _STRUCTURE)

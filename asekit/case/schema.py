@@ -25,6 +25,7 @@ from asekit.atmosphere import MAX_ALTITUDE, MIN_ALTITUDE
 from asekit.case.imported import ImportedModel
 from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
 from asekit.rfa.methods import RFA_FITS
+from asekit.structure.mesh import Grading, Stations, check_stations, station_array
 from asekit.structure.supports import SUPPORTS
 from asekit.util.validate import positive, read_toml
 
@@ -100,11 +101,19 @@ def auto_boxes(planform, u_min: float, f_max: float, n_chord: int | None = None,
 @dataclass(frozen=True)
 class PanelSpec:
     """One flat trapezoidal panel: its planform (m) and its structural mesh (elements chordwise
-    ``n_chord`` and spanwise ``n_span``). Panels are joined spanwise in order."""
+    ``n_chord`` and spanwise ``n_span``). Panels are joined spanwise in order.
+
+    ``chord_spacing`` / ``span_spacing``: where the nodes sit along the chord / span, None for
+    equal spacing, a :class:`~asekit.structure.mesh.Stations` (explicit fractions, keys
+    ``chord_stations`` / ``span_stations``) or a :class:`~asekit.structure.mesh.Grading`
+    (clustered toward a fraction, keys ``chord_grading`` / ``span_grading``). The chord spacing
+    is the same on every panel (a conforming mesh)."""
 
     planform: Planform
     n_chord: int
     n_span: int
+    chord_spacing: Stations | Grading | None = None
+    span_spacing: Stations | Grading | None = None
 
 
 @dataclass(frozen=True)
@@ -452,6 +461,56 @@ def _wrap(path, fn, *args, **kw):
         raise CaseError(f"{path}: {exc}") from None
 
 
+def _grading(t: _Table) -> Grading:
+    """A ``{toward, ratio, width, ramp}`` table (:class:`~asekit.structure.mesh.Grading`)."""
+    toward = t.numbers("toward", required=True, low=0.0, high=1.0, low_open=False,
+                       ascending=True)
+    ratio = t.number("ratio", required=True, low=1.0, high=1e6, low_open=False)
+    width = t.number("width", 0.0, low=0.0, high=1.0, low_open=False, high_open=True)
+    ramp = t.number("ramp", None, low=0.0, high=1.0)
+    t.done()
+    return Grading(toward, ratio, width, ramp)
+
+
+def _spacing(t: _Table, direction: str, count: str):
+    """``<direction>_stations`` (a list of fractions) or ``<direction>_grading`` (a table), not
+    both; None when neither is given."""
+    sk, gk = f"{direction}_stations", f"{direction}_grading"
+    if t.has(sk) and t.has(gk):
+        raise CaseError(f"{t.key(sk)} and {t.key(gk)} both given: give one of them")
+    if t.has(sk):
+        st = t.numbers(sk, min_length=2, low=0.0, high=1.0, low_open=False)
+        try:
+            return Stations(tuple(check_stations(t.key(sk), st)))
+        except ValueError as exc:
+            raise CaseError(str(exc)) from None
+    g = t.table(gk)
+    if g is None:
+        return None
+    if t.d.get(count) is None:
+        raise CaseError(f"{t.key(count)} is missing: {t.key(gk)} needs the element count")
+    return _grading(g)
+
+
+def _panel_mesh(t: _Table):
+    """(n_chord, n_span, chord_spacing, span_spacing) of one panel: the counts default to the
+    element counts of explicit station lists; each spacing is checked against its count."""
+    chord, span = _spacing(t, "chord", "n_chord"), _spacing(t, "span", "n_span")
+    counts = []
+    for k, sp in (("n_chord", chord), ("n_span", span)):
+        given = isinstance(sp, Stations) and not t.has(k)
+        counts.append(t.integer(k, sp.n_elements if given else None, required=not given,
+                                high=2000))
+    for k, sp, n in (("chord", chord, counts[0]), ("span", span, counts[1])):
+        if sp is not None:
+            key = t.key(f"{k}_stations" if isinstance(sp, Stations) else f"{k}_grading")
+            try:
+                station_array(sp, n, key)
+            except ValueError as exc:
+                raise CaseError(f"{exc} ({t.key(f'n_{k}')} = {n})") from None
+    return counts[0], counts[1], chord, span
+
+
 def _panels(raw) -> tuple[PanelSpec, ...]:
     if raw is None:
         raise CaseError("panel is missing: give at least one [[panel]] table")
@@ -464,26 +523,42 @@ def _panels(raw) -> tuple[PanelSpec, ...]:
         tle = t.numbers("tip_leading_edge", required=True, length=2, unit="m")
         rc = t.number("root_chord", required=True, low=0.0, high=1e4, unit="m")
         tc = t.number("tip_chord", required=True, low=0.0, high=1e4, unit="m")
-        nc = t.integer("n_chord", required=True, high=2000)
-        ns = t.integer("n_span", required=True, high=2000)
+        nc, ns, chord, span = _panel_mesh(t)
         t.done()
         if tle[1] <= rle[1]:
             raise CaseError(f"panel[{i}].tip_leading_edge y ({tle[1]:g} m) must exceed "
                             f"root_leading_edge y ({rle[1]:g} m): the planform is crossed or "
                             f"has zero span")
         if i:
-            prev = panels[-1].planform
-            if not (np.allclose(prev.tip_le, rle, atol=1e-9) and math.isclose(prev.tip_chord, rc,
-                                                                              rel_tol=1e-9)):
-                raise CaseError(f"panel[{i}] root (leading edge {list(rle)}, chord {rc:g} m) must "
-                                f"coincide with panel[{i - 1}] tip (leading edge "
-                                f"{list(prev.tip_le)}, chord {prev.tip_chord:g} m)")
-            if nc != panels[0].n_chord:
-                raise CaseError(f"panel[{i}].n_chord must equal panel[0].n_chord = "
-                                f"{panels[0].n_chord} (a conforming structural mesh), got {nc}")
+            _check_joint(i, panels, rle, rc, nc)
+            chord = _joint_chord_spacing(i, panels[0].chord_spacing, chord)
         _check_sweep(i, rle, rc, tle, tc)
-        panels.append(PanelSpec(_wrap(f"panel[{i}]", Planform, rle, rc, tle, tc), nc, ns))
+        panels.append(PanelSpec(_wrap(f"panel[{i}]", Planform, rle, rc, tle, tc), nc, ns,
+                                chord, span))
     return tuple(panels)
+
+
+def _check_joint(i, panels, rle, rc, nc):
+    """Panel ``i``'s root must be panel ``i - 1``'s tip, with panel 0's chordwise count."""
+    prev = panels[-1].planform
+    if not (np.allclose(prev.tip_le, rle, atol=1e-9) and math.isclose(prev.tip_chord, rc,
+                                                                      rel_tol=1e-9)):
+        raise CaseError(f"panel[{i}] root (leading edge {list(rle)}, chord {rc:g} m) must "
+                        f"coincide with panel[{i - 1}] tip (leading edge "
+                        f"{list(prev.tip_le)}, chord {prev.tip_chord:g} m)")
+    if nc != panels[0].n_chord:
+        raise CaseError(f"panel[{i}].n_chord must equal panel[0].n_chord = "
+                        f"{panels[0].n_chord} (a conforming structural mesh), got {nc}")
+
+
+def _joint_chord_spacing(i, first, mine):
+    """Panel ``i``'s chord spacing: panel 0's (the chordwise nodes are shared); a panel may
+    omit it or repeat it, not give another."""
+    if mine is not None and mine != first:
+        raise CaseError(f"panel[{i}] chord spacing {mine} must equal panel[0]'s "
+                        f"({first or 'equal spacing'}): the panels share their chordwise nodes "
+                        f"(a conforming structural mesh); give it on panel[0] only")
+    return first
 
 
 def _check_sweep(i, rle, rc, tle, tc) -> None:
