@@ -6,7 +6,7 @@ Run on demand, against any asekit on the path (e.g. an older checkout for a befo
     PYTHONPATH=. python tests/benchmarks/fuzz_case.py [--case nalci2013_fin] [--mutations 200]
         [--seed 22] [--timeout 20]
 
-Each mutation changes one leaf of the case's TOML table (scaled by 0, -1, 1e-6, 1e6 or 1e30,
+Each mutation changes one leaf of the case's TOML table (scaled by 0, -1, 1e-6, 3, 10, 100, 1e6 or 1e30,
 replaced by NaN, a string, a bool, an empty list or a non-integer, or deleted), then runs
 ``case_from_dict`` and the pipeline's modal model, boxes, GAF database and flutter (GAFs cached in
 a temporary folder). Outcomes:
@@ -63,6 +63,9 @@ MUTATIONS = {
     "zero": lambda v: _scale(v, 0),
     "negate": lambda v: _scale(v, -1),
     "tiny": lambda v: _scale(v, 1e-6),
+    "x3": lambda v: _scale(v, 3),
+    "x10": lambda v: _scale(v, 10),
+    "x100": lambda v: _scale(v, 100),
     "huge": lambda v: _scale(v, 1e6),
     "1e30": lambda v: _scale(v, 1e30),
     "nan": lambda v: math.nan,
