@@ -180,10 +180,41 @@ class _Interrupts:
         return False
 
 
+class _OneLineWarnings:
+    """While a command runs, every warning is shown once, as one line ``warning: <Category>:
+    <message>`` on standard error, without the source file and line, through ``tqdm.write`` so
+    that it never breaks a progress bar (issue 30). ``--debug`` keeps Python's own display.
+    The previous warning settings are restored on exit (``warnings.catch_warnings``)."""
+
+    def __init__(self, debug: bool = False):
+        self.debug = debug
+        self.seen: set = set()
+        self._catch = None
+
+    def show(self, message, category, filename, lineno, file=None, line=None):
+        text = " ".join(str(message).split())
+        if (category, text) in self.seen:
+            return
+        self.seen.add((category, text))
+        from tqdm import tqdm
+        tqdm.write(f"warning: {category.__name__}: {text}", file=sys.stderr)
+
+    def __enter__(self):
+        import warnings
+        self._catch = warnings.catch_warnings()
+        self._catch.__enter__()
+        if not self.debug:
+            warnings.showwarning = self.show
+        return self
+
+    def __exit__(self, *exc):
+        return self._catch.__exit__(*exc)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    with _Interrupts() as interrupts:
+    with _Interrupts() as interrupts, _OneLineWarnings(getattr(args, "debug", False)):
         try:
             code = args.func(args)
             if code and interrupts.seen:    # the command reported the error it was turned into

@@ -46,3 +46,20 @@ def test_sweep_without_pandas_names_the_pip_install_before_any_work(tmp_path):
     assert r.stderr.strip().splitlines() == [
         "error: asekit sweep (the results table) needs pandas: pip install 'asekit-aero[sweep]'"]
     assert not (tmp_path / "o.csv").exists()
+
+
+def test_warnings_are_one_line_each_shown_once_and_restored(capsys):
+    """issue 30: library warnings came with source lines, into the progress bar, every time."""
+    import warnings
+
+    from asekit.cli.main import _OneLineWarnings
+    before = warnings.showwarning
+    with _OneLineWarnings():
+        for _ in range(3):
+            warnings.warn("p-k: the k-iteration did not\n  converge at U = 17400 m/s",
+                          RuntimeWarning, stacklevel=1)
+        warnings.warn("another", UserWarning, stacklevel=1)
+    assert warnings.showwarning is before
+    err = capsys.readouterr().err.splitlines()
+    assert err == ["warning: RuntimeWarning: p-k: the k-iteration did not converge at U = "
+                   "17400 m/s", "warning: UserWarning: another"]
