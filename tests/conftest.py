@@ -243,3 +243,11 @@ def thesis_table():
     from asekit.util.paths import THESIS_FILE
     with open(THESIS_FILE, "rb") as fh:
         return tomllib.load(fh)
+
+
+@pytest.fixture
+def session_gaf_cache(tmp_path_factory, monkeypatch):
+    """Rebuilt GAF databases go to one session temporary folder, never the user's cache (the
+    fin's database is shipped in data/ and only read). Use it per module with
+    ``pytestmark = pytest.mark.usefixtures("session_gaf_cache")``."""
+    monkeypatch.setenv("ASEKIT_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "gaf-cache"))

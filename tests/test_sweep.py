@@ -349,17 +349,23 @@ def test_resume_from_a_partial_file(tmp_path):
         S.run_sweep(other, out=out)
 
 
+def _mark_second_row_failed(out, error: str, output: str) -> None:
+    """Rewrite the second sample of a two-sample output CSV as a failed row (``error``, the
+    ``output`` cell emptied), as a lost worker leaves it."""
+    lines = out.read_text().splitlines(keepends=True)
+    cols = next(csv.reader([lines[0]]))
+    cells = next(csv.reader([lines[2]]))
+    cells[cols.index("status")], cells[cols.index("error")] = "failed", error
+    cells[cols.index(output)] = ""
+    out.write_text(lines[0] + lines[1] + ",".join(cells) + "\n")
+
+
 def test_resume_keeps_or_retries_failed_rows(tmp_path):
     sw = S.sweep_from_dict(sweep_dict([{"path": "support.torsional_stiffness",
                                         "values": [100.0, 120.0]}], outputs=["f1_hz"]))
     out = tmp_path / "r.csv"
     full = S.run_sweep(sw, out=out)
-    lines = out.read_text().splitlines(keepends=True)
-    cols = next(csv.reader([lines[0]]))
-    cells = next(csv.reader([lines[2]]))
-    cells[cols.index("status")], cells[cols.index("error")] = "failed", "KilledWorker: lost"
-    cells[cols.index("f1_hz")] = ""
-    out.write_text(lines[0] + lines[1] + ",".join(cells) + "\n")
+    _mark_second_row_failed(out, "KilledWorker: lost", "f1_hz")
     kept = S.run_sweep(sw, out=out, retry_failed=False)
     assert kept["status"].tolist() == ["ok", "failed"]           # a finished row is kept
     again = S.run_sweep(sw, out=out)                             # the default: rerun failed
@@ -812,12 +818,7 @@ def test_a_plain_resume_retries_failed_rows_and_keep_failed_keeps_them(tmp_path,
     f.write_text(_toml(d))
     out = tmp_path / "r.csv"
     full = S.run_sweep(S.sweep_from_dict(d), out=out)
-    lines = out.read_text().splitlines(keepends=True)
-    cols = next(csv.reader([lines[0]]))
-    cells = next(csv.reader([lines[2]]))
-    cells[cols.index("status")], cells[cols.index("error")] = "failed", "WorkerLost: lost"
-    cells[cols.index("f1_hz")] = ""
-    out.write_text(lines[0] + lines[1] + ",".join(cells) + "\n")
+    _mark_second_row_failed(out, "WorkerLost: lost", "f1_hz")
     args = ["sweep", str(f), "--out", str(out), "--quiet"]
     assert main(args + ["--keep-failed"]) == 1
     assert "error: 1 of 2 samples failed" in capsys.readouterr().err

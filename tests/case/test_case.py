@@ -20,10 +20,8 @@ AGARD = CASES_DIR / "agard445_6.toml"
 FV16 = CASES_DIR / "nafems_fv16.toml"
 
 
-@pytest.fixture(autouse=True)
-def _cache(tmp_path_factory, monkeypatch):
-    """Rebuilt GAF databases go to a session temporary folder, never the user's cache."""
-    monkeypatch.setenv("ASEKIT_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "gaf-cache"))
+#: rebuilt GAF databases go to a session temporary folder (tests/conftest.py)
+pytestmark = pytest.mark.usefixtures("session_gaf_cache")
 
 
 def _fin_dict() -> dict:

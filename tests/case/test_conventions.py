@@ -30,11 +30,8 @@ FV16 = CASES_DIR / "nafems_fv16.toml"
 NOTEBOOKS = Path(__file__).resolve().parents[2] / "notebooks"
 
 
-@pytest.fixture(autouse=True)
-def _cache(tmp_path_factory, monkeypatch):
-    """Rebuilt GAF databases go to a session temporary folder, never the user's cache (the
-    fin's database is shipped in data/ and only read)."""
-    monkeypatch.setenv("ASEKIT_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "gaf-cache"))
+#: rebuilt GAF databases go to a session temporary folder (tests/conftest.py)
+pytestmark = pytest.mark.usefixtures("session_gaf_cache")
 
 
 # ---------------------------------------------------------------------------------------------
