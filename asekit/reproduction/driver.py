@@ -18,15 +18,19 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import json
+import logging
 import math
+import re
 import textwrap
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from asekit.reproduction.thesis import _load, is_number, thesis_value
+from asekit.reproduction.thesis import _load, all_keys, is_number, thesis_value
 from asekit.util.paths import THESIS_FILE
 from asekit.util.plotting import save_figure
+
+_log = logging.getLogger(__name__)
 
 #: Chapters in the thesis's order (its one-way data flow). A chapter whose module does not
 #: exist yet is skipped; a chapter whose module exists but fails raises.
@@ -46,12 +50,16 @@ CHAPTERS: tuple[tuple[str, str], ...] = (
 class Quantity:
     """One computed value: ``key`` (dotted, stable), ``asekit`` (float, list, bool or None when
     the quantity does not exist, e.g. no flutter below the top of the sweep) and its ``unit``.
-    ``note`` explains a difference or an assumption in a few words."""
+    ``note`` explains a difference or an assumption in a few words. ``computed`` is False for
+    a row this run did not compute (e.g. the converged study without ``--converged``): its
+    verdict is then "not computed" whether or not the thesis gives a number, and its note says
+    how to compute it."""
 
     key: str
     asekit: float | list | bool | None
     unit: str
     note: str = ""
+    computed: bool = True
 
 
 @dataclass(frozen=True)
@@ -164,11 +172,20 @@ def _close(t: float, a: float, tol: float) -> bool:
     return abs(a - t) <= tol * abs(t) if t != 0 else abs(a) <= tol
 
 
-def verdict(key: str, thesis, asekit) -> str:
+def verdict(key: str, thesis, asekit, computed: bool = True) -> str:
     """Verdict of one row: "within tolerance", "explained difference" (outside tolerance, with
     an ``explained`` text in data/thesis.toml), "differs", "requirement met" / "requirement
-    missed" (bounds), "in range" / "outside range", "not reported" (no thesis value) or
-    "not computed" (asekit None)."""
+    missed" (bounds), "in range" / "outside range", "not computed" (not computed in this run:
+    ``computed`` False; or asekit None against a thesis number) or "not reported" (the thesis
+    gives no number for a row asekit computed).
+
+    >>> verdict("aero.boxes", None, 140)
+    'not reported'
+    >>> verdict("aero.boxes", None, None, computed=False)
+    'not computed'
+    """
+    if not computed:
+        return "not computed"
     kind, tol = comparison_kind(key)
     if thesis is None or kind == "none":
         return "not reported"
@@ -213,8 +230,67 @@ def comparison_rows(quantities) -> list[tuple[str, str, str, str, str, str, str]
         kind, _ = comparison_kind(q.key)
         diff = difference(tv.value, q.asekit) if kind == "value" else ""
         rows.append((q.key, _fmt(tv.value), _fmt(q.asekit), q.unit, diff, q.note,
-                     verdict(q.key, tv.value, q.asekit)))
+                     verdict(q.key, tv.value, q.asekit, getattr(q, "computed", True))))
     return rows
+
+
+# --------------------------------------------------------------------------------------------
+# notes and "why" lines that cite other rows
+# --------------------------------------------------------------------------------------------
+#: a dotted row key (``flutter.pk.M075.h0.speed_ms``) or a family of rows (``flutter.converged.*``)
+_CITATION = re.compile(r"\b[a-z][a-z0-9_]*(?:(?:\.[A-Za-z0-9_]+)+(?:\.\*)?|\.\*)")
+
+
+def _cited_rows(text: str, known) -> list[list[str]]:
+    """The rows each row citation in ``text`` names (a key of ``known``, or ``prefix.*``: every
+    known key under the prefix); words that name no known row (file names, numbers) are no
+    citations."""
+    cited = []
+    for token in _CITATION.findall(text):
+        if token.endswith(".*"):
+            keys = [k for k in known if k.startswith(token[:-1])]
+        else:
+            keys = [token] if token in known else []
+        if keys:
+            cited.append(keys)
+    return cited
+
+
+def without_empty_citations(text: str, empty, known) -> str:
+    """``text`` without its clauses that cite a row that is empty in this run: a row of
+    ``empty`` (no asekit value, or not run), or for ``prefix.*`` a family whose rows are all
+    empty. Clauses are separated by ``"; "`` or ``", and "``; the clause after a dropped one
+    takes the stronger of the two separators and loses a leading "and ".
+
+    >>> known = {"a.x", "a.y", "b.z"}
+    >>> without_empty_citations("the mesh is coarse; the fine one gives 254 m/s (a.*), and "
+    ...                         "b.z agrees", empty={"a.x", "a.y"}, known=known)
+    'the mesh is coarse; b.z agrees'
+    """
+    if not text:
+        return text
+    parts = re.split(r"(; |, and )", text)
+    out, sep, dropped = "", "", False
+    for i in range(0, len(parts), 2):
+        piece = parts[i]
+        own = parts[i - 1] if i else ""
+        sep = "; " if "; " in (sep, own) and dropped else own
+        if any(all(k in empty for k in keys) for keys in _cited_rows(piece, known)):
+            dropped = True
+            continue
+        if dropped and piece.startswith("and "):
+            piece = piece[4:]
+        out += (sep if out else "") + piece
+        dropped, sep = False, ""
+    return out
+
+
+def _empty_rows(rows) -> tuple[set, set]:
+    """(the keys empty in the table of ``rows``: every thesis key without a row, or whose row
+    has no asekit value; every key a citation may name)."""
+    known = set(all_keys(Path(THESIS_FILE))) | {r[0] for r in rows}
+    filled = {r[0] for r in rows if r[2] != "-"}
+    return known - filled, known
 
 
 _HEAD = ("quantity", "thesis", "asekit", "unit", "difference", "verdict")
@@ -267,6 +343,8 @@ def format_table(rows, wide: bool = False, notes: bool = True) -> str:
     onto indented lines under its row. ``wide``: one line per row with the note at its end
     (as wide as it needs). Rows of 6 strings (without a verdict) are accepted."""
     rows = [tuple(r) + ("",) * (7 - len(r)) for r in rows]
+    empty, known = _empty_rows(rows)
+    rows = [r[:5] + (without_empty_citations(r[5], empty, known),) + r[6:] for r in rows]
     cells = [(r[0], r[1], r[2], r[3], r[4], r[6]) for r in rows]
     if wide:
         widths = [max(len(c[i]) for c in cells + [_HEAD]) for i in range(6)]
@@ -274,7 +352,7 @@ def format_table(rows, wide: bool = False, notes: bool = True) -> str:
                  "  ".join("-" * w for w in widths)]
         for c, r in zip(cells, rows):
             line = "  ".join(x.ljust(w) for x, w in zip(c, widths))
-            why = _explanation(r[0], r[6]) if notes else ""
+            why = _explanation(r[0], r[6], empty, known) if notes else ""
             lines.append((line + (f"  # {r[5]}" if notes and r[5] else "")
                           + (f"  why: {why}" if why else "")).rstrip())
         return "\n".join(lines)
@@ -289,19 +367,21 @@ def format_table(rows, wide: bool = False, notes: bool = True) -> str:
         if notes and r[5]:
             lines += textwrap.wrap(r[5], 100, initial_indent="    # ",
                                    subsequent_indent="      ", break_on_hyphens=False)
-        why = _explanation(r[0], r[6]) if notes else ""
+        why = _explanation(r[0], r[6], empty, known) if notes else ""
         if why:
             lines += textwrap.wrap(why, 100, initial_indent="    why: ",
                                    subsequent_indent="      ", break_on_hyphens=False)
     return "\n".join(lines)
 
 
-def _explanation(key: str, verdict_text: str) -> str:
+def _explanation(key: str, verdict_text: str, empty=frozenset(), known=frozenset()) -> str:
     """The ``explained`` text of data/thesis.toml for a row whose verdict is "explained
-    difference" (shown under the row), else ""."""
+    difference" (shown under the row), else "", without the clauses that cite a row of
+    ``empty`` (:func:`without_empty_citations`)."""
     if verdict_text != "explained difference":
         return ""
-    return str(_load(Path(THESIS_FILE)).get(key, {}).get("explained", ""))
+    text = str(_load(Path(THESIS_FILE)).get(key, {}).get("explained", ""))
+    return without_empty_citations(text, empty, known)
 
 
 def comparison_table(quantities, wide: bool = False) -> str:
@@ -318,6 +398,114 @@ class ChapterFailed(RuntimeError):
 
 def _chapter_label(name: str) -> str:
     return dict(CHAPTERS).get(name, name)
+
+
+def _run_chapter_safely(name: str, figures: bool) -> ChapterResult:
+    """:func:`run_chapter`, an exception reported as the chapter's failure."""
+    try:
+        return run_chapter(name, figures=figures)
+    except KeyboardInterrupt:
+        raise
+    except Exception as exc:      # noqa: BLE001 - reported as the chapter's failure
+        _log.debug("chapter %s raised", name, exc_info=True)
+        return ChapterResult(chapter=name, quantities=(),
+                             failures=(f"{type(exc).__name__}: {exc}",))
+
+
+def _run_chapters(names, figures_dir, progress: bool, keep_going: bool, out: dict):
+    """Run ``names`` in order, filling ``out`` (quantities, seconds, failures): (the table
+    rows, the chapter the run stopped at or None)."""
+    rows, stopped, bar = [], None, None
+    if progress:
+        from tqdm.auto import tqdm
+        bar = tqdm(total=len(names), unit="chapter", leave=False, file=None)
+    try:
+        for name in names:
+            if bar is not None:
+                bar.set_description(_chapter_label(name))
+            _log.info("chapter %s (%s) ...", name, _chapter_label(name))
+            t0 = time.perf_counter()
+            result = _run_chapter_safely(name, figures_dir is not None)
+            out["seconds"][name] = round(time.perf_counter() - t0, 3)
+            _log.info("chapter %s: %d rows in %.1f s%s", name, len(result.quantities),
+                      out["seconds"][name], " (failed)" if result.failures else "")
+            for q, row in zip(result.quantities, comparison_rows(result.quantities)):
+                out["quantities"][q.key] = {"thesis": _json_value(thesis_value(q.key).value),
+                                            "asekit": _json_value(q.asekit), "unit": q.unit,
+                                            "note": q.note, "verdict": row[6]}
+                rows.append(row)
+            if result.failures:
+                out["failures"][name] = list(result.failures)
+            if figures_dir is not None:
+                for fig_name, fig in result.figures.items():
+                    save_figure(fig, figures_dir, fig_name)
+                    _log.debug("figure %s written to %s", fig_name, figures_dir)
+            if bar is not None:
+                bar.update(1)
+            if result.failures and not keep_going:
+                stopped = name
+                break
+    finally:
+        if bar is not None:
+            bar.close()
+    return rows, stopped
+
+
+#: verdicts that are no comparison: the row has no asekit value in this run, or no thesis value
+NOT_COMPARED = ("not computed", "not reported")
+
+
+def table_counts(rows, names) -> dict:
+    """The counts of a run's table: one per verdict (rows of the table), ``"not run"`` (the
+    rows of data/thesis.toml that no chapter of this run produced: chapters left out with
+    ``--only``, or stopped or failed) and ``"chapters not run"`` (their names, in order).
+    "not computed" (asekit has no value in this run) and "not reported" (the thesis gives no
+    number) are counted apart.
+
+    >>> table_counts([("aero.boxes", "-", "140", "-", "", "", "not reported")], ["aero"])[
+    ...     "not reported"]
+    1
+    """
+    counts: dict = {}
+    for r in rows:
+        counts[r[6]] = counts.get(r[6], 0) + 1
+    in_run = {r[0] for r in rows}
+    counts["not run"] = sum(1 for k in all_keys(Path(THESIS_FILE)) if k not in in_run)
+    counts["chapters not run"] = [n for n, _ in CHAPTERS if n not in names]
+    return counts
+
+
+def count_lines(counts: dict) -> list[str]:
+    """The two summary lines of the table: the verdicts of the compared rows, then the rows
+    with nothing to compare, "not computed" (in the table, and the rows of the chapters not
+    run) apart from "not reported".
+
+    >>> count_lines({"within tolerance": 3, "not computed": 1, "not reported": 2,
+    ...              "not run": 5, "chapters not run": ["servo"]})[1]
+    'not computed in this run: 6 rows (1 in the table, 5 of the chapters not run: servo); \
+not reported (the thesis gives no number): 2 rows'
+    """
+    compared = [f"{v} {k}" for k, v in counts.items()
+                if k not in NOT_COMPARED and k not in ("not run", "chapters not run")]
+    table, not_run = counts.get("not computed", 0), counts.get("not run", 0)
+    where = ""
+    if not_run:
+        chapters = ", ".join(counts.get("chapters not run", [])) or "failed or stopped"
+        where = f" ({table} in the table, {not_run} of the chapters not run: {chapters})"
+    return ["verdicts: " + (", ".join(compared) or "no row compared"),
+            f"not computed in this run: {table + not_run} rows{where}; not reported (the thesis "
+            f"gives no number): {counts.get('not reported', 0)} rows"]
+
+
+def _write_json(out: dict, json_path) -> None:
+    text = json.dumps(out, indent=2)
+    if str(json_path) == "-":
+        import sys
+        sys.stdout.write(text + "\n")
+    else:
+        Path(json_path).parent.mkdir(parents=True, exist_ok=True)
+        Path(json_path).write_text(text)
+        _log.info("JSON written to %s", json_path)
 
 
 def reproduce(chapters: list[str] | None = None, figures_dir: str | Path | None = None,
@@ -338,70 +526,32 @@ def reproduce(chapters: list[str] | None = None, figures_dir: str | Path | None 
         failure and raise :class:`ChapterFailed` after printing what ran.
 
     Returns the JSON-ready dict ``{"quantities": {key: {thesis, asekit, unit, note,
-    verdict}}, "seconds": {...}, "failures": {chapter: [reasons]}}``.
+    verdict}}, "seconds": {...}, "failures": {chapter: [reasons]}, "counts": {verdict: rows,
+    "not run": rows, "chapters not run": [names]}}`` (:func:`table_counts`). A note that cites
+    a row empty in this run loses that clause (:func:`without_empty_citations`).
     """
     names = list(chapters) if chapters else available_chapters()
     unknown = [n for n in names if n not in dict(CHAPTERS)]
     if unknown:
         raise ValueError(f"unknown chapter(s) {unknown}; valid: {[n for n, _ in CHAPTERS]}")
     out = {"quantities": {}, "seconds": {}, "failures": {}}
-    rows = []
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-        bar = tqdm(total=len(names), unit="chapter", leave=False, file=None)
-    stopped = None
-    try:
-        for name in names:
-            if bar is not None:
-                bar.set_description(_chapter_label(name))
-            t0 = time.perf_counter()
-            try:
-                result = run_chapter(name, figures=figures_dir is not None)
-            except KeyboardInterrupt:
-                raise
-            except Exception as exc:      # noqa: BLE001 - reported as the chapter's failure
-                result = ChapterResult(chapter=name, quantities=(),
-                                       failures=(f"{type(exc).__name__}: {exc}",))
-            out["seconds"][name] = round(time.perf_counter() - t0, 3)
-            for q, row in zip(result.quantities, comparison_rows(result.quantities)):
-                out["quantities"][q.key] = {"thesis": _json_value(thesis_value(q.key).value),
-                                            "asekit": _json_value(q.asekit), "unit": q.unit,
-                                            "note": q.note, "verdict": row[6]}
-                rows.append(row)
-            if result.failures:
-                out["failures"][name] = list(result.failures)
-            if figures_dir is not None:
-                for fig_name, fig in result.figures.items():
-                    save_figure(fig, figures_dir, fig_name)
-            if bar is not None:
-                bar.update(1)
-            if result.failures and not keep_going:
-                stopped = name
-                break
-    finally:
-        if bar is not None:
-            bar.close()
+    rows, stopped = _run_chapters(names, figures_dir, progress, keep_going, out)
+    empty, known = _empty_rows(rows)
+    for entry in out["quantities"].values():
+        entry["note"] = without_empty_citations(entry["note"], empty, known)
+    ran = list(out["seconds"])
+    out["counts"] = table_counts(rows, ran)
     echo(format_table(rows, wide=wide))
     echo("")
-    counts: dict[str, int] = {}
-    for r in rows:
-        counts[r[6]] = counts.get(r[6], 0) + 1
     summary = ["seconds: " + ", ".join(f"{k} {v:.2f}" for k, v in out["seconds"].items()),
-               "verdicts: " + ", ".join(f"{v} {k}" for k, v in counts.items())]
+               *count_lines(out["counts"])]
     summary += [f"FAILED chapter {name} ({_chapter_label(name)}): {reason}"
                 for name, reasons in out["failures"].items() for reason in reasons]
     for line in summary:
         echo("\n".join(textwrap.wrap(line, 100, subsequent_indent="  ")) if not wide
              else line)
     if json_path is not None:
-        text = json.dumps(out, indent=2)
-        if str(json_path) == "-":
-            import sys
-            sys.stdout.write(text + "\n")
-        else:
-            Path(json_path).parent.mkdir(parents=True, exist_ok=True)
-            Path(json_path).write_text(text)
+        _write_json(out, json_path)
     if stopped is not None:
         rest = names[names.index(stopped) + 1:]
         raise ChapterFailed(f"chapter {stopped} failed: {'; '.join(out['failures'][stopped])}"

@@ -198,8 +198,10 @@ def run(figures: bool = False) -> ChapterResult:
                      f"{'-' if ca is None else f'{100 * ca:.2f}'} % (boxes)"
                      + ("" if conv["converged"] else "; NOT converged to 1 %"))
         speed, freq = conv["speed"], conv["freq"]
-    q.append(Quantity("flutter.converged.pk.M075.h0.speed_ms", speed, "m/s", conv_note))
-    q.append(Quantity("flutter.converged.pk.M075.h0.freq_hz", freq, "Hz", conv_note))
+    q.append(Quantity("flutter.converged.pk.M075.h0.speed_ms", speed, "m/s", conv_note,
+                      computed=conv is not None))
+    q.append(Quantity("flutter.converged.pk.M075.h0.freq_hz", freq, "Hz", conv_note,
+                      computed=conv is not None))
     damp = damping_study(modal, db, velocities=DAMPING_VELOCITIES)
     q.append(Quantity("flutter.damping.pk.M075.h0.speed_ms",
                       [r["speed"] for r in damp if r["kind"] == "zeta"], "m/s",
