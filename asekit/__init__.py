@@ -21,9 +21,17 @@ Examples
 'nalci2013_fin'
 """
 
+import logging
+
 from asekit.case import Case, CaseError, load_case
 from asekit.util.paths import CASES_DIR, FIN_FILE
 from asekit.util.version import __version__
+
+# Library etiquette (Python's logging HOWTO, "Configuring Logging for a Library"): every module
+# logs to its own logger (``logging.getLogger(__name__)``, children of "asekit"); the package
+# adds only a NullHandler and configures nothing else. The command line shows the messages
+# (-v, --log-file: asekit.cli.main); in Python, ``logging.basicConfig(level=logging.INFO)``.
+logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 __all__ = ["CASES_DIR", "Case", "CaseError", "FIN_FILE", "load_case", "pipeline", "__version__"]
 

@@ -17,7 +17,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import math
+import time
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,6 +36,8 @@ from asekit.util.cache import CacheError, load_npz, save_npz
 from asekit.util.paths import DATA_DIR, user_cache_dir
 from asekit.util.validate import finite_array, positive, real
 from asekit.util.version import __version__
+
+_log = logging.getLogger(__name__)
 
 #: The reference fin's database, shipped read-only with the repository (so CI does not rebuild
 #: it). Rebuilt databases go to the user cache directory (:func:`asekit.util.paths.user_cache_dir`).
@@ -369,19 +373,25 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
         for c in candidates:
             db = _load_matching(c, fp, settings, n)
             if db is not None:
+                _log.info("GAF database read from the cache %s", c)
                 return db
+            _log.debug("GAF cache %s: no matching database", c)
     meta = dict(settings)
     meta.update({"fingerprint": fp, "asekit_version": __version__, "n_rigid": model.n_rigid,
                  "mode_set": model.label, "frequencies_hz": [float(f) for f in model.frequencies_hz],
                  "Q_units": "per unit dynamic pressure; rigid-pitch row/column in m^3 per rad",
                  "sign": "F_i = q sum_j Q_ij zeta_j; Q_cc > 0 de-centering"})
     meta.update(metadata or {})
+    _log.info("GAF database: computing %d Mach x %d reduced frequencies (%s)",
+              np.size(machs), np.size(ks), method)
+    t0 = time.perf_counter()
     db = build_gaf_database(fe_spline(model, boxes), boxes, machs, ks, b_ref, model.n_rigid,
                             symmetric, method, progress, meta)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
         save_npz(target, {"machs": db.machs, "k": db.k, "Q": db.Q}, meta)
         written = _load_matching(target, fp, settings, n)      # what a later run will read
+        _log.info("GAF database built in %.1f s, cached at %s", time.perf_counter() - t0, target)
         if written is not None:
             return written
     except OSError as exc:

@@ -9,6 +9,7 @@ memoised on the case (frozen, hashable) so that one run computes each once.
 from __future__ import annotations
 
 import functools
+import logging
 import math
 import time
 import warnings
@@ -49,6 +50,7 @@ from asekit.structure.supports import support_kind
 from asekit.util.conventions import mode_label
 from asekit.util.validate import finite
 
+_log = logging.getLogger(__name__)
 # ---------------------------------------------------------------------------------------------
 # the door: a numerical failure of a checked case becomes a SolverError saying what to change
 # ---------------------------------------------------------------------------------------------
@@ -69,8 +71,11 @@ def _door(step: str, change: str):
     def decorate(fn):
         @functools.wraps(fn)
         def wrapper(*args, **kw):
+            t0 = time.perf_counter()
             try:
-                return fn(*args, **kw)
+                result = fn(*args, **kw)
+                _log.debug("%s: %.3g s", step, time.perf_counter() - t0)
+                return result
             except (SolverError, CaseError, NotImplementedError, RecursionError):
                 raise
             except (np.linalg.LinAlgError, RuntimeError, MemoryError, SystemError) as exc:
@@ -186,9 +191,13 @@ def modal_model(case: Case) -> ModalModel:
                         f"f_max or give modes.count")
     d = case.damping
     try:
-        return _read_only(with_damping(model, d.modal_damping_ratio, d.structural_g))
+        model = _read_only(with_damping(model, d.modal_damping_ratio, d.structural_g))
     except ValueError as exc:
         raise CaseError(str(exc)) from None
+    f = model.frequencies_hz
+    _log.info("modal model of %s: %d modes, %.4g to %.4g Hz (%s)", case.name, f.size,
+              f.min(), f.max(), model.label)
+    return model
 
 
 def _one_panel(case: Case, what: str):
@@ -675,6 +684,9 @@ def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -
                                   or env_h[0] <= c.altitude <= env_h[1]):
             margins.append(_margin(c, pts, env_m[1]))
     notes = [_start_note(r, U) for r in results if r.unstable_at_start]
+    _log.info("flutter of %s: %d Mach x %d flight conditions, flutter.method %r over %d "
+              "airspeeds each, in %.1f s", case.name, len(case.aero.machs), len(conds),
+              case.flutter.method, len(U), time.perf_counter() - t0)
     return FlutterAnalysis(tuple(results), tuple(div), tuple(matches), tuple(margins),
                            time.perf_counter() - t0, tuple(notes))
 

@@ -8,11 +8,14 @@ and units follow docs/conventions.md (elastic modes from 1, "rigid pitch", g > 0
 from __future__ import annotations
 
 import json
+import logging
 import sys
 from pathlib import Path
 
 from asekit.cli import outputs
 from asekit.cli.cases import resolve_case
+
+_log = logging.getLogger(__name__)
 
 
 def add_parser(sub) -> None:
@@ -46,6 +49,7 @@ def _read_case(args, load_case):
 
 def _error(msg: str) -> int:
     print(f"error: {msg}", file=sys.stderr)
+    _log.error("error: %s", msg, extra={"file_only": True})     # for --log-file
     return 2
 
 

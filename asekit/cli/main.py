@@ -9,6 +9,14 @@ Commands (argparse subcommands; each sets ``func(args) -> exit code``, so more c
 * ``cases [--copy NAME DIR]``: the shipped case files (see :mod:`asekit.cli.cases`);
 * ``--version``.
 
+Options of every command (before or after its name): ``-v/--verbose`` (the package's info
+messages: stages, cache hits and misses, times; ``-vv`` debug), ``--quiet`` (warnings and
+errors only, and no progress bar where the command draws one), ``--log-file PATH`` (every
+message at debug level, warnings and the error line included, written to PATH; checked like the
+other outputs before any work), ``--debug`` (the traceback of an error). Messages and warnings
+reach standard error through ``tqdm.write``, one line each, so that they never break a progress
+bar; the logging and warning settings are restored when the command returns.
+
 Output paths are checked (and their missing folders made) before any work
 (:mod:`asekit.cli.outputs`). Every error is one line on standard error, never a traceback
 (``--debug`` shows it). Exit codes: 0 success; 2 bad input (arguments, a case, sweep or deck
@@ -24,6 +32,7 @@ that needs them, so that a refused input is reported within a second or two.
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import sys
 
@@ -82,12 +91,10 @@ def _reproduce(args) -> int:
                         echo=echo, wide=args.wide, progress=not args.quiet,
                         keep_going=args.keep_going)
     except ChapterFailed as exc:
-        print(f"asekit reproduce: {exc}", file=sys.stderr)
-        return 1
+        return _report(f"asekit reproduce: {exc}", 1)
     if out["failures"] and not args.keep_going:      # a failure in the last chapter run
-        print("asekit reproduce: chapter(s) failed: " + ", ".join(out["failures"])
-              + "; pass --keep-going to accept", file=sys.stderr)
-        return 1
+        return _report("asekit reproduce: chapter(s) failed: " + ", ".join(out["failures"])
+                       + "; pass --keep-going to accept", 1)
     return 0
 
 
@@ -121,17 +128,38 @@ def build_parser() -> argparse.ArgumentParser:
     add_analyse(sub)
     add_sweep(sub)
     add_cases(sub)
-    parser.add_argument("--debug", action="store_true", help=_DEBUG_HELP)
+    _add_common(parser, top=True)
     seen = set()
     for p in sub.choices.values():              # also after the command (aliases: once)
         if id(p) not in seen:
             seen.add(id(p))
-            p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                           help=_DEBUG_HELP)
+            _add_common(p, top=False)
     return parser
 
 
 _DEBUG_HELP = "show the traceback of an error (for a bug report)"
+
+
+def _add_common(p: argparse.ArgumentParser, top: bool) -> None:
+    """The options of every command: --debug, -v/--verbose, --quiet, --log-file. On a
+    subcommand their default is SUPPRESS, so that one given before the command is not reset
+    by the subcommand's default; a subcommand's own --quiet (its progress bar) is kept and
+    gets the same default."""
+    default = (lambda value: value) if top else (lambda value: argparse.SUPPRESS)
+    p.add_argument("--debug", action="store_true", default=default(False), help=_DEBUG_HELP)
+    p.add_argument("-v", "--verbose", action="count", default=default(0),
+                   help="show the package's info messages (stages, caches, times); -vv: "
+                        "debug messages too")
+    own = p._option_string_actions.get("--quiet")
+    if own is None:
+        p.add_argument("--quiet", action="store_true", default=default(False),
+                       help="warnings and errors only (no progress bar)")
+    elif not top:
+        own.default = argparse.SUPPRESS
+        own.help = "warnings and errors only, no progress bar"
+    p.add_argument("--log-file", metavar="PATH", default=default(None),
+                   help="also write every message at debug level (warnings and errors "
+                        "included) to PATH")
 
 
 def _input_error(exc: BaseException) -> bool:
@@ -182,8 +210,9 @@ class _Interrupts:
 
 class _OneLineWarnings:
     """While a command runs, every warning is shown once, as one line ``warning: <Category>:
-    <message>`` on standard error, without the source file and line, through ``tqdm.write`` so
-    that it never breaks a progress bar (issue 30). ``--debug`` keeps Python's own display.
+    <message>`` on standard error, without the source file and line, through the
+    ``asekit.cli.main`` logger (:class:`_TqdmHandler`: ``tqdm.write``, so that it never breaks a
+    progress bar; and the ``--log-file``) (issue 30). ``--debug`` keeps Python's own display.
     The previous warning settings are restored on exit (``warnings.catch_warnings``)."""
 
     def __init__(self, debug: bool = False):
@@ -196,8 +225,7 @@ class _OneLineWarnings:
         if (category, text) in self.seen:
             return
         self.seen.add((category, text))
-        from tqdm import tqdm
-        tqdm.write(f"warning: {category.__name__}: {text}", file=sys.stderr)
+        _log.warning("%s: %s", category.__name__, text)
 
     def __enter__(self):
         import warnings
@@ -211,29 +239,140 @@ class _OneLineWarnings:
         return self._catch.__exit__(*exc)
 
 
+class _TqdmHandler(logging.Handler):
+    """A logging handler that writes each record as one line through ``tqdm.write`` (standard
+    error), so that a message never breaks a progress bar: ``info: message``, ``warning:
+    message``; at debug level the logger's name follows the level (``debug: asekit.aero.gaf:
+    message``). Records marked ``file_only`` (the error line the command prints itself) are
+    left to the log file."""
+
+    def __init__(self, level: int):
+        super().__init__(level)
+        self.addFilter(lambda record: not getattr(record, "file_only", False))
+
+    def format(self, record: logging.LogRecord) -> str:
+        text = " ".join(record.getMessage().split())
+        name = f"{record.name}: " if self.level <= logging.DEBUG else ""
+        return f"{record.levelname.lower()}: {name}{text}"
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            from tqdm import tqdm
+            tqdm.write(self.format(record), file=sys.stderr)
+        except Exception:           # noqa: BLE001 - logging must not raise (logging's rule)
+            self.handleError(record)
+
+
+#: the logger of the package (every module logs to a child: ``logging.getLogger(__name__)``)
+_PACKAGE = logging.getLogger("asekit")
+_log = logging.getLogger(__name__)
+
+
+def console_level(verbose: int = 0, quiet: bool = False) -> int:
+    """The level shown on standard error: WARNING by default and with ``--quiet``, INFO with
+    ``-v``, DEBUG with ``-vv``.
+
+    >>> console_level(), console_level(1), console_level(2), console_level(2, quiet=True)
+    (30, 20, 10, 30)
+    """
+    if quiet or verbose <= 0:
+        return logging.WARNING
+    return logging.INFO if verbose == 1 else logging.DEBUG
+
+
+class _Logging:
+    """While a command runs, the ``asekit`` logger writes to standard error through
+    :class:`_TqdmHandler` at :func:`console_level`, and with ``log_file`` every record at
+    debug level to that file (opened when the command starts, so that an unusable path is an
+    error before any work). The logger's level, handlers and propagation are restored on
+    exit (tests call :func:`main` in-process)."""
+
+    def __init__(self, verbose: int = 0, quiet: bool = False, log_file: str | None = None):
+        self.console = console_level(verbose, quiet)
+        self.log_file = log_file
+        self.handlers: list[logging.Handler] = []
+
+    def __enter__(self):
+        self.saved = (_PACKAGE.level, list(_PACKAGE.handlers), _PACKAGE.propagate)
+        self.handlers = [_TqdmHandler(self.console)]
+        if self.log_file:
+            fh = logging.FileHandler(self.log_file, mode="w", encoding="utf-8", delay=False)
+            fh.setLevel(logging.DEBUG)
+            fh.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: "
+                                              "%(message)s"))
+            self.handlers.append(fh)
+        for h in self.handlers:
+            _PACKAGE.addHandler(h)
+        _PACKAGE.setLevel(min(h.level for h in self.handlers))
+        _PACKAGE.propagate = False       # one line per message, whatever the root logger has
+        return self
+
+    def __exit__(self, *exc):
+        level, handlers, propagate = self.saved
+        for h in self.handlers:
+            _PACKAGE.removeHandler(h)
+            h.close()
+        _PACKAGE.setLevel(level)
+        _PACKAGE.propagate = propagate
+        for h in handlers:
+            if h not in _PACKAGE.handlers:
+                _PACKAGE.addHandler(h)
+        return False
+
+
+def _log_file_error(args) -> str | None:
+    """Why ``--log-file`` cannot be written (its missing folders are made), else None."""
+    path = getattr(args, "log_file", None)
+    reason = outputs.check_file("--log-file", path, dash=False)
+    if reason is None and path is not None:
+        try:
+            with open(path, "a", encoding="utf-8"):
+                pass
+        except OSError as exc:
+            reason = f"--log-file {path}: cannot write the file ({exc.strerror or exc})"
+    return reason
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    with _Interrupts() as interrupts, _OneLineWarnings(getattr(args, "debug", False)):
-        try:
-            code = args.func(args)
-            if code and interrupts.seen:    # the command reported the error it was turned into
-                print("interrupted", file=sys.stderr)
-                return 130
-            return code
-        except KeyboardInterrupt:
-            print("interrupted", file=sys.stderr)
-            return 130
-        except Exception as exc:            # one line, never a traceback (unless --debug)
-            if interrupts.seen:
-                print("interrupted", file=sys.stderr)
-                return 130
-            if getattr(args, "debug", False):
-                import traceback
-                traceback.print_exc()
-            line, code = error_line(exc, args.command)
-            print(line, file=sys.stderr)
-            return code
+    reason = _log_file_error(args)
+    if reason:
+        print(f"error: {reason}", file=sys.stderr)
+        return 2
+    debug = getattr(args, "debug", False)
+    with _Logging(getattr(args, "verbose", 0), getattr(args, "quiet", False),
+                  getattr(args, "log_file", None)), \
+            _Interrupts() as interrupts, _OneLineWarnings(debug):
+        _log.debug("asekit %s: %s", __version__, " ".join(sys.argv[:1] + list(
+            sys.argv[1:] if argv is None else argv)))
+        return _run(args, interrupts, debug)
+
+
+def _report(line: str, code: int) -> int:
+    """Print the one line of a failed command on standard error (and log it to the file)."""
+    print(line, file=sys.stderr)
+    _log.error(line, extra={"file_only": True})
+    return code
+
+
+def _run(args, interrupts: _Interrupts, debug: bool) -> int:
+    """The command, its errors turned into one line and an exit code."""
+    try:
+        code = args.func(args)
+        if code and interrupts.seen:    # the command reported the error it was turned into
+            return _report("interrupted", 130)
+        return code
+    except KeyboardInterrupt:
+        return _report("interrupted", 130)
+    except Exception as exc:            # one line, never a traceback (unless --debug)
+        if interrupts.seen:
+            return _report("interrupted", 130)
+        if debug:
+            import traceback
+            traceback.print_exc()
+        _log.debug("traceback", exc_info=True, extra={"file_only": True})
+        return _report(*error_line(exc, args.command))
 
 
 if __name__ == "__main__":

@@ -8,10 +8,13 @@ with their count, and the same command run again retries them."""
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 from pathlib import Path
 
 from asekit.cli import outputs
+
+_log = logging.getLogger(__name__)
 
 
 def add_parser(sub) -> None:
@@ -37,6 +40,7 @@ def add_parser(sub) -> None:
 
 def _error(msg: str) -> int:
     print(f"error: {msg}", file=sys.stderr)
+    _log.error("error: %s", msg, extra={"file_only": True})     # for --log-file
     return 2
 
 

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import math
 import os
 import tempfile
@@ -46,6 +47,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+_log = logging.getLogger(__name__)
 
 DIGEST_VERSION = 2
 #: temporary files of a cache path older than this (s) are orphans whatever their pid
@@ -160,6 +163,7 @@ def save_npz(path: str | Path, arrays: dict[str, np.ndarray], metadata: dict) ->
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+    _log.debug("cache written: %s", path)
     return path
 
 
@@ -266,6 +270,7 @@ def load_npz(path: str | Path, expect_metadata: dict | None = None,
                                          for s, g in zip(shape, got.shape)):
             raise CacheError(f"cache file {path}: array {key!r} has shape {got.shape}, "
                              f"expected {tuple(shape)}")
+    _log.debug("cache read and verified: %s", path)
     return arrays, meta
 
 

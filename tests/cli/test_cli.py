@@ -50,16 +50,20 @@ def test_sweep_without_pandas_names_the_pip_install_before_any_work(tmp_path):
 
 def test_warnings_are_one_line_each_shown_once_and_restored(capsys):
     """issue 30: library warnings came with source lines, into the progress bar, every time."""
+    import logging
     import warnings
 
-    from asekit.cli.main import _OneLineWarnings
+    from asekit.cli.main import _Logging, _OneLineWarnings
     before = warnings.showwarning
-    with _OneLineWarnings():
+    package = logging.getLogger("asekit")
+    handlers, level = list(package.handlers), package.level
+    with _Logging(), _OneLineWarnings():
         for _ in range(3):
             warnings.warn("p-k: the k-iteration did not\n  converge at U = 17400 m/s",
                           RuntimeWarning, stacklevel=1)
         warnings.warn("another", UserWarning, stacklevel=1)
     assert warnings.showwarning is before
+    assert package.handlers == handlers and package.level == level
     err = capsys.readouterr().err.splitlines()
     assert err == ["warning: RuntimeWarning: p-k: the k-iteration did not converge at U = "
                    "17400 m/s", "warning: UserWarning: another"]
