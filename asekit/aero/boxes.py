@@ -392,7 +392,9 @@ def check_mesh_rules(mesh: BoxMesh, u_min: float, f_max: float, bpw_min: float =
         if rep.offending_bpw_strips.size:
             s = rep.offending_bpw_strips
             warnings.warn(f"boxes per wavelength below {bpw_min:g} on strips {s.tolist()} "
-                          f"(minimum {bpw[s].min():.3g}); refine chordwise", MeshRuleWarning,
+                          f"(minimum {bpw[s].min():.3g}); refine chordwise (a case file: more "
+                          "chordwise boxes in aero.boxes, a lower aero.f_max or a higher "
+                          "aero.u_min)", MeshRuleWarning,
                           stacklevel=2)
         if rep.offending_chord_strips.size:
             s = rep.offending_chord_strips

@@ -699,7 +699,8 @@ def _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box, cells_per_wavelengt
             warnings.warn(f"mesh too coarse for the supersonic kernel at mach={m:g}, "
                           f"k={k_max:g}: {bpw:.2g} boxes per wavelength 2 pi b (M - 1)/(k M) < "
                           f"bpw_min={bpw_min:g}; use box chords below "
-                          f"{kernel_wavelength(m, k_max, b) / bpw_min:.3g} m", MeshRuleWarning,
+                          f"{kernel_wavelength(m, k_max, b) / bpw_min:.3g} m (a case file: "
+                          "more chordwise boxes in aero.boxes)", MeshRuleWarning,
                           stacklevel=3)
     for attempt in range(4):        # small boxes (fine meshes, slivers): refine the grid
         try:

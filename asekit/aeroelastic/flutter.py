@@ -595,16 +595,19 @@ def _warn_unconverged(U, conv, modes, n_r, max_iter, tol, n_path_bad):
     if conv.all() and n_path_bad == 0:
         return
     bad = np.argwhere(~conv)
-    listed = ", ".join(f"{mode_label(int(modes[jt]), n_r)} at U = {U[i]:.6g}"
+    listed = ", ".join(f"{mode_label(int(modes[jt]), n_r)} at U = {U[i]:.6g} m/s"
                        for i, jt in bad[:8])
     more = f" and {len(bad) - 8} more" if len(bad) > 8 else ""
     sub = n_path_bad - len(bad)
     sub_text = f" (and {sub} sub-step points of the continuation)" if sub > 0 else ""
-    warnings.warn(f"p-k: the k-iteration did not converge within max_iter = {max_iter} "
-                  f"(tol {tol:g}) at {len(bad)} of {conv.size} requested points{sub_text}: "
-                  f"{listed}{more}; their roots are the last iterate (PkResult.converged is "
-                  "False there). Raise max_iter or check those points.",
-                  FlutterConvergenceWarning, stacklevel=4)   # caller, past @small_dense
+    # Issue 30: the advice names the one option that takes it (pk_flutter's max_iter; a case
+    # file has no such key), and every number its unit (tol is a relative change: no unit).
+    warnings.warn(f"p-k: the k-iteration did not converge within {max_iter} iterations "
+                  f"(relative frequency change still above {tol:g}) at {len(bad)} of "
+                  f"{conv.size} requested points{sub_text}: {listed}{more}; their roots are "
+                  "the last iterate (PkResult.converged is False there): treat them as "
+                  "approximate; from Python, pk_flutter(..., max_iter=N) allows more "
+                  "iterations", FlutterConvergenceWarning, stacklevel=4)  # past @small_dense
 
 
 def _crossings(U, sigma, freq_hz, real_mask, tol: float = 0.0):
@@ -846,7 +849,9 @@ def match_point_table(modal, gaf_for_mach, machs, altitudes, velocities, kind="f
                                           inst.at_first_point))
                 if inst.at_first_point:
                     warnings.warn(f"match point Mach {mach:g}, altitude {h:g} m: "
-                                  f"{inst.describe()}; lower the first velocity",
+                                  f"{inst.describe()}, only a bound; velocities starting "
+                                  f"below {float(np.atleast_1d(velocities)[0]):g} m/s "
+                                  "(match_point_table's argument) locate it",
                                   RuntimeWarning, stacklevel=2)
     return rows
 
@@ -871,7 +876,8 @@ def matched_mach(rows: list[MatchPointRow], altitude: float) -> float | None:
     if bounded:
         warnings.warn(f"matched_mach at altitude {altitude:g} m: the sweep was unstable at its "
                       f"first point for Mach {', '.join(f'{b:g}' for b in bounded)} (flutter at "
-                      "or below U0); the match cannot be located there", RuntimeWarning,
+                      "or below its first airspeed); the match cannot be located there",
+                      RuntimeWarning,
                       stacklevel=2)
     return None
 

@@ -186,6 +186,9 @@ def test_mesh_rules_warn_with_strip_names(boxes_of, fin_box_mesh):
         rep = check_mesh_rules(coarse, 180.0, 1000.0)
     text = " ".join(str(r.message) for r in rec)
     assert "strips [0]" in text and "boxes per chord" in text and "aspect ratio" in text
+    # issue 30: the advice names the case keys that take it
+    assert ("refine chordwise (a case file: more chordwise boxes in aero.boxes, a lower "
+            "aero.f_max or a higher aero.u_min)") in text
     assert not rep.ok
     # the default fin mesh satisfies all three rules of thesis Section 3.2.1
     with warnings.catch_warnings():
