@@ -473,9 +473,10 @@ def _start_kind(r: ConditionResult) -> str:
 
 def _start_note(r: ConditionResult, velocities) -> str:
     """The note of a condition unstable at the first point of the sweep."""
-    return (f"M {r.mach:g}, rho {r.condition.density:.4g}: {_start_kind(r)} at or below "
-            f"{velocities[0]:g} m/s (the first point of the sweep, "
-            f"{mode_label(r.start_mode, r.pk.n_rigid)}): start the sweep lower to locate it")
+    return (f"M {r.mach:g}, rho {r.condition.density:.4g} kg/m^3: {_start_kind(r)} at or "
+            f"below {velocities[0]:g} m/s (the first point of the sweep, "
+            f"{mode_label(r.start_mode, r.pk.n_rigid)}): start the sweep lower "
+            f"(flight.velocities.min) to locate it")
 
 
 def _flutter_points(here: list[ConditionResult], velocities) -> list[tuple[float, float, str]]:
@@ -527,7 +528,7 @@ def _match_point(c: FlightCondition, pts) -> dict:
         if unknown:
             parts.append(f"flutter at or below {unknown[0][1]:g} m/s (the first point of the "
                          f"sweep) at M {_machs(unknown)}, the flight speed M a below it: not "
-                         "located, start the sweep lower")
+                         "located, start the sweep lower (flight.velocities.min)")
         if d and all(v > 0 for _, v in d):
             parts.append(f"U_f > M a at every analysed Mach with a crossing: no match up to "
                          f"M {d[-1][0]:g} (flutter-free there)")
@@ -589,7 +590,8 @@ def _margin(c: FlightCondition, pts, env_mach: float) -> dict:
     if kind == "upper":
         out["note"] = (f"flutter at or below {uf:.4g} m/s (the first point of the sweep)"
                        + (": inside the envelope" if uf < u_env else
-                          ": the margin is at most this; start the sweep lower"))
+                          ": the margin is at most this; start the sweep lower "
+                          "(flight.velocities.min)"))
     elif kind == "lower":
         out["note"] = f"no flutter up to {uf:.4g} m/s (the last point of the sweep)"
     elif kind is None:

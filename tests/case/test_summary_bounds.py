@@ -72,6 +72,7 @@ def test_fin_sweep_above_flutter_margin_is_an_upper_bound(fin_from_300):
         assert m["flutter_speed_upper_bound_ms"] == 300.0
         assert m["margin_upper_bound"] == pytest.approx(300.0 / (0.6 * a) - 1, rel=1e-12)
         assert "start the sweep lower" in m["note"]         # 300 m/s > M 0.6 a: not located
+        assert "(flight.velocities.min)" in m["note"]       # issue 30: the key that takes it
     lines = [ln for ln in R.format_summary(s, width=300).splitlines()
              if ln.startswith("flutter margin")]
     assert len(lines) == 3 and all("at most +" in ln and " -" not in ln for ln in lines)
