@@ -53,6 +53,7 @@ import hashlib
 import io
 import itertools
 import json
+import logging
 import math
 import os
 import re
@@ -76,6 +77,8 @@ from asekit.util.conventions import mode_number
 from asekit.util.extras import require
 from asekit.util.paths import CASES_DIR
 from asekit.util.validate import read_toml
+
+_log = logging.getLogger(__name__)
 
 
 class SweepError(ValueError):
@@ -1094,6 +1097,8 @@ def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | N
                     if next(csv.reader([ln]))[i_st] == "ok"}
         _rewrite(path, cols, done)                    # drops a cut-off last line
     todo = [(i, v) for i, v in enumerate(design) if i not in done]
+    _log.info("sweep %s: %d samples, %d kept from %s, %d to run (%s executor)", sweep.name,
+              len(design), len(done), path, len(todo), executor)
     rows_mem = dict(done)
     fh = None
     cl = cluster = None
@@ -1114,6 +1119,8 @@ def run_sweep(sweep: Sweep, out=None, executor: str = "serial", workers: int | N
             fh = open(path, "a")
 
         def record(row):
+            _log.debug("sweep %s: sample %s %s", sweep.name, row.get("sample"),
+                       row.get("status"))
             line = format_row(row, cols)
             rows_mem[row["sample"]] = line
             if fh is not None:

@@ -24,9 +24,17 @@ def _reproduce_json(tmp_path, *only):
 
 
 def _check_schema(data, chapters):
-    assert set(data) == {"quantities", "seconds", "failures"}
+    assert set(data) == {"quantities", "seconds", "failures", "counts"}
     assert data["failures"] == {}
     assert set(data["seconds"]) == set(chapters)
+    # issue 30: the counts of the table, "not computed" apart from "not reported"; every
+    # thesis row is in the table or counted as not run
+    counts = data["counts"]
+    verdicts = [e["verdict"] for e in data["quantities"].values()]
+    assert {k: v for k, v in counts.items() if k not in ("not run", "chapters not run")} == \
+        {v: verdicts.count(v) for v in set(verdicts)}
+    assert counts["not run"] + len(data["quantities"]) == len(all_keys())
+    assert set(counts["chapters not run"]).isdisjoint(chapters)
     known = set(all_keys())
     assert data["quantities"]
     for key, entry in data["quantities"].items():
