@@ -373,7 +373,7 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
         for c in candidates:
             db = _load_matching(c, fp, settings, n)
             if db is not None:
-                _log.info("GAF database read from the cache %s", c)
+                _log.info("GAF database read from %s (fingerprint and checksum verified)", c)
                 return db
             _log.debug("GAF cache %s: no matching database", c)
     meta = dict(settings)
