@@ -459,9 +459,13 @@ def analyse_condition(case: Case, db: GafDatabase, mach: float, cond: FlightCond
     inst = tuple(inst)
     start = [i for i in inst if i.at_first_point]          # unstable at U0 (asekit.aeroelastic.flutter)
     crossings = [i for i in inst if not i.at_first_point]
-    return ConditionResult(float(mach), cond, pk, inst, first_of(crossings, "flutter"),
-                           first_of(crossings, "divergence"), bool(start),
-                           start[0].mode if start else None)
+    result = ConditionResult(float(mach), cond, pk, inst, first_of(crossings, "flutter"),
+                             first_of(crossings, "divergence"), bool(start),
+                             start[0].mode if start else None)
+    _log.debug("%s at M %g, rho %.4g kg/m^3, %g to %g m/s: %s", case.flutter.method, mach,
+               cond.density, U[0], U[-1], result.flutter.describe() if result.flutter
+               else "unstable at the first airspeed" if start else "no flutter in the sweep")
+    return result
 
 
 def _start_kind(r: ConditionResult) -> str:
