@@ -177,3 +177,17 @@ def _restore_showwarning():
     yield
     warnings.showwarning = saved
 
+
+
+def test_main_restores_the_logging_settings(tmp_path, capsys):
+    """main() in-process leaves the package logger as it found it (handlers, level,
+    propagation) and closes the log file, whatever the command's exit."""
+    pkg = logging.getLogger("asekit")
+    before = (pkg.level, list(pkg.handlers), pkg.propagate)
+    log = tmp_path / "cases.log"
+    assert main(["cases", "-vv", "--log-file", str(log)]) == 0
+    assert (pkg.level, list(pkg.handlers), pkg.propagate) == before
+    assert main(["analyse", str(tmp_path / "missing.toml"), "-v"]) == 2
+    assert (pkg.level, list(pkg.handlers), pkg.propagate) == before
+    assert "DEBUG asekit.cli.main: asekit " in log.read_text()
+    capsys.readouterr()
