@@ -32,6 +32,7 @@ from asekit.case.schema import (
     Case,
     CaseError,
     SolverError,
+    check_resources,
 )
 from asekit.rfa.methods import rfa_kind
 from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, DCMotor, Transmission
@@ -337,11 +338,17 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True,
     :func:`box_mesh`, loaded from a shipped database (the fin's ``data/gaf_fin.npz``) or the
     user cache when one matches its fingerprint (mode set, boxes' corners, Mach, k, b_ref,
     symmetry, method), else rebuilt (``cache=False``: always) into the user cache or ``path``
-    (:func:`asekit.aero.gaf.cached_gaf_database`)."""
+    (:func:`asekit.aero.gaf.cached_gaf_database`). A rebuild caches each (Mach, k) entry as it
+    is computed, so a failed or interrupted run resumes where it stopped
+    (:class:`asekit.aero.gaf.GafEntryCache`). Before anything is computed, the case's
+    resources are checked (:func:`asekit.case.schema.check_resources`: a case built in Python
+    skips the loader's check), a case over a limit refused with a CaseError naming the keys."""
     a = case.aero
     if a is None:
         raise CaseError(f"{case.name}: the case has no aerodynamics (an imported deck without "
                         f"CAERO1 / MKAERO1)")
+    if case.structure is None:
+        check_resources(case.panels, a)
     # the database's method: the DLM kernel name, or the aerodynamic method (asekit.aero.methods)
     method = a.kernel if a.method == "dlm" else a.method
     return cached_gaf_database(modal_model(case), box_mesh(case), a.machs,

@@ -172,12 +172,12 @@ def _fits(panels, aero) -> bool:
     return _dlm_excess(panels, aero) is None and _grid_excess(panels, aero) is None
 
 
-def _largest_fitting(panels, aero, vary) -> float | None:
-    """The largest scale s in [_LOWEST, 1) (to 0.1 %) at which ``vary(aero, s)`` fits, or None
+def _largest_fitting(panels, aero, vary, lowest: float = _LOWEST) -> float | None:
+    """The largest scale s in [lowest, 1) (to 0.1 %) at which ``vary(aero, s)`` fits, or None
     (bisection in log s; the counts grow with s)."""
-    if not _fits(panels, vary(aero, _LOWEST)):
+    if lowest >= 1.0 or not _fits(panels, vary(aero, lowest)):
         return None
-    lo, hi = math.log(_LOWEST), 0.0
+    lo, hi = math.log(lowest), 0.0
     for _ in range(_STEPS):
         mid = 0.5 * (lo + hi)
         if _fits(panels, vary(aero, math.exp(mid))):
@@ -209,24 +209,24 @@ def _k_scaled(aero, s):
     return replace(aero, reduced_frequencies=kept + (top,))
 
 
-def _chord_scaled(aero, s):
-    return replace(aero, boxes=tuple((max(1, math.floor(nc * s)), ns) for nc, ns in aero.boxes))
-
-
 def _box_scaled(aero, s):
     r = math.sqrt(s)
     return replace(aero, boxes=tuple((max(1, math.floor(nc * r)), max(1, math.floor(ns * r)))
                                      for nc, ns in aero.boxes))
 
 
-def fixes(panels, aero, grid: bool = True) -> list[str]:
+def fixes(panels, aero) -> list[str]:
     """What fits, in case-file terms: the largest ``aero.f_max`` / smallest ``aero.u_min``
     (when k or the boxes are automatic), the largest k of an explicit
-    ``aero.reduced_frequencies``, and coarser explicit ``aero.boxes`` (chordwise for the
-    Mach-box grid, ``grid``; both counts for the DLM matrix)."""
+    ``aero.reduced_frequencies``, and coarser explicit ``aero.boxes`` (both counts scaled
+    alike: the grid's cells follow the box chords and the strip widths, the DLM matrix the
+    box count)."""
     out = []
     if aero.reduced_frequencies is None or aero.boxes is None:
-        s = _largest_fitting(panels, aero, _ratio)
+        # the automatic k list needs k_max > 0.001 (asekit.aero.gaf.default_reduced_frequencies)
+        k_auto = 2 * math.pi * aero.f_max * aero.reference_semichord / aero.u_min
+        lowest = max(_LOWEST, 0.0011 / k_auto) if aero.reduced_frequencies is None else _LOWEST
+        s = _largest_fitting(panels, aero, _ratio, lowest)
         if s is not None:
             f = _round_down(aero.f_max * s)
             u = _round_up(aero.u_min / s)
@@ -237,10 +237,9 @@ def fixes(panels, aero, grid: bool = True) -> list[str]:
             out.append(f"aero.reduced_frequencies up to k = "
                        f"{_round_down(aero.reduced_frequencies[-1] * s):g}")
     if aero.boxes is not None:
-        vary = _chord_scaled if grid else _box_scaled
-        s = _largest_fitting(panels, aero, vary)
+        s = _largest_fitting(panels, aero, _box_scaled)
         if s is not None:
-            boxes = vary(aero, s).boxes
+            boxes = _box_scaled(aero, s).boxes
             out.append("aero.boxes = [" + ", ".join(f"{{ n_chord = {nc}, n_span = {ns} }}"
                                                     for nc, ns in boxes) + "]")
     return out
@@ -280,7 +279,7 @@ def resource_problem(panels, aero) -> str | None:
         return (f"aero.boxes: {what} need a {need / 2 ** 30:.3g} GiB DLM matrix (limit "
                 f"{MAX_MATRIX_BYTES / 2 ** 30:.3g} GiB, asekit.aero.boxes.MAX_MATRIX_BYTES): "
                 f"at most {fit} boxes fit (e.g. {math.isqrt(fit)} x {math.isqrt(fit)}); {knob}; "
-                + _fix_text(fixes(panels, aero, grid=False)))
+                + _fix_text(fixes(panels, aero)))
     grid = _grid_excess(panels, aero)
     if grid is None:
         return None
