@@ -366,14 +366,12 @@ def _mach_entries(box_modes, mesh, mach, ks, b_ref, symmetric, method, bar, aero
         warnings.simplefilter("ignore")       # given where the method is used
         name = "dlm" if method in DLM_KERNELS else resolve_method(method, mach)
     if name == "supersonic":       # the grid of the whole list's largest k, entry by entry
-        opts = dict(aero_options or {}, k_grid=float(ks.max()))
-        for j, kk in enumerate(todo):
-            with warnings.catch_warnings():
-                if j:                   # the grid's warnings were given at the first k
-                    warnings.simplefilter("ignore")
-                gaf_from_box_modes(box_modes, mesh, mach, [kk], b_ref, symmetric, method,
-                                   progress=update, aero_options=opts,
-                                   on_k=lambda _, qk, j=j: keep(j, qk))
+        def project(j, cp):        # the operations of gaf_from_box_modes, k by k
+            keep(j, modal_forces(box_modes, cp, mesh.area))
+            if update is not None:
+                update(1)
+        pressures(mesh, mach, todo, b_ref, lambda kk: box_modes.normalwash(kk, b_ref), method,
+                  symmetric, **dict(aero_options or {}, k_grid=float(ks.max()), on_k=project))
     else:
         gaf_from_box_modes(box_modes, mesh, mach, todo, b_ref, symmetric, method,
                            progress=update, aero_options=aero_options, on_k=keep)

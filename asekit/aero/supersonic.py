@@ -915,7 +915,8 @@ def supersonic_pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash
                          symmetric: bool = False, cells_per_box: float = CELLS_PER_BOX,
                          cells_per_wavelength: float = CELLS_PER_WAVELENGTH,
                          max_cells: int = MAX_CELLS, bpw_min: float = BPW_MIN,
-                         warn: bool = True, k_grid: float | None = None) -> np.ndarray:
+                         warn: bool = True, k_grid: float | None = None,
+                         on_k=None) -> np.ndarray:
     """DeltaCp (n_k, n, m) for given normalwash columns without forming the matrices (one grid
     solve per column instead of one per box: the cheap path for a few modes).
 
@@ -924,7 +925,8 @@ def supersonic_pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash
     equals ``A[ik] @ normalwash[ik]`` to rounding). ``k_grid`` (default the largest k) is the
     reduced frequency the grid resolves: a k list computed in parts with the whole list's
     largest k gives, k by k, the same numbers as the whole list (a resumed GAF database,
-    :func:`asekit.aero.gaf.build_gaf_database`)."""
+    :func:`asekit.aero.gaf.build_gaf_database`). ``on_k(ik, DeltaCp_k)``, when given, is called
+    with each k's (n, m) pressures as soon as they are computed."""
     m, ks, b, grid, s, tw = _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box,
                                      cells_per_wavelength, max_cells, bpw_min, warn, k_grid)
     out = None
@@ -938,6 +940,8 @@ def supersonic_pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash
         if out is None:
             out = np.empty((ks.size, mesh.n, w.shape[1]), complex)
         out[ik] = cp
+        if on_k is not None:
+            on_k(ik, out[ik])
     if not np.all(np.isfinite(out)):
         raise FloatingPointError("supersonic pressures are not finite")
     return out
