@@ -293,5 +293,40 @@ def resource_problem(panels, aero) -> str | None:
             + _fix_text(fixes(panels, aero)))
 
 
-__all__ = ["MAX_CELLS", "aero_reduced_frequencies", "auto_boxes", "box_counts", "fixes",
+#: Largest p-k work of a case: Mach numbers x flight conditions x speeds of the sweep. About
+#: 20 ms a point on the project's shared 2-core machine (the clipped-delta fin, 4 elastic modes:
+#: 14 conditions x 111 speeds in 30 s), so about 1.4 h at the limit.
+MAX_PK_POINTS = 250_000
+
+
+def pk_problem(n_machs: int, n_conditions: int, velocities) -> str | None:
+    """One line when the flutter sweeps (``n_machs`` x ``n_conditions`` x the speeds of
+    ``flight.velocities``) exceed :data:`MAX_PK_POINTS` points, naming the keys and the
+    ``flight.velocities.step`` that fits; else None. The p-k roots are continued with step
+    control, so a coarser sweep finds the same first flutter
+    (:func:`asekit.aeroelastic.flutter.pk_flutter`).
+
+    Examples
+    --------
+    >>> pk_problem(7, 2, [100.0 + 10 * i for i in range(111)]) is None
+    True
+    >>> pk_problem(20, 40, [100.0 + 0.1 * i for i in range(9001)])[:60]
+    'flight.velocities: 20 Mach numbers x 40 flight conditions x '
+    """
+    n = len(velocities)
+    points = n_machs * n_conditions * n
+    if points <= MAX_PK_POINTS:
+        return None
+    span = float(velocities[-1]) - float(velocities[0])
+    per_sweep = MAX_PK_POINTS // (n_machs * n_conditions)
+    fit = (f"flight.velocities.step >= {_round_up(span / (per_sweep - 1)):g} m/s fits"
+           if per_sweep >= 2 else "fewer aero.machs or flight conditions fit")
+    return (f"flight.velocities: {n_machs} Mach numbers x {n_conditions} flight conditions x "
+            f"{n} speeds = {points} p-k points (at most {MAX_PK_POINTS}, about "
+            f"{MAX_PK_POINTS * 0.02 / 3600:.2g} h at 20 ms a point), set by aero.machs, "
+            f"flight.altitudes / flight.densities and flight.velocities; {fit} (the p-k "
+            f"continuation's step control finds the same first flutter on a coarser sweep)")
+
+
+__all__ = ["MAX_CELLS", "MAX_PK_POINTS", "pk_problem", "aero_reduced_frequencies", "auto_boxes", "box_counts", "fixes",
            "panel_surfaces", "resource_problem"]

@@ -22,7 +22,7 @@ from asekit.aero.methods import METHODS, resolve_method
 from asekit.aeroelastic.methods import FLUTTER_METHODS
 from asekit.atmosphere import MAX_ALTITUDE, MIN_ALTITUDE
 from asekit.case.imported import ImportedModel
-from asekit.case.resources import resource_problem
+from asekit.case.resources import pk_problem, resource_problem
 from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
 from asekit.rfa.methods import RFA_FITS
 from asekit.structure.mesh import Grading, Stations, check_stations, station_array
@@ -828,6 +828,10 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     aero = _aero(top.table("aero", required=True), panels)
     check_resources(panels, aero)
     flight = _flight(top.table("flight", required=True))
+    n_cond = len(flight.altitudes if flight.altitudes is not None else flight.densities)
+    problem = pk_problem(len(aero.machs), n_cond, flight.velocities)
+    if problem is not None:
+        raise CaseError(problem)
     actuator = _actuator(top.table("actuator"))
     flutter = _flutter(top.table("flutter"))
     fsi = top.table("flutter_speed_index")

@@ -240,3 +240,23 @@ def test_a_corrupt_entry_is_recomputed(tmp_path, monkeypatch):
     count = _Counter(monkeypatch)
     again = P.gaf_database(case, progress=False)
     assert count.n == 1 and np.array_equal(again.Q, ref.Q)
+
+
+def test_huge_pk_work_refused_with_the_step_that_fits():
+    """7 Machs x 40 altitudes x 18001 speeds = 5.0e6 p-k points (about 28 h at the 20 ms a
+    point measured on the clipped-delta fin) is refused by the loader; the step it names
+    fits and a step 5 % finer does not."""
+    d = _dict(f_max=400.0)
+    d["flight"]["altitudes"] = [250.0 * i for i in range(40)]
+    d["flight"]["velocities"] = {"min": 100.0, "max": 1900.0, "step": 0.1}
+    with pytest.raises(CaseError) as exc:
+        case_from_dict(d)
+    msg = str(exc.value)
+    assert msg.startswith("flight.velocities: 7 Mach numbers x 40 flight conditions x 18001 "
+                          "speeds"), msg
+    step = float(re.search(r"flight\.velocities\.step >= ([0-9.]+) m/s fits", msg).group(1))
+    d["flight"]["velocities"]["step"] = step
+    case_from_dict(d)
+    d["flight"]["velocities"]["step"] = step / 1.05
+    with pytest.raises(CaseError, match="p-k points"):
+        case_from_dict(d)
