@@ -260,3 +260,21 @@ def test_huge_pk_work_refused_with_the_step_that_fits():
     d["flight"]["velocities"]["step"] = step / 1.05
     with pytest.raises(CaseError, match="p-k points"):
         case_from_dict(d)
+
+
+@pytest.mark.slow
+def test_the_issues_case_with_the_values_it_names_runs_and_is_reused(tmp_path, monkeypatch):
+    """The issue's "Done when": with the f_max the refusal names, the clipped-delta fin's GAF
+    database is computed (7 Machs x 15 k = 105 entries; 75 s measured on the shared 2-core
+    machine) and a second run computes none of them (read from the cache)."""
+    monkeypatch.setenv("ASEKIT_CACHE_DIR", str(tmp_path))
+    with pytest.raises(CaseError) as exc:
+        case_from_dict(_dict())
+    f_fit, _ = _fix_values(str(exc.value))
+    case = case_from_dict(_dict(f_max=f_fit))
+    count = _Counter(monkeypatch)
+    db = P.gaf_database(case, progress=False)
+    assert count.n == 7 * 15 and db.Q.shape[:2] == (7, 15)
+    assert np.all(np.isfinite(db.Q))
+    again = P.gaf_database(case, progress=False)
+    assert count.n == 7 * 15 and np.array_equal(again.Q, db.Q)
