@@ -32,6 +32,20 @@ from asekit.util.validate import integer, positive
 MAX_MATRIX_BYTES = 4 * 2 ** 30
 #: largest number of boxes of one surface (the corners alone of 1e6 boxes are 96 MB)
 MAX_BOXES = 200_000
+#: The doublet lattice's mesh rule (thesis Eq. 3.5): boxes per wavelength U_min / (f_max dx).
+BPW_MIN = 15.0
+
+
+def dlm_max_box_chord(u_min: float, f_max: float, bpw_min: float = BPW_MIN) -> float:
+    """The longest box chord (m) of the DLM mesh rule BPW = U_min / (f_max dx) >= ``bpw_min``
+    (thesis Eq. 3.5): dx = u_min / (bpw_min f_max), u_min in m/s, f_max in Hz.
+
+    Examples
+    --------
+    >>> round(dlm_max_box_chord(180.0, 1000.0), 6)     # the reference fin: 12 mm
+    0.012
+    """
+    return u_min / (bpw_min * f_max)
 
 
 def check_matrix_memory(n_boxes: int, n_matrices: int, itemsize: int, what: str,
@@ -314,19 +328,36 @@ def mesh_surfaces(surfaces) -> BoxMesh:
     surfaces = list(surfaces)
     if not surfaces:
         raise ValueError("surfaces must contain at least one TrapezoidSurface")
-    corners, strip, surf = [], [], []
+    corners, strip = box_corners(surfaces)
+    surf = np.concatenate([np.full(s.n_span * s.n_chord, i) for i, s in enumerate(surfaces)])
+    names = tuple(s.name for s in surfaces)
+    if len(set(names)) != len(names):
+        names = tuple(f"{s.name}[{i}]" for i, s in enumerate(surfaces))
+    return BoxMesh(corners, strip, surf, names)
+
+
+def box_corners(surfaces) -> tuple[np.ndarray, np.ndarray]:
+    """(corners (n, 4, 3), strip (n,)) of the boxes :func:`mesh_surfaces` would make, without
+    building the :class:`BoxMesh` (no overlap check: a cheap input to size estimates such as
+    :func:`asekit.aero.supersonic.grid_size`).
+
+    Examples
+    --------
+    >>> c, s = box_corners([TrapezoidSurface((0, 0), 0.3, (0.2, 0.2), 0.1, 4, 2)])
+    >>> c.shape, s.tolist()
+    ((8, 4, 3), [0, 0, 0, 0, 1, 1, 1, 1])
+    """
+    if isinstance(surfaces, TrapezoidSurface):
+        surfaces = [surfaces]
+    corners, strip = [], []
     strip0 = 0
     for i, s in enumerate(surfaces):
         if not isinstance(s, TrapezoidSurface):
             raise ValueError(f"surfaces[{i}] must be a TrapezoidSurface, got {type(s).__name__}")
         corners.append(s.boxes())
         strip.append(strip0 + np.repeat(np.arange(s.n_span), s.n_chord))
-        surf.append(np.full(s.n_span * s.n_chord, i))
         strip0 += s.n_span
-    names = tuple(s.name for s in surfaces)
-    if len(set(names)) != len(names):
-        names = tuple(f"{s.name}[{i}]" for i, s in enumerate(surfaces))
-    return BoxMesh(np.concatenate(corners), np.concatenate(strip), np.concatenate(surf), names)
+    return np.concatenate(corners), np.concatenate(strip)
 
 
 @dataclass(frozen=True)
@@ -363,7 +394,7 @@ class MeshRuleReport:
                     or self.offending_ar_boxes.size)
 
 
-def check_mesh_rules(mesh: BoxMesh, u_min: float, f_max: float, bpw_min: float = 15.0,
+def check_mesh_rules(mesh: BoxMesh, u_min: float, f_max: float, bpw_min: float = BPW_MIN,
                      boxes_per_chord_min: int = 4, ar_max: float = 3.0,
                      warn: bool = True) -> MeshRuleReport:
     """Evaluate the DLM mesh rules of thesis Section 3.2.1 and warn about violations.

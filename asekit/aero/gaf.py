@@ -21,7 +21,7 @@ import logging
 import math
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -46,6 +46,8 @@ GAF_FILE = DATA_DIR / "gaf_fin.npz"
 SHIPPED_DATABASES = (GAF_FILE,)
 #: Format version of the database file; bump when its layout or meaning changes.
 GAF_FORMAT = 1
+#: The folder of the per-(Mach, k) entries (:class:`GafEntryCache`), next to the databases.
+ENTRY_FOLDER = "gaf_entries"
 
 
 def _finite_table(Q, k: np.ndarray) -> np.ndarray:
@@ -183,7 +185,7 @@ class GafDatabase:
 def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref: float,
                        symmetric: bool = False, method: str = "quartic",
                        progress=None, aero_options: dict | None = None,
-                       max_bytes: int | None = None) -> np.ndarray:
+                       max_bytes: int | None = None, on_k=None) -> np.ndarray:
     """Q(M, k) (n_k, n_modes, n_modes) for mode shapes already interpolated to the boxes.
 
     The k sweep is streamed (:func:`asekit.aero.dlm.map_normalwash_matrices`): one LU
@@ -193,7 +195,9 @@ def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref
     shared by the k of a batch (all k on small meshes). ``method`` "auto",
     "dlm", "supersonic" or "piston" chooses the aerodynamics per Mach
     (:mod:`asekit.aero.methods`; ``aero_options`` go to its pressure matrices); "quartic" and
-    "parabolic" are the DLM kernels.
+    "parabolic" are the DLM kernels. ``on_k(ik, Q_k)``, when given, is called with each k's
+    (n_modes, n_modes) result as soon as it is computed (the per-entry cache of
+    :func:`build_gaf_database`).
     """
     ks = check_k(k)
     if method not in DLM_KERNELS:
@@ -202,13 +206,19 @@ def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref
                            method, symmetric, **(aero_options or {}))
             if progress is not None:
                 progress(ks.size)
-            return np.stack([modal_forces(box_modes, c, mesh.area) for c in cp])
+            out = np.stack([modal_forces(box_modes, c, mesh.area) for c in cp])
+            if on_k is not None:
+                for ik in range(ks.size):
+                    on_k(ik, out[ik])
+            return out
         method = "quartic"
     out = np.empty((ks.size, box_modes.h_cp.shape[1], box_modes.h_cp.shape[1]), complex)
 
     def project(ik, kk, d):
         cp = factor_normalwash_matrix(d, overwrite=True).pressures(box_modes.normalwash(kk, b_ref))
         out[ik] = modal_forces(box_modes, cp, mesh.area)
+        if on_k is not None:
+            on_k(ik, out[ik])
         if progress is not None:
             progress(1)
 
@@ -274,13 +284,114 @@ def _blas_threads_for(n_boxes: int):
     return blas_threads_for(n_boxes, SMALL_SOLVE_BOXES)
 
 
+@dataclass(frozen=True, eq=False)
+class GafEntryCache:
+    """Per-(Mach, k) GAF entries of one database request, cached as they are computed so that
+    a failed or interrupted build resumes where it stopped (:func:`build_gaf_database`).
+
+    ``folder`` holds one file per entry, ``gafk_<key>_M<mach>_k<k>.npz``, written atomically
+    and verified on load (:mod:`asekit.util.cache`: checksum, the ``key``, the Mach, k, the
+    grid's k and the Q shape); ``key`` is the fingerprint of everything an entry depends on
+    but the Mach list (the mode set, the boxes, the k list, b_ref, symmetry, method:
+    :func:`entry_fingerprint`), so a database over more Machs reuses the entries of the others.
+    A file that fails a check is recomputed; an entry that cannot be written is only not cached.
+    ``computed`` counts the entries computed (not loaded) through this object.
+    """
+
+    folder: Path
+    key: str
+    n_modes: int
+    k_grid: float
+    computed: list = field(default_factory=list)
+
+    def path(self, mach: float, k: float) -> Path:
+        """The entry's file."""
+        return Path(self.folder) / f"gafk_{self.key[:32]}_M{float(mach)!r}_k{float(k)!r}.npz"
+
+    def _meta(self, mach: float, k: float) -> dict:
+        return {"entry_fingerprint": self.key, "mach": float(mach), "k": float(k),
+                "k_grid": float(self.k_grid), "format": GAF_FORMAT}
+
+    def load(self, mach: float, k: float) -> np.ndarray | None:
+        """Q (n_modes, n_modes) of the entry if its file exists and passes every check."""
+        try:
+            arrays, _ = load_npz(self.path(mach, k), expect_metadata=self._meta(mach, k),
+                                 expect_shapes={"Q": (self.n_modes, self.n_modes)})
+        except (CacheError, OSError, ValueError):
+            return None
+        q = arrays["Q"]
+        return q if q.dtype.kind == "c" and np.all(np.isfinite(q)) else None
+
+    def save(self, mach: float, k: float, q: np.ndarray) -> None:
+        """Write the entry (atomically); a folder that cannot be written is skipped."""
+        self.computed.append((float(mach), float(k)))
+        try:
+            save_npz(self.path(mach, k), {"Q": np.asarray(q, complex)}, self._meta(mach, k))
+        except OSError:
+            pass
+
+
+class _FreshEntries(GafEntryCache):
+    """The entries of a rebuild: never read, written as they are computed."""
+
+    def load(self, mach: float, k: float) -> None:
+        return None
+
+
+def _mach_entries(box_modes, mesh, mach, ks, b_ref, symmetric, method, bar, aero_options,
+                  entries: GafEntryCache | None) -> np.ndarray:
+    """Q (n_k, n, n) at one Mach: the cached entries loaded, the others computed (and cached
+    as each is done). Computed k by k where needed, so a resumed Mach gives the numbers of an
+    uninterrupted one bit for bit (the Mach-box grid always resolves the list's largest k)."""
+    update = None if bar is None else bar.update
+    if entries is None:
+        return gaf_from_box_modes(box_modes, mesh, mach, ks, b_ref, symmetric, method,
+                                  progress=update, aero_options=aero_options)
+    n = box_modes.h_cp.shape[1]
+    q = np.empty((ks.size, n, n), complex)
+    missing = []
+    for ik, kk in enumerate(ks):
+        got = entries.load(mach, kk)
+        if got is None:
+            missing.append(ik)
+        else:
+            q[ik] = got
+            if update is not None:
+                update(1)
+    if not missing:
+        return q
+    todo = ks[missing]
+
+    def keep(j, qk):
+        q[missing[j]] = qk
+        entries.save(mach, todo[j], qk)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")       # given where the method is used
+        name = "dlm" if method in DLM_KERNELS else resolve_method(method, mach)
+    if name == "supersonic":       # the grid of the whole list's largest k, entry by entry
+        def project(j, cp):        # the operations of gaf_from_box_modes, k by k
+            keep(j, modal_forces(box_modes, cp, mesh.area))
+            if update is not None:
+                update(1)
+        pressures(mesh, mach, todo, b_ref, lambda kk: box_modes.normalwash(kk, b_ref), method,
+                  symmetric, **dict(aero_options or {}, k_grid=float(ks.max()), on_k=project))
+    else:
+        gaf_from_box_modes(box_modes, mesh, mach, todo, b_ref, symmetric, method,
+                           progress=update, aero_options=aero_options, on_k=keep)
+    return q
+
+
 def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: float, n_rigid: int,
                        symmetric: bool = False, method: str = "quartic", progress: bool = True,
-                       metadata: dict | None = None,
-                       aero_options: dict | None = None) -> GafDatabase:
+                       metadata: dict | None = None, aero_options: dict | None = None,
+                       entries: GafEntryCache | None = None) -> GafDatabase:
     """Compute Q over ``machs`` x ``ks`` (tqdm bar over Mach x k when ``progress``); ``method``
     and ``aero_options`` as in :func:`gaf_from_box_modes` (e.g. "auto" over subsonic and
-    supersonic Mach numbers, refusing the transonic gap)."""
+    supersonic Mach numbers, refusing the transonic gap). With ``entries``
+    (:class:`GafEntryCache`) each (Mach, k) entry is read from it when cached and written to
+    it as soon as it is computed: an interrupted build resumes where it stopped and gives the
+    same numbers, bit for bit, as an uninterrupted one."""
     # the Mach range of the method (asekit.aero.methods); an explicit method warns in the gap
     machs = np.array([float(m) for m in np.atleast_1d(machs)])
     for i, m in enumerate(machs):
@@ -300,9 +411,8 @@ def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: flo
     try:
         with _blas_threads_for(mesh.n):
             for im, mach in enumerate(machs):
-                q[im] = gaf_from_box_modes(box_modes, mesh, mach, ks, b_ref, symmetric, method,
-                                           progress=None if bar is None else bar.update,
-                                           aero_options=aero_options)
+                q[im] = _mach_entries(box_modes, mesh, mach, ks, b_ref, symmetric, method, bar,
+                                      aero_options, entries)
     finally:
         if bar is not None:
             bar.close()
@@ -323,6 +433,14 @@ def mode_set_fingerprint(model, settings: dict) -> str:
     ``ModalModel`` and the ``settings`` (see :func:`database_settings`)."""
     return _fingerprint({"shapes": model.shapes, "nodes": model.nodes,
                          "frequencies_hz": model.frequencies_hz}, settings)
+
+
+def entry_fingerprint(model, settings: dict) -> str:
+    """Fingerprint of the per-(Mach, k) entries of a database request
+    (:class:`GafEntryCache`): :func:`mode_set_fingerprint` of the settings without the Mach
+    list (an entry at one Mach does not depend on the others; it does on the k list, whose
+    largest k sets the Mach-box grid)."""
+    return mode_set_fingerprint(model, {key: v for key, v in settings.items() if key != "machs"})
 
 
 def _load_matching(path: Path, fp: str, settings: dict, n_modes: int):
@@ -350,7 +468,8 @@ def _load_matching(path: Path, fp: str, settings: dict, n_modes: int):
 
 def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetric: bool = False,
                         method: str = "quartic", progress: bool = True, rebuild: bool = False,
-                        cache_dir=None, path=None, metadata: dict | None = None) -> GafDatabase:
+                        cache_dir=None, path=None, metadata: dict | None = None,
+                        entries: GafEntryCache | None = None) -> GafDatabase:
     """The GAF database of a ``ModalModel`` on ``boxes`` over ``machs`` x ``ks``, from a cache
     when one matches, else computed (tqdm bar) and written atomically.
 
@@ -359,6 +478,11 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
     :func:`asekit.util.paths.user_cache_dir`). A file is used only if its checksum passes and its
     fingerprint (mode set + settings), Mach and k arrays, b_ref and array shape all match.
     A rebuild that cannot be written (read-only folder) is returned all the same, with a warning.
+
+    A build caches each (Mach, k) entry as it is computed (:class:`GafEntryCache`, in
+    ``gaf_entries/`` next to the database file, or ``entries``): a failed or interrupted build
+    resumes where it stopped, and a database over other Machs of the same request reuses
+    them. ``rebuild`` recomputes the entries too.
     """
     settings = database_settings(machs, ks, b_ref, boxes, symmetric, method)
     fp = mode_set_fingerprint(model, settings)
@@ -369,6 +493,9 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
         cdir = Path(user_cache_dir() if cache_dir is None else cache_dir)
         target = cdir / f"gaf_{fp[:32]}.npz"
         candidates = [*SHIPPED_DATABASES, target]
+    if entries is None and rebuild:         # recompute every entry (and cache it afresh)
+        entries = _FreshEntries(target.parent / ENTRY_FOLDER, entry_fingerprint(model, settings),
+                                n, float(np.max(ks)))
     if not rebuild:
         for c in candidates:
             db = _load_matching(c, fp, settings, n)
@@ -382,11 +509,14 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
                  "Q_units": "per unit dynamic pressure; rigid-pitch row/column in m^3 per rad",
                  "sign": "F_i = q sum_j Q_ij zeta_j; Q_cc > 0 de-centering"})
     meta.update(metadata or {})
+    if entries is None:
+        entries = GafEntryCache(target.parent / ENTRY_FOLDER, entry_fingerprint(model, settings),
+                                n, float(np.max(ks)))
     _log.info("GAF database: computing %d Mach x %d reduced frequencies (%s)",
               np.size(machs), np.size(ks), method)
     t0 = time.perf_counter()
     db = build_gaf_database(fe_spline(model, boxes), boxes, machs, ks, b_ref, model.n_rigid,
-                            symmetric, method, progress, meta)
+                            symmetric, method, progress, meta, entries=entries)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
         save_npz(target, {"machs": db.machs, "k": db.k, "Q": db.Q}, meta)

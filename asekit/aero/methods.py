@@ -36,16 +36,17 @@ from typing import Callable
 
 import numpy as np
 
-from asekit.aero.boxes import BoxMesh
+from asekit.aero.boxes import BoxMesh, dlm_max_box_chord
 from asekit.aero.dlm import factor_normalwash_matrix, map_normalwash_matrices, normalwash_matrices
 from asekit.aero.piston import piston_pressure_matrices
+from asekit.aero.supersonic import max_box_chord as _mach_box_chord
 from asekit.aero.supersonic import supersonic_pressure_matrices, supersonic_pressures
 from asekit.aero.validity import SUBSONIC, SUPERSONIC, MachRange, check_k, mach_number
 from asekit.aero.validity import check_mach as _check_mach_range
 
 __all__ = ["AERO_METHODS", "AeroMethod", "DLM_KERNELS", "DLM_MACH_MAX", "METHODS",
            "SUPERSONIC_MACH_MIN", "TransonicGapError", "TransonicWarning", "check_k",
-           "check_mach", "check_method", "method_spec", "pressure_matrices", "pressures",
+           "check_mach", "check_method", "max_box_chord", "method_spec", "pressure_matrices", "pressures",
            "PressureMatrix", "resolve_method"]
 
 #: auto: highest Mach number given to the DLM, lowest given to the supersonic method.
@@ -131,6 +132,13 @@ class AeroMethod:
         method: 0.1, measured on the AGARD 445.6 case (256 boxes, 4 modes, 10 k, one BLAS
         thread: the matrices 6.6 s at M 1.072 and 13.1 s at M 1.141, one sample's pressures
         1.15 s and 2.26 s, so break-even near 6 samples = 24 columns).
+    box_chord : its mesh rule, ``(mach, k_max, b_ref, u_min, f_max) -> dx`` the longest box
+        chord (m) it accepts (None for ``auto``: :func:`max_box_chord` resolves it per Mach).
+        The DLM: 15 boxes per wavelength U_min / f_max (thesis Eq. 3.5); the Mach box: 6 per
+        shortest kernel wavelength 2 pi b (M - 1) / (k_max M)
+        (:func:`asekit.aero.supersonic.max_box_chord`); piston theory, a local law with no
+        kernel wavelength: the DLM's rule, which resolves the convected wavelength U / f of the
+        normalwash i k h / b (asekit's choice).
     """
 
     name: str
@@ -142,6 +150,17 @@ class AeroMethod:
     pressure_matrices: Callable | None
     operators: Callable | None
     reuse_break_even: float = 0.0
+    box_chord: Callable | None = None
+
+
+def _dlm_box_chord(mach, k_max, b_ref, u_min, f_max):
+    """The DLM's rule (thesis Eq. 3.5): 15 boxes per wavelength U_min / f_max."""
+    return dlm_max_box_chord(u_min, f_max)
+
+
+def _supersonic_box_chord(mach, k_max, b_ref, u_min, f_max):
+    """The Mach-box rule: 6 boxes per kernel wavelength 2 pi b (M - 1) / (k_max M)."""
+    return _mach_box_chord(mach, k_max, b_ref)
 
 
 #: The aero-method registry: ``aero.method`` name -> :class:`AeroMethod`.
@@ -151,14 +170,15 @@ AERO_METHODS: dict[str, AeroMethod] = {
                        True, None, None),
     "dlm": AeroMethod("dlm", "doublet lattice (Albano & Rodden), subsonic", SUBSONIC, "the DLM",
                       "; use method='supersonic' or 'piston' above M 1", True, _dlm_matrices,
-                      _dlm_operators, 0.0),
+                      _dlm_operators, 0.0, _dlm_box_chord),
     "supersonic": AeroMethod("supersonic", "Mach-box lifting-surface method, supersonic",
                              SUPERSONIC, "method='supersonic'", "; use method='dlm' below M 1",
                              True, _supersonic_matrices, _matrix_operators(_supersonic_matrices),
-                             0.1),
+                             0.1, _supersonic_box_chord),
     "piston": AeroMethod("piston", "piston theory (Lighthill; Ashley & Zartarian), supersonic",
                          SUPERSONIC, "method='piston'", "; use method='dlm' below M 1", True,
-                         _piston_matrices, _matrix_operators(_piston_matrices), 0.0),
+                         _piston_matrices, _matrix_operators(_piston_matrices), 0.0,
+                         _dlm_box_chord),
 }
 #: The method names (the registry's keys).
 METHODS = tuple(AERO_METHODS)
@@ -212,6 +232,26 @@ def resolve_method(method: str, mach: float, name: str = "mach") -> str:
                       "transonic dip); treat the result as doubtful", TransonicWarning,
                       stacklevel=2)
     return spec.name
+
+
+def max_box_chord(method: str, mach: float, k_max: float, b_ref: float, u_min: float,
+                  f_max: float) -> float:
+    """The longest box chord (m) the mesh rule of the method used at ``mach`` accepts
+    (:attr:`AeroMethod.box_chord`; ``auto`` resolved per Mach, the transonic gap's explicit
+    methods without their warning): k_max the largest reduced frequency, b_ref (m), u_min
+    (m/s), f_max (Hz).
+
+    Examples
+    --------
+    >>> round(max_box_chord("auto", 0.8, 12.57, 0.1, 100.0, 2000.0), 5)   # DLM: U / (15 f)
+    0.00333
+    >>> round(max_box_chord("auto", 1.5, 12.57, 0.1, 100.0, 2000.0), 5)   # Mach box
+    0.00278
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TransonicWarning)
+        spec = AERO_METHODS[resolve_method(method, mach)]
+    return float(spec.box_chord(mach, k_max, b_ref, u_min, f_max))
 
 
 def check_mach(mach: float, method: str = "dlm", name: str = "mach") -> float:

@@ -108,6 +108,15 @@ _GAUSS_F = np.polynomial.legendre.leggauss(32)
 EMPTY_AREA_FRACTION = 0.02
 #: dx / (beta dy) of the grid cells: 1, Mach boxes (see :func:`mach_grid`).
 MACH_BOX_RATIO = 1.0
+#: Grid resolution defaults (:func:`mach_grid`): cells across the mean box chord, cells per
+#: kernel wavelength, and the largest number of cells solved for (wing, diaphragm and wake;
+#: the grid rectangle may hold 4 times as many).
+CELLS_PER_BOX = 1.5
+CELLS_PER_WAVELENGTH = 8.0
+MAX_CELLS = 6000
+#: The mesh rule of the Mach-box method: boxes per shortest kernel wavelength
+#: 2 pi b (M - 1) / (k M) (a MeshRuleWarning below it; :func:`max_box_chord`).
+BPW_MIN = 6.0
 
 
 # ---------------------------------------------------------------------------------------------
@@ -295,37 +304,81 @@ def kernel_wavelength(mach: float, k: float, b_ref: float) -> float:
     return math.inf if k <= 0 else 2.0 * math.pi * b_ref * (mach - 1.0) / (k * mach)
 
 
-def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric: bool = False,
-              cells_per_box: float = 1.5, cells_per_wavelength: float = 8.0,
-              max_cells: int = 6000) -> MachGrid:
-    """Build the cell grid (:class:`MachGrid`) for ``mesh`` at ``mach`` and the highest reduced
-    frequency ``k_max``: dx from ``cells_per_box`` cells across the area-weighted mean box chord and
-    ``cells_per_wavelength`` cells per :func:`kernel_wavelength` (upper bounds); dy = dx / beta
-    (Mach boxes), with cell boundaries on the strip edges when the strips are equally wide.
-    The grid extends (x_max - x_min) / (2 beta) beyond the spanwise extremes of the mesh: no
-    off-wing point farther out both feels the wing and influences it.
+def max_box_chord(mach: float, k_max: float, b_ref: float, bpw_min: float = BPW_MIN) -> float:
+    """The longest box chord (m) of the mesh rule of the Mach-box method: ``bpw_min`` boxes
+    per shortest kernel wavelength, dx <= 2 pi b (M - 1) / (k_max M bpw_min) (the rule
+    :func:`supersonic_pressure_matrices` warns about; inf for k_max = 0).
 
-    Raises ValueError when more than ``max_cells`` cells would be needed.
+    Examples
+    --------
+    >>> round(max_box_chord(1.5, 1.0, 0.1), 5)      # 2 pi 0.1 0.5 / (1.5 x 6) m
+    0.03491
     """
-    m = check_supersonic_mach(mach)
+    return kernel_wavelength(mach, k_max, b_ref) / float(bpw_min)
+
+
+@dataclass(frozen=True)
+class _Geometry:
+    """What the cell grid needs of a box mesh: ``corners`` (n, 4, 3), the box ``chord`` and
+    ``area`` (n,) and whether a trailing edge is subsonic at the Mach number."""
+
+    corners: np.ndarray
+    chord: np.ndarray
+    area: np.ndarray
+    subsonic_te: bool
+
+
+def _corner_geometry(corners: np.ndarray, strip: np.ndarray, mach: float) -> _Geometry:
+    """:class:`_Geometry` from box corners and strip indices alone (the formulas of
+    :class:`~asekit.aero.boxes.BoxMesh`, without its overlap check: the cheap estimate)."""
+    c = np.asarray(corners, float)
+    chord = 0.5 * ((c[:, 1, 0] - c[:, 0, 0]) + (c[:, 2, 0] - c[:, 3, 0]))
+    p1 = c[:, 0] + 0.25 * (c[:, 1] - c[:, 0])
+    p3 = c[:, 3] + 0.25 * (c[:, 2] - c[:, 3])
+    d = p3 - p1
+    area = chord * 2.0 * (0.5 * np.hypot(d[:, 1], d[:, 2]))
+    strip = np.asarray(strip)
+    tans = []
+    for s in np.unique(strip):
+        members = np.flatnonzero(strip == s)
+        e = c[members[np.argmax(c[members, 1, 0])]]
+        tans.append(abs((e[2, 0] - e[1, 0]) / (e[2, 1] - e[1, 1])))
+    return _Geometry(c, chord, area, bool(np.any(np.array(tans) >= math.sqrt(mach * mach - 1))))
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """The cell grid's frame: all corners (the image's too, ``owner`` and ``is_img`` per box),
+    origin (x0, y0), cell size dx, dy (m), nx x ny cells, beta."""
+
+    all_c: np.ndarray
+    owner: np.ndarray
+    is_img: np.ndarray
+    x0: float
+    y0: float
+    dx: float
+    dy: float
+    nx: int
+    ny: int
+    beta: float
+
+
+def _layout(geo: _Geometry, m: float, k_max: float, b_ref: float, symmetric: bool,
+            cells_per_box: float, cells_per_wavelength: float, max_cells: int) -> _Layout:
+    """The grid frame of :func:`mach_grid` (its docstring); ValueError for a grid whose
+    spanwise count alone is not finite or beyond 4 ``max_cells``."""
     beta = math.sqrt(m * m - 1.0)
-    _check_planar(mesh)
-    subsonic_te = has_subsonic_trailing_edge(mesh, m)
-    cells_per_box = float(cells_per_box)
-    if not (math.isfinite(cells_per_box) and cells_per_box >= 1.0):
-        raise ValueError(f"cells_per_box must be >= 1, got {cells_per_box!r}")
-    if not (math.isfinite(cells_per_wavelength) and cells_per_wavelength >= 2.0):
-        raise ValueError(f"cells_per_wavelength must be >= 2, got {cells_per_wavelength!r}")
-    corners = mesh.corners
+    corners = geo.corners
+    n = corners.shape[0]
     if symmetric:
-        img = mesh.mirrored().corners
+        img = (corners * np.array([1.0, -1.0, 1.0]))[:, [3, 2, 1, 0]]
         all_c = np.concatenate([corners, img])
-        owner = np.concatenate([np.arange(mesh.n), np.arange(mesh.n)])
-        is_img = np.concatenate([np.zeros(mesh.n, bool), np.ones(mesh.n, bool)])
+        owner = np.concatenate([np.arange(n), np.arange(n)])
+        is_img = np.concatenate([np.zeros(n, bool), np.ones(n, bool)])
     else:
-        all_c, owner, is_img = corners, np.arange(mesh.n), np.zeros(mesh.n, bool)
+        all_c, owner, is_img = corners, np.arange(n), np.zeros(n, bool)
     x_min, x_max = float(all_c[:, :, 0].min()), float(all_c[:, :, 0].max())
-    dx = float(np.sum(mesh.chord * mesh.area) / np.sum(mesh.area)) / cells_per_box
+    dx = float(np.sum(geo.chord * geo.area) / np.sum(geo.area)) / cells_per_box
     dx = min(dx, kernel_wavelength(m, k_max, b_ref) / cells_per_wavelength)
     # Mach boxes: dx = beta dy, the cell diagonals on Mach lines (the classic choice of
     # [ZH55]). Then cells of one row lie outside each other's Mach cones (the diaphragm is
@@ -353,15 +406,19 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     margin = (x_max - x_min) / (2.0 * beta) + dy
     n_lo = math.ceil(margin / dy)
     ny_w = max(1, round((y_wmax - y_wmin) / dy))
-    y0 = y_wmin - n_lo * dy
-    ny = ny_w + 2 * n_lo
-    if nx * ny > 4 * max_cells:
-        raise ValueError(f"the supersonic grid would need about {nx * ny} cells (> {max_cells} "
-                         f"relevant cells, max_cells) at mach={m:g}, k={k_max:g}: coarsen with "
-                         "cells_per_box / cells_per_wavelength or lower k")
+    return _Layout(all_c, owner, is_img, x_min, y_wmin - n_lo * dy, dx, dy, nx, ny_w + 2 * n_lo,
+                   beta)
+
+
+def _select_cells(lay: _Layout, subsonic_te: bool):
+    """(box, ii, jj, wing, wake, dia) of the nx x ny grid: the box holding each cell centre
+    (-1: none), the cells' indices, the wing cells (mask), the wake cells (mask) and the
+    solved off-wing cells (indices): the diaphragm and wake cells that both feel the wing and
+    influence it."""
+    nx, ny, dx, dy, beta = lay.nx, lay.ny, lay.dx, lay.dy, lay.beta
     ii, jj = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     ii, jj = ii.ravel(), jj.ravel()
-    box = _locate_grid(all_c, x_min, y0, dx, dy, nx, ny)
+    box = _locate_grid(lay.all_c, lay.x0, lay.y0, dx, dy, nx, ny)
     wing = box >= 0
     if not wing.any():
         raise ValueError("no grid cell centre lies on the mesh: the mesh is degenerate")
@@ -374,7 +431,6 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     # behind supersonic trailing edges the wake cannot reach the wing: leave it out; behind a
     # subsonic one it can, and its cells are solved with DeltaCp = 0
     cand = np.flatnonzero((~wing) & (~wake)) if not subsonic_te else np.flatnonzero(~wing)
-    wi, wj = ii[wing], jj[wing]
     # keep the off-wing cells inside the downstream Mach cone of some wing cell and ahead of
     # another's: per column, the most upstream / downstream wing cell decides (the cone test
     # is monotone in the streamwise distance)
@@ -385,22 +441,126 @@ def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric:
     down = (down_dx > 0) & (beta * (ddy - dy) < down_dx + dx)
     up = (up_dx > 0) & (beta * (ddy - dy) < up_dx + dx)
     keep = down.any(axis=1) & up.any(axis=1)
-    dia = cand[keep]
+    return box, ii, jj, wing, wake, cand[keep]
+
+
+def _empty_boxes(lay: _Layout, box: np.ndarray, wing: np.ndarray, area: np.ndarray):
+    """(indices of the boxes, image included, that hold no cell centre; their share of the
+    area)."""
+    all_area = np.concatenate([area, area]) if lay.all_c.shape[0] > area.size else area
+    counts = np.bincount(box[wing], minlength=lay.all_c.shape[0])
+    empty = np.flatnonzero(counts == 0)
+    return empty, float(all_area[empty].sum() / all_area.sum())
+
+
+def _check_grid_options(cells_per_box: float, cells_per_wavelength: float) -> float:
+    cells_per_box = float(cells_per_box)
+    if not (math.isfinite(cells_per_box) and cells_per_box >= 1.0):
+        raise ValueError(f"cells_per_box must be >= 1, got {cells_per_box!r}")
+    if not (math.isfinite(cells_per_wavelength) and cells_per_wavelength >= 2.0):
+        raise ValueError(f"cells_per_wavelength must be >= 2, got {cells_per_wavelength!r}")
+    return cells_per_box
+
+
+def mach_grid(mesh: BoxMesh, mach: float, k_max: float, b_ref: float, symmetric: bool = False,
+              cells_per_box: float = CELLS_PER_BOX,
+              cells_per_wavelength: float = CELLS_PER_WAVELENGTH,
+              max_cells: int = MAX_CELLS) -> MachGrid:
+    """Build the cell grid (:class:`MachGrid`) for ``mesh`` at ``mach`` and the highest reduced
+    frequency ``k_max``: dx from ``cells_per_box`` cells across the area-weighted mean box chord and
+    ``cells_per_wavelength`` cells per :func:`kernel_wavelength` (upper bounds); dy = dx / beta
+    (Mach boxes), with cell boundaries on the strip edges when the strips are equally wide.
+    The grid extends (x_max - x_min) / (2 beta) beyond the spanwise extremes of the mesh: no
+    off-wing point farther out both feels the wing and influences it.
+
+    Raises ValueError when more than ``max_cells`` cells would be needed (:func:`grid_size`
+    counts them without building the grid).
+    """
+    m = check_supersonic_mach(mach)
+    _check_planar(mesh)
+    cells_per_box = _check_grid_options(cells_per_box, cells_per_wavelength)
+    geo = _Geometry(mesh.corners, mesh.chord, mesh.area, has_subsonic_trailing_edge(mesh, m))
+    lay = _layout(geo, m, k_max, b_ref, symmetric, cells_per_box, cells_per_wavelength,
+                  max_cells)
+    if lay.nx * lay.ny > 4 * max_cells:
+        raise ValueError(f"the supersonic grid would need about {lay.nx * lay.ny} cells (> "
+                         f"{max_cells} relevant cells, max_cells) at mach={m:g}, k={k_max:g}: "
+                         "coarsen with cells_per_box / cells_per_wavelength or lower k")
+    box, ii, jj, wing, wake, dia = _select_cells(lay, geo.subsonic_te)
     n_rel = int(wing.sum()) + dia.size
     if n_rel > max_cells:
         raise ValueError(f"the supersonic grid needs {n_rel} cells (> max_cells={max_cells}) at "
                          f"mach={m:g}, k={k_max:g}: coarsen with cells_per_box / "
                          "cells_per_wavelength, or raise max_cells")
-    counts = np.bincount(box[wing], minlength=all_c.shape[0])
-    empty = np.flatnonzero(counts == 0)
-    area = np.concatenate([mesh.area, mesh.area]) if symmetric else mesh.area
-    if empty.size and area[empty].sum() > EMPTY_AREA_FRACTION * area.sum():
-        raise GridTooCoarseError(f"boxes {owner[empty][:10].tolist()} hold no cell centre of the "
-                         f"supersonic grid (dx {dx:.3g} m, dy {dy:.3g} m; "
-                         f"{100 * area[empty].sum() / area.sum():.2g} % of the area): raise "
-                         "cells_per_box")
-    return MachGrid(x_min, y0, dx, dy, nx, ny, beta, wi, wj, owner[box[wing]], is_img[box[wing]],
-                    ii[dia], jj[dia], wake[dia] if subsonic_te else None)
+    empty, share = _empty_boxes(lay, box, wing, mesh.area)
+    if share > EMPTY_AREA_FRACTION:
+        raise GridTooCoarseError(f"boxes {lay.owner[empty][:10].tolist()} hold no cell centre "
+                                 f"of the supersonic grid (dx {lay.dx:.3g} m, dy {lay.dy:.3g} m; "
+                                 f"{100 * share:.2g} % of the area): raise cells_per_box")
+    return MachGrid(lay.x0, lay.y0, lay.dx, lay.dy, lay.nx, lay.ny, lay.beta, ii[wing], jj[wing],
+                    lay.owner[box[wing]], lay.is_img[box[wing]], ii[dia], jj[dia],
+                    wake[dia] if geo.subsonic_te else None)
+
+
+@dataclass(frozen=True)
+class GridSize:
+    """The size of the Mach-box grid of a mesh at one Mach number and highest k, counted
+    without building it (:func:`grid_size`): ``n_grid`` = nx ny cells of the grid rectangle,
+    ``n_relevant`` the wing, diaphragm and wake cells solved for (None when ``n_grid`` alone
+    is over the limit: not counted), ``max_cells`` the limit of :func:`mach_grid`."""
+
+    n_grid: int
+    n_relevant: int | None
+    max_cells: int
+
+    @property
+    def fits(self) -> bool:
+        """Whether :func:`mach_grid` accepts the grid (both counts within the limits)."""
+        return (self.n_grid <= 4 * self.max_cells and self.n_relevant is not None
+                and self.n_relevant <= self.max_cells)
+
+    @property
+    def cells(self) -> int:
+        """The count that decides: the relevant cells when counted, else the rectangle's."""
+        return self.n_grid if self.n_relevant is None else self.n_relevant
+
+
+def grid_size(corners: np.ndarray, strip: np.ndarray, mach: float, k_max: float, b_ref: float,
+              symmetric: bool = False, cells_per_box: float = CELLS_PER_BOX,
+              cells_per_wavelength: float = CELLS_PER_WAVELENGTH,
+              max_cells: int = MAX_CELLS) -> GridSize:
+    """Count the cells of the grid :func:`supersonic_pressure_matrices` would build for boxes
+    with ``corners`` (n, 4, 3) and chordwise-strip indices ``strip`` (n,) (a
+    :class:`~asekit.aero.boxes.BoxMesh`'s, or :func:`asekit.aero.boxes.box_corners` of
+    surfaces not yet meshed) at ``mach`` and ``k_max``, without building the grid or the
+    mesh: the frame in closed form, the relevant cells (wing, diaphragm, wake) counted only
+    when the frame is within the limit (a few ms then). The same refinement as the solver's
+    when boxes hold no cell centre (``cells_per_box`` x 1.5, up to three times).
+
+    Examples
+    --------
+    >>> from asekit.aero.boxes import TrapezoidSurface, box_corners
+    >>> c, s = box_corners([TrapezoidSurface((0, 0), 0.3, (0.2, 0.2), 0.1, 8, 6)])
+    >>> g = grid_size(c, s, 1.5, 1.0, 0.1)
+    >>> g.fits, g.n_relevant
+    (True, 492)
+    >>> grid_size(c, s, 1.5, 20.0, 0.1).fits       # k 20: the kernel's wavelength 5 mm
+    False
+    """
+    m = check_supersonic_mach(mach)
+    cpb = _check_grid_options(cells_per_box, cells_per_wavelength)
+    geo = _corner_geometry(corners, strip, m)
+    for attempt in range(4):
+        lay = _layout(geo, m, float(k_max), float(b_ref), symmetric, cpb * 1.5 ** attempt,
+                      cells_per_wavelength, max_cells)
+        n_grid = lay.nx * lay.ny
+        if n_grid > 4 * max_cells:
+            return GridSize(n_grid, None, int(max_cells))
+        box, _, _, wing, _, dia = _select_cells(lay, geo.subsonic_te)
+        n_rel = int(wing.sum()) + dia.size
+        if n_rel > max_cells or _empty_boxes(lay, box, wing, geo.area)[1] <= EMPTY_AREA_FRACTION:
+            break
+    return GridSize(n_grid, n_rel, int(max_cells))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -686,13 +846,18 @@ def _transfer(mesh: BoxMesh, grid: MachGrid):
 
 
 def _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box, cells_per_wavelength, max_cells,
-             bpw_min, warn):
+             bpw_min, warn, k_grid=None):
     m = check_supersonic_mach(mach)
     ks = check_k(k)
     b = float(b_ref)
     if not (math.isfinite(b) and b > 0):
         raise ValueError(f"b_ref must be a finite reference semi-chord > 0 m, got {b_ref!r}")
     k_max = float(ks.max())
+    if k_grid is not None:
+        k_grid = float(check_k(k_grid, "k_grid").max())
+        if k_grid < k_max:
+            raise ValueError(f"k_grid must be >= the largest k ({k_max:g}), got {k_grid:g}")
+        k_max = k_grid
     if warn and k_max > 0:
         bpw = kernel_wavelength(m, k_max, b) / float(mesh.chord.max())
         if bpw < bpw_min:
@@ -715,9 +880,10 @@ def _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box, cells_per_wavelengt
 
 
 def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
-                                 symmetric: bool = False, cells_per_box: float = 1.5,
-                                 cells_per_wavelength: float = 8.0, max_cells: int = 6000,
-                                 bpw_min: float = 6.0, warn: bool = True) -> np.ndarray:
+                                 symmetric: bool = False, cells_per_box: float = CELLS_PER_BOX,
+                                 cells_per_wavelength: float = CELLS_PER_WAVELENGTH,
+                                 max_cells: int = MAX_CELLS, bpw_min: float = BPW_MIN,
+                                 warn: bool = True) -> np.ndarray:
     """Supersonic pressure-per-normalwash matrices A (n_k, n, n) complex, DeltaCp = A (w/U)
     with w/U at the DLM control points and DeltaCp lumped at the load points (module
     docstring), the counterpart of the DLM's AIC.
@@ -747,17 +913,23 @@ def supersonic_pressure_matrices(mesh: BoxMesh, mach: float, k, b_ref: float,
 
 
 def supersonic_pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash,
-                         symmetric: bool = False, cells_per_box: float = 1.5,
-                         cells_per_wavelength: float = 8.0, max_cells: int = 6000,
-                         bpw_min: float = 6.0, warn: bool = True) -> np.ndarray:
+                         symmetric: bool = False, cells_per_box: float = CELLS_PER_BOX,
+                         cells_per_wavelength: float = CELLS_PER_WAVELENGTH,
+                         max_cells: int = MAX_CELLS, bpw_min: float = BPW_MIN,
+                         warn: bool = True, k_grid: float | None = None,
+                         on_k=None) -> np.ndarray:
     """DeltaCp (n_k, n, m) for given normalwash columns without forming the matrices (one grid
     solve per column instead of one per box: the cheap path for a few modes).
 
     ``normalwash`` is a callable ``k -> (n, m)`` array of w/U at the control points, or an
     (n_k, n, m) array; the other arguments as :func:`supersonic_pressure_matrices` (the result
-    equals ``A[ik] @ normalwash[ik]`` to rounding)."""
+    equals ``A[ik] @ normalwash[ik]`` to rounding). ``k_grid`` (default the largest k) is the
+    reduced frequency the grid resolves: a k list computed in parts with the whole list's
+    largest k gives, k by k, the same numbers as the whole list (a resumed GAF database,
+    :func:`asekit.aero.gaf.build_gaf_database`). ``on_k(ik, DeltaCp_k)``, when given, is called
+    with each k's (n, m) pressures as soon as they are computed."""
     m, ks, b, grid, s, tw = _prepare(mesh, mach, k, b_ref, symmetric, cells_per_box,
-                                     cells_per_wavelength, max_cells, bpw_min, warn)
+                                     cells_per_wavelength, max_cells, bpw_min, warn, k_grid)
     out = None
     for ik, kk in enumerate(ks):
         w = np.asarray(normalwash(float(kk)) if callable(normalwash) else normalwash[ik])
@@ -769,6 +941,8 @@ def supersonic_pressures(mesh: BoxMesh, mach: float, k, b_ref: float, normalwash
         if out is None:
             out = np.empty((ks.size, mesh.n, w.shape[1]), complex)
         out[ik] = cp
+        if on_k is not None:
+            on_k(ik, out[ik])
     if not np.all(np.isfinite(out)):
         raise FloatingPointError("supersonic pressures are not finite")
     return out

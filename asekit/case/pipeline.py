@@ -18,21 +18,22 @@ from functools import lru_cache
 
 import numpy as np
 
-from asekit.aero.boxes import TrapezoidSurface, check_matrix_memory, mesh_surfaces
-from asekit.aero.gaf import GafDatabase, cached_gaf_database, default_reduced_frequencies
+from asekit.aero.boxes import check_matrix_memory, mesh_surfaces
+from asekit.aero.gaf import GafDatabase, cached_gaf_database
 from asekit.aeroelastic.flutter import Instability, PkResult, divergence_speeds, first_of
 from asekit.aeroelastic.methods import flutter_method
 from asekit.aeroelastic.statespace import fin_outputs
 from asekit.ase import loop as ase_mod
 from asekit.ase import metrics
 from asekit.atmosphere import standard_atmosphere
+from asekit.case.resources import aero_reduced_frequencies, box_counts, panel_surfaces
 from asekit.case.schema import (
     MOTOR_KEYS,
     TRANSMISSION_KEYS,
     Case,
     CaseError,
     SolverError,
-    auto_boxes,
+    check_resources,
 )
 from asekit.rfa.methods import rfa_kind
 from asekit.servo.actuator import SYSTEM_3, ActuatorParameters, DCMotor, Transmission
@@ -305,28 +306,22 @@ def imported_box_mesh(case: Case):
 @lru_cache(maxsize=16)
 @_door("the aerodynamic boxes", _AERO)
 def box_mesh(case: Case):
-    """The doublet-lattice boxes, per panel ``aero.boxes`` or automatic (:func:`auto_boxes`),
+    """The doublet-lattice boxes, per panel ``aero.boxes`` or automatic (the mesh rule of the
+    method used at each Mach, :func:`asekit.case.resources.box_counts`),
     or the imported structure's boxes; the surfaces are named ``"surface"`` (one panel) or
     ``"panel<i>"``. Refuses (ValueError from :func:`asekit.aero.boxes.check_matrix_memory`) a
     mesh whose dense DLM matrix would not fit in memory."""
     if case.structure is not None:
         return imported_box_mesh(case)
     a = case.aero
-    counts = [a.boxes[i] if a.boxes is not None else auto_boxes(p.planform, a.u_min, a.f_max)
-              for i, p in enumerate(case.panels)]
+    counts = box_counts(case.panels, a)
     n_boxes = sum(nc * ns for nc, ns in counts)
     # refused before any box is made, naming the case keys that set the count
     check_matrix_memory(n_boxes, 1, 16, f"one DLM matrix of case {case.name!r} ({n_boxes} boxes"
                         f"{' from the mesh rules' if a.boxes is None else ''})",
                         "lower aero.f_max, raise aero.u_min or give aero.boxes"
                         if a.boxes is None else "lower aero.boxes")
-    surfaces = []
-    for i, (p, (nc, ns)) in enumerate(zip(case.panels, counts)):
-        pf = p.planform
-        surfaces.append(TrapezoidSurface(pf.root_le + (0.0,), pf.root_chord, pf.tip_le + (0.0,),
-                                         pf.tip_chord, nc, ns,
-                                         name=f"panel{i}" if len(case.panels) > 1 else "surface"))
-    return mesh_surfaces(surfaces)
+    return mesh_surfaces(panel_surfaces(case.panels, counts))
 
 
 @_door("the reduced frequencies", _AERO)
@@ -342,10 +337,7 @@ def reduced_frequencies(case: Case) -> np.ndarray:
     >>> k.size, round(float(k[-1]), 4)
     (15, 2.7227)
     """
-    a = case.aero
-    if a.reduced_frequencies is not None:
-        return np.asarray(a.reduced_frequencies, float)
-    return default_reduced_frequencies(2 * math.pi * a.f_max * a.reference_semichord / a.u_min)
+    return np.asarray(aero_reduced_frequencies(case.aero), float)
 
 
 @_door("the GAF database (doublet lattice, Mach box or piston theory)", _AERO)
@@ -355,11 +347,17 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True,
     :func:`box_mesh`, loaded from a shipped database (the fin's ``data/gaf_fin.npz``) or the
     user cache when one matches its fingerprint (mode set, boxes' corners, Mach, k, b_ref,
     symmetry, method), else rebuilt (``cache=False``: always) into the user cache or ``path``
-    (:func:`asekit.aero.gaf.cached_gaf_database`)."""
+    (:func:`asekit.aero.gaf.cached_gaf_database`). A rebuild caches each (Mach, k) entry as it
+    is computed, so a failed or interrupted run resumes where it stopped
+    (:class:`asekit.aero.gaf.GafEntryCache`). Before anything is computed, the case's
+    resources are checked (:func:`asekit.case.schema.check_resources`: a case built in Python
+    skips the loader's check), a case over a limit refused with a CaseError naming the keys."""
     a = case.aero
     if a is None:
         raise CaseError(f"{case.name}: the case has no aerodynamics (an imported deck without "
                         f"CAERO1 / MKAERO1)")
+    if case.structure is None:
+        check_resources(case.panels, a)
     # the database's method: the DLM kernel name, or the aerodynamic method (asekit.aero.methods)
     method = a.kernel if a.method == "dlm" else a.method
     return cached_gaf_database(modal_model(case), box_mesh(case), a.machs,

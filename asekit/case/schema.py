@@ -18,16 +18,16 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from asekit.aero.boxes import MAX_MATRIX_BYTES
 from asekit.aero.methods import METHODS, resolve_method
 from asekit.aeroelastic.methods import FLUTTER_METHODS
 from asekit.atmosphere import MAX_ALTITUDE, MIN_ALTITUDE
 from asekit.case.imported import ImportedModel
+from asekit.case.resources import pk_problem, resource_problem
 from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
 from asekit.rfa.methods import RFA_FITS
 from asekit.structure.mesh import Grading, Stations, check_stations, station_array
 from asekit.structure.supports import SUPPORTS
-from asekit.util.validate import positive, read_toml
+from asekit.util.validate import read_toml
 
 
 class CaseError(ValueError):
@@ -65,34 +65,6 @@ def structural_factor_bytes(n_dof: int) -> float:
 def _max_dof(max_bytes: float) -> int:
     """The largest n_dof whose :func:`structural_factor_bytes` fits in ``max_bytes``."""
     return int((max_bytes / (12.0 * 10.4)) ** (1.0 / 1.294))
-
-
-def auto_boxes(planform, u_min: float, f_max: float, n_chord: int | None = None,
-               n_span: int | None = None, bpw_min: float = 15.0,
-               ar_max: float = 3.0) -> tuple[int, int]:
-    """Box counts (n_chord, n_span) of one panel from the mesh rules (thesis Sec. 3.2.1).
-
-    n_chord (unless given): the smallest n_chord >= 4 with boxes per wavelength
-    U_min / (f_max dx) > ``bpw_min`` (strictly) on the root strip, dx = root chord / n_chord
-    (Eq. 3.5); n_span (unless given): the smallest keeping the tip boxes' aspect ratio
-    span / (n_span dx_tip) below 0.9 ``ar_max`` (a 10 % margin), dx_tip = tip chord / n_chord.
-    u_min in m/s, f_max in Hz.
-
-    Examples
-    --------
-    >>> from asekit.geometry import Planform
-    >>> auto_boxes(Planform((0.0, 0.0), 0.156, (0.078, 0.15), 0.078), 180.0, 1000.0)
-    (14, 10)
-    """
-    u_min, f_max = positive("aero.u_min", u_min), positive("aero.f_max", f_max)
-    bpw_min, ar_max = positive("bpw_min", bpw_min), positive("ar_max", ar_max)
-    if n_chord is None:
-        dx_max = u_min / (bpw_min * f_max)
-        n_chord = max(4, math.floor(planform.root_chord / dx_max) + 1)
-    if n_span is None:
-        dx_tip = planform.tip_chord / n_chord
-        n_span = max(1, math.ceil(planform.span / (0.9 * ar_max * dx_tip)))
-    return int(n_chord), int(n_span)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -741,28 +713,14 @@ def _aero(t: _Table, panels) -> AeroSpec:
     return AeroSpec(machs, b, ks, f_max, u_min, boxes, kernel, symmetry, method)
 
 
-def _check_memory(panels, aero: AeroSpec) -> None:
-    """Refuse, before any computation, a case whose dense DLM matrix (16 n_boxes^2 bytes, one
-    at a time: :func:`asekit.aero.dlm.iter_normalwash_matrices`) exceeds
-    :data:`asekit.aero.boxes.MAX_MATRIX_BYTES`, or whose structural LU factor
-    (:func:`structural_factor_bytes`) exceeds :data:`MAX_STRUCTURAL_BYTES`; the error names
-    the keys that set the size and the largest size that fits."""
-    if aero.boxes is None:
-        counts = [auto_boxes(p.planform, aero.u_min, aero.f_max) for p in panels]
-    else:
-        counts = list(aero.boxes)
-    n = sum(nc * ns for nc, ns in counts)
-    need = 16.0 * n * n
-    if need > MAX_MATRIX_BYTES:
-        fit = math.isqrt(int(MAX_MATRIX_BYTES // 16))
-        what = (" ".join(f"{nc} x {ns}" for nc, ns in counts) + f" = {n} boxes" +
-                (" from the mesh rules" if aero.boxes is None else ""))
-        knob = ("lower aero.f_max, raise aero.u_min or give aero.boxes" if aero.boxes is None
-                else "lower aero.boxes")
-        raise CaseError(f"aero.boxes: {what} need a {need / 2 ** 30:.3g} GiB DLM matrix (limit "
-                        f"{MAX_MATRIX_BYTES / 2 ** 30:.3g} GiB, asekit.aero.boxes."
-                        f"MAX_MATRIX_BYTES): at most {fit} boxes fit (e.g. "
-                        f"{math.isqrt(fit)} x {math.isqrt(fit)}); {knob}")
+def check_resources(panels, aero: AeroSpec) -> None:
+    """Refuse (:class:`CaseError`), before any computation, a case whose structural LU factor
+    (:func:`structural_factor_bytes`) exceeds :data:`MAX_STRUCTURAL_BYTES`, whose dense DLM
+    matrix (16 n_boxes^2 bytes, one at a time: :func:`asekit.aero.dlm.iter_normalwash_matrices`)
+    exceeds :data:`asekit.aero.boxes.MAX_MATRIX_BYTES`, or whose Mach-box grid at a supersonic
+    Mach exceeds :data:`asekit.aero.supersonic.MAX_CELLS` cells
+    (:func:`asekit.case.resources.resource_problem`); the one-line error names the keys that
+    set the size and the values that fit. Called by the loader and at the pipeline's door."""
     nc = panels[0].n_chord
     ns = sum(p.n_span for p in panels)
     dof = 3 * (nc + 1) * (ns + 1)
@@ -774,6 +732,9 @@ def _check_memory(panels, aero: AeroSpec) -> None:
                         f"factor (limit {MAX_STRUCTURAL_BYTES / 2 ** 30:.3g} GiB, asekit.case."
                         f"schema.MAX_STRUCTURAL_BYTES): at most {_max_dof(MAX_STRUCTURAL_BYTES)}"
                         f" dof fit (e.g. {side} x {side} elements); lower n_chord or n_span")
+    problem = resource_problem(panels, aero)
+    if problem is not None:
+        raise CaseError(problem)
 
 
 def _flight(t: _Table) -> FlightSpec:
@@ -865,8 +826,12 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     damping = _damping(top.table("damping"))
     modes = _modes(top.table("modes"), support)
     aero = _aero(top.table("aero", required=True), panels)
-    _check_memory(panels, aero)
+    check_resources(panels, aero)
     flight = _flight(top.table("flight", required=True))
+    n_cond = len(flight.altitudes if flight.altitudes is not None else flight.densities)
+    problem = pk_problem(len(aero.machs), n_cond, flight.velocities)
+    if problem is not None:
+        raise CaseError(problem)
     actuator = _actuator(top.table("actuator"))
     flutter = _flutter(top.table("flutter"))
     fsi = top.table("flutter_speed_index")

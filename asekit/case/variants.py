@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from asekit.case.pipeline import auto_boxes
+from asekit.case.resources import auto_boxes
 from asekit.case.schema import Case, CaseError
 from asekit.structure.mesh import Grading, Stations, check_stations, station_array
 
@@ -79,7 +79,7 @@ def with_mesh(case: Case, n_chord: int | None = None, n_span: int | None = None,
 
 def with_boxes(case: Case, n_chord: int | None = None, n_span: int | None = None) -> Case:
     """The one-panel ``case`` with ``aero.boxes = [(n_chord, n_span)]``; a count left None
-    follows the mesh rules (:func:`asekit.case.pipeline.auto_boxes`, the spanwise count from
+    follows the mesh rules (:func:`asekit.case.resources.auto_boxes`, the spanwise count from
     the given chordwise one); both None gives the automatic mesh (``aero.boxes = "auto"``)."""
     p = _one_panel(case, "with_boxes")
     if n_chord is None and n_span is None:
