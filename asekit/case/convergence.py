@@ -311,6 +311,8 @@ UNITS = {"speed_extrapolated_ms": "m/s", "speed_error_ms": "m/s (grid convergenc
          "frequency_extrapolated_hz": "Hz", "frequency_error_hz": "Hz (grid convergence index)",
          "speeds_ms": "m/s", "order": "- (order of convergence in the cell size h)",
          "cell_size": "- (h = (elements x boxes)^(-1/4), relative)", "ratio": "-",
+         "meshes": "count", "assumed_order": "- (order used when not observed)",
+         "order_observed": "bool (order observed on three meshes, else assumed)",
          "structure": "elements (chordwise, spanwise) per panel",
          "aero_boxes": "boxes (chordwise, spanwise) per panel"}
 
