@@ -348,7 +348,8 @@ def summary_fields(study: ConvergenceStudy) -> dict:
 def add_to_summary(summary: dict, study: ConvergenceStudy) -> dict:
     """The ``analyse`` JSON ``summary`` with the study's fields added (a new dict): every
     flutter row gains the four extrapolated keys, the document a ``convergence`` block and the
-    keys' units."""
+    keys' units, ``seconds`` the study's wall-clock time (the coarser meshes only when the
+    finest analysis was reused)."""
     extra = summary_fields(study)
     if len(extra["flutter"]) != len(summary["flutter"]):
         raise ValueError("the convergence study and the summary have different flutter rows")
@@ -356,6 +357,7 @@ def add_to_summary(summary: dict, study: ConvergenceStudy) -> dict:
     out["flutter"] = [{**row, **f} for row, f in zip(summary["flutter"], extra["flutter"])]
     out["convergence"] = extra["convergence"]
     out["units"] = {**summary.get("units", {}), **UNITS}
+    out["seconds"] = {**summary.get("seconds", {}), "convergence": float(study.seconds)}
     return out
 
 

@@ -225,6 +225,7 @@ def test_summary_gains_the_extrapolated_fields(agard_studies):
               "frequency_error_hz"):
         assert k in s["units"]
     assert s["convergence"]["structure"] == [[[20, 20]], [[13, 13]], [[9, 9]]]
+    assert s["seconds"]["convergence"] == study.seconds
     text = format_study(study)
     assert f"{row['speed_extrapolated_ms']:.2f} +- {row['speed_error_ms']:.2f}" in text
     assert max(len(ln) for ln in text.splitlines()) <= 100
