@@ -136,9 +136,11 @@ def run(figures: bool = False) -> ChapterResult:
                  "flutter.first_instability.pk.M075.h0.speed_ms",
                  "flutter.first_instability.root_locus.M075.h0.speed_ms",
                  "flutter.first_instability.time_domain.M075.h0.speed_ms"]
+    fin_keys += [f"flutter.extrapolated.pk.M075.h0.{s}"
+                 for s in ("speed_ms", "speed_error_ms", "freq_hz", "freq_error_hz")]
     if data is None:
         for key in fin_keys:
-            unit = "Hz" if key.endswith("freq_hz") else ("-" if "fit_error" in key else "m/s")
+            unit = "Hz" if key.endswith("_hz") else ("-" if "fit_error" in key else "m/s")
             q.append(Quantity(key, None, unit, reason))
         if figures and ha is not None:
             figs.update(ha145b_figures(ha))
