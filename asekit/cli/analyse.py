@@ -94,13 +94,16 @@ def run(args) -> int:
             from asekit.case import convergence
             convergence.check_study(case)
         analysis = run_analysis(case, progress=not args.quiet)
-        s = summary(analysis)
-        if study:
-            conv = convergence.convergence_study(case, finest=analysis.flutter,
-                                                 progress=not args.quiet)
-            s = convergence.add_to_summary(s, conv)
     except (ValueError, SolverError) as exc:
         return _error(_named(name, exc))
+    s = summary(analysis)
+    if study:
+        try:
+            conv = convergence.convergence_study(case, finest=analysis.flutter,
+                                                 progress=not args.quiet)
+        except (ValueError, SolverError) as exc:
+            return _error(_named(name, exc))
+        s = convergence.add_to_summary(s, conv)
     to_stdout = args.json == "-"
     print(format_summary(s), file=sys.stderr if to_stdout else sys.stdout)
     if study:
