@@ -159,7 +159,8 @@ def check_study(case: Case, spec: ConvergenceSpec | None = None) -> ConvergenceS
     """The study's settings (``spec``, default the case's ``[convergence]``), checked against
     the case before any computation: a case-file surface (not an imported deck) whose coarsest
     mesh keeps at least :data:`MIN_COUNT` elements and boxes per direction, with equal or
-    graded node spacing (explicit stations cannot be coarsened)."""
+    graded node spacing (explicit stations cannot be coarsened), each coarser structure
+    supported as the case says (e.g. a single-node shaft needs a node on its axis)."""
     spec = case.convergence if spec is None else spec
     if case.structure is not None or not case.panels:
         raise CaseError(f"{case.name}: convergence needs a case-file surface ([[panel]]), not "
@@ -172,7 +173,14 @@ def check_study(case: Case, spec: ConvergenceSpec | None = None) -> ConvergenceS
             if isinstance(sp, Stations):
                 raise CaseError(f"panel[{i}].{d}_stations: explicit stations cannot be "
                                 f"coarsened for convergence; use {d}_grading or equal spacing")
-    study_meshes(case, spec)
+    for i, c in enumerate(study_meshes(case, spec)[1:], start=2):
+        try:                              # each coarser structure supported (cheap: coarser)
+            pipeline.supported_system(c)
+        except ValueError as exc:
+            p = c.panels[0]
+            raise CaseError(f"convergence.ratio = {spec.ratio:g}: mesh {i} of the study "
+                            f"(panel[0] {p.n_chord} x {p.n_span} elements) fails: "
+                            f"{' '.join(str(exc).split())}") from None
     return spec
 
 

@@ -130,6 +130,15 @@ def test_too_coarse_a_study_is_refused_before_any_computation():
         check_study(fin, ConvergenceSpec(meshes=3, ratio=3.0))
 
 
+def test_a_coarse_mesh_its_support_cannot_hold_is_refused_first():
+    """The thesis's fin (6 x 7, single-node shaft at mid-chord): ratio 1.5 makes its third
+    mesh 3 x 3, with no node on the shaft axis."""
+    with pytest.raises(CaseError, match=r"convergence.ratio = 1.5: mesh 3 of the study "
+                                        r"\(panel\[0\] 3 x 3 elements\) fails: .*axis_point"):
+        check_study(load_case(FIN_FILE), ConvergenceSpec(meshes=3, ratio=1.5))
+    assert check_study(load_case(FIN_FILE), ConvergenceSpec(meshes=2, ratio=1.5))
+
+
 def test_explicit_stations_are_refused():
     fin = load_case(FIN_FILE)
     case = with_mesh(fin, 4, 7, Stations((0.0, 0.2, 0.5, 0.8, 1.0)))
