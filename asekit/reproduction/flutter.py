@@ -1009,7 +1009,8 @@ def extrapolated_flutter(db, cache: bool = True, **kw) -> dict:
     Returns ``{"speeds", "freqs"}`` (per mesh, finest first: m/s, Hz), ``"speed"``,
     ``"speed_error"``, ``"freq"``, ``"freq_error"`` (m/s, Hz; None without flutter on a mesh),
     ``"order"``, ``"observed"``, ``"meshes"``. Stored in the user cache under a fingerprint of
-    its inputs and the physics source (like :func:`converged_flutter_study`); ``db`` (the fin's
+    its inputs and the source of the physics and of the case layer's study (like
+    :func:`converged_flutter_study`); ``db`` (the fin's
     GAF database) enters the fingerprint only. About 9 s CPU and 350 MB cold.
     """
     import warnings
@@ -1021,6 +1022,7 @@ def extrapolated_flutter(db, cache: bool = True, **kw) -> dict:
                              case.flight.velocities,
                              ("graded", _EXTRAPOLATED_VERSION, case.panels[0]),
                              (case.aero.boxes, spec))
+    key = _with_source(key, "case/convergence.py", "case/pipeline.py", "case/variants.py")
     path = user_cache_dir() / f"flutter_extrapolated_{key[:16]}.npz"
     if cache:
         try:
@@ -1047,6 +1049,19 @@ def extrapolated_flutter(db, cache: bool = True, **kw) -> dict:
         save_npz(path, {"speeds": np.array(speeds, float), "freqs": np.array(freqs, float)},
                  {"fingerprint": key, "result": out})
     return {**out, "speeds": speeds, "freqs": freqs}
+
+
+def _with_source(key: str, *modules: str) -> str:
+    """``key`` extended by the source of asekit's ``modules`` (paths under the package)."""
+    import hashlib
+    from pathlib import Path
+
+    h = hashlib.sha256(key.encode())
+    pkg = Path(__file__).resolve().parent.parent
+    for rel in modules:
+        h.update(rel.encode())
+        h.update((pkg / rel).read_bytes())
+    return h.hexdigest()
 
 
 def _study_meshes_of(case, spec):
