@@ -253,6 +253,20 @@ class FlutterSpec:
 
 
 @dataclass(frozen=True)
+class ConvergenceSpec:
+    """The discretisation-error study (``[convergence]``, :mod:`asekit.case.convergence`):
+    ``enabled`` runs it with every ``analyse``; the case's meshes and ``meshes - 1`` coarser
+    ones (2 or 3 meshes), each coarser by ``ratio`` per direction (element and box counts
+    divided by it); ``order`` the order of convergence assumed when three meshes do not give
+    one (two meshes always assume it)."""
+
+    enabled: bool = False
+    meshes: int = 3
+    ratio: float = 1.5
+    order: float = 1.0
+
+
+@dataclass(frozen=True)
 class Case:
     """A complete case: what the surface is, how it is held and analysed.
 
@@ -276,6 +290,7 @@ class Case:
     actuator: ActuatorSpec | None = None
     flutter_index: FlutterIndexSpec | None = None
     flutter: FlutterSpec = FlutterSpec()
+    convergence: ConvergenceSpec = ConvergenceSpec()
     reference: str = ""
     source: str = field(default="", compare=False)
     structure: ImportedModel | None = None
@@ -296,8 +311,8 @@ class Case:
         """SHA-256 of everything that defines the case (not its name or file location); an
         imported structure enters through its content digest."""
         d = asdict(replace(self, structure=None))
-        for k in ("name", "reference", "source"):
-            d.pop(k)
+        for k in ("name", "reference", "source", "convergence"):    # (convergence: how it is
+            d.pop(k)                                               # studied, not what it is)
         if self.structure is not None:      # (absent otherwise: the file cases' digests stay)
             d["structure"] = self.structure.digest
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
@@ -809,6 +824,19 @@ def _flutter(t: _Table | None) -> FlutterSpec:
     return FlutterSpec(method, rfa, lags)
 
 
+def _convergence(t: _Table | None) -> ConvergenceSpec:
+    if t is None:
+        return ConvergenceSpec()
+    spec = ConvergenceSpec(enabled=t.boolean("enabled", False),
+                           meshes=t.integer("meshes", default=3, low=2, high=3),
+                           ratio=t.number("ratio", default=1.5, low=1.2, high=4.0,
+                                          low_open=False),
+                           order=t.number("order", default=1.0, low=0.5, high=4.0,
+                                          low_open=False))
+    t.done()
+    return spec
+
+
 def case_from_dict(d: dict, source: str = "") -> Case:
     """Build and check a :class:`Case` from the parsed TOML dictionary ``d``."""
     top = _Table(d, "")
@@ -834,6 +862,7 @@ def case_from_dict(d: dict, source: str = "") -> Case:
         raise CaseError(problem)
     actuator = _actuator(top.table("actuator"))
     flutter = _flutter(top.table("flutter"))
+    convergence = _convergence(top.table("convergence"))
     fsi = top.table("flutter_speed_index")
     if fsi is not None:
         fsi_spec = FlutterIndexSpec(fsi.number("semichord", required=True, low=0.0, unit="m"),
@@ -853,7 +882,7 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     return Case(name=name, panels=panels, thickness=thickness, material=material,
                 support=support, aero=aero, flight=flight, modes=modes, damping=damping,
                 point_masses=masses, actuator=actuator, flutter_index=fsi_spec,
-                flutter=flutter, reference=reference, source=source)
+                flutter=flutter, convergence=convergence, reference=reference, source=source)
 
 
 def load_case(path) -> Case:

@@ -29,6 +29,10 @@ def add_parser(sub) -> None:
     p.add_argument("--json", metavar="PATH", help="write the summary as JSON ('-': stdout)")
     p.add_argument("--report", metavar="DIR", help="write index.html, figures and summary.json")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--convergence", action="store_true",
+                   help="also run the case on coarser meshes and report the extrapolated "
+                        "flutter speed and frequency with error bars ([convergence] in the "
+                        "case file; also when convergence.enabled = true)")
     p.set_defaults(func=run)
 
 
@@ -88,13 +92,26 @@ def run(args) -> int:
         write_report,
         write_text_atomic,
     )
+    study = getattr(args, "convergence", False) or case.convergence.enabled
     try:
+        if study:                       # the study's meshes checked before any computation
+            from asekit.case import convergence
+            convergence.check_study(case)
         analysis = run_analysis(case, progress=not args.quiet)
     except (ValueError, SolverError) as exc:
         return _error(_named(name, exc))
     s = summary(analysis)
+    if study:
+        try:
+            conv = convergence.convergence_study(case, finest=analysis.flutter,
+                                                 progress=not args.quiet)
+        except (ValueError, SolverError) as exc:
+            return _error(_named(name, exc))
+        s = convergence.add_to_summary(s, conv)
     to_stdout = args.json == "-"
     print(format_summary(s), file=sys.stderr if to_stdout else sys.stdout)
+    if study:
+        print("\n" + convergence.format_study(conv), file=sys.stderr if to_stdout else sys.stdout)
     if args.json:
         text = json.dumps(s, indent=2)
         if to_stdout:

@@ -34,6 +34,7 @@ from asekit.aeroelastic.flutter import (
 from asekit.aeroelastic.statespace import ModalArrays, aeroelastic_matrices, modal_arrays
 from asekit.atmosphere import standard_atmosphere
 from asekit.case import pipeline
+from asekit.case.schema import ConvergenceSpec
 from asekit.case.variants import with_boxes, with_mesh
 from asekit.io.op4 import ha145b_path, load_ha145b
 from asekit.reproduction.driver import ChapterResult, Quantity
@@ -135,9 +136,11 @@ def run(figures: bool = False) -> ChapterResult:
                  "flutter.first_instability.pk.M075.h0.speed_ms",
                  "flutter.first_instability.root_locus.M075.h0.speed_ms",
                  "flutter.first_instability.time_domain.M075.h0.speed_ms"]
+    fin_keys += [f"flutter.extrapolated.pk.M075.h0.{s}"
+                 for s in ("speed_ms", "speed_error_ms", "freq_hz", "freq_error_hz")]
     if data is None:
         for key in fin_keys:
-            unit = "Hz" if key.endswith("freq_hz") else ("-" if "fit_error" in key else "m/s")
+            unit = "Hz" if key.endswith("_hz") else ("-" if "fit_error" in key else "m/s")
             q.append(Quantity(key, None, unit, reason))
         if figures and ha is not None:
             figs.update(ha145b_figures(ha))
@@ -202,6 +205,7 @@ def run(figures: bool = False) -> ChapterResult:
                       computed=conv is not None))
     q.append(Quantity("flutter.converged.pk.M075.h0.freq_hz", freq, "Hz", conv_note,
                       computed=conv is not None))
+    q.extend(extrapolated_quantities(extrapolated_flutter(db)))
     damp = damping_study(modal, db, velocities=DAMPING_VELOCITIES)
     q.append(Quantity("flutter.damping.pk.M075.h0.speed_ms",
                       [r["speed"] for r in damp if r["kind"] == "zeta"], "m/s",
@@ -968,3 +972,126 @@ def _study_from_arrays(arrays, meta) -> dict:
             "structure": tuple(meta["final_structure"]), "aero": tuple(meta["final_aero"]),
             "change_structure": meta["change_structure"], "change_aero": meta["change_aero"],
             "converged": meta["converged"]}
+
+
+# --------------------------------------------------------------------------------------------
+# the converged answer by default: graded meshes, extrapolated, with an error bar (issue 23)
+# --------------------------------------------------------------------------------------------
+#: The finest meshes of the default extrapolated flutter: structure graded toward the shaft
+#: region (asekit.case.variants.with_shaft_grading), boxes; the study adds two coarser ones.
+EXTRAPOLATED_STRUCTURE = (64, 48)
+EXTRAPOLATED_AERO = (28, 20)
+#: Its convergence settings (asekit.case.convergence): three meshes, each 1.5x coarser.
+EXTRAPOLATED_SPEC = ConvergenceSpec(meshes=3, ratio=1.5)
+_EXTRAPOLATED_VERSION = 1
+
+
+def extrapolated_case(structure=EXTRAPOLATED_STRUCTURE, aero=EXTRAPOLATED_AERO,
+                      mach: float = 0.75, altitude: float = 0.0,
+                      velocities=np.arange(140.0, 340.0 + 1e-9, 2.0)):
+    """The fin with the distributed shaft of :data:`asekit.reproduction.fin.DEFAULT_SHAFT_RADIUS`
+    on a ``structure`` mesh graded toward it and an ``aero`` box mesh, at one Mach and
+    altitude (the converged study's sweep)."""
+    from dataclasses import replace
+
+    from asekit.case.variants import with_shaft_grading
+    case = distributed_case()
+    case = replace(case, aero=replace(case.aero, machs=(float(mach),)),
+                   flight=replace(case.flight, altitudes=(float(altitude),),
+                                  velocities=tuple(float(v) for v in velocities)))
+    return with_boxes(with_shaft_grading(case, *structure), *aero)
+
+
+def extrapolated_flutter(db, cache: bool = True, **kw) -> dict:
+    """The fin's converged flutter by default (issue 23): p-k at M 0.75, sea level, of
+    :func:`extrapolated_case` on its graded mesh and two coarser ones
+    (:data:`EXTRAPOLATED_SPEC`), Richardson-extrapolated with the observed order and Roache's
+    GCI as the error bar (:func:`asekit.case.convergence.convergence_study`).
+
+    Returns ``{"speeds", "freqs"}`` (per mesh, finest first: m/s, Hz), ``"speed"``,
+    ``"speed_error"``, ``"freq"``, ``"freq_error"`` (m/s, Hz; None without flutter on a mesh),
+    ``"order"``, ``"observed"``, ``"meshes"``. Stored in the user cache under a fingerprint of
+    its inputs and the source of the physics and of the case layer's study (like
+    :func:`converged_flutter_study`); ``db`` (the fin's
+    GAF database) enters the fingerprint only. About 9 s CPU and 350 MB cold.
+    """
+    import warnings
+
+    from asekit.case.convergence import convergence_study
+    case = extrapolated_case(**kw)
+    spec = EXTRAPOLATED_SPEC
+    key = _study_fingerprint(db, case.aero.machs[0], case.flight.altitudes[0],
+                             case.flight.velocities,
+                             ("graded", _EXTRAPOLATED_VERSION, case.panels[0]),
+                             (case.aero.boxes, spec))
+    key = _with_source(key, "case/convergence.py", "case/pipeline.py", "case/variants.py")
+    path = user_cache_dir() / f"flutter_extrapolated_{key[:16]}.npz"
+    if cache:
+        try:
+            arrays, meta = load_npz(path)
+            if meta.get("fingerprint") == key:
+                return {**meta["result"], "speeds": arrays["speeds"].tolist(),
+                        "freqs": arrays["freqs"].tolist()}
+        except CacheError:
+            pass                                    # missing or corrupt: recompute
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")             # coarse meshes under-resolve the region
+        (row,) = convergence_study(case, spec).rows
+    sp, fr = row.speed, row.frequency
+    out = {"speed": None if sp is None else sp.value,
+           "speed_error": None if sp is None else sp.error,
+           "freq": None if fr is None else fr.value,
+           "freq_error": None if fr is None else fr.error,
+           "order": None if sp is None else sp.order,
+           "observed": None if sp is None else sp.observed,
+           "meshes": [list(m) for m in _study_meshes_of(case, spec)], "note": row.note}
+    speeds = [np.nan] if sp is None else list(sp.values)
+    freqs = [np.nan] if fr is None else list(fr.values)
+    if cache:
+        save_npz(path, {"speeds": np.array(speeds, float), "freqs": np.array(freqs, float)},
+                 {"fingerprint": key, "result": out})
+    return {**out, "speeds": speeds, "freqs": freqs}
+
+
+def _with_source(key: str, *modules: str) -> str:
+    """``key`` extended by the source of asekit's ``modules`` (paths under the package)."""
+    import hashlib
+    from pathlib import Path
+
+    h = hashlib.sha256(key.encode())
+    pkg = Path(__file__).resolve().parent.parent
+    for rel in modules:
+        h.update(rel.encode())
+        h.update((pkg / rel).read_bytes())
+    return h.hexdigest()
+
+
+def _study_meshes_of(case, spec):
+    from asekit.case.convergence import study_meshes
+    return [(c.panels[0].n_chord, c.panels[0].n_span, *c.aero.boxes[0])
+            for c in study_meshes(case, spec)]
+
+
+def extrapolated_quantities(r: dict) -> list:
+    """The four ``flutter.extrapolated.pk.M075.h0.*`` quantities of
+    :func:`extrapolated_flutter`'s result (the 6x7 thesis-mesh rows stay the like-for-like
+    comparison)."""
+    meshes = ", ".join(f"{a}x{b}/{c}x{d}" for a, b, c, d in r["meshes"])
+    order = ("-" if r["order"] is None else
+             f"order {r['order']:.2f} {'observed' if r['observed'] else 'assumed'}")
+
+    def per(vals, unit):
+        return "no flutter on a mesh" if r["speed"] is None else \
+            ", ".join(f"{v:.2f}" for v in vals) + f" {unit}"
+
+    fs = "1.25 (order observed)" if r["observed"] else "3 (order assumed)"
+    gci = f"Roache's (1994) grid convergence index, safety factor {fs}"
+    extra = f"; {r['note']}" if r["note"] else ""
+    base = "flutter.extrapolated.pk.M075.h0"
+    return [Quantity(f"{base}.speed_ms", r["speed"], "m/s",
+                     f"distributed shaft, graded FE / boxes {meshes}: "
+                     f"{per(r['speeds'], 'm/s')}; {order}{extra}"),
+            Quantity(f"{base}.speed_error_ms", r["speed_error"], "m/s", gci),
+            Quantity(f"{base}.freq_hz", r["freq"], "Hz",
+                     f"same meshes: {per(r['freqs'], 'Hz')}"),
+            Quantity(f"{base}.freq_error_hz", r["freq_error"], "Hz", gci)]

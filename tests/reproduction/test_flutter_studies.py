@@ -95,3 +95,31 @@ def test_converged_study_is_cached_and_verified(monkeypatch, tmp_path):
     files[0].write_bytes(b"not an npz")
     with pytest.raises(AssertionError, match="recomputed"):
         rf.converged_flutter_study(db, **kw)
+
+
+@needs_db
+def test_extrapolated_flutter_is_cached_and_verified(monkeypatch, tmp_path):
+    """The default reproduce's extrapolated rows (issue 23) on small graded meshes: computed
+    once, then read from the user cache; a corrupted file is recomputed, not trusted."""
+    import asekit.case.convergence as conv
+    db, _ = DATA
+    monkeypatch.setenv("ASEKIT_CACHE_DIR", str(tmp_path))
+    kw = dict(structure=(24, 18), aero=(14, 10), velocities=np.arange(150.0, 300.0, 4.0))
+    first = rf.extrapolated_flutter(db, **kw)
+    files = list(tmp_path.glob("flutter_extrapolated_*.npz"))
+    assert len(files) == 1
+    assert first["meshes"] == [[24, 18, 14, 10], [16, 12, 9, 7], [11, 8, 6, 4]]
+    assert len(first["speeds"]) == 3 and first["speed_error"] > 0
+    q = {x.key: x for x in rf.extrapolated_quantities(first)}
+    assert q["flutter.extrapolated.pk.M075.h0.speed_ms"].asekit == first["speed"]
+    assert q["flutter.extrapolated.pk.M075.h0.freq_error_hz"].unit == "Hz"
+
+    def boom(*a, **k):
+        raise AssertionError("recomputed although cached")
+
+    monkeypatch.setattr(conv, "convergence_study", boom)
+    again = rf.extrapolated_flutter(db, **kw)
+    assert again == first
+    files[0].write_bytes(b"not an npz")
+    with pytest.raises(AssertionError, match="recomputed"):
+        rf.extrapolated_flutter(db, **kw)

@@ -2,6 +2,11 @@
 (``tests/reproduction/data/reproduce_baseline.json``, ``seconds`` dropped): every quantity's
 asekit value within 1e-9 relative (lists elementwise, None stays None), every verdict equal.
 
+The four ``flutter.extrapolated.*`` rows (issue 23: the fin's converged flutter by default,
+graded meshes extrapolated with an error bar) were added to the baseline on 2026-12-03 from
+``python -m asekit reproduce --only flutter --json`` (two cold runs, bit-identical); no other
+value of the baseline changed.
+
 The two ``flutter.converged.*`` rows are computed only when their GAF database is already in
 the user cache (CI computes it first), so they are skipped when the baseline holds None.
 """
