@@ -25,15 +25,29 @@ from dataclasses import dataclass
 import numpy as np
 
 
-def cell(value, fmt: str = "") -> str:
+def significant(value, digits: int = 4) -> str:
+    """A number with ``digits`` significant digits and no exponent for large values: whole
+    numbers of ``digits`` or more digits print as integers with thousands separators, small ones
+    in ``g`` notation.
+
+    >>> significant(157100.0), significant(0.719156), significant(2.958e-4), significant(-1.5e-7)
+    ('157,100', '0.7192', '0.0002958', '-1.5e-07')
+    """
+    v = float(value)
+    if np.isfinite(v) and abs(v) >= 10 ** (digits - 1):
+        return f"{v:,.0f}"
+    return f"{v:.{digits}g}"
+
+
+def cell(value, fmt="") -> str:
     """One table cell as text.
 
     Parameters
     ----------
     value : a number (Python or numpy scalar), a string, ``None`` (shown as "-"), a bool
         ("yes"/"no") or a sequence of numbers (shown as "a, b, c", each with ``fmt``).
-    fmt : a :func:`format` spec for numbers, e.g. ``".2f"``, ``".4g"``, ``"+.1%"``; empty: ``"g"``
-        for floats.
+    fmt : a :func:`format` spec for numbers, e.g. ``".2f"``, ``".4g"``, ``"+.1%"`` (empty: ``"g"``
+        for floats), or a function of the number returning its text (e.g. :func:`significant`).
 
     Returns
     -------
@@ -52,13 +66,15 @@ def cell(value, fmt: str = "") -> str:
         return "yes" if value else "no"
     if isinstance(value, str):
         return value
+    if callable(fmt) and isinstance(value, numbers.Real):
+        return fmt(value)
     if isinstance(value, numbers.Integral):
         return format(int(value), fmt) if fmt else str(int(value))
     if isinstance(value, numbers.Real):
         return format(float(value), fmt or "g")
     if isinstance(value, numbers.Complex):
         z = complex(value)
-        spec = fmt or "g"
+        spec = fmt if isinstance(fmt, str) and fmt else "g"
         return f"{format(z.real, spec)}{format(z.imag, '+' + spec.lstrip('+'))}j"
     if isinstance(value, (list, tuple, np.ndarray)):
         return ", ".join(cell(v, fmt) for v in np.asarray(value, dtype=object).ravel())
@@ -75,7 +91,8 @@ class Table:
     rows : rows of raw values (numbers, strings, None, sequences), one per row, ``len(columns)``
         each.
     units : per column, the unit shown in the header as "name (unit)"; "" or None for none.
-    formats : per column, the :func:`format` spec of its numbers (see :func:`cell`).
+    formats : per column, the :func:`format` spec of its numbers or a function (see
+        :func:`cell`).
     title : an optional caption (HTML caption, or a first line of the text form).
     """
 
@@ -107,7 +124,7 @@ class Table:
     def cells(self) -> list[list[str]]:
         """Every row's cells as text (:func:`cell` with the column's format)."""
         fmts = self.formats or ("",) * len(self.columns)
-        return [[cell(v, f or "") for v, f in zip(r, fmts)] for r in self.rows]
+        return [[cell(v, f if f else "") for v, f in zip(r, fmts)] for r in self.rows]
 
     def _numeric(self) -> list[bool]:
         """Per column: True if every value is a number (right-aligned)."""
