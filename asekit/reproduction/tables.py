@@ -127,9 +127,13 @@ class Table:
         return [[cell(v, f if f else "") for v, f in zip(r, fmts)] for r in self.rows]
 
     def _numeric(self) -> list[bool]:
-        """Per column: True if every value is a number (right-aligned)."""
-        return [all(isinstance(r[j], numbers.Number) and not isinstance(r[j], bool)
-                    for r in self.rows) and bool(self.rows) for j in range(len(self.columns))]
+        """Per column: True if every value is a number or None and one at least is a number
+        (right-aligned)."""
+        def number(v):
+            return isinstance(v, numbers.Number) and not isinstance(v, (bool, np.bool_))
+
+        return [all(number(r[j]) or r[j] is None for r in self.rows)
+                and any(number(r[j]) for r in self.rows) for j in range(len(self.columns))]
 
     def __str__(self) -> str:
         head, body, right = self.header, self.cells, self._numeric()
