@@ -560,16 +560,16 @@ def loop_frequency_response(plant, controller, f_hz, delay=DELAY) -> np.ndarray:
     return np.array(out)
 
 
-def format_envelope(checks, designs_order=None) -> str:
-    """Pass/fail text table: a row per (Mach, altitude, case), a column per design; a failed
-    cell names the failed requirements."""
+def envelope_rows(checks, designs_order=None) -> tuple[list[str], list[tuple]]:
+    """The design keys and one row per (Mach, altitude, case) of ``checks``: (Mach, altitude m,
+    case, then a cell per design: "pass <settling> ms", or "FAIL" and every failed requirement,
+    or "-" where the design was not checked there)."""
     keys = designs_order or list(dict.fromkeys(c.design for c in checks))
-    rows = {}
+    by_row = {}
     for c in checks:
-        rows.setdefault((c.mach, c.altitude, c.case), {})[c.design] = c
-    w = max(len(k) for k in keys) + 2
-    lines = ["M    h (m)  case          " + "".join(k.ljust(max(w, 22)) for k in keys)]
-    for (M, h, case), d in rows.items():
+        by_row.setdefault((c.mach, c.altitude, c.case), {})[c.design] = c
+    rows = []
+    for (M, h, case), d in by_row.items():
         cells = []
         for k in keys:
             c = d.get(k)
@@ -578,11 +578,20 @@ def format_envelope(checks, designs_order=None) -> str:
             elif c.table2_pass:
                 cells.append(f"pass {c.settling_ms:.0f} ms")
             else:
-                bad = [n for n, ok in c.passes.items() if not ok]
-                cells.append("FAIL " + ",".join(bad)[:17])
-        lines.append(f"{M:<4} {h:<6.0f} {case:<13} " + "".join(s.ljust(max(w, 22))
-                                                               for s in cells))
-    return "\n".join(lines)
+                cells.append("FAIL " + ", ".join(n for n, ok in c.passes.items() if not ok))
+        rows.append((float(M), float(h), case, *cells))
+    return keys, rows
+
+
+def format_envelope(checks, designs_order=None) -> str:
+    """Pass/fail text table: a row per (Mach, altitude, case), a column per design, each column
+    as wide as its widest cell; a failed cell names every failed requirement."""
+    keys, rows = envelope_rows(checks, designs_order)
+    text = [["M", "h (m)", "case", *keys]]
+    text += [[f"{r[0]:g}", f"{r[1]:.0f}", *r[2:]] for r in rows]
+    widths = [max(len(line[j]) for line in text) for j in range(len(text[0]))]
+    return "\n".join("  ".join(v.ljust(w) for v, w in zip(line, widths)).rstrip()
+                     for line in text)
 
 
 def fig_fit_error(study):

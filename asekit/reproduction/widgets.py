@@ -10,11 +10,13 @@ then simply are not displayed), so notebooks run under nbval and in a plain Pyth
 from __future__ import annotations
 
 import math
+import textwrap
 from dataclasses import dataclass
 
 import numpy as np
 
 from asekit.ase import loop as ase
+from asekit.ase.margins import NyquistMargins, nyquist_margins
 from asekit.case import pipeline
 from asekit.reproduction.fin import CORNERS, fin_case
 from asekit.servo.actuator import (
@@ -155,9 +157,11 @@ def servo_panel(controller: PDController = SYSTEM_3, supply_voltage: float = 24.
 @dataclass(frozen=True)
 class AseSnapshot:
     """What the Ch. 5 panel shows: the forward path ``fwtf`` (FWTF 2 for AEM1, FWTF 3 for
-    AEM2) and its ``crossovers``, closed-loop ``stable``, the linear unit step of the elastic fin
-    (``t`` s, ``outputs`` name -> rad: transmission, fin root, corners) and of the rigid-fin
-    design model (``theta_rigid``, Eq. 4.18 with the fin's J_fin)."""
+    AEM2), its Bode ``crossovers`` and its Nyquist count ``nyquist`` (open-loop right-half-plane
+    poles, encirclements, gain margins: :func:`asekit.ase.margins.nyquist_margins`), closed-loop
+    ``stable``, the linear unit step of the elastic fin (``t`` s, ``outputs`` name -> rad:
+    transmission, fin root, corners) and of the rigid-fin design model (``theta_rigid``,
+    Eq. 4.18 with the fin's J_fin)."""
 
     controller: PDController
     topology: str
@@ -165,6 +169,7 @@ class AseSnapshot:
     altitude: float
     fwtf: object
     crossovers: object
+    nyquist: NyquistMargins
     stable: bool
     t: np.ndarray
     outputs: dict
@@ -191,35 +196,97 @@ def ase_snapshot(gain: float, kp: float, kd: float, mach: float = 0.5, altitude:
     _, theta_rigid = step_response(fin.rigid_fin_actuator(), ctrl, t_final=t_final,
                                    amplitude=1.0, n=t.size)
     return AseSnapshot(ctrl, topology, float(mach), float(altitude), fwtf, ase.crossovers(fwtf),
-                       ase.is_stable(cl), t, dict(zip(names, y)), np.asarray(theta_rigid))
+                       nyquist_margins(fwtf), ase.is_stable(cl), t, dict(zip(names, y)),
+                       np.asarray(theta_rigid))
+
+
+def _db(value: float | None) -> str:
+    """A gain margin in dB for the readout ("none" for None, "+inf"/"-inf" kept)."""
+    return "none" if value is None else f"{value:+.1f} dB"
+
+
+def _describe_rhp(poles) -> str:
+    """The open-loop right-half-plane poles in words: a real one is static (the de-centering
+    steady hinge moment), a complex pair an aeroelastic oscillation (flutter) at its frequency."""
+    real = [p for p in poles if abs(p.imag) <= 1e-6 * max(1.0, abs(p))]
+    pairs = [p for p in poles if p.imag > 1e-6 * max(1.0, abs(p))]
+    parts = [f"{p.real:+.1f} rad/s, static: the fin's de-centering hinge moment" for p in real]
+    parts += [f"{p.real:+.1f} +- {p.imag:.0f}j rad/s, flutter at {p.imag / (2 * math.pi):.1f} Hz"
+              for p in pairs]
+    return "; ".join(parts)
+
+
+def ase_readout(snap: AseSnapshot, width: int = 110) -> str:
+    """The Ch. 5 panel's stability readout: why the Bode margins and the closed-loop verdict
+    agree (or seem not to), by the Nyquist criterion Z = P - N.
+
+    P is the number of open-loop poles of the forward path in the right half plane, N the net
+    counter-clockwise encirclements of -1 by its Nyquist curve and Z the closed-loop poles in the
+    right half plane (Astrom & Murray, *Feedback Systems*, 2nd ed. 2021, Thm 10.3). With P > 0
+    (the fin's de-centering steady hinge moment gives FWTF 2 a pole near +15 rad/s) a negative
+    Bode phase margin does not mean instability: the loop is stable when N = P, and its gain
+    margins are a lower and an upper bound on the loop gain (dB).
+
+    Returns the readout, its lines wrapped at ``width`` characters (no trailing newline).
+    """
+    n = snap.nyquist
+    name = f"FWTF{2 if snap.topology == 'AEM1' else 3}"
+    P, Z = n.open_loop_unstable_poles, n.closed_loop_unstable_poles
+    N = P - Z
+    if P:
+        head = (f"{name} open loop UNSTABLE: P = {P} right-half-plane pole{'s' if P > 1 else ''} "
+                f"({_describe_rhp(n.open_loop_rhp_poles)}), so the Bode phase margin is no "
+                "stability test.")
+    else:
+        head = f"{name} open loop stable (P = 0): the Bode margins apply as usual."
+    verdict = "closed loop stable" if Z == 0 else f"closed loop UNSTABLE ({Z} poles in the RHP)"
+    mid = (f"Nyquist: N = {N} counter-clockwise encirclement{'s' if abs(N) != 1 else ''} of -1, "
+           f"Z = P - N = {Z}: {verdict}.")
+    x = snap.crossovers
+    bode = ", ".join(f"{pm:.1f} deg at {fc:.1f} Hz"
+                     for fc, pm in zip(x.gain_crossovers_hz, x.phase_margins_deg))
+    lines = [head, mid, f"Bode: |L| = 1 with phase margin {bode or 'none (no gain crossover)'};"
+             " Bode reads the smallest; only N decides stability."]
+    if Z == 0:
+        lines.append(f"Stable for loop-gain changes from {_db(n.lower_gain_margin_db)} (lower gain "
+                     f"margin) to {_db(n.upper_gain_margin_db)} (upper gain margin).")
+    return "\n".join(textwrap.fill(line, width=width, subsequent_indent="  ") for line in lines)
 
 
 def _draw_ase(snap: AseSnapshot):
     import matplotlib.pyplot as plt
 
-
     c = snap.controller
     fig, axes = new_figure(f"{snap.topology}, M {snap.mach:g}, h {snap.altitude:g} m, K_c {c.gain:g}"
                            f", K_P {c.kp:g}, K_D {c.kd:g}", "Figs 65-71 (live)", nrows=1, ncols=2,
-                           figsize=(12, 4.2))
+                           figsize=(13, 5.2))
     ax1, ax2 = axes
     f = np.logspace(0, np.log10(3000.0), 3000)
     h = ase.frequency_response(snap.fwtf, f)
     ax1.semilogx(f, 20 * np.log10(np.abs(h)))
     ax1.axhline(0.0, color=THESIS_COLOR, lw=0.8)
     x = snap.crossovers
-    ax1.set_title(f"FWTF{2 if snap.topology == 'AEM1' else 3}: PM {x.phase_margin_deg:.1f} deg, "
-                  f"GM {x.gain_margin_db:.1f} dB", fontsize=9)
+    unstable_ol = snap.nyquist.open_loop_unstable_poles > 0
+    ax1.set_title(f"FWTF{2 if snap.topology == 'AEM1' else 3} (Bode): PM {x.phase_margin_deg:.1f} deg,"
+                  f" GM {x.gain_margin_db:.1f} dB" + (" - open loop unstable, see below"
+                                                      if unstable_ol else ""), fontsize=9)
     ax1.set(xlabel="frequency (Hz)", ylabel="|forward path| (dB)")
     for name, y in snap.outputs.items():
         ax2.plot(1e3 * snap.t, y, lw=1.0 if name != "theta" else 1.8, label=name)
     ax2.plot(1e3 * snap.t, snap.theta_rigid, color="g", lw=2, ls="--", label="rigid-fin design")
-    ax2.set_title("closed loop " + ("stable" if snap.stable else "UNSTABLE"), fontsize=9,
+    ax2.set_title("closed loop " + ("stable" if snap.stable else "UNSTABLE")
+                  + f" (Nyquist: Z = {snap.nyquist.closed_loop_unstable_poles})", fontsize=9,
                   color="k" if snap.stable else "C3")
     if not snap.stable:
         ax2.set_yscale("symlog", linthresh=1.0)
-    ax2.set(xlabel="time (ms)", ylabel="unit-step response (-)")
-    ax2.legend(fontsize=7)
+    ax2.set(xlabel="time (ms)", ylabel="unit-step response (rad/rad)")
+    # the legend beside the axes, never over the curves
+    ax2.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+    readout = ase_readout(snap)
+    fig.subplots_adjust(left=0.06, right=0.84, top=0.86, wspace=0.22,
+                        bottom=0.12 + 0.037 * (readout.count("\n") + 1))
+    fig.text(0.06, 0.01, readout, ha="left", va="bottom", fontsize=9,
+             color="k" if snap.stable else "C3", family="monospace")
     plt.show()
     return fig
 

@@ -66,3 +66,22 @@ def test_sensor_filter_and_resolution(data, model):
     # the measured (filtered, unquantised) angle follows the fin root in steady state
     assert np.max(np.abs(r.outputs["measured"][late] - r.fin_root[late])) < 1e-3 * cmd + \
         3 * sensor.resolution
+
+
+def test_envelope_table_names_every_failed_requirement_without_cutting_cells():
+    """Issue 30: the envelope table's failed cells name every failed requirement and no cell
+    runs into its neighbour (the 17-character cut made 'FAIL stable,settling,sFAIL ...')."""
+    from asekit.reproduction.design import Check, envelope_rows, format_envelope
+
+    bad = Check("system3_aem2", "AEM2", 0.4, 0.0, "nominal", False, 900.0, 80.0, 50.0, 30.0,
+                20.0, 0.0)
+    good = Check("lqg_scheduled", "AEM1", 0.4, 0.0, "nominal", True, 34.2, 0.0, 0.0, 10.0, 2.0,
+                 0.0)
+    keys, rows = envelope_rows([bad, good])
+    assert keys == ["system3_aem2", "lqg_scheduled"]
+    assert rows == [(0.4, 0.0, "nominal",
+                     "FAIL stable, settling, steady error, overshoot, voltage, current",
+                     "pass 34 ms")]
+    header, line = format_envelope([bad, good]).splitlines()
+    assert line.index("pass 34 ms") == header.index("lqg_scheduled")     # columns line up
+    assert "current  pass" in line

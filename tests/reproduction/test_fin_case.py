@@ -46,3 +46,20 @@ def test_shipped_gaf_database_is_the_pipelines():
     assert meta["fingerprint"] == mode_set_fingerprint(pipeline.modal_model(case), settings)
     db = pipeline.gaf_database(case, progress=False)
     assert db.metadata["fingerprint"] == meta["fingerprint"]
+
+
+def test_fig4_thickness_comes_from_the_case_law():
+    """Issue 30: Fig 4 and its check read the thickness from the case (not from the reference
+    numbers): a fin with a 3 -> 1 mm law gives 3 and 1 mm at the root and tip chords, and the
+    assembled mass equals rho * integral of c(y) h(y) dy. For the trapezoid (chord 156 -> 78
+    mm, span 150 mm, data/cases/nalci2013_fin.toml) and h = 3 - 2 eta mm that integral is
+    0.150 m * (156*3 - (156*2 + 78*3)/2 + 78*2/3) mm^2 = 0.150 * 247 mm^2 = 37.05 mm^2 m,
+    times 2700 kg/m^3: 100.035 g."""
+    from asekit.geometry import Thickness
+    from asekit.reproduction import structure as rs
+
+    case = dataclasses.replace(fin.fin_case(), thickness=Thickness(0.003, 0.001))
+    c = rs.thickness_check(case)
+    assert abs(c.root_mm - 3.0) < 1e-9 and abs(c.tip_mm - 1.0) < 1e-9
+    assert abs(c.exact_mass / 0.100035 - 1) < 1e-9
+    assert abs(c.fe_mass / c.exact_mass - 1) < 1e-9
