@@ -41,6 +41,7 @@ import textwrap
 from dataclasses import dataclass, replace
 
 from asekit.case import pipeline
+from asekit.case.resources import box_counts
 from asekit.case.schema import Case, CaseError, ConvergenceSpec
 from asekit.structure.mesh import Stations
 from asekit.util.conventions import mode_number
@@ -149,10 +150,7 @@ def _coarse(n: int, factor: float, what: str, spec: ConvergenceSpec) -> int:
 
 
 def _box_counts(case: Case) -> tuple[tuple[int, int], ...]:
-    a = case.aero
-    return tuple(a.boxes[i] if a.boxes is not None else
-                 pipeline.auto_boxes(p.planform, a.u_min, a.f_max)
-                 for i, p in enumerate(case.panels))
+    return box_counts(case.panels, case.aero)
 
 
 def check_study(case: Case, spec: ConvergenceSpec | None = None) -> ConvergenceSpec:

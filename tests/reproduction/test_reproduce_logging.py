@@ -15,8 +15,8 @@ from asekit.reproduction.driver import ChapterResult, Quantity, format_table
 from asekit.reproduction.thesis import all_keys
 
 #: data/thesis.toml: flutter.pk.M075.h2500.speed_ms is "explained" with a clause citing
-#: flutter.converged.* ("the converged model flutters at 254 m/s (flutter.converged.*), and of
-#: the thesis's stated inputs ...").
+#: flutter.converged.* ("..., and the uniform-mesh study gives 254 m/s (flutter.converged.*),
+#: and of the thesis's stated inputs ...").
 CITING = "flutter.pk.M075.h2500.speed_ms"
 CONVERGED = ("flutter.converged.pk.M075.h0.speed_ms", "flutter.converged.pk.M075.h0.freq_hz")
 
@@ -76,7 +76,7 @@ def test_why_line_never_cites_an_empty_row(monkeypatch, capsys):
     _fake(monkeypatch, converged=(254.0, 139.0))
     assert main(["reproduce", "--only", "flutter", "--quiet"]) == 0
     text = " ".join(capsys.readouterr().out.split())
-    assert "the converged model flutters at 254 m/s (flutter.converged.*)" in text
+    assert "the uniform-mesh study gives 254 m/s (flutter.converged.*)" in text
 
 
 def test_format_table_alone_drops_citations_of_rows_it_lacks():
