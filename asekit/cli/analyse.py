@@ -100,6 +100,6 @@ def run(args) -> int:
     if args.report:
         import matplotlib
         matplotlib.use("Agg")
-        index = write_report(analysis, args.report)
+        index = write_report(analysis, args.report, progress=not args.quiet)
         print(f"report: {index}", file=sys.stderr)
     return 0
