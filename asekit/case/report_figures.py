@@ -196,6 +196,11 @@ def fig_flutter_mach(a) -> ReportFigure:
     for i, c in enumerate(conds):
         _plot_condition_speeds(ax, a, c, f"C{i}")
         _plot_flight_speed(ax, a, c, f"C{i}", (lo - pad, hi + pad))
+    if len(machs) == 1:                                # one Mach: the speeds written out
+        for r in a.flutter.results:
+            if r.flutter is not None and not r.unstable_at_start:
+                ax.annotate(f"{r.flutter.speed:.1f} m/s", (r.mach, r.flutter.speed),
+                            textcoords="offset points", xytext=(6, 4), fontsize=8)
     matched = []
     for m in a.flutter.match_points:
         if m["matched_mach"] is not None:
@@ -218,12 +223,18 @@ def fig_flutter_mach(a) -> ReportFigure:
            "no flutter up to (the last point)":
                any(r.flutter is None and not r.unstable_at_start for r in a.flutter.results)}
     _mach_legend(ax, conds, has)
-    alt = (f"Flutter speed (solid) and divergence speed (dashed) against Mach "
-           f"{', '.join(f'{m:g}' for m in machs)} at {', '.join(map(condition_label, conds))}")
+    alt = ("Flutter speed (solid)" + (" and divergence speed (dashed)" if has[
+        "divergence speed"] else "") + f" against Mach {', '.join(f'{m:g}' for m in machs)} at "
+        + ", ".join(map(condition_label, conds)))
     if has["flight speed U = M a"]:
         alt += ", with the flight speed M a (dotted)"
     if has["envelope"]:
         alt += f" and the envelope M {env[0]:g}-{env[1]:g} (thick)"
+    low = min((r for r in a.flutter.results if r.flutter is not None
+               and not r.unstable_at_start), key=lambda r: r.flutter.speed, default=None)
+    if low is not None:
+        alt += (f"; lowest flutter speed {low.flutter.speed:.1f} m/s at M {low.mach:g}, "
+                f"{condition_label(low.condition)}")
     alt += ("; match points: " + "; ".join(matched)) if matched else "; no match point"
     if gap:
         alt += "; the transonic gap is left open"
@@ -234,8 +245,13 @@ def fig_flutter_mach(a) -> ReportFigure:
 # V-g / V-f and root locus per Mach
 # ---------------------------------------------------------------------------------------------
 def _grid(n: int, max_cols: int = 3):
-    ncols = min(n, max_cols)
-    return ncols, math.ceil(n / ncols)
+    """(columns, rows) of ``n`` panels, at most ``max_cols`` wide, rows filled evenly (4 -> 2 x 2).
+
+    >>> _grid(1), _grid(3), _grid(4), _grid(5), _grid(7)
+    ((1, 1), (3, 1), (2, 2), (3, 2), (3, 3))
+    """
+    rows = math.ceil(n / max_cols)
+    return math.ceil(n / rows), rows
 
 
 def _vg_panel(ax_g, ax_f, r, velocities):
@@ -328,33 +344,38 @@ def _outlines(quads):
 
 
 def fig_planform(a) -> ReportFigure:
-    """The planform: the FE mesh (grey) under the aerodynamic box outlines (thin, orange), and
-    the pitch axis of a shaft support."""
+    """The planform in two panels sharing their axes: the FE mesh (grey, with the pitch axis of
+    a shaft support) and the aerodynamic boxes (orange outlines over the FE mesh, faint), so
+    that neither hides the other however close the two meshes are."""
     from matplotlib.collections import LineCollection
-    from matplotlib.lines import Line2D
     mesh = P.structural_mesh(a.case)
     boxes = P.box_mesh(a.case).corners
     n_el, n_box = len(mesh.elements), len(boxes)
-    fig, ax = new_figure(f"{a.case.name}: planform, FE mesh and aerodynamic boxes",
-                         figsize=(7.5, 5.0), layout="constrained")
-    ax.add_collection(LineCollection(_outlines(mesh.nodes[np.asarray(mesh.elements)]),
-                                     colors="0.6", lw=1.6, zorder=2))
-    ax.add_collection(LineCollection(_outlines(boxes[:, :, :2]), colors="C1", lw=0.7,
-                                     zorder=3))
-    h = [Line2D([], [], color="0.6", lw=1.6, label=f"FE mesh ({n_el} plate elements)"),
-         Line2D([], [], color="C1", lw=0.7, label=f"aerodynamic boxes ({n_box})")]
+    fe = _outlines(mesh.nodes[np.asarray(mesh.elements)])
+    fig, (ax1, ax2) = new_figure(f"{a.case.name}: planform, FE mesh and aerodynamic boxes",
+                                 ncols=2, figsize=(8.0, 5.0), sharex=True, sharey=True,
+                                 layout="constrained")
+    ax1.add_collection(LineCollection(fe, colors="0.3", lw=0.8))
+    ax1.set_title(f"FE mesh: {n_el} plate elements", fontsize=10)
+    ax2.add_collection(LineCollection(fe, colors="0.75", lw=0.6, zorder=2))
+    ax2.add_collection(LineCollection(_outlines(boxes[:, :, :2]), colors="C1", lw=1.0,
+                                      zorder=3))
+    ax2.set_title(f"aerodynamic boxes: {n_box} (FE mesh faint)", fontsize=10)
     s = a.case.support
-    if s is not None and s.kind == "shaft":
-        h += ax.plot(s.axis_point[1], s.axis_point[0], "rs", zorder=4, label="pitch axis")
-    ax.autoscale_view()
-    ax.set_xlabel("y (m), span from the root")
-    ax.set_ylabel("x (m), downstream")
-    ax.invert_yaxis()
-    ax.set_aspect("equal")
-    _legend_right(ax, handles=h)
-    alt = (f"Planform of {a.case.name}: {n_el} plate elements (grey) under {n_box} "
-           f"aerodynamic boxes (thin orange outlines)"
-           + (", pitch axis marked" if s is not None and s.kind == "shaft" else ""))
+    shaft = s is not None and s.kind == "shaft"
+    for ax in (ax1, ax2):
+        if shaft:
+            ax.plot(s.axis_point[1], s.axis_point[0], "rs", zorder=4, label="pitch axis")
+        ax.autoscale_view()
+        ax.set_xlabel("y (m), span from the root")
+        ax.set_aspect("equal")
+    ax1.set_ylabel("x (m), downstream")
+    ax1.invert_yaxis()
+    if shaft:
+        ax2.legend(loc="lower left")
+    alt = (f"Planform of {a.case.name}: left the FE mesh of {n_el} plate elements, right the "
+           f"{n_box} aerodynamic boxes (orange) over the FE mesh (faint grey)"
+           + ("; the pitch axis marked red" if shaft else ""))
     return ReportFigure(fig, alt, SECTIONS[2])
 
 
@@ -368,9 +389,6 @@ def _mode_panel(ax, m, tri, j, levels):
         ax.tricontour(m.nodes[:, 1], m.nodes[:, 0], tri, w, levels=[0.0], colors="k",
                       linewidths=1.4)
     ax.set_title(f"{mode_label(j, m.n_rigid)}: {m.frequencies_hz[j]:.4g} Hz", fontsize=10)
-    ax.set_xlabel("y (m)")
-    ax.set_ylabel("x (m)")
-    ax.invert_yaxis()
     ax.set_aspect("equal")
     return cs
 
@@ -383,7 +401,7 @@ def fig_modes(a) -> ReportFigure:
     ncols, nrows = _grid(n)
     fig, axes = new_figure(f"{a.case.name}: mode shapes w / max|w|, node lines (w = 0) black",
                            nrows=nrows, ncols=ncols, figsize=(3.4 * ncols + 1.2, 3.2 * nrows + 0.8),
-                           layout="constrained")
+                           sharex=True, sharey=True, layout="constrained")
     axes = np.atleast_1d(np.asarray(axes, dtype=object)).ravel()
     el = np.asarray(m.elements)
     tri = np.concatenate([el[:, [0, 1, 2]], el[:, [0, 2, 3]]])
@@ -393,7 +411,15 @@ def fig_modes(a) -> ReportFigure:
         cs = _mode_panel(axes[j], m, tri, j, levels)
     for ax in axes[n:]:
         ax.set_visible(False)
-    fig.colorbar(cs, ax=list(axes[:n]), label="w / max|w| (-)", shrink=0.9)
+    for j, ax in enumerate(axes[:n]):                  # shared axes: labels on the outside
+        if j % ncols == 0:
+            ax.set_ylabel("x (m)")
+        if j + ncols >= n:
+            ax.set_xlabel("y (m)")
+            ax.xaxis.set_tick_params(labelbottom=True)
+    axes[0].invert_yaxis()                             # shared: once for all
+    axes[0].locator_params(axis="x", nbins=4)          # tick labels clear of the neighbour's
+    fig.colorbar(cs, ax=list(axes[:n]), label="w / max|w| (-)", shrink=0.7)
     alt = (f"Mode shapes of the {n} kept modes (w normalised, node lines black): "
            + ", ".join(f"{mode_label(j, m.n_rigid)} {m.frequencies_hz[j]:.4g} Hz"
                        for j in range(n)))
