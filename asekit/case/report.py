@@ -364,6 +364,27 @@ def format_summary(s: dict, width: int = 100) -> str:
 # ---------------------------------------------------------------------------------------------
 # figures and the HTML report
 # ---------------------------------------------------------------------------------------------
+def fig_planform(a: Analysis):
+    """The planform figure (FE mesh; aerodynamic boxes over it): a matplotlib figure."""
+    return RF.fig_planform(a).figure
+
+
+def fig_modes(a: Analysis):
+    """Every kept mode shape with a colour bar and the node lines: a matplotlib figure."""
+    return RF.fig_modes(a).figure
+
+
+def fig_vg(a: Analysis, result):
+    """V-g and V-f of one analysed condition (a ``ConditionResult`` of ``a.flutter.results``),
+    the flutter point starred: a matplotlib figure."""
+    return RF.fig_vg_mach(a, result.mach, [result]).figure
+
+
+def fig_root_locus(a: Analysis, result):
+    """The root locus of the p-k roots of one analysed condition: a matplotlib figure."""
+    return RF.fig_root_locus_mach(a, result.mach, [result]).figure
+
+
 def figures(a: Analysis) -> dict:
     """{file name: :class:`~asekit.case.report_figures.ReportFigure`} of the report
     (:func:`asekit.case.report_figures.figures`: the flutter-against-Mach figure, V-g / V-f and

@@ -270,10 +270,11 @@ def _vg_panel(ax_g, ax_f, r, velocities):
     ax_g.set_ylim(*G_LIMITS)
 
 
-def fig_vg_mach(a, mach: float) -> ReportFigure:
+def fig_vg_mach(a, mach: float, results=None) -> ReportFigure:
     """V-g (top) and V-f (bottom) of every flight condition at ``mach``: one column per
-    condition, colours per mode (:func:`asekit.util.plotting.plot_vg`), flutter points starred."""
-    rs = [r for r in a.flutter.results if r.mach == mach]
+    condition, colours per mode (:func:`asekit.util.plotting.plot_vg`), flutter points starred.
+    ``results``: the conditions to draw (default: every one analysed at ``mach``)."""
+    rs = [r for r in a.flutter.results if r.mach == mach] if results is None else list(results)
     U = a.case.flight.velocities
     ncols, npairs = _grid(len(rs))
     fig, axes = new_figure(f"{a.case.name}: V-g and V-f at M {mach:g}", nrows=2 * npairs,
@@ -301,11 +302,11 @@ def fig_vg_mach(a, mach: float) -> ReportFigure:
     return ReportFigure(fig, alt, SECTIONS[1])
 
 
-def fig_root_locus_mach(a, mach: float) -> ReportFigure:
+def fig_root_locus_mach(a, mach: float, results=None) -> ReportFigure:
     """The p-k roots at ``mach`` in the complex plane (Re p 1/s, Im p / 2 pi Hz) over the
     airspeed sweep, one colour per flight condition, modes named at the lowest speed, flutter
-    points starred."""
-    rs = [r for r in a.flutter.results if r.mach == mach]
+    points starred. ``results``: the conditions to draw (default: every one at ``mach``)."""
+    rs = [r for r in a.flutter.results if r.mach == mach] if results is None else list(results)
     fig, ax = new_figure(f"{a.case.name}: root locus of the p-k roots at M {mach:g}",
                          figsize=(8.0, 5.2), layout="constrained")
     for i, r in enumerate(rs):

@@ -242,3 +242,26 @@ def test_critical_condition_bounds_and_no_envelope():
     c = critical_condition({"flutter": [_row(0.5, 0.0, 100.0, first=True)] + rows})
     assert "unstable at the first point" in c["text"] and c["speed_ms"] == 100.0
     assert critical_condition({"flutter": []})["text"].startswith("no flutter")
+
+
+def test_single_condition_figures_keep_their_api():
+    """``fig_vg(a, result)`` and friends (notebooks/bring_your_own_surface.ipynb) draw one
+    condition: V-g over V-f, the flutter point starred at the crossing the result names."""
+    import matplotlib.pyplot as plt
+
+    from asekit.case import load_case
+    from asekit.case.report import fig_modes, fig_planform, fig_root_locus, fig_vg, run_analysis
+    from asekit.util.conventions import vg_damping_label
+    from asekit.util.paths import CASES_DIR
+    a = run_analysis(load_case(CASES_DIR / "agard445_6.toml"))
+    (r,) = a.flutter.results
+    figs = [fig_vg(a, r), fig_root_locus(a, r), fig_planform(a), fig_modes(a)]
+    try:
+        ax_g, ax_f = figs[0].axes
+        assert ax_g.get_ylabel() == vg_damping_label("p") and ax_f.get_ylabel() == "frequency (Hz)"
+        star = [ln for ln in ax_g.get_lines() if ln.get_label() == "flutter point"]
+        assert star and star[0].get_xdata()[0] == r.flutter.speed
+        assert len(figs[3].axes) == len(a.modal.frequencies_hz) + 1          # + the colour bar
+    finally:
+        for f in figs:
+            plt.close(f)
