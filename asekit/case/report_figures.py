@@ -338,10 +338,18 @@ def fig_root_locus_mach(a, mach: float, results=None) -> ReportFigure:
 # ---------------------------------------------------------------------------------------------
 # structure
 # ---------------------------------------------------------------------------------------------
-def _outlines(quads):
-    """Closed outlines (n, 5, 2) of (n, 4, 2) quadrilaterals as (span y, chord x) pairs."""
-    q = np.asarray(quads, float)[:, [0, 1, 2, 3, 0], :]
-    return q[:, :, ::-1]
+def _outlines(polygons):
+    """Closed outlines of polygons given by their (x, y) corners (m), as (span y, chord x)
+    point lists for a LineCollection; any number of corners per polygon.
+
+    >>> _outlines([[(0, 0), (1, 0), (1, 2)]])[0].tolist()
+    [[0.0, 0.0], [0.0, 1.0], [2.0, 1.0], [0.0, 0.0]]
+    """
+    out = []
+    for p in polygons:
+        p = np.asarray(p, float)[:, :2]
+        out.append(np.vstack([p, p[:1]])[:, ::-1])
+    return out
 
 
 def fig_planform(a) -> ReportFigure:
@@ -352,14 +360,14 @@ def fig_planform(a) -> ReportFigure:
     mesh = P.structural_mesh(a.case)
     boxes = P.box_mesh(a.case).corners
     n_el, n_box = len(mesh.elements), len(boxes)
-    fe = _outlines(mesh.nodes[np.asarray(mesh.elements)])
+    fe = _outlines([mesh.nodes[np.asarray(e)] for e in mesh.elements])
     fig, (ax1, ax2) = new_figure(f"{a.case.name}: planform, FE mesh and aerodynamic boxes",
                                  ncols=2, figsize=(8.0, 5.0), sharex=True, sharey=True,
                                  layout="constrained")
     ax1.add_collection(LineCollection(fe, colors="0.3", lw=0.8))
     ax1.set_title(f"FE mesh: {n_el} plate elements", fontsize=10)
     ax2.add_collection(LineCollection(fe, colors="0.75", lw=0.6, zorder=2))
-    ax2.add_collection(LineCollection(_outlines(boxes[:, :, :2]), colors="C1", lw=1.0,
+    ax2.add_collection(LineCollection(_outlines(boxes), colors="C1", lw=1.0,
                                       zorder=3))
     ax2.set_title(f"aerodynamic boxes: {n_box} (FE mesh faint)", fontsize=10)
     s = a.case.support
@@ -480,8 +488,8 @@ def figures(a) -> dict:
     actuator the ASE figures."""
     out = {"flutter_mach": fig_flutter_mach(a)}
     for i, m in enumerate(_machs(a)):
-        out[f"vg_{i}_M{m:g}"] = fig_vg_mach(a, m)
-        out[f"root_locus_{i}_M{m:g}"] = fig_root_locus_mach(a, m)
+        out[f"vg_{i}"] = fig_vg_mach(a, m)              # i: the Mach's rank, ascending
+        out[f"root_locus_{i}"] = fig_root_locus_mach(a, m)
     out["planform"] = fig_planform(a)
     out["modes"] = fig_modes(a)
     if a.ase is not None:
