@@ -230,6 +230,8 @@ def fig_flutter_mach(a) -> ReportFigure:
         alt += ", with the flight speed M a (dotted)"
     if has["envelope"]:
         alt += f" and the envelope M {env[0]:g}-{env[1]:g} (thick)"
+    if not has["divergence speed"]:
+        alt += "; no static divergence"
     low = min((r for r in a.flutter.results if r.flutter is not None
                and not r.unstable_at_start), key=lambda r: r.flutter.speed, default=None)
     if low is not None:
@@ -380,8 +382,8 @@ def fig_planform(a) -> ReportFigure:
         ax.set_aspect("equal")
     ax1.set_ylabel("x (m), downstream")
     ax1.invert_yaxis()
-    if shaft:
-        ax2.legend(loc="lower left")
+    if shaft:                                          # below the panels: covers no box
+        fig.legend(handles=ax1.get_lines()[-1:], loc="outside lower center")
     alt = (f"Planform of {a.case.name}: left the FE mesh of {n_el} plate elements, right the "
            f"{n_box} aerodynamic boxes (orange) over the FE mesh (faint grey)"
            + ("; the pitch axis marked red" if shaft else ""))
