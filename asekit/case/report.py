@@ -166,7 +166,10 @@ def summary(a: Analysis) -> dict:
 
 
 def _where(alt, rho=None) -> str:
-    return f"{alt:g} m" if alt is not None else f"rho {rho:.4g} kg/m^3"
+    """A flight condition in words: its altitude, else its density (when known)."""
+    if alt is not None:
+        return f"{alt:g} m"
+    return f"rho {rho:.4g} kg/m^3" if rho is not None else "the given density"
 
 
 def _nearest_row(rows, altitude, mach):
@@ -198,8 +201,9 @@ def _critical_margin(s: dict) -> dict | None:
     found = {"value": f"flutter at {speed:.1f} m/s",
              "at most": f"flutter at or below {speed:.1f} m/s",
              "at least": f"no flutter up to {speed:.1f} m/s"}[bound]
-    text = (f"M {m['envelope_mach']:g} (the envelope's top), {_where(m['altitude_m'])}: "
-            f"{found} vs the flight speed {m['envelope_speed_ms']:.1f} m/s")
+    place = _where(m["altitude_m"], None if row is None else row["density"])
+    text = (f"M {m['envelope_mach']:g} (the envelope's top), {place}: {found} vs the flight "
+            f"speed {m['envelope_speed_ms']:.1f} m/s")
     if row is not None and row["frequency_hz"] is not None:
         text += (f", {row['frequency_hz']:.4g} Hz, {mode_label_of(row['mode'])}"
                  + ("" if row["mach"] == m["envelope_mach"] else f" (at M {row['mach']:g})"))

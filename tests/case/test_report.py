@@ -264,3 +264,13 @@ def test_single_condition_figures_keep_their_api():
     finally:
         for f in figs:
             plt.close(f)
+
+
+def test_critical_condition_by_density():
+    """Conditions given by density and speed of sound (no altitude) are named by density."""
+    from asekit.case.report import critical_condition
+    row = {**_row(0.6, None, 213.0, 142.4), "density": 0.5}
+    margin = {"altitude_m": None, "envelope_mach": 0.6, "envelope_speed_ms": 204.2,
+              "margin": 213.0 / 204.2 - 1, "flutter_speed_ms": 213.0}
+    c = critical_condition({"flutter": [row], "flutter_margins": [margin]})
+    assert "rho 0.5 kg/m^3" in c["text"] and c["text"].endswith("outside the envelope by 4.3 %")
