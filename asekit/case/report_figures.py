@@ -238,6 +238,11 @@ def fig_flutter_mach(a) -> ReportFigure:
         alt += (f"; lowest flutter speed {low.flutter.speed:.1f} m/s at M {low.mach:g}, "
                 f"{condition_label(low.condition)}")
     alt += ("; match points: " + "; ".join(matched)) if matched else "; no match point"
+    across = [m for m in a.flutter.match_points if m.get("match_across_sonic")]
+    if across:
+        alt += "; U_f = M a inside the transonic gap (not interpolated) at " + ", ".join(
+            f"{m['altitude_m']:g} m (M {m['match_across_sonic'][0]:g}-"
+            f"{m['match_across_sonic'][1]:g})" for m in across)
     if gap:
         alt += "; the transonic gap is left open"
     return ReportFigure(fig, alt, SECTIONS[0])

@@ -167,6 +167,8 @@ def test_mach_figure_leaves_the_transonic_gap_open():
 
     from asekit.case.report_figures import fig_flutter_mach
     a = _fake_analysis([(0.8, 300.0), (0.9, 280.0), (1.2, 420.0), (1.5, 500.0)])
+    a.flutter.match_points = ({"altitude_m": 0.0, "matched_mach": None,
+                               "matched_speed_ms": None, "match_across_sonic": [0.9, 1.2]},)
     rf = fig_flutter_mach(a)
     try:
         ax = rf.figure.axes[0]
@@ -184,6 +186,7 @@ def test_mach_figure_leaves_the_transonic_gap_open():
             t.get_text() for t in ax.get_legend().get_texts()]
         assert len(ax.patches) == 1                                  # the shaded gap
         assert "transonic gap is left open" in rf.alt
+        assert "U_f = M a inside the transonic gap (not interpolated) at 0 m (M 0.9-1.2)" in rf.alt
         assert ax.get_xlabel() == "Mach number M (-)" and ax.get_ylabel() == "speed (m/s)"
     finally:
         plt.close(rf.figure)
