@@ -25,7 +25,8 @@ def add_parser(sub) -> None:
                    help="a Nastran deck's unit system (default SI)")
     p.add_argument("--json", metavar="PATH", help="write the summary as JSON ('-': stdout)")
     p.add_argument("--report", metavar="DIR", help="write index.html, figures and summary.json")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress bars (modes, GAF database, p-k, ASE loop, report figures)")
     p.set_defaults(func=run)
 
 
