@@ -643,7 +643,8 @@ def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -
     Parameters
     ----------
     case : the case.
-    progress : show the GAF database's progress bar when it is computed.
+    progress : show the GAF database's progress bar when it is computed, and a bar over the
+        p-k solutions (Mach x flight condition).
     db : a GAF database to use instead of :func:`gaf_database` (e.g. a sweep's).
 
     Returns
@@ -668,7 +669,11 @@ def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -
     model = modal_model(case)
     db = gaf_database(case, progress=progress) if db is None else db
     conds = flight_conditions(case)
-    results = [analyse_condition(case, db, m, c, model) for m in case.aero.machs for c in conds]
+    pairs = [(m, c) for m in case.aero.machs for c in conds]
+    if progress:
+        from tqdm.auto import tqdm
+        pairs = tqdm(pairs, desc="p-k flutter (Mach x condition)", leave=False)
+    results = [analyse_condition(case, db, m, c, model) for m, c in pairs]
     div = []
     for m in case.aero.machs:
         Q0 = db.at(m).Q[0].real

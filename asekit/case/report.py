@@ -1,7 +1,10 @@
 """What ``python -m asekit analyse`` prints and writes: the summary (a dict that is the JSON
-output), a plain-text table of it, and an HTML report with the figures a user expects
-(planform with FE and aero meshes, mode shapes, V-g and V-f with the flutter point marked,
-root locus; with an actuator also the FWTF Bode with its margins and the step responses).
+output, the critical condition named first), a plain-text table of it, and an HTML report:
+the summary first, a link to the JSON, then the figures of :mod:`asekit.case.report_figures`
+(flutter and divergence speed against Mach with the envelope and match points; V-g, V-f and
+root locus at every analysed Mach and flight condition; planform with FE mesh and aero boxes;
+every kept mode shape; with an actuator the FWTF Bode and the step responses), each with an
+alt text that says what it shows.
 
 Conventions (docs/conventions.md): SI in the JSON and the table; every JSON key carries its
 unit as a suffix (``_ms`` m/s, ``_hz`` Hz, ``_m`` m, ``_s`` s, ``_deg`` deg, ``_pct`` %), and
@@ -13,6 +16,7 @@ g = 2 Re p / |Im p|, > 0 unstable.
 
 from __future__ import annotations
 
+import contextlib
 import html
 import json
 import math
@@ -21,13 +25,11 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
-from asekit.ase import loop as ase_mod
 from asekit.case import pipeline as P
+from asekit.case import report_figures as RF
 from asekit.case.schema import Case
 from asekit.util.conventions import mode_label, mode_number
-from asekit.util.plotting import new_figure, plot_vg, save_figure
+from asekit.util.plotting import save_figure
 
 #: The unit of every numeric key of the summary (the JSON's ``units`` block; docs/conventions.md).
 #: Key suffixes name the unit too: ``_ms`` m/s, ``_hz`` Hz, ``_m`` m, ``_s`` s, ``_deg`` deg,
@@ -69,20 +71,39 @@ class Analysis:
     seconds: dict
 
 
+@contextlib.contextmanager
+def _stage(desc: str, progress: bool):
+    """A one-step tqdm bar on standard error around a stage without an inner loop (shown
+    while it runs, removed when done; nothing when ``progress`` is False)."""
+    if not progress:
+        yield
+        return
+    from tqdm.auto import tqdm
+    with tqdm(total=1, desc=desc, leave=False, bar_format="{desc}: {elapsed}") as bar:
+        yield
+        bar.update(1)
+
+
 def run_analysis(case: Case, progress: bool = False) -> Analysis:
-    """Run the whole pipeline of ``case`` and time each step."""
+    """Run the whole pipeline of ``case`` and time each step (s).
+
+    ``progress`` shows a tqdm bar on standard error for every stage: the modes, the GAF
+    database (Mach x k), the p-k flutter solutions (Mach x flight condition) and the ASE loop.
+    """
     sec = {}
     t = time.perf_counter()
-    modal = P.modal_model(case)
+    with _stage("modes", progress):
+        modal = P.modal_model(case)
     sec["modes"] = time.perf_counter() - t
     t = time.perf_counter()
     db = P.gaf_database(case, progress=progress)
     sec["gaf_database"] = time.perf_counter() - t
     t = time.perf_counter()
-    fa = P.flutter(case, db=db)
+    fa = P.flutter(case, db=db, progress=progress)
     sec["flutter"] = time.perf_counter() - t
     t = time.perf_counter()
-    ase = P.ase(case, db=db)
+    with _stage("ASE loop", progress and case.actuator is not None):
+        ase = P.ase(case, db=db)
     if ase is not None:
         sec["ase"] = time.perf_counter() - t
     return Analysis(case, modal, db, fa, ase, sec)
@@ -140,7 +161,108 @@ def summary(a: Analysis) -> dict:
                                                for k, v in s.corner_overshoot.items()},
                       "fwtf_phase_margin_deg": {str(i): _f(x.phase_margin_deg)
                                                 for i, x in s.crossovers.items()}}
+    out["critical"] = critical_condition(out)
     return out
+
+
+def _where(alt, rho=None) -> str:
+    """A flight condition in words: its altitude, else its density (when known)."""
+    if alt is not None:
+        return f"{alt:g} m"
+    return f"rho {rho:.4g} kg/m^3" if rho is not None else "the given density"
+
+
+def _nearest_row(rows, altitude, mach):
+    """The flutter row at ``altitude`` nearest in Mach to ``mach`` on the same side of M 1."""
+    here = [r for r in rows if r["altitude_m"] == altitude and r["mode"] is not None
+            and (r["mach"] == mach or not P._across_sonic(r["mach"], mach))]
+    return min(here, key=lambda r: abs(r["mach"] - mach), default=None)
+
+
+def _critical_margin(s: dict) -> dict | None:
+    """The lowest flutter margin of ``s["flutter_margins"]`` (a value or its bound)."""
+    def value(m):
+        for key, bound in (("margin", "value"), ("margin_upper_bound", "at most"),
+                           ("margin_lower_bound", "at least")):
+            if m.get(key) is not None:
+                return m[key], bound
+        return None, None
+    ms = [(value(m), m) for m in s.get("flutter_margins", ()) if value(m)[0] is not None]
+    if not ms:
+        return None
+    (margin, bound), m = min(ms, key=lambda x: x[0][0])
+    speed = {"value": m.get("flutter_speed_ms"), "at most": m.get("flutter_speed_upper_bound_ms"),
+             "at least": m.get("flutter_speed_lower_bound_ms")}[bound]
+    row = _nearest_row(s.get("flutter", ()), m["altitude_m"], m["envelope_mach"])
+    where = "inside" if margin < 0 else "outside"
+    # a bound on the margin words the distance from the envelope the other way round inside it
+    qual = {"value": "", "at most": "at least " if margin < 0 else "at most ",
+            "at least": "at most " if margin < 0 else "at least "}[bound]
+    found = {"value": f"flutter at {speed:.1f} m/s",
+             "at most": f"flutter at or below {speed:.1f} m/s",
+             "at least": f"no flutter up to {speed:.1f} m/s"}[bound]
+    place = _where(m["altitude_m"], None if row is None else row["density"])
+    text = (f"M {m['envelope_mach']:g} (the envelope's top), {place}: {found} vs the flight "
+            f"speed {m['envelope_speed_ms']:.1f} m/s")
+    if row is not None and row["frequency_hz"] is not None:
+        text += (f", {row['frequency_hz']:.4g} Hz, {mode_label_of(row['mode'])}"
+                 + ("" if row["mach"] == m["envelope_mach"] else f" (at M {row['mach']:g})"))
+    text += f": flutter {where} the envelope by {qual}{abs(100 * margin):.1f} %"
+    return {"mach": m["envelope_mach"], "altitude_m": m["altitude_m"], "speed_ms": speed,
+            "frequency_hz": None if row is None else row["frequency_hz"],
+            "mode": None if row is None else row["mode"], "margin": margin,
+            "margin_bound": bound, "envelope_speed_ms": m["envelope_speed_ms"], "text": text}
+
+
+def mode_label_of(number) -> str:
+    """The text label of a JSON ``mode`` (an elastic number or "rigid pitch")."""
+    return number if isinstance(number, str) else f"mode {number}"
+
+
+def critical_condition(s: dict) -> dict:
+    """The critical condition of a summary :func:`summary` (a dict, so the JSON works too):
+    the lowest flutter margin against the envelope (docs/case-format.md ``flight.envelope_*``),
+    else, without an envelope, the condition unstable at the first point of the sweep or the
+    lowest flutter speed. Returns ``{"mach", "altitude_m", "speed_ms", "frequency_hz", "mode",
+    "margin", "text"}`` (None where unknown); ``text`` words it for a person, e.g. "M 0.6 (the
+    envelope's top), 0 m: flutter at 213.0 m/s vs the flight speed 204.2 m/s, 142.4 Hz, mode 2:
+    flutter outside the envelope by 4.3 %".
+
+    Examples
+    --------
+    >>> row = {"mach": 0.5, "altitude_m": 0.0, "density": 1.225, "speed_ms": 150.0,
+    ...        "frequency_hz": 20.0, "mode": 2, "unstable_at_first_point": False,
+    ...        "speed_upper_bound_ms": None}
+    >>> margin = {"altitude_m": 0.0, "envelope_mach": 0.5, "envelope_speed_ms": 170.1,
+    ...           "margin": 150.0 / 170.1 - 1, "flutter_speed_ms": 150.0}
+    >>> print(critical_condition({"flutter": [row], "flutter_margins": [margin]})["text"])
+    ... # doctest: +NORMALIZE_WHITESPACE
+    M 0.5 (the envelope's top), 0 m: flutter at 150.0 m/s vs the flight speed 170.1 m/s,
+    20 Hz, mode 2: flutter inside the envelope by 11.8 %
+    """
+    c = _critical_margin(s)
+    if c is not None:
+        return c
+    rows = list(s.get("flutter", ()))
+    first = [r for r in rows if r.get("unstable_at_first_point")]
+    found = [r for r in rows if r.get("speed_ms") is not None]
+    none = {"mach": None, "altitude_m": None, "speed_ms": None, "frequency_hz": None,
+            "mode": None, "margin": None}
+    if first:
+        r = first[0]
+        text = (f"M {r['mach']:g}, {_where(r['altitude_m'], r['density'])}: unstable at the "
+                f"first point of the sweep ({mode_label_of(r['mode'])} at or below "
+                f"{r['speed_upper_bound_ms']:g} m/s): start the sweep lower")
+        return {**none, "mach": r["mach"], "altitude_m": r["altitude_m"],
+                "speed_ms": r["speed_upper_bound_ms"], "mode": r["mode"], "text": text}
+    if found:
+        r = min(found, key=lambda r: r["speed_ms"])
+        text = (f"M {r['mach']:g}, {_where(r['altitude_m'], r['density'])}: the lowest flutter "
+                f"speed, {r['speed_ms']:.1f} m/s, {r['frequency_hz']:.4g} Hz, "
+                f"{mode_label_of(r['mode'])} (no envelope in the case: no margin)")
+        return {**none, **{k: r[k] for k in ("mach", "altitude_m", "speed_ms", "frequency_hz",
+                                              "mode")}, "text": text}
+    return {**none, "text": "no flutter in the sweep at any analysed condition"}
 
 
 def _cell(v, fmt="{:.4g}"):
@@ -187,6 +309,9 @@ def format_summary(s: dict, width: int = 100) -> str:
     lines.append("modes (Hz): " + ", ".join(f"{mode_label(j, r)} {v:.4g}"
                                             for j, v in enumerate(f) if j >= r)
                  + (f"  (+ {mode_label(0, r)})" if r else ""))
+    if s.get("critical"):
+        lines += textwrap.wrap("critical: " + s["critical"]["text"], width,
+                               subsequent_indent="  ")
     has_fsi = any("flutter_speed_index" in row for row in s["flutter"])
     head = f"{'Mach':>6} {'altitude m':>10} {'rho kg/m3':>10} {'U_f m/s':>9} {'f_f Hz':>8} {'mode':>4}"
     if has_fsi:
@@ -244,125 +369,32 @@ def format_summary(s: dict, width: int = 100) -> str:
 # figures and the HTML report
 # ---------------------------------------------------------------------------------------------
 def fig_planform(a: Analysis):
-    fig, ax = new_figure(f"{a.case.name}: planform, FE mesh (black) and aerodynamic boxes (blue)")
-    mesh = P.structural_mesh(a.case)
-    for e in mesh.elements:
-        xy = mesh.nodes[np.r_[e, e[0]]]
-        ax.plot(xy[:, 1], xy[:, 0], "k-", lw=0.6)
-    for c in P.box_mesh(a.case).corners:
-        xy = c[[0, 1, 2, 3, 0]]
-        ax.plot(xy[:, 1], xy[:, 0], "C0-", lw=0.4, alpha=0.7)
-    s = a.case.support
-    if s.kind == "shaft":
-        ax.plot(s.axis_point[1], s.axis_point[0], "rs", label="pitch axis")
-        ax.legend()
-    ax.set_xlabel("y (m, span)")
-    ax.set_ylabel("x (m, downstream)")
-    ax.invert_yaxis()
-    ax.set_aspect("equal")
-    return fig
+    """The planform figure (FE mesh; aerodynamic boxes over it): a matplotlib figure."""
+    return RF.fig_planform(a).figure
 
 
-def fig_modes(a: Analysis, n: int = 4):
-    m = a.modal
-    idx = list(range(m.n_rigid, min(len(m.frequencies_hz), m.n_rigid + n)))
-    fig, axes = new_figure(f"{a.case.name}: mode shapes (w, contours)", ncols=len(idx),
-                           figsize=(3.2 * len(idx), 3.6))
-    axes = np.atleast_1d(axes)
-    tri = np.concatenate([m.elements[:, [0, 1, 2]], m.elements[:, [0, 2, 3]]])
-    for ax, j in zip(axes, idx):
-        w = m.shapes[:, 0, j]
-        ax.tricontourf(m.nodes[:, 1], m.nodes[:, 0], tri, w / np.abs(w).max(), levels=15,
-                       cmap="RdBu_r")
-        ax.set_title(f"{mode_label(j, m.n_rigid)}: {m.frequencies_hz[j]:.4g} Hz")
-        ax.set_xlabel("y (m)")
-        ax.set_ylabel("x (m)")
-        ax.invert_yaxis()
-        ax.set_aspect("equal")
-    return fig
+def fig_modes(a: Analysis):
+    """Every kept mode shape with a colour bar and the node lines: a matplotlib figure."""
+    return RF.fig_modes(a).figure
 
 
 def fig_vg(a: Analysis, result):
-    """V-g and V-f of the p-k roots at one condition (:func:`asekit.util.plotting.plot_vg`: g = 2 Re
-    p / |Im p|, > 0 unstable; modes named "mode 1", ...), the flutter point starred."""
-    pk = result.pk
-    alt = result.condition.altitude
-    where = f"{alt:g} m" if alt is not None else f"rho {result.condition.density:.4g} kg/m^3"
-    fig, (ax1, ax2) = new_figure(f"{a.case.name}: V-g and V-f, M {result.mach:g}, {where}",
-                                 nrows=2, figsize=(6.4, 6.4), sharex=True)
-    plot_vg(ax1, ax2, pk.velocities, pk.p, pk.mode_labels, g_limits=None)
-    f = result.flutter
-    if f is not None:
-        ax1.plot(f.speed, 0.0, "r*", ms=12, label=f"flutter {f.speed:.1f} m/s ({f.mode_name})")
-        ax2.plot(f.speed, f.frequency_hz, "r*", ms=12)
-    ax1.set_ylim(-0.5, 0.3)
-    ax1.legend(ncol=2)
-    ax2.set_xlabel("airspeed U (m/s)")
-    return fig
+    """V-g and V-f of one analysed condition (a ``ConditionResult`` of ``a.flutter.results``),
+    the flutter point starred: a matplotlib figure."""
+    return RF.fig_vg_mach(a, result.mach, [result]).figure
 
 
 def fig_root_locus(a: Analysis, result):
-    pk = result.pk
-    fig, ax = new_figure(f"{a.case.name}: root locus of the p-k roots, M {result.mach:g}")
-    for j, name in enumerate(pk.mode_labels):
-        ax.plot(pk.p[:, j].real, pk.p[:, j].imag / (2 * math.pi), ".-", ms=2, label=name)
-    f = result.flutter
-    if f is not None:
-        ax.plot(0.0, f.frequency_hz, "r*", ms=12, label=f"flutter {f.speed:.1f} m/s")
-    ax.legend(ncol=2, fontsize=8)
-    ax.axvline(0.0, color="k", lw=0.8)
-    ax.set_xlabel("Re p (1/s), > 0 unstable")
-    ax.set_ylabel("Im p / 2 pi (Hz)")
-    return fig
-
-
-def fig_ase_bode(a: Analysis):
-    s = a.ase
-    f = np.logspace(0, 3.5, 800)
-    fig, (ax1, ax2) = new_figure(f"{a.case.name}: forward paths FWTF 1-3, M {s.mach:g}",
-                                 nrows=2, figsize=(6.4, 6.4), sharex=True)
-    for i in (1, 2, 3):
-        h = ase_mod.frequency_response(ase_mod.forward_path(s.model, s.controller, i), f)
-        ax1.semilogx(f, 20 * np.log10(np.abs(h)), label=f"FWTF {i}")
-        ax2.semilogx(f, np.degrees(np.unwrap(np.angle(h))))
-        c = s.crossovers[i]
-        if c.gain_crossovers_hz.size:
-            ax1.plot(c.gain_crossovers_hz[0], 0.0, "k|", ms=12)
-    ax1.axhline(0.0, color="k", lw=0.8)
-    ax2.axhline(-180.0, color="k", lw=0.8)
-    ax1.set_ylabel("gain (dB)")
-    ax2.set_ylabel("phase (deg)")
-    ax2.set_xlabel("frequency (Hz)")
-    ax1.legend()
-    return fig
-
-
-def fig_ase_steps(a: Analysis):
-    s = a.ase
-    fig, ax = new_figure(f"{a.case.name}: power-limited step, fin-root pitch")
-    for t, sim in s.simulations.items():
-        ax.plot(sim.t * 1e3, np.degrees(sim.fin_root), label=t)
-    ax.axhline(a.case.actuator.step_deg, color="k", lw=0.8, ls="--", label="command")
-    ax.set_xlabel("time (ms)")
-    ax.set_ylabel("fin-root pitch (deg)")
-    ax.set_ylim(-0.5 * a.case.actuator.step_deg, 2.5 * a.case.actuator.step_deg)
-    ax.legend()
-    return fig
+    """The root locus of the p-k roots of one analysed condition: a matplotlib figure."""
+    return RF.fig_root_locus_mach(a, result.mach, [result]).figure
 
 
 def figures(a: Analysis) -> dict:
-    """{name: figure} of the report (V-g / V-f and root locus for the first Mach at each flight
-    condition, plus the ASE figures with an actuator)."""
-    figs = {"planform": fig_planform(a), "modes": fig_modes(a)}
-    first_mach = a.case.aero.machs[-1]
-    for i, r in enumerate(x for x in a.flutter.results if x.mach == first_mach):
-        figs[f"vg_{i}"] = fig_vg(a, r)
-        if i == 0:
-            figs["root_locus"] = fig_root_locus(a, r)
-    if a.ase is not None:
-        figs["ase_bode"] = fig_ase_bode(a)
-        figs["ase_steps"] = fig_ase_steps(a)
-    return figs
+    """{file name: :class:`~asekit.case.report_figures.ReportFigure`} of the report
+    (:func:`asekit.case.report_figures.figures`: the flutter-against-Mach figure, V-g / V-f and
+    root locus at every analysed Mach for every flight condition, planform, every kept mode
+    shape, and with an actuator the ASE figures)."""
+    return RF.figures(a)
 
 
 def write_text_atomic(path, text: str) -> Path:
@@ -383,19 +415,78 @@ def write_text_atomic(path, text: str) -> Path:
     return path
 
 
-def _report_page(s: dict, names) -> str:
-    body = "\n".join(f'<figure><img src="{html.escape(n)}" alt="{html.escape(n)}"></figure>'
-                     for n in names)
-    return (f"<!doctype html><html><head><meta charset='utf-8'><title>asekit: "
-            f"{html.escape(s['case'])}</title><style>body{{font-family:sans-serif;max-width:70em;"
-            f"margin:auto}} img{{max-width:100%}} pre{{background:#f4f4f4;padding:1em}}</style>"
-            f"</head><body><h1>{html.escape(s['case'])}</h1><pre>"
-            f"{html.escape(format_summary(s, width=120))}</pre>{body}</body></html>")
+_CSS = ("body{font-family:sans-serif;max-width:75em;margin:auto;padding:0 1em} "
+        "img{max-width:100%;height:auto} pre{background:#f4f4f4;padding:1em;overflow-x:auto} "
+        ".critical{background:#fff4e5;border-left:4px solid #e8a33d;padding:.6em 1em} "
+        "figcaption{font-size:90%;color:#444}")
 
 
-def write_report(a: Analysis, directory) -> Path:
-    """Write ``directory/index.html`` (summary table and figures) with the PNGs beside it and
-    ``summary.json``; returns the index path.
+def _item(v):
+    """A ``figures`` value as (figure, alt, section): a ReportFigure, or a bare figure."""
+    if isinstance(v, RF.ReportFigure):
+        return v.figure, v.alt, v.section
+    return v, None, "Figures"
+
+
+def _report_page(s: dict, saved) -> str:
+    """The HTML page: the summary first (the critical condition, a link to the JSON, the
+    table), then the figures by section; ``saved`` is [(file name, alt text, section)]."""
+    e = html.escape
+    name = s.get("case", "")
+    crit = s.get("critical")
+    head = [f"<h1>{e(name)}</h1>"]
+    if s.get("reference"):
+        head.append(f"<p>{e(s['reference'])}</p>")
+    head.append("<h2 id='summary'>Summary</h2>")
+    if crit:
+        head.append(f"<p class='critical'><strong>Critical condition:</strong> "
+                    f"{e(crit['text'])}</p>")
+    head.append("<p>Every number of this page, with the unit of each key: "
+                "<a href='summary.json'>summary.json</a>.</p>")
+    head.append(f"<pre>{e(format_summary(s, width=120))}</pre>")
+    sections = []
+    for _, _, sec in saved:
+        if sec not in sections:
+            sections.append(sec)
+    body = []
+    for sec in sections:
+        body.append(f"<h2>{e(sec)}</h2>")
+        body += [f"<figure><img src='{e(f)}' alt='{e(alt or f)}'>"
+                 + (f"<figcaption>{e(alt)}</figcaption>" if alt else "") + "</figure>"
+                 for f, alt, x in saved if x == sec]
+    return (f"<!doctype html><html lang='en'><head><meta charset='utf-8'><title>asekit: "
+            f"{e(name)}</title><style>{_CSS}</style></head><body>" + "\n".join(head + body)
+            + "</body></html>\n")
+
+
+def _save_figures(a, directory, progress: bool):
+    """Save every figure of :func:`figures` into ``directory``; [(file, alt, section)]."""
+    items = list(figures(a).items())
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+        bar = tqdm(total=len(items), desc="report figures", leave=False)
+    saved = []
+    try:
+        for name, v in items:
+            fig, alt, sec = _item(v)
+            saved.append((save_figure(fig, directory, name).name, alt, sec))
+            if bar is not None:
+                bar.update(1)
+    finally:
+        import matplotlib.pyplot as plt
+        for _, v in items:
+            plt.close(_item(v)[0])
+        if bar is not None:
+            bar.close()
+    return saved
+
+
+def write_report(a: Analysis, directory, progress: bool = False) -> Path:
+    """Write ``directory/index.html`` (the summary first: the critical condition, a link to
+    ``summary.json`` and the table; then the figures, each with an alt text saying what it
+    shows) with the PNGs beside it and ``summary.json``; returns the index path. ``progress``
+    shows a tqdm bar over the figures.
 
     The report is written into a temporary folder next to ``directory`` and moved into place
     when complete (an existing report there is replaced), so an interrupted run (SIGINT) leaves
@@ -415,8 +506,8 @@ def write_report(a: Analysis, directory) -> Path:
     try:
         s = summary(a)
         (tmp / "summary.json").write_text(json.dumps(s, indent=2))
-        names = [save_figure(f, tmp, n).name for n, f in figures(a).items()]
-        (tmp / "index.html").write_text(_report_page(s, names))
+        saved = _save_figures(a, tmp, progress)
+        (tmp / "index.html").write_text(_report_page(s, saved))
         if d.exists():
             old = d.with_name(f".{d.name}.{os.getpid()}.old")
             os.replace(d, old)

@@ -28,7 +28,8 @@ def add_parser(sub) -> None:
                    help="a Nastran deck's unit system (default SI)")
     p.add_argument("--json", metavar="PATH", help="write the summary as JSON ('-': stdout)")
     p.add_argument("--report", metavar="DIR", help="write index.html, figures and summary.json")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress bars (modes, GAF database, p-k, ASE loop, report figures)")
     p.add_argument("--convergence", action="store_true",
                    help="also run the case on coarser meshes and report the extrapolated "
                         "flutter speed and frequency with error bars ([convergence] in the "
@@ -121,6 +122,6 @@ def run(args) -> int:
     if args.report:
         import matplotlib
         matplotlib.use("Agg")
-        index = write_report(analysis, args.report)
+        index = write_report(analysis, args.report, progress=not args.quiet)
         print(f"report: {index}", file=sys.stderr)
     return 0

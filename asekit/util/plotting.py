@@ -65,13 +65,23 @@ def new_figure(title: str, thesis_figure: str | None = None, nrows: int = 1, nco
 
 
 def save_figure(fig, directory: str | Path, name: str) -> Path:
-    """Save ``fig`` as ``directory/name.png`` (tight layout) and close it; returns the path."""
+    """Save ``fig`` as ``directory/name.png`` and close it; returns the path.
+
+    A figure made with ``layout="constrained"`` keeps its title, legends and colour bars inside
+    the image by its own layout; any other figure gets
+    :meth:`~matplotlib.figure.Figure.tight_layout` and is cut to its drawn content
+    (``bbox_inches="tight"``, one more draw) so that a title or a legend outside the axes is
+    never clipped.
+    """
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     path = directory / f"{name}.png"
     with matplotlib.rc_context(STYLE):
-        fig.tight_layout()
-        fig.savefig(path)
+        if fig.get_layout_engine() is None:
+            fig.tight_layout()
+            fig.savefig(path, bbox_inches="tight", pad_inches=0.1)
+        else:
+            fig.savefig(path)
     plt.close(fig)
     return path
 

@@ -1,0 +1,505 @@
+"""The figures of the ``analyse`` HTML report (:mod:`asekit.case.report`), each with the alt
+text that says what it shows.
+
+- the flutter and divergence speeds against Mach, one colour per flight condition, with the
+  flight speed U = M a(h), the envelope, the match points and the transonic gap left open
+  (speeds are never joined across M 1: :func:`asekit.case.pipeline._across_sonic`);
+- per analysed Mach, V-g and V-f of every flight condition (small multiples: one column per
+  condition, colours per mode through :func:`asekit.util.plotting.plot_vg`) and the root locus
+  (one colour per condition), the flutter points starred;
+- the planform (thin grey FE mesh over coloured aerodynamic box outlines) and every kept mode
+  shape with one colour bar and the node lines (w = 0);
+- with an actuator, the forward paths FWTF 1-3 and the power-limited step responses.
+
+Conventions (docs/conventions.md): SI inside, Hz and deg only on the axes; elastic modes named
+from 1 and the rigid mode "rigid pitch" (:func:`asekit.util.conventions.mode_label`); V-g damping
+g = 2 Re p / |Im p|, > 0 unstable. The style is :mod:`asekit.util.plotting`'s; every figure uses
+matplotlib's constrained layout and is saved with ``bbox_inches="tight"``, so titles and
+legends stay inside the image.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from asekit.aero.methods import DLM_MACH_MAX, SUPERSONIC_MACH_MIN
+from asekit.ase import loop as ase_mod
+from asekit.case import pipeline as P
+from asekit.util.conventions import mode_label
+from asekit.util.plotting import new_figure, plot_vg
+
+#: Report sections, in page order.
+SECTIONS = ("Flutter and divergence against Mach", "V-g, V-f and root locus at each Mach",
+            "Structure: planform and mode shapes", "Aeroservoelastic loop")
+
+#: The g axis of the V-g panels (-): wide enough for the crossings, narrow enough to read them.
+G_LIMITS = (-0.5, 0.3)
+
+
+@dataclass(frozen=True)
+class ReportFigure:
+    """One figure of the report: the matplotlib ``figure``, its ``alt`` text (what it shows,
+    with the numbers a reader looks for) and the report ``section`` it belongs to."""
+
+    figure: object
+    alt: str
+    section: str
+
+
+def condition_label(c) -> str:
+    """A flight condition as the report names it: ``"2500 m"`` or ``"rho 0.4278 kg/m^3"``.
+
+    Examples
+    --------
+    >>> from asekit.case.pipeline import FlightCondition
+    >>> condition_label(FlightCondition(2500.0, 0.957, 334.9)), condition_label(
+    ...     FlightCondition(None, 0.4278, None))
+    ('2500 m', 'rho 0.4278 kg/m^3')
+    """
+    if c.altitude is not None:
+        return f"{c.altitude:g} m"
+    return f"rho {c.density:.4g} kg/m^3"
+
+
+def flutter_phrase(r, velocities) -> str:
+    """What the p-k sweep of one condition found, in words: ``"mode 2 crosses g = 0 at
+    218.1 m/s (140.9 Hz)"``, unstable at the first point, or no flutter up to the last one."""
+    if r.unstable_at_start:
+        return (f"{P._start_kind(r)} at or below {velocities[0]:g} m/s, the first point "
+                f"({mode_label(r.start_mode, r.pk.n_rigid)})")
+    f = r.flutter
+    if f is None:
+        return f"no flutter up to {velocities[-1]:g} m/s"
+    return f"{f.mode_name} crosses g = 0 at {f.speed:.1f} m/s ({f.frequency_hz:.4g} Hz)"
+
+
+def _conditions(a):
+    """The flight conditions in analysis order (each once)."""
+    out = []
+    for r in a.flutter.results:
+        if r.condition not in out:
+            out.append(r.condition)
+    return out
+
+
+def _machs(a):
+    return sorted({r.mach for r in a.flutter.results})
+
+
+# ---------------------------------------------------------------------------------------------
+# flutter and divergence against Mach
+# ---------------------------------------------------------------------------------------------
+def _broken_line(points):
+    """(Mach, speed) arrays of consecutive points with NaN between two Machs on either side of
+    M 1, so that matplotlib never draws a line across the transonic gap."""
+    xs, ys = [], []
+    for i, (m, u) in enumerate(points):
+        if i and P._across_sonic(points[i - 1][0], m):
+            xs.append(np.nan)
+            ys.append(np.nan)
+        xs.append(m)
+        ys.append(u)
+    return np.array(xs, float), np.array(ys, float)
+
+
+def _shows_gap(machs, env) -> bool:
+    lo, hi = min(machs + env), max(machs + env)
+    return lo < SUPERSONIC_MACH_MIN and hi > DLM_MACH_MAX and (lo < 1.0 < hi or any(
+        DLM_MACH_MAX < m < SUPERSONIC_MACH_MIN for m in machs))
+
+
+def _envelope_covers(case, c) -> bool:
+    f = case.flight
+    if f.envelope_mach is None or c.speed_of_sound is None:
+        return False
+    h = f.envelope_altitude
+    return h is None or c.altitude is None or h[0] <= c.altitude <= h[1]
+
+
+def _plot_condition_speeds(ax, a, c, color):
+    """Flutter (solid, bounds as triangles) and divergence (dashed) speeds of one condition."""
+    U = a.case.flight.velocities
+    pts = P._flutter_points([r for r in a.flutter.results if r.condition == c], U)
+    x, y = _broken_line([(m, u if kind == "value" else np.nan) for m, u, kind in pts])
+    ax.plot(x, y, "-o", color=color, ms=5)
+    for kind, marker in (("upper", "v"), ("lower", "^")):
+        b = [(m, u) for m, u, k in pts if k == kind]
+        if b:
+            ax.plot(*np.array(b).T, marker, color=color, ms=8, ls="none")
+    div = sorted((d["mach"], np.nan if d["speed_ms"] is None else d["speed_ms"])
+                 for d in a.flutter.divergence
+                 if d["altitude_m"] == c.altitude and d["density"] == c.density)
+    if div:
+        ax.plot(*_broken_line(div), "--x", color=color, ms=6, lw=1.2)
+
+
+def _plot_flight_speed(ax, a, c, color, mach_range):
+    """The flight speed U = M a(h) (dotted) and, inside the envelope, its thick band."""
+    if c.speed_of_sound is None:
+        return
+    m = np.linspace(*mach_range, 50)
+    ax.plot(m, m * c.speed_of_sound, ":", color=color, lw=1.0)
+    if _envelope_covers(a.case, c):
+        e = np.array(a.case.flight.envelope_mach, float)
+        ax.plot(e, e * c.speed_of_sound, "-", color=color, lw=6, alpha=0.3,
+                solid_capstyle="butt")
+
+
+def _legend_right(ax, **kw):
+    """A legend to the right of ``ax``, outside it (inside the image: constrained layout)."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, **kw)
+
+
+def _mach_legend(ax, conds, has):
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    h = [Line2D([], [], color=f"C{i}", lw=3, label=condition_label(c))
+         for i, c in enumerate(conds)]
+    k = "0.3"
+    style = [("flutter speed U_f", Line2D([], [], color=k, ls="-", marker="o", ms=5)),
+             ("divergence speed", Line2D([], [], color=k, ls="--", marker="x")),
+             ("flutter at or below (unstable at the first point)",
+              Line2D([], [], color=k, ls="none", marker="v", ms=8)),
+             ("no flutter up to (the last point)",
+              Line2D([], [], color=k, ls="none", marker="^", ms=8)),
+             ("flight speed U = M a", Line2D([], [], color=k, ls=":")),
+             ("envelope", Line2D([], [], color=k, lw=6, alpha=0.3)),
+             ("match point (U_f = M a)", Line2D([], [], color=k, ls="none", marker="o", ms=10,
+                                                mfc="none", mec="k", mew=2)),
+             ("transonic gap", Patch(color="0.85"))]
+    gap = f"transonic gap M {DLM_MACH_MAX:g}-{SUPERSONIC_MACH_MIN:g} (never interpolated)"
+    h.append(Line2D([], [], ls="none", label=" "))
+    for name, handle in style:
+        if has.get(name, True):
+            handle.set_label(gap if name == "transonic gap" else name)
+            h.append(handle)
+    _legend_right(ax, handles=h, fontsize=8)
+
+
+def fig_flutter_mach(a) -> ReportFigure:
+    """Flutter and divergence speed (m/s) against Mach for every flight condition, with the
+    flight speed M a, the envelope, the match points and the transonic gap."""
+    conds, machs = _conditions(a), _machs(a)
+    env = list(a.case.flight.envelope_mach or ())
+    lo, hi = min(machs + env), max(machs + env)
+    pad = max(0.05, 0.05 * (hi - lo))
+    fig, ax = new_figure(f"{a.case.name}: flutter and divergence speed against Mach",
+                         figsize=(9.0, 5.2), layout="constrained")
+    gap = _shows_gap(machs, env)
+    if gap:
+        ax.axvspan(DLM_MACH_MAX, SUPERSONIC_MACH_MIN, color="0.85", zorder=0)
+        ax.text(0.5 * (DLM_MACH_MAX + SUPERSONIC_MACH_MIN), 0.02, "transonic gap",
+                transform=ax.get_xaxis_transform(), ha="center", fontsize=8, rotation=90)
+    for i, c in enumerate(conds):
+        _plot_condition_speeds(ax, a, c, f"C{i}")
+        _plot_flight_speed(ax, a, c, f"C{i}", (lo - pad, hi + pad))
+    if len(machs) == 1:                                # one Mach: the speeds written out
+        for r in a.flutter.results:
+            if r.flutter is not None and not r.unstable_at_start:
+                ax.annotate(f"{r.flutter.speed:.1f} m/s", (r.mach, r.flutter.speed),
+                            textcoords="offset points", xytext=(6, 4), fontsize=8)
+    matched = []
+    for m in a.flutter.match_points:
+        if m["matched_mach"] is not None:
+            i = next(j for j, c in enumerate(conds) if c.altitude == m["altitude_m"])
+            ax.plot(m["matched_mach"], m["matched_speed_ms"], "o", ms=10, mfc="none", mec="k",
+                    mew=2, zorder=5)
+            ax.plot(m["matched_mach"], m["matched_speed_ms"], "o", ms=5, color=f"C{i}", zorder=6)
+            matched.append(f"{condition_label(conds[i])} M {m['matched_mach']:.3f} "
+                           f"({m['matched_speed_ms']:.1f} m/s)")
+    ax.set_xlim(lo - pad, hi + pad)
+    ax.set_ylim(bottom=0.0)
+    ax.set_xlabel("Mach number M (-)")
+    ax.set_ylabel("speed (m/s)")
+    has = {"flight speed U = M a": any(c.speed_of_sound for c in conds),
+           "envelope": any(_envelope_covers(a.case, c) for c in conds),
+           "match point (U_f = M a)": bool(matched), "transonic gap": gap,
+           "divergence speed": any(d["speed_ms"] is not None for d in a.flutter.divergence),
+           "flutter at or below (unstable at the first point)":
+               any(r.unstable_at_start for r in a.flutter.results),
+           "no flutter up to (the last point)":
+               any(r.flutter is None and not r.unstable_at_start for r in a.flutter.results)}
+    _mach_legend(ax, conds, has)
+    alt = ("Flutter speed (solid)" + (" and divergence speed (dashed)" if has[
+        "divergence speed"] else "") + f" against Mach {', '.join(f'{m:g}' for m in machs)} at "
+        + ", ".join(map(condition_label, conds)))
+    if has["flight speed U = M a"]:
+        alt += ", with the flight speed M a (dotted)"
+    if has["envelope"]:
+        alt += f" and the envelope M {env[0]:g}-{env[1]:g} (thick)"
+    if not has["divergence speed"]:
+        alt += "; no static divergence"
+    low = min((r for r in a.flutter.results if r.flutter is not None
+               and not r.unstable_at_start), key=lambda r: r.flutter.speed, default=None)
+    if low is not None:
+        alt += (f"; lowest flutter speed {low.flutter.speed:.1f} m/s at M {low.mach:g}, "
+                f"{condition_label(low.condition)}")
+    alt += ("; match points: " + "; ".join(matched)) if matched else "; no match point"
+    across = [m for m in a.flutter.match_points if m.get("match_across_sonic")]
+    if across:
+        alt += "; U_f = M a inside the transonic gap (not interpolated) at " + ", ".join(
+            f"{m['altitude_m']:g} m (M {m['match_across_sonic'][0]:g}-"
+            f"{m['match_across_sonic'][1]:g})" for m in across)
+    if gap:
+        alt += "; the transonic gap is left open"
+    return ReportFigure(fig, alt, SECTIONS[0])
+
+
+# ---------------------------------------------------------------------------------------------
+# V-g / V-f and root locus per Mach
+# ---------------------------------------------------------------------------------------------
+def _grid(n: int, max_cols: int = 3):
+    """(columns, rows) of ``n`` panels, at most ``max_cols`` wide, rows filled evenly (4 -> 2 x 2).
+
+    >>> _grid(1), _grid(3), _grid(4), _grid(5), _grid(7)
+    ((1, 1), (3, 1), (2, 2), (3, 2), (3, 3))
+    """
+    rows = math.ceil(n / max_cols)
+    return math.ceil(n / rows), rows
+
+
+def _vg_panel(ax_g, ax_f, r, velocities):
+    pk = r.pk
+    plot_vg(ax_g, ax_f, pk.velocities, pk.p, pk.mode_labels, g_limits=None)
+    f = r.flutter
+    if f is not None and not r.unstable_at_start:
+        ax_g.plot(f.speed, 0.0, "r*", ms=12, label="flutter point")
+        ax_f.plot(f.speed, f.frequency_hz, "r*", ms=12)
+        head = f"flutter {f.speed:.1f} m/s, {f.frequency_hz:.4g} Hz ({f.mode_name})"
+    elif r.unstable_at_start:
+        head = f"unstable at the first point ({velocities[0]:g} m/s)"
+    else:
+        head = f"no flutter up to {velocities[-1]:g} m/s"
+    ax_g.set_title(f"{condition_label(r.condition)}\n{head}", fontsize=9)
+    ax_g.set_ylim(*G_LIMITS)
+
+
+def fig_vg_mach(a, mach: float, results=None) -> ReportFigure:
+    """V-g (top) and V-f (bottom) of every flight condition at ``mach``: one column per
+    condition, colours per mode (:func:`asekit.util.plotting.plot_vg`), flutter points starred.
+    ``results``: the conditions to draw (default: every one analysed at ``mach``)."""
+    rs = [r for r in a.flutter.results if r.mach == mach] if results is None else list(results)
+    U = a.case.flight.velocities
+    ncols, npairs = _grid(len(rs))
+    fig, axes = new_figure(f"{a.case.name}: V-g and V-f at M {mach:g}", nrows=2 * npairs,
+                           ncols=ncols, figsize=(3.8 * ncols + 0.8, 5.0 * npairs + 1.0),
+                           sharex=True, sharey="row", layout="constrained")
+    axes = np.asarray(axes, dtype=object).reshape(2 * npairs, ncols)
+    for i, r in enumerate(rs):
+        _vg_panel(axes[2 * (i // ncols), i % ncols], axes[2 * (i // ncols) + 1, i % ncols], r, U)
+    for i in range(len(rs), npairs * ncols):           # empty slots of the last row
+        axes[-2, i % ncols].set_visible(False)
+        axes[-1, i % ncols].set_visible(False)
+    for col in range(ncols):
+        last = (len(rs) - 1 - col) // ncols             # the column's last pair
+        axes[2 * last + 1, col].xaxis.set_tick_params(labelbottom=True)
+        axes[2 * last + 1, col].set_xlabel("airspeed U (m/s)")
+        for row in range(2 * npairs):
+            if col:
+                axes[row, col].set_ylabel("")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(len(labels), 7))
+    for row in range(0, 2 * npairs, 2):                # the g label is long: a taller row
+        axes[row, 0].yaxis.label.set_fontsize(9)
+    alt = (f"V-g and V-f at M {mach:g}: " + "; ".join(
+        f"at {condition_label(r.condition)} {flutter_phrase(r, U)}" for r in rs))
+    return ReportFigure(fig, alt, SECTIONS[1])
+
+
+def fig_root_locus_mach(a, mach: float, results=None) -> ReportFigure:
+    """The p-k roots at ``mach`` in the complex plane (Re p 1/s, Im p / 2 pi Hz) over the
+    airspeed sweep, one colour per flight condition, modes named at the lowest speed, flutter
+    points starred. ``results``: the conditions to draw (default: every one at ``mach``)."""
+    rs = [r for r in a.flutter.results if r.mach == mach] if results is None else list(results)
+    fig, ax = new_figure(f"{a.case.name}: root locus of the p-k roots at M {mach:g}",
+                         figsize=(8.0, 5.2), layout="constrained")
+    for i, r in enumerate(rs):
+        p = r.pk.p
+        for j in range(p.shape[1]):
+            ax.plot(p[:, j].real, p[:, j].imag / (2 * math.pi), "-", color=f"C{i}", lw=1.2,
+                    label=condition_label(r.condition) if j == 0 else None)
+            ax.plot(p[0, j].real, p[0, j].imag / (2 * math.pi), "o", color=f"C{i}", ms=4,
+                    mfc="none")
+            if i == 0:
+                ax.annotate(r.pk.mode_labels[j], (p[0, j].real, p[0, j].imag / (2 * math.pi)),
+                            textcoords="offset points", xytext=(-4, 4), ha="right", fontsize=8)
+        f = r.flutter
+        if f is not None and not r.unstable_at_start:
+            ax.plot(0.0, f.frequency_hz, "*", color=f"C{i}", mec="k", ms=13, zorder=5)
+    ax.plot([], [], "o", color="0.3", mfc="none", ms=4, label="lowest airspeed")
+    ax.plot([], [], "*", color="0.6", mec="k", ms=13, label="flutter point")
+    ax.axvline(0.0, color="k", lw=0.8)
+    ax.set_xlabel("Re p (1/s), > 0 unstable")
+    ax.set_ylabel("Im p / 2 pi (Hz)")
+    _legend_right(ax, fontsize=8)
+    U = a.case.flight.velocities
+    alt = (f"Root locus at M {mach:g} from {U[0]:g} to {U[-1]:g} m/s, one colour per "
+           f"condition: " + "; ".join(f"at {condition_label(r.condition)} "
+                                      f"{flutter_phrase(r, U)}" for r in rs))
+    return ReportFigure(fig, alt, SECTIONS[1])
+
+
+# ---------------------------------------------------------------------------------------------
+# structure
+# ---------------------------------------------------------------------------------------------
+def _outlines(polygons):
+    """Closed outlines of polygons given by their (x, y) corners (m), as (span y, chord x)
+    point lists for a LineCollection; any number of corners per polygon.
+
+    >>> _outlines([[(0, 0), (1, 0), (1, 2)]])[0].tolist()
+    [[0.0, 0.0], [0.0, 1.0], [2.0, 1.0], [0.0, 0.0]]
+    """
+    out = []
+    for p in polygons:
+        p = np.asarray(p, float)[:, :2]
+        out.append(np.vstack([p, p[:1]])[:, ::-1])
+    return out
+
+
+def fig_planform(a) -> ReportFigure:
+    """The planform in two panels sharing their axes: the FE mesh (grey, with the pitch axis of
+    a shaft support) and the aerodynamic boxes (orange outlines over the FE mesh, faint), so
+    that neither hides the other however close the two meshes are."""
+    from matplotlib.collections import LineCollection
+    mesh = P.structural_mesh(a.case)
+    boxes = P.box_mesh(a.case).corners
+    n_el, n_box = len(mesh.elements), len(boxes)
+    fe = _outlines([mesh.nodes[np.asarray(e)] for e in mesh.elements])
+    fig, (ax1, ax2) = new_figure(f"{a.case.name}: planform, FE mesh and aerodynamic boxes",
+                                 ncols=2, figsize=(8.0, 5.0), sharex=True, sharey=True,
+                                 layout="constrained")
+    ax1.add_collection(LineCollection(fe, colors="0.3", lw=0.8))
+    ax1.set_title(f"FE mesh: {n_el} plate elements", fontsize=10)
+    ax2.add_collection(LineCollection(fe, colors="0.75", lw=0.6, zorder=2))
+    ax2.add_collection(LineCollection(_outlines(boxes), colors="C1", lw=1.0,
+                                      zorder=3))
+    ax2.set_title(f"aerodynamic boxes: {n_box} (FE mesh faint)", fontsize=10)
+    s = a.case.support
+    shaft = s is not None and s.kind == "shaft"
+    for ax in (ax1, ax2):
+        if shaft:
+            ax.plot(s.axis_point[1], s.axis_point[0], "rs", zorder=4, label="pitch axis")
+        ax.autoscale_view()
+        ax.set_xlabel("y (m), span from the root")
+        ax.set_aspect("equal")
+    ax1.set_ylabel("x (m), downstream")
+    ax1.invert_yaxis()
+    if shaft:                                          # below the panels: covers no box
+        fig.legend(handles=ax1.get_lines()[-1:], loc="outside lower center")
+    alt = (f"Planform of {a.case.name}: left the FE mesh of {n_el} plate elements, right the "
+           f"{n_box} aerodynamic boxes (orange) over the FE mesh (faint grey)"
+           + ("; the pitch axis marked red" if shaft else ""))
+    return ReportFigure(fig, alt, SECTIONS[2])
+
+
+def _mode_panel(ax, m, tri, j, levels):
+    w = m.shapes[:, 0, j]
+    scale = np.abs(w).max()
+    w = w / scale if scale > 0 else w
+    cs = ax.tricontourf(m.nodes[:, 1], m.nodes[:, 0], tri, w, levels=levels, cmap="RdBu_r",
+                        vmin=-1.0, vmax=1.0)
+    if w.min() < 0 < w.max():
+        ax.tricontour(m.nodes[:, 1], m.nodes[:, 0], tri, w, levels=[0.0], colors="k",
+                      linewidths=1.4)
+    ax.set_title(f"{mode_label(j, m.n_rigid)}: {m.frequencies_hz[j]:.4g} Hz", fontsize=10)
+    ax.set_aspect("equal")
+    return cs
+
+
+def fig_modes(a) -> ReportFigure:
+    """Every kept mode (the rigid pitch mode included): w normalised to max |w| = 1, one colour
+    bar, the node lines (w = 0) in black."""
+    m = a.modal
+    n = len(m.frequencies_hz)
+    ncols, nrows = _grid(n)
+    fig, axes = new_figure(f"{a.case.name}: mode shapes w / max|w|, node lines (w = 0) black",
+                           nrows=nrows, ncols=ncols, figsize=(3.4 * ncols + 1.2, 3.2 * nrows + 0.8),
+                           sharex=True, sharey=True, layout="constrained")
+    axes = np.atleast_1d(np.asarray(axes, dtype=object)).ravel()
+    el = np.asarray(m.elements)
+    tri = np.concatenate([el[:, [0, 1, 2]], el[:, [0, 2, 3]]])
+    levels = np.linspace(-1.0, 1.0, 21)
+    cs = None
+    for j in range(n):
+        cs = _mode_panel(axes[j], m, tri, j, levels)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    for j, ax in enumerate(axes[:n]):                  # shared axes: labels on the outside
+        if j % ncols == 0:
+            ax.set_ylabel("x (m)")
+        if j + ncols >= n:
+            ax.set_xlabel("y (m)")
+            ax.xaxis.set_tick_params(labelbottom=True)
+    axes[0].invert_yaxis()                             # shared: once for all
+    axes[0].locator_params(axis="x", nbins=4)          # tick labels clear of the neighbour's
+    fig.colorbar(cs, ax=list(axes[:n]), label="w / max|w| (-)", shrink=0.7)
+    alt = (f"Mode shapes of the {n} kept modes (w normalised, node lines black): "
+           + ", ".join(f"{mode_label(j, m.n_rigid)} {m.frequencies_hz[j]:.4g} Hz"
+                       for j in range(n)))
+    return ReportFigure(fig, alt, SECTIONS[2])
+
+
+# ---------------------------------------------------------------------------------------------
+# the ASE loop
+# ---------------------------------------------------------------------------------------------
+def fig_ase_bode(a) -> ReportFigure:
+    """Gain (dB) and phase (deg) of the forward paths FWTF 1-3, gain crossovers marked."""
+    s = a.ase
+    f = np.logspace(0, 3.5, 800)
+    fig, (ax1, ax2) = new_figure(f"{a.case.name}: forward paths FWTF 1-3, M {s.mach:g}",
+                                 nrows=2, figsize=(7.0, 6.4), sharex=True, layout="constrained")
+    for i in (1, 2, 3):
+        h = ase_mod.frequency_response(ase_mod.forward_path(s.model, s.controller, i), f)
+        ax1.semilogx(f, 20 * np.log10(np.abs(h)), label=f"FWTF {i}")
+        ax2.semilogx(f, np.degrees(np.unwrap(np.angle(h))))
+        c = s.crossovers[i]
+        if c.gain_crossovers_hz.size:
+            ax1.plot(c.gain_crossovers_hz[0], 0.0, "k|", ms=12)
+    ax1.axhline(0.0, color="k", lw=0.8)
+    ax2.axhline(-180.0, color="k", lw=0.8)
+    ax1.set_ylabel("gain (dB)")
+    ax2.set_ylabel("phase (deg)")
+    ax2.set_xlabel("frequency (Hz)")
+    ax1.legend()
+    pm = "; ".join(f"FWTF {i} phase margin {c.phase_margin_deg:.1f} deg"
+                   for i, c in s.crossovers.items() if c.phase_margin_deg is not None
+                   and math.isfinite(c.phase_margin_deg))
+    alt = f"Bode plot of the forward paths FWTF 1-3 at M {s.mach:g}" + (f": {pm}" if pm else "")
+    return ReportFigure(fig, alt, SECTIONS[3])
+
+
+def fig_ase_steps(a) -> ReportFigure:
+    """Fin-root pitch (deg) of the power-limited step responses against time (ms)."""
+    s = a.ase
+    step = a.case.actuator.step_deg
+    fig, ax = new_figure(f"{a.case.name}: power-limited step, fin-root pitch",
+                         figsize=(7.0, 4.4), layout="constrained")
+    for t, sim in s.simulations.items():
+        ax.plot(sim.t * 1e3, np.degrees(sim.fin_root), label=t)
+    ax.axhline(step, color="k", lw=0.8, ls="--", label="command")
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("fin-root pitch (deg)")
+    ax.set_ylim(-0.5 * step, 2.5 * step)
+    ax.legend()
+    alt = (f"Fin-root pitch after a {step:g} deg step command: " + "; ".join(
+        f"{t} {'stable' if s.stable[t] else 'unstable'}" for t in s.simulations))
+    return ReportFigure(fig, alt, SECTIONS[3])
+
+
+def figures(a) -> dict:
+    """{file name: :class:`ReportFigure`} of the report, in page order: the Mach figure, V-g /
+    V-f and root locus at every analysed Mach, the planform and mode shapes, and with an
+    actuator the ASE figures."""
+    out = {"flutter_mach": fig_flutter_mach(a)}
+    for i, m in enumerate(_machs(a)):
+        out[f"vg_{i}"] = fig_vg_mach(a, m)              # i: the Mach's rank, ascending
+        out[f"root_locus_{i}"] = fig_root_locus_mach(a, m)
+    out["planform"] = fig_planform(a)
+    out["modes"] = fig_modes(a)
+    if a.ase is not None:
+        out["ase_bode"] = fig_ase_bode(a)
+        out["ase_steps"] = fig_ase_steps(a)
+    return out
