@@ -16,15 +16,12 @@ No intersphinx, no CDN. ``-D nb_execution_mode=cache`` reuses executed notebooks
 from __future__ import annotations
 
 import os
-import re
-import shutil
 import sys
 from pathlib import Path
 
-from sphinx.errors import ConfigError
-
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))        # the checkout's asekit, also when it is not installed
+sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 
 import asekit  # noqa: E402
 
@@ -40,6 +37,7 @@ extensions = [
     "sphinx.ext.mathjax",
     "numpydoc",
     "myst_nb",
+    "asekit_docs",
 ]
 
 root_doc = "index"
@@ -74,13 +72,8 @@ nb_ipywidgets_js: dict = {}          # no widget manager from a CDN: panels show
 # leave every figure undrawn)
 os.environ.pop("MPLBACKEND", None)
 
-# --- math offline: MathJax 2.7 from the jupyter-server-mathjax package, copied into _static
-try:
-    import jupyter_server_mathjax
-except ImportError as exc:        # pragma: no cover - depends on the environment
-    raise ConfigError("the docs need jupyter-server-mathjax (offline MathJax): "
-                      "pip install -e '.[docs]'") from exc
-MATHJAX_DIR = Path(jupyter_server_mathjax.__file__).parent / "static"
+# --- math offline: MathJax 2.7 of the jupyter-server-mathjax package, copied into _static by
+# the asekit_docs extension (docs/_ext/asekit_docs.py)
 mathjax_path = "mathjax/MathJax.js?config=TeX-AMS-MML_HTMLorMML-full"
 # the package ships the STIX-Web fonts only (as the Jupyter notebook configures them)
 mathjax2_config = {
@@ -103,67 +96,3 @@ html_theme_options = {
 html_static_path: list[str] = []
 html_show_sourcelink = False
 html_copy_source = False
-
-
-_LITERAL = re.compile(r"(``.*?``|`[^`]*`)")
-
-
-def escape_bars(lines):
-    """Escape ``|`` in the prose of a docstring (a list of lines, changed in place).
-
-    The docstrings write absolute values and norms as plain text (``g = 2 Re p / |Im p|``),
-    which reStructuredText reads as substitution references; only the rendered copy is changed
-    (``help()`` and the doctests read the source). Literal blocks (after ``::``), doctest
-    lines, inline literals and roles, and grid-table rows are left as they are.
-    """
-    literal_indent = None
-    for i, line in enumerate(lines):
-        stripped = line.strip()
-        indent = len(line) - len(line.lstrip())
-        if literal_indent is not None:
-            if not stripped or indent > literal_indent:
-                continue
-            literal_indent = None
-        if stripped.endswith("::"):
-            literal_indent = indent
-        table_row = stripped.startswith("|") and stripped.endswith("|") and stripped.count("|") > 2
-        if (not stripped or table_row or stripped.startswith((">>>", "...", "+-", "+="))
-                or "|" not in line):
-            continue
-        parts = _LITERAL.split(line)
-        lines[i] = "".join(part if k % 2 else part.replace("|", r"\|")
-                           for k, part in enumerate(parts))
-
-
-def _escape_bars(app, what, name, obj, options, lines):
-    escape_bars(lines)
-
-
-def _copy_mathjax(app, exception):
-    """Copy MathJax into ``_static/mathjax`` of an HTML build (``mathjax_path`` points there)."""
-    if exception is None and app.builder.format == "html":
-        shutil.copytree(MATHJAX_DIR, Path(app.outdir) / "_static" / "mathjax",
-                        dirs_exist_ok=True, ignore=shutil.ignore_patterns("__pycache__"))
-
-
-def _notebook_links(app, doctree):
-    """Links between notebooks (``ch3_flutter.ipynb``) name documents of ``notebooks/``.
-
-    ``docs/notebooks`` is a symbolic link; Sphinx resolves link targets through it to the real
-    folder, outside the source tree, so they are mapped back to their documents here.
-    """
-    from sphinx import addnodes
-
-    real = str(ROOT / "notebooks") + os.sep
-    for node in doctree.findall(addnodes.pending_xref):
-        target = node.get("reftarget", "")
-        if node.get("reftype") == "myst" and target.startswith(real):
-            node["reftarget"] = "notebooks/" + target[len(real):]
-
-
-def setup(app):
-    if not (MATHJAX_DIR / "MathJax.js").is_file():
-        raise ConfigError(f"MathJax.js not found in {MATHJAX_DIR}: reinstall jupyter-server-mathjax")
-    app.connect("autodoc-process-docstring", _escape_bars)
-    app.connect("doctree-read", _notebook_links)
-    app.connect("build-finished", _copy_mathjax)
