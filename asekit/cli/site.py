@@ -137,7 +137,8 @@ def _css_problems(css: Path, root: Path) -> list[str]:
 def check_site(outdir) -> list[str]:
     """Offline check of a built HTML site: one line per problem, none when it is sound.
 
-    A problem is a page that loads a script, style sheet, image, frame or media file from the
+    A page is an HTML file outside ``_static`` (which holds the theme's templates). A problem
+    is a page that loads a script, style sheet, image, frame or media file from the
     network (``http(s)://`` or ``//``; links the reader may follow to the web are allowed), a
     local link or loaded file that does not exist, a ``#fragment`` naming no element of its
     target page, a style sheet whose ``url()`` or ``@import`` points to the network or to a
@@ -175,6 +176,8 @@ def check_site(outdir) -> list[str]:
         raise ValueError(f"outdir must be a built site holding index.html, got {root}")
     pages, problems = {}, []
     for html in sorted(root.rglob("*.html")):
+        if "_static" in html.relative_to(root).parts:    # theme templates, not pages
+            continue
         page = _Page()
         page.feed(html.read_text(encoding="utf-8", errors="replace"))
         pages[html.resolve()] = page

@@ -30,6 +30,8 @@ def _sound_site(root):
            "a { background: url(data:image/png;base64,AAAA); }")
     for f in site.MATHJAX_FILES:
         _write(root / f)
+    # a theme's template in _static is not a page (its links are Jinja expressions)
+    _write(root / "_static" / "macros.html", "<script src=\"{{ pathto('x.js', 1) }}\"></script>")
     return root
 
 
