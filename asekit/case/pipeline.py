@@ -279,8 +279,27 @@ def _shaft(case: Case, what: str):
 
 @_door("the pitch inertia", _STRUCTURE)
 def pitch_inertia_exact(case: Case) -> float:
-    """Pitch inertia (kg m^2) of a one-panel flat case about its shaft axis by exact integration
-    (:func:`asekit.structure.assembly.plate_pitch_inertia`; no point masses)."""
+    """Pitch inertia of a one-panel flat case about its shaft axis, by exact integration.
+
+    J = int_y rho h(y) int_x [(x - x_axis)^2 + h(y)^2 / 12] dx dy over the planform, with the
+    plate's own rotary inertia (:func:`asekit.structure.assembly.plate_pitch_inertia`; no point
+    masses): the reference for the FE model's J_fin.
+
+    Parameters
+    ----------
+    case : Case
+        A one-panel case with ``support.kind = "shaft"``.
+
+    Returns
+    -------
+    float
+        The pitch inertia (kg m^2).
+
+    Raises
+    ------
+    CaseError
+        More than one panel, no shaft, or a thickness or material the integration refuses.
+    """
     p = _one_panel(case, "pitch_inertia_exact")
     try:
         return plate_pitch_inertia(p.planform, case.thickness, case.material.density,
@@ -291,8 +310,21 @@ def pitch_inertia_exact(case: Case) -> float:
 
 @_door("the in-plane modes", _STRUCTURE)
 def inplane_modes(case: Case, n_modes: int = 4) -> InPlaneModes:
-    """In-plane modes of a shaft-supported case held only at the shaft node
-    (:func:`asekit.structure.modes.inplane_modes` on :func:`structural_mesh`)."""
+    """In-plane (membrane) modes of a shaft-supported case held only at the shaft node.
+
+    Parameters
+    ----------
+    case : Case
+        A case with ``support.kind = "shaft"``.
+    n_modes : int, optional
+        Number of modes (default 4).
+
+    Returns
+    -------
+    InPlaneModes
+        Frequencies (Hz) and shapes (:func:`asekit.structure.modes.inplane_modes` on
+        :func:`structural_mesh`); the first is the in-plane rigid rotation about the shaft.
+    """
     return _inplane_modes(structural_mesh(case), case.material,
                           _shaft(case, "inplane_modes").axis_point, n_modes)
 
@@ -1033,9 +1065,29 @@ def corner_points(case: Case) -> dict:
 
 @_door("the actuator", _ASE)
 def actuator_setup(case: Case):
-    """(ActuatorParameters, PDController, PowerLimits) of the case's ``[actuator]``: the keys
-    it sets, asekit's defaults (thesis Tables 12, 16, 17) for the rest. The actuator's load
-    inertia is 0: the fin's inertia enters through its modal model (:func:`asekit.ase.loop.build_model`)."""
+    """The servo-actuator of the case's ``[actuator]``: the keys it sets, asekit's defaults
+    (thesis Tables 12, 16, 17) for the rest.
+
+    Parameters
+    ----------
+    case : Case
+        The case; it needs ``[actuator]``.
+
+    Returns
+    -------
+    act : ActuatorParameters
+        DC motor and transmission; the load inertia is 0 (the fin's inertia enters through
+        its modal model, :func:`asekit.ase.loop.build_model`).
+    ctl : PDController
+        The controller (gain ``k_c``, ``k_p``, ``k_d``).
+    lim : PowerLimits
+        Supply voltage (V) and current limit (A).
+
+    Raises
+    ------
+    CaseError
+        The case has no ``[actuator]``.
+    """
     a = case.actuator
     if a is None:
         raise CaseError("the case has no [actuator]")
