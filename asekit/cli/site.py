@@ -3,9 +3,10 @@
 Builds the Sphinx site of ``docs/`` (user guide, API reference, every notebook of
 ``notebooks/`` executed into the gallery; ``docs/conf.py``) with warnings as errors,
 
-    sphinx-build -W --keep-going -b html docs OUTDIR
+    sphinx-build -W --keep-going -b html docs OUTDIR/html
 
-then checks the built pages offline (:func:`check_site`): every local link and image exists,
+(the pages in ``OUTDIR/html``; myst-nb's executed notebooks and cache beside them, so nothing
+is written outside OUTDIR), then checks the built pages offline (:func:`check_site`): every local link and image exists,
 every ``#anchor`` names an element of its page, and no page loads a script, style sheet, image
 or frame from the network. The sources live in a checkout of the repository, not in the
 installed package: without them (e.g. from a wheel) the command says so in one line and exits 2.
@@ -134,6 +135,28 @@ def _css_problems(css: Path, root: Path) -> list[str]:
     return problems
 
 
+def _page_problems(html: Path, page: _Page, root: Path, pages: dict) -> list[str]:
+    """The problems of one parsed page ``html`` of the site in ``root`` (all pages: ``pages``)."""
+    name, problems = html.relative_to(root), []
+    for url in page.loaded:
+        if _is_remote(url):
+            problems.append(f"{name}: loads {url} from the network")
+        elif _is_local(url) and not url.startswith("data:") and not _target(html, url)[0].exists():
+            problems.append(f"{name}: missing {url}")
+    for url in page.links:
+        if not _is_local(url) or url.startswith(("data:", "javascript:")):
+            continue
+        path, fragment = _target(html, url)
+        if not path.exists():
+            problems.append(f"{name}: broken link {url}")
+        elif fragment and path.suffix == ".html":
+            target = pages.get(path.resolve())
+            if target is not None and fragment not in target.ids:
+                problems.append(f"{name}: broken link {url} (no id {fragment!r} in "
+                                f"{path.resolve().relative_to(root)})")
+    return problems
+
+
 def check_site(outdir) -> list[str]:
     """Offline check of a built HTML site: one line per problem, none when it is sound.
 
@@ -148,7 +171,8 @@ def check_site(outdir) -> list[str]:
     Parameters
     ----------
     outdir : str or pathlib.Path
-        The folder of the built site (sphinx-build's output folder, with ``index.html``).
+        The folder of the built site (sphinx-build's output folder, with ``index.html``), or
+        the folder of :func:`build` holding it as ``html/``.
 
     Returns
     -------
@@ -172,6 +196,8 @@ def check_site(outdir) -> list[str]:
     index.html: broken link #top (no id 'top' in index.html)
     """
     root = Path(outdir)
+    if not (root / "index.html").is_file() and (root / "html" / "index.html").is_file():
+        root = root / "html"
     if not (root / "index.html").is_file():
         raise ValueError(f"outdir must be a built site holding index.html, got {root}")
     pages, problems = {}, []
@@ -183,25 +209,8 @@ def check_site(outdir) -> list[str]:
         pages[html.resolve()] = page
     uses_mathjax = False
     for html, page in pages.items():
-        name = html.relative_to(root.resolve())
-        for url in page.loaded:
-            uses_mathjax |= "mathjax/MathJax.js" in url
-            if _is_remote(url):
-                problems.append(f"{name}: loads {url} from the network")
-            elif _is_local(url) and not url.startswith("data:") \
-                    and not _target(html, url)[0].exists():
-                problems.append(f"{name}: missing {url}")
-        for url in page.links:
-            if not _is_local(url) or url.startswith(("data:", "javascript:")):
-                continue
-            path, fragment = _target(html, url)
-            if not path.exists():
-                problems.append(f"{name}: broken link {url}")
-            elif fragment and path.suffix == ".html":
-                target = pages.get(path.resolve())
-                if target is not None and fragment not in target.ids:
-                    problems.append(f"{name}: broken link {url} (no id {fragment!r} in "
-                                    f"{path.resolve().relative_to(root.resolve())})")
+        problems += _page_problems(html, page, root.resolve(), pages)
+        uses_mathjax |= any("mathjax/MathJax.js" in url for url in page.loaded)
     for css in sorted(root.rglob("*.css")):
         problems += _css_problems(css, root)
     if uses_mathjax:
@@ -211,12 +220,14 @@ def check_site(outdir) -> list[str]:
 
 
 def build(outdir, timeout: float = 900.0, cache: bool = False, echo=print) -> int:
-    """Build the site into ``outdir`` with sphinx-build (warnings are errors), then check it.
+    """Build the site into ``outdir/html`` with sphinx-build (warnings are errors), then check it.
 
     Parameters
     ----------
     outdir : str or pathlib.Path
-        Output folder of the HTML pages (created if absent; must not be a file).
+        Output folder (created if absent; must not be a file): the pages go to ``html/``,
+        myst-nb's executed notebooks (``jupyter_execute/``) and cache (``.jupyter_cache/``)
+        beside them.
     timeout : float
         Per-cell timeout of the notebook execution (s), > 0.
     cache : bool
@@ -255,14 +266,14 @@ def build(outdir, timeout: float = 900.0, cache: bool = False, echo=print) -> in
     status = build_main(["-W", "--keep-going", "-b", "html",
                          "-D", f"nb_execution_timeout={int(round(timeout))}",
                          "-D", f"nb_execution_mode={'cache' if cache else 'force'}",
-                         str(docs), str(outdir)])
+                         str(docs), str(outdir / "html")])
     if status:
         return status
-    problems = check_site(outdir)
+    problems = check_site(outdir / "html")
     for line in problems:
         print(f"error: {line}", file=sys.stderr)
-    pages = sum(1 for _ in outdir.rglob("*.html"))
-    echo(f"site written to {outdir / 'index.html'}: {pages} pages in "
+    pages = sum(1 for f in (outdir / "html").rglob("*.html") if "_static" not in f.parts)
+    echo(f"site written to {outdir / 'html' / 'index.html'}: {pages} pages in "
          f"{time.perf_counter() - t0:.0f} s" + (f", {len(problems)} problems" if problems else ""))
     return 1 if problems else 0
 
@@ -272,7 +283,8 @@ def main(argv=None) -> int:
     [--check-only]``; returns the exit status."""
     ap = argparse.ArgumentParser(prog="python -m asekit.cli.site",
                                  description=__doc__.splitlines()[0])
-    ap.add_argument("outdir", help="folder for the HTML pages (created if absent)")
+    ap.add_argument("outdir", help="output folder (created if absent): the pages go to "
+                    "OUTDIR/html")
     ap.add_argument("--timeout", type=float, default=900.0,
                     help="per-cell timeout of the notebook execution (s)")
     ap.add_argument("--cache", action="store_true",

@@ -64,9 +64,12 @@ def test_every_kind_of_problem_is_one_line(tmp_path):
 
 
 def test_check_only_exit_status(tmp_path, capsys):
-    assert site.main([str(_sound_site(tmp_path)), "--check-only"]) == 0
-    _write(tmp_path / "index.html", '<a href="gone.html">gone</a>')
-    assert site.main([str(tmp_path), "--check-only"]) == 1
+    assert site.main([str(_sound_site(tmp_path / "pages")), "--check-only"]) == 0
+    _sound_site(tmp_path / "out" / "html")    # build()'s folder: the pages in OUT/html
+    assert site.main([str(tmp_path / "out"), "--check-only"]) == 0
+    capsys.readouterr()
+    _write(tmp_path / "pages" / "index.html", '<a href="gone.html">gone</a>')
+    assert site.main([str(tmp_path / "pages"), "--check-only"]) == 1
     assert capsys.readouterr().err == "error: index.html: broken link gone.html\n"
     assert site.main([str(tmp_path / "nothing"), "--check-only"]) == 2
     err = capsys.readouterr().err
