@@ -496,8 +496,8 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True,
     (``aero.method``: doublet lattice, Mach box or piston theory) for the normalwash of each
     mode of :func:`modal_model` splined to the boxes of :func:`box_mesh`, integrated against
     each mode, over ``aero.machs`` x :func:`reduced_frequencies`. Forces are per unit
-    dynamic pressure: the aerodynamic generalized force is q Q_mm x (q in Pa, Q in m^3 per
-    unit modal coordinate). Loaded from a shipped database (the fin's ``data/gaf_fin.npz``) or
+    dynamic pressure: the aerodynamic generalized force is q Q_mm x (q in Pa, x the modal
+    coordinates; e.g. Q_cc of the rigid pitch mode in m^3/rad). Loaded from a shipped database (the fin's ``data/gaf_fin.npz``) or
     the user cache (``$ASEKIT_CACHE_DIR``) when one matches its fingerprint (mode set, boxes'
     corners, Mach, k, b_ref, symmetry, method), else computed and written there atomically
     (:func:`asekit.aero.gaf.cached_gaf_database`).
