@@ -109,6 +109,7 @@ def test_bars_escaped_in_prose_only(ext):
 
 
 def test_offline_mathjax_is_installed(ext):
+    pytest.importorskip("jupyter_server_mathjax", reason="the [docs] extra (environment.txt)")
     path = ext.mathjax_dir()
     assert (path / "config" / "TeX-AMS-MML_HTMLorMML-full.js").is_file()
     assert (path / "jax" / "output" / "HTML-CSS" / "fonts" / "STIX-Web" / "fontdata.js").is_file()
