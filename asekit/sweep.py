@@ -159,6 +159,8 @@ DISTRIBUTIONS = ("normal", "uniform", "lognormal", "truncated_normal")
 class Parameter:
     """One varied key.
 
+    Attributes
+    ----------
     path : the case-file key path (or ``flight.mach`` / ``flight.altitude``).
     kind : ``"grid"`` (``values``) or a distribution: ``"normal"`` (``a`` = mean,
         ``b`` = standard deviation), ``"uniform"`` (``low``, ``high``), ``"lognormal"``

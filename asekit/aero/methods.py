@@ -115,18 +115,31 @@ def _matrix_operators(builder):
 class AeroMethod:
     """One unsteady aerodynamic method of the registry.
 
-    name : the ``aero.method`` value; summary : one line; mach_range : its valid Mach numbers
-    (None for ``auto``, which picks a method per Mach); who : how error messages name it;
-    hint : what a message suggests outside the range.
-    structure_independent : its pressure operator depends on the boxes, Mach and k only (not
-    on the mode shapes or the thickness), so one operator per (M, k) serves every structure on
-    the same boxes (:mod:`asekit.sweep` forms it once per sweep).
-    pressure_matrices : builder ``(mesh, mach, ks, b_ref, symmetric, kernel, **options) ->
-    A (n_k, n, n)`` with DeltaCp = A (w/U) (None for ``auto``).
-    operators : builder with the same arguments of one operator per k, each with a
-    ``pressures(w) -> DeltaCp`` method (the DLM: LU factors of D; the others:
-    :class:`PressureMatrix`).
-    reuse_break_even : forming the operators costs about as much as computing the pressures of
+    Attributes
+    ----------
+    name : str
+        The ``aero.method`` value.
+    summary : str
+        One line.
+    mach_range : MachRange or None
+        Its valid Mach numbers (None for ``auto``, which picks a method per Mach).
+    who : str
+        How error messages name it.
+    hint : str
+        What a message suggests outside the range.
+    structure_independent : bool
+        Its pressure operator depends on the boxes, Mach and k only (not on the mode shapes or
+        the thickness), so one operator per (M, k) serves every structure on the same boxes
+        (:mod:`asekit.sweep` forms it once per sweep).
+    pressure_matrices : callable or None
+        Builder ``(mesh, mach, ks, b_ref, symmetric, kernel, **options) -> A`` of the
+        (n_k, n, n) matrices with DeltaCp = A (w/U) (None for ``auto``).
+    operators : callable or None
+        Builder with the same arguments of one operator per k, each with a
+        ``pressures(w) -> DeltaCp`` method (the DLM: LU factors of D; the others:
+        :class:`PressureMatrix`).
+    reuse_break_even : float
+        Forming the operators costs about as much as computing the pressures of
         ``reuse_break_even * n_boxes`` normalwash columns one sample at a time; a sweep forms
         them once when its samples x modes reach that (0: always worth it). The Mach-box
         method: 0.1, measured on the AGARD 445.6 case (256 boxes, 4 modes, 10 k, one BLAS

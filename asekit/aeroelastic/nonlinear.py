@@ -41,13 +41,13 @@ this module only needs (A0, b, c).
 
 Connection law (frozen :class:`Connection`): stiffness k outside a band of half-width delta
 centred on ``preload`` (rad; the band is [preload - delta, preload + delta]), stiffness k1
-(``inner_stiffness``, 0 for pure freeplay) inside it, continuous:
+(``inner_stiffness``, 0 for pure freeplay) inside it, continuous::
 
     f(d) = k1 (d - p)                                 |d - p| <= delta
     f(d) = k1 delta sgn + k (d - p - delta sgn)        otherwise, sgn = sign(d - p).       (2)
 
 Describing function (sinusoidal input d = A sin(omega t), p = 0; Gelb & Vander Velde,
-*Multiple-Input Describing Functions and Nonlinear System Design*, 1968, ch. 2, dead zone):
+*Multiple-Input Describing Functions and Nonlinear System Design*, 1968, ch. 2, dead zone)::
 
     N(A) = k1,                                                    A <= delta
     N(A) = k1 + (k - k1) [1 - (2/pi)(asin(delta/A) + (delta/A) sqrt(1 - (delta/A)^2))],

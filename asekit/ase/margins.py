@@ -48,6 +48,8 @@ __all__ = ["NyquistMargins", "nyquist_margins"]
 class NyquistMargins:
     """Margins of the negative-feedback loop ``1 + k L(s)`` (k = 1 nominal), Nyquist-counted.
 
+    Attributes
+    ----------
     open_loop_unstable_poles : P, open-loop poles with Re > 0 (the poles themselves in
         ``open_loop_rhp_poles``, rad/s).
     origin_poles : open-loop poles at s = 0 (integrators; the contour passes them on the right).

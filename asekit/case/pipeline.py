@@ -95,8 +95,27 @@ def _door(step: str, change: str):
 @lru_cache(maxsize=16)
 @_door("the structural mesh", _STRUCTURE)
 def structural_mesh(case: Case) -> PlateMesh:
-    """The plate mesh of all panels (``panel[i].n_chord x n_span`` elements each), or the
-    imported model's mesh (``case.structure``)."""
+    """The structural finite-element mesh of the case.
+
+    Parameters
+    ----------
+    case : Case
+        The case (:func:`asekit.case.load_case`).
+
+    Returns
+    -------
+    PlateMesh
+        The MITC4 plate mesh of all panels (``panel[i].n_chord x n_span`` elements each;
+        nodes in m, thickness at every node from the case's thickness law), or the imported
+        model's mesh when ``case.structure`` is given. Memoised on the case.
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import FIN_FILE
+    >>> structural_mesh(load_case(FIN_FILE)).elements.shape      # 6 x 7 MITC4 elements
+    (42, 4)
+    """
     if case.structure is not None:
         return case.structure.mesh
     return panels_mesh([p.planform for p in case.panels], case.thickness,
@@ -106,8 +125,22 @@ def structural_mesh(case: Case) -> PlateMesh:
 
 @_door("assembling K and M", _STRUCTURE)
 def mass_and_stiffness(case: Case):
-    """Global sparse K (plate) and M (plate + point masses) of the case's mesh (the imported
-    model's K and M when ``case.structure`` is given, plus the case's point masses)."""
+    """Global stiffness and mass matrices of the case's structural mesh.
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+
+    Returns
+    -------
+    K, M : scipy.sparse.csr_matrix
+        (3 n_nodes, 3 n_nodes) stiffness (N/m, N, N m/rad blocks) and mass (kg, kg m, kg m^2
+        blocks) in the DOFs (w, theta_x, theta_y) of every node: the plate's (Mindlin-Reissner
+        MITC4, :func:`asekit.structure.assembly.assemble`) plus the case's point masses in M,
+        or the imported model's K and M when ``case.structure`` is given. No support applied
+        (that is :func:`supported_system`).
+    """
     mesh = structural_mesh(case)
     K, M = _imported_matrices(case) if case.structure is not None else assemble(mesh,
                                                                                  case.material)
@@ -148,9 +181,25 @@ def _memo_with_warnings(fn):
 
 @_door("the supported structure", _STRUCTURE)
 def supported_system(case: Case) -> SupportedSystem:
-    """The case's supported structure (its ``support.kind`` of
-    :data:`asekit.structure.supports.SUPPORTS`; for a shaft, the FN1 or FN2 system as
-    ``support.model`` says) on :func:`structural_mesh` with :func:`mass_and_stiffness`."""
+    """The case's supported structure: K and M reduced by its support.
+
+    Parameters
+    ----------
+    case : Case
+        The case; ``support.kind`` names a kind of :data:`asekit.structure.supports.SUPPORTS`
+        (for a shaft, the FN1 or FN2 system as ``support.model`` says).
+
+    Returns
+    -------
+    SupportedSystem
+        The reduced stiffness and mass (u = T q) on :func:`structural_mesh` with
+        :func:`mass_and_stiffness`, or the imported deck's own supports.
+
+    Raises
+    ------
+    CaseError
+        A support key the kind refuses (the message names ``support.<key>``).
+    """
     K, M = mass_and_stiffness(case)
     if case.structure is not None:             # the imported deck's own supports
         return case.structure.supported_system(K, M)
@@ -163,11 +212,36 @@ def supported_system(case: Case) -> SupportedSystem:
 @_memo_with_warnings
 @_door("the modal model (plate eigenproblem: ARPACK with SuperLU)", _STRUCTURE)
 def modal_model(case: Case) -> ModalModel:
-    """The case's modal model (thesis Eqs. 2.45-2.46): for a shaft with ``model = "FN2"`` and
-    ``modes.keep_rigid`` the rigid pitch mode first (n_rigid = 1), otherwise the elastic modes
-    only; damping from ``[damping]``. Built by the support kind's ``modal_model``
-    (:data:`asekit.structure.supports.SUPPORTS`); memoised on the case, its arrays read-only.
-    An imported structure: :func:`imported_modal_model`.
+    """The case's modal model: natural modes of the supported plate (thesis Eqs. 2.45-2.46).
+
+    Solves the generalised eigenproblem K phi = omega^2 M phi of :func:`supported_system`
+    (shift-invert ARPACK) and keeps the elastic modes below ``modes.f_max`` (Hz) or the first
+    ``modes.count``, mass-normalised (phi^T M phi = I). For a shaft with ``model = "FN2"`` and
+    ``modes.keep_rigid`` the rigid pitch mode comes first (n_rigid = 1, a unit nose-up pitch
+    about the shaft, 0 Hz), otherwise the elastic modes only. Modal damping from
+    ``[damping]`` (zeta or g = 2 zeta). Built by the support kind's ``modal_model``
+    (:data:`asekit.structure.supports.SUPPORTS`); an imported structure:
+    :func:`imported_modal_model`.
+
+    Parameters
+    ----------
+    case : Case
+        The case (:func:`asekit.case.load_case`).
+
+    Returns
+    -------
+    ModalModel
+        ``frequencies_hz`` (Hz), modal mass ``M`` (1 for elastic modes; J_fin in kg m^2 for
+        the rigid mode), stiffness ``K`` ((rad/s)^2 on the diagonal), damping ``C``, the mode
+        ``shapes`` (w in m, rotations in rad per unit modal coordinate) at the FE ``nodes``.
+        Memoised on the (frozen) case: one object per case, its arrays read-only.
+
+    Raises
+    ------
+    CaseError
+        No elastic mode below ``modes.f_max``, or a support or damping value the model refuses.
+    SolverError
+        The eigenproblem failed; the message says which case keys to check.
 
     Examples
     --------
@@ -215,8 +289,27 @@ def _shaft(case: Case, what: str):
 
 @_door("the pitch inertia", _STRUCTURE)
 def pitch_inertia_exact(case: Case) -> float:
-    """Pitch inertia (kg m^2) of a one-panel flat case about its shaft axis by exact integration
-    (:func:`asekit.structure.assembly.plate_pitch_inertia`; no point masses)."""
+    """Pitch inertia of a one-panel flat case about its shaft axis, by exact integration.
+
+    J = int_y rho h(y) int_x [(x - x_axis)^2 + h(y)^2 / 12] dx dy over the planform, with the
+    plate's own rotary inertia (:func:`asekit.structure.assembly.plate_pitch_inertia`; no point
+    masses): the reference for the FE model's J_fin.
+
+    Parameters
+    ----------
+    case : Case
+        A one-panel case with ``support.kind = "shaft"``.
+
+    Returns
+    -------
+    float
+        The pitch inertia (kg m^2).
+
+    Raises
+    ------
+    CaseError
+        More than one panel, no shaft, or a thickness or material the integration refuses.
+    """
     p = _one_panel(case, "pitch_inertia_exact")
     try:
         return plate_pitch_inertia(p.planform, case.thickness, case.material.density,
@@ -227,8 +320,21 @@ def pitch_inertia_exact(case: Case) -> float:
 
 @_door("the in-plane modes", _STRUCTURE)
 def inplane_modes(case: Case, n_modes: int = 4) -> InPlaneModes:
-    """In-plane modes of a shaft-supported case held only at the shaft node
-    (:func:`asekit.structure.modes.inplane_modes` on :func:`structural_mesh`)."""
+    """In-plane (membrane) modes of a shaft-supported case held only at the shaft node.
+
+    Parameters
+    ----------
+    case : Case
+        A case with ``support.kind = "shaft"``.
+    n_modes : int, optional
+        Number of modes (default 4).
+
+    Returns
+    -------
+    InPlaneModes
+        Frequencies (Hz) and shapes (:func:`asekit.structure.modes.inplane_modes` on
+        :func:`structural_mesh`); the first is the in-plane rigid rotation about the shaft.
+    """
     return _inplane_modes(structural_mesh(case), case.material,
                           _shaft(case, "inplane_modes").axis_point, n_modes)
 
@@ -306,11 +412,38 @@ def imported_box_mesh(case: Case):
 @lru_cache(maxsize=16)
 @_door("the aerodynamic boxes", _AERO)
 def box_mesh(case: Case):
-    """The doublet-lattice boxes, per panel ``aero.boxes`` or automatic (the mesh rule of the
-    method used at each Mach, :func:`asekit.case.resources.box_counts`),
-    or the imported structure's boxes; the surfaces are named ``"surface"`` (one panel) or
-    ``"panel<i>"``. Refuses (ValueError from :func:`asekit.aero.boxes.check_matrix_memory`) a
-    mesh whose dense DLM matrix would not fit in memory."""
+    """The aerodynamic boxes (panels of the lifting-surface mesh) of the case.
+
+    Per panel, ``aero.boxes`` (n_chord, n_span) or, with ``boxes = "auto"``, the mesh rule
+    of the method used at each Mach (:func:`asekit.case.resources.box_counts`: box length
+    against the shortest wavelength, aspect ratio); an imported structure's own boxes (CAERO1). The surfaces
+    are named ``"surface"`` (one panel) or ``"panel<i>"``.
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+
+    Returns
+    -------
+    BoxMesh
+        ``corners`` (n_boxes, 4, 3) m, ``strip`` and ``surface`` indices per box; memoised
+        on the case.
+
+    Raises
+    ------
+    ValueError
+        The dense DLM matrix of that many boxes would not fit in memory
+        (:func:`asekit.aero.boxes.check_matrix_memory`); the message names ``aero.f_max``,
+        ``aero.u_min`` or ``aero.boxes``.
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import CASES_DIR
+    >>> box_mesh(load_case(CASES_DIR / "agard445_6.toml")).corners.shape   # 16 x 16 boxes
+    (256, 4, 3)
+    """
     if case.structure is not None:
         return imported_box_mesh(case)
     a = case.aero
@@ -326,8 +459,22 @@ def box_mesh(case: Case):
 
 @_door("the reduced frequencies", _AERO)
 def reduced_frequencies(case: Case) -> np.ndarray:
-    """``aero.reduced_frequencies`` or, automatically, :func:`default_reduced_frequencies` up
-    to k_max = 2 pi f_max b / u_min (thesis Sec. 3.2.1).
+    """The reduced frequencies k = omega b / U of the GAF database.
+
+    ``aero.reduced_frequencies`` when given, otherwise :func:`default_reduced_frequencies` up
+    to k_max = 2 pi f_max b / u_min (thesis Sec. 3.2.1; b = ``aero.reference_semichord`` m,
+    f_max = ``aero.f_max`` Hz, u_min = ``aero.u_min`` m/s), so that the database covers every
+    mode up to f_max at every speed down to u_min.
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_k,) ascending reduced frequencies (dimensionless).
 
     Examples
     --------
@@ -343,15 +490,55 @@ def reduced_frequencies(case: Case) -> np.ndarray:
 @_door("the GAF database (doublet lattice, Mach box or piston theory)", _AERO)
 def gaf_database(case: Case, progress: bool = True, cache: bool = True,
                  path=None) -> GafDatabase:
-    """Q_mm(M, k) over ``aero.machs`` x the reduced frequencies of :func:`modal_model` on
-    :func:`box_mesh`, loaded from a shipped database (the fin's ``data/gaf_fin.npz``) or the
-    user cache when one matches its fingerprint (mode set, boxes' corners, Mach, k, b_ref,
-    symmetry, method), else rebuilt (``cache=False``: always) into the user cache or ``path``
+    """The generalized aerodynamic forces Q_mm(M, k) of the case (thesis Sec. 2.2).
+
+    Q_mm = Phi_a^T S A(M, k) W Phi_a: the pressures of the case's aerodynamic method
+    (``aero.method``: doublet lattice, Mach box or piston theory) for the normalwash of each
+    mode of :func:`modal_model` splined to the boxes of :func:`box_mesh`, integrated against
+    each mode, over ``aero.machs`` x :func:`reduced_frequencies`. Forces are per unit
+    dynamic pressure: the aerodynamic generalized force is q Q_mm x (q in Pa, x the modal
+    coordinates; e.g. Q_cc of the rigid pitch mode in m^3/rad). Loaded from a shipped database (the fin's ``data/gaf_fin.npz``) or
+    the user cache (``$ASEKIT_CACHE_DIR``) when one matches its fingerprint (mode set, boxes'
+    corners, Mach, k, b_ref, symmetry, method), else computed and written there atomically
     (:func:`asekit.aero.gaf.cached_gaf_database`). A rebuild caches each (Mach, k) entry as it
     is computed, so a failed or interrupted run resumes where it stopped
     (:class:`asekit.aero.gaf.GafEntryCache`). Before anything is computed, the case's
     resources are checked (:func:`asekit.case.schema.check_resources`: a case built in Python
-    skips the loader's check), a case over a limit refused with a CaseError naming the keys."""
+    skips the loader's check).
+
+    Parameters
+    ----------
+    case : Case
+        The case; it needs aerodynamics (``[aero]``).
+    progress : bool, optional
+        Show a progress bar while the database is computed (default True).
+    cache : bool, optional
+        Read and write the cache (default True); False always recomputes.
+    path : str or pathlib.Path, optional
+        A file to write the database to instead of the user cache.
+
+    Returns
+    -------
+    GafDatabase
+        ``machs`` (n_M,), ``k`` (n_k,), ``Q`` (n_M, n_k, n_modes, n_modes) complex,
+        ``b_ref`` (m); ``at(mach)`` gives one Mach's table.
+
+    Raises
+    ------
+    CaseError
+        The case has no aerodynamics, or it is over a resource limit (the message names the
+        case keys that change it and the values that fit).
+
+    Examples
+    --------
+    The fin's database is shipped (4 Mach numbers x 15 k, 6 modes):
+
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import FIN_FILE
+    >>> db = gaf_database(load_case(FIN_FILE), progress=False)
+    >>> db.machs.tolist(), db.Q.shape
+    ([0.4, 0.5, 0.6, 0.75], (4, 15, 6, 6))
+    """
     a = case.aero
     if a is None:
         raise CaseError(f"{case.name}: the case has no aerodynamics (an imported deck without "
@@ -372,8 +559,17 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True,
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class FlightCondition:
-    """An analysed condition: altitude (m, None when the density was given), density
-    (kg/m^3) and speed of sound (m/s, None when unknown)."""
+    """An analysed flight condition.
+
+    Attributes
+    ----------
+    altitude : float or None
+        Altitude (m); None when the case gives densities instead of altitudes.
+    density : float
+        Air density (kg/m^3).
+    speed_of_sound : float or None
+        Speed of sound (m/s); None when unknown (then no match point is computed).
+    """
 
     altitude: float | None
     density: float
@@ -382,7 +578,35 @@ class FlightCondition:
 
 @_door("the flight conditions", _FLUTTER)
 def flight_conditions(case: Case) -> list[FlightCondition]:
-    """The analysed conditions: per altitude (standard atmosphere) or per density."""
+    """The flight conditions the flutter analysis runs at.
+
+    Per ``flight.altitudes`` (m) through the 1976 standard atmosphere
+    (:func:`asekit.atmosphere.standard_atmosphere`), or per ``flight.densities`` (kg/m^3)
+    with the optional ``flight.speeds_of_sound`` (m/s).
+
+    Parameters
+    ----------
+    case : Case
+        The case; it needs ``[flight]``.
+
+    Returns
+    -------
+    list of FlightCondition
+        One per altitude or density, in the case's order.
+
+    Raises
+    ------
+    CaseError
+        The case has no flight conditions.
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import FIN_FILE
+    >>> c = flight_conditions(load_case(FIN_FILE))[0]        # sea level
+    >>> c.altitude, round(c.density, 3), round(c.speed_of_sound, 1)
+    (0.0, 1.225, 340.3)
+    """
     f = case.flight
     if f is None:
         raise CaseError(f"{case.name}: the case has no flight conditions (an imported deck "
@@ -400,13 +624,27 @@ def flight_conditions(case: Case) -> list[FlightCondition]:
 
 @dataclass(frozen=True)
 class ConditionResult:
-    """p-k at one (Mach, flight condition).
+    """The flutter solution at one (Mach, flight condition).
 
-    pk : the sweep; instabilities : every crossing found; flutter / divergence : the first of
-    each kind (None if none in the sweep); unstable_at_start : the lowest speed of the sweep is
-    already unstable (flutter or divergence at or below it: the sweep must start lower);
-    start_mode : the 0-based index (among the modes solved) of the mode unstable there (its
-    user-facing name: ``asekit.util.conventions.mode_label(start_mode, pk.n_rigid)``).
+    Attributes
+    ----------
+    mach : float
+        Mach number.
+    condition : FlightCondition
+        The flight condition.
+    pk : PkResult
+        The tracked roots over ``flight.velocities`` (speeds m/s, frequencies Hz, V-g
+        damping g = 2 Re p / abs(Im p), g > 0 unstable).
+    instabilities : tuple of Instability
+        Every crossing found.
+    flutter, divergence : Instability or None
+        The first of each kind (None if none in the sweep).
+    unstable_at_start : bool
+        The lowest speed of the sweep is already unstable (flutter or divergence at or below
+        it: the sweep must start lower).
+    start_mode : int or None
+        The 0-based index (among the modes solved) of the mode unstable there (its
+        user-facing name: ``asekit.util.conventions.mode_label(start_mode, pk.n_rigid)``).
     """
 
     mach: float
@@ -421,9 +659,25 @@ class ConditionResult:
 
 @dataclass(frozen=True)
 class FlutterAnalysis:
-    """All conditions, the static divergence speeds per Mach and density, the match points
-    (Mach at which the flutter speed equals M a, per altitude) and the flutter margins
-    (U_f / U_envelope - 1 at the envelope's top Mach, per altitude inside the envelope)."""
+    """The flutter analysis of a case (:func:`flutter`).
+
+    Attributes
+    ----------
+    results : tuple of ConditionResult
+        One per Mach and flight condition, Mach-major.
+    divergence : tuple of dict
+        Static divergence speed per Mach and condition: ``mach``, ``altitude_m``,
+        ``density`` (kg/m^3), ``speed_ms`` (m/s, None when none).
+    match_points : tuple of dict
+        Per altitude, the Mach at which the flutter speed equals M a (the flight speed).
+    margins : tuple of dict
+        Per altitude inside the envelope, the flutter margin U_f / U_envelope - 1 at the
+        envelope's top Mach (a fraction; negative: flutter inside the envelope).
+    seconds : float
+        Wall time of the analysis (s).
+    notes : tuple of str
+        Sentences on conditions already unstable at the sweep's first speed.
+    """
 
     results: tuple[ConditionResult, ...]
     divergence: tuple[dict, ...]
@@ -435,9 +689,26 @@ class FlutterAnalysis:
 
 @_door("the rational function approximation", _FLUTTER)
 def rfa_at(case: Case, db: GafDatabase, mach: float):
-    """The case's rational function approximation (``flutter.rfa`` with ``flutter.lags`` lag
-    roots, :data:`asekit.rfa.methods.RFA_FITS`) of the GAFs at ``mach`` (interpolated linearly
-    between the database's Mach numbers)."""
+    """The rational function approximation of the GAFs at one Mach number.
+
+    Q(s) ~ A0 + A1 (s b/U) + A2 (s b/U)^2 + sum_n A_{n+2} s / (s + beta_n U/b) (Roger, thesis
+    Eqs. 2.52-2.56) or the minimum-state form, as ``flutter.rfa`` says, with ``flutter.lags`` lag
+    roots (:data:`asekit.rfa.methods.RFA_FITS`).
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+    db : GafDatabase
+        The GAF database (:func:`gaf_database`).
+    mach : float
+        Mach number; the GAFs are interpolated linearly between the database's Mach numbers.
+
+    Returns
+    -------
+    RogerFit or MinimumStateFit
+        The fit (coefficient matrices, lag roots, fit error).
+    """
     g = db.at(mach, interpolate=True)
     k, q = g.k, g.Q
     return rfa_kind(case.flutter.rfa).fit(k, q, db.b_ref, mach, case.flutter.lags)
@@ -446,8 +717,31 @@ def rfa_at(case: Case, db: GafDatabase, mach: float):
 @_door("the flutter solution", _FLUTTER)
 def analyse_condition(case: Case, db: GafDatabase, mach: float, cond: FlightCondition,
                       model: ModalModel | None = None) -> ConditionResult:
-    """The case's flutter method (``flutter.method``, :data:`FLUTTER_METHODS`) at one Mach and
-    flight condition: the tracked roots over ``flight.velocities`` and their instabilities."""
+    """Flutter at one Mach number and flight condition.
+
+    The case's flutter method (``flutter.method``,
+    :data:`asekit.aeroelastic.methods.FLUTTER_METHODS`; p-k by default) tracks the roots of
+    the aeroelastic equation [M p^2 + C p + K - q Q(p)] x = 0 over ``flight.velocities`` (m/s)
+    and finds where their damping changes sign.
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+    db : GafDatabase
+        Its GAF database (:func:`gaf_database`); ``mach`` must be one of its Mach numbers.
+    mach : float
+        Mach number.
+    cond : FlightCondition
+        The flight condition (density kg/m^3).
+    model : ModalModel, optional
+        The modal model (default :func:`modal_model` of the case).
+
+    Returns
+    -------
+    ConditionResult
+        The tracked roots, every instability, the first flutter and divergence.
+    """
     model = modal_model(case) if model is None else model
     gaf = db.at(mach)
     U = np.asarray(case.flight.velocities, float)
@@ -640,18 +934,33 @@ def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -
     divergence speeds (Eq. 3.13 eigenproblem on the steady GAFs), match points and flutter
     margins.
 
+    The flutter speed at each condition is where a tracked root's V-g damping
+    g = 2 Re p / abs(Im p) crosses zero upwards (``docs/conventions.md``); the divergence
+    speed solves det(K - q Q(0)) = 0; a match point is the Mach at which the flutter speed
+    equals the flight speed M a at that altitude.
+
     Parameters
     ----------
-    case : the case.
-    progress : show the GAF database's progress bar when it is computed, and a bar over the
-        p-k solutions (Mach x flight condition).
-    db : a GAF database to use instead of :func:`gaf_database` (e.g. a sweep's).
+    case : Case
+        The case; it needs ``[aero]`` and ``[flight]``.
+    progress : bool, optional
+        Show the GAF database's progress bar when it is computed, and a bar over the p-k
+        solutions (Mach x flight condition) (default False).
+    db : GafDatabase, optional
+        A GAF database to use instead of :func:`gaf_database` (e.g. a sweep's).
 
     Returns
     -------
     FlutterAnalysis
         ``results`` (one :class:`ConditionResult` per Mach and condition: speeds m/s,
         frequencies Hz), ``divergence``, ``match_points``, ``margins``, ``notes``.
+
+    Raises
+    ------
+    CaseError
+        The case has no aerodynamics or no flight conditions.
+    SolverError
+        A numerical failure; the message names the case keys to check.
 
     Examples
     --------
@@ -705,10 +1014,32 @@ def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class AseResult:
-    """The ASE loop at the actuator's flight condition: the model, closed-loop stability of
-    AEM1 / AEM2 (and their largest closed-loop pole real parts, 1/s), FWTF 1-3 crossovers and
-    the power-limited step responses (settling time s, steady error and corner overshoot as
-    fractions of the command)."""
+    """The aeroservoelastic loop at the actuator's flight condition (:func:`ase`).
+
+    Attributes
+    ----------
+    model : AeroservoelasticModel
+        The open-loop model (:func:`asekit.ase.loop.build_model`).
+    controller : PDController
+        The servo controller.
+    mach, altitude, velocity : float
+        The flight condition: Mach, altitude (m), speed (m/s).
+    stable : dict
+        Closed-loop stability per topology (``"AEM1"``: motor-angle feedback, ``"AEM2"``:
+        fin-root feedback).
+    max_real_pole : dict
+        Largest real part of the closed-loop poles per topology (1/s).
+    crossovers : dict
+        Gain and phase crossovers of the forward-path transfer functions FWTF 1-3.
+    simulations : dict
+        The power-limited step responses per topology.
+    settling_s : dict
+        2 % settling time per topology (s; inf when it never settles).
+    steady_error : dict
+        Final error per topology, a fraction of the command.
+    corner_overshoot : dict
+        Per topology, the overshoot at each corner of the surface, a fraction of the command.
+    """
 
     model: object
     controller: object
@@ -726,8 +1057,26 @@ class AseResult:
 
 @_door("the corner points", _STRUCTURE)
 def corner_points(case: Case) -> dict:
-    """The surface's four corners (root LE/TE of the first panel, tip LE/TE of the last; of an
-    imported structure: :func:`imported_corner_points`)."""
+    """The surface's four corners, where the ASE loop reads its outputs.
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+
+    Returns
+    -------
+    dict
+        ``root_le``, ``root_te`` (of the first panel), ``tip_le``, ``tip_te`` (of the last):
+        (x, y) in m; of an imported structure: :func:`imported_corner_points`.
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import FIN_FILE
+    >>> list(corner_points(load_case(FIN_FILE)))
+    ['root_le', 'root_te', 'tip_le', 'tip_te']
+    """
     if case.structure is not None:
         return imported_corner_points(case)
     r, t = case.panels[0].planform, case.panels[-1].planform
@@ -737,9 +1086,29 @@ def corner_points(case: Case) -> dict:
 
 @_door("the actuator", _ASE)
 def actuator_setup(case: Case):
-    """(ActuatorParameters, PDController, PowerLimits) of the case's ``[actuator]``: the keys
-    it sets, asekit's defaults (thesis Tables 12, 16, 17) for the rest. The actuator's load
-    inertia is 0: the fin's inertia enters through its modal model (:func:`asekit.ase.loop.build_model`)."""
+    """The servo-actuator of the case's ``[actuator]``: the keys it sets, asekit's defaults
+    (thesis Tables 12, 16, 17) for the rest.
+
+    Parameters
+    ----------
+    case : Case
+        The case; it needs ``[actuator]``.
+
+    Returns
+    -------
+    act : ActuatorParameters
+        DC motor and transmission; the load inertia is 0 (the fin's inertia enters through
+        its modal model, :func:`asekit.ase.loop.build_model`).
+    ctl : PDController
+        The controller (gain ``k_c``, ``k_p``, ``k_d``).
+    lim : PowerLimits
+        Supply voltage (V) and current limit (A).
+
+    Raises
+    ------
+    CaseError
+        The case has no ``[actuator]``.
+    """
     a = case.actuator
     if a is None:
         raise CaseError("the case has no [actuator]")
@@ -758,11 +1127,27 @@ def actuator_setup(case: Case):
 
 @dataclass(frozen=True)
 class AseCondition:
-    """A case's aeroservoelastic model at one flight condition and what it was built from:
-    ``model`` (:class:`asekit.ase.loop.AeroservoelasticModel`), ``modal`` (ModalModel), ``rfa``
-    (the rational fit at ``mach``), ``q_cc`` (steady Re Q_cc at ``mach`` and the database's
-    lowest k, m^3/rad), ``mach``, ``altitude`` (m), ``density`` (kg/m^3), ``velocity``
-    (m/s)."""
+    """A case's aeroservoelastic model at one flight condition and what it was built from.
+
+    Attributes
+    ----------
+    model : AeroservoelasticModel
+        The state-space model (:class:`asekit.ase.loop.AeroservoelasticModel`).
+    modal : ModalModel
+        The modal model.
+    rfa : RogerFit or MinimumStateFit
+        The rational fit at ``mach``.
+    q_cc : float
+        Steady Re Q_cc at ``mach`` and the database's lowest k (m^3/rad).
+    mach : float
+        Mach number.
+    altitude : float
+        Altitude (m).
+    density : float
+        Air density (kg/m^3).
+    velocity : float
+        Flight speed (m/s).
+    """
 
     model: object
     modal: object
@@ -809,16 +1194,35 @@ def ase_condition(case: Case, mach: float | None = None, altitude: float | None 
 
     Parameters
     ----------
-    case : a shaft-supported case with a rigid pitch mode (FN2, ``modes.keep_rigid``).
-    mach, altitude : the flight condition (default ``[actuator.condition]``, else 0.5 and 0 m).
-    actuator : :class:`asekit.servo.actuator.ActuatorParameters` (default: build_model's, the thesis's).
-    count_fin_inertia_twice : the thesis's Simulink choice (see build_model).
-    n_lags, fit : the rational fit.
-    db, modal : a database and its modal model to use instead of the case's.
+    case : Case
+        A shaft-supported case with a rigid pitch mode (FN2, ``modes.keep_rigid``).
+    mach : float, optional
+        Mach number (default ``[actuator.condition]``, else 0.5).
+    altitude : float, optional
+        Altitude (m; default ``[actuator.condition]``, else 0 m).
+    actuator : ActuatorParameters, optional
+        The servo-actuator (:class:`asekit.servo.actuator.ActuatorParameters`; default:
+        build_model's, the thesis's).
+    count_fin_inertia_twice : bool, optional
+        The thesis's Simulink choice (see :func:`asekit.ase.loop.build_model`).
+    n_lags : int, optional
+        Lag roots of the rational fit (default ``flutter.lags``).
+    fit : callable, optional
+        ``fit(k, Q, b_ref, mach) -> RFA`` replacing the case's fit.
+    db : GafDatabase, optional
+        A GAF database to use instead of the case's.
+    modal : ModalModel, optional
+        The modal model of ``db`` (default the case's).
 
     Returns
     -------
-    :class:`AseCondition`.
+    AseCondition
+        The model and what it was built from.
+
+    Raises
+    ------
+    ValueError
+        ``mach`` outside the database's Mach range, or not finite.
     """
 
     a = case.actuator
@@ -850,7 +1254,29 @@ def ase_condition(case: Case, mach: float | None = None, altitude: float | None 
 
 @_door("the ASE loop", _ASE)
 def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
-    """The Ch. 5 analysis of the case's actuator (None without ``[actuator]``)."""
+    """The aeroservoelastic analysis of the case's actuator (thesis Ch. 5).
+
+    At the actuator's flight condition (``[actuator.condition]``), builds the ASE model
+    (:func:`ase_condition`: structure + RFA aerodynamics + DC motor, transmission and PD
+    controller of ``[actuator]``), closes the loop with motor-angle (AEM1) and fin-root (AEM2)
+    feedback, checks the closed-loop poles, computes the crossovers of the forward-path
+    transfer functions FWTF 1-3 and simulates a power-limited step of ``actuator.step_deg``
+    (deg) over 0.2 s.
+
+    Parameters
+    ----------
+    case : Case
+        The case; without ``[actuator]`` nothing is computed.
+    db : GafDatabase, optional
+        A GAF database to use instead of :func:`gaf_database`.
+
+    Returns
+    -------
+    AseResult or None
+        Stability, pole real parts (1/s), crossovers, step responses, settling times (s),
+        steady errors and corner overshoots (fractions of the command); None without
+        ``[actuator]``.
+    """
     if case.actuator is None:
         return None
 

@@ -93,6 +93,8 @@ class SupportSpec:
     """How the surface is held; ``kind`` is a key of :data:`asekit.structure.supports.SUPPORTS`
     (which reads the kind's keys and builds its structure), the other fields are the kinds' keys.
 
+    Attributes
+    ----------
     kind : ``"clamped_root"`` (every DOF of the root-chord nodes fixed), ``"edges"`` (``edges``:
         the condition -- clamped, simply_supported, sliding or free -- of the root, tip, leading
         and trailing edges, e.g. for panel flutter) or ``"shaft"`` (the

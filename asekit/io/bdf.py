@@ -138,6 +138,8 @@ class BdfModel:
     :func:`deck_case` is made of, plus the Nastran ids the export writes back (the case's
     ``structure.deck``). Analyse the case, not this record.
 
+    Attributes
+    ----------
     mesh : the plate mesh over all GRIDs (nodes that no element uses carry only springs,
         masses or rigid links); node_ids : (n_nodes,) the GRID id of each node.
     K, M : global sparse stiffness and mass (3 DOFs per node: w, theta_x, theta_y), springs

@@ -30,6 +30,8 @@ from asekit.rfa.roger import roger_fit
 class RfaKind:
     """One rational function approximation.
 
+    Attributes
+    ----------
     name : its registry key; description : one line for docs and errors;
     fit : ``fit(k, Q, b_ref, mach, lags) -> RFA`` on tabulated GAFs Q (n_k, n, n) at the reduced
         frequencies k (k = omega b_ref / U, b_ref in m), ``lags`` the number of lag roots (Roger:

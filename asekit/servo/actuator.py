@@ -43,7 +43,9 @@ from asekit.util.validate import finite, finite_result, in_range, integer
 class DCMotor:
     """Permanent-magnet DC motor constants (thesis Sec. 2.3.1.2, Table 12).
 
-    Parameters (defaults: Faulhaber 2642 024CR, thesis Table 12)
+    The defaults are the Faulhaber 2642 024CR of thesis Table 12.
+
+    Parameters
     ----------
     resistance : terminal resistance R (ohm), > 0.
     inductance : rotor inductance L (H), > 0.

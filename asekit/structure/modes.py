@@ -185,6 +185,8 @@ def modes_up_to(system: SupportedSystem, f_max_hz: float, M_fin=None, n_start: i
 class ModalModel:
     """The fin's reduced structural model in the m-set (thesis Eqs. (2.5), (2.45)-(2.46)).
 
+    Attributes
+    ----------
     frequencies_hz : (n_modes,) rigid mode(s) first (0 Hz), then the elastic modes kept.
     M : (n_modes, n_modes) modal mass, fictitious inertia removed; M[0, 0] = J_fin for FN2.
     K : (n_modes, n_modes) modal stiffness (zero row/col for the rigid mode).
@@ -424,6 +426,8 @@ class InPlaneModes:
     """In-plane (membrane) modes of a plate pinned at one node (u = v = 0), the situation of the
     thesis's discarded mode (Fig. 16).
 
+    Attributes
+    ----------
     frequencies_hz : (n,) ascending; the first is the in-plane rigid rotation about the pinned
         node (0 Hz up to round-off: nothing but an artificial drilling stiffness restrains it).
     shapes : (n_nodes, 2, n) u, v per node (mass-normalised).

@@ -153,6 +153,8 @@ def planform_edge_supports(mesh: PlateMesh, K, M, root: str = "clamped", tip: st
 class SupportKind:
     """How one kind of support is read from a case file and turned into a structure.
 
+    Attributes
+    ----------
     name : the ``support.kind`` value.
     description : one line for error messages and documentation.
     parse : ``parse(table, root_planform) -> dict`` of the kind's values from the ``[support]``
@@ -163,8 +165,8 @@ class SupportKind:
         hashable), so a new kind needs no new field.
     system : ``system(mesh, K, M, spec) -> SupportedSystem``, the supported structure (the
         FN1 or FN2 shaft system as ``spec.model`` says).
-    modal_model : ``modal_model(mesh, K, M, spec, f_max_hz, n_modes, keep_rigid) ->
-        ModalModel`` (thesis Eqs. 2.45-2.46): the elastic modes kept below ``f_max_hz`` (Hz) or
+    modal_model : ``modal_model(mesh, K, M, spec, f_max_hz, n_modes, keep_rigid)``
+        -> ModalModel (thesis Eqs. 2.45-2.46): the elastic modes kept below ``f_max_hz`` (Hz) or
         the first ``n_modes``, with the rigid pitch mode first when the kind has one and
         ``keep_rigid``.
     has_rigid_mode : ``has_rigid_mode(spec) -> bool``, whether the model can keep a rigid
