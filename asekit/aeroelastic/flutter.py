@@ -599,15 +599,21 @@ def _warn_unconverged(U, conv, modes, n_r, max_iter, tol, n_path_bad):
                        for i, jt in bad[:8])
     more = f" and {len(bad) - 8} more" if len(bad) > 8 else ""
     sub = n_path_bad - len(bad)
-    sub_text = f" (and {sub} sub-step points of the continuation)" if sub > 0 else ""
+    if len(bad):
+        where = (f"at {len(bad)} of {conv.size} requested points"
+                 + (f" (and {sub} sub-step points of the continuation)" if sub > 0 else "")
+                 + f": {listed}{more}; their roots are the last iterate (PkResult.converged "
+                 "is False there): treat them as approximate")
+    else:               # only between the requested points: their results are converged
+        where = (f"at {sub} sub-step points of the continuation between the requested "
+                 f"velocities (all {conv.size} requested points converged); the tracking "
+                 "through those steps used the last iterate")
     # Issue 30: the advice names the one option that takes it (pk_flutter's max_iter; a case
     # file has no such key), and every number its unit (tol is a relative change: no unit).
     warnings.warn(f"p-k: the k-iteration did not converge within {max_iter} iterations "
-                  f"(relative frequency change still above {tol:g}) at {len(bad)} of "
-                  f"{conv.size} requested points{sub_text}: {listed}{more}; their roots are "
-                  "the last iterate (PkResult.converged is False there): treat them as "
-                  "approximate; from Python, pk_flutter(..., max_iter=N) allows more "
-                  "iterations", FlutterConvergenceWarning, stacklevel=4)  # past @small_dense
+                  f"(relative frequency change still above {tol:g}) {where}; from Python, "
+                  "pk_flutter(..., max_iter=N) allows more iterations",
+                  FlutterConvergenceWarning, stacklevel=4)  # past @small_dense
 
 
 def _crossings(U, sigma, freq_hz, real_mask, tol: float = 0.0):

@@ -130,3 +130,21 @@ def test_sweep_above_flutter_is_at_or_below_the_first_point(agard):
     f = first_of(inst, "flutter")
     assert f.at_first_point and f.speed == 300.0 and f.speed_tolerance == 300.0
     assert f.mode == 0
+
+
+def test_unconverged_warning_names_only_what_failed():
+    """Issue 30: a k-iteration that failed only between the requested velocities is worded so
+    (no "at 0 of 524 requested points: ;"); a failure at a requested point names it in m/s (points: mode x velocity)."""
+    from asekit.aeroelastic.flutter import FlutterConvergenceWarning, _warn_unconverged
+    U = np.array([100.0, 200.0, 300.0])
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        _warn_unconverged(U, np.ones((3, 2), bool), np.arange(2), 0, 30, 1e-6, n_path_bad=4)
+        conv = np.ones((3, 2), bool)
+        conv[1, 0] = False
+        _warn_unconverged(U, conv, np.arange(2), 0, 30, 1e-6, n_path_bad=1)
+    first, second = (str(r.message) for r in rec)
+    assert all(issubclass(r.category, FlutterConvergenceWarning) for r in rec)
+    assert "at 4 sub-step points" in first and "all 6 requested points converged" in first
+    assert "0 of" not in first
+    assert "at 1 of 6 requested points" in second and "U = 200 m/s" in second
