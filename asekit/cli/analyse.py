@@ -53,9 +53,7 @@ def _read_case(args, load_case):
 
 
 def _error(msg: str) -> int:
-    print(f"error: {msg}", file=sys.stderr)
-    _log.error("error: %s", msg, extra={"file_only": True})     # for --log-file
-    return 2
+    return outputs.print_error(f"error: {msg}", 2, _log)
 
 
 def _named(name: str, exc: BaseException) -> str:

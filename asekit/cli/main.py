@@ -351,9 +351,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _report(line: str, code: int) -> int:
     """Print the one line of a failed command on standard error (and log it to the file)."""
-    print(line, file=sys.stderr)
-    _log.error(line, extra={"file_only": True})
-    return code
+    return outputs.print_error(line, code, _log)
 
 
 def _run(args, interrupts: _Interrupts, debug: bool) -> int:

@@ -5,7 +5,9 @@ makes the missing folders of a usable path."""
 
 from __future__ import annotations
 
+import logging
 import os
+import sys
 from pathlib import Path
 
 
@@ -64,3 +66,12 @@ def check_dir(option: str, value: str | None, what: str = "the output") -> str |
     if reason:
         return f"{option} {value}: {reason}"
     return _make(path.parent if str(path.parent) else Path("."), option)
+
+
+def print_error(line: str, code: int, log: logging.Logger) -> int:
+    """Print ``line``, the one line of a failed command, on standard error, log it to
+    ``log`` for ``--log-file`` only (marked ``file_only``: the console handler leaves it out)
+    and return the exit ``code``."""
+    print(line, file=sys.stderr)
+    log.error("%s", line, extra={"file_only": True})
+    return code

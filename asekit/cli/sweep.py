@@ -39,9 +39,7 @@ def add_parser(sub) -> None:
 
 
 def _error(msg: str) -> int:
-    print(f"error: {msg}", file=sys.stderr)
-    _log.error("error: %s", msg, extra={"file_only": True})     # for --log-file
-    return 2
+    return outputs.print_error(f"error: {msg}", 2, _log)
 
 
 def _missing_extra(args) -> str | None:
