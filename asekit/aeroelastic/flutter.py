@@ -253,6 +253,11 @@ class Instability:
 
 
 class _PkProblem:
+    """Eq. (3.12) at one density on one GAF table, in first-order form: the lower blocks of
+    the system matrix are -M^-1 (K - q Re Q(k)) and -M^-1 (C - rho b U Im Q(k) / (2 k)), with
+    M^-1 Re Q and M^-1 Im Q / k tabulated once (linear interpolation in k is then a blend of
+    two tabulated matrices)."""
+
     def __init__(self, M, K, C, gaf: TabulatedGaf, rho, interpolation):
         self.M, self.K, self.C = M, K, C
         self.Minv = np.linalg.inv(M)
@@ -260,38 +265,49 @@ class _PkProblem:
         self.rho = rho
         self.n = M.shape[0]
         self.interp = interpolation
-        # pre-split for speed (linear interpolation inline)
         kk = gaf.k
-        self._qr = gaf.Q.real
         qik = gaf.Q.imag / np.where(kk > 0, kk, 1.0)[:, None, None]
         if kk[0] == 0:
             qik[0] = qik[1]
-        self._qik = qik
+        self._mqr = self.Minv @ gaf.Q.real              # M^-1 Re Q(k_j), (n_k, n, n)
+        self._mqik = self.Minv @ qik                    # M^-1 Im Q(k_j) / k_j
+        self._mk, self._mc = -self.Minv @ K, -self.Minv @ C
+        self._kmin, self._kmax = float(kk[0]), float(kk[-1])
+        self._eye = np.eye(self.n)
 
-    def _parts(self, k):
+    def _parts(self, ks: np.ndarray):
+        """M^-1 Re Q(k) and M^-1 Im Q(k) / k at the reduced frequencies ``ks`` (m,), each
+        (m, n, n): linearly interpolated in k inline (clamped to the tabulated range), or by
+        :meth:`TabulatedGaf.parts` for other interpolations."""
         if self.interp != "linear":
-            return self.gaf.parts(k, self.interp)
+            parts = [self.gaf.parts(float(k), self.interp) for k in ks]
+            return (self.Minv @ np.array([a for a, _ in parts]),
+                    self.Minv @ np.array([c for _, c in parts]))
         kk = self.gaf.k
-        kq = min(max(k, kk[0]), kk[-1])
-        j = min(max(int(np.searchsorted(kk, kq)) - 1, 0), kk.size - 2)
-        t = (kq - kk[j]) / (kk[j + 1] - kk[j])
-        return ((1 - t) * self._qr[j] + t * self._qr[j + 1],
-                (1 - t) * self._qik[j] + t * self._qik[j + 1])
+        kq = np.minimum(np.maximum(ks, self._kmin), self._kmax)
+        j = np.minimum(np.maximum(np.searchsorted(kk, kq) - 1, 0), kk.size - 2)
+        t = ((kq - kk[j]) / (kk[j + 1] - kk[j]))[:, None, None]
+        return ((1 - t) * self._mqr[j] + t * self._mqr[j + 1],
+                (1 - t) * self._mqik[j] + t * self._mqik[j + 1])
 
     def eig(self, U, k):
         """All roots p and modal eigenvectors of Eq. (3.12) at (U, k)."""
-        qr, qik = self._parts(k)
-        q = 0.5 * self.rho * U ** 2
-        b = self.gaf.b_ref
-        Keff = self.K - q * qr
-        Ceff = self.C - 0.5 * self.rho * b * U * qik
-        n = self.n
-        A = np.zeros((2 * n, 2 * n))
-        A[:n, n:] = np.eye(n)
-        A[n:, :n] = -self.Minv @ Keff
-        A[n:, n:] = -self.Minv @ Ceff
+        lam, vec = self.eig_batch(U, np.array([float(k)]))
+        return lam[0], vec[0]
+
+    def eig_batch(self, U, ks: np.ndarray):
+        """The roots (m, 2n) and modal eigenvectors (m, n, 2n) of Eq. (3.12) at airspeed ``U``
+        and each reduced frequency of ``ks`` (m,): the m first-order system matrices are
+        stacked and solved by one call of :func:`numpy.linalg.eig` (issue 23: one LAPACK
+        call per batch instead of one Python round trip per root)."""
+        mqr, mqik = self._parts(np.asarray(ks, float))
+        n, m = self.n, mqr.shape[0]
+        A = np.zeros((m, 2 * n, 2 * n))
+        A[:, :n, n:] = self._eye
+        A[:, n:, :n] = self._mk + (0.5 * self.rho * U ** 2) * mqr
+        A[:, n:, n:] = self._mc + (0.5 * self.rho * self.gaf.b_ref * U) * mqik
         lam, vec = np.linalg.eig(A)
-        return lam, vec[:n]
+        return lam, vec[:, :n, :]
 
     def solve_mode(self, U, omega_guess, ref, tol=1e-7, max_iter=60):
         """Converge one root: returns (p, vector, k, converged)."""
@@ -302,41 +318,93 @@ class _PkProblem:
         distance (1/s) from p to the nearest other root of the last eigenproblem (other real
         roots not counted when p is real: a real pair is one branch, reported by its least
         stable root; inf when there is none)."""
+        p, v, k, ok, sp = self.solve_roots(U, np.array([float(omega_guess)]),
+                                           np.asarray(ref)[None, :], tol, max_iter)
+        return p[0], v[0], k[0], bool(ok[0]), float(sp[0])
+
+    def solve_roots(self, U, omega_guess: np.ndarray, refs: np.ndarray, tol=1e-7, max_iter=60):
+        """Converge m roots at airspeed ``U`` together (Hassig's k-iteration, batched).
+
+        Root i starts from the circular frequency ``omega_guess[i]`` (rad/s) and follows the
+        eigenvector ``refs[i]`` (n,): at each iteration, k_i = omega_i b / U, the eigenproblem
+        of Eq. (3.12) is solved at every k_i of the roots not yet converged (one stacked
+        :meth:`eig_batch`), and root i takes the upper-half-plane root that best correlates
+        with ``refs[i]`` (MAC, less 0.2 times its relative frequency distance); a real pair
+        is reported by its least stable well-correlated real root. Root i has converged when
+        its frequency changes by at most ``tol`` relative. Returns ``(p (m,), vectors (m, n),
+        k (m,), converged (m,), spacing (m,))``, ``spacing`` the distance (1/s) from p to the
+        nearest other root of its last eigenproblem (other real roots not counted when p is
+        real; inf when there is none).
+        """
         b = self.gaf.b_ref
-        omega = max(float(omega_guess), 0.0)
-        p_best, v_best = None, None
-        for _ in range(max_iter):
-            k = omega * b / U
-            lam, vec = self.eig(U, k)
-            upper = lam.imag >= -1e-9 * np.maximum(np.abs(lam), 1.0)
-            lam_u, vec_u = lam[upper], vec[:, upper]
-            mac = _mac(ref, vec_u)
-            # among well-correlated roots prefer the one nearest the current frequency
-            score = mac - 0.2 * np.abs(np.abs(lam_u.imag) - omega) / max(omega, np.abs(lam).max()
-                                                                        * 1e-3, 1e-12)
-            real_roots = np.abs(lam_u.imag) <= 1e-9 * np.maximum(np.abs(lam_u), 1.0)
-            j = int(np.argmax(score))
-            if real_roots[j]:
-                # a real pair: report the least stable of the well-correlated real roots
-                cand = np.nonzero(real_roots & (mac >= 0.8 * mac[j]))[0]
-                j = int(cand[np.argmax(lam_u.real[cand])])
-            p_best, v_best = lam_u[j], vec_u[:, j]
-            omega_new = abs(p_best.imag)
-            if abs(omega_new - omega) <= tol * max(omega_new, 1e-6 * U / b, 1e-12):
-                return p_best, v_best, omega_new * b / U, True, _spacing(lam_u, real_roots, j)
-            omega = omega_new
-        return (p_best, v_best, abs(p_best.imag) * b / U, False,
-                _spacing(lam_u, real_roots, j))
+        omega = np.maximum(np.asarray(omega_guess, float), 0.0)
+        m = omega.size
+        p_out, v_out = np.zeros(m, complex), np.zeros((m, self.n), complex)
+        ok, spacing = np.zeros(m, bool), np.full(m, np.inf)
+        active = np.arange(m)
+        last_w, last_f = np.full(m, np.nan), np.full(m, np.nan)
+        for it in range(max_iter):
+            om = omega[active]
+            lam, vec = self.eig_batch(U, om * b / U)
+            p, v, sp = _pick_roots(lam, vec, refs[active], om)
+            om_new = np.abs(p.imag)
+            conv = np.abs(om_new - om) <= tol * np.maximum(np.maximum(om_new, 1e-6 * U / b),
+                                                           1e-12)
+            done = conv | (it == max_iter - 1)
+            idx = active[done]
+            p_out[idx], v_out[idx], ok[idx], spacing[idx] = p[done], v[done], conv[done], sp[done]
+            omega[active] = _secant_step(om, om_new - om, last_w[active], last_f[active])
+            last_w[active], last_f[active] = om, om_new - om
+            active = active[~done]
+            if active.size == 0:
+                break
+        return p_out, v_out, np.abs(p_out.imag) * b / U, ok, spacing
 
 
-def _spacing(lam_u: np.ndarray, real_roots: np.ndarray, j: int) -> float:
-    """Distance from root ``lam_u[j]`` to the nearest other root (other real roots not counted
-    when it is real); inf when there is none."""
-    other = np.ones(lam_u.size, bool)
-    other[j] = False
-    if real_roots[j]:
-        other &= ~real_roots
-    return float(np.min(np.abs(lam_u[other] - lam_u[j]))) if other.any() else np.inf
+def _secant_step(w: np.ndarray, f: np.ndarray, w0: np.ndarray, f0: np.ndarray) -> np.ndarray:
+    """The next frequency of the k-iteration for the fixed point w = g(w), f = g(w) - w: the
+    secant root of f through (w0, f0) and (w, f) where its slope says the iteration contracts
+    (-3 < f' < -0.2, i.e. -2 < g' < 0.8), else the plain fixed-point step g(w) = w + f (the
+    first iteration, a root that changed branch, a slope out of range)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = (f - f0) / (w - w0)
+        secant = w - f / slope
+    use = np.isfinite(secant) & (slope > -3.0) & (slope < -0.2) & (secant > 0)
+    return np.where(use, secant, w + f)
+
+
+def _mac_rows(refs: np.ndarray, vec: np.ndarray) -> np.ndarray:
+    """MAC of each row's reference vector ``refs[i]`` (n,) against the columns of ``vec[i]``
+    (n, c): (m, c)."""
+    num = np.abs(np.einsum("in,inc->ic", refs.conj(), vec)) ** 2
+    den = (np.real(np.einsum("in,in->i", refs.conj(), refs))[:, None]
+           * np.real(np.einsum("inc,inc->ic", vec.conj(), vec))) + 1e-300
+    return num / den
+
+
+def _pick_roots(lam: np.ndarray, vec: np.ndarray, refs: np.ndarray, omega: np.ndarray):
+    """One k-iteration's choice for m roots at once (see :meth:`_PkProblem.solve_roots`):
+    from the roots ``lam`` (m, 2n) and vectors ``vec`` (m, n, 2n) of m eigenproblems, the
+    upper-half-plane root of each that best matches its reference vector ``refs[i]`` and
+    frequency ``omega[i]``; returns (p (m,), vectors (m, n), spacing (m,))."""
+    absl = np.abs(lam)
+    upper = lam.imag >= -1e-9 * np.maximum(absl, 1.0)
+    real = upper & (np.abs(lam.imag) <= 1e-9 * np.maximum(absl, 1.0))
+    mac = _mac_rows(refs, vec)
+    scale = np.maximum(np.maximum(omega, absl.max(axis=1) * 1e-3), 1e-12)
+    score = mac - 0.2 * np.abs(np.abs(lam.imag) - omega[:, None]) / scale[:, None]
+    rows = np.arange(lam.shape[0])
+    j = np.argmax(np.where(upper, score, -np.inf), axis=1)
+    if real[rows, j].any():
+        # a real pair: report the least stable of the well-correlated real roots
+        cand = real & (mac >= 0.8 * mac[rows, j][:, None])
+        j = np.where(real[rows, j], np.argmax(np.where(cand, lam.real, -np.inf), axis=1), j)
+    p = lam[rows, j]
+    other = upper.copy()
+    other[rows, j] = False
+    other &= ~(real & real[rows, j][:, None])
+    spacing = np.where(other, np.abs(lam - p[:, None]), np.inf).min(axis=1)
+    return p, vec[rows, :, j], spacing
 
 
 @dataclass(frozen=True)
@@ -352,22 +420,19 @@ class _Roots:
 
 
 def _solve_all(prob: _PkProblem, u: float, prev: _Roots, tol, max_iter) -> _Roots:
-    """Every tracked root at airspeed ``u``, each continued from its root at ``prev``."""
-    out = [prob.solve_root(u, abs(p.imag), v, tol, max_iter) for p, v in zip(prev.p, prev.v)]
-    p, v, k, ok, sp = zip(*out)
-    return _Roots(np.array(p), np.array(v), np.array(k), np.array(ok), np.array(sp))
+    """Every tracked root at airspeed ``u``, each continued from its root at ``prev`` (one
+    batched k-iteration, :meth:`_PkProblem.solve_roots`)."""
+    return _Roots(*prob.solve_roots(u, np.abs(prev.p.imag), prev.v, tol, max_iter))
 
 
 def _same_root(r: _Roots) -> list[tuple[int, int]]:
     """Pairs of tracked columns that hold the same root (equal to 1e-6 of its magnitude, their
     eigenvectors correlated above 0.99)."""
-    pairs = []
-    for i in range(r.p.size):
-        for j in range(i + 1, r.p.size):
-            close = abs(r.p[i] - r.p[j]) <= 1e-6 * max(abs(r.p[i]), abs(r.p[j]), 1e-12)
-            if close and _mac(r.v[i], r.v[j][:, None])[0] > 0.99:
-                pairs.append((i, j))
-    return pairs
+    a = np.abs(r.p)
+    close = np.triu(np.abs(r.p[:, None] - r.p[None, :])
+                    <= 1e-6 * np.maximum(np.maximum(a[:, None], a[None, :]), 1e-12), 1)
+    return [(int(i), int(j)) for i, j in np.argwhere(close)
+            if _mac(r.v[i], r.v[j][:, None])[0] > 0.99]
 
 
 def _step_accepted(prev: _Roots, new: _Roots, fraction: float, min_mac: float) -> bool:
@@ -377,8 +442,8 @@ def _step_accepted(prev: _Roots, new: _Roots, fraction: float, min_mac: float) -
     real root for good: each reports the least stable real root it correlates with)."""
     if np.any(np.abs(new.p - prev.p) > fraction * prev.spacing):
         return False
-    macs = [_mac(a, b[:, None])[0] for a, b in zip(prev.v, new.v)]
-    return min(macs) >= min_mac and not set(_same_root(new)) - set(_same_root(prev))
+    macs = _mac_rows(prev.v, new.v[:, :, None])[:, 0]
+    return macs.min() >= min_mac and not set(_same_root(new)) - set(_same_root(prev))
 
 
 def _reassign(prob: _PkProblem, u: float, prev: _Roots, new: _Roots, tol, max_iter) -> _Roots:
