@@ -34,9 +34,11 @@ rho the density and q = rho V^2 / 2.
   (EPS the FLUTTER card's field 9, default 1e-3). Damping g = 2 gamma = 2 Re p / |Im p|
   (the transient decay rate coefficient gamma; real roots clipped to +-2 as asekit does),
   frequency |Im p| / 2 pi. Each velocity is solved from the converged k of the same mode at
-  the previous velocity (the first from its structural frequency); the root is the one whose
-  eigenvector correlates best with the mode's previous vector (Nastran sorts by frequency;
-  asekit by MAC, which gives the same curves when the frequencies do not cross).
+  the previous velocity (the first from its structural frequency, mode j taking the j-th root
+  in frequency order as Nastran does, real roots one slot); later, the root is the one whose
+  eigenvector correlates best with the mode's previous vector and whose k is nearest, never a
+  root an earlier mode of the same point has taken (Nastran sorts by frequency; asekit by
+  MAC, which gives the same curves when the frequencies do not cross).
 * **PKNL** (PK "without looping"): the FLFACT density, Mach and velocity lists have equal
   lengths and index i is one flight point (rho_i, M_i, V_i); no density x Mach x velocity
   loop. The crossing is interpolated linearly in g between consecutive points (index order)
@@ -301,14 +303,41 @@ def _pk_roots(m: ModalArrays, gaf, rho, V, k, interpolation):
     return lam[keep], vec[:n, keep]
 
 
-def _pk_mode(m, gaf, rho, V, k0, ref, interpolation, eps):
-    """Nastran's k iteration for one mode: (p, vector, k, converged)."""
+def _taken(lam: np.ndarray, taken: list) -> np.ndarray:
+    """Whether each root is (to 1e-3 relative: EPS apart in k) one already claimed by another
+    mode."""
+    if not taken:
+        return np.zeros(lam.size, bool)
+    t = np.asarray(taken)
+    scale = np.maximum(np.abs(lam), 1e-12)[:, None]
+    return np.any(np.abs(lam[:, None] - t[None, :]) <= 1e-3 * scale, axis=1)
+
+
+def _by_frequency(lam: np.ndarray, rank: int) -> int:
+    """Nastran's choice at a cold start: the ``rank``-th root in frequency order, the real
+    roots (zero frequency) counted as one slot (their least stable root)."""
+    real = np.abs(lam.imag) <= 1e-9 * np.maximum(np.abs(lam), 1.0)
+    osc = np.flatnonzero(~real)
+    slots = list(osc[np.argsort(np.abs(lam.imag[osc]))])
+    if real.any():
+        r = np.flatnonzero(real)
+        slots.insert(0, int(r[np.argmax(lam.real[r])]))
+    return int(slots[min(rank, len(slots) - 1)])
+
+
+def _pk_mode(m, gaf, rho, V, k0, ref, interpolation, eps, taken=(), rank=None):
+    """Nastran's k iteration for one mode: (p, vector, k, converged). The root: the one whose
+    eigenvector correlates best with ``ref`` (the mode's vector at the previous point), or,
+    with ``rank`` (the first point), the ``rank``-th in frequency order as Nastran sorts them;
+    roots in ``taken`` (claimed by the modes solved before at this point) are not chosen
+    again."""
     b, k = gaf.b_ref, k0
     for _ in range(MAX_K_ITER):
         lam, vec = _pk_roots(m, gaf, rho, V, k, interpolation)
         score = mac_matrix(ref[:, None], vec)[0]
         score = score - 0.05 * np.abs(np.abs(lam.imag) * b / V - k) / max(k, 1e-3)
-        j = int(np.argmax(score))
+        score = score - 10.0 * _taken(lam, list(taken))
+        j = int(np.argmax(score)) if rank is None else _by_frequency(lam, rank)
         k_new = abs(lam[j].imag) * b / V
         if abs(k_new - k) < eps * max(1.0, k):
             return lam[j], vec[:, j], k_new, True
@@ -316,7 +345,7 @@ def _pk_mode(m, gaf, rho, V, k0, ref, interpolation, eps):
     return lam[j], vec[:, j], k_new, False
 
 
-def _pk_point(m, gaf, rho, V, k_prev, v_prev, interpolation, eps):
+def _pk_point(m, gaf, rho, V, k_prev, v_prev, interpolation, eps, cold=False):
     n = m.n_modes
     p = np.empty(n, complex)
     vec = np.empty((n, n), complex)
@@ -324,7 +353,8 @@ def _pk_point(m, gaf, rho, V, k_prev, v_prev, interpolation, eps):
     conv = np.empty(n, bool)
     for j in range(n):
         p[j], vec[j], k[j], conv[j] = _pk_mode(m, gaf, rho, V, k_prev[j], v_prev[j],
-                                               interpolation, eps)
+                                               interpolation, eps, p[:j],
+                                               rank=j if cold else None)
     return p, vec, k, conv
 
 
@@ -341,9 +371,11 @@ def _pk_sweep(m, gaf_of, points, interpolation, eps, method):
     k_prev = None
     for i, (rho, mach, V) in enumerate(points):
         gaf = gaf_of(mach)
-        if k_prev is None:
+        cold = k_prev is None
+        if cold:
             k_prev = omega0 * gaf.b_ref / V
-        P[i], X[i], Kr[i], C[i] = _pk_point(m, gaf, rho, V, k_prev, v_prev, interpolation, eps)
+        P[i], X[i], Kr[i], C[i] = _pk_point(m, gaf, rho, V, k_prev, v_prev, interpolation, eps,
+                                            cold)
         k_prev, v_prev = Kr[i], X[i]
     dens = np.array([p[0] for p in points], float)
     machs = np.array([np.nan if p[1] is None else p[1] for p in points], float)
@@ -542,8 +574,18 @@ def flutter_summary(res: NastranFlutterResult, nvalue: int | None = None,
 K_POINTS = 200
 
 
-def _held(modal, gaf: TabulatedGaf):
-    """The elastic modes only (a rigid mode held, as asekit's p-k does by default)."""
+def elastic_part(modal, gaf: TabulatedGaf):
+    """(ModalArrays, TabulatedGaf) of the elastic modes only: a rigid mode held, as asekit's
+    p-k does by default (the flutter of the elastic modes of a clamped or held surface).
+
+    Examples
+    --------
+    >>> m = modal_arrays(M=np.eye(2), K=np.diag([0.0, 4.0]), n_rigid=1)
+    >>> g = TabulatedGaf(np.array([0.0, 1.0]), np.zeros((2, 2, 2), complex), 1.0)
+    >>> e, ge = elastic_part(m, g)
+    >>> e.K.tolist(), ge.Q.shape
+    ([[4.0]], (2, 1, 1))
+    """
     m = _modal(modal)
     if m.n_rigid == 0:
         return m, gaf
@@ -580,7 +622,7 @@ def as_instabilities(found: list[NastranCrossing], name: str, U=None) -> list:
 
 def solve_pk(modal, gaf, rfa, density, velocities):
     """Registry entry ``"nastran_pk"``: :func:`pk_method` -> (PkResult, instabilities)."""
-    m, g = _held(modal, gaf)
+    m, g = elastic_part(modal, gaf)
     res = pk_method(m, g, density, velocities, mach=gaf.mach)
     roots = _as_pk_result(res, m, res.velocity[:, 0], res.eigenvalue, res.k, res.vectors,
                           res.converged)
@@ -608,7 +650,7 @@ def _resample_column(V, g, f, k, U):
 
 
 def _solve_k(modal, gaf, density, velocities, vectors: bool, name: str):
-    m, g = _held(modal, gaf)
+    m, g = elastic_part(modal, gaf)
     U = positive_array("velocities", velocities)
     res = k_method(m, g, density, _k_grid(g), vectors=vectors, mach=gaf.mach)
     n = m.n_modes

@@ -317,7 +317,9 @@ def format_summary(s: dict, width: int = 100) -> str:
     if has_fsi:
         head += f" {'FSI':>7} {'w_f/w_a':>7}"
     head += "  note"
-    lines += ["", "flutter (p-k, rigid modes held)", head]
+    methods = sorted({f"FLUTTER {r['sid']} {r['method']}" for r in s["flutter"] if "method" in r})
+    lines += ["", f"flutter ({', '.join(methods) if methods else 'p-k'}, rigid modes held)",
+              head]
     for row in s["flutter"]:
         ln = (f"{row['mach']:>6.3g} {_cell(row['altitude_m'], '{:.0f}'):>10} "
               f"{row['density']:>10.4g} {_speed_cell(row):>9} "
