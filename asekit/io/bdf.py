@@ -26,8 +26,8 @@ constraints), CQUAD4 (corner thicknesses T1-T4; material angle THETA or MCID) wi
 SPC / SPC1, CELAS1 (PELAS) / CELAS2 springs to ground or between grids, RBE2 (a rigid region,
 e.g. the shaft), CAERO1 with PAERO1 (NSPAN/NCHORD or AEFACT LSPAN/LCHORD divisions),
 SPLINE1 / SPLINE4 with SET1 / AELIST (checked: every box must be splined), AERO / AEROS (REFC,
-RHOREF, SYMXZ), MKAERO1, FLFACT, FLUTTER (PK, PKNL), EIGR / EIGRL (number of modes or the
-frequency range), TABDMP1 (G or CRIT modal damping), PARAM WTMASS. CTRIA3 is modelled as a
+RHOREF, SYMXZ), MKAERO1, FLFACT, FLUTTER (K, KE, PK, PKNL: :func:`deck_flutter` runs each
+card with its own method), EIGR / EIGRL (number of modes or the frequency range), TABDMP1 (G or CRIT modal damping), PARAM WTMASS. CTRIA3 is modelled as a
 degenerated MITC4 (its third node repeated: a collapsed quadrilateral, Bathe, *Finite Element
 Procedures*, 1996, Ch. 5), stiffer than the quadrilateral on coarse meshes but convergent
 (tests/io/test_bdf.py: NAFEMS FV16). Solids, beams, bars, rods and other shells are refused with
