@@ -540,11 +540,28 @@ def _summary_row(res, i, j) -> str:
             f"{res.frequency_hz[i, j]:12.4E} {lam.real:12.4E} {lam.imag:12.4E}")
 
 
+def _vector_lines(res: NastranFlutterResult, nv: int) -> list[str]:
+    """The eigenvectors Nastran prints: at the points flagged by ``print_vectors`` (negative
+    FLFACT velocities), each of the first ``nv`` modes' modal vector, scaled to a largest
+    component of 1."""
+    if res.vectors is None or res.print_vectors is None or not res.print_vectors.any():
+        return []
+    lines = ["", "EIGENVECTORS (modal coordinates, largest component 1)"]
+    for i in np.flatnonzero(res.print_vectors):
+        for j in range(nv):
+            v = res.vectors[i, j]
+            v = v / v[np.argmax(np.abs(v))]
+            comps = " ".join(f"{c.real:+.4E}{c.imag:+.4E}j" for c in v)
+            lines.append(f"V = {res.velocity[i, j]:.4E}  {res.mode_labels[j]}: {comps}")
+    return lines
+
+
 def flutter_summary(res: NastranFlutterResult, nvalue: int | None = None,
                     velocity_unit: str = "m/s") -> str:
     """Nastran's FLUTTER SUMMARY as text: one block per mode (``POINT = j``, the first
     ``nvalue`` modes, Nastran's NVALUE), one row per point: KFREQ, 1./KFREQ, DENSITY, MACH,
-    VELOCITY, DAMPING (g), FREQUENCY (Hz), the complex eigenvalue (PK: p; K: lambda).
+    VELOCITY, DAMPING (g), FREQUENCY (Hz), the complex eigenvalue (PK: p; K: lambda); then
+    the eigenvectors of the points whose FLFACT velocity was negative.
 
     Examples
     --------
@@ -563,7 +580,7 @@ def flutter_summary(res: NastranFlutterResult, nvalue: int | None = None,
         lines += ["", f"FLUTTER SUMMARY   POINT = {j + 1} ({res.mode_labels[j]})   "
                       f"METHOD = {res.method}   velocity in {velocity_unit}", head]
         lines += [_summary_row(res, i, j) for i in range(res.damping_g.shape[0])]
-    return "\n".join(lines[1:])
+    return "\n".join(lines[1:] + _vector_lines(res, nv))
 
 
 # ---------------------------------------------------------------------------------------------

@@ -163,10 +163,22 @@ def test_bad_input_names_the_field():
 
 
 def test_negative_velocities_ask_for_vectors():
+    """A negative FLFACT velocity: solved at |V|, its eigenvectors printed in the summary."""
     modal, gaf = _one_dof()
     res = N.pk_method(modal, gaf, 1.0, [-1.0, 2.0, -3.0])
     assert res.print_vectors.tolist() == [True, False, True]
     assert res.velocity[:, 0].tolist() == [1.0, 2.0, 3.0]
+    text = N.flutter_summary(res)
+    assert "EIGENVECTORS" in text and text.count("mode 1: +1.0000E+00") == 2
+
+
+def test_imeth_s_equals_l_on_linear_tables():
+    """IMETH = S (asekit: a cubic spline in k) reproduces a table that is linear in k exactly,
+    so it gives IMETH = L's roots."""
+    modal, gaf = _one_dof()
+    a = N.pk_method(modal, gaf, 1.0, [2.0, 6.0], interpolation="L")
+    b = N.pk_method(modal, gaf, 1.0, [2.0, 6.0], interpolation="S")
+    np.testing.assert_allclose(a.eigenvalue, b.eigenvalue, rtol=1e-10)
 
 
 def test_summary_has_nvalue_blocks(ha145b):
