@@ -28,29 +28,34 @@ def ha145b():
     return c, m, gaf
 
 
+@pytest.fixture(scope="module")
+def ha145b_pk(ha145b):
+    """Nastran's PK on HA145B over the example's 4800-25200 in/s (69 velocities)."""
+    c, m, gaf = ha145b
+    return N.pk_method(m, gaf, c.rho, np.linspace(4800.0, 25200.0, 69))
+
+
 def _flutter(found, mode=None):
     hits = [c for c in found if c.kind == "flutter" and not c.unstable_at_first_point
             and (mode is None or c.mode == mode)]
     return min(hits, key=lambda c: c.speed)
 
 
-def test_ha145b_pk_against_nastran(ha145b):
+def test_ha145b_pk_against_nastran(ha145b_pk):
     """Nastran's PK on Nastran's own matrices: the published flutter point within 1 % in speed
     (the V grid is 300 in/s: the linear-in-g crossing is read as Nastran's user reads it)."""
-    c, m, gaf = ha145b
-    res = N.pk_method(m, gaf, c.rho, np.linspace(4800.0, 25200.0, 69))
-    fl = _flutter(N.crossings(res))
+    fl = _flutter(N.crossings(ha145b_pk))
     assert fl.mode == 1                                  # the second mode (0-based 1)
     assert fl.speed == pytest.approx(HA145B_FLUTTER_SPEED, rel=0.01)
     assert fl.frequency_hz == pytest.approx(HA145B_FLUTTER_FREQ, rel=0.02)
     assert not fl.unstable_at_first_point
 
 
-def test_ha145b_k_ke_pk_agree_at_zero_damping(ha145b):
+def test_ha145b_k_ke_pk_agree_at_zero_damping(ha145b, ha145b_pk):
     """At g = 0 the K method's harmonic motion is the PK root's: the crossings coincide (to the
     interpolation of the tabulated curves, 0.3 %), and K and KE give the same eigenvalues."""
     c, m, gaf = ha145b
-    pk = _flutter(N.crossings(N.pk_method(m, gaf, c.rho, np.linspace(4800.0, 25200.0, 69))))
+    pk = _flutter(N.crossings(ha145b_pk))
     ks = np.geomspace(0.02, 1.0, 200)
     k = N.k_method(m, gaf, c.rho, ks)
     ke = N.k_method(m, gaf, c.rho, ks, vectors=False)
@@ -66,9 +71,9 @@ def test_ha145b_k_ke_pk_agree_at_zero_damping(ha145b):
 def test_ha145b_nastran_pk_is_asekit_pk_equation(ha145b):
     """asekit's p-k solves the same equation (thesis Eq. 3.12 = MSC Eq. 2-124): the flutter
     mode's damping and frequency agree at every velocity to the k tolerances (EPS 1e-3 vs
-    1e-7), and the crossing speeds within the linear interpolation of a 300 in/s step."""
+    1e-7), and the crossing speeds within the linear interpolation of a 1200 in/s step."""
     c, m, gaf = ha145b
-    U = np.linspace(4800.0, 25200.0, 69)
+    U = np.linspace(4800.0, 25200.0, 18)
     ase = pk_flutter(m, gaf, c.rho, U, max_iter=200)
     tight = N.pk_method(m, gaf, c.rho, U, eps=1e-9)
     np.testing.assert_allclose(tight.damping_g[:, 1], ase.damping_g[:, 1], atol=2e-5)
@@ -80,7 +85,7 @@ def test_ha145b_nastran_pk_is_asekit_pk_equation(ha145b):
     np.testing.assert_allclose(nas.damping_g[stable, 1], ase.damping_g[stable, 1], atol=2e-4)
     np.testing.assert_allclose(nas.damping_g[:, 1], ase.damping_g[:, 1], atol=4e-3)
     fa = [i for i in pk_instabilities(ase, m, gaf) if i.kind == "flutter"][0]
-    assert _flutter(N.crossings(nas)).speed == pytest.approx(fa.speed, rel=1e-3)
+    assert _flutter(N.crossings(nas)).speed == pytest.approx(fa.speed, rel=5e-3)
 
 
 def _one_dof(a=-2.0, c=-3.0, m=1.0, K=400.0, B=0.0, b=1.0):
