@@ -147,6 +147,6 @@ def run(args) -> int:
     if args.report:
         import matplotlib
         matplotlib.use("Agg")
-        index = write_report(analysis, args.report, progress=not args.quiet)
+        index = write_report(analysis, args.report, progress=not args.quiet, s=s)
         print(f"report: {index}", file=sys.stderr)
     return 0
