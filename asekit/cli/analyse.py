@@ -69,11 +69,13 @@ def _deck_cards(case, s: dict) -> tuple[dict, str]:
     each card with its own method (:func:`asekit.io.bdf.deck_flutter`: K, KE, PK, PKNL as
     MSC Nastran defines them), asekit's own p-k rows of the pipeline move to
     ``s["flutter_asekit_pk"]``; and the cards' FLUTTER SUMMARY text."""
+    from asekit.case.report import critical_condition
     from asekit.io import bdf
     solved = bdf.deck_flutter(case)
     if not solved:
         return s, ""
     s = dict(s, flutter_asekit_pk=s["flutter"], flutter=bdf.flutter_rows(solved))
+    s["critical"] = critical_condition(s)          # from the cards' rows
     return s, bdf.format_flutter_summary(solved)
 
 
