@@ -1874,7 +1874,8 @@ def deck_case(bdf: BdfModel, name: str | None = None) -> Case:
     ``aero`` (its Mach numbers, the MKAERO1 k, REFC / 2, SYMXZ) and ``flight`` (its FLFACT
     densities x RHOREF and velocities); None without CAERO1 / FLUTTER. A PKNL request's
     matched (density, Mach, velocity) triples become the full grid density x Mach over all
-    velocities (a superset). Further FLUTTER requests are listed in ``bdf.flutter`` only.
+    velocities (a superset) for the pipeline's p-k. Every FLUTTER request, each with its own
+    method (K, KE, PK, PKNL at its matched points), is run by :func:`deck_flutter`.
 
     Parameters
     ----------
