@@ -7,6 +7,9 @@ so the pipeline, the report and the sweeps treat them alike:
 
 - ``"pk"``: the p-k method with mode tracking on the tabulated GAFs (thesis Eq. 3.12,
   :func:`asekit.aeroelastic.flutter.pk_flutter`);
+- ``"nastran_pk"``, ``"k"``, ``"ke"``: MSC Nastran's PK, K and KE methods with Nastran's
+  damping definitions (:mod:`asekit.aeroelastic.nastran`; docs/nastran-flutter.md); PKNL's
+  matched flight points are a FLUTTER card's, run by :func:`asekit.io.bdf.deck_flutter`;
 - ``"root_locus"``: eigenvalues of the state-space system A_sys (thesis Eq. 2.63) on a rational
   function approximation of the GAFs (:func:`asekit.aeroelastic.flutter.root_locus`).
 
@@ -17,7 +20,7 @@ one tracked root per column) and one :class:`FlutterMethod` entry below.
 Examples
 --------
 >>> sorted(FLUTTER_METHODS)
-['pk', 'root_locus']
+['k', 'ke', 'nastran_pk', 'pk', 'root_locus']
 >>> flutter_method("root_locus").needs_rfa
 True
 """
@@ -36,6 +39,7 @@ from asekit.aeroelastic.flutter import (
     root_locus,
     root_locus_instabilities,
 )
+from asekit.aeroelastic.nastran import solve_k, solve_ke, solve_pk
 
 
 @dataclass(frozen=True)
@@ -73,6 +77,12 @@ def _root_locus(modal, gaf, rfa, density, velocities):
 FLUTTER_METHODS: dict[str, FlutterMethod] = {
     "pk": FlutterMethod("pk", "p-k with mode tracking on the tabulated GAFs (Eq. 3.12)",
                         False, _pk),
+    "nastran_pk": FlutterMethod("nastran_pk", "MSC Nastran's PK: k iterated per mode to EPS "
+                                "1e-3, g = 2 Re p / |Im p|, no continuation", False, solve_pk),
+    "k": FlutterMethod("k", "MSC Nastran's K method: the structural damping g that makes "
+                       "harmonic motion possible, V = omega b / k", False, solve_k),
+    "ke": FlutterMethod("ke", "MSC Nastran's KE: the K method, eigenvalues only", False,
+                        solve_ke),
     "root_locus": FlutterMethod("root_locus", "eigenvalues of the RFA state space (Eq. 2.63)",
                                 True, _root_locus),
 }

@@ -347,6 +347,15 @@ def _imported_matrices(case: Case):
     return case.structure.K.tocsr(), case.structure.M.tocsr()
 
 
+def _deck_words(structure, msg: str) -> str:
+    """``msg`` in a Nastran user's words when the structure is a deck's: ``modes.count`` is
+    the deck's EIGRL / EIGR ND field (``structure.deck.eigen_card``)."""
+    card = getattr(getattr(structure, "deck", None), "eigen_card", "")
+    if not card:
+        return msg
+    return msg.replace("structure / modes: ", "").replace("modes.count", f"{card} ND")
+
+
 @_door("the modal model of the imported structure",
        "check the deck's materials, properties and constraints, or give modes.count")
 def imported_modal_model(case: Case) -> ModalModel:
@@ -368,7 +377,7 @@ def imported_modal_model(case: Case) -> ModalModel:
     try:
         model = fixed_modal_model(s.supported_system(K, M), M, md.f_max, md.count)
     except ValueError as exc:
-        raise CaseError(f"structure / modes: {exc}") from None
+        raise CaseError(_deck_words(s, f"structure / modes: {exc}")) from None
     if len(model.frequencies_hz) < 1:
         raise CaseError(f"modes: no mode below modes.f_max = {md.f_max:g} Hz; raise f_max or "
                         f"give modes.count")

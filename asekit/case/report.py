@@ -317,7 +317,9 @@ def format_summary(s: dict, width: int = 100) -> str:
     if has_fsi:
         head += f" {'FSI':>7} {'w_f/w_a':>7}"
     head += "  note"
-    lines += ["", "flutter (p-k, rigid modes held)", head]
+    methods = sorted({f"FLUTTER {r['sid']} {r['method']}" for r in s["flutter"] if "method" in r})
+    lines += ["", f"flutter ({', '.join(methods) if methods else 'p-k'}, rigid modes held)",
+              head]
     for row in s["flutter"]:
         ln = (f"{row['mach']:>6.3g} {_cell(row['altitude_m'], '{:.0f}'):>10} "
               f"{row['density']:>10.4g} {_speed_cell(row):>9} "
@@ -482,11 +484,12 @@ def _save_figures(a, directory, progress: bool):
     return saved
 
 
-def write_report(a: Analysis, directory, progress: bool = False) -> Path:
+def write_report(a: Analysis, directory, progress: bool = False, s: dict | None = None) -> Path:
     """Write ``directory/index.html`` (the summary first: the critical condition, a link to
     ``summary.json`` and the table; then the figures, each with an alt text saying what it
     shows) with the PNGs beside it and ``summary.json``; returns the index path. ``progress``
-    shows a tqdm bar over the figures.
+    shows a tqdm bar over the figures; ``s`` the summary to show and write (default
+    :func:`summary` of ``a``; a Nastran deck's adds its FLUTTER cards' rows).
 
     The report is written into a temporary folder next to ``directory`` and moved into place
     when complete (an existing report there is replaced), so an interrupted run (SIGINT) leaves
@@ -504,7 +507,7 @@ def write_report(a: Analysis, directory, progress: bool = False) -> Path:
     os.chmod(tmp, 0o777 & ~umask)           # mkdtemp's folder is private (0700)
     old = None
     try:
-        s = summary(a)
+        s = summary(a) if s is None else s
         (tmp / "summary.json").write_text(json.dumps(s, indent=2))
         saved = _save_figures(a, tmp, progress)
         (tmp / "index.html").write_text(_report_page(s, saved))

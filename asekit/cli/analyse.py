@@ -1,7 +1,9 @@
 """``python -m asekit analyse CASE.toml|DECK.bdf [--units U] [--json PATH] [--report DIR]``: run a
 case file (or a Nastran deck, :func:`asekit.io.bdf.read_bdf`) through
 the pipeline (modes -> GAF database -> p-k flutter -> match points and margins -> ASE loop when
-an actuator is given), print the summary table, and optionally write the JSON summary and an
+an actuator is given), print the summary table (a deck: every FLUTTER card with its own
+method, K / KE / PK / PKNL as MSC Nastran defines them, its rows in the JSON's ``"flutter"``
+and Nastran's FLUTTER SUMMARY printed), and optionally write the JSON summary and an
 HTML report. A bad case file gets one line naming the key and exit status 2. Modes, damping
 and units follow docs/conventions.md (elastic modes from 1, "rigid pitch", g > 0 unstable)."""
 
@@ -62,6 +64,34 @@ def _named(name: str, exc: BaseException) -> str:
     return text if text.startswith(name) else f"{name}: {text}"
 
 
+def _deck_cards(case, s: dict) -> tuple[dict, str]:
+    """A Nastran deck's summary: ``s["flutter"]`` becomes one row per FLUTTER card crossing,
+    each card with its own method (:func:`asekit.io.bdf.deck_flutter`: K, KE, PK, PKNL as
+    MSC Nastran defines them), asekit's own p-k rows of the pipeline move to
+    ``s["flutter_asekit_pk"]``; and the cards' FLUTTER SUMMARY text."""
+    from asekit.case.report import critical_condition
+    from asekit.io import bdf
+    solved = bdf.deck_flutter(case)
+    if not solved:
+        return s, ""
+    s = dict(s, flutter_asekit_pk=s["flutter"], flutter=bdf.flutter_rows(solved))
+    s["critical"] = critical_condition(s)          # from the cards' rows
+    return s, bdf.format_flutter_summary(solved)
+
+
+def _write_outputs(args, s: dict, text: str, write_text_atomic) -> None:
+    """The summary text (standard output, or standard error when the JSON goes there) and
+    the JSON summary (``--json PATH`` or ``-``)."""
+    to_stdout = args.json == "-"
+    print(text, file=sys.stderr if to_stdout else sys.stdout)
+    if args.json:
+        dumped = json.dumps(s, indent=2)
+        if to_stdout:
+            print(dumped)
+        else:
+            write_text_atomic(args.json, dumped + "\n")
+
+
 def run(args) -> int:
     """The command: output paths first, then the case (the loader's checks), then the
     pipeline; an input error or a numerical failure of the case is one line and exit 2 (other
@@ -100,6 +130,12 @@ def run(args) -> int:
     except (ValueError, SolverError) as exc:
         return _error(_named(name, exc))
     s = summary(analysis)
+    cards = None
+    if getattr(case.structure, "deck", None) is not None:         # a Nastran deck
+        try:
+            s, cards = _deck_cards(case, s)
+        except (ValueError, SolverError) as exc:
+            return _error(_named(name, exc))
     if study:
         try:
             conv = convergence.convergence_study(case, finest=analysis.flutter,
@@ -107,19 +143,12 @@ def run(args) -> int:
         except (ValueError, SolverError) as exc:
             return _error(_named(name, exc))
         s = convergence.add_to_summary(s, conv)
-    to_stdout = args.json == "-"
-    print(format_summary(s), file=sys.stderr if to_stdout else sys.stdout)
-    if study:
-        print("\n" + convergence.format_study(conv), file=sys.stderr if to_stdout else sys.stdout)
-    if args.json:
-        text = json.dumps(s, indent=2)
-        if to_stdout:
-            print(text)
-        else:
-            write_text_atomic(args.json, text + "\n")
+    texts = [format_summary(s)] + ([convergence.format_study(conv)] if study else []) + (
+        [cards] if cards else [])
+    _write_outputs(args, s, "\n\n".join(texts), write_text_atomic)
     if args.report:
         import matplotlib
         matplotlib.use("Agg")
-        index = write_report(analysis, args.report, progress=not args.quiet)
+        index = write_report(analysis, args.report, progress=not args.quiet, s=s)
         print(f"report: {index}", file=sys.stderr)
     return 0

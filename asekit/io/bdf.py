@@ -26,8 +26,8 @@ constraints), CQUAD4 (corner thicknesses T1-T4; material angle THETA or MCID) wi
 SPC / SPC1, CELAS1 (PELAS) / CELAS2 springs to ground or between grids, RBE2 (a rigid region,
 e.g. the shaft), CAERO1 with PAERO1 (NSPAN/NCHORD or AEFACT LSPAN/LCHORD divisions),
 SPLINE1 / SPLINE4 with SET1 / AELIST (checked: every box must be splined), AERO / AEROS (REFC,
-RHOREF, SYMXZ), MKAERO1, FLFACT, FLUTTER (PK, PKNL), EIGR / EIGRL (number of modes or the
-frequency range), TABDMP1 (G or CRIT modal damping), PARAM WTMASS. CTRIA3 is modelled as a
+RHOREF, SYMXZ), MKAERO1, FLFACT, FLUTTER (K, KE, PK, PKNL: :func:`deck_flutter` runs each
+card with its own method), EIGR / EIGRL (number of modes or the frequency range), TABDMP1 (G or CRIT modal damping), PARAM WTMASS. CTRIA3 is modelled as a
 degenerated MITC4 (its third node repeated: a collapsed quadrilateral, Bathe, *Finite Element
 Procedures*, 1996, Ch. 5), stiffer than the quadrilateral on coarse meshes but convergent
 (tests/io/test_bdf.py: NAFEMS FV16). Solids, beams, bars, rods and other shells are refused with
@@ -121,15 +121,30 @@ def _need_pynastran():
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class FlutterRequest:
-    """A FLUTTER card resolved to SI: ``method`` (PK / PKNL), ``densities`` (kg/m^3),
-    ``machs``, ``velocities`` (m/s, absolute values); for PK every combination of density x
-    Mach is swept over the velocities, for PKNL the three lists are matched point by point."""
+    """A FLUTTER card resolved to SI, as Nastran reads it: ``method`` (K, KE, PK, PKNL),
+    ``densities`` (kg/m^3, FLFACT DENS x RHOREF), ``machs``, ``velocities`` (m/s, absolute
+    values; PK / PKNL) or ``reduced_frequencies`` (K / KE, FLFACT RFREQ), ``print_vectors``
+    (one flag per velocity: negative in the FLFACT, Nastran prints the eigenvectors there),
+    ``imeth`` ('L' linear or 'S' surface interpolation of Q in k), ``nvalue`` (number of
+    roots printed, None: all) and ``eps`` (k convergence of PK / PKNL). K, KE and PK loop over
+    every density x Mach (x velocity or k); PKNL's equal-length lists are matched point by
+    point (point i = (densities[i], machs[i], velocities[i]))."""
 
     sid: int
     method: str
     densities: tuple[float, ...]
     machs: tuple[float, ...]
     velocities: tuple[float, ...]
+    reduced_frequencies: tuple[float, ...] = ()
+    print_vectors: tuple[bool, ...] = ()
+    imeth: str = "L"
+    nvalue: int | None = None
+    eps: float = 1e-3
+
+    def points(self) -> list[tuple[float, float]]:
+        """The (density, Mach) pairs a K / KE / PK request loops over (Mach outer, density
+        inner)."""
+        return [(d, m) for m in self.machs for d in self.densities]
 
 
 @dataclass(frozen=True)
@@ -149,7 +164,8 @@ class BdfModel:
         Nastran box ids; b_ref : reference semichord REFC / 2 (m); rho_ref (kg/m^3);
         symmetric : SYMXZ = 1 (a wall at y = 0).
     machs, reduced_frequencies : the MKAERO1 grid (all pairs); flutter : the FLUTTER requests.
-    n_modes, f_max_hz : from EIGR / EIGRL (None when absent); damping_g : (frequency Hz,
+    n_modes, f_max_hz : from EIGR / EIGRL (None when absent), eigen_card : that card and its
+        id ('EIGRL 10'; '' without one), named by errors about the number of modes; damping_g : (frequency Hz,
         g) table from TABDMP1 (CRIT converted to g = 2 zeta) or None.
     materials : {(pid, material angle rad): material}; element_pids, element_angles :
         (n_elem,) property id and material 1-axis angle (rad from +x) of each element;
@@ -176,6 +192,7 @@ class BdfModel:
     n_modes: int | None = None
     f_max_hz: float | None = None
     damping_g: tuple[tuple[float, float], ...] | None = None
+    eigen_card: str = ""
     materials: dict = field(default_factory=dict)
     element_pids: np.ndarray | None = None
     element_angles: np.ndarray | None = None
@@ -1170,6 +1187,16 @@ def _read_eigen_method(model, deck: _Deck):
     return (int(nd) if nd else None), (float(v2) / deck.T if v2 else None)
 
 
+def _eigen_card(model) -> str:
+    """'EIGRL 10' / 'EIGR 10': the card :func:`_read_eigen_method` reads, '' without one."""
+    methods = model.methods
+    if not methods:
+        return ""
+    meth = _case_value(model, "METHOD")
+    mth = methods.get(meth) if meth in methods else methods[min(methods)]
+    return f"{mth.type} {mth.sid}"
+
+
 def _read_tabdmp1(model, deck: _Deck):
     """TABDMP1 (the first): modal damping vs frequency as ((f Hz, g), ...); TYPE G as given,
     CRIT (fraction of critical) as g = 2 zeta.
@@ -1420,37 +1447,87 @@ def _check_splines(model, box_ids, notes):
                      "modes with its finite-element shape functions, not the surface spline")
 
 
+def _flfact(model, f, v, name: str) -> tuple[int, np.ndarray]:
+    sid = v if isinstance(v, (int, np.integer)) else getattr(v, "sid", v)
+    if int(sid) not in model.flfacts:
+        raise BdfError(f"FLUTTER {f.sid} {name} = {sid}: no FLFACT {sid}")
+    vals = np.asarray(model.flfacts[int(sid)].factors, float)
+    if vals.size < 1:
+        raise BdfError(f"FLUTTER {f.sid} {name}: FLFACT {sid} lists no value")
+    return int(sid), vals
+
+
+def _flutter_options(f) -> tuple[str, int | None, float]:
+    """IMETH, NVALUE and EPS of a FLUTTER card, checked."""
+    imeth = str(getattr(f, "imethod", "L") or "L").upper()
+    if imeth not in ("L", "S"):
+        raise BdfError(f"FLUTTER {f.sid} IMETH = {imeth!r} must be 'L' (linear) or 'S' "
+                       f"(surface)")
+    nvalue = getattr(f, "nvalue", None)
+    if nvalue is not None and (not isinstance(nvalue, (int, np.integer)) or nvalue < 1):
+        raise BdfError(f"FLUTTER {f.sid} NVALUE = {nvalue!r} must be an integer >= 1")
+    eps = getattr(f, "epsilon", None)
+    eps = 1e-3 if eps is None else float(eps)
+    if not (math.isfinite(eps) and eps > 0):
+        raise BdfError(f"FLUTTER {f.sid} EPS = {eps!r} must be > 0 (default 1.0E-3)")
+    return imeth, (int(nvalue) if nvalue is not None else None), eps
+
+
+def _check_pknl(f, ids, lists) -> None:
+    n = [len(v) for v in lists]
+    if len(set(n)) != 1:
+        parts = ", ".join(f"{name} = FLFACT {sid} has {k}" for name, sid, k in
+                          zip(("DENS", "MACH", "RFREQ"), ids, n))
+        raise BdfError(f"FLUTTER {f.sid} PKNL: {parts} values; PKNL needs equal lengths "
+                       f"(one flight point per index)")
+
+
 def _flutter(model, f, rho_ref, deck) -> FlutterRequest:
-    """A FLUTTER request with its FLFACT lists in SI (densities x RHOREF, |velocities|).
+    """A FLUTTER request with its FLFACT lists in SI (densities x RHOREF, |velocities|), as
+    MSC Nastran reads it (Quick Reference Guide, FLUTTER and FLFACT).
 
     +---------+-----+--------+------+------+-------+-------+-------+------+
     |    1    |  2  |   3    |  4   |  5   |   6   |   7   |   8   |  9   |
     +=========+=====+========+======+======+=======+=======+=======+======+
-    | FLUTTER | SID | METHOD | DENS | MACH | RFREQ | IMETH | NVALUE| OMAX |
+    | FLUTTER | SID | METHOD | DENS | MACH | RFREQ | IMETH | NVALUE| EPS  |
     +---------+-----+--------+------+------+-------+-------+-------+------+
     | FLFACT  | SID |   F1   |  F2  |  F3  |  F4   |  F5   |  F6   |  F7  |
     +---------+-----+--------+------+------+-------+-------+-------+------+
+
+    METHOD K / KE: RFREQ lists reduced frequencies k > 0; PK / PKNL: velocities (negative:
+    print the eigenvectors at |V|). PKNL: DENS, MACH and VEL lists of equal length, one flight
+    point per index. DENS are density ratios (x AERO RHOREF).
     """
-    method = f.method
-    if method not in ("PK", "PKNL"):
-        raise BdfError(f"FLUTTER {f.sid}: method {method} is not supported (PK, PKNL)")
+    method = str(f.method).upper()
+    if method not in ("K", "KE", "PK", "PKNL"):
+        raise BdfError(f"FLUTTER {f.sid} METHOD = {method} must be K, KE, PK or PKNL")
     if rho_ref is None:
         raise BdfError(f"FLUTTER {f.sid} needs AERO (RHOREF)")
-
-    def fl(v, name, kind=None, scale=1.0):
-        sid = v if isinstance(v, (int, np.integer)) else v.sid
-        vals = np.asarray(model.flfacts[int(sid)].factors, float) * scale
-        for j, x in enumerate(vals if kind else ()):  # PK: a negative V asks for vectors
-            _check_range(deck, f"FLFACT {sid} (FLUTTER {f.sid} {name}) F{j + 1}", x / scale,
-                         kind, si=abs(x) if kind == "velocity" else x)
-        return vals
-    dens = fl(f.density, "DENS", "fluid density", rho_ref)
-    mach = fl(f.mach, "MACH")                # checked on the MKAERO1 grid (_aero_of)
-    vel = np.abs(fl(f.reduced_freq_velocity, "RFREQ", "velocity", deck.L / deck.T))
-    if method == "PKNL" and not len(dens) == len(mach) == len(vel):
-        raise BdfError(f"FLUTTER {f.sid} PKNL: FLFACT lists must have equal lengths")
-    return FlutterRequest(int(f.sid), method, tuple(map(float, dens)), tuple(map(float, mach)),
-                          tuple(map(float, vel)))
+    imeth, nvalue, eps = _flutter_options(f)
+    ids, raw = zip(*(_flfact(model, f, v, name) for v, name in (
+        (f.density, "DENS"), (f.mach, "MACH"), (f.reduced_freq_velocity, "RFREQ"))))
+    for j, x in enumerate(raw[0]):
+        _check_range(deck, f"FLFACT {ids[0]} (FLUTTER {f.sid} DENS) F{j + 1}", x,
+                     "fluid density", si=x * rho_ref)
+    dens = raw[0] * rho_ref
+    if method == "PKNL":
+        _check_pknl(f, ids, raw)
+    common = dict(sid=int(f.sid), method=method, densities=tuple(map(float, dens)),
+                  machs=tuple(map(float, raw[1])), imeth=imeth, nvalue=nvalue, eps=eps)
+    if method in ("K", "KE"):
+        bad = [j for j, k in enumerate(raw[2]) if not (math.isfinite(k) and k > 0)]
+        if bad:
+            raise BdfError(f"FLFACT {ids[2]} (FLUTTER {f.sid} RFREQ) F{bad[0] + 1} = "
+                           f"{raw[2][bad[0]]:g}: reduced frequencies of the {method} method "
+                           f"must be > 0")
+        return FlutterRequest(velocities=(), reduced_frequencies=tuple(map(float, raw[2])),
+                              **common)
+    vel = raw[2] * deck.L / deck.T
+    for j, x in enumerate(raw[2]):
+        _check_range(deck, f"FLFACT {ids[2]} (FLUTTER {f.sid} RFREQ) F{j + 1}", x,
+                     "velocity", si=abs(x) * deck.L / deck.T)
+    return FlutterRequest(velocities=tuple(map(float, np.abs(vel))),
+                          print_vectors=tuple(bool(x < 0) for x in raw[2]), **common)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1714,6 +1791,7 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
                       f"{_fmt(ignored)}", UnsupportedCardWarning, stacklevel=2)
     return BdfModel(mesh=mesh, node_ids=deck.nids, K=K, M=M, system=system, **aero,
                     n_modes=n_modes, f_max_hz=f_max, damping_g=_read_tabdmp1(model, deck),
+                    eigen_card=_eigen_card(model),
                     materials=materials, element_pids=pids.copy(),
                     element_angles=_angles(keys, len(quads)), springs=springs, masses=masses,
                     fixed=tuple(sorted(fixed)), rigid=rigid, ignored=tuple(ignored),
@@ -1749,11 +1827,12 @@ def _support_words(bdf: BdfModel) -> str:
 
 
 def _flight_of(bdf: BdfModel) -> FlightSpec | None:
-    """The flight conditions of the deck's first FLUTTER request (the case control's FMETHOD):
-    its densities and its velocities (ascending, duplicates dropped)."""
-    if not bdf.flutter:
+    """The flight conditions of the deck's first PK / PKNL FLUTTER request (the case control's
+    FMETHOD first): its densities and its velocities (ascending, duplicates dropped)."""
+    swept = [r for r in bdf.flutter if r.velocities]        # PK / PKNL (K, KE sweep k)
+    if not swept:
         return None
-    req = bdf.flutter[0]
+    req = swept[0]
     return FlightSpec(velocities=tuple(sorted(set(req.velocities))),
                       densities=tuple(dict.fromkeys(req.densities)))
 
@@ -1765,13 +1844,13 @@ def _aero_of(bdf: BdfModel) -> AeroSpec | None:
     if bdf.boxes is None:
         return None
     machs = bdf.machs
-    if bdf.flutter:
-        req = bdf.flutter[0]
+    for req in bdf.flutter:
         off = [m for m in req.machs if not any(abs(m - g) <= 1e-9 for g in bdf.machs)]
         if off:
-            raise BdfError(f"FLUTTER {req.sid}: Mach {off[0]} is not on the MKAERO1 grid "
+            raise BdfError(f"FLUTTER {req.sid} MACH: Mach {off[0]} is not on the MKAERO1 grid "
                            f"{list(bdf.machs)}")
-        machs = tuple(sorted(set(req.machs)))
+    if bdf.flutter:
+        machs = tuple(sorted(set(bdf.flutter[0].machs)))
     return AeroSpec(machs=machs, reference_semichord=bdf.b_ref,
                     reduced_frequencies=bdf.reduced_frequencies,
                     symmetry="wall" if bdf.symmetric else "none")
@@ -1795,7 +1874,8 @@ def deck_case(bdf: BdfModel, name: str | None = None) -> Case:
     ``aero`` (its Mach numbers, the MKAERO1 k, REFC / 2, SYMXZ) and ``flight`` (its FLFACT
     densities x RHOREF and velocities); None without CAERO1 / FLUTTER. A PKNL request's
     matched (density, Mach, velocity) triples become the full grid density x Mach over all
-    velocities (a superset). Further FLUTTER requests are listed in ``bdf.flutter`` only.
+    velocities (a superset) for the pipeline's p-k. Every FLUTTER request, each with its own
+    method (K, KE, PK, PKNL at its matched points), is run by :func:`deck_flutter`.
 
     Parameters
     ----------
@@ -1850,6 +1930,116 @@ def read_bdf(path, units: str = "SI", tol: float | None = None,
     6066
     """
     return deck_case(read_deck(path, units, tol, thickness_rule), name=name)
+
+
+# ---------------------------------------------------------------------------------------------
+# the deck's FLUTTER cards, each with its own method (MSC Nastran's K, KE, PK, PKNL)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class DeckFlutter:
+    """One FLUTTER card solved as Nastran would: ``request`` the card, ``results`` one
+    :class:`~asekit.aeroelastic.nastran.NastranFlutterResult` per density x Mach loop (PKNL:
+    one, over its matched points), ``crossings`` every g = 0 crossing (and root unstable at
+    the first point) of them, sorted by speed."""
+
+    request: FlutterRequest
+    results: tuple
+    crossings: tuple
+
+
+def _signed(req: FlutterRequest) -> np.ndarray:
+    v = np.asarray(req.velocities, float)
+    return np.where(np.asarray(req.print_vectors, bool), -v, v) if req.print_vectors else v
+
+
+def _solve_request(req: FlutterRequest, modal, db) -> DeckFlutter:
+    from asekit.aeroelastic import nastran as N
+
+    def gaf(mach):
+        return N.elastic_part(modal, db.at(mach))
+
+    if req.method == "PKNL":
+        m = gaf(req.machs[0])[0]
+        results = [N.pknl_method(m, lambda mach: gaf(mach)[1], req.densities, req.machs,
+                                 _signed(req), eps=req.eps, interpolation=req.imeth)]
+    else:
+        results = []
+        for rho, mach in req.points():
+            m, g = gaf(mach)
+            if req.method == "PK":
+                results.append(N.pk_method(m, g, rho, _signed(req), eps=req.eps,
+                                           interpolation=req.imeth, mach=mach))
+            else:
+                results.append(N.k_method(m, g, rho, req.reduced_frequencies,
+                                          vectors=req.method == "K", interpolation=req.imeth,
+                                          mach=mach))
+    found = sorted((c for r in results for c in N.crossings(r)), key=lambda c: c.speed)
+    return DeckFlutter(req, tuple(results), tuple(found))
+
+
+def deck_flutter(case: Case, db=None) -> list[DeckFlutter]:
+    """Every FLUTTER card of a deck's case (:func:`read_bdf`) with its own method, densities,
+    Machs and velocities or reduced frequencies (:mod:`asekit.aeroelastic.nastran`; asekit's
+    modes of the deck's structure and asekit's doublet lattice, rigid modes held).
+
+    Parameters
+    ----------
+    case : Case
+        From :func:`read_bdf` (``case.structure.deck`` holds the FLUTTER requests).
+    db : GafDatabase, optional
+        GAFs at every Mach of the cards (default: :func:`asekit.case.pipeline.gaf_database`
+        of the case with the Machs of every card).
+
+    Returns
+    -------
+    list of DeckFlutter, in the deck's order (the case control's FMETHOD first).
+    """
+    bdf = getattr(case.structure, "deck", None)
+    if bdf is None or not bdf.flutter:
+        return []
+    from dataclasses import replace
+    modal = pl.modal_model(case)
+    if db is None:
+        machs = tuple(sorted({m for r in bdf.flutter for m in r.machs}))
+        db = pl.gaf_database(replace(case, aero=replace(case.aero, machs=machs)),
+                             progress=False)
+    return [_solve_request(req, modal, db) for req in bdf.flutter]
+
+
+def flutter_rows(solved: list[DeckFlutter]) -> list[dict]:
+    """The JSON rows of :func:`deck_flutter`: one per crossing (or root unstable at the first
+    point), a card without any gives one row with ``speed_ms`` None. Keys: method, sid, mach,
+    density (kg/m^3), speed_ms, frequency_hz, mode (1-based elastic mode),
+    unstable_at_first_point, altitude_m (None: a deck gives densities)."""
+    rows = []
+    for d in solved:
+        r = d.request
+        for c in d.crossings:
+            rows.append({"method": r.method, "sid": r.sid, "mach": c.mach,
+                         "density": c.density, "altitude_m": None, "speed_ms": c.speed,
+                         "frequency_hz": 0.0 if c.kind == "divergence" else c.frequency_hz,
+                         "mode": c.mode + 1, "kind": c.kind,
+                         "unstable_at_first_point": c.unstable_at_first_point,
+                         "speed_upper_bound_ms": c.speed if c.unstable_at_first_point
+                         else None})
+        if not d.crossings:
+            rows.append({"method": r.method, "sid": r.sid, "mach": r.machs[0],
+                         "density": r.densities[0], "altitude_m": None, "speed_ms": None,
+                         "frequency_hz": None, "mode": None, "kind": None,
+                         "unstable_at_first_point": False, "speed_upper_bound_ms": None})
+    return rows
+
+
+def format_flutter_summary(solved: list[DeckFlutter]) -> str:
+    """Nastran's FLUTTER SUMMARY of every card (V in m/s, g, f Hz per mode, the card's NVALUE
+    modes), :func:`asekit.aeroelastic.nastran.flutter_summary`."""
+    from asekit.aeroelastic.nastran import flutter_summary
+    blocks = []
+    for d in solved:
+        for res in d.results:
+            blocks.append(f"FLUTTER {d.request.sid} ({d.request.method})\n"
+                          + flutter_summary(res, d.request.nvalue, "m/s"))
+    return "\n\n".join(blocks)
 
 
 # ---------------------------------------------------------------------------------------------

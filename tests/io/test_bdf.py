@@ -412,7 +412,7 @@ def test_analyse_cli_reads_a_deck(tmp_path, capsys):
                      "--json", str(out)]) == 0
         s = json.loads(out.read_text())
         ref = pl.flutter(_read(HA145E / "ha145e.bdf", units="in-lbf-s")).results[0].flutter
-        assert s["flutter"][0]["speed_ms"] == pytest.approx(ref.speed, rel=1e-12)
+        assert s["flutter_asekit_pk"][0]["speed_ms"] == pytest.approx(ref.speed, rel=1e-12)
         assert main(["analyse", str(HA145E / "ha145e_structure.bdf"), "--units",
                      "in-lbf-s", "--quiet"]) == 2
     assert "ha145e_structure.bdf" in capsys.readouterr().err
@@ -705,3 +705,156 @@ def test_mutated_decks_end_ok_or_in_a_bdf_error():
         seen = fuzz.run(60, 22, 60.0, 1)
     assert set(seen) <= {"ok", "ok+warning", "BdfError"}, seen
     assert seen["BdfError"] > 20 and seen["ok"] > 5          # both kinds are exercised
+
+
+# ---------------------------------------------------------------------------------------------
+# FLUTTER / FLFACT as MSC Nastran reads them (issue 24): K, KE, PK, PKNL per card
+# ---------------------------------------------------------------------------------------------
+_IN = 0.0254                                    # m per in
+
+
+def _flutter_deck(tmp_path, name="fl.bdf", pknl_v=(4000., 4800., 5400., 5800., 6200., 6600.,
+                                                  7000.), extra=()):
+    """HA145E with four more FLUTTER cards: PKNL 40 (seven matched density-ratio, Mach,
+    velocity points; PKNL 41: card 30's density and first seven velocities), K 50 and KE 51 (seven k around the flutter k ~ 0.126), PK 60 (negative
+    velocities: print eigenvectors; IMETH L, NVALUE 2, EPS 1e-4)."""
+    add = [_card("FLFACT", 11, 0.6, 0.8, 1.0, 1.2, 1.4, 1.6, 1.8),
+           _card("FLFACT", 12, *([0.45] * 7)),
+           _card("FLFACT", 13, *pknl_v),
+           _card("FLUTTER", 40, "PKNL", 11, 12, 13),
+           _card("FLFACT", 21, 0.16, 0.15, 0.14, 0.13, 0.12, 0.11, 0.10),
+           _card("FLUTTER", 50, "K", 1, 2, 21),
+           _card("FLUTTER", 51, "KE", 1, 2, 21),
+           _card("FLFACT", 23, -4000.0, 5000.0, -6000.0),
+           _card("FLUTTER", 60, "PK", 1, 2, 23, "L", 2, 1.0e-4),
+           _card("FLFACT", 14, *([1.0] * 7)),
+           _card("FLFACT", 15, 4000., 4200., 4400., 4600., 4800., 5000., 5200.),
+           _card("FLUTTER", 41, "PKNL", 14, 12, 15), *extra]
+    return _ha145e_deck(tmp_path, add=add, name=name)
+
+
+@pytest.fixture(scope="module")
+def flutter_cards(tmp_path_factory):
+    case = _read(_flutter_deck(tmp_path_factory.mktemp("fl")), units="in-lbf-s",
+                 thickness_rule="centroid")
+    return case, {d.request.sid: d for d in B.deck_flutter(case)}
+
+
+def test_flutter_cards_read_as_nastran(flutter_cards):
+    """One method per FLUTTER card; PKNL lists matched; negative velocities flag the points
+    whose eigenvectors Nastran prints; IMETH, NVALUE and EPS read; K's RFREQ are k."""
+    case, d = flutter_cards
+    req = {r.sid: r for r in case.structure.deck.flutter}
+    assert {r.sid: r.method for r in case.structure.deck.flutter} == {
+        30: "PK", 40: "PKNL", 41: "PKNL", 50: "K", 51: "KE", 60: "PK"}
+    assert case.structure.deck.flutter[0].sid == 30                 # FMETHOD = 30 first
+    assert len(req[40].densities) == len(req[40].machs) == len(req[40].velocities) == 7
+    assert req[50].reduced_frequencies[0] == 0.16 and req[50].velocities == ()
+    r = req[60]
+    assert r.print_vectors == (True, False, True) and r.velocities[0] == pytest.approx(
+        4000.0 * _IN) and (r.imeth, r.nvalue, r.eps) == ("L", 2, 1.0e-4)
+    assert d[60].results[0].print_vectors.tolist() == [True, False, True]
+    assert len(d[40].results) == 1 and d[40].results[0].damping_g.shape == (7, 4)
+
+
+def test_flutter_cards_agree_at_zero_damping(flutter_cards):
+    """PK (card 30, 200 in/s steps), K and KE (cards 50, 51, k steps of 0.01) cross g = 0 at
+    the same flutter point of mode 2 (harmonic motion is the same root in both definitions):
+    within 1 % in speed (measured 5895.5 vs 5912.7 in/s) and 2 % in frequency (114.1 vs
+    112.5 Hz). They differ by more than the interpolation because the deck's TABDMP1 g = 0.01
+    is viscous in PK (B = g omega_j m_j: an effective g = 0.01 f / f_j = 0.005 at the flutter
+    frequency of mode 2, f_j = 218 Hz) and structural in K (g = 0.01 at every frequency). The
+    ZAERO g-method result of the same example (ha145e.out, 5753.150 in/s, 111.7 Hz) within
+    5 % (asekit's DLM and plate vs ZONA6 and Nastran's plate: test_ha145e_flutter_against_
+    published)."""
+    _, d = flutter_cards
+    pk = [c for c in d[30].crossings if c.mode == 1 and not c.unstable_at_first_point][0]
+    assert abs(pk.speed / _IN / 5753.150 - 1) < 0.05
+    for sid in (50, 51):
+        k = [c for c in d[sid].crossings if c.mode == 1][0]
+        assert k.speed == pytest.approx(pk.speed, rel=0.01)
+        assert k.frequency_hz == pytest.approx(pk.frequency_hz, rel=0.02)
+    assert d[51].results[0].vectors is None and d[50].results[0].vectors is not None
+
+
+def test_pknl_one_matched_crossing(flutter_cards, tmp_path):
+    """PKNL: one flight point per index (not every velocity at every density). Its first
+    point is the PK root at (rho_1, V_1) alone; PKNL 41 on card 30's density and first seven
+    velocities is card 30's PK sweep there (same starts, same sequence); PKNL 40's mode-2
+    crossing lies between its bracketing points, interpolated in g; a deck whose first point is
+    already unstable is flagged."""
+    from asekit.aeroelastic import nastran as N
+    case, d = flutter_cards
+    res = d[40].results[0]
+    req = d[40].request
+    m, g = N.elastic_part(pl.modal_model(case), pl.gaf_database(case, progress=False).at(0.45))
+    one = N.pk_method(m, g, req.densities[0], [req.velocities[0]])
+    np.testing.assert_allclose(res.damping_g[0], one.damping_g[0], atol=1e-12)
+    np.testing.assert_allclose(d[41].results[0].damping_g, d[30].results[0].damping_g[:7],
+                               atol=1e-12)
+    (x,) = [c for c in d[40].crossings if c.mode == 1]
+    gi = res.damping_g[:, 1]
+    i = x.index
+    assert gi[i - 1] <= 0 < gi[i] and not x.unstable_at_first_point
+    assert req.velocities[i - 1] <= x.speed <= req.velocities[i]
+    assert req.densities[i - 1] <= x.density <= req.densities[i]
+    late = _read(_flutter_deck(tmp_path, pknl_v=(8000., 8200., 8400., 8600., 8800., 9000.,
+                                                 9200.)), units="in-lbf-s",
+                 thickness_rule="centroid")      # point 1: rho ratio 0.6, above its 7040 in/s
+    (y,) = [c for dd in B.deck_flutter(late) if dd.request.sid == 40 for c in dd.crossings
+            if c.mode == 1]
+    assert y.unstable_at_first_point and y.speed == pytest.approx(8000.0 * _IN)
+
+
+def test_flutter_rows_and_summary(flutter_cards):
+    """The JSON rows (one per crossing, each naming its card's method) and the FLUTTER
+    SUMMARY text (NVALUE = 2 of card 60: two mode blocks)."""
+    _, d = flutter_cards
+    rows = B.flutter_rows(list(d.values()))
+    keys = {"method", "mach", "density", "speed_ms", "frequency_hz", "mode",
+            "unstable_at_first_point"}
+    assert all(keys <= set(r) for r in rows)
+    assert {r["method"] for r in rows} >= {"PK", "PKNL", "K", "KE"}
+    pknl = [r for r in rows if r["sid"] == 40 and r["mode"] == 2]
+    assert len(pknl) == 1
+    text = B.format_flutter_summary([d[60]])
+    assert text.count("FLUTTER SUMMARY") == 2 and "METHOD = PK" in text
+
+
+def test_flutter_card_errors_name_card_and_field(tmp_path):
+    """PKNL lists of unequal length, a K reduced frequency <= 0 and EIGR ND above the modes
+    found: one line naming the Nastran card and field."""
+    p = _ha145e_deck(tmp_path, add=[_card("FLUTTER", 40, "PKNL", 1, 2, 3)])
+    with pytest.raises(B.BdfError, match=r"FLUTTER 40 PKNL: DENS = FLFACT 1 has 1, MACH = "
+                                         r"FLFACT 2 has 1, RFREQ = FLFACT 3 has 15 values"):
+        _read(p, units="in-lbf-s")
+    p = _ha145e_deck(tmp_path, add=[_card("FLFACT", 21, 0.1, 0.0),
+                                    _card("FLUTTER", 50, "K", 1, 2, 21)], name="k.bdf")
+    with pytest.raises(B.BdfError, match=r"FLFACT 21 \(FLUTTER 50 RFREQ\) F2 = 0"):
+        _read(p, units="in-lbf-s")
+    nd = _ha145e_deck(tmp_path, replace=[("MGIV                            4",
+                                          "MGIV                            900")],
+                      name="nd.bdf")
+    from asekit.case import CaseError
+    with pytest.raises(CaseError, match=r"EIGR 10 ND = 900 elastic") as e:
+        pl.modal_model(_read(nd, units="in-lbf-s"))
+    assert "modes.count" not in str(e.value)
+
+
+def test_analyse_cli_deck_flutter_rows(tmp_path, capsys):
+    """``asekit analyse DECK.bdf --json``: ``"flutter"`` holds one row per FLUTTER card
+    crossing (method, mach, density, speed_ms, frequency_hz, mode, unstable_at_first_point),
+    asekit's own p-k rows are ``"flutter_asekit_pk"``; the FLUTTER SUMMARY is printed."""
+    import json
+
+    from asekit.cli.main import main
+    out = tmp_path / "s.json"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", B.UnsupportedCardWarning)
+        assert main(["analyse", str(HA145E / "ha145e.bdf"), "--units", "in-lbf-s", "--quiet",
+                     "--json", str(out)]) == 0
+    s = json.loads(out.read_text())
+    (row,) = s["flutter"]
+    assert row["method"] == "PK" and row["mode"] == 2 and not row["unstable_at_first_point"]
+    assert row["speed_ms"] == pytest.approx(s["flutter_asekit_pk"][0]["speed_ms"], rel=0.01)
+    assert "FLUTTER SUMMARY" in capsys.readouterr().out
