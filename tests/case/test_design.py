@@ -25,6 +25,9 @@ from asekit.case.design import (
 from asekit.case.toml_writer import dumps
 from asekit.util.paths import FIN_FILE
 
+#: rebuilt GAF databases go to a session temporary folder (tests/conftest.py)
+pytestmark = pytest.mark.usefixtures("session_gaf_cache")
+
 
 def _small_raw() -> dict:
     raw = tomllib.loads(FIN_FILE.read_text())
