@@ -72,6 +72,12 @@ OBJECTIVES = ("mass",)
 #: case pipeline (FN2 modes, its own GAF database) differs from the optimiser's chain (FN1 modes,
 #: the same boxes) by ~1e-7 relative, and SLSQP meets an active constraint only to its tolerance.
 CONSTRAINT_SLACK = 1e-4
+#: The p-k sweep that locates the first crossing uses at most this many of the case's velocities
+#: (evenly strided, the last one kept; the solver's step control inserts sub-steps where roots
+#: move fast); the crossing is then converged by Newton's method to 1e-12 relative. A root that
+#: crosses and re-crosses between two of these points is missed by the optimiser but not by the
+#: re-analysis of ``asekit optimise``, which runs the case's own sweep.
+SWEEP_POINTS = 40
 _THICKNESS = ("thickness.root", "thickness.tip")
 
 
@@ -384,6 +390,13 @@ def _gafs(ev: Evaluator, mesh, shapes: np.ndarray) -> np.ndarray:
     return out
 
 
+def _sweep(velocities) -> np.ndarray:
+    """At most :data:`SWEEP_POINTS` of the velocities, the first and last included."""
+    v = np.asarray(velocities, float)
+    stride = max(1, math.ceil((v.size - 1) / (SWEEP_POINTS - 1)))
+    return np.unique(np.append(v[::stride], v[-1]))
+
+
 def _flutter(ev: Evaluator, mats: dict, gaf: TabulatedGaf, density: float):
     """(U_f, f_f, dU_f) of the first flutter crossing in the case's velocity sweep (NaN and a
     zero gradient when there is none)."""
@@ -391,7 +404,7 @@ def _flutter(ev: Evaluator, mats: dict, gaf: TabulatedGaf, density: float):
     modal = modal_arrays(M=mats["M"], K=mats["K"], C=mats["C"])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = pk_flutter(modal, gaf, density, ev.case.flight.velocities)
+        res = pk_flutter(modal, gaf, density, _sweep(ev.case.flight.velocities))
         flut = [i for i in pk_instabilities(res, modal, gaf)
                 if i.kind == "flutter" and not i.at_first_point]
     if not flut:
