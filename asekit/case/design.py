@@ -505,7 +505,7 @@ def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.
 
 
 def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
-             progress=None) -> DesignResult:
+             progress=None, evaluator: Evaluator | None = None) -> DesignResult:
     """Minimise the mass subject to the flutter margin (module docstring) with SLSQP and the
     analytic gradients; variables scaled by their baseline values.
 
@@ -513,7 +513,9 @@ def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
     ----------
     case : the case; problem : its :class:`DesignProblem`;
     check_gradients : compare the analytic gradients with central differences at the baseline;
-    progress : optional callable ``progress(dict)`` called once per iteration (a history row).
+    progress : optional callable ``progress(dict)`` called once per iteration (a history row);
+    evaluator : an :class:`Evaluator` of this case and problem to reuse (its memoised
+        evaluations and aerodynamic operators), default a new one.
 
     Returns
     -------
@@ -521,7 +523,7 @@ def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
     """
     from scipy.optimize import minimize
     t0 = time.perf_counter()
-    ev = Evaluator(case, problem)
+    ev = Evaluator(case, problem) if evaluator is None else evaluator
     x0 = np.array([case_value(case, p) for p in ev.paths])
     check, t_check = None, 0.0
     if check_gradients:
