@@ -40,16 +40,30 @@ def _error(msg: str) -> int:
     return outputs.print_error(f"error: {msg}", 2, _log)
 
 
-def _pipeline_margin(case) -> float | None:
-    """The smallest flutter margin (%) of the case pipeline over its envelope altitudes."""
+def _reanalysis(case, margin: float) -> dict:
+    """The case pipeline's verdict: the smallest flutter margin (%) over the envelope altitudes,
+    the lowest divergence speed at the envelope's top Mach (None: none in the sweep), and
+    whether both clear (1 + margin) M a."""
     from asekit.case import pipeline as P
-    vals = [m["margin"] for m in P.flutter(case).margins if m["margin"] is not None]
-    return 100.0 * min(vals) if vals else None
+    fa = P.flutter(case)
+    vals = [m["margin"] for m in fa.margins if m["margin"] is not None]
+    top = case.flight.envelope_mach[1]
+    lo, hi = case.flight.envelope_altitude or (-float("inf"), float("inf"))
+    div = [d["speed_ms"] for d in fa.divergence if d["speed_ms"] is not None
+           and abs(d["mach"] - top) < 1e-12 and lo <= d["altitude_m"] <= hi]
+    env = {m["altitude_m"]: m["envelope_speed_ms"] for m in fa.margins}
+    div_ok = all(d["speed_ms"] is None or d["speed_ms"] >= (1 + margin) * env[d["altitude_m"]]
+                 for d in fa.divergence if abs(d["mach"] - top) < 1e-12
+                 and d["altitude_m"] in env)
+    pct = 100.0 * min(vals) if len(vals) == len(fa.margins) and vals else None
+    return {"flutter_margin_pct": pct, "divergence_speed_ms": min(div) if div else None,
+            "meets_constraints": bool(pct is not None and pct >= 100 * margin - 1e-9
+                                      and div_ok)}
 
 
-def _block(ev, paths, margin_pct) -> dict:
+def _block(ev, paths, verdict: dict) -> dict:
     import numpy as np
-    return {"mass_kg": ev.mass_kg, "flutter_margin_pct": margin_pct,
+    return {"mass_kg": ev.mass_kg, **verdict,
             "predicted_margin_pct": float(np.nanmin(ev.margins) * 100),
             "flutter_speeds_ms": [None if not np.isfinite(u) else float(u) for u in ev.speeds_ms],
             "envelope_speeds_ms": ev.envelope_ms.tolist(),
@@ -94,8 +108,8 @@ def run(args) -> int:
         reanalysed = load_case(args.out_case)
     else:
         reanalysed = with_values(case, result.paths, result.optimised.values)
-    base = _block(result.baseline, result.paths, _pipeline_margin(case))
-    opt = _block(result.optimised, result.paths, _pipeline_margin(reanalysed))
+    base = _block(result.baseline, result.paths, _reanalysis(case, problem.flutter_margin))
+    opt = _block(result.optimised, result.paths, _reanalysis(reanalysed, problem.flutter_margin))
     doc = {"design": {"baseline": base, "optimised": opt,
                       "gain": {"mass_kg": base["mass_kg"] - opt["mass_kg"],
                                "mass_pct": 100 * (1 - opt["mass_kg"] / base["mass_kg"])},

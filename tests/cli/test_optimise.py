@@ -70,3 +70,4 @@ def test_fin_minimum_mass_end_to_end(tmp_path, capsys):
     raw = tomllib.loads(opt.read_text())
     assert raw["thickness"]["tip"] == pytest.approx(d["optimised"]["values"]["thickness.tip"])
     assert d["optimised"]["mass_kg"] < d["baseline"]["mass_kg"]
+    assert d["optimised"]["meets_constraints"] and not d["baseline"]["meets_constraints"]
