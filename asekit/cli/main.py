@@ -7,6 +7,8 @@ Commands (argparse subcommands; each sets ``func(args) -> exit code``, so more c
 * ``analyse CASE.toml [--json PATH] [--report DIR]``: a case file (see :mod:`asekit.cli.analyse`);
 * ``sweep SWEEP.toml --out PATH``: a sweep file (see :mod:`asekit.cli.sweep`);
 * ``cases [--copy NAME DIR]``: the shipped case files (see :mod:`asekit.cli.cases`);
+* ``optimise CASE.toml DESIGN.toml [--json PATH] [--out-case PATH]``: minimum-mass design under
+  the flutter margin (see :mod:`asekit.cli.optimise`);
 * ``--version``.
 
 Options of every command (before or after its name): ``-v/--verbose`` (the package's info
@@ -39,6 +41,7 @@ import sys
 from asekit.cli import outputs
 from asekit.cli.analyse import add_parser as add_analyse
 from asekit.cli.cases import add_parser as add_cases
+from asekit.cli.optimise import add_parser as add_optimise
 from asekit.cli.sweep import add_parser as add_sweep
 from asekit.util.version import __version__
 
@@ -128,6 +131,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_analyse(sub)
     add_sweep(sub)
     add_cases(sub)
+    add_optimise(sub)
     _add_common(parser, top=True)
     seen = set()
     for p in sub.choices.values():              # also after the command (aliases: once)

@@ -1,0 +1,564 @@
+"""Design optimisation of a case with analytic sensitivities (issue 28): the lightest surface
+that keeps its flutter margin over the case's envelope.
+
+A design file (TOML, docs/design-format.md) names the variables by case-key path with bounds,
+the objective and the flutter-margin constraint::
+
+    [design]
+    objective = "mass"            # minimise the structural mass (plate + point masses)
+    flutter_margin = 0.15         # U_f >= (1 + 0.15) U_envelope at every envelope altitude
+    max_iterations = 40
+
+    [[design.variable]]
+    path = "thickness.root"       # m
+    lower = 0.002
+    upper = 0.008
+
+The constraint is the case's own margin (:func:`asekit.case.pipeline.flutter`'s ``margins``):
+at every analysed altitude inside ``flight.envelope.altitude``, the flutter speed at the
+envelope's top Mach (one of ``aero.machs``), U_f / (M a) - 1 >= ``flutter_margin``.
+
+Each evaluation runs the chain of the physics layer with its derivatives:
+plate matrices and their thickness / point-mass derivatives
+(:mod:`asekit.structure.sensitivity`), the elastic modes of the shaft-supported plate (FN1: the
+elastic modes of the case's FN2 model to O(J_fin / I_f)) and Nelson's mode-shape derivatives,
+the GAFs of the extended mode set through the case's factored aerodynamic operators (formed
+once), the p-k flutter point and dU_f (:mod:`asekit.aeroelastic.sensitivity`). The optimiser is
+:func:`scipy.optimize.minimize` (SLSQP) with these gradients, on variables scaled by their
+baseline values.
+
+Supported variables: ``thickness.root``, ``thickness.tip`` (flat chordwise profile) and
+``point_mass[i].mass``. Supported structures: a ``shaft`` support (FN1 or FN2) or
+``clamped_root``, undamped (no ``[damping]``). Divergence, frequency separation and the servo
+requirements are not constraints yet.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from asekit.aero.gaf import TabulatedGaf
+from asekit.aero.methods import AERO_METHODS, resolve_method
+from asekit.aero.spline import fe_spline, modal_forces
+from asekit.aeroelastic.flutter import pk_flutter, pk_instabilities
+from asekit.aeroelastic.sensitivity import (
+    extended_shapes,
+    flutter_point,
+    flutter_speed_sensitivity,
+    gaf_derivative,
+)
+from asekit.aeroelastic.statespace import modal_arrays
+from asekit.case import pipeline as P
+from asekit.case.schema import Case, CaseError
+from asekit.structure.assembly import clamped_edge, shaft_support
+from asekit.structure.modes import ModalModel, normal_modes, select_modes
+from asekit.structure.sensitivity import (
+    element_parts,
+    mode_shape_derivatives,
+    point_mass_derivative,
+    reduce,
+    thickness_derivatives,
+)
+from asekit.util.validate import read_toml
+
+OBJECTIVES = ("mass",)
+#: The optimiser asks for U_f >= (1 + margin) M a (1 + CONSTRAINT_SLACK): the re-analysis by the
+#: case pipeline (FN2 modes, its own GAF database) differs from the optimiser's chain (FN1 modes,
+#: the same boxes) by ~1e-7 relative, and SLSQP meets an active constraint only to its tolerance.
+CONSTRAINT_SLACK = 1e-4
+#: The p-k sweep that locates the first crossing uses at most this many of the case's velocities
+#: (evenly strided, the last one kept; the solver's step control inserts sub-steps where roots
+#: move fast); the crossing is then converged by Newton's method to 1e-12 relative. A root that
+#: crosses and re-crosses between two of these points is missed by the optimiser but not by the
+#: re-analysis of ``asekit optimise``, which runs the case's own sweep.
+SWEEP_POINTS = 40
+_THICKNESS = ("thickness.root", "thickness.tip")
+
+
+class DesignError(ValueError):
+    """A design file or design problem the optimiser refuses (the message names the key)."""
+
+
+@dataclass(frozen=True)
+class DesignVariable:
+    """A case key varied by the optimiser: ``path`` (e.g. ``thickness.root``), ``lower`` and
+    ``upper`` bounds in the key's unit."""
+
+    path: str
+    lower: float
+    upper: float
+
+
+@dataclass(frozen=True)
+class DesignProblem:
+    """A parsed design file: ``variables``, ``objective`` ("mass"), ``flutter_margin`` (a
+    fraction), ``max_iterations``, ``source`` (the file)."""
+
+    variables: tuple[DesignVariable, ...]
+    objective: str = "mass"
+    flutter_margin: float = 0.15
+    max_iterations: int = 40
+    source: str = ""
+
+
+def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default=None):
+    v = d.get(key, default)
+    if v is None:
+        raise DesignError(f"{where}.{key} is required")
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
+            or not low <= v <= high:
+        raise DesignError(f"{where}.{key} must be a number in [{low:g}, {high:g}], got {v!r}")
+    return float(v)
+
+
+def _variable_path(path, where: str) -> str:
+    import re
+    if isinstance(path, str) and (path in _THICKNESS
+                                  or re.fullmatch(r"point_mass\[\d+\]\.mass", path)):
+        return path
+    raise DesignError(f"{where}.path must be one of {list(_THICKNESS)} or point_mass[i].mass, "
+                      f"got {path!r}")
+
+
+def design_from_dict(d: dict, source: str = "") -> DesignProblem:
+    """The :class:`DesignProblem` of a design file's dict; DesignError naming the key.
+
+    Examples
+    --------
+    >>> p = design_from_dict({"design": {"variable": [{"path": "thickness.tip",
+    ...                                                "lower": 0.001, "upper": 0.004}]}})
+    >>> p.variables[0].path, p.flutter_margin
+    ('thickness.tip', 0.15)
+    """
+    if not isinstance(d, dict) or not isinstance(d.get("design"), dict):
+        raise DesignError("a design file needs a [design] table")
+    t = d["design"]
+    unknown = set(t) - {"objective", "flutter_margin", "max_iterations", "variable"}
+    if unknown:
+        raise DesignError(f"design: unknown keys {sorted(unknown)} (known: objective, "
+                          f"flutter_margin, max_iterations, variable)")
+    objective = t.get("objective", "mass")
+    if objective not in OBJECTIVES:
+        raise DesignError(f"design.objective must be one of {list(OBJECTIVES)}, got {objective!r}")
+    raw = t.get("variable")
+    if not isinstance(raw, list) or not raw:
+        raise DesignError("design.variable must hold at least one [[design.variable]] table")
+    out, seen = [], set()
+    for i, v in enumerate(raw):
+        where = f"design.variable[{i}]"
+        if not isinstance(v, dict) or set(v) - {"path", "lower", "upper"}:
+            raise DesignError(f"{where} must be a table with the keys path, lower, upper")
+        path = _variable_path(v.get("path"), where)
+        if path in seen:
+            raise DesignError(f"{where}.path {path!r} is given twice")
+        seen.add(path)
+        lo, hi = _number(v, "lower", where, 0.0), _number(v, "upper", where, 0.0)
+        if not lo < hi:
+            raise DesignError(f"{where}: lower ({lo:g}) must be below upper ({hi:g})")
+        out.append(DesignVariable(path, lo, hi))
+    margin = _number(t, "flutter_margin", "design", 0.0, 10.0, 0.15)
+    iters = _number(t, "max_iterations", "design", 1, 10000, 40)
+    if iters != int(iters):
+        raise DesignError(f"design.max_iterations must be an integer, got {iters!r}")
+    return DesignProblem(tuple(out), objective, margin, int(iters), source)
+
+
+def load_design(path) -> DesignProblem:
+    """Read and check a design file (TOML); DesignError naming the key."""
+    return design_from_dict(read_toml(path, DesignError), str(path))
+
+
+# ---------------------------------------------------------------------------------------------
+# the case's values and the case with new values
+# ---------------------------------------------------------------------------------------------
+def _point_index(path: str) -> int:
+    return int(path[path.index("[") + 1:path.index("]")])
+
+
+def case_value(case: Case, path: str) -> float:
+    """The current value of a design variable's key in ``case``."""
+    if path == "thickness.root":
+        return float(case.thickness.root)
+    if path == "thickness.tip":
+        return float(case.thickness.tip)
+    i = _point_index(path)
+    if i >= len(case.point_masses):
+        raise DesignError(f"{path}: the case has {len(case.point_masses)} point masses")
+    return float(case.point_masses[i].mass)
+
+
+def with_values(case: Case, paths, values) -> Case:
+    """The case with the design variables' keys set to ``values``."""
+    th = case.thickness
+    pms = list(case.point_masses)
+    for path, v in zip(paths, values):
+        if path == "thickness.root":
+            th = dataclasses.replace(th, root=float(v))
+        elif path == "thickness.tip":
+            th = dataclasses.replace(th, tip=float(v))
+        else:
+            i = _point_index(path)
+            pms[i] = dataclasses.replace(pms[i], mass=float(v))
+    return dataclasses.replace(case, thickness=th, point_masses=tuple(pms))
+
+
+def set_case_values(raw: dict, paths, values) -> dict:
+    """The case file's dict (as read) with the design keys set, for writing the optimised case."""
+    import copy
+    out = copy.deepcopy(raw)
+    for path, v in zip(paths, values):
+        if path.startswith("thickness."):
+            out.setdefault("thickness", {})[path.split(".")[1]] = float(v)
+        else:
+            out["point_mass"][_point_index(path)]["mass"] = float(v)
+    return out
+
+
+def check_case(case: Case, problem: DesignProblem) -> None:
+    """Refuse, before any work, a case the optimiser does not handle (one line naming the key)."""
+    if case.structure is not None:
+        raise DesignError("design: an imported structure (a Nastran deck) has no case keys to "
+                          "vary; optimise a case file")
+    if case.support.kind not in ("shaft", "clamped_root"):
+        raise DesignError(f"support.kind = {case.support.kind!r}: the optimiser handles "
+                          f"'shaft' and 'clamped_root'")
+    d = case.damping
+    if d.modal_damping_ratio is not None or d.structural_g is not None:
+        raise DesignError("damping: the optimiser's flutter derivatives are for an undamped "
+                          "structure; remove [damping]")
+    if not getattr(case.thickness.profile, "is_flat", True):
+        raise DesignError("thickness.profile must be 'flat' for the thickness variables")
+    if case.aero is None or case.flight is None or case.flight.envelope_mach is None \
+            or case.flight.altitudes is None:
+        raise DesignError("the case needs [aero], [flight] altitudes and [flight.envelope] "
+                          "for the flutter-margin constraint")
+    top = float(case.flight.envelope_mach[1])
+    if not any(abs(top - m) < 1e-12 for m in case.aero.machs):
+        raise DesignError(f"flight.envelope.mach top {top:g} must be one of aero.machs "
+                          f"{list(case.aero.machs)} (the margin is computed there)")
+    for i, v in enumerate(problem.variables):
+        x0 = case_value(case, v.path)
+        if not v.lower <= x0 <= v.upper:
+            raise DesignError(f"design.variable[{i}] {v.path} = {x0:g} in the case lies outside "
+                              f"its bounds [{v.lower:g}, {v.upper:g}]")
+
+
+def envelope_conditions(case: Case) -> list:
+    """The analysed flight conditions inside ``flight.envelope.altitude``."""
+    lo, hi = case.flight.envelope_altitude or (-math.inf, math.inf)
+    return [c for c in P.flight_conditions(case) if lo <= c.altitude <= hi]
+
+
+# ---------------------------------------------------------------------------------------------
+# one evaluation of the chain with its derivatives
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Evaluation:
+    """Mass (kg), flutter speeds and margins with their gradients at one design.
+
+    values : (n_var,) the design; mass_kg, d_mass (n_var,); speeds_ms (n_cond,) U_f per envelope
+    altitude (NaN: no flutter in the velocity sweep); d_speeds (n_cond, n_var); envelope_ms
+    (n_cond,) M a; margins (n_cond,) U_f / (M a) - 1; frequencies_hz (n_cond,) at flutter.
+    """
+
+    values: np.ndarray
+    mass_kg: float
+    d_mass: np.ndarray
+    speeds_ms: np.ndarray
+    d_speeds: np.ndarray
+    envelope_ms: np.ndarray
+    frequencies_hz: np.ndarray
+
+    @property
+    def margins(self) -> np.ndarray:
+        return self.speeds_ms / self.envelope_ms - 1.0
+
+
+@dataclass
+class Evaluator:
+    """The design chain of one case and design problem (module docstring); evaluations are
+    memoised on the design vector. ``operators``: the factored aerodynamic operators of the
+    envelope's top Mach (formed once: the boxes do not change)."""
+
+    case: Case
+    problem: DesignProblem
+    n_elastic: int = 0
+    operators: tuple = ()
+    calls: int = 0
+    _memo: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        check_case(self.case, self.problem)
+        base = P.modal_model(self.case)
+        self.n_elastic = base.frequencies_hz.size - base.n_rigid
+        a = self.case.aero
+        mach = self.mach
+        spec = AERO_METHODS[resolve_method(a.method, mach)]
+        if spec.operators is None or not spec.structure_independent:
+            raise DesignError(f"aero.method = {a.method!r} at M {mach:g}: the optimiser needs a "
+                              f"structure-independent aerodynamic operator (dlm, supersonic, piston)")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            self.operators = spec.operators(P.box_mesh(self.case), mach,
+                                            P.reduced_frequencies(self.case),
+                                            a.reference_semichord, a.symmetry == "wall",
+                                            a.kernel if a.method == "dlm" else "quartic")
+
+    @property
+    def mach(self) -> float:
+        return float(self.case.flight.envelope_mach[1])
+
+    @property
+    def paths(self) -> tuple[str, ...]:
+        return tuple(v.path for v in self.problem.variables)
+
+    def __call__(self, values) -> Evaluation:
+        key = tuple(float(v) for v in values)
+        if key not in self._memo:
+            self.calls += 1
+            self._memo[key] = evaluate(self, np.array(key))
+        return self._memo[key]
+
+
+def _system(case: Case, mesh, K, M):
+    s = case.support
+    if s.kind == "clamped_root":
+        return clamped_edge(mesh, K, M)
+    return shaft_support(mesh, K, M, s.axis_point, s.torsional_stiffness, model="FN1",
+                         region="single_node" if s.radius is None else "distributed",
+                         radius=s.radius or 0.0, bending_stiffness=s.bending_stiffness)
+
+
+def _elastic_modes(system, M, n_elastic: int):
+    """(lam, q) of the first ``n_elastic`` out-of-plane modes of the FN1 / clamped system."""
+    n = min(system.K.shape[0], 2 * n_elastic + 4)
+    modes = normal_modes(system, n, M_fin=M)
+    keep = np.flatnonzero(select_modes(modes.frequencies_hz, modes.out_of_plane, 1e300))
+    if keep.size < n_elastic:
+        raise CaseError(f"the design has {keep.size} out-of-plane modes below the search, "
+                        f"{n_elastic} needed")
+    keep = keep[:n_elastic]
+    return modes.eigenvalues[keep], modes.q[:, keep]
+
+
+def _thickness_dh(mesh, parts, path: str):
+    """dh/d(thickness.root or .tip) at the stiffness and mass points: 1 - eta or eta."""
+    out = []
+    for xy in (parts.xy_k, parts.xy_m):
+        eta = (xy[..., 1] - mesh.y_root) / mesh.span
+        out.append(1.0 - eta if path == "thickness.root" else eta)
+    return out
+
+
+def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts):
+    """Global dK, dM (fin DOFs) and d(mass) per design variable."""
+    dK, dM, dm = [], [], []
+    w_mass = parts.Mt[:, :, 0::3, 0::3].sum(axis=(2, 3))         # (ne, ng): rho w det per point
+    for path in ev.paths:
+        if path in _THICKNESS:
+            dh_k, dh_m = _thickness_dh(mesh, parts, path)
+            k, m = thickness_derivatives(mesh, parts, dh_k[None], dh_m[None])
+            dK.append(k[0])
+            dM.append(m[0])
+            dm.append(float(np.sum(w_mass * dh_m)))
+        else:
+            pm = case.point_masses[_point_index(path)]
+            dM.append(point_mass_derivative(mesh, pm.position))
+            dK.append(0 * dM[-1])
+            dm.append(1.0)
+    mass = float(np.sum(w_mass * parts.h_m)) + sum(p.mass for p in case.point_masses)
+    return dK, dM, mass, np.array(dm)
+
+
+def _gafs(ev: Evaluator, mesh, shapes: np.ndarray) -> np.ndarray:
+    """Q (n_k, N, N) of the (extended) mode table on the boxes through the factored operators."""
+    model = ModalModel(frequencies_hz=np.zeros(shapes.shape[2]), M=None, K=None, C=None,
+                       n_rigid=0, J_fin=0.0, nodes=mesh.nodes, shapes=shapes,
+                       elements=mesh.elements, label="")
+    boxes = P.box_mesh(ev.case)
+    bm = fe_spline(model, boxes)
+    ks, b = P.reduced_frequencies(ev.case), ev.case.aero.reference_semichord
+    out = np.empty((ks.size, shapes.shape[2], shapes.shape[2]), complex)
+    for ik, kk in enumerate(ks):
+        out[ik] = modal_forces(bm, ev.operators[ik].pressures(bm.normalwash(kk, b)), boxes.area)
+    return out
+
+
+def _sweep(velocities) -> np.ndarray:
+    """At most :data:`SWEEP_POINTS` of the velocities, the first and last included."""
+    v = np.asarray(velocities, float)
+    stride = max(1, math.ceil((v.size - 1) / (SWEEP_POINTS - 1)))
+    return np.unique(np.append(v[::stride], v[-1]))
+
+
+def _flutter(ev: Evaluator, mats: dict, gaf: TabulatedGaf, density: float):
+    """(U_f, f_f, dU_f) of the first flutter crossing in the case's velocity sweep (NaN and a
+    zero gradient when there is none)."""
+    n_var = mats["dK"].shape[0]
+    modal = modal_arrays(M=mats["M"], K=mats["K"], C=mats["C"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = pk_flutter(modal, gaf, density, _sweep(ev.case.flight.velocities))
+        flut = [i for i in pk_instabilities(res, modal, gaf)
+                if i.kind == "flutter" and not i.at_first_point]
+    if not flut:
+        return math.nan, math.nan, np.zeros(n_var)
+    f = min(flut, key=lambda i: i.speed)
+    col = list(res.modes).index(f.mode)
+    iu = max(int(np.searchsorted(res.velocities, f.speed)) - 1, 0)
+    U, p, _ = flutter_point(mats["M"], mats["K"], mats["C"], gaf, density, f.speed,
+                            res.p[iu, col], res.vectors[iu, col])
+    s = flutter_speed_sensitivity(mats["M"], mats["K"], mats["C"], gaf, density, U, p,
+                                  mats["dM"], mats["dK"], mats["dC"], mats["dQ"])
+    return U, s.frequency_hz, s.d_speed
+
+
+def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
+    """One evaluation of the chain (module docstring) at the design ``values``."""
+    case = with_values(ev.case, ev.paths, values)
+    mesh = P.structural_mesh(case)
+    K, M = P.mass_and_stiffness(case)
+    parts = element_parts(mesh, case.material)
+    dK, dM, mass, d_mass = _matrix_derivatives(ev, case, mesh, parts)
+    system = _system(case, mesh, K, M)
+    lam, q = _elastic_modes(system, M, ev.n_elastic)
+    dKr = [reduce(system.T, a) for a in dK]
+    dMr = [reduce(system.T, a) for a in dM]
+    dlam, dq = mode_shape_derivatives(system.K, system.M, lam, q, dKr, dMr)
+    n = lam.size
+    shapes = (system.T @ q).reshape(mesh.n_nodes, 3, n)
+    dshapes = np.array([(system.T @ d).reshape(mesh.n_nodes, 3, n) for d in dq])
+    Q = _gafs(ev, mesh, extended_shapes(shapes, dshapes))
+    gaf = TabulatedGaf(P.reduced_frequencies(case), Q[:, :n, :n],
+                       case.aero.reference_semichord, ev.mach)
+    n_var = len(dK)
+    mats = {"M": np.eye(n), "K": np.diag(lam), "C": np.zeros((n, n)),
+            "dM": np.zeros((n_var, n, n)), "dK": np.array([np.diag(d) for d in dlam]),
+            "dC": np.zeros((n_var, n, n)), "dQ": gaf_derivative(Q, n)}
+    conds = envelope_conditions(case)
+    out = [_flutter(ev, mats, gaf, c.density) for c in conds]
+    return Evaluation(values=values, mass_kg=mass, d_mass=d_mass,
+                      speeds_ms=np.array([o[0] for o in out]),
+                      d_speeds=np.array([o[2] for o in out]),
+                      envelope_ms=np.array([ev.mach * c.speed_of_sound for c in conds]),
+                      frequencies_hz=np.array([o[1] for o in out]))
+
+
+# ---------------------------------------------------------------------------------------------
+# the optimiser
+# ---------------------------------------------------------------------------------------------
+def _constraint(ev: Evaluator, e: Evaluation):
+    """g_a = U_f / ((1 + margin) (1 + slack) M a) - 1 >= 0 per envelope altitude and its gradient; no
+    flutter in the sweep counts as U_f = the sweep's last speed (a lower bound), gradient 0."""
+    u = np.where(np.isnan(e.speeds_ms), ev.case.flight.velocities[-1], e.speeds_ms)
+    scale = (1.0 + ev.problem.flutter_margin) * (1.0 + CONSTRAINT_SLACK) * e.envelope_ms
+    return u / scale - 1.0, e.d_speeds / scale[:, None]
+
+
+@dataclass(frozen=True)
+class DesignResult:
+    """The outcome of :func:`optimise`.
+
+    paths : the variables' case keys; baseline, optimised : :class:`Evaluation` at the case's
+    values and at the optimum; history : one dict per optimiser iteration (values, mass_kg,
+    min_margin_pct); success, message : the optimiser's verdict; evaluations : chain
+    evaluations; seconds : wall time; gradient_check : (n_var,) max relative error of the
+    analytic gradients (mass and flutter speeds) against central differences at the baseline
+    (None when not checked); gradient_check_seconds : the time of those differences.
+    """
+
+    paths: tuple[str, ...]
+    baseline: Evaluation
+    optimised: Evaluation
+    history: tuple[dict, ...]
+    success: bool
+    message: str
+    evaluations: int
+    seconds: float
+    gradient_check: np.ndarray | None = None
+    gradient_check_seconds: float = 0.0
+
+    @property
+    def max_rel_error(self) -> float | None:
+        return None if self.gradient_check is None else float(np.max(self.gradient_check))
+
+
+def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.ndarray:
+    """Max relative error per variable of the analytic d(mass) and dU_f against central
+    differences of the whole chain (step ``rel_step`` times the value)."""
+    e0 = ev(x0)
+    err = np.zeros(x0.size)
+    for j in range(x0.size):
+        h = rel_step * x0[j]
+        ep, em = ev(x0 + h * np.eye(x0.size)[j]), ev(x0 - h * np.eye(x0.size)[j])
+        pairs = [(e0.d_mass[j], (ep.mass_kg - em.mass_kg) / (2 * h))]
+        pairs += [(a, (b - c) / (2 * h)) for a, b, c in
+                  zip(e0.d_speeds[:, j], ep.speeds_ms, em.speeds_ms) if np.isfinite(b - c)]
+        err[j] = max(abs(a - f) / max(abs(f), 1e-300) for a, f in pairs)
+    return err
+
+
+def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
+             progress=None, evaluator: Evaluator | None = None) -> DesignResult:
+    """Minimise the mass subject to the flutter margin (module docstring) with SLSQP and the
+    analytic gradients; variables scaled by their baseline values.
+
+    Parameters
+    ----------
+    case : the case; problem : its :class:`DesignProblem`;
+    check_gradients : compare the analytic gradients with central differences at the baseline;
+    progress : optional callable ``progress(dict)`` called once per iteration (a history row);
+    evaluator : an :class:`Evaluator` of this case and problem to reuse (its memoised
+        evaluations and aerodynamic operators), default a new one.
+
+    Returns
+    -------
+    :class:`DesignResult`.
+    """
+    from scipy.optimize import minimize
+    t0 = time.perf_counter()
+    ev = Evaluator(case, problem) if evaluator is None else evaluator
+    x0 = np.array([case_value(case, p) for p in ev.paths])
+    check, t_check = None, 0.0
+    if check_gradients:
+        tc = time.perf_counter()
+        check = gradient_check(ev, x0)
+        t_check = time.perf_counter() - tc
+    m0 = ev(x0).mass_kg
+    history = []
+
+    def obj(z):
+        e = ev(z * x0)
+        return e.mass_kg / m0, e.d_mass * x0 / m0
+
+    def cons(z):
+        return _constraint(ev, ev(z * x0))[0]
+
+    def cons_jac(z):
+        return _constraint(ev, ev(z * x0))[1] * x0[None, :]
+
+    def record(z):
+        e = ev(z * x0)
+        row = {"iteration": len(history) + 1, "values": (z * x0).tolist(),
+               "mass_kg": e.mass_kg, "min_margin_pct": float(np.nanmin(e.margins) * 100)}
+        history.append(row)
+        if progress is not None:
+            progress(row)
+
+    bounds = [(v.lower / x, v.upper / x) for v, x in zip(problem.variables, x0)]
+    res = minimize(obj, np.ones(x0.size), jac=True, method="SLSQP", bounds=bounds,
+                   constraints=[{"type": "ineq", "fun": cons, "jac": cons_jac}],
+                   options={"maxiter": problem.max_iterations, "ftol": 1e-6},
+                   callback=record)
+    x = np.clip(res.x * x0, [v.lower for v in problem.variables],
+                [v.upper for v in problem.variables])
+    return DesignResult(paths=ev.paths, baseline=ev(x0), optimised=ev(x), history=tuple(history),
+                        success=bool(res.success), message=str(res.message),
+                        evaluations=ev.calls, seconds=time.perf_counter() - t0,
+                        gradient_check=check, gradient_check_seconds=t_check)

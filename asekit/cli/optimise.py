@@ -1,0 +1,140 @@
+"""``python -m asekit optimise CASE.toml DESIGN.toml [--json PATH] [--out-case PATH]
+[--no-gradient-check]``: minimise the mass of a case's surface subject to its flutter margin
+(a design file, :mod:`asekit.case.design`), write the optimised case file and re-analyse it.
+
+The optimised design's margin is not the optimiser's own number: the written case (or, without
+``--out-case``, the same case built in memory) is analysed again by the case pipeline
+(:func:`asekit.case.pipeline.flutter`), like ``asekit analyse`` would. The JSON holds
+``design.baseline`` and ``design.optimised`` (``mass_kg``, ``flutter_margin_pct`` from the
+pipeline, ``predicted_margin_pct`` from the optimiser's chain, the variables' ``values``),
+``design.gradient_check`` (``max_rel_error`` of the analytic gradients against central
+differences at the baseline, ``seconds``) and ``design.history`` (one row per iteration). Bad
+input gets one line and exit status 2.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import sys
+from pathlib import Path
+
+from asekit.cli import outputs
+
+_log = logging.getLogger(__name__)
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("optimise", aliases=["optimize"],
+                       help="minimum-mass design of a case under its flutter margin")
+    p.add_argument("case", metavar="CASE.toml", help="the case file (see data/cases/)")
+    p.add_argument("design", metavar="DESIGN.toml", help="the design file (see data/designs/)")
+    p.add_argument("--json", metavar="PATH", help="write the results as JSON ('-': stdout)")
+    p.add_argument("--out-case", metavar="PATH", help="write the optimised case file (TOML)")
+    p.add_argument("--no-gradient-check", dest="gradient_check", action="store_false",
+                   help="skip the finite-difference check of the gradients at the baseline")
+    p.set_defaults(func=run)
+
+
+def _error(msg: str) -> int:
+    return outputs.print_error(f"error: {msg}", 2, _log)
+
+
+def _reanalysis(case, margin: float) -> dict:
+    """The case pipeline's verdict: the smallest flutter margin (%) over the envelope altitudes,
+    the lowest divergence speed at the envelope's top Mach (None: none in the sweep), and
+    whether both clear (1 + margin) M a."""
+    from asekit.case import pipeline as P
+    fa = P.flutter(case)
+    vals = [m["margin"] for m in fa.margins if m["margin"] is not None]
+    top = case.flight.envelope_mach[1]
+    lo, hi = case.flight.envelope_altitude or (-float("inf"), float("inf"))
+    div = [d["speed_ms"] for d in fa.divergence if d["speed_ms"] is not None
+           and abs(d["mach"] - top) < 1e-12 and lo <= d["altitude_m"] <= hi]
+    env = {m["altitude_m"]: m["envelope_speed_ms"] for m in fa.margins}
+    div_ok = all(d["speed_ms"] is None or d["speed_ms"] >= (1 + margin) * env[d["altitude_m"]]
+                 for d in fa.divergence if abs(d["mach"] - top) < 1e-12
+                 and d["altitude_m"] in env)
+    pct = 100.0 * min(vals) if len(vals) == len(fa.margins) and vals else None
+    return {"flutter_margin_pct": pct, "divergence_speed_ms": min(div) if div else None,
+            "meets_constraints": bool(pct is not None and pct >= 100 * margin - 1e-9
+                                      and div_ok)}
+
+
+def _block(ev, paths, verdict: dict) -> dict:
+    import numpy as np
+    return {"mass_kg": ev.mass_kg, **verdict,
+            "predicted_margin_pct": float(np.nanmin(ev.margins) * 100),
+            "flutter_speeds_ms": [None if not np.isfinite(u) else float(u) for u in ev.speeds_ms],
+            "envelope_speeds_ms": ev.envelope_ms.tolist(),
+            "values": dict(zip(paths, ev.values.tolist()))}
+
+
+def _write_case(args, raw: dict, result) -> None:
+    from asekit.case.design import set_case_values
+    from asekit.case.toml_writer import dumps
+    text = dumps(set_case_values(raw, result.paths, result.optimised.values))
+    Path(args.out_case).write_text(f"# optimised by asekit optimise {Path(args.design).name} "
+                                   f"from {Path(args.case).name}\n" + text)
+
+
+def run(args) -> int:
+    for opt, value in (("--json", args.json), ("--out-case", args.out_case)):
+        reason = outputs.check_file(opt, value, dash=opt == "--json")
+        if reason:
+            return _error(reason)
+    from asekit.case import load_case
+    from asekit.case.design import DesignError, load_design, optimise, with_values
+    from asekit.util.validate import read_toml
+    try:
+        case = load_case(args.case)
+        raw = read_toml(args.case)
+        problem = load_design(args.design)
+    except FileNotFoundError as exc:
+        return _error(f"{exc.filename} not found")
+    except (DesignError, ValueError) as exc:
+        return _error(str(exc))
+    quiet = getattr(args, "quiet", False)
+
+    def show(row):
+        if not quiet:
+            vals = ", ".join(f"{v:.5g}" for v in row["values"])
+            print(f"iteration {row['iteration']:3d}: mass {row['mass_kg']:.5g} kg, min margin "
+                  f"{row['min_margin_pct']:+.2f} %, [{vals}]", file=sys.stderr)
+
+    result = optimise(case, problem, check_gradients=args.gradient_check, progress=show)
+    if args.out_case:
+        _write_case(args, raw, result)
+        reanalysed = load_case(args.out_case)
+    else:
+        reanalysed = with_values(case, result.paths, result.optimised.values)
+    base = _block(result.baseline, result.paths, _reanalysis(case, problem.flutter_margin))
+    opt = _block(result.optimised, result.paths, _reanalysis(reanalysed, problem.flutter_margin))
+    doc = {"design": {"baseline": base, "optimised": opt,
+                      "gain": {"mass_kg": base["mass_kg"] - opt["mass_kg"],
+                               "mass_pct": 100 * (1 - opt["mass_kg"] / base["mass_kg"])},
+                      "gradient_check": {"max_rel_error": result.max_rel_error,
+                                         "per_variable": None if result.gradient_check is None
+                                         else dict(zip(result.paths,
+                                                       result.gradient_check.tolist())),
+                                         "seconds": result.gradient_check_seconds},
+                      "optimiser": {"method": "SLSQP", "success": result.success,
+                                    "message": result.message,
+                                    "iterations": len(result.history),
+                                    "evaluations": result.evaluations,
+                                    "seconds": result.seconds},
+                      "flutter_margin_required_pct": 100 * problem.flutter_margin,
+                      "history": list(result.history)},
+           "units": {"mass_kg": "kg", "flutter_margin_pct": "%", "seconds": "s",
+                     "values": "the unit of each case key (thickness m, point mass kg)"}}
+    text = json.dumps(doc, indent=2)
+    if args.json == "-":
+        print(text)
+    elif args.json:
+        Path(args.json).write_text(text + "\n")
+    print(f"mass {base['mass_kg']:.5g} -> {opt['mass_kg']:.5g} kg, min flutter margin "
+          f"{base['flutter_margin_pct']:+.2f} % -> {opt['flutter_margin_pct']:+.2f} % (required "
+          f"{100 * problem.flutter_margin:+.0f} %, re-analysed), gradient check "
+          f"{result.max_rel_error if result.max_rel_error is not None else float('nan'):.2g}",
+          file=sys.stderr)
+    return 0

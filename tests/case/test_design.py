@@ -1,0 +1,122 @@
+"""The design problem and optimiser (asekit.case.design, issue 28) on a small version of the
+reference fin: 4 x 4 plate elements, 3 elastic modes, 6 x 6 doublet-lattice boxes, 7 reduced
+frequencies, M 0.4 / 0.6, sea level and 2500 m, a coarse velocity sweep. Small so that one
+evaluation of the chain takes about a second; the shipped problem (the 6 x 7 fin) runs in the
+command-line test marked slow.
+"""
+
+import copy
+import tomllib
+
+import numpy as np
+import pytest
+
+from asekit.case import case_from_dict
+from asekit.case import pipeline as P
+from asekit.case.design import (
+    DesignError,
+    Evaluator,
+    design_from_dict,
+    gradient_check,
+    optimise,
+    set_case_values,
+    with_values,
+)
+from asekit.case.toml_writer import dumps
+from asekit.util.paths import FIN_FILE
+
+#: rebuilt GAF databases go to a session temporary folder (tests/conftest.py)
+pytestmark = pytest.mark.usefixtures("session_gaf_cache")
+
+
+def _small_raw() -> dict:
+    raw = tomllib.loads(FIN_FILE.read_text())
+    raw["panel"][0].update(n_chord=4, n_span=4)
+    raw["modes"] = {"count": 3, "keep_rigid": True}
+    raw["aero"].update(machs=[0.4, 0.6], boxes=[{"n_chord": 6, "n_span": 6}],
+                       reduced_frequencies=[0.001, 0.1, 0.2, 0.3, 0.45, 0.6, 0.8])
+    raw["flight"].update(altitudes=[0.0, 2500.0],
+                         velocities={"min": 120.0, "max": 420.0, "step": 20.0})
+    raw["point_mass"] = [{"position": [0.12, 0.14], "mass": 0.01}]
+    raw.pop("actuator")
+    return raw
+
+
+RAW = _small_raw()
+CASE = case_from_dict(copy.deepcopy(RAW), "small fin")
+PROBLEM = design_from_dict({"design": {"flutter_margin": 0.15, "max_iterations": 20, "variable": [
+    {"path": "thickness.root", "lower": 0.0015, "upper": 0.008},
+    {"path": "thickness.tip", "lower": 0.001, "upper": 0.006},
+    {"path": "point_mass[0].mass", "lower": 0.0, "upper": 0.05}]}})
+
+
+@pytest.fixture(scope="module")
+def ev():
+    return Evaluator(CASE, PROBLEM)
+
+
+@pytest.mark.parametrize("design, message", [
+    ({}, r"needs a \[design\] table"),
+    ({"design": {"variable": []}}, "design.variable must hold"),
+    ({"design": {"variable": [{"path": "material.density", "lower": 1, "upper": 2}]}},
+     r"design.variable\[0\].path must be one of"),
+    ({"design": {"variable": [{"path": "thickness.tip", "lower": 0.004, "upper": 0.002}]}},
+     r"design.variable\[0\]: lower \(0.004\) must be below upper"),
+    ({"design": {"objective": "drag", "variable": []}}, "design.objective must be one of"),
+    ({"design": {"flutter_margin": -1, "variable": [
+        {"path": "thickness.tip", "lower": 0.001, "upper": 0.002}]}},
+     "design.flutter_margin must be"),
+    ({"design": {"typo": 1}}, r"design: unknown keys \['typo'\]"),
+])
+def test_design_file_errors_name_the_key(design, message):
+    with pytest.raises(DesignError, match=message):
+        design_from_dict(design)
+
+
+def test_case_outside_bounds_is_refused_before_work():
+    p = design_from_dict({"design": {"variable": [
+        {"path": "thickness.root", "lower": 0.005, "upper": 0.008}]}})
+    with pytest.raises(DesignError, match=r"thickness.root = 0.004 in the case lies outside"):
+        Evaluator(CASE, p)
+
+
+def test_written_case_round_trips():
+    """The TOML writer: the fin's file read back equals what was written, and the optimised
+    values land in the case it describes."""
+    raw = tomllib.loads(FIN_FILE.read_text())
+    assert tomllib.loads(dumps(raw)) == raw
+    out = set_case_values(raw, ["thickness.tip"], [0.0017])
+    case = case_from_dict(tomllib.loads(dumps(out)))
+    assert case.thickness.tip == 0.0017 and raw["thickness"]["tip"] == 0.002
+
+
+def test_chain_matches_the_pipeline_and_its_gradients_match_differences(ev):
+    x0 = np.array([0.004, 0.002, 0.01])
+    e = ev(x0)
+    # the optimiser's flutter speeds are the pipeline's (FN2 model, its own GAF database) at the
+    # envelope's top Mach, to the FN1 / FN2 difference O(J_fin / I_f) and the crossing's
+    # refinement tolerance (REFINE_RTOL = 1e-6)
+    fa = P.flutter(CASE)
+    for u, m in zip(e.speeds_ms, fa.margins):
+        assert u == pytest.approx(m["flutter_speed_ms"], rel=1e-5)
+    # mass: rho times the trapezoid's volume (linear thickness and chord), plus the point mass
+    area_weighted_h = 0.15 * (0.156 * 0.004 / 3 + (0.156 * 0.002 + 0.078 * 0.004) / 6
+                              + 0.078 * 0.002 / 3)
+    assert e.mass_kg == pytest.approx(2700.0 * area_weighted_h + 0.01, rel=1e-12)
+    err = gradient_check(ev, x0)
+    assert np.max(err) <= 1e-5, err
+
+
+@pytest.mark.slow
+def test_optimised_design_meets_the_margin_when_reanalysed(ev):
+    res = optimise(CASE, PROBLEM, check_gradients=False)
+    assert res.success, res.message
+    opt = with_values(CASE, res.paths, res.optimised.values)
+    margins = [m["margin"] for m in P.flutter(opt).margins]
+    assert min(margins) >= 0.15 - 1e-9, margins
+    base = [m["margin"] for m in P.flutter(CASE).margins]
+    # the baseline misses the margin at sea level; the optimum meets it at its lowest mass,
+    # the point mass removed (it only adds mass here) and the constraint active
+    assert min(base) < 0.15
+    assert res.optimised.values[2] == pytest.approx(0.0, abs=1e-8)
+    assert min(margins) == pytest.approx(0.15, abs=2e-3)

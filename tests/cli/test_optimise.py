@@ -1,0 +1,73 @@
+"""``asekit optimise`` (issue 28): refused input in one line before any work (exit 2); the
+shipped fin problem end to end (slow): the written case re-analysed by the pipeline meets the
+15 % flutter margin the baseline misses."""
+
+from __future__ import annotations
+
+import json
+import tomllib
+
+import pytest
+
+from asekit.case import load_case
+from asekit.case import pipeline as P
+from asekit.cli.main import main
+from asekit.util.paths import CASES_DIR, DATA_DIR
+
+FIN = CASES_DIR / "nalci2013_fin.toml"
+DESIGN = DATA_DIR / "designs" / "fin_min_mass.toml"
+
+pytestmark = pytest.mark.usefixtures("session_gaf_cache")
+
+
+@pytest.fixture
+def no_work(monkeypatch):
+    def ran(*a, **k):
+        pytest.fail("the pipeline ran")
+    for name in ("modal_model", "gaf_database", "flutter", "box_mesh"):
+        monkeypatch.setattr(P, name, ran)
+
+
+def test_shipped_design_file_parses():
+    from asekit.case.design import load_design
+    p = load_design(DESIGN)
+    assert [v.path for v in p.variables] == ["thickness.root", "thickness.tip"]
+    assert p.flutter_margin == 0.15
+
+
+@pytest.mark.parametrize("text, fragment", [
+    ("[design]\nobjective = 'drag'\n", "design.objective must be one of ['mass']"),
+    ("[design]\n[[design.variable]]\npath = 'thickness.tip'\nlower = 0.003\nupper = 0.006\n",
+     "thickness.tip = 0.002 in the case lies outside its bounds"),
+    ("[design\n", "design.toml"),
+])
+def test_bad_design_is_one_line_exit_2(tmp_path, capsys, no_work, text, fragment):
+    d = tmp_path / "design.toml"
+    d.write_text(text)
+    assert main(["optimise", str(FIN), str(d)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error:") and fragment in err[0], err
+
+
+def test_missing_file_is_one_line_exit_2(tmp_path, capsys, no_work):
+    assert main(["optimise", str(FIN), str(tmp_path / "none.toml")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "not found" in err[0], err
+
+
+@pytest.mark.slow
+def test_fin_minimum_mass_end_to_end(tmp_path, capsys):
+    out, opt = tmp_path / "out.json", tmp_path / "opt.toml"
+    assert main(["optimise", str(FIN), str(DESIGN), "--json", str(out),
+                 "--out-case", str(opt)]) == 0
+    d = json.loads(out.read_text())["design"]
+    # independent of the optimiser: the written file, loaded and analysed by the pipeline
+    margins = [m["margin"] for m in P.flutter(load_case(opt)).margins]
+    assert min(margins) >= 0.15
+    assert d["optimised"]["flutter_margin_pct"] == pytest.approx(100 * min(margins), abs=1e-9)
+    assert d["baseline"]["flutter_margin_pct"] < 15.0            # the fin misses it (4.3 %)
+    assert d["gradient_check"]["max_rel_error"] <= 1e-5
+    raw = tomllib.loads(opt.read_text())
+    assert raw["thickness"]["tip"] == pytest.approx(d["optimised"]["values"]["thickness.tip"])
+    assert d["optimised"]["mass_kg"] < d["baseline"]["mass_kg"]
+    assert d["optimised"]["meets_constraints"] and not d["baseline"]["meets_constraints"]
