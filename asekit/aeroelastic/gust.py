@@ -1,0 +1,252 @@
+"""The gust input of the aeroelastic state space, discrete 1-cos gusts and their responses
+(issue 27).
+
+The modal equation of :mod:`asekit.aeroelastic.statespace` (thesis Eq. 2.44) gains the gust
+force of the Roger-fitted gust column (:mod:`asekit.rfa.gust`, Q~_g with coefficients A_g):
+
+    (s^2 M + s C + K - q Q~(s)) zeta = T_act + q Q~_g(s) w_g(s) / U,
+
+    q Q~_g(s) w_g / U = q/U A0g w_g + (rho b / 2) A1g w_g' + (rho b^2 / (2 U)) A2g w_g''
+                        + q sum_n A_{g,n+2} x_gn,
+    x_gn' = -(U/b) beta_n x_gn + w_g' / U         (one lag state per lag root, all modes),
+
+(q = rho U^2 / 2, b the fits' reference semi-chord, w_g the upward gust velocity in m/s at the
+gust reference station x0 of the column). So the state vector of Eq. (2.63) is extended by the
+N_g gust lag states, and the gust enters through
+
+    z' = A z + B [theta, theta', theta''] + B_g [w_g, w_g', w_g''],
+
+B_g holding M_bar_ss^-1 F_g,s in the elastic acceleration rows (F_g = q [A0g/U, A1g b/U^2,
+A2g b^2/U^3]) and 1/U in the gust-lag rows. The hinge moment T_hinge@fin (Eqs. 2.68-2.70) gains
+the gust force on the rigid row, F_g,c - M_bar_cs M_bar_ss^-1 F_g,s (the feed-through D_g) and
+the lag states' q (A_gc - M_bar_cs M_bar_ss^-1 A_gs) (its C columns). With theta held at zero
+(the actuator clamped, FN2) it is the torque the actuator must hold.
+
+Discrete gust: the "1-cos" gust of gradient distance H (m; the gust is 2H long) and design
+velocity U_ds (m/s) (CS-25.341(a), FAR 25.341(a); the gust front reaches x0 at t = 0),
+
+    w_g(t) = U_ds / 2 (1 - cos(pi U t / H)),     0 <= U t <= 2 H,     0 otherwise.
+
+Units SI: rho kg/m^3, U m/s, b m, w_g m/s, the hinge moment N m.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from asekit.aeroelastic.statespace import ModalArrays, aeroelastic_matrices, modal_arrays
+from asekit.util.validate import finite_array, finite_result, positive
+
+#: Names of the gust inputs (m/s, m/s^2, m/s^3).
+GUST_INPUT_NAMES = ("w_gust", "w_gust_dot", "w_gust_ddot")
+
+
+@dataclass(frozen=True)
+class GustStateSpace:
+    """The aeroelastic state space with gust input at one (rho, U) (module docstring).
+
+    Attributes
+    ----------
+    A : (n_z, n_z) with n_z = 2 n_s + modal lag states + N_g gust lag states.
+    B : (n_z, 3) inputs theta, theta', theta'' (rad, rad/s, rad/s^2; (n_z, 0) without a rigid
+        mode); B_g : (n_z, 3) inputs w_g, w_g', w_g'' (m/s, m/s^2, m/s^3).
+    C_hinge, D_hinge, Dg_hinge : hinge moment T_hinge@fin (N m) = C_hinge z + D_hinge theta-
+        inputs + Dg_hinge gust inputs ((0, .) arrays without a rigid mode).
+    state_names : Eq. (2.63)'s names, then ``gust_lag<n>``.
+    n_elastic, n_rigid : modes; velocity (m/s), density (kg/m^3).
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    B_g: np.ndarray
+    C_hinge: np.ndarray
+    D_hinge: np.ndarray
+    Dg_hinge: np.ndarray
+    state_names: tuple
+    n_elastic: int
+    n_rigid: int
+    velocity: float
+    density: float
+
+    @property
+    def n_states(self) -> int:
+        return self.A.shape[0]
+
+    def acceleration_rows(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(C, D, D_g) of the elastic modal accelerations zeta_s'' (n_s rows): the rows of
+        A, B, B_g that give zeta_s_dot' (for inertial loads)."""
+        r = slice(self.n_elastic, 2 * self.n_elastic)
+        return self.A[r], self.B[r], self.B_g[r]
+
+
+def _check_gust_fit(gust, rfa, n_modes: int):
+    Ag = finite_array("gust.A", gust.A)
+    if Ag.ndim != 2 or Ag.shape[1] != n_modes:
+        raise ValueError(f"gust fit has shape {Ag.shape}; expected (N + 3, n_modes = {n_modes})")
+    if not np.isclose(float(gust.b_ref), float(rfa.b_ref), rtol=1e-12):
+        raise ValueError(f"gust.b_ref = {gust.b_ref} differs from rfa.b_ref = {rfa.b_ref}: both "
+                         "fits must use the same reference semi-chord")
+    roots = finite_array("gust.lag_roots", gust.lag_roots)
+    if np.any(roots <= 0):
+        raise ValueError(f"gust.lag_roots must all be > 0, got {roots}")
+    return Ag, np.atleast_1d(roots)
+
+
+def gust_state_space(modal, rfa, gust, rho: float, velocity: float) -> GustStateSpace:
+    """The state space of Eq. (2.63) with the gust input (module docstring).
+
+    Parameters
+    ----------
+    modal : ModalArrays or any object with M, K, C, n_rigid (rigid mode first).
+    rfa : the modal fit (:class:`asekit.rfa.RogerFit` or ``MinimumStateFit``).
+    gust : :class:`asekit.rfa.gust.GustFit` of the same modes and b_ref.
+    rho : density (kg/m^3) > 0; velocity : true airspeed U (m/s) > 0.
+
+    Returns
+    -------
+    :class:`GustStateSpace`
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from asekit.rfa.gust import GustFit
+    >>> from asekit.rfa.roger import RogerFit
+    >>> k = np.array([0.0, 1.0])
+    >>> rfa = RogerFit(np.zeros((4, 1, 1)), np.array([0.2]), 0.5, k, np.zeros((2, 1, 1)),
+    ...                np.zeros((1, 1)), 0.0)
+    >>> g = GustFit(np.array([[2.0], [0.0], [0.0], [0.0]]), np.array([0.2]), 0.5, k,
+    ...             np.ones((2, 1)))
+    >>> model = type("M", (), {"M": [[1.0]], "K": [[100.0]], "C": None, "n_rigid": 0})()
+    >>> ss = gust_state_space(model, rfa, g, 1.0, 10.0)
+    >>> float(ss.B_g[1, 0])            # q A0g / (U M) = 50 * 2 / 10
+    10.0
+    """
+    m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
+    mats = aeroelastic_matrices(m, rfa, rho, velocity)
+    Ag, roots = _check_gust_fit(gust, rfa, m.n_modes)
+    rho, U, b = mats.density, mats.velocity, float(rfa.b_ref)
+    q = 0.5 * rho * U ** 2
+    A = finite_array("rfa.A", rfa.A)
+    Mb = m.M - 0.5 * rho * b ** 2 * A[2]
+    c, s = slice(0, m.n_rigid), slice(m.n_rigid, m.n_modes)
+    ns, nz0, ng = mats.n_elastic, mats.n_states, roots.size
+    Mss_inv = np.linalg.inv(Mb[s, s])
+    Fg = q * np.column_stack([Ag[0] / U, Ag[1] * b / U ** 2, Ag[2] * b ** 2 / U ** 3])  # (n, 3)
+    Flag = q * Ag[3:].T                                                                  # (n, N_g)
+    nz = nz0 + ng
+    Asys = np.zeros((nz, nz))
+    Asys[:nz0, :nz0] = mats.A
+    acc = slice(ns, 2 * ns)
+    Asys[acc, nz0:] = Mss_inv @ Flag[s]
+    Asys[nz0:, nz0:] = -np.diag(U / b * roots)
+    Bg = np.zeros((nz, 3))
+    Bg[acc] = Mss_inv @ Fg[s]
+    Bg[nz0:, 1] = 1.0 / U
+    B = np.vstack([mats.B, np.zeros((ng, mats.B.shape[1]))])
+    if m.n_rigid:
+        couple = Mb[c, s] @ Mss_inv
+        C_h = np.hstack([mats.C_hinge, Flag[c] - couple @ Flag[s]])
+        Dg_h = Fg[c] - couple @ Fg[s]
+    else:
+        C_h, Dg_h = np.zeros((0, nz)), np.zeros((0, 3))
+    for what, a in (("A", Asys), ("B_g", Bg), ("C_hinge", C_h), ("Dg_hinge", Dg_h)):
+        finite_result(f"the gust state space's {what}", a,
+                      f"rho = {rho:g} kg/m^3, velocity = {U:g} m/s: give a physical condition")
+    names = tuple(mats.state_names) + tuple(f"gust_lag{n + 1}" for n in range(ng))
+    return GustStateSpace(A=Asys, B=B, B_g=Bg, C_hinge=C_h, D_hinge=mats.D_hinge,
+                          Dg_hinge=Dg_h, state_names=names, n_elastic=ns, n_rigid=m.n_rigid,
+                          velocity=U, density=rho)
+
+
+def one_minus_cosine(t, velocity: float, gradient_length: float, design_velocity: float,
+                     delay: float = 0.0) -> np.ndarray:
+    """The discrete 1-cos gust and its time derivatives at times ``t`` (s):
+    w_g = U_ds/2 (1 - cos(pi U (t - delay) / H)) for 0 <= U (t - delay) <= 2 H, else 0
+    (CS-25.341(a); H the gradient distance, the gust 2 H long).
+
+    Parameters
+    ----------
+    t : times (s); velocity : U (m/s) > 0; gradient_length : H (m) > 0;
+    design_velocity : U_ds (m/s), finite (its sign the gust's: > 0 up);
+    delay : time (s) the gust front reaches the reference station.
+
+    Returns
+    -------
+    (3, len(t)) array: w_g (m/s), w_g' (m/s^2), w_g'' (m/s^3).
+
+    Examples
+    --------
+    >>> w = one_minus_cosine([0.0, 0.5, 1.0, 1.5], 10.0, 5.0, 2.0)
+    >>> np.round(w[0], 12) + 0.0
+    array([0., 2., 0., 0.])
+    """
+    tt = finite_array("t", t).ravel()
+    U = positive("velocity", velocity)
+    H = positive("gradient_length", gradient_length)
+    wd = float(finite_array("design_velocity", design_velocity))
+    d = float(finite_array("delay", delay))
+    om = np.pi * U / H
+    tau = tt - d
+    inside = (tau >= 0) & (tau <= 2 * H / U)
+    out = np.zeros((3, tt.size))
+    out[0] = np.where(inside, 0.5 * wd * (1 - np.cos(om * tau)), 0.0)
+    out[1] = np.where(inside, 0.5 * wd * om * np.sin(om * tau), 0.0)
+    out[2] = np.where(inside, 0.5 * wd * om ** 2 * np.cos(om * tau), 0.0)
+    return out
+
+
+@dataclass(frozen=True)
+class GustResponse:
+    """Time histories of a gust response: ``t`` (s), ``states`` (n_t, n_z), ``gust``
+    (3, n_t: w_g, w_g', w_g''), ``modal`` (n_t, n_s) elastic coordinates,
+    ``acceleration`` (n_t, n_s) their second derivatives, ``hinge_moment`` (n_t,) N m (zeros
+    without a rigid mode; theta held at zero)."""
+
+    t: np.ndarray
+    states: np.ndarray
+    gust: np.ndarray
+    modal: np.ndarray
+    acceleration: np.ndarray
+    hinge_moment: np.ndarray
+
+
+def gust_response(ss: GustStateSpace, t, gust) -> GustResponse:
+    """Response of :class:`GustStateSpace` from rest to the gust inputs ``gust`` (3, n_t) at
+    the uniformly spaced times ``t`` (s), theta held at zero (the actuator clamped), by the
+    exact discretisation of a first-order hold (scipy.signal.lsim).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from asekit.rfa.gust import GustFit
+    >>> from asekit.rfa.roger import RogerFit
+    >>> k = np.array([0.0, 1.0])
+    >>> rfa = RogerFit(np.zeros((4, 1, 1)), np.array([0.2]), 0.5, k, np.zeros((2, 1, 1)),
+    ...                np.zeros((1, 1)), 0.0)
+    >>> g = GustFit(np.array([[2.0], [0.0], [0.0], [0.0]]), np.array([0.2]), 0.5, k,
+    ...             np.ones((2, 1)))
+    >>> model = type("M", (), {"M": [[1.0]], "K": [[100.0]], "C": [[20.0]], "n_rigid": 0})()
+    >>> ss = gust_state_space(model, rfa, g, 1.0, 10.0)
+    >>> t = np.linspace(0, 5, 501)
+    >>> r = gust_response(ss, t, np.vstack([np.ones(501), np.zeros((2, 501))]))
+    >>> round(float(r.modal[-1, 0]), 4)       # static: q A0g (w/U) / K = 100 * 0.1 / 100
+    0.1
+    """
+    from scipy.signal import lsim
+
+    tt = finite_array("t", t).ravel()
+    if tt.size < 2 or np.any(np.diff(tt) <= 0):
+        raise ValueError("t must hold >= 2 ascending times (s)")
+    g = finite_array("gust", gust)
+    if g.shape != (3, tt.size):
+        raise ValueError(f"gust must be (3, len(t)) = (3, {tt.size}): w_g, w_g', w_g''; got "
+                         f"{g.shape}")
+    nz, ns = ss.n_states, ss.n_elastic
+    _, _, x = lsim((ss.A, ss.B_g, np.eye(nz), np.zeros((nz, 3))), g.T, tt, interp=True)
+    x = np.atleast_2d(x).reshape(tt.size, nz)
+    Ca, _, Dga = ss.acceleration_rows()
+    acc = x @ Ca.T + g.T @ Dga.T
+    hinge = (x @ ss.C_hinge.T + g.T @ ss.Dg_hinge.T)[:, 0] if ss.n_rigid else np.zeros(tt.size)
+    return GustResponse(tt, x, g, x[:, :ns], acc, hinge)
