@@ -194,3 +194,75 @@ def gust_table(box_modes: BoxModes, mesh: BoxMesh, machs, k, b_ref: float, x0: f
     qg = np.stack([gust_columns(box_modes, mesh, v, ks, b_ref, x0, method, symmetric,
                                 aero_options) for v in ms])
     return GustGafTable(np.array(ms), ks, qg, float(b_ref), float(x0))
+
+
+@dataclass(frozen=True)
+class GustAeroTables:
+    """One Mach's aerodynamic tables of a gust-loads analysis, from one pressure solve per k
+    (:func:`gust_aero_tables`), all per unit dynamic pressure:
+
+    Q : (n_k, n, n) modal GAFs (Eq. 2.11); Qg : (n_k, n) gust column (per unit W/U);
+    QL : (n_k, n_loads, n) aerodynamic load rows per unit modal coordinate; QLg : (n_k, n_loads)
+    the loads per unit W/U; k : reduced frequencies; b_ref (m); x0 : gust reference (m).
+    A load row r sums the box forces with the weights ``load_weights[:, r]`` (e.g. 1 for the
+    shear, y - y_root for the bending moment about the root line)."""
+
+    k: np.ndarray
+    Q: np.ndarray
+    Qg: np.ndarray
+    QL: np.ndarray
+    QLg: np.ndarray
+    b_ref: float
+    x0: float
+
+
+def gust_aero_tables(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref: float,
+                     load_weights, x0: float = 0.0, method: str = "auto",
+                     symmetric: bool = False, aero_options: dict | None = None) -> GustAeroTables:
+    """Modal GAFs, gust column and aerodynamic load rows from one pressure solve per k: the
+    normalwash columns of the modes and of the gust, their DeltaCp by ``method``
+    (:func:`asekit.aero.methods.pressures`), projected on the modes (H_lp^T diag(A), Eq. 2.11)
+    and on the load weights (W^T diag(A): force summation of the box forces at the load
+    points).
+
+    Parameters
+    ----------
+    box_modes, mesh, mach, k, b_ref, x0, method, symmetric, aero_options :
+        as :func:`gust_columns`.
+    load_weights : (n_boxes, n_loads) weight of each box's force (at its load point) in each
+        load: 1 for a shear (N per N), the lever arm (m) for a moment.
+
+    Returns
+    -------
+    :class:`GustAeroTables`
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
+    >>> from asekit.aero.spline import analytic_modes
+    >>> m = mesh_surfaces(TrapezoidSurface((0, 0, 0), 1.0, (0, 4, 0), 1.0, 4, 8))
+    >>> plunge = analytic_modes(m, [lambda x, y: (1 + 0 * x, 0 * x)])
+    >>> t = gust_aero_tables(plunge, m, 0.0, [0.0, 0.5], 0.5, np.ones((m.n, 1)), method="dlm")
+    >>> bool(np.allclose(t.QLg[:, 0], t.Qg[:, 0]))     # shear of all boxes = the plunge force
+    True
+    """
+    ks = check_k(k)
+    b = positive("b_ref", b_ref)
+    xg = _x0(x0)
+    w_l = finite_array("load_weights", load_weights)
+    if w_l.ndim != 2 or w_l.shape[0] != mesh.n:
+        raise ValueError(f"load_weights must be (n_boxes, n_loads) = ({mesh.n}, n); got "
+                         f"{w_l.shape}")
+    x = mesh.control_point[:, 0]
+
+    def wash(kk):
+        return np.hstack([box_modes.normalwash(kk, b), gust_normalwash(x, kk, b, xg)[:, None]])
+
+    cp = pressures(mesh, mach_number(mach), ks, b, wash, method, symmetric,
+                   **(aero_options or {}))
+    force = np.asarray(mesh.area)[None, :, None] * cp              # (n_k, n_boxes, n + 1)
+    modal = np.einsum("bm,kbc->kmc", box_modes.h_lp, force)
+    loads = np.einsum("bl,kbc->klc", w_l, force)
+    return GustAeroTables(ks, modal[:, :, :-1], modal[:, :, -1], loads[:, :, :-1],
+                          loads[:, :, -1], b, xg)

@@ -202,7 +202,7 @@ class GustResponse:
     """Time histories of a gust response: ``t`` (s), ``states`` (n_t, n_z), ``gust``
     (3, n_t: w_g, w_g', w_g''), ``modal`` (n_t, n_s) elastic coordinates,
     ``acceleration`` (n_t, n_s) their second derivatives, ``hinge_moment`` (n_t,) N m (zeros
-    without a rigid mode; theta held at zero)."""
+    without a rigid mode; theta held at zero); ``velocity`` (m/s), ``density`` (kg/m^3)."""
 
     t: np.ndarray
     states: np.ndarray
@@ -210,6 +210,8 @@ class GustResponse:
     modal: np.ndarray
     acceleration: np.ndarray
     hinge_moment: np.ndarray
+    velocity: float = 0.0
+    density: float = 0.0
 
 
 def gust_response(ss: GustStateSpace, t, gust) -> GustResponse:
@@ -249,4 +251,99 @@ def gust_response(ss: GustStateSpace, t, gust) -> GustResponse:
     Ca, _, Dga = ss.acceleration_rows()
     acc = x @ Ca.T + g.T @ Dga.T
     hinge = (x @ ss.C_hinge.T + g.T @ ss.Dg_hinge.T)[:, 0] if ss.n_rigid else np.zeros(tt.size)
-    return GustResponse(tt, x, g, x[:, :ns], acc, hinge)
+    return GustResponse(tt, x, g, x[:, :ns], acc, hinge, ss.velocity, ss.density)
+
+
+def first_order_filter(t, u, rates) -> np.ndarray:
+    """y' = -a y + u(t) from y(t_0) = 0 for each rate a > 0 (1/s), u linear between samples
+    (first-order hold, exact recurrence):
+
+        y_{j+1} = e^{-a h} y_j + u_j (1 - e^{-a h}) / a + (u_{j+1} - u_j) / h
+                  (h / a - (1 - e^{-a h}) / a^2).
+
+    ``t`` (n_t,) ascending; ``u`` (n_t, m); ``rates`` (m,) or scalar. Returns (n_t, m).
+
+    Examples
+    --------
+    >>> t = np.linspace(0, 10, 1001)
+    >>> y = first_order_filter(t, np.ones((1001, 1)), 2.0)   # step: (1 - e^{-2 t}) / 2
+    >>> round(float(y[-1, 0]), 6)
+    0.5
+    """
+    tt = finite_array("t", t).ravel()
+    uu = finite_array("u", u)
+    uu = uu.reshape(tt.size, -1)
+    a = np.broadcast_to(finite_array("rates", rates), (uu.shape[1],)).astype(float)
+    if np.any(a <= 0):
+        raise ValueError(f"rates must be > 0 (1/s), got {a}")
+    y = np.zeros_like(uu)
+    for j, h in enumerate(np.diff(tt)):
+        e = np.exp(-a * h)
+        g0 = (1 - e) / a
+        y[j + 1] = e * y[j] + uu[j] * g0 + (uu[j + 1] - uu[j]) / h * (h / a - g0 / a)
+    return y
+
+
+def load_histories(resp: GustResponse, load_fit, inertial_rows, n_rigid: int = 0
+                   ) -> np.ndarray:
+    """Loads by force summation (aerodynamic + inertial) along a gust response.
+
+    The aerodynamic load rows Q_L (n_loads, n) and their gust part Q_Lg (n_loads) (from
+    :func:`asekit.aero.gust.gust_aero_tables`) are fitted together in Roger form, ``load_fit``
+    a :class:`asekit.rfa.gust.GustFit` of the columns ``[Q_L.reshape(n_k, -1), Q_Lg]`` (row
+    major: load r, mode j at column r n + j; then the n_loads gust columns). In time (p = s b/U)
+
+        L_aero = q [A0 zeta + (b/U) A1 zeta' + (b/U)^2 A2 zeta'' + sum_n y_n]
+                 + q [A0g w/U + A1g b w'/U^2 + A2g b^2 w''/U^3 + sum_n A_gn x_gn],
+        y_n' = -(U/b) beta_n y_n + A_n zeta',   x_gn' = -(U/b) beta_n x_gn + w'/U,
+
+    (only the elastic coordinates: the rigid one is held at zero), and the inertial load is
+    ``inertial_rows`` (n_loads, n_s) times zeta_s'' (-u_r^T M Phi_s for a load whose rigid
+    displacement field is u_r). Returns (n_t, n_loads) in N and N m.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from asekit.rfa.gust import GustFit
+    >>> from asekit.rfa.roger import RogerFit
+    >>> k = np.array([0.0, 1.0])
+    >>> rfa = RogerFit(np.zeros((4, 1, 1)), np.array([0.2]), 0.5, k, np.zeros((2, 1, 1)),
+    ...                np.zeros((1, 1)), 0.0)
+    >>> g = GustFit(np.array([[2.0], [0.0], [0.0], [0.0]]), np.array([0.2]), 0.5, k,
+    ...             np.ones((2, 1)))
+    >>> model = type("M", (), {"M": [[1.0]], "K": [[100.0]], "C": [[20.0]], "n_rigid": 0})()
+    >>> ss = gust_state_space(model, rfa, g, 1.0, 10.0)
+    >>> t = np.linspace(0, 5, 501)
+    >>> r = gust_response(ss, t, np.vstack([np.ones(501), np.zeros((2, 501))]))
+    >>> lf = GustFit(np.array([[0.0, 2.0], [0, 0], [0, 0], [0, 0]]), np.array([0.2]), 0.5, k,
+    ...              np.ones((2, 2)))
+    >>> shear = load_histories(r, lf, [[-1.0]])            # aero 10 N, inertia -zeta''
+    >>> round(float(shear[-1, 0]), 4)                       # = the spring force K zeta
+    10.0
+    """
+    ns = resp.modal.shape[1]
+    inert = np.atleast_2d(finite_array("inertial_rows", inertial_rows))
+    nl = inert.shape[0]
+    A = finite_array("load_fit.A", load_fit.A)
+    n = ns + int(n_rigid)
+    if inert.shape[1] != ns or A.shape[1] != nl * (n + 1):
+        raise ValueError(f"inertial_rows must be (n_loads, n_s = {ns}) and load_fit (N + 3, "
+                         f"n_loads (n + 1)) with n = {n} modes; got {inert.shape}, {A.shape}")
+    roots = np.atleast_1d(load_fit.lag_roots)
+    b = float(load_fit.b_ref)
+    U = float(resp.velocity)
+    q = 0.5 * resp.density * U ** 2
+    Am = A[:, :nl * n].reshape(A.shape[0], nl, n)[:, :, n_rigid:]        # (N + 3, nl, ns)
+    Ag = A[:, nl * n:]                                                   # (N + 3, nl)
+    t, w = resp.t, resp.gust
+    z, zd, zdd = resp.modal, resp.states[:, ns:2 * ns], resp.acceleration
+    aero = (z @ Am[0].T + (b / U) * zd @ Am[1].T + (b / U) ** 2 * zdd @ Am[2].T
+            + np.outer(w[0] / U, Ag[0]) + np.outer(w[1] * b / U ** 2, Ag[1])
+            + np.outer(w[2] * b ** 2 / U ** 3, Ag[2]))
+    rates = U / b * roots
+    xg = first_order_filter(t, np.repeat((w[1] / U)[:, None], roots.size, 1), rates)
+    yl = first_order_filter(t, np.hstack([zd @ Am[3 + i].T for i in range(roots.size)]),
+                            np.repeat(rates, nl))
+    for i in range(roots.size):
+        aero = aero + yl[:, i * nl:(i + 1) * nl] + np.outer(xg[:, i], Ag[3 + i])
+    return q * aero + zdd @ inert.T

@@ -144,3 +144,23 @@ def test_table_and_errors():
         gust_normalwash(np.zeros(2), -0.1, 0.5)
     with pytest.raises(ValueError, match="Qg must be"):
         GustGafTable([0.5], [0.0, 1.0], np.ones((1, 3, 1)), 0.5)
+
+
+def test_one_solve_tables_match_the_separate_ones():
+    # gust_aero_tables: the modal GAFs equal gaf_from_box_modes', the gust column
+    # gust_columns', and a load row with the plunge mode's weights equals the plunge row
+    from asekit.aero.gaf import gaf_from_box_modes
+    from asekit.aero.gust import gust_aero_tables
+    m = mesh_surfaces(TrapezoidSurface((0, 0, 0), 1.0, (0.3, 2, 0), 0.6, 4, 5))
+    modes = analytic_modes(m, [lambda x, y: (1 + 0 * x, 0 * x),
+                               lambda x, y: (-(x - 0.3), -1 + 0 * x)])
+    ks = [0.0, 0.4]
+    weights = np.column_stack([np.ones(m.n), m.load_point[:, 1]])
+    t = gust_aero_tables(modes, m, 0.5, ks, 0.5, weights, x0=0.1, method="dlm")
+    scale = np.abs(t.Q).max()
+    assert np.abs(t.Q - gaf_from_box_modes(modes, m, 0.5, ks, 0.5)).max() < 1e-12 * scale
+    assert np.abs(t.Qg - gust_columns(modes, m, 0.5, ks, 0.5, x0=0.1, method="dlm")).max() \
+        < 1e-12 * scale
+    assert np.abs(t.QL[:, 0] - t.Q[:, 0]).max() < 1e-12 * scale
+    with pytest.raises(ValueError, match="load_weights must be"):
+        gust_aero_tables(modes, m, 0.5, ks, 0.5, np.ones((3, 1)))

@@ -7,7 +7,12 @@ import numpy as np
 import pytest
 from scipy.special import hankel2, j0, j1
 
-from asekit.aeroelastic.gust import gust_response, gust_state_space, one_minus_cosine
+from asekit.aeroelastic.gust import (
+    gust_response,
+    gust_state_space,
+    load_histories,
+    one_minus_cosine,
+)
 from asekit.aeroelastic.statespace import ModalArrays
 from asekit.rfa.gust import gust_fit
 from asekit.rfa.roger import roger_fit
@@ -106,6 +111,14 @@ def test_plunging_section_in_a_one_minus_cosine_gust():
     assert np.abs(h_ss).max() == pytest.approx(peak, rel=0.03)
     assert np.abs(h_ss - h_ref).max() < 0.03 * peak
     assert h_ss[np.argmax(np.abs(h_ss))] > 0                 # an upward gust lifts the section
+
+    # force summation: the root shear = aerodynamic lift (its own Roger fit of the lift row
+    # and the gust lift, same lags) + inertia -m h''; for this one-mode section it must equal
+    # the spring force K h of the reference (equilibrium), within the same 3 % of the peak
+    load_fit = gust_fit(k, np.hstack([Qhh[:, 0, :], Qhg]), b, lag_roots=rfa.lag_roots)
+    shear = load_histories(gust_response(ss, t, w), load_fit, -modal.M)[:, 0]
+    ref = modal.K[0, 0] * h_ref
+    assert np.abs(shear - ref).max() < 0.03 * np.abs(ref).max()
 
 
 def test_one_minus_cosine_profile_and_errors():
