@@ -43,7 +43,12 @@ from asekit.aero.boxes import BoxMesh
 from asekit.aero.methods import pressures
 from asekit.aero.spline import BoxModes, modal_forces
 from asekit.aero.validity import check_k, mach_number
+from asekit.util.blas import blas_threads_for
 from asekit.util.validate import finite_array, positive
+
+#: Below this many boxes the pressure solves run on one BLAS thread (as
+#: :data:`asekit.aero.gaf.SMALL_SOLVE_BOXES`: threads stall on small matrices).
+SMALL_SOLVE_BOXES = 2000
 
 
 def _x0(x0) -> float:
@@ -121,8 +126,9 @@ def gust_columns(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref: floa
     b = positive("b_ref", b_ref)
     xg = _x0(x0)
     x = mesh.control_point[:, 0]
-    cp = pressures(mesh, m, ks, b, lambda kk: gust_normalwash(x, kk, b, xg)[:, None], method,
-                   symmetric, **(aero_options or {}))
+    with blas_threads_for(mesh.n, SMALL_SOLVE_BOXES):
+        cp = pressures(mesh, m, ks, b, lambda kk: gust_normalwash(x, kk, b, xg)[:, None],
+                       method, symmetric, **(aero_options or {}))
     return np.stack([modal_forces(box_modes, c, mesh.area)[:, 0] for c in cp])
 
 
@@ -259,8 +265,9 @@ def gust_aero_tables(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref: 
     def wash(kk):
         return np.hstack([box_modes.normalwash(kk, b), gust_normalwash(x, kk, b, xg)[:, None]])
 
-    cp = pressures(mesh, mach_number(mach), ks, b, wash, method, symmetric,
-                   **(aero_options or {}))
+    with blas_threads_for(mesh.n, SMALL_SOLVE_BOXES):
+        cp = pressures(mesh, mach_number(mach), ks, b, wash, method, symmetric,
+                       **(aero_options or {}))
     force = np.asarray(mesh.area)[None, :, None] * cp              # (n_k, n_boxes, n + 1)
     modal = np.einsum("bm,kbc->kmc", box_modes.h_lp, force)
     loads = np.einsum("bl,kbc->klc", w_l, force)

@@ -32,6 +32,7 @@ Units SI: rho kg/m^3, U m/s, b m, w_g m/s, the hinge moment N m.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -270,14 +271,30 @@ def first_order_filter(t, u, rates) -> np.ndarray:
     >>> round(float(y[-1, 0]), 6)
     0.5
     """
+    from scipy.signal import lfilter
+
     tt = finite_array("t", t).ravel()
     uu = finite_array("u", u)
     uu = uu.reshape(tt.size, -1)
     a = np.broadcast_to(finite_array("rates", rates), (uu.shape[1],)).astype(float)
     if np.any(a <= 0):
         raise ValueError(f"rates must be > 0 (1/s), got {a}")
+    steps = np.diff(tt)
+    if tt.size < 2 or np.any(steps <= 0):
+        raise ValueError("t must hold >= 2 ascending times (s)")
     y = np.zeros_like(uu)
-    for j, h in enumerate(np.diff(tt)):
+    if np.allclose(steps, steps[0], rtol=1e-9, atol=0):
+        # uniform steps: the recurrence is the IIR filter y_j - e y_{j-1} = c1 u_j + (c0 - c1)
+        # u_{j-1}, started from y_0 = 0
+        h = float(steps[0])
+        for i, ai in enumerate(a):
+            e = math.exp(-ai * h)
+            g0 = (1 - e) / ai
+            c1 = h / ai - g0 / ai
+            c1 /= h
+            y[:, i] = lfilter([c1, g0 - c1], [1.0, -e], uu[:, i], zi=[-c1 * uu[0, i]])[0]
+        return y
+    for j, h in enumerate(steps):
         e = np.exp(-a * h)
         g0 = (1 - e) / a
         y[j + 1] = e * y[j] + uu[j] * g0 + (uu[j + 1] - uu[j]) / h * (h / a - g0 / a)

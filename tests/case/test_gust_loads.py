@@ -1,0 +1,107 @@
+"""Discrete-gust loads of a case (asekit.case.gust_loads) and the [gust] table (schema)."""
+
+import dataclasses
+import tomllib
+
+import numpy as np
+import pytest
+
+from asekit.aero.gust import gust_aero_tables
+from asekit.aero.spline import fe_spline
+from asekit.atmosphere import standard_atmosphere
+from asekit.case import CaseError, case_from_dict
+from asekit.case import pipeline as P
+from asekit.case.gust_loads import _inertial_rows, _load_weights, gust_json, gust_loads
+from asekit.case.schema import GustSpec
+from asekit.util.paths import FIN_FILE
+
+pytestmark = pytest.mark.usefixtures("session_gaf_cache")
+
+
+@pytest.fixture(scope="module")
+def fin_gusts(fin_case):
+    case = dataclasses.replace(fin_case, gust=GustSpec((0.3, 40.0), 10.0, 0.5, 0.0))
+    return case, gust_loads(case)
+
+
+def test_long_gust_tends_to_the_static_aeroelastic_load(fin_gusts):
+    # A gust much longer than the fin's response times (H = 40 m at 170 m/s: 0.24 s to its
+    # peak, the first elastic mode near 100 Hz) loads the fin quasi-statically: its peaks must
+    # approach the static aeroelastic equilibrium at the incidence U_ds / U, computed here
+    # from the k = 0 tables without any fit or time integration:
+    #   (K_ss - q Q_ss(0)) zeta_s = q Qg_s(0) alpha,  load = q (QL_s(0) zeta_s + QLg(0) alpha),
+    # hinge = q (Q_cs(0) zeta_s + Q_cg(0) alpha)  (actuator clamped, theta = 0).
+    case, res = fin_gusts
+    modal, boxes = P.modal_model(case), P.box_mesh(case)
+    y_root = float(np.min(boxes.corners[:, :, 1]))
+    t = gust_aero_tables(fe_spline(modal, boxes), boxes, 0.5, [0.0], 0.078,
+                         _load_weights(boxes, y_root), res.x0, "quartic")
+    atm = standard_atmosphere(0.0)
+    U = 0.5 * float(atm.speed_of_sound)
+    q = 0.5 * float(atm.density) * U ** 2
+    alpha = 10.0 / U
+    s = slice(1, None)
+    zeta = np.linalg.solve(modal.K[s, s] - q * t.Q[0, s, s].real, q * t.Qg[0, s].real * alpha)
+    shear, bending = q * (t.QL[0, :, s].real @ zeta + t.QLg[0].real * alpha)
+    hinge = q * (t.Q[0, 0, s].real @ zeta + t.Qg[0, 0].real * alpha)
+    long = res.cases[1]
+    # measured: 40.88 N, 3.063 N m, 0.6417 N m; the time domain within 0.04 % of them
+    assert long.peak_root_shear == pytest.approx(shear, rel=0.01)
+    assert long.peak_root_bending == pytest.approx(bending, rel=0.01)
+    assert long.peak_hinge_moment == pytest.approx(hinge, rel=0.01)
+    assert shear > 0 and bending > 0                  # an upward gust lifts and bends tip-up
+
+
+def test_gust_json_rows(fin_gusts):
+    case, res = fin_gusts
+    rows = gust_json(res)
+    assert [r["gust_length_m"] for r in rows] == [0.3, 40.0]
+    for r in rows:
+        assert set(r) == {"mach", "altitude_m", "gust_length_m", "peak_hinge_moment_Nm",
+                          "peak_root_bending_Nm", "peak_root_shear_N", "peak_current_A"}
+        assert r["peak_current_A"] is None and r["mach"] == 0.5 and r["altitude_m"] == 0.0
+        assert all(np.isfinite(r[k]) for k in ("peak_hinge_moment_Nm", "peak_root_bending_Nm"))
+    assert res.tuned("root_bending").gradient_length in (0.3, 40.0)
+    assert max(res.fit_errors.values()) < 0.05
+    assert gust_json(None) == []
+
+
+def test_inertial_rows_of_a_rigid_translation():
+    # -u^T M Phi: a unit translation's inertial row is minus the modal participation of the
+    # elastic modes; the rigid pitch (held) is left out, and the rows are finite
+    from asekit.case import load_case
+    case = load_case(FIN_FILE)
+    modal = P.modal_model(case)
+    rows = _inertial_rows(case, modal, 0.0)
+    assert rows.shape == (2, modal.M.shape[0] - modal.n_rigid)
+    assert np.all(np.isfinite(rows)) and np.abs(rows[0]).max() > 0
+
+
+def _with_gust(**gust):
+    with open(FIN_FILE, "rb") as fh:
+        d = tomllib.load(fh)
+    d["gust"] = gust
+    return d
+
+
+@pytest.mark.parametrize("gust,message", [
+    ({"design_velocity": 10.0}, "gust.gradient_lengths is missing"),
+    ({"gradient_lengths": [1.0, 0.5], "design_velocity": 10.0}, "strictly ascending"),
+    ({"gradient_lengths": [-1.0], "design_velocity": 10.0}, r"gust.gradient_lengths\[0\]"),
+    ({"gradient_lengths": [1.0], "design_velocity": 0.0}, "gust.design_velocity must be > 0"),
+    ({"gradient_lengths": [1.0], "design_velocity": 5.0, "mach": 0.9},
+     "gust.mach must lie within aero.machs"),
+    ({"gradient_lengths": [1.0], "design_velocity": 5.0, "altitude": -1e5}, "gust.altitude"),
+    ({"gradient_lengths": [1.0], "design_velocity": 5.0, "speed": 3}, "gust.speed is not a known"),
+])
+def test_gust_table_errors(gust, message):
+    with pytest.raises(CaseError, match=message):
+        case_from_dict(_with_gust(**gust))
+
+
+def test_gust_table_defaults_and_fingerprint(fin_case):
+    c = case_from_dict(_with_gust(gradient_lengths=[1.0, 5.0], design_velocity=8.0))
+    assert c.gust == GustSpec((1.0, 5.0), 8.0, fin_case.actuator.mach, fin_case.actuator.altitude)
+    # a case without [gust] keeps its fingerprint (caches keyed on it stay valid)
+    assert dataclasses.replace(c, gust=None).fingerprint() == fin_case.fingerprint()
+    assert c.fingerprint() != fin_case.fingerprint()
