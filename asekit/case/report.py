@@ -27,6 +27,7 @@ from pathlib import Path
 
 from asekit.case import pipeline as P
 from asekit.case import report_figures as RF
+from asekit.case.gust_loads import gust_json, gust_loads
 from asekit.case.schema import Case
 from asekit.util.conventions import mode_label, mode_number
 from asekit.util.plotting import save_figure
@@ -55,13 +56,19 @@ UNITS = {
     "settling_s": "s", "steady_error_pct": "%", "corner_overshoot_pct": "%",
     "fwtf_phase_margin_deg": "deg",
     "seconds": "s (wall-clock time per step)",
+    "gust_length_m": "m (the 1-cos gust's gradient distance H; the gust is 2 H long)",
+    "peak_hinge_moment_Nm": "N m (largest |T_hinge@fin|, signed; actuator clamped)",
+    "peak_root_bending_Nm": "N m (largest |root bending moment|, signed; tip up > 0)",
+    "peak_root_shear_N": "N (largest |root shear|, signed; up > 0)",
+    "peak_current_A": "A (null: the gust is not yet in the closed ASE loop)",
 }
 
 
 @dataclass(frozen=True)
 class Analysis:
     """Everything one ``analyse`` run computed: the case, its modal model, GAF database,
-    flutter analysis, ASE result (None without an actuator) and step timings (s)."""
+    flutter analysis, ASE result (None without an actuator), step timings (s) and the
+    discrete-gust loads (:class:`asekit.case.gust_loads.GustLoads`; None without ``[gust]``)."""
 
     case: Case
     modal: object
@@ -69,6 +76,7 @@ class Analysis:
     flutter: object
     ase: object
     seconds: dict
+    gust: object = None
 
 
 @contextlib.contextmanager
@@ -106,7 +114,13 @@ def run_analysis(case: Case, progress: bool = False) -> Analysis:
         ase = P.ase(case, db=db)
     if ase is not None:
         sec["ase"] = time.perf_counter() - t
-    return Analysis(case, modal, db, fa, ase, sec)
+    gust = None
+    if case.gust is not None:
+        t = time.perf_counter()
+        with _stage("gust loads", progress):
+            gust = gust_loads(case)
+        sec["gust"] = time.perf_counter() - t
+    return Analysis(case, modal, db, fa, ase, sec, gust)
 
 
 def _f(v):
@@ -161,6 +175,8 @@ def summary(a: Analysis) -> dict:
                                                for k, v in s.corner_overshoot.items()},
                       "fwtf_phase_margin_deg": {str(i): _f(x.phase_margin_deg)
                                                 for i, x in s.crossovers.items()}}
+    if a.gust is not None:
+        out["gust"] = gust_json(a.gust)
     out["critical"] = critical_condition(out)
     return out
 
@@ -300,6 +316,20 @@ def _margin_text(m: dict) -> str:
     return "-" + (f" ({m['note']})" if m.get("note") else "")
 
 
+def _gust_lines(rows) -> list:
+    """The summary's lines of the ``"gust"`` rows (none without them)."""
+    if not rows:
+        return []
+    lines = ["", f"1-cos gusts at M {rows[0]['mach']:g}, {rows[0]['altitude_m']:g} m (peaks; "
+             "actuator clamped):", "  H (m)   hinge moment (N m)   root bending (N m)   "
+             "root shear (N)"]
+    for r in rows:
+        lines.append(f"  {r['gust_length_m']:<7g} {_cell(r['peak_hinge_moment_Nm']):>18}   "
+                     f"{_cell(r['peak_root_bending_Nm']):>18}   "
+                     f"{_cell(r['peak_root_shear_N']):>14}")
+    return lines
+
+
 def format_summary(s: dict, width: int = 100) -> str:
     """A plain-text summary of :func:`summary` that fits ``width`` columns."""
     lines = textwrap.wrap(f"case {s['case']}" + (f"  ({s['reference']})" if s.get("reference")
@@ -355,6 +385,7 @@ def format_summary(s: dict, width: int = 100) -> str:
                 + f", final error {_cell(a['steady_error_pct'][t], '{:.2f}')} %; corner "
                 f"overshoot {min(ov.values()):.0f}-{max(ov.values()):.0f} %", width,
                 initial_indent="  ", subsequent_indent="    ")
+    lines += _gust_lines(s.get("gust"))
     for n in s["notes"]:
         lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")

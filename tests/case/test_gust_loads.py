@@ -105,3 +105,13 @@ def test_gust_table_defaults_and_fingerprint(fin_case):
     # a case without [gust] keeps its fingerprint (caches keyed on it stay valid)
     assert dataclasses.replace(c, gust=None).fingerprint() == fin_case.fingerprint()
     assert c.fingerprint() != fin_case.fingerprint()
+
+
+def test_summary_lines(fin_gusts):
+    from asekit.case.report import UNITS, _gust_lines
+    _, res = fin_gusts
+    lines = _gust_lines(gust_json(res))
+    assert lines[1].startswith("1-cos gusts at M 0.5, 0 m") and len(lines) == 3 + len(res.cases)
+    assert _gust_lines([]) == []
+    for key in gust_json(res)[0]:
+        assert key in UNITS or key == "mach"
