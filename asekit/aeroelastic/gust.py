@@ -364,3 +364,129 @@ def load_histories(resp: GustResponse, load_fit, inertial_rows, n_rigid: int = 0
     for i in range(roots.size):
         aero = aero + yl[:, i * nl:(i + 1) * nl] + np.outer(xg[:, i], Ag[3 + i])
     return q * aero + zdd @ inert.T
+
+
+# ---------------------------------------------------------------------------------------------
+# continuous turbulence (frequency domain)
+# ---------------------------------------------------------------------------------------------
+#: von Karman's constant a of the vertical-gust spectrum (1.339 L omega / U).
+VON_KARMAN_A = 1.339
+
+
+def turbulence_psd(omega, velocity: float, scale_length: float, sigma: float,
+                   spectrum: str = "von_karman") -> np.ndarray:
+    """One-sided PSD of the vertical gust velocity, Phi(omega) ((m/s)^2 / (rad/s)), with
+    int_0^inf Phi d omega = sigma^2 (Hoblit, *Gust Loads on Aircraft*, AIAA 1988, Eqs. 2.7-2.8;
+    MIL-F-8785C):
+
+    von Karman: Phi = sigma^2 L / (pi U) (1 + 8/3 (a L omega/U)^2) / (1 + (a L omega/U)^2)^(11/6),
+    a = 1.339; Dryden: Phi = sigma^2 L / (pi U) (1 + 3 (L omega/U)^2) / (1 + (L omega/U)^2)^2.
+
+    Parameters
+    ----------
+    omega : frequencies (rad/s) >= 0; velocity : U (m/s) > 0; scale_length : L (m) > 0;
+    sigma : RMS gust velocity (m/s) > 0; spectrum : "von_karman" or "dryden".
+
+    Examples
+    --------
+    >>> float(np.round(turbulence_psd(0.0, 100.0, 762.0, 1.0) * np.pi * 100 / 762, 12))
+    1.0
+    """
+    w = finite_array("omega", omega)
+    if np.any(w < 0):
+        raise ValueError("omega must be >= 0 rad/s")
+    U, L, s = positive("velocity", velocity), positive("scale_length", scale_length), \
+        positive("sigma", sigma)
+    base = s ** 2 * L / (np.pi * U)
+    if spectrum == "von_karman":
+        x2 = (VON_KARMAN_A * L * w / U) ** 2
+        return base * (1 + 8 / 3 * x2) / (1 + x2) ** (11 / 6)
+    if spectrum == "dryden":
+        x2 = (L * w / U) ** 2
+        return base * (1 + 3 * x2) / (1 + x2) ** 2
+    raise ValueError(f"spectrum must be 'von_karman' or 'dryden', got {spectrum!r}")
+
+
+def gust_frequency_response(ss: GustStateSpace, omega, load_fit=None, inertial_rows=None,
+                            n_rigid: int = 0) -> dict:
+    """Frequency responses per unit gust velocity (w_g = e^{i omega t} m/s at x0) of
+    :class:`GustStateSpace`: ``"modal"`` (n_w, n_s) elastic coordinates, ``"hinge_moment"``
+    (n_w,) N m per m/s (with a rigid mode), and with ``load_fit``/``inertial_rows`` (as in
+    :func:`load_histories`) ``"loads"`` (n_w, n_loads): q [Q~_L(k) zeta + Q~_Lg(k) / U]
+    - omega^2 inertial_rows zeta, k = omega b / U.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from asekit.rfa.gust import GustFit
+    >>> from asekit.rfa.roger import RogerFit
+    >>> k = np.array([0.0, 1.0])
+    >>> rfa = RogerFit(np.zeros((4, 1, 1)), np.array([0.2]), 0.5, k, np.zeros((2, 1, 1)),
+    ...                np.zeros((1, 1)), 0.0)
+    >>> g = GustFit(np.array([[2.0], [0.0], [0.0], [0.0]]), np.array([0.2]), 0.5, k,
+    ...             np.ones((2, 1)))
+    >>> model = type("M", (), {"M": [[1.0]], "K": [[100.0]], "C": [[20.0]], "n_rigid": 0})()
+    >>> ss = gust_state_space(model, rfa, g, 1.0, 10.0)
+    >>> h = gust_frequency_response(ss, [0.0])["modal"][0, 0]   # q A0g (1/U) / K = 10 / 100
+    >>> complex(np.round(h, 12))
+    (0.1+0j)
+    """
+    w = finite_array("omega", omega).ravel()
+    nz, ns = ss.n_states, ss.n_elastic
+    u = np.stack([np.ones_like(w), 1j * w, -w ** 2], axis=1).astype(complex)     # (n_w, 3)
+    x = np.stack([np.linalg.solve(1j * wi * np.eye(nz) - ss.A, ss.B_g @ ui)
+                  for wi, ui in zip(w, u)])
+    out = {"modal": x[:, :ns]}
+    if ss.n_rigid:
+        out["hinge_moment"] = x @ ss.C_hinge[0] + u @ ss.Dg_hinge[0]
+    if load_fit is not None:
+        inert = np.atleast_2d(finite_array("inertial_rows", inertial_rows))
+        nl = inert.shape[0]
+        n = ns + int(n_rigid)
+        U, b = ss.velocity, float(load_fit.b_ref)
+        q = 0.5 * ss.density * U ** 2
+        ev = load_fit.evaluate(w * b / U)                                        # (n_w, cols)
+        QL = ev[:, :nl * n].reshape(w.size, nl, n)[:, :, n_rigid:]
+        out["loads"] = (q * (np.einsum("wls,ws->wl", QL, x[:, :ns]) + ev[:, nl * n:] / U)
+                        - (w ** 2)[:, None] * (x[:, :ns] @ inert.T))
+    return out
+
+
+def spectral_statistics(omega, transfer, psd) -> dict:
+    """RMS, A-bar and N0 of a response to continuous turbulence (Hoblit 1988, Eqs. 2.13-2.16):
+    sigma_y^2 = int |H|^2 Phi d omega, A-bar = sigma_y / sigma_w, N0 = (1 / 2 pi)
+    sqrt(int omega^2 |H|^2 Phi / int |H|^2 Phi) (zero up-crossings per second), by the
+    trapezoidal rule over the given ``omega`` grid (rad/s; its upper end is a cut-off, which
+    N0 depends on when |H|^2 Phi falls slowly).
+
+    Parameters
+    ----------
+    omega : (n_w,) ascending rad/s; transfer : (n_w,) response per unit gust velocity;
+    psd : (n_w,) one-sided gust PSD ((m/s)^2 / (rad/s)).
+
+    Returns
+    -------
+    dict ``rms`` (unit of the response), ``A_bar`` (rms over the gust RMS of ``psd`` on the
+    same grid: response per m/s), ``N0_per_s`` (1/s).
+
+    Examples
+    --------
+    >>> w = np.linspace(0, 10, 10001)
+    >>> s = spectral_statistics(w, 2.0 * np.ones(w.size), np.where(w <= 1, 1.0, 0.0))
+    >>> round(s["rms"], 3), round(s["A_bar"], 3)
+    (2.0, 2.0)
+    """
+    from scipy.integrate import trapezoid
+
+    w = finite_array("omega", omega).ravel()
+    h2 = np.abs(np.asarray(transfer).ravel()) ** 2
+    p = finite_array("psd", psd).ravel()
+    if not (w.size == h2.size == p.size) or w.size < 2 or np.any(np.diff(w) <= 0):
+        raise ValueError("omega, transfer and psd must have the same length >= 2, omega "
+                         "strictly ascending")
+    m0 = trapezoid(h2 * p, w)
+    m2 = trapezoid(w ** 2 * h2 * p, w)
+    sig_w = math.sqrt(trapezoid(p, w))
+    rms = math.sqrt(m0)
+    return {"rms": rms, "A_bar": rms / sig_w if sig_w > 0 else float("nan"),
+            "N0_per_s": math.sqrt(m2 / m0) / (2 * np.pi) if m0 > 0 else float("nan")}
