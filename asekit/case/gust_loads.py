@@ -32,10 +32,13 @@ import numpy as np
 from asekit.aero.gust import gust_aero_tables
 from asekit.aero.spline import fe_spline
 from asekit.aeroelastic.gust import (
+    gust_frequency_response,
     gust_response,
     gust_state_space,
     load_histories,
     one_minus_cosine,
+    spectral_statistics,
+    turbulence_psd,
 )
 from asekit.atmosphere import standard_atmosphere
 from asekit.case.pipeline import box_mesh, mass_and_stiffness, modal_model, reduced_frequencies
@@ -82,7 +85,10 @@ class GustLoadCase:
 class GustLoads:
     """The ``[gust]`` analysis: flight condition (``mach``, ``altitude`` m, ``velocity`` m/s,
     ``density`` kg/m^3), ``design_velocity`` (m/s), ``x0`` (m), one :class:`GustLoadCase` per
-    gradient distance, and the Roger fits' errors (``fit_errors``: modal, gust, loads)."""
+    gradient distance, the Roger fits' errors (``fit_errors``: modal, gust, loads) and, with
+    ``[gust.turbulence]``, ``turbulence``: {"hinge_moment", "root_shear", "root_bending"} ->
+    :func:`asekit.aeroelastic.gust.spectral_statistics` (rms, A_bar, N0_per_s), plus
+    ``omega_max`` (rad/s, the integration's upper end: k_max U / b, the fits' range)."""
 
     mach: float
     altitude: float
@@ -92,6 +98,7 @@ class GustLoads:
     x0: float
     cases: tuple
     fit_errors: dict
+    turbulence: dict | None = None
 
     def tuned(self, which: str = "root_bending") -> GustLoadCase:
         """The gust of the largest peak ``which`` ("root_bending", "root_shear",
@@ -168,7 +175,49 @@ def gust_loads(case: Case) -> GustLoads | None:
         out.append(GustLoadCase(float(H), t, w[0], resp.hinge_moment if modal.n_rigid else None,
                                 loads[:, 0], loads[:, 1]))
     errs = {"modal": float(rfa.fit_error), "gust": gfit.fit_error, "loads": lfit.fit_error}
-    return GustLoads(g.mach, g.altitude, U, rho, g.design_velocity, x0, tuple(out), errs)
+    turb = None
+    if g.turbulence_sigma is not None:
+        turb = _turbulence(ss, lfit, inert, modal.n_rigid, g, float(np.max(ks)) * U / b)
+    return GustLoads(g.mach, g.altitude, U, rho, g.design_velocity, x0, tuple(out), errs, turb)
+
+
+#: Frequencies of the turbulence integrals: 0, then geometric from 1e-3 U / L (well inside
+#: the spectrum's knee U / (1.339 L)) to k_max U / b.
+TURBULENCE_POINTS = 4000
+
+
+def _turbulence(ss, lfit, inert, n_rigid, g, omega_max: float) -> dict:
+    """RMS, A-bar, N0 of the loads in continuous turbulence (module docstring)."""
+    w0 = min(1e-3 * ss.velocity / g.scale_length, 1e-6 * omega_max)
+    w = np.concatenate([[0.0], np.geomspace(w0, omega_max, TURBULENCE_POINTS)])
+    fr = gust_frequency_response(ss, w, lfit, inert, n_rigid)
+    psd = turbulence_psd(w, ss.velocity, g.scale_length, g.turbulence_sigma, g.spectrum)
+    out = {"omega_max": omega_max}
+    if "hinge_moment" in fr:
+        out["hinge_moment"] = spectral_statistics(w, fr["hinge_moment"], psd)
+    out["root_shear"] = spectral_statistics(w, fr["loads"][:, 0], psd)
+    out["root_bending"] = spectral_statistics(w, fr["loads"][:, 1], psd)
+    return out
+
+
+def turbulence_json(result: GustLoads | None) -> list:
+    """The ``analyse --json`` ``"turbulence"`` rows (one per flight condition): ``mach``,
+    ``altitude_m``, ``rms_hinge_moment_Nm``, ``A_bar_hinge`` (N m per m/s), ``N0_per_s`` (of
+    the hinge moment; null without a rigid mode), ``rms_root_bending_Nm``,
+    ``A_bar_root_bending`` (N m per m/s), ``N0_root_bending_per_s``, ``sigma_ms``,
+    ``scale_length_m``, ``spectrum``, ``omega_max`` (rad/s)."""
+    if result is None or result.turbulence is None:
+        return []
+    t = result.turbulence
+    h = t.get("hinge_moment")
+    bend = t["root_bending"]
+    g = {"mach": result.mach, "altitude_m": result.altitude,
+         "rms_hinge_moment_Nm": None if h is None else h["rms"],
+         "A_bar_hinge": None if h is None else h["A_bar"],
+         "N0_per_s": None if h is None else h["N0_per_s"],
+         "rms_root_bending_Nm": bend["rms"], "A_bar_root_bending": bend["A_bar"],
+         "N0_root_bending_per_s": bend["N0_per_s"], "omega_max": t["omega_max"]}
+    return [g]
 
 
 def gust_json(result: GustLoads | None) -> list:

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from asekit.case import pipeline as P
 from asekit.case import report_figures as RF
-from asekit.case.gust_loads import gust_json, gust_loads
+from asekit.case.gust_loads import gust_json, gust_loads, turbulence_json
 from asekit.case.schema import Case
 from asekit.util.conventions import mode_label, mode_number
 from asekit.util.plotting import save_figure
@@ -61,6 +61,13 @@ UNITS = {
     "peak_root_bending_Nm": "N m (largest |root bending moment|, signed; tip up > 0)",
     "peak_root_shear_N": "N (largest |root shear|, signed; up > 0)",
     "peak_current_A": "A (null: the gust is not yet in the closed ASE loop)",
+    "rms_hinge_moment_Nm": "N m (RMS in continuous turbulence)",
+    "A_bar_hinge": "N m per m/s (RMS hinge moment / RMS gust velocity)",
+    "N0_per_s": "1/s (zero up-crossings of the hinge moment per second)",
+    "rms_root_bending_Nm": "N m (RMS in continuous turbulence)",
+    "A_bar_root_bending": "N m per m/s (RMS root bending / RMS gust velocity)",
+    "N0_root_bending_per_s": "1/s (zero up-crossings of the root bending per second)",
+    "omega_max": "rad/s (upper end of the turbulence integrals: k_max U / b)",
 }
 
 
@@ -177,6 +184,8 @@ def summary(a: Analysis) -> dict:
                                                 for i, x in s.crossovers.items()}}
     if a.gust is not None:
         out["gust"] = gust_json(a.gust)
+        if a.gust.turbulence is not None:
+            out["turbulence"] = turbulence_json(a.gust)
     out["critical"] = critical_condition(out)
     return out
 
@@ -330,6 +339,18 @@ def _gust_lines(rows) -> list:
     return lines
 
 
+def _turbulence_lines(rows) -> list:
+    """The summary's line of the ``"turbulence"`` rows (none without them)."""
+    out = []
+    for r in rows or []:
+        out.append(f"turbulence at M {r['mach']:g}, {r['altitude_m']:g} m: hinge moment RMS "
+                   f"{_cell(r['rms_hinge_moment_Nm'])} N m (A-bar {_cell(r['A_bar_hinge'])}, "
+                   f"N0 {_cell(r['N0_per_s'])} /s); root bending RMS "
+                   f"{_cell(r['rms_root_bending_Nm'])} N m (A-bar "
+                   f"{_cell(r['A_bar_root_bending'])}, N0 {_cell(r['N0_root_bending_per_s'])} /s)")
+    return out
+
+
 def format_summary(s: dict, width: int = 100) -> str:
     """A plain-text summary of :func:`summary` that fits ``width`` columns."""
     lines = textwrap.wrap(f"case {s['case']}" + (f"  ({s['reference']})" if s.get("reference")
@@ -385,7 +406,7 @@ def format_summary(s: dict, width: int = 100) -> str:
                 + f", final error {_cell(a['steady_error_pct'][t], '{:.2f}')} %; corner "
                 f"overshoot {min(ov.values()):.0f}-{max(ov.values()):.0f} %", width,
                 initial_indent="  ", subsequent_indent="    ")
-    lines += _gust_lines(s.get("gust"))
+    lines += _gust_lines(s.get("gust")) + _turbulence_lines(s.get("turbulence"))
     for n in s["notes"]:
         lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")

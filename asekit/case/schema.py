@@ -236,7 +236,9 @@ class GustSpec:
     each gust 2 H long), the design gust velocity U_ds (m/s, true airspeed, upward), the flight
     condition (Mach, altitude in m; default the actuator's, else the first of aero.machs at
     0 m), the gust reference station x0 (m; default the most upstream leading edge) and the
-    simulated time after the gust has passed (s)."""
+    simulated time after the gust has passed (s); with ``[gust.turbulence]`` also continuous
+    turbulence: RMS gust velocity sigma (m/s), scale length L (m, default 762 m = 2500 ft) and
+    spectrum ("von_karman" or "dryden")."""
 
     gradient_lengths: tuple[float, ...]
     design_velocity: float
@@ -244,6 +246,9 @@ class GustSpec:
     altitude: float = 0.0
     x0: float | None = None
     settle_time: float = 0.5
+    turbulence_sigma: float | None = None
+    scale_length: float = 762.0
+    spectrum: str = "von_karman"
 
 
 @dataclass(frozen=True)
@@ -872,11 +877,18 @@ def _gust(t: _Table | None, aero: AeroSpec, actuator: ActuatorSpec | None) -> Gu
                    low=MIN_ALTITUDE, low_open=False, high=MAX_ALTITUDE, unit="m")
     x0 = t.number("x0", low=-1e3, high=1e3, unit="m")
     settle = t.number("settle_time", default=0.5, low=0.0, high=60.0, unit="s")
+    turb = t.table("turbulence")
+    sigma, scale, spectrum = None, 762.0, "von_karman"
+    if turb is not None:
+        sigma = turb.number("sigma", required=True, low=0.0, high=100.0, unit="m/s")
+        scale = turb.number("scale_length", default=762.0, low=0.0, high=1e5, unit="m")
+        spectrum = turb.string("spectrum", ("von_karman", "dryden"), default="von_karman")
+        turb.done()
     t.done()
     if not aero.machs[0] <= mach <= aero.machs[-1]:
         raise CaseError(f"gust.mach must lie within aero.machs [{aero.machs[0]:g}, "
                         f"{aero.machs[-1]:g}], got {mach:g}")
-    return GustSpec(lengths, wds, mach, alt, x0, settle)
+    return GustSpec(lengths, wds, mach, alt, x0, settle, sigma, scale, spectrum)
 
 
 def case_from_dict(d: dict, source: str = "") -> Case:
