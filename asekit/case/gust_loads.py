@@ -18,8 +18,10 @@ each gust (:func:`~asekit.aeroelastic.gust.one_minus_cosine`) and the loads are 
 - hinge moment (N m): T_hinge@fin of the shaft (docs/conventions.md), the rigid pitch held
   at zero (a stiff actuator); None without a rigid pitch mode.
 
-The motor current in a gust needs the gust in the closed ASE loop, which is not built yet:
-``peak_current_A`` is reported as null (issue 27).
+- motor current (A): with ``[actuator]``, the gust in the closed AEM1 loop (motor-angle
+  feedback, :mod:`asekit.ase.gust`), linear: without the voltage and current limits, so a peak
+  above ``actuator.current_limit`` says the actuator would saturate. None without an actuator
+  (or when that loop is unstable).
 """
 
 from __future__ import annotations
@@ -40,8 +42,16 @@ from asekit.aeroelastic.gust import (
     spectral_statistics,
     turbulence_psd,
 )
+from asekit.ase.gust import closed_loop_gust, closed_loop_gust_response
 from asekit.atmosphere import standard_atmosphere
-from asekit.case.pipeline import box_mesh, mass_and_stiffness, modal_model, reduced_frequencies
+from asekit.case.pipeline import (
+    actuator_setup,
+    ase_condition,
+    box_mesh,
+    mass_and_stiffness,
+    modal_model,
+    reduced_frequencies,
+)
 from asekit.case.schema import Case, CaseError
 from asekit.rfa.gust import gust_fit
 from asekit.rfa.methods import rfa_kind
@@ -55,7 +65,8 @@ STEPS_PER_GRADIENT = 40
 class GustLoadCase:
     """One 1-cos gust's loads: ``gradient_length`` H (m), ``t`` (s), ``w_gust`` (m/s), and the
     histories ``hinge_moment`` (N m, None without a rigid mode), ``root_shear`` (N),
-    ``root_bending`` (N m), with their peaks (largest magnitude, signed)."""
+    ``root_bending`` (N m), ``current`` (A, the AEM1 loop's motor current; None without an
+    actuator), with their peaks (largest magnitude, signed)."""
 
     gradient_length: float
     t: np.ndarray
@@ -63,6 +74,7 @@ class GustLoadCase:
     hinge_moment: np.ndarray | None
     root_shear: np.ndarray
     root_bending: np.ndarray
+    current: np.ndarray | None = None
 
     @staticmethod
     def _peak(y) -> float | None:
@@ -71,6 +83,10 @@ class GustLoadCase:
     @property
     def peak_hinge_moment(self) -> float | None:
         return self._peak(self.hinge_moment)
+
+    @property
+    def peak_current(self) -> float | None:
+        return self._peak(self.current)
 
     @property
     def peak_root_shear(self) -> float:
@@ -122,6 +138,17 @@ def _inertial_rows(case: Case, modal, y_root: float) -> np.ndarray:
     return -(M @ u.T).T @ phi
 
 
+def _current_loop(case: Case, g, rfa, ss):
+    """The AEM1 loop with the gust (:func:`asekit.ase.gust.closed_loop_gust`) at the gust's
+    condition, with the same fit as ``ss``; None without an actuator or if it is unstable."""
+    if case.actuator is None:
+        return None
+    act, ctl, _ = actuator_setup(case)
+    cond = ase_condition(case, g.mach, g.altitude, actuator=act, fit=lambda *_: rfa)
+    loop = closed_loop_gust(cond.model, ctl, ss)
+    return loop if np.max(np.linalg.eigvals(loop.A).real) < 0 else None
+
+
 def gust_loads(case: Case) -> GustLoads | None:
     """The discrete-gust loads of ``case`` (module docstring); None without ``[gust]``.
 
@@ -162,6 +189,7 @@ def gust_loads(case: Case) -> GustLoads | None:
     rho, U = float(atm.density), g.mach * float(atm.speed_of_sound)
     ss = gust_state_space(modal, rfa, gfit, rho, U)
     inert = _inertial_rows(case, modal, y_root)
+    loop = _current_loop(case, g, rfa, ss)
     f_max = float(np.max(modal.frequencies_hz))
     out = []
     for H in g.gradient_lengths:
@@ -172,8 +200,9 @@ def gust_loads(case: Case) -> GustLoads | None:
         w = one_minus_cosine(t, U, H, g.design_velocity)
         resp = gust_response(ss, t, w)
         loads = load_histories(resp, lfit, inert, modal.n_rigid)
+        cur = None if loop is None else closed_loop_gust_response(loop, t, w)["current"]
         out.append(GustLoadCase(float(H), t, w[0], resp.hinge_moment if modal.n_rigid else None,
-                                loads[:, 0], loads[:, 1]))
+                                loads[:, 0], loads[:, 1], cur))
     errs = {"modal": float(rfa.fit_error), "gust": gfit.fit_error, "loads": lfit.fit_error}
     turb = None
     if g.turbulence_sigma is not None:
@@ -224,7 +253,7 @@ def gust_json(result: GustLoads | None) -> list:
     """The ``analyse --json`` ``"gust"`` rows: one per gradient distance, ``mach``,
     ``altitude_m``, ``gust_length_m`` (the gradient distance H), ``peak_hinge_moment_Nm``
     (null without a rigid mode), ``peak_root_bending_Nm``, ``peak_root_shear_N``,
-    ``peak_current_A`` (null: the gust is not yet in the closed ASE loop)."""
+    ``peak_current_A`` (the linear AEM1 loop's motor current; null without an actuator)."""
     if result is None:
         return []
     return [{"mach": result.mach, "altitude_m": result.altitude,
@@ -232,4 +261,4 @@ def gust_json(result: GustLoads | None) -> list:
              "peak_hinge_moment_Nm": c.peak_hinge_moment,
              "peak_root_bending_Nm": c.peak_root_bending,
              "peak_root_shear_N": c.peak_root_shear,
-             "peak_current_A": None} for c in result.cases]
+             "peak_current_A": c.peak_current} for c in result.cases]

@@ -60,7 +60,8 @@ UNITS = {
     "peak_hinge_moment_Nm": "N m (largest |T_hinge@fin|, signed; actuator clamped)",
     "peak_root_bending_Nm": "N m (largest |root bending moment|, signed; tip up > 0)",
     "peak_root_shear_N": "N (largest |root shear|, signed; up > 0)",
-    "peak_current_A": "A (null: the gust is not yet in the closed ASE loop)",
+    "peak_current_A": "A (motor current of the linear AEM1 loop, no power limits; null "
+                      "without an actuator)",
     "rms_hinge_moment_Nm": "N m (RMS in continuous turbulence)",
     "A_bar_hinge": "N m per m/s (RMS hinge moment / RMS gust velocity)",
     "N0_per_s": "1/s (zero up-crossings of the hinge moment per second)",
@@ -330,12 +331,13 @@ def _gust_lines(rows) -> list:
     if not rows:
         return []
     lines = ["", f"1-cos gusts at M {rows[0]['mach']:g}, {rows[0]['altitude_m']:g} m (peaks; "
-             "actuator clamped):", "  H (m)   hinge moment (N m)   root bending (N m)   "
-             "root shear (N)"]
+             "loads with the actuator clamped, current in the AEM1 loop):",
+             "  H (m)   hinge moment (N m)   root bending (N m)   root shear (N)   current (A)"]
     for r in rows:
         lines.append(f"  {r['gust_length_m']:<7g} {_cell(r['peak_hinge_moment_Nm']):>18}   "
                      f"{_cell(r['peak_root_bending_Nm']):>18}   "
-                     f"{_cell(r['peak_root_shear_N']):>14}")
+                     f"{_cell(r['peak_root_shear_N']):>14}   "
+                     f"{_cell(r['peak_current_A']):>11}")
     return lines
 
 
