@@ -173,3 +173,15 @@ def test_summary_lines(fin_gusts):
     assert _gust_lines([]) == []
     for key in gust_json(res)[0]:
         assert key in UNITS or key == "mach"
+
+
+def test_report_figure(fin_gusts):
+    import matplotlib.pyplot as plt
+
+    from asekit.case.report_figures import fig_gust_histories
+    case, res = fin_gusts
+    a = type("A", (), {"case": case, "gust": res})()
+    f = fig_gust_histories(a)
+    assert len(f.figure.axes) == 3 and "largest hinge moment" in f.alt
+    assert f.section == "Gust loads"
+    plt.close(f.figure)
