@@ -56,9 +56,11 @@ from asekit.case.schema import Case, CaseError
 from asekit.rfa.gust import gust_fit
 from asekit.rfa.methods import rfa_kind
 
-#: Time steps per gust gradient time H / U in the simulation (and at least this many over
-#: the shortest period of the model's elastic modes).
+#: Time steps per gust gradient time H / U in the simulation.
 STEPS_PER_GRADIENT = 40
+#: Time steps per period of the model's highest mode (the first-order hold is exact for the
+#: piecewise-linear gust; this resolves the output's peaks).
+STEPS_PER_PERIOD = 20
 
 
 @dataclass(frozen=True)
@@ -194,7 +196,7 @@ def gust_loads(case: Case) -> GustLoads | None:
     out = []
     for H in g.gradient_lengths:
         t_end = 2 * H / U + g.settle_time
-        dt = min(H / U / STEPS_PER_GRADIENT, 1.0 / (STEPS_PER_GRADIENT * max(f_max, 1e-9)))
+        dt = min(H / U / STEPS_PER_GRADIENT, 1.0 / (STEPS_PER_PERIOD * max(f_max, 1e-9)))
         nt = min(int(math.ceil(t_end / dt)) + 1, 200001)
         t = np.linspace(0.0, t_end, nt)
         w = one_minus_cosine(t, U, H, g.design_velocity)
