@@ -490,3 +490,49 @@ def spectral_statistics(omega, transfer, psd) -> dict:
     rms = math.sqrt(m0)
     return {"rms": rms, "A_bar": rms / sig_w if sig_w > 0 else float("nan"),
             "N0_per_s": math.sqrt(m2 / m0) / (2 * np.pi) if m0 > 0 else float("nan")}
+
+
+def dryden_realisation(t, velocity: float, scale_length: float, sigma: float,
+                       seed: int | None = 0) -> np.ndarray:
+    """A time-domain realisation of Dryden vertical turbulence by its shaping filter, with a
+    seed (MIL-F-8785C; Hoblit 1988, Sec. 2.6):
+
+        H(s) = sigma sqrt(L / U) (1 + sqrt(3) tau s) / (1 + tau s)^2,   tau = L / U,
+
+    driven by white noise of unit intensity (two-sided PSD 1 / (2 pi)), so that the output's
+    one-sided PSD is :func:`turbulence_psd` (``spectrum="dryden"``). The noise is held over each
+    step (variance 1 / dt) and the filter discretised exactly for it (zero-order hold); the
+    derivatives are the numerical ones of the samples (``numpy.gradient``), as the gust state
+    space's inputs need them.
+
+    Parameters
+    ----------
+    t : (n_t,) uniformly spaced times (s), dt well below tau; velocity : U (m/s) > 0;
+    scale_length : L (m) > 0; sigma : RMS gust velocity (m/s) > 0; seed : the random seed.
+
+    Returns
+    -------
+    (3, n_t) w_g (m/s), w_g' (m/s^2), w_g'' (m/s^3).
+
+    Examples
+    --------
+    >>> w = dryden_realisation(np.linspace(0, 10, 1001), 100.0, 50.0, 2.0, seed=1)
+    >>> w.shape
+    (3, 1001)
+    """
+    from scipy.signal import cont2discrete, lfilter
+
+    tt = finite_array("t", t).ravel()
+    steps = np.diff(tt)
+    if tt.size < 3 or np.any(steps <= 0) or not np.allclose(steps, steps[0], rtol=1e-9):
+        raise ValueError("t must hold >= 3 uniformly spaced ascending times (s)")
+    U, L, s = positive("velocity", velocity), positive("scale_length", scale_length), \
+        positive("sigma", sigma)
+    dt, tau = float(steps[0]), L / U
+    num = s * math.sqrt(tau) * np.array([math.sqrt(3.0) * tau, 1.0])
+    den = np.array([tau ** 2, 2 * tau, 1.0])
+    numd, dend, _ = cont2discrete((num, den), dt, method="zoh")
+    noise = np.random.default_rng(seed).standard_normal(tt.size) / math.sqrt(dt)
+    w = lfilter(np.ravel(numd), dend, noise)
+    wd = np.gradient(w, dt)
+    return np.vstack([w, wd, np.gradient(wd, dt)])

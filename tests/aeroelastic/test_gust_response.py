@@ -188,3 +188,25 @@ def test_plunging_section_in_von_karman_turbulence():
     assert got["A_bar"] == pytest.approx(ref["A_bar"], rel=0.03)
     assert got["N0_per_s"] == pytest.approx(ref["N0_per_s"], rel=0.03)
     assert 0.3 < ref["N0_per_s"] < 3.0          # below the 3 Hz plunge: low-frequency gusts
+
+
+def test_dryden_realisation_has_the_dryden_spectrum():
+    # the shaping filter's output (seed 3, 20000 tau long) has the variance sigma^2 (standard
+    # error of the estimate about 1 % for this length) and, by Welch's method averaged over
+    # bands around the knee U / L, the Dryden PSD (MIL-F-8785C; Hoblit 1988). Measured:
+    # variance +0.3 %, band means -3.8 % (0.2-0.4 rad/s), -3.9 % (0.8-1.2), +1.1 % (2.5-3.5);
+    # single Welch bins scatter by about 9 % (120 segments), hence the band means.
+    from scipy.signal import welch
+
+    from asekit.aeroelastic.gust import dryden_realisation, turbulence_psd
+    U, L, sigma, dt = 100.0, 100.0, 2.0, 0.01
+    t = np.arange(0.0, 20000.0, dt)
+    w = dryden_realisation(t, U, L, sigma, seed=3)[0]
+    assert np.var(w) == pytest.approx(sigma ** 2, rel=0.05)
+    f, p = welch(w, fs=1 / dt, nperseg=2 ** 14)
+    omega, psd = 2 * np.pi * f, p / (2 * np.pi)              # one-sided per rad/s
+    for lo, hi in ((0.2, 0.4), (0.8, 1.2), (2.5, 3.5)):
+        band = (omega >= lo) & (omega <= hi)
+        ratio = np.mean(psd[band] / turbulence_psd(omega[band], U, L, sigma, "dryden"))
+        assert ratio == pytest.approx(1.0, abs=0.1), (lo, hi, ratio)
+    assert np.array_equal(w, dryden_realisation(t, U, L, sigma, seed=3)[0])     # seeded
