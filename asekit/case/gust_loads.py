@@ -166,7 +166,7 @@ def gust_loads(case: Case) -> GustLoads | None:
     ------
     CaseError
         The case is an imported deck (no plate mesh for the inertial loads) or has no
-        aerodynamics.
+        aerodynamics, or the aeroelastic system is unstable at the gust's condition.
     """
     g = case.gust
     if g is None:
@@ -190,6 +190,12 @@ def gust_loads(case: Case) -> GustLoads | None:
     atm = standard_atmosphere(g.altitude)
     rho, U = float(atm.density), g.mach * float(atm.speed_of_sound)
     ss = gust_state_space(modal, rfa, gfit, rho, U)
+    growth = float(np.max(np.linalg.eigvals(ss.A).real))
+    if growth >= 0:
+        raise CaseError(f"gust.mach = {g.mach:g}, gust.altitude = {g.altitude:g} m: the "
+                        f"aeroelastic system (actuator clamped) is unstable there (largest "
+                        f"Re pole {growth:.3g} 1/s: beyond flutter or divergence), so its gust "
+                        f"loads are unbounded; choose a stable flight condition")
     inert = _inertial_rows(case, modal, y_root)
     loop = _current_loop(case, g, rfa, ss)
     f_max = float(np.max(modal.frequencies_hz))

@@ -185,3 +185,19 @@ def test_report_figure(fin_gusts):
     assert len(f.figure.axes) == 3 and "largest hinge moment" in f.alt
     assert f.section == "Gust loads"
     plt.close(f.figure)
+
+
+def test_unstable_condition_is_refused():
+    # AGARD 445.6 (weakened, clamped) at M 0.499 and 3000 m (q = 12 kPa) is beyond its flutter
+    # dynamic pressure: the time response would grow without bound, so the gust analysis
+    # refuses the condition naming the keys, instead of reporting a meaningless peak
+    from asekit.case import load_case
+    from asekit.util.paths import CASES_DIR
+    c = load_case(CASES_DIR / "agard445_6.toml")
+    c = dataclasses.replace(c, gust=GustSpec((1.0,), 10.0, 0.499, 3000.0))
+    with pytest.raises(CaseError, match="gust.mach = 0.499, gust.altitude = 3000 m: the "
+                                        "aeroelastic system"):
+        gust_loads(c)
+    ok = gust_loads(dataclasses.replace(c, gust=GustSpec((1.0,), 10.0, 0.499, 10000.0)))
+    assert ok.cases[0].hinge_moment is None and ok.cases[0].current is None     # no shaft
+    assert gust_json(ok)[0]["peak_hinge_moment_Nm"] is None
