@@ -5,6 +5,7 @@
 - :mod:`asekit.aero.dlm`: subsonic doublet-lattice method (parabolic and quartic kernels).
 - :mod:`asekit.aero.spline`: structure -> aero interpolation and the force transpose.
 - :mod:`asekit.aero.gaf`: generalised aerodynamic forces and the fin's cached GAF database.
+- :mod:`asekit.aero.gust`: the gust normalwash and the gust GAF column Q_hg(M, k).
 
 Conventions: x downstream, y span, z up; e^{i omega t}; k = omega b / U with the reference
 semi-chord b stated by the caller (the fin: root semi-chord 0.078 m); Delta Cp > 0 pushes a box

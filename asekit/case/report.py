@@ -27,6 +27,7 @@ from pathlib import Path
 
 from asekit.case import pipeline as P
 from asekit.case import report_figures as RF
+from asekit.case.gust_loads import gust_json, gust_loads, turbulence_json
 from asekit.case.schema import Case
 from asekit.util.conventions import mode_label, mode_number
 from asekit.util.plotting import save_figure
@@ -55,13 +56,27 @@ UNITS = {
     "settling_s": "s", "steady_error_pct": "%", "corner_overshoot_pct": "%",
     "fwtf_phase_margin_deg": "deg",
     "seconds": "s (wall-clock time per step)",
+    "gust_length_m": "m (the 1-cos gust's gradient distance H; the gust is 2 H long)",
+    "peak_hinge_moment_Nm": "N m (largest |T_hinge@fin|, signed; actuator clamped)",
+    "peak_root_bending_Nm": "N m (largest |root bending moment|, signed; tip up > 0)",
+    "peak_root_shear_N": "N (largest |root shear|, signed; up > 0)",
+    "peak_current_A": "A (motor current of the linear AEM1 loop, no power limits; null "
+                      "without an actuator)",
+    "rms_hinge_moment_Nm": "N m (RMS in continuous turbulence)",
+    "A_bar_hinge": "N m per m/s (RMS hinge moment / RMS gust velocity)",
+    "N0_per_s": "1/s (zero up-crossings of the hinge moment per second)",
+    "rms_root_bending_Nm": "N m (RMS in continuous turbulence)",
+    "A_bar_root_bending": "N m per m/s (RMS root bending / RMS gust velocity)",
+    "N0_root_bending_per_s": "1/s (zero up-crossings of the root bending per second)",
+    "omega_max": "rad/s (upper end of the turbulence integrals: k_max U / b)",
 }
 
 
 @dataclass(frozen=True)
 class Analysis:
     """Everything one ``analyse`` run computed: the case, its modal model, GAF database,
-    flutter analysis, ASE result (None without an actuator) and step timings (s)."""
+    flutter analysis, ASE result (None without an actuator), step timings (s) and the
+    discrete-gust loads (:class:`asekit.case.gust_loads.GustLoads`; None without ``[gust]``)."""
 
     case: Case
     modal: object
@@ -69,6 +84,7 @@ class Analysis:
     flutter: object
     ase: object
     seconds: dict
+    gust: object = None
 
 
 @contextlib.contextmanager
@@ -106,7 +122,13 @@ def run_analysis(case: Case, progress: bool = False) -> Analysis:
         ase = P.ase(case, db=db)
     if ase is not None:
         sec["ase"] = time.perf_counter() - t
-    return Analysis(case, modal, db, fa, ase, sec)
+    gust = None
+    if case.gust is not None:
+        t = time.perf_counter()
+        with _stage("gust loads", progress):
+            gust = gust_loads(case)
+        sec["gust"] = time.perf_counter() - t
+    return Analysis(case, modal, db, fa, ase, sec, gust)
 
 
 def _f(v):
@@ -161,6 +183,10 @@ def summary(a: Analysis) -> dict:
                                                for k, v in s.corner_overshoot.items()},
                       "fwtf_phase_margin_deg": {str(i): _f(x.phase_margin_deg)
                                                 for i, x in s.crossovers.items()}}
+    if a.gust is not None:
+        out["gust"] = gust_json(a.gust)
+        if a.gust.turbulence is not None:
+            out["turbulence"] = turbulence_json(a.gust)
     out["critical"] = critical_condition(out)
     return out
 
@@ -300,6 +326,33 @@ def _margin_text(m: dict) -> str:
     return "-" + (f" ({m['note']})" if m.get("note") else "")
 
 
+def _gust_lines(rows) -> list:
+    """The summary's lines of the ``"gust"`` rows (none without them)."""
+    if not rows:
+        return []
+    lines = ["", f"1-cos gusts at M {rows[0]['mach']:g}, {rows[0]['altitude_m']:g} m (peaks; "
+             "loads with the actuator clamped, current in the AEM1 loop):",
+             "  H (m)   hinge moment (N m)   root bending (N m)   root shear (N)   current (A)"]
+    for r in rows:
+        lines.append(f"  {r['gust_length_m']:<7g} {_cell(r['peak_hinge_moment_Nm']):>18}   "
+                     f"{_cell(r['peak_root_bending_Nm']):>18}   "
+                     f"{_cell(r['peak_root_shear_N']):>14}   "
+                     f"{_cell(r['peak_current_A']):>11}")
+    return lines
+
+
+def _turbulence_lines(rows) -> list:
+    """The summary's line of the ``"turbulence"`` rows (none without them)."""
+    out = []
+    for r in rows or []:
+        out.append(f"turbulence at M {r['mach']:g}, {r['altitude_m']:g} m: hinge moment RMS "
+                   f"{_cell(r['rms_hinge_moment_Nm'])} N m (A-bar {_cell(r['A_bar_hinge'])}, "
+                   f"N0 {_cell(r['N0_per_s'])} /s); root bending RMS "
+                   f"{_cell(r['rms_root_bending_Nm'])} N m (A-bar "
+                   f"{_cell(r['A_bar_root_bending'])}, N0 {_cell(r['N0_root_bending_per_s'])} /s)")
+    return out
+
+
 def format_summary(s: dict, width: int = 100) -> str:
     """A plain-text summary of :func:`summary` that fits ``width`` columns."""
     lines = textwrap.wrap(f"case {s['case']}" + (f"  ({s['reference']})" if s.get("reference")
@@ -357,6 +410,7 @@ def format_summary(s: dict, width: int = 100) -> str:
                 + f", final error {_cell(a['steady_error_pct'][t], '{:.2f}')} %; corner "
                 f"overshoot {min(ov.values()):.0f}-{max(ov.values()):.0f} %", width,
                 initial_indent="  ", subsequent_indent="    ")
+    lines += _gust_lines(s.get("gust")) + _turbulence_lines(s.get("turbulence"))
     for n in s["notes"]:
         lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")

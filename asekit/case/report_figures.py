@@ -33,7 +33,7 @@ from asekit.util.plotting import new_figure, plot_vg
 
 #: Report sections, in page order.
 SECTIONS = ("Flutter and divergence against Mach", "V-g, V-f and root locus at each Mach",
-            "Structure: planform and mode shapes", "Aeroservoelastic loop")
+            "Structure: planform and mode shapes", "Aeroservoelastic loop", "Gust loads")
 
 #: The g axis of the V-g panels (-): wide enough for the crossings, narrow enough to read them.
 G_LIMITS = (-0.5, 0.3)
@@ -489,6 +489,38 @@ def fig_ase_steps(a) -> ReportFigure:
     return ReportFigure(fig, alt, SECTIONS[3])
 
 
+def fig_gust_histories(a) -> ReportFigure:
+    """Hinge moment, root bending moment and (with an actuator) motor current against time in
+    each 1-cos gust of ``[gust]`` (:mod:`asekit.case.gust_loads`)."""
+    g = a.gust
+    rows = [("root_bending", "root bending (N m)")]
+    if g.cases[0].hinge_moment is not None:
+        rows.insert(0, ("hinge_moment", "hinge moment (N m)"))
+    if g.cases[0].current is not None:
+        rows.append(("current", "motor current (A)"))
+    fig, axes = new_figure(f"{a.case.name}: 1-cos gusts, U_ds {g.design_velocity:g} m/s at "
+                           f"M {g.mach:g}, {g.altitude:g} m", nrows=len(rows),
+                           figsize=(7.0, 2.2 * len(rows) + 0.8), layout="constrained",
+                           sharex=True)
+    axes = np.atleast_1d(axes)
+    for c in g.cases:
+        for ax, (name, _) in zip(axes, rows):
+            ax.plot(c.t * 1e3, getattr(c, name), label=f"H = {c.gradient_length:g} m")
+    for ax, (_, label) in zip(axes, rows):
+        ax.set_ylabel(label)
+    axes[-1].set_xlabel("time (ms)")
+    axes[0].legend(fontsize="small")
+    tuned = g.tuned("root_bending")
+    lengths = ", ".join(f"{c.gradient_length:g}" for c in g.cases)
+    alt = (f"Loads in 1-cos gusts of gradient distance {lengths} m; the largest root bending "
+           f"{tuned.peak_root_bending:.3g} N m at H = {tuned.gradient_length:g} m")
+    if tuned.peak_hinge_moment is not None:
+        h = g.tuned("hinge_moment")
+        alt += (f"; the largest hinge moment {h.peak_hinge_moment:.3g} N m at H = "
+                f"{h.gradient_length:g} m")
+    return ReportFigure(fig, alt, SECTIONS[4])
+
+
 def figures(a) -> dict:
     """{file name: :class:`ReportFigure`} of the report, in page order: the Mach figure, V-g /
     V-f and root locus at every analysed Mach, the planform and mode shapes, and with an
@@ -502,4 +534,6 @@ def figures(a) -> dict:
     if a.ase is not None:
         out["ase_bode"] = fig_ase_bode(a)
         out["ase_steps"] = fig_ase_steps(a)
+    if getattr(a, "gust", None) is not None:
+        out["gust_histories"] = fig_gust_histories(a)
     return out

@@ -231,6 +231,27 @@ class ActuatorSpec:
 
 
 @dataclass(frozen=True)
+class GustSpec:
+    """Discrete 1-cos gusts (issue 27, :mod:`asekit.case.gust_loads`): gradient distances H (m;
+    each gust 2 H long), the design gust velocity U_ds (m/s, true airspeed, upward), the flight
+    condition (Mach, altitude in m; default the actuator's, else the first of aero.machs at
+    0 m), the gust reference station x0 (m; default the most upstream leading edge) and the
+    simulated time after the gust has passed (s); with ``[gust.turbulence]`` also continuous
+    turbulence: RMS gust velocity sigma (m/s), scale length L (m, default 762 m = 2500 ft) and
+    spectrum ("von_karman" or "dryden")."""
+
+    gradient_lengths: tuple[float, ...]
+    design_velocity: float
+    mach: float
+    altitude: float = 0.0
+    x0: float | None = None
+    settle_time: float = 0.5
+    turbulence_sigma: float | None = None
+    scale_length: float = 762.0
+    spectrum: str = "von_karman"
+
+
+@dataclass(frozen=True)
 class FlutterIndexSpec:
     """Normalisation of the flutter speed as a flutter speed index
     FSI = U_f / (b_s omega_alpha sqrt(mu)) (Yates 1987): ``semichord`` b_s (m), ``f_alpha``
@@ -293,6 +314,7 @@ class Case:
     flutter_index: FlutterIndexSpec | None = None
     flutter: FlutterSpec = FlutterSpec()
     convergence: ConvergenceSpec = ConvergenceSpec()
+    gust: GustSpec | None = None
     reference: str = ""
     source: str = field(default="", compare=False)
     structure: ImportedModel | None = None
@@ -317,6 +339,8 @@ class Case:
             d.pop(k)                                               # studied, not what it is)
         if self.structure is not None:      # (absent otherwise: the file cases' digests stay)
             d["structure"] = self.structure.digest
+        if self.gust is None:               # (absent: the digests of cases without gusts stay)
+            d.pop("gust")
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
 
 
@@ -839,6 +863,34 @@ def _convergence(t: _Table | None) -> ConvergenceSpec:
     return spec
 
 
+def _gust(t: _Table | None, aero: AeroSpec, actuator: ActuatorSpec | None) -> GustSpec | None:
+    if t is None:
+        return None
+    lengths = t.numbers("gradient_lengths", required=True, low=0.0, high=1000.0, unit="m",
+                        ascending=True)
+    if len(lengths) > 50:
+        raise CaseError(f"gust.gradient_lengths must hold at most 50 values, got {len(lengths)}")
+    wds = t.number("design_velocity", required=True, low=0.0, high=100.0, unit="m/s")
+    mach = t.number("mach", default=actuator.mach if actuator is not None else aero.machs[0],
+                    low=0.0, low_open=False)
+    alt = t.number("altitude", default=actuator.altitude if actuator is not None else 0.0,
+                   low=MIN_ALTITUDE, low_open=False, high=MAX_ALTITUDE, unit="m")
+    x0 = t.number("x0", low=-1e3, high=1e3, unit="m")
+    settle = t.number("settle_time", default=0.5, low=0.0, high=60.0, unit="s")
+    turb = t.table("turbulence")
+    sigma, scale, spectrum = None, 762.0, "von_karman"
+    if turb is not None:
+        sigma = turb.number("sigma", required=True, low=0.0, high=100.0, unit="m/s")
+        scale = turb.number("scale_length", default=762.0, low=0.0, high=1e5, unit="m")
+        spectrum = turb.string("spectrum", ("von_karman", "dryden"), default="von_karman")
+        turb.done()
+    t.done()
+    if not aero.machs[0] <= mach <= aero.machs[-1]:
+        raise CaseError(f"gust.mach must lie within aero.machs [{aero.machs[0]:g}, "
+                        f"{aero.machs[-1]:g}], got {mach:g}")
+    return GustSpec(lengths, wds, mach, alt, x0, settle, sigma, scale, spectrum)
+
+
 def case_from_dict(d: dict, source: str = "") -> Case:
     """Build and check a :class:`Case` from the parsed TOML dictionary ``d``."""
     top = _Table(d, "")
@@ -865,6 +917,7 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     actuator = _actuator(top.table("actuator"))
     flutter = _flutter(top.table("flutter"))
     convergence = _convergence(top.table("convergence"))
+    gust = _gust(top.table("gust"), aero, actuator)
     fsi = top.table("flutter_speed_index")
     if fsi is not None:
         fsi_spec = FlutterIndexSpec(fsi.number("semichord", required=True, low=0.0, unit="m"),
@@ -884,7 +937,8 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     return Case(name=name, panels=panels, thickness=thickness, material=material,
                 support=support, aero=aero, flight=flight, modes=modes, damping=damping,
                 point_masses=masses, actuator=actuator, flutter_index=fsi_spec,
-                flutter=flutter, convergence=convergence, reference=reference, source=source)
+                flutter=flutter, convergence=convergence, gust=gust, reference=reference,
+                source=source)
 
 
 def load_case(path) -> Case:

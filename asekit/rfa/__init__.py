@@ -8,6 +8,9 @@ A0, A1, A2 in front, ``lag_realization()``, ``fit_error``, ``b_ref``):
 * :mod:`asekit.rfa.minimum_state` -- the minimum-state fit of Karpel (1982) by the iterative
   least squares of Tiffany & Adams (1988), n_L lag states shared by all elements.
 
+The gust column Q_hg of :mod:`asekit.aero.gust` has its own Roger fit, :mod:`asekit.rfa.gust`
+(one lag state per lag root, shared by the modes; :mod:`asekit.aeroelastic.gust` uses it).
+
 The aeroelastic state space (:mod:`asekit.aeroelastic.statespace`), the root locus and the ASE loop take
 either.
 """

@@ -1,0 +1,272 @@
+"""Discrete-gust loads of a case (issue 27): the ``[gust]`` table's 1-cos gusts over their
+gradient distances, with the hinge moment (actuator clamped), root shear and root bending
+moment by force summation, and their peaks (the "tuned" gust: the worst over the lengths).
+
+For the case's flight condition (``gust.mach``, ``gust.altitude``; 1976 standard atmosphere,
+U = M a): one pressure solve per reduced frequency gives the modal GAFs, the gust column and
+the aerodynamic load rows (:func:`asekit.aero.gust.gust_aero_tables`, gust referred to
+``gust.x0``, default the most upstream leading edge); each is fitted in Roger form with the
+modal fit's lag roots (:mod:`asekit.rfa.gust`; the modal fit is the case's ``flutter.rfa``);
+the gust state space (:func:`asekit.aeroelastic.gust.gust_state_space`) is integrated through
+each gust (:func:`~asekit.aeroelastic.gust.one_minus_cosine`) and the loads are summed
+(:func:`~asekit.aeroelastic.gust.load_histories`):
+
+- root shear (N): the sum of the normal forces on the surface, aerodynamic + inertial
+  (-u^T M Phi zeta'' with u the unit translation w = 1);
+- root bending moment (N m): their moment about the root chord line y = y_root, positive when
+  an upward load bends the tip up (u: w = y - y_root, theta_x = 1);
+- hinge moment (N m): T_hinge@fin of the shaft (docs/conventions.md), the rigid pitch held
+  at zero (a stiff actuator); None without a rigid pitch mode.
+
+- motor current (A): with ``[actuator]``, the gust in the closed AEM1 loop (motor-angle
+  feedback, :mod:`asekit.ase.gust`), linear: without the voltage and current limits, so a peak
+  above ``actuator.current_limit`` says the actuator would saturate. None without an actuator
+  (or when that loop is unstable).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from asekit.aero.gust import gust_aero_tables
+from asekit.aero.spline import fe_spline
+from asekit.aeroelastic.gust import (
+    gust_frequency_response,
+    gust_response,
+    gust_state_space,
+    load_histories,
+    one_minus_cosine,
+    spectral_statistics,
+    turbulence_psd,
+)
+from asekit.ase.gust import closed_loop_gust, closed_loop_gust_response
+from asekit.atmosphere import standard_atmosphere
+from asekit.case.pipeline import (
+    actuator_setup,
+    ase_condition,
+    box_mesh,
+    mass_and_stiffness,
+    modal_model,
+    reduced_frequencies,
+)
+from asekit.case.schema import Case, CaseError
+from asekit.rfa.gust import gust_fit
+from asekit.rfa.methods import rfa_kind
+
+#: Time steps per gust gradient time H / U in the simulation.
+STEPS_PER_GRADIENT = 40
+#: Time steps per period of the model's highest mode (the first-order hold is exact for the
+#: piecewise-linear gust; this resolves the output's peaks).
+STEPS_PER_PERIOD = 20
+
+
+@dataclass(frozen=True)
+class GustLoadCase:
+    """One 1-cos gust's loads: ``gradient_length`` H (m), ``t`` (s), ``w_gust`` (m/s), and the
+    histories ``hinge_moment`` (N m, None without a rigid mode), ``root_shear`` (N),
+    ``root_bending`` (N m), ``current`` (A, the AEM1 loop's motor current; None without an
+    actuator), with their peaks (largest magnitude, signed)."""
+
+    gradient_length: float
+    t: np.ndarray
+    w_gust: np.ndarray
+    hinge_moment: np.ndarray | None
+    root_shear: np.ndarray
+    root_bending: np.ndarray
+    current: np.ndarray | None = None
+
+    @staticmethod
+    def _peak(y) -> float | None:
+        return None if y is None else float(y[int(np.argmax(np.abs(y)))])
+
+    @property
+    def peak_hinge_moment(self) -> float | None:
+        return self._peak(self.hinge_moment)
+
+    @property
+    def peak_current(self) -> float | None:
+        return self._peak(self.current)
+
+    @property
+    def peak_root_shear(self) -> float:
+        return self._peak(self.root_shear)
+
+    @property
+    def peak_root_bending(self) -> float:
+        return self._peak(self.root_bending)
+
+
+@dataclass(frozen=True)
+class GustLoads:
+    """The ``[gust]`` analysis: flight condition (``mach``, ``altitude`` m, ``velocity`` m/s,
+    ``density`` kg/m^3), ``design_velocity`` (m/s), ``x0`` (m), one :class:`GustLoadCase` per
+    gradient distance, the Roger fits' errors (``fit_errors``: modal, gust, loads) and, with
+    ``[gust.turbulence]``, ``turbulence``: {"hinge_moment", "root_shear", "root_bending"} ->
+    :func:`asekit.aeroelastic.gust.spectral_statistics` (rms, A_bar, N0_per_s), plus
+    ``omega_max`` (rad/s, the integration's upper end: k_max U / b, the fits' range)."""
+
+    mach: float
+    altitude: float
+    velocity: float
+    density: float
+    design_velocity: float
+    x0: float
+    cases: tuple
+    fit_errors: dict
+    turbulence: dict | None = None
+
+    def tuned(self, which: str = "root_bending") -> GustLoadCase:
+        """The gust of the largest peak ``which`` ("root_bending", "root_shear",
+        "hinge_moment")."""
+        return max(self.cases, key=lambda c: abs(getattr(c, f"peak_{which}") or 0.0))
+
+
+def _load_weights(boxes, y_root: float) -> np.ndarray:
+    return np.column_stack([np.ones(boxes.n), boxes.load_point[:, 1] - y_root])
+
+
+def _inertial_rows(case: Case, modal, y_root: float) -> np.ndarray:
+    _, M = mass_and_stiffness(case)
+    nodes = modal.nodes
+    n = nodes.shape[0]
+    u = np.zeros((2, 3 * n))
+    u[0, 0::3] = 1.0                                    # unit translation w = 1
+    u[1, 0::3] = nodes[:, 1] - y_root                  # rotation about the root line:
+    u[1, 1::3] = 1.0                                    # w = y - y_root, theta_x = dw/dy = 1
+    phi = modal.shapes.reshape(3 * n, -1)[:, modal.n_rigid:]
+    return -(M @ u.T).T @ phi
+
+
+def _current_loop(case: Case, g, rfa, ss):
+    """The AEM1 loop with the gust (:func:`asekit.ase.gust.closed_loop_gust`) at the gust's
+    condition, with the same fit as ``ss``; None without an actuator or if it is unstable."""
+    if case.actuator is None:
+        return None
+    act, ctl, _ = actuator_setup(case)
+    cond = ase_condition(case, g.mach, g.altitude, actuator=act, fit=lambda *_: rfa)
+    loop = closed_loop_gust(cond.model, ctl, ss)
+    return loop if np.max(np.linalg.eigvals(loop.A).real) < 0 else None
+
+
+def gust_loads(case: Case) -> GustLoads | None:
+    """The discrete-gust loads of ``case`` (module docstring); None without ``[gust]``.
+
+    Parameters
+    ----------
+    case : Case with a ``[gust]`` table (:class:`asekit.case.schema.GustSpec`).
+
+    Returns
+    -------
+    GustLoads or None
+
+    Raises
+    ------
+    CaseError
+        The case is an imported deck (no plate mesh for the inertial loads) or has no
+        aerodynamics, or the aeroelastic system is unstable at the gust's condition.
+    """
+    g = case.gust
+    if g is None:
+        return None
+    if case.structure is not None or case.aero is None:
+        raise CaseError("gust: discrete-gust loads need a case-file surface with [aero] "
+                        "(imported decks are not supported yet)")
+    modal, boxes, a = modal_model(case), box_mesh(case), case.aero
+    b = a.reference_semichord
+    y_root = float(np.min(boxes.corners[:, :, 1]))
+    x0 = float(np.min(boxes.corners[:, :, 0])) if g.x0 is None else g.x0
+    ks = reduced_frequencies(case)
+    method = a.kernel if a.method == "dlm" else a.method
+    tab = gust_aero_tables(fe_spline(modal, boxes), boxes, g.mach, ks, b,
+                           _load_weights(boxes, y_root), x0, method, a.symmetry == "wall")
+    rfa = rfa_kind(case.flutter.rfa).fit(ks, tab.Q, b, g.mach, case.flutter.lags)
+    gfit = gust_fit(ks, tab.Qg, b, lag_roots=rfa.lag_roots, mach=g.mach)
+    nk, nl, n = tab.QL.shape
+    lfit = gust_fit(ks, np.hstack([tab.QL.reshape(nk, nl * n), tab.QLg]), b,
+                    lag_roots=rfa.lag_roots, mach=g.mach)
+    atm = standard_atmosphere(g.altitude)
+    rho, U = float(atm.density), g.mach * float(atm.speed_of_sound)
+    ss = gust_state_space(modal, rfa, gfit, rho, U)
+    growth = float(np.max(np.linalg.eigvals(ss.A).real))
+    if growth >= 0:
+        raise CaseError(f"gust.mach = {g.mach:g}, gust.altitude = {g.altitude:g} m: the "
+                        f"aeroelastic system (actuator clamped) is unstable there (largest "
+                        f"Re pole {growth:.3g} 1/s: beyond flutter or divergence), so its gust "
+                        f"loads are unbounded; choose a stable flight condition")
+    inert = _inertial_rows(case, modal, y_root)
+    loop = _current_loop(case, g, rfa, ss)
+    f_max = float(np.max(modal.frequencies_hz))
+    out = []
+    for H in g.gradient_lengths:
+        t_end = 2 * H / U + g.settle_time
+        dt = min(H / U / STEPS_PER_GRADIENT, 1.0 / (STEPS_PER_PERIOD * max(f_max, 1e-9)))
+        nt = min(int(math.ceil(t_end / dt)) + 1, 200001)
+        t = np.linspace(0.0, t_end, nt)
+        w = one_minus_cosine(t, U, H, g.design_velocity)
+        resp = gust_response(ss, t, w)
+        loads = load_histories(resp, lfit, inert, modal.n_rigid)
+        cur = None if loop is None else closed_loop_gust_response(loop, t, w)["current"]
+        out.append(GustLoadCase(float(H), t, w[0], resp.hinge_moment if modal.n_rigid else None,
+                                loads[:, 0], loads[:, 1], cur))
+    errs = {"modal": float(rfa.fit_error), "gust": gfit.fit_error, "loads": lfit.fit_error}
+    turb = None
+    if g.turbulence_sigma is not None:
+        turb = _turbulence(ss, lfit, inert, modal.n_rigid, g, float(np.max(ks)) * U / b)
+    return GustLoads(g.mach, g.altitude, U, rho, g.design_velocity, x0, tuple(out), errs, turb)
+
+
+#: Frequencies of the turbulence integrals: 0, then geometric from 1e-3 U / L (well inside
+#: the spectrum's knee U / (1.339 L)) to k_max U / b.
+TURBULENCE_POINTS = 4000
+
+
+def _turbulence(ss, lfit, inert, n_rigid, g, omega_max: float) -> dict:
+    """RMS, A-bar, N0 of the loads in continuous turbulence (module docstring)."""
+    w0 = min(1e-3 * ss.velocity / g.scale_length, 1e-6 * omega_max)
+    w = np.concatenate([[0.0], np.geomspace(w0, omega_max, TURBULENCE_POINTS)])
+    fr = gust_frequency_response(ss, w, lfit, inert, n_rigid)
+    psd = turbulence_psd(w, ss.velocity, g.scale_length, g.turbulence_sigma, g.spectrum)
+    out = {"omega_max": omega_max}
+    if "hinge_moment" in fr:
+        out["hinge_moment"] = spectral_statistics(w, fr["hinge_moment"], psd)
+    out["root_shear"] = spectral_statistics(w, fr["loads"][:, 0], psd)
+    out["root_bending"] = spectral_statistics(w, fr["loads"][:, 1], psd)
+    return out
+
+
+def turbulence_json(result: GustLoads | None) -> list:
+    """The ``analyse --json`` ``"turbulence"`` rows (one per flight condition): ``mach``,
+    ``altitude_m``, ``rms_hinge_moment_Nm``, ``A_bar_hinge`` (N m per m/s), ``N0_per_s`` (of
+    the hinge moment; null without a rigid mode), ``rms_root_bending_Nm``,
+    ``A_bar_root_bending`` (N m per m/s), ``N0_root_bending_per_s``, ``sigma_ms``,
+    ``scale_length_m``, ``spectrum``, ``omega_max`` (rad/s)."""
+    if result is None or result.turbulence is None:
+        return []
+    t = result.turbulence
+    h = t.get("hinge_moment")
+    bend = t["root_bending"]
+    g = {"mach": result.mach, "altitude_m": result.altitude,
+         "rms_hinge_moment_Nm": None if h is None else h["rms"],
+         "A_bar_hinge": None if h is None else h["A_bar"],
+         "N0_per_s": None if h is None else h["N0_per_s"],
+         "rms_root_bending_Nm": bend["rms"], "A_bar_root_bending": bend["A_bar"],
+         "N0_root_bending_per_s": bend["N0_per_s"], "omega_max": t["omega_max"]}
+    return [g]
+
+
+def gust_json(result: GustLoads | None) -> list:
+    """The ``analyse --json`` ``"gust"`` rows: one per gradient distance, ``mach``,
+    ``altitude_m``, ``gust_length_m`` (the gradient distance H), ``peak_hinge_moment_Nm``
+    (null without a rigid mode), ``peak_root_bending_Nm``, ``peak_root_shear_N``,
+    ``peak_current_A`` (the linear AEM1 loop's motor current; null without an actuator)."""
+    if result is None:
+        return []
+    return [{"mach": result.mach, "altitude_m": result.altitude,
+             "gust_length_m": c.gradient_length,
+             "peak_hinge_moment_Nm": c.peak_hinge_moment,
+             "peak_root_bending_Nm": c.peak_root_bending,
+             "peak_root_shear_N": c.peak_root_shear,
+             "peak_current_A": c.peak_current} for c in result.cases]
