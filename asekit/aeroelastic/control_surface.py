@@ -208,17 +208,29 @@ class StaticEffectiveness:
         return np.sqrt(2.0 * self.reversal_q / rho)
 
 
-def steady_generalised_forces(fm: FlapModel, hm: HingedMesh, mach: float,
-                              symmetric: bool = False) -> tuple[np.ndarray, np.ndarray,
-                                                                np.ndarray]:
-    """(Q0, lift, roll): the steady GAFs Q0 (n, n) per unit dynamic pressure (vortex lattice,
-    :mod:`asekit.aero.vlm`), and the lift (m^2) and rolling moment about the root chord y = 0
-    (m^3, positive for lift at y > 0) of each mode per unit dynamic pressure and coordinate
-    (of the half model when ``symmetric``)."""
-    from asekit.aero.vlm import steady_pressure
+#: the images in the plane y = 0 of the steady solution: none (an isolated surface), a wall
+#: (symmetric loading: a symmetric deflection of both halves) or antisymmetric loading (the
+#: two ailerons of a wing deflected in opposite senses, the rolling case)
+IMAGES = ("none", "symmetric", "antisymmetric")
 
+
+def steady_generalised_forces(fm: FlapModel, hm: HingedMesh, mach: float,
+                              image: str = "none") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(Q0, lift, roll): the steady GAFs Q0 (n, n) per unit dynamic pressure (vortex lattice,
+    :mod:`asekit.aero.vlm`, with the ``image`` of :data:`IMAGES` in y = 0: the antisymmetric
+    normalwash matrix is D_self - D_image = 2 D_self - D_symmetric), and the lift (m^2) and
+    rolling moment about y = 0 (m^3, positive for lift at y > 0) of each coordinate per unit
+    dynamic pressure (of the half model when there is an image)."""
+    from asekit.aero.vlm import vlm_normalwash_matrix
+
+    if image not in IMAGES:
+        raise ValueError(f"image must be one of {IMAGES}, got {image!r}")
     mesh = hm.mesh
-    cp = steady_pressure(mesh, mach, fm.box_modes.normalwash(0.0, 1.0).real, symmetric)
+    d = vlm_normalwash_matrix(mesh, mach, False)
+    if image != "none":
+        d_sym = vlm_normalwash_matrix(mesh, mach, True)
+        d = d_sym if image == "symmetric" else 2.0 * d - d_sym
+    cp = np.linalg.solve(d, fm.box_modes.normalwash(0.0, 1.0).real)
     q0 = fm.box_modes.h_lp.T @ (mesh.area[:, None] * cp)
     lift = (mesh.area * mesh.normal[:, 2]) @ cp
     roll = (mesh.area * mesh.normal[:, 2] * mesh.load_point[:, 1]) @ cp
@@ -226,7 +238,7 @@ def steady_generalised_forces(fm: FlapModel, hm: HingedMesh, mach: float,
 
 
 def static_effectiveness(fm: FlapModel, hm: HingedMesh, mach: float, q_max: float,
-                         n_q: int = 60, symmetric: bool = False,
+                         n_q: int = 60, image: str = "none",
                          what: str = "rolling moment") -> StaticEffectiveness:
     """Flexible-to-rigid effectiveness against dynamic pressure and the reversal dynamic
     pressure of every surface (module docstring), the surfaces held at their deflection
@@ -239,6 +251,9 @@ def static_effectiveness(fm: FlapModel, hm: HingedMesh, mach: float, q_max: floa
     mach : 0 <= M < 1 (vortex lattice).
     q_max : the largest dynamic pressure searched (Pa, > 0).
     n_q : points of the effectiveness curve (>= 2).
+    image : the image in y = 0 (:data:`IMAGES`): "antisymmetric" for the ailerons of a half
+        wing at a symmetry plane (rolling), "symmetric" for flaps, "none" for an isolated
+        surface.
     what : "rolling moment" (about y = 0, a half wing's aileron) or "lift".
 
     Returns
@@ -248,7 +263,7 @@ def static_effectiveness(fm: FlapModel, hm: HingedMesh, mach: float, q_max: floa
     q_max = positive("q_max", q_max)
     if what not in ("rolling moment", "lift"):
         raise ValueError(f"what must be 'rolling moment' or 'lift', got {what!r}")
-    q0, lift, roll = steady_generalised_forces(fm, hm, mach, symmetric)
+    q0, lift, roll = steady_generalised_forces(fm, hm, mach, image)
     r = roll if what == "rolling moment" else lift
     nr, nw = fm.modal.n_rigid, fm.n_wing
     w = np.arange(nr, nw)

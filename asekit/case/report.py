@@ -55,6 +55,13 @@ UNITS = {
     "settling_s": "s", "steady_error_pct": "%", "corner_overshoot_pct": "%",
     "fwtf_phase_margin_deg": "deg",
     "seconds": "s (wall-clock time per step)",
+    "dCL_ddelta_per_rad": "1/rad (lift coefficient on the panel area per rad of deflection)",
+    "dCL_dalpha_per_rad": "1/rad",
+    "Ch_delta": "1/rad (hinge moment / (q S_f c_f), > 0 trailing edge down)",
+    "Ch_alpha": "1/rad (hinge moment / (q S_f c_f), > 0 trailing edge down)",
+    "reversal_speed_ms": "m/s", "divergence_speed_ms": "m/s",
+    "hinge_inertia": "kg m^2 (about the hinge)",
+    "static_unbalance": "kg m (> 0: centre of mass aft of the hinge)",
 }
 
 
@@ -69,6 +76,7 @@ class Analysis:
     flutter: object
     ase: object
     seconds: dict
+    control: tuple = ()
 
 
 @contextlib.contextmanager
@@ -106,7 +114,13 @@ def run_analysis(case: Case, progress: bool = False) -> Analysis:
         ase = P.ase(case, db=db)
     if ase is not None:
         sec["ase"] = time.perf_counter() - t
-    return Analysis(case, modal, db, fa, ase, sec)
+    control = ()
+    if case.control_surfaces:
+        t = time.perf_counter()
+        with _stage("control surfaces", progress):
+            control = P.control_surfaces(case)
+        sec["control_surfaces"] = time.perf_counter() - t
+    return Analysis(case, modal, db, fa, ase, sec, control)
 
 
 def _f(v):
@@ -161,6 +175,14 @@ def summary(a: Analysis) -> dict:
                                                for k, v in s.corner_overshoot.items()},
                       "fwtf_phase_margin_deg": {str(i): _f(x.phase_margin_deg)
                                                 for i, x in s.crossovers.items()}}
+    if a.control:
+        out["control_surfaces"] = [
+            {"name": r.name, "mach": r.mach, "dCL_ddelta_per_rad": r.dCL_ddelta_per_rad,
+             "dCL_dalpha_per_rad": r.dCL_dalpha_per_rad, "Ch_delta": r.Ch_delta,
+             "Ch_alpha": r.Ch_alpha, "reversal_speed_ms": _f(r.reversal_speed_ms),
+             "divergence_speed_ms": _f(r.divergence_speed_ms), "density": r.density,
+             "hinge_inertia": r.inertia, "static_unbalance": r.static_unbalance}
+            for r in a.control]
     out["critical"] = critical_condition(out)
     return out
 
@@ -300,6 +322,21 @@ def _margin_text(m: dict) -> str:
     return "-" + (f" ({m['note']})" if m.get("note") else "")
 
 
+def _control_lines(rows) -> list[str]:
+    """The control-surface block of the summary: one line per surface and Mach."""
+    if not rows:
+        return []
+    out = ["", "control surfaces (rigid derivatives per rad; reversal of the rolling moment)",
+           f"{'surface':>10} {'Mach':>6} {'dCL/dd':>8} {'dCL/da':>8} {'Ch_d':>8} {'Ch_a':>8} "
+           f"{'U_rev m/s':>10}"]
+    for r in rows:
+        rev = r["reversal_speed_ms"]
+        out.append(f"{r['name'][:10]:>10} {r['mach']:>6.3g} {r['dCL_ddelta_per_rad']:>8.4f} "
+                   f"{r['dCL_dalpha_per_rad']:>8.4f} {r['Ch_delta']:>8.4f} {r['Ch_alpha']:>8.4f} "
+                   f"{'none' if rev is None else f'{rev:.1f}':>10}")
+    return out
+
+
 def format_summary(s: dict, width: int = 100) -> str:
     """A plain-text summary of :func:`summary` that fits ``width`` columns."""
     lines = textwrap.wrap(f"case {s['case']}" + (f"  ({s['reference']})" if s.get("reference")
@@ -355,6 +392,7 @@ def format_summary(s: dict, width: int = 100) -> str:
                 + f", final error {_cell(a['steady_error_pct'][t], '{:.2f}')} %; corner "
                 f"overshoot {min(ov.values()):.0f}-{max(ov.values()):.0f} %", width,
                 initial_indent="  ", subsequent_indent="    ")
+    lines += _control_lines(s.get("control_surfaces", ()))
     for n in s["notes"]:
         lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")
