@@ -1424,3 +1424,67 @@ def control_surfaces(case: Case) -> tuple[ControlSurfaceRow, ...]:
                 None if u_d is None or u_d > u_lim else u_d, u_lim,
                 float(fm.inertia[i]), float(fm.static_unbalance[i])))
     return tuple(rows)
+
+
+@dataclass(frozen=True)
+class ControlSurfaceFlutterRow:
+    """Flutter with the hinge coordinates free (on their springs) at one Mach and flight
+    condition: ``speed_ms`` and ``frequency_hz`` of the first flutter crossing (None: none in
+    the sweep, or ``unstable_at_first_point``), ``mode`` its tracked column's name (the
+    surface's name for a hinge coordinate, else the elastic mode number from 1)."""
+
+    mach: float
+    altitude: float | None
+    density: float
+    speed_ms: float | None
+    frequency_hz: float | None
+    mode: object
+    unstable_at_first_point: bool
+
+
+def _column_name(index: int, n_rigid: int, n_wing: int, names) -> object:
+    from asekit.util.conventions import mode_number
+    return names[index - n_wing] if index >= n_wing else mode_number(index, n_rigid)
+
+
+@_memo_with_warnings
+@_door("the flutter with the hinge degrees of freedom (p-k)", _CONTROL)
+def control_surface_flutter(case: Case) -> tuple[ControlSurfaceFlutterRow, ...]:
+    """p-k flutter of the case with its control surfaces free on their hinge springs
+    (:func:`control_surface_model`), at every ``aero.machs`` x flight condition over
+    ``flight.velocities``, the rigid modes held as in :func:`flutter`. The GAFs are those of the
+    wing's modes and the surfaces' deflections (:func:`control_surface_mesh`, the case's
+    ``aero.method``; computed, not cached). Memoised on the case.
+
+    Returns
+    -------
+    tuple of ControlSurfaceFlutterRow
+        Mach by Mach, condition by condition.
+    """
+    from asekit.aero.gaf import build_gaf_database
+    from asekit.aeroelastic.flutter import pk_flutter, pk_instabilities
+
+    hm = control_surface_mesh(case)
+    fm = control_surface_model(case)
+    a = case.aero
+    method = a.kernel if a.method == "dlm" else a.method
+    db = build_gaf_database(fm.box_modes, hm.mesh, a.machs, reduced_frequencies(case),
+                            a.reference_semichord, fm.modal.n_rigid,
+                            symmetric=a.symmetry == "wall", method=method, progress=False)
+    U = np.asarray(case.flight.velocities, float)
+    rows = []
+    for m in a.machs:
+        gaf = db.at(m)
+        for c in flight_conditions(case):
+            res = pk_flutter(fm.modal, gaf, c.density, U)
+            inst = pk_instabilities(res, fm.modal, gaf, c.density)
+            start = [i for i in inst if i.at_first_point]
+            f = first_of([i for i in inst if not i.at_first_point], "flutter")
+            f = None if start else f
+            # f.mode counts the modes solved (the rigid ones held): back to the model's index
+            mode = None if f is None else _column_name(f.mode + fm.modal.n_rigid - res.n_rigid,
+                                                       fm.modal.n_rigid, fm.n_wing, fm.names)
+            rows.append(ControlSurfaceFlutterRow(
+                float(m), c.altitude, c.density, None if f is None else float(f.speed),
+                None if f is None else float(f.frequency_hz), mode, bool(start)))
+    return tuple(rows)

@@ -77,6 +77,7 @@ class Analysis:
     ase: object
     seconds: dict
     control: tuple = ()
+    control_flutter: tuple = ()
 
 
 @contextlib.contextmanager
@@ -120,7 +121,13 @@ def run_analysis(case: Case, progress: bool = False) -> Analysis:
         with _stage("control surfaces", progress):
             control = P.control_surfaces(case)
         sec["control_surfaces"] = time.perf_counter() - t
-    return Analysis(case, modal, db, fa, ase, sec, control)
+        t = time.perf_counter()
+        with _stage("flutter with the hinge degrees of freedom", progress):
+            control_flutter = P.control_surface_flutter(case)
+        sec["control_surface_flutter"] = time.perf_counter() - t
+    else:
+        control_flutter = ()
+    return Analysis(case, modal, db, fa, ase, sec, control, control_flutter)
 
 
 def _f(v):
@@ -183,6 +190,11 @@ def summary(a: Analysis) -> dict:
              "divergence_speed_ms": _f(r.divergence_speed_ms), "density": r.density,
              "hinge_inertia": r.inertia, "static_unbalance": r.static_unbalance}
             for r in a.control]
+        out["control_surface_flutter"] = [
+            {"mach": r.mach, "altitude_m": r.altitude, "density": r.density,
+             "speed_ms": _f(r.speed_ms), "frequency_hz": _f(r.frequency_hz), "mode": r.mode,
+             "unstable_at_first_point": r.unstable_at_first_point}
+            for r in a.control_flutter]
     out["critical"] = critical_condition(out)
     return out
 
@@ -337,6 +349,23 @@ def _control_lines(rows) -> list[str]:
     return out
 
 
+def _control_flutter_lines(rows) -> list[str]:
+    """The flutter rows with the hinge degrees of freedom free: one line per Mach and
+    condition, the mode named (a surface by its name)."""
+    if not rows:
+        return []
+    out = ["", "flutter with the control surfaces free on their hinges (p-k, rigid modes held)",
+           f"{'Mach':>6} {'rho kg/m3':>10} {'U_f m/s':>9} {'f_f Hz':>8}  mode"]
+    for r in rows:
+        sp = ("UNSTABLE AT FIRST POINT" if r["unstable_at_first_point"] else
+              "none" if r["speed_ms"] is None else f"{r['speed_ms']:.2f}")
+        mode = "-" if r["mode"] is None else (f"mode {r['mode']}" if isinstance(r["mode"], int)
+                                              else str(r["mode"]))
+        out.append(f"{r['mach']:>6.3g} {r['density']:>10.4g} {sp:>9} "
+                   f"{_cell(r['frequency_hz'], '{:.2f}'):>8}  {mode}")
+    return out
+
+
 def format_summary(s: dict, width: int = 100) -> str:
     """A plain-text summary of :func:`summary` that fits ``width`` columns."""
     lines = textwrap.wrap(f"case {s['case']}" + (f"  ({s['reference']})" if s.get("reference")
@@ -393,6 +422,7 @@ def format_summary(s: dict, width: int = 100) -> str:
                 f"overshoot {min(ov.values()):.0f}-{max(ov.values()):.0f} %", width,
                 initial_indent="  ", subsequent_indent="    ")
     lines += _control_lines(s.get("control_surfaces", ()))
+    lines += _control_flutter_lines(s.get("control_surface_flutter", ()))
     for n in s["notes"]:
         lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")
