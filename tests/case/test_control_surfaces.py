@@ -166,3 +166,19 @@ def test_pipeline_flutter_with_the_hinge_and_a_mass_balance():
     for f, lk, b in zip(free, locked, balanced):
         assert f.speed_ms < 0.7 * lk.flutter.speed
         assert b.speed_ms == pytest.approx(lk.flutter.speed, rel=0.05)
+
+
+def test_report_figure_of_the_effectiveness(rows):
+    from types import SimpleNamespace
+
+    import matplotlib.pyplot as plt
+
+    from asekit.case.report_figures import SECTIONS, fig_control_effectiveness
+    a = SimpleNamespace(case=SimpleNamespace(name="aileron_wing"), control=rows)
+    rf = fig_control_effectiveness(a)
+    try:
+        assert rf.section == SECTIONS[-1] == "Control surfaces"
+        assert f"reversal at {rows[0].reversal_speed_ms:.1f} m/s" in rf.alt
+        assert len(rf.figure.axes[0].lines) >= len(rows)
+    finally:
+        plt.close(rf.figure)
