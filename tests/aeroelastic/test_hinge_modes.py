@@ -1,6 +1,7 @@
 """The hinge degree of freedom of a rigid control surface in a plate wing's modal model
 (asekit.aeroelastic.control_surface): inertia and static unbalance, flutter against mass
-balance, static control effectiveness, reversal and divergence."""
+balance, static control effectiveness, reversal and divergence. (Named apart from
+tests/aero/test_control_surface.py: pytest needs unique test-module basenames.)"""
 
 import math
 
