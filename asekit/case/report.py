@@ -182,7 +182,7 @@ def summary(a: Analysis) -> dict:
                                                for k, v in s.corner_overshoot.items()},
                       "fwtf_phase_margin_deg": {str(i): _f(x.phase_margin_deg)
                                                 for i, x in s.crossovers.items()}}
-    if a.control:
+    if getattr(c, "control_surfaces", ()):   # (surfaces at supersonic Machs only: no rows)
         out["control_surfaces"] = [
             {"name": r.name, "mach": r.mach, "dCL_ddelta_per_rad": r.dCL_ddelta_per_rad,
              "dCL_dalpha_per_rad": r.dCL_dalpha_per_rad, "Ch_delta": r.Ch_delta,
