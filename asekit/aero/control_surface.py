@@ -46,7 +46,8 @@ from asekit.aero.spline import BoxModes, modal_forces
 from asekit.util.validate import in_range, integer
 
 __all__ = ["ControlSurface", "HingedMesh", "hinged_mesh", "deflection_modes", "hinge_moments",
-           "steady_control_derivatives", "ControlDerivatives", "glauert_flap_effectiveness"]
+           "steady_control_derivatives", "ControlDerivatives", "glauert_flap_effectiveness",
+           "oscillatory_control_coefficients"]
 
 
 @dataclass(frozen=True)
@@ -355,6 +356,41 @@ def steady_control_derivatives(hm: HingedMesh, mach: float, symmetric: bool = Fa
     n_s = len(hm.surfaces)
     return ControlDerivatives(float(mach), s, float(lift[0] / s), lift[1:] / s,
                               h[:, 0] / sc, h[np.arange(n_s), 1 + np.arange(n_s)] / sc)
+
+
+def oscillatory_control_coefficients(hm: HingedMesh, mach: float, k, b_ref: float,
+                                     method: str = "auto", symmetric: bool = False):
+    """Lift and hinge-moment coefficients of oscillating deflections delta exp(i omega t) at
+    reduced frequencies ``k`` (k = omega b_ref / U) by the method of
+    :mod:`asekit.aero.methods` (``"auto"``: the doublet lattice below M 1, the Mach box
+    above), the deflection normalwash of :func:`deflection_modes`.
+
+    Returns
+    -------
+    CL_delta : (n_k, n_s) complex, lift coefficient on the panel area (doubled with the image
+        when ``symmetric``) per rad of each surface's deflection.
+    Ch_delta : (n_k, n_s, n_s) complex, C_h of surface i (rows) per rad of surface j's
+        deflection, H / (q S_f c_f) (module docstring).
+
+    Examples
+    --------
+    >>> panel = TrapezoidSurface((0, 0), 1.0, (0, 3.0), 1.0, 8, 6)
+    >>> hm = hinged_mesh(panel, ControlSurface("f", 0.75, 0.75))
+    >>> cl, ch = oscillatory_control_coefficients(hm, 0.0, [0.001, 0.5], 0.5, symmetric=True)
+    >>> bool(abs(cl[1, 0]) < abs(cl[0, 0])), bool(ch[0, 0, 0].real < 0)
+    (True, True)
+    """
+    from asekit.aero.methods import pressures
+
+    mesh = hm.mesh
+    modes = deflection_modes(hm)
+    cp = pressures(mesh, mach, k, b_ref, lambda kk: modes.normalwash(kk, b_ref), method,
+                   symmetric)                                    # (n_k, n, n_s)
+    s = float(np.sum(mesh.area)) * (2.0 if symmetric else 1.0)
+    lift = np.einsum("b,kbj->kj", mesh.area * mesh.normal[:, 2], cp) * (2.0 if symmetric else 1.0)
+    sc = np.array([hm.surface_area(i) * hm.mean_chord(i) for i in range(len(hm.surfaces))])
+    h = np.stack([modal_forces(modes, c, mesh.area) for c in cp])   # (n_k, n_s, n_s)
+    return lift / s, h / sc[None, :, None]
 
 
 def glauert_flap_effectiveness(flap_chord_fraction: float) -> float:

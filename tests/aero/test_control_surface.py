@@ -213,3 +213,17 @@ def test_supersonic_flap_effectiveness_against_ackeret(mach, n_chord, measured):
     tau = (lift[1] / lift[0]).real
     assert tau == pytest.approx(0.25, rel=0.07)
     assert tau == pytest.approx(measured, abs=1e-3)
+
+
+def test_oscillatory_coefficients_reach_the_steady_lattice_as_k_vanishes():
+    """The doublet lattice's k -> 0 part is the vortex lattice (Albano & Rodden 1969, Eq. 21):
+    at k = 0.001 the oscillating flap's lift and hinge moment equal the steady ones within
+    0.5 %; the lift's magnitude then falls with k (Theodorsen's C(k) behaviour)."""
+    from asekit.aero.control_surface import oscillatory_control_coefficients
+    panel = TrapezoidSurface((0, 0), 1.0, (0, 3.0), 1.0, 8, 6)
+    hm = hinged_mesh(panel, ControlSurface("flap", 0.75, 0.75))
+    steady = steady_control_derivatives(hm, 0.3, symmetric=True)
+    cl, ch = oscillatory_control_coefficients(hm, 0.3, [0.001, 0.3], 0.5, symmetric=True)
+    assert cl[0, 0] == pytest.approx(steady.dCL_ddelta[0], rel=5e-3)
+    assert ch[0, 0, 0] == pytest.approx(steady.Ch_delta[0], rel=5e-3)
+    assert abs(cl[1, 0]) < abs(cl[0, 0])
