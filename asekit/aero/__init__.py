@@ -1,6 +1,8 @@
 """Aerodynamics of lifting surfaces (thesis Sections 2.2 and 3.2).
 
 - :mod:`asekit.aero.boxes`: trapezoidal surfaces, box meshes and the DLM mesh rules.
+- :mod:`asekit.aero.control_surface`: hinged control surfaces: hinge-aligned boxes, the
+  deflection normalwash, hinge moments and steady control derivatives.
 - :mod:`asekit.aero.vlm`: steady vortex lattice with Prandtl-Glauert compressibility.
 - :mod:`asekit.aero.dlm`: subsonic doublet-lattice method (parabolic and quartic kernels).
 - :mod:`asekit.aero.spline`: structure -> aero interpolation and the force transpose.

@@ -1310,3 +1310,190 @@ def ase(case: Case, db: GafDatabase | None = None) -> AseResult | None:
     cross = {i: ase_mod.crossovers(ase_mod.forward_path(m, ctl, i)) for i in (1, 2, 3)}
     return AseResult(m, ctl, a.mach, a.altitude, U, stable, maxre, cross, sims, settle, err,
                      over)
+
+
+# ---------------------------------------------------------------------------------------------
+# control surfaces (issue 25)
+# ---------------------------------------------------------------------------------------------
+_CONTROL = "check [[control_surface]] (panel, hinge_chord_fraction, span_fraction, hinge keys)"
+
+
+@lru_cache(maxsize=8)
+@_door("the control-surface boxes", _CONTROL)
+def control_surface_mesh(case: Case):
+    """The case's boxes cut along its control surfaces' hinge lines and side edges
+    (:func:`asekit.aero.control_surface.hinged_mesh`), the panel's box counts as
+    :func:`box_mesh`; one-panel cases. Memoised on the case."""
+    from asekit.aero.control_surface import ControlSurface, hinged_mesh
+
+    if not case.control_surfaces:
+        raise CaseError(f"{case.name}: the case has no [[control_surface]]")
+    if case.structure is not None or len(case.panels) != 1:
+        what = "an imported structure" if case.structure is not None else \
+            f"{len(case.panels)} panels"
+        raise CaseError(f"control_surface: control surfaces need a one-panel case file (this "
+                        f"case has {what})")
+    surface = panel_surfaces(case.panels, box_counts(case.panels, case.aero))[0]
+    specs = [ControlSurface(c.name, *c.hinge_chord_fraction, *c.span_fraction)
+             for c in case.control_surfaces]
+    try:
+        return hinged_mesh(surface, specs)
+    except ValueError as exc:
+        raise CaseError(f"control_surface: {exc}") from None
+
+
+@lru_cache(maxsize=8)
+@_door("the modal model with the hinge coordinates", _CONTROL)
+def control_surface_model(case: Case):
+    """The wing's modal model (:func:`modal_model`, surfaces locked) with one hinge coordinate
+    per control surface, its hinge spring, damper and balance masses
+    (:func:`asekit.aeroelastic.control_surface.flap_modal_model`). Memoised on the case."""
+    from asekit.aeroelastic.control_surface import BalanceMass, flap_modal_model
+
+    hm = control_surface_mesh(case)
+    _, m_fe = mass_and_stiffness(case)
+    cs = case.control_surfaces
+    balance = tuple(BalanceMass(i, x, y, m) for i, c in enumerate(cs)
+                    for (x, y), m in c.mass_balance)
+    return flap_modal_model(modal_model(case), m_fe, hm, [c.hinge_stiffness for c in cs],
+                            [c.hinge_damping for c in cs], balance)
+
+
+@dataclass(frozen=True)
+class ControlSurfaceRow:
+    """Steady results of one control surface at one Mach number (rigid derivatives per rad,
+    C_h = H / (q S_f c_f); the flexible rolling-moment effectiveness against speed at
+    ``density`` (kg/m^3), the first flight condition, the surfaces held at their deflection;
+    reversal and divergence speeds in m/s, None when not found below ``speed_limit_ms``)."""
+
+    name: str
+    mach: float
+    dCL_ddelta_per_rad: float
+    dCL_dalpha_per_rad: float
+    Ch_delta: float
+    Ch_alpha: float
+    density: float
+    speeds_ms: np.ndarray
+    effectiveness_ratio: np.ndarray
+    reversal_speed_ms: float | None
+    divergence_speed_ms: float | None
+    speed_limit_ms: float
+    inertia: float
+    static_unbalance: float
+
+
+@_memo_with_warnings
+@_door("the control-surface effectiveness and reversal (vortex lattice)", _CONTROL)
+def control_surfaces(case: Case) -> tuple[ControlSurfaceRow, ...]:
+    """Control effectiveness, hinge-moment derivatives and reversal of every control surface
+    at every subsonic Mach of ``aero.machs`` (vortex lattice, :mod:`asekit.aero.vlm`).
+
+    Rigid: dCL/d alpha, dCL/d delta, C_h alpha, C_h delta
+    (:func:`asekit.aero.control_surface.steady_control_derivatives`, the wall's image when
+    ``aero.symmetry = "wall"``). Flexible: the rolling moment about the root (y = 0) per unit
+    deflection over its rigid value against speed, at the first flight condition's density,
+    with the antisymmetric image at a wall (ailerons deflected in opposite senses), and the
+    reversal speed where it crosses zero (:func:`asekit.aeroelastic.control_surface.
+    static_effectiveness`), searched up to twice the highest flight velocity.
+
+    Parameters
+    ----------
+    case : Case
+        A one-panel case with ``[[control_surface]]``.
+
+    Returns
+    -------
+    tuple of ControlSurfaceRow
+        Surface by surface, Mach by Mach (Machs >= 1 are skipped: the vortex lattice is
+        subsonic). Memoised on the case.
+    """
+    from asekit.aero.control_surface import steady_control_derivatives
+    from asekit.aeroelastic.control_surface import static_effectiveness
+
+    hm = control_surface_mesh(case)
+    fm = control_surface_model(case)
+    rho = flight_conditions(case)[0].density
+    u_lim = 2.0 * float(max(case.flight.velocities))
+    wall = case.aero.symmetry == "wall"
+    rows = []
+    for mach in case.aero.machs:
+        if mach >= 1.0:
+            continue
+        d = steady_control_derivatives(hm, mach, symmetric=wall)
+        se = static_effectiveness(fm, hm, mach, 0.5 * rho * u_lim ** 2, n_q=41,
+                                  image="antisymmetric" if wall else "none")
+        u_r = se.reversal_speed(rho)
+        u_d = math.sqrt(2.0 * se.divergence_q / rho) if math.isfinite(se.divergence_q) else None
+        for i, name in enumerate(fm.names):
+            rows.append(ControlSurfaceRow(
+                name, float(mach), float(d.dCL_ddelta[i]), float(d.dCL_dalpha),
+                float(d.Ch_delta[i]), float(d.Ch_alpha[i]), float(rho),
+                np.sqrt(2.0 * se.dynamic_pressure / rho), se.ratio[i],
+                None if not math.isfinite(u_r[i]) else float(u_r[i]),
+                None if u_d is None or u_d > u_lim else u_d, u_lim,
+                float(fm.inertia[i]), float(fm.static_unbalance[i])))
+    return tuple(rows)
+
+
+@dataclass(frozen=True)
+class ControlSurfaceFlutterRow:
+    """Flutter with the hinge coordinates free (on their springs) at one Mach and flight
+    condition: ``speed_ms`` and ``frequency_hz`` of the first flutter crossing (None: none in
+    the sweep, or ``unstable_at_first_point``), ``mode`` its tracked column's name (the
+    surface's name for a hinge coordinate, else the elastic mode number from 1)."""
+
+    mach: float
+    altitude: float | None
+    density: float
+    speed_ms: float | None
+    frequency_hz: float | None
+    mode: object
+    unstable_at_first_point: bool
+
+
+def _column_name(index: int, n_rigid: int, n_wing: int, names) -> object:
+    from asekit.util.conventions import mode_number
+    return names[index - n_wing] if index >= n_wing else mode_number(index, n_rigid)
+
+
+@_memo_with_warnings
+@_door("the flutter with the hinge degrees of freedom (p-k)", _CONTROL)
+def control_surface_flutter(case: Case) -> tuple[ControlSurfaceFlutterRow, ...]:
+    """p-k flutter of the case with its control surfaces free on their hinge springs
+    (:func:`control_surface_model`), at every ``aero.machs`` x flight condition over
+    ``flight.velocities``, the rigid modes held as in :func:`flutter`. The GAFs are those of the
+    wing's modes and the surfaces' deflections (:func:`control_surface_mesh`, the case's
+    ``aero.method``; computed, not cached). Memoised on the case.
+
+    Returns
+    -------
+    tuple of ControlSurfaceFlutterRow
+        Mach by Mach, condition by condition.
+    """
+    from asekit.aero.gaf import build_gaf_database
+    from asekit.aeroelastic.flutter import pk_flutter, pk_instabilities
+
+    hm = control_surface_mesh(case)
+    fm = control_surface_model(case)
+    a = case.aero
+    method = a.kernel if a.method == "dlm" else a.method
+    db = build_gaf_database(fm.box_modes, hm.mesh, a.machs, reduced_frequencies(case),
+                            a.reference_semichord, fm.modal.n_rigid,
+                            symmetric=a.symmetry == "wall", method=method, progress=False)
+    U = np.asarray(case.flight.velocities, float)
+    rows = []
+    for m in a.machs:
+        gaf = db.at(m)
+        for c in flight_conditions(case):
+            res = pk_flutter(fm.modal, gaf, c.density, U)
+            inst = pk_instabilities(res, fm.modal, gaf, c.density)
+            start = [i for i in inst if i.at_first_point]
+            f = first_of([i for i in inst if not i.at_first_point], "flutter")
+            f = None if start else f
+            # f.mode counts the modes solved (the rigid ones held): back to the model's index
+            mode = None if f is None else _column_name(f.mode + fm.modal.n_rigid - res.n_rigid,
+                                                       fm.modal.n_rigid, fm.n_wing, fm.names)
+            rows.append(ControlSurfaceFlutterRow(
+                float(m), c.altitude, c.density, None if f is None else float(f.speed),
+                None if f is None else float(f.frequency_hz), mode, bool(start)))
+    return tuple(rows)

@@ -69,6 +69,13 @@ UNITS = {
     "A_bar_root_bending": "N m per m/s (RMS root bending / RMS gust velocity)",
     "N0_root_bending_per_s": "1/s (zero up-crossings of the root bending per second)",
     "omega_max": "rad/s (upper end of the turbulence integrals: k_max U / b)",
+    "dCL_ddelta_per_rad": "1/rad (lift coefficient on the panel area per rad of deflection)",
+    "dCL_dalpha_per_rad": "1/rad",
+    "Ch_delta": "1/rad (hinge moment / (q S_f c_f), > 0 trailing edge down)",
+    "Ch_alpha": "1/rad (hinge moment / (q S_f c_f), > 0 trailing edge down)",
+    "reversal_speed_ms": "m/s", "divergence_speed_ms": "m/s",
+    "hinge_inertia": "kg m^2 (about the hinge)",
+    "static_unbalance": "kg m (> 0: centre of mass aft of the hinge)",
 }
 
 
@@ -85,6 +92,8 @@ class Analysis:
     ase: object
     seconds: dict
     gust: object = None
+    control: tuple = ()
+    control_flutter: tuple = ()
 
 
 @contextlib.contextmanager
@@ -128,7 +137,20 @@ def run_analysis(case: Case, progress: bool = False) -> Analysis:
         with _stage("gust loads", progress):
             gust = gust_loads(case)
         sec["gust"] = time.perf_counter() - t
-    return Analysis(case, modal, db, fa, ase, sec, gust)
+    control = ()
+    if case.control_surfaces:
+        t = time.perf_counter()
+        with _stage("control surfaces", progress):
+            control = P.control_surfaces(case)
+        sec["control_surfaces"] = time.perf_counter() - t
+        t = time.perf_counter()
+        with _stage("flutter with the hinge degrees of freedom", progress):
+            control_flutter = P.control_surface_flutter(case)
+        sec["control_surface_flutter"] = time.perf_counter() - t
+    else:
+        control_flutter = ()
+    return Analysis(case, modal, db, fa, ase, sec, gust=gust, control=control,
+                    control_flutter=control_flutter)
 
 
 def _f(v):
@@ -187,6 +209,19 @@ def summary(a: Analysis) -> dict:
         out["gust"] = gust_json(a.gust)
         if a.gust.turbulence is not None:
             out["turbulence"] = turbulence_json(a.gust)
+    if getattr(c, "control_surfaces", ()):   # (surfaces at supersonic Machs only: no rows)
+        out["control_surfaces"] = [
+            {"name": r.name, "mach": r.mach, "dCL_ddelta_per_rad": r.dCL_ddelta_per_rad,
+             "dCL_dalpha_per_rad": r.dCL_dalpha_per_rad, "Ch_delta": r.Ch_delta,
+             "Ch_alpha": r.Ch_alpha, "reversal_speed_ms": _f(r.reversal_speed_ms),
+             "divergence_speed_ms": _f(r.divergence_speed_ms), "density": r.density,
+             "hinge_inertia": r.inertia, "static_unbalance": r.static_unbalance}
+            for r in a.control]
+        out["control_surface_flutter"] = [
+            {"mach": r.mach, "altitude_m": r.altitude, "density": r.density,
+             "speed_ms": _f(r.speed_ms), "frequency_hz": _f(r.frequency_hz), "mode": r.mode,
+             "unstable_at_first_point": r.unstable_at_first_point}
+            for r in a.control_flutter]
     out["critical"] = critical_condition(out)
     return out
 
@@ -350,6 +385,37 @@ def _turbulence_lines(rows) -> list:
                    f"N0 {_cell(r['N0_per_s'])} /s); root bending RMS "
                    f"{_cell(r['rms_root_bending_Nm'])} N m (A-bar "
                    f"{_cell(r['A_bar_root_bending'])}, N0 {_cell(r['N0_root_bending_per_s'])} /s)")
+
+
+def _control_lines(rows) -> list[str]:
+    """The control-surface block of the summary: one line per surface and Mach."""
+    if not rows:
+        return []
+    out = ["", "control surfaces (rigid derivatives per rad; reversal of the rolling moment)",
+           f"{'surface':>10} {'Mach':>6} {'dCL/dd':>8} {'dCL/da':>8} {'Ch_d':>8} {'Ch_a':>8} "
+           f"{'U_rev m/s':>10}"]
+    for r in rows:
+        rev = r["reversal_speed_ms"]
+        out.append(f"{r['name'][:10]:>10} {r['mach']:>6.3g} {r['dCL_ddelta_per_rad']:>8.4f} "
+                   f"{r['dCL_dalpha_per_rad']:>8.4f} {r['Ch_delta']:>8.4f} {r['Ch_alpha']:>8.4f} "
+                   f"{'none' if rev is None else f'{rev:.1f}':>10}")
+    return out
+
+
+def _control_flutter_lines(rows) -> list[str]:
+    """The flutter rows with the hinge degrees of freedom free: one line per Mach and
+    condition, the mode named (a surface by its name)."""
+    if not rows:
+        return []
+    out = ["", "flutter with the control surfaces free on their hinges (p-k, rigid modes held)",
+           f"{'Mach':>6} {'rho kg/m3':>10} {'U_f m/s':>9} {'f_f Hz':>8}  mode"]
+    for r in rows:
+        sp = ("UNSTABLE AT FIRST POINT" if r["unstable_at_first_point"] else
+              "none" if r["speed_ms"] is None else f"{r['speed_ms']:.2f}")
+        mode = "-" if r["mode"] is None else (f"mode {r['mode']}" if isinstance(r["mode"], int)
+                                              else str(r["mode"]))
+        out.append(f"{r['mach']:>6.3g} {r['density']:>10.4g} {sp:>9} "
+                   f"{_cell(r['frequency_hz'], '{:.2f}'):>8}  {mode}")
     return out
 
 
@@ -411,6 +477,8 @@ def format_summary(s: dict, width: int = 100) -> str:
                 f"overshoot {min(ov.values()):.0f}-{max(ov.values()):.0f} %", width,
                 initial_indent="  ", subsequent_indent="    ")
     lines += _gust_lines(s.get("gust")) + _turbulence_lines(s.get("turbulence"))
+    lines += _control_lines(s.get("control_surfaces", ()))
+    lines += _control_flutter_lines(s.get("control_surface_flutter", ()))
     for n in s["notes"]:
         lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")

@@ -33,7 +33,8 @@ from asekit.util.plotting import new_figure, plot_vg
 
 #: Report sections, in page order.
 SECTIONS = ("Flutter and divergence against Mach", "V-g, V-f and root locus at each Mach",
-            "Structure: planform and mode shapes", "Aeroservoelastic loop", "Gust loads")
+            "Structure: planform and mode shapes", "Aeroservoelastic loop", "Gust loads",
+            "Control surfaces")
 
 #: The g axis of the V-g panels (-): wide enough for the crossings, narrow enough to read them.
 G_LIMITS = (-0.5, 0.3)
@@ -521,6 +522,29 @@ def fig_gust_histories(a) -> ReportFigure:
     return ReportFigure(fig, alt, SECTIONS[4])
 
 
+def fig_control_effectiveness(a) -> ReportFigure:
+    """Flexible-to-rigid rolling-moment effectiveness of each control surface against speed,
+    one curve per surface and Mach, the reversal speeds marked (dotted)."""
+    fig, ax = new_figure(f"{a.case.name}: control-surface effectiveness (rolling moment, "
+                         f"flexible / rigid)", figsize=(7.0, 4.4), layout="constrained")
+    parts = []
+    for r in a.control:
+        line, = ax.plot(r.speeds_ms, r.effectiveness_ratio, label=f"{r.name}, M {r.mach:g}")
+        if r.reversal_speed_ms is not None:
+            ax.axvline(r.reversal_speed_ms, ls=":", color=line.get_color())
+        parts.append(f"{r.name} at M {r.mach:g}: reversal " + (
+            f"at {r.reversal_speed_ms:.1f} m/s" if r.reversal_speed_ms is not None else
+            f"none below {r.speed_limit_ms:.0f} m/s"))
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_xlabel(f"airspeed (m/s), density {a.control[0].density:.4g} kg/m^3")
+    ax.set_ylabel("effectiveness ratio (-)")
+    ax.set_ylim(-1.0, 1.2)
+    ax.legend()
+    alt = ("Rolling moment per unit control deflection, flexible over rigid, against airspeed; "
+           + "; ".join(parts))
+    return ReportFigure(fig, alt, SECTIONS[5])
+
+
 def figures(a) -> dict:
     """{file name: :class:`ReportFigure`} of the report, in page order: the Mach figure, V-g /
     V-f and root locus at every analysed Mach, the planform and mode shapes, and with an
@@ -536,4 +560,6 @@ def figures(a) -> dict:
         out["ase_steps"] = fig_ase_steps(a)
     if getattr(a, "gust", None) is not None:
         out["gust_histories"] = fig_gust_histories(a)
+    if getattr(a, "control", ()):
+        out["control_effectiveness"] = fig_control_effectiveness(a)
     return out

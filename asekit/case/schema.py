@@ -135,6 +135,26 @@ class PointMass:
 
 
 @dataclass(frozen=True)
+class ControlSurfaceSpec:
+    """A hinged control surface (``[[control_surface]]``, issue 25) on panel ``panel``
+    (0-based): its hinge line at chord fractions ``hinge_chord_fraction`` = (inboard, outboard)
+    of the panel's local chord, between the span fractions ``span_fraction`` = (start, end) of
+    the panel; ``kind`` "rigid" (a rigid surface rotating about its hinge, as Nastran's
+    AESURF); ``hinge_stiffness`` N m/rad and ``hinge_damping`` N m s/rad of the hinge;
+    ``mass_balance``: ((x, y) m, mass kg) pairs fixed to the surface
+    (:mod:`asekit.aeroelastic.control_surface`)."""
+
+    name: str
+    panel: int
+    hinge_chord_fraction: tuple[float, float]
+    span_fraction: tuple[float, float] = (0.0, 1.0)
+    kind: str = "rigid"
+    hinge_stiffness: float = 0.0
+    hinge_damping: float = 0.0
+    mass_balance: tuple[tuple[tuple[float, float], float], ...] = ()
+
+
+@dataclass(frozen=True)
 class DampingSpec:
     """Damping of the elastic modes (docs/conventions.md): ``modal_damping_ratio`` zeta (viscous,
     C_ii = 2 zeta omega_i M_ii; one value or one per elastic mode) or ``structural_g``
@@ -311,6 +331,7 @@ class Case:
     damping: DampingSpec = DampingSpec()
     point_masses: tuple[PointMass, ...] = ()
     actuator: ActuatorSpec | None = None
+    control_surfaces: tuple[ControlSurfaceSpec, ...] = ()
     flutter_index: FlutterIndexSpec | None = None
     flutter: FlutterSpec = FlutterSpec()
     convergence: ConvergenceSpec = ConvergenceSpec()
@@ -341,6 +362,8 @@ class Case:
             d["structure"] = self.structure.digest
         if self.gust is None:               # (absent: the digests of cases without gusts stay)
             d.pop("gust")
+        if not self.control_surfaces:       # (likewise: cases without control surfaces)
+            d.pop("control_surfaces")
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
 
 
@@ -688,6 +711,73 @@ def _point_masses(raw, panels=()) -> tuple[PointMass, ...]:
     return tuple(out)
 
 
+#: the kinds of control surface (``control_surface[i].kind``); "elastic" (a plate region
+#: released along the hinge) is not implemented yet
+CONTROL_SURFACE_KINDS = ("rigid",)
+
+
+def _mass_balance(t: _Table, path: str, panels) -> tuple:
+    raw = t.raw("mass_balance", [])
+    if not isinstance(raw, list):
+        raise CaseError(f"{path}.mass_balance must be an array of tables "
+                        f"([[control_surface.mass_balance]])")
+    out = []
+    for j, d in enumerate(raw):
+        b = _Table(d, f"{path}.mass_balance[{j}]")
+        pos = b.numbers("position", required=True, length=2, unit="m")
+        m = b.number("mass", required=True, low=0.0, high=1e9, unit="kg")
+        b.done()
+        if not _on_planform(panels, *pos):
+            raise CaseError(f"{b.path}.position {list(pos)} m is off the planform: a balance "
+                            f"mass must lie on a panel")
+        out.append((pos, m))
+    return tuple(out)
+
+
+def _one_control_surface(t: _Table, i: int, panels) -> ControlSurfaceSpec:
+    path = f"control_surface[{i}]"
+    name = t.text("name", "")
+    if not name:
+        raise CaseError(f"{path}.name is missing or empty")
+    panel = t.integer("panel", 0, low=0, high=max(len(panels) - 1, 0))
+    hinge = t.numbers("hinge_chord_fraction", required=True, length=2, low=0.0, high=1.0,
+                      high_open=True)
+    span = t.numbers("span_fraction", default=[0.0, 1.0], length=2, low=0.0, low_open=False,
+                     high=1.0)
+    if span[1] <= span[0]:
+        raise CaseError(f"{path}.span_fraction must be [start, end] with 0 <= start < end "
+                        f"<= 1, got {list(span)}")
+    kind = t.string("kind", CONTROL_SURFACE_KINDS, default="rigid")
+    k_h = t.number("hinge_stiffness", required=True, low=0.0, low_open=False, high=1e12,
+                   unit="N m/rad")
+    c_h = t.number("hinge_damping", 0.0, low=0.0, low_open=False, high=1e12,
+                   unit="N m s/rad")
+    balance = _mass_balance(t, path, panels)
+    t.done()
+    return ControlSurfaceSpec(name, panel, hinge, span, kind, k_h, c_h, balance)
+
+
+def _control_surfaces(raw, panels) -> tuple[ControlSurfaceSpec, ...]:
+    """The ``[[control_surface]]`` tables (docs/case-format.md), every key checked."""
+    if raw is None:
+        return ()
+    if not isinstance(raw, list):
+        raise CaseError("control_surface must be an array of tables ([[control_surface]])")
+    out = tuple(_one_control_surface(_Table(d, f"control_surface[{i}]"), i, panels)
+                for i, d in enumerate(raw))
+    names = [c.name for c in out]
+    if len(set(names)) != len(names):
+        raise CaseError(f"control_surface[].name must be unique, got {names}")
+    for i, a in enumerate(out):
+        for j, b in enumerate(out[:i]):
+            if a.panel == b.panel and min(a.span_fraction[1], b.span_fraction[1]) > \
+                    max(a.span_fraction[0], b.span_fraction[0]):
+                raise CaseError(f"control_surface[{i}].span_fraction {list(a.span_fraction)} "
+                                f"overlaps control_surface[{j}] ({b.name!r}) on panel "
+                                f"{a.panel}: give each surface its own span range")
+    return out
+
+
 def _damping(t: _Table | None) -> DampingSpec:
     if t is None:
         return DampingSpec()
@@ -905,6 +995,7 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     material = _material(top.table("material", required=True))
     support = _support(top.table("support", required=True), panels)
     masses = _point_masses(top.raw("point_mass"), panels)
+    surfaces = _control_surfaces(top.raw("control_surface"), panels)
     damping = _damping(top.table("damping"))
     modes = _modes(top.table("modes"), support)
     aero = _aero(top.table("aero", required=True), panels)
@@ -936,7 +1027,8 @@ def case_from_dict(d: dict, source: str = "") -> Case:
                         f"[{aero.machs[0]:g}, {aero.machs[-1]:g}], got {actuator.mach:g}")
     return Case(name=name, panels=panels, thickness=thickness, material=material,
                 support=support, aero=aero, flight=flight, modes=modes, damping=damping,
-                point_masses=masses, actuator=actuator, flutter_index=fsi_spec,
+                point_masses=masses, actuator=actuator, control_surfaces=surfaces,
+                flutter_index=fsi_spec,
                 flutter=flutter, convergence=convergence, gust=gust, reference=reference,
                 source=source)
 

@@ -1,0 +1,409 @@
+"""Hinged control surfaces (flaps, ailerons, tabs) on a trapezoidal panel: a box mesh aligned
+with the hinge line and the side edges, the normalwash of a rigid deflection, hinge moments and
+the steady control derivatives.
+
+Geometry. A :class:`ControlSurface` lies on one :class:`~asekit.aero.boxes.TrapezoidSurface`
+(the panel): its hinge line joins the points at chord fraction ``hinge_inboard`` of the panel's
+local chord at span fraction ``span_start`` and at ``hinge_outboard`` at ``span_end``; the
+surface is the part of the panel aft of that line between the two span stations (to the
+trailing edge). :func:`hinged_mesh` cuts the panel at every side edge and along every hinge
+line, so that box edges fall on the hinge line and on the side edges (MSC Nastran's AESURF
+practice, and the requirement of the doublet lattice that a discontinuous normalwash fall on
+box edges: Rodden & Johnson, *MSC/NASTRAN Aeroelastic Analysis User's Guide*, 1994, Sec. 2.3).
+
+Deflection. A positive deflection delta is a rotation about the hinge axis that moves the
+trailing edge down, the sense of the pitch convention (a nose-up rotation about +y,
+docs/conventions.md). A point at in-plane distance d aft of the hinge line moves along the box
+normal by h = -delta d; with the hinge swept by Lambda_h, the streamwise slope is
+dh/dx = -delta cos(Lambda_h). The normalwash of an oscillating deflection delta exp(i omega t)
+is then the modal one of :mod:`asekit.aero.spline` (thesis Eq. 2.10 and the DLM of
+:mod:`asekit.aero.dlm`),
+
+    w/U = dh/dx + i k h / b = -delta (cos(Lambda_h) + i k d / b)      (on the surface's boxes),
+
+and 0 elsewhere, so every method of :mod:`asekit.aero.methods` (VLM at k = 0, DLM, Mach box,
+piston theory) takes it through the same interface as a structural mode
+(:class:`~asekit.aero.spline.BoxModes`).
+
+Hinge moment. The work-conjugate of delta, per unit dynamic pressure (m^3),
+
+    H / q = sum_boxes h(load point) DeltaCp A = -sum_{surface boxes} d DeltaCp A,
+
+positive when it tends to deflect the trailing edge down (Eqs. 2.10-2.11 of the thesis with the
+deflection as the mode). The hinge-moment coefficient is C_h = H / (q S_f c_f) with S_f the
+surface's area and c_f its mean chord aft of the hinge (S_f over the surface's span), the
+usual NACA definition (Abbott & von Doenhoff, *Theory of Wing Sections*, 1959, Sec. 8.7).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from asekit.aero.boxes import BoxMesh, TrapezoidSurface
+from asekit.aero.spline import BoxModes, modal_forces
+from asekit.util.validate import in_range, integer
+
+__all__ = ["ControlSurface", "HingedMesh", "hinged_mesh", "deflection_modes", "hinge_moments",
+           "steady_control_derivatives", "ControlDerivatives", "glauert_flap_effectiveness",
+           "oscillatory_control_coefficients"]
+
+
+@dataclass(frozen=True)
+class ControlSurface:
+    """A rigid control surface aft of a hinge line on one panel.
+
+    Parameters
+    ----------
+    name : label used in outputs.
+    hinge_inboard, hinge_outboard : chord fractions (0, 1) of the hinge line at the surface's
+        inboard and outboard side edges (0 the leading edge, 1 the trailing edge).
+    span_start, span_end : span fractions of the panel, 0 <= span_start < span_end <= 1, of the
+        inboard and outboard side edges.
+
+    Examples
+    --------
+    >>> ControlSurface("aileron", 0.75, 0.75, 0.5, 1.0).flap_chord_fraction
+    0.25
+    """
+
+    name: str
+    hinge_inboard: float
+    hinge_outboard: float
+    span_start: float = 0.0
+    span_end: float = 1.0
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"name must be a non-empty string, got {self.name!r}")
+        for nm in ("hinge_inboard", "hinge_outboard"):
+            object.__setattr__(self, nm, in_range(nm, getattr(self, nm), 0.0, high=1.0,
+                                                  high_inclusive=False))
+        object.__setattr__(self, "span_start", in_range("span_start", self.span_start, 0.0,
+                                                        inclusive=True, high=1.0,
+                                                        high_inclusive=False))
+        object.__setattr__(self, "span_end", in_range("span_end", self.span_end, 0.0, high=1.0))
+        if self.span_end <= self.span_start:
+            raise ValueError(f"span_end must be > span_start = {self.span_start:g}, "
+                             f"got {self.span_end:g}")
+
+    @property
+    def flap_chord_fraction(self) -> float:
+        """Mean chord fraction aft of the hinge, 1 - (hinge_inboard + hinge_outboard) / 2."""
+        return 1.0 - 0.5 * (self.hinge_inboard + self.hinge_outboard)
+
+
+@dataclass(frozen=True)
+class HingedMesh:
+    """A panel's boxes cut along its control surfaces' hinge lines and side edges.
+
+    ``mesh`` the :class:`BoxMesh`; ``surfaces`` the control surfaces; ``on_surface``
+    (n_surfaces, n_boxes) bool, the boxes of each surface; ``hinge_point`` (n_surfaces, 3) the
+    hinge line's inboard end and ``hinge_axis`` (n_surfaces, 3) its unit direction (outboard).
+    """
+
+    mesh: BoxMesh
+    surfaces: tuple
+    on_surface: np.ndarray
+    hinge_point: np.ndarray
+    hinge_axis: np.ndarray
+
+    def distance_aft(self, index: int, points: np.ndarray) -> np.ndarray:
+        """In-plane distance (m) of ``points`` (m, 3) aft of hinge line ``index``, measured
+        perpendicular to the hinge line, positive downstream."""
+        s = self.hinge_axis[index]
+        aft = np.array([s[1], -s[0], 0.0])
+        aft /= np.linalg.norm(aft)
+        return (np.asarray(points, float) - self.hinge_point[index]) @ aft
+
+    def surface_area(self, index: int) -> float:
+        """Area S_f (m^2) of surface ``index``."""
+        return float(np.sum(self.mesh.area[self.on_surface[index]]))
+
+    def surface_span(self, index: int) -> float:
+        """Span (m) of surface ``index``: the widths of its strips."""
+        m = self.on_surface[index]
+        strips, first = np.unique(self.mesh.strip[m], return_index=True)
+        return float(np.sum(2.0 * self.mesh.half_width[m][first]))
+
+    def mean_chord(self, index: int) -> float:
+        """Mean chord c_f (m) of surface ``index`` aft of its hinge: S_f / its span."""
+        return self.surface_area(index) / self.surface_span(index)
+
+
+def _span_cuts(surfaces) -> np.ndarray:
+    cuts = {0.0, 1.0}
+    for s in surfaces:
+        cuts.update((s.span_start, s.span_end))
+    return np.array(sorted(cuts))
+
+
+def _hinge_fraction_at(surfaces, eta: float, side: str) -> float | None:
+    """The hinge chord fraction at span fraction ``eta`` of the surface that touches it from
+    ``side`` ("left": the surface ends there, "right": it starts there), or None."""
+    for s in surfaces:
+        if side == "left" and abs(s.span_end - eta) < 1e-12:
+            return s.hinge_outboard
+        if side == "right" and abs(s.span_start - eta) < 1e-12:
+            return s.hinge_inboard
+    return None
+
+
+def _segment_hinges(surfaces, e0: float, e1: float, default: float):
+    """(index of the surface covering [e0, e1] or -1, hinge fraction at e0, at e1)."""
+    for i, s in enumerate(surfaces):
+        if s.span_start <= e0 + 1e-12 and s.span_end >= e1 - 1e-12:
+            t0 = (e0 - s.span_start) / (s.span_end - s.span_start)
+            t1 = (e1 - s.span_start) / (s.span_end - s.span_start)
+            h = (s.hinge_inboard, s.hinge_outboard)
+            return i, h[0] + t0 * (h[1] - h[0]), h[0] + t1 * (h[1] - h[0])
+    h0 = _hinge_fraction_at(surfaces, e0, "left")
+    h1 = _hinge_fraction_at(surfaces, e1, "right")
+    h0 = h1 if h0 is None else h0
+    h1 = h0 if h1 is None else h1
+    return -1, (default if h0 is None else h0), (default if h1 is None else h1)
+
+
+def _check_overlap(surfaces) -> None:
+    order = sorted(surfaces, key=lambda s: s.span_start)
+    for a, b in zip(order, order[1:]):
+        if b.span_start < a.span_end - 1e-12:
+            raise ValueError(f"control surfaces '{a.name}' and '{b.name}' overlap in span "
+                             f"({a.span_start:g}-{a.span_end:g} and {b.span_start:g}-"
+                             f"{b.span_end:g}): give each its own span range")
+
+
+def _point(panel: TrapezoidSurface, eta: float, xi: float) -> np.ndarray:
+    r, t = np.asarray(panel.root_le), np.asarray(panel.tip_le)
+    le = r + eta * (t - r)
+    chord = panel.root_chord + eta * (panel.tip_chord - panel.root_chord)
+    return le + np.array([xi * chord, 0.0, 0.0])
+
+
+def hinged_mesh(panel: TrapezoidSurface, surfaces, n_chord_aft: int | None = None) -> HingedMesh:
+    """Boxes of ``panel`` whose chordwise lines fall on the hinge lines and whose spanwise
+    lines fall on the side edges of ``surfaces``.
+
+    Parameters
+    ----------
+    panel : the trapezoid; its ``n_chord`` (boxes per chord) and ``n_span`` (boxes across the
+        span) are kept, the span boxes shared among the spanwise segments in proportion to
+        their width (at least one each).
+    surfaces : :class:`ControlSurface` (one or a sequence; spans must not overlap).
+    n_chord_aft : boxes aft of the hinge (1 .. n_chord - 1); default the nearest integer to
+        n_chord times the mean chord fraction aft of the hinges.
+
+    Returns
+    -------
+    HingedMesh : the boxes (strips root to tip, leading-edge box first in each strip, as
+    :func:`asekit.aero.boxes.mesh_surfaces`) and each surface's boxes and hinge line.
+
+    Examples
+    --------
+    >>> panel = TrapezoidSurface((0, 0), 1.0, (0, 4.0), 1.0, 8, 8)
+    >>> hm = hinged_mesh(panel, ControlSurface("aileron", 0.75, 0.75, 0.5, 1.0))
+    >>> hm.mesh.n, int(hm.on_surface[0].sum()), round(hm.surface_area(0), 6)
+    (64, 8, 0.5)
+    """
+    if isinstance(surfaces, ControlSurface):
+        surfaces = (surfaces,)
+    surfaces = tuple(surfaces)
+    if not surfaces or not all(isinstance(s, ControlSurface) for s in surfaces):
+        raise ValueError("surfaces must be one or more ControlSurface")
+    if not isinstance(panel, TrapezoidSurface):
+        raise ValueError(f"panel must be a TrapezoidSurface, got {type(panel).__name__}")
+    _check_overlap(surfaces)
+    if panel.n_chord < 2:
+        raise ValueError(f"panel.n_chord must be >= 2 (boxes ahead of and aft of the hinge), "
+                         f"got {panel.n_chord}")
+    mean_aft = float(np.mean([s.flap_chord_fraction for s in surfaces]))
+    if n_chord_aft is None:
+        n_chord_aft = min(panel.n_chord - 1, max(1, round(panel.n_chord * mean_aft)))
+    n_aft = integer("n_chord_aft", n_chord_aft, low=1, high=panel.n_chord - 1)
+    n_fwd = panel.n_chord - n_aft
+    cuts = _span_cuts(surfaces)
+    widths = np.diff(cuts)
+    n_seg = np.maximum(1, np.round(panel.n_span * widths).astype(int))
+    corners, strip, owner = [], [], []
+    strip0 = 0
+    for e0, e1, ns in zip(cuts[:-1], cuts[1:], n_seg):
+        isurf, h0, h1 = _segment_hinges(surfaces, e0, e1, 1.0 - mean_aft)
+        le0, le1 = _point(panel, e0, 0.0), _point(panel, e1, 0.0)
+        hp0, hp1 = _point(panel, e0, h0), _point(panel, e1, h1)
+        te0, te1 = _point(panel, e0, 1.0), _point(panel, e1, 1.0)
+        fwd = TrapezoidSurface(le0, hp0[0] - le0[0], le1, hp1[0] - le1[0], n_fwd, int(ns))
+        aft = TrapezoidSurface(hp0, te0[0] - hp0[0], hp1, te1[0] - hp1[0], n_aft, int(ns))
+        cf = fwd.boxes().reshape(int(ns), n_fwd, 4, 3)
+        ca = aft.boxes().reshape(int(ns), n_aft, 4, 3)
+        corners.append(np.concatenate([cf, ca], axis=1).reshape(-1, 4, 3))
+        strip.append(strip0 + np.repeat(np.arange(int(ns)), panel.n_chord))
+        owner.append(np.tile(np.r_[np.full(n_fwd, -1), np.full(n_aft, isurf)], int(ns)))
+        strip0 += int(ns)
+    corners = np.concatenate(corners)
+    mesh = BoxMesh(corners, np.concatenate(strip), np.zeros(len(corners), int), (panel.name,))
+    owner = np.concatenate(owner)
+    on = np.array([owner == i for i in range(len(surfaces))])
+    pts = np.array([_point(panel, s.span_start, s.hinge_inboard) for s in surfaces])
+    ends = np.array([_point(panel, s.span_end, s.hinge_outboard) for s in surfaces])
+    axis = (ends - pts) / np.linalg.norm(ends - pts, axis=1)[:, None]
+    return HingedMesh(mesh, surfaces, on, pts, axis)
+
+
+def deflection_modes(hm: HingedMesh) -> BoxModes:
+    """The unit deflections (1 rad, trailing edge down) of the surfaces as box modes:
+    h = -d, dh/dx = -cos(Lambda_h) on each surface's boxes, 0 elsewhere (module docstring),
+    one column per surface; ``.normalwash(k, b_ref)`` gives w/U = dh/dx + i k h / b.
+
+    Examples
+    --------
+    >>> panel = TrapezoidSurface((0, 0), 1.0, (0, 4.0), 1.0, 4, 2)
+    >>> m = deflection_modes(hinged_mesh(panel, ControlSurface("flap", 0.75, 0.75)))
+    >>> m.normalwash(0.0, 0.5)[:4, 0].real.tolist()       # steady: w/U = -delta on the flap
+    [0.0, 0.0, 0.0, -1.0]
+    """
+    mesh = hm.mesh
+    n_s = len(hm.surfaces)
+    h_cp, s_cp, h_lp = (np.zeros((mesh.n, n_s)) for _ in range(3))
+    for i in range(n_s):
+        on = hm.on_surface[i]
+        ax = hm.hinge_axis[i]
+        cos_sweep = ax[1] / np.hypot(ax[0], ax[1])      # d(distance aft)/dx = cos(Lambda_h)
+        h_cp[on, i] = -hm.distance_aft(i, mesh.control_point[on])
+        s_cp[on, i] = -cos_sweep
+        h_lp[on, i] = -hm.distance_aft(i, mesh.load_point[on])
+    return BoxModes(h_cp, s_cp, h_lp)
+
+
+def hinge_moments(hm: HingedMesh, delta_cp: np.ndarray) -> np.ndarray:
+    """Hinge moments per unit dynamic pressure H / q (m^3), (n_surfaces, n_cols), of the
+    pressure jumps ``delta_cp`` (n_boxes, n_cols): -sum d DeltaCp A over each surface's boxes
+    (module docstring), positive when they tend to deflect the trailing edge down.
+
+    Examples
+    --------
+    A unit DeltaCp on a flap of chord 0.25 m and span 2 m, one box per chord: each box's load
+    acts at its quarter chord (the lattice's load point), d = 0.0625 m, so H / q = -0.0625 x
+    0.5 m^2 (-0.0625 for the continuous integral, -c_f^2 / 2 x span: the boxes converge to it).
+
+    >>> hm = hinged_mesh(TrapezoidSurface((0, 0), 1.0, (0, 2.0), 1.0, 4, 2),
+    ...                  ControlSurface("flap", 0.75, 0.75))
+    >>> round(float(hinge_moments(hm, np.ones(hm.mesh.n))[0, 0]), 6)
+    -0.03125
+    """
+    cp = np.asarray(delta_cp)
+    if cp.ndim == 1:
+        cp = cp[:, None]
+    if cp.shape[0] != hm.mesh.n:
+        raise ValueError(f"delta_cp must have {hm.mesh.n} rows (one per box), got {cp.shape[0]}")
+    return modal_forces(deflection_modes(hm), cp, hm.mesh.area)
+
+
+@dataclass(frozen=True)
+class ControlDerivatives:
+    """Steady (rigid) derivatives of a panel with control surfaces at one Mach number, per
+    radian: lift coefficients on the reference area, ``dCL_dalpha`` and ``dCL_ddelta``
+    (n_surfaces,); hinge-moment coefficients C_h = H / (q S_f c_f), ``Ch_alpha`` and
+    ``Ch_delta`` (n_surfaces,); ``mach``; ``reference_area`` (m^2)."""
+
+    mach: float
+    reference_area: float
+    dCL_dalpha: float
+    dCL_ddelta: np.ndarray
+    Ch_alpha: np.ndarray
+    Ch_delta: np.ndarray
+
+    @property
+    def effectiveness(self) -> np.ndarray:
+        """(dCL/d delta) / (dCL/d alpha), the 3-D flap effectiveness (-)."""
+        return self.dCL_ddelta / self.dCL_dalpha
+
+
+def steady_control_derivatives(hm: HingedMesh, mach: float, symmetric: bool = False,
+                               reference_area: float | None = None) -> ControlDerivatives:
+    """dCL/d alpha, dCL/d delta, C_h alpha and C_h delta of every surface from the vortex
+    lattice (:mod:`asekit.aero.vlm`) at Mach ``mach`` (0 <= M < 1).
+
+    The angle of attack is w/U = -1 on every box, a deflection the steady normalwash of
+    :func:`deflection_modes`; CL = sum DeltaCp A n_z / S (S the panel's area, doubled with
+    its image when ``symmetric``, or ``reference_area``), C_h = H / (q S_f c_f) with H from
+    :func:`hinge_moments`.
+
+    Examples
+    --------
+    >>> panel = TrapezoidSurface((0, 0), 1.0, (0, 3.0), 1.0, 8, 12)
+    >>> d = steady_control_derivatives(hinged_mesh(panel, ControlSurface("f", .75, .75)), 0.0,
+    ...                                symmetric=True)
+    >>> round(float(d.effectiveness[0]), 2), bool(d.Ch_delta[0] < 0 and d.Ch_alpha[0] < 0)
+    (0.59, True)
+    """
+    from asekit.aero.vlm import steady_pressure
+
+    mesh = hm.mesh
+    nz = mesh.normal[:, 2]
+    modes = deflection_modes(hm)
+    wash = np.column_stack([-nz, modes.normalwash(0.0, 1.0).real])
+    cp = steady_pressure(mesh, mach, wash, symmetric)
+    lift = (mesh.area * nz) @ cp
+    s = float(np.sum(mesh.area))
+    if symmetric:
+        lift = 2.0 * lift
+        s *= 2.0
+    if reference_area is not None:
+        s = in_range("reference_area", reference_area, 0.0)
+    h = hinge_moments(hm, cp)                       # (n_surfaces, 1 + n_surfaces)
+    sc = np.array([hm.surface_area(i) * hm.mean_chord(i) for i in range(len(hm.surfaces))])
+    n_s = len(hm.surfaces)
+    return ControlDerivatives(float(mach), s, float(lift[0] / s), lift[1:] / s,
+                              h[:, 0] / sc, h[np.arange(n_s), 1 + np.arange(n_s)] / sc)
+
+
+def oscillatory_control_coefficients(hm: HingedMesh, mach: float, k, b_ref: float,
+                                     method: str = "auto", symmetric: bool = False):
+    """Lift and hinge-moment coefficients of oscillating deflections delta exp(i omega t) at
+    reduced frequencies ``k`` (k = omega b_ref / U) by the method of
+    :mod:`asekit.aero.methods` (``"auto"``: the doublet lattice below M 1, the Mach box
+    above), the deflection normalwash of :func:`deflection_modes`.
+
+    Returns
+    -------
+    CL_delta : (n_k, n_s) complex, lift coefficient on the panel area (doubled with the image
+        when ``symmetric``) per rad of each surface's deflection.
+    Ch_delta : (n_k, n_s, n_s) complex, C_h of surface i (rows) per rad of surface j's
+        deflection, H / (q S_f c_f) (module docstring).
+
+    Examples
+    --------
+    >>> panel = TrapezoidSurface((0, 0), 1.0, (0, 3.0), 1.0, 8, 6)
+    >>> hm = hinged_mesh(panel, ControlSurface("f", 0.75, 0.75))
+    >>> cl, ch = oscillatory_control_coefficients(hm, 0.0, [0.001, 0.5], 0.5, symmetric=True)
+    >>> bool(abs(cl[1, 0]) < abs(cl[0, 0])), bool(ch[0, 0, 0].real < 0)
+    (True, True)
+    """
+    from asekit.aero.methods import pressures
+
+    mesh = hm.mesh
+    modes = deflection_modes(hm)
+    cp = pressures(mesh, mach, k, b_ref, lambda kk: modes.normalwash(kk, b_ref), method,
+                   symmetric)                                    # (n_k, n, n_s)
+    s = float(np.sum(mesh.area)) * (2.0 if symmetric else 1.0)
+    lift = np.einsum("b,kbj->kj", mesh.area * mesh.normal[:, 2], cp) * (2.0 if symmetric else 1.0)
+    sc = np.array([hm.surface_area(i) * hm.mean_chord(i) for i in range(len(hm.surfaces))])
+    h = np.stack([modal_forces(modes, c, mesh.area) for c in cp])   # (n_k, n_s, n_s)
+    return lift / s, h / sc[None, :, None]
+
+
+def glauert_flap_effectiveness(flap_chord_fraction: float) -> float:
+    """Thin-airfoil flap effectiveness tau = 1 - (theta_h - sin theta_h) / pi with
+    cos theta_h = 1 - 2 x_h / c, x_h / c = 1 - E (Glauert, *The Elements of Aerofoil and
+    Airscrew Theory*, 1926, Sec. 7.5; Abbott & von Doenhoff Eq. 8.14): the 2-D
+    (dcl/d delta) / (dcl/d alpha) of a flap of chord fraction E.
+
+    Examples
+    --------
+    >>> round(glauert_flap_effectiveness(0.25), 3)
+    0.609
+    """
+    e = in_range("flap_chord_fraction", flap_chord_fraction, 0.0, high=1.0)
+    th = np.arccos(1.0 - 2.0 * (1.0 - e))
+    return float(1.0 - (th - np.sin(th)) / np.pi)

@@ -1,0 +1,344 @@
+"""Control surfaces in the aeroelastic model: the hinge degree of freedom of a rigid surface
+added to a plate's modal model, its inertia and static unbalance, and the static aeroelastic
+control effectiveness and reversal.
+
+Hinge mode (MSC Nastran's AESURF with a rigid surface and a hinge spring: Rodden & Johnson,
+*MSC/NASTRAN Aeroelastic Analysis User's Guide*, 1994, Sec. 3.5). The wing's modes phi are
+computed with the surface locked to the wing (it is part of the plate); each surface adds one
+coordinate delta, its rigid rotation about the hinge relative to the wing (trailing edge down
+positive, :mod:`asekit.aero.control_surface`). The displacement of the structure is the Ritz
+expansion u = Phi zeta + U_f delta, with U_f the surface's rigid rotation on the finite-element
+degrees of freedom (w = -d, theta_x = dw/dy, theta_y = -dw/dx; d the distance aft of the
+hinge), so that the modal mass, stiffness and damping are
+
+    M = [[M_ww, Phi^T M_fe U_f], [U_f^T M_fe Phi, U_f^T M_fe U_f]] + balance masses,
+    K = diag(K_ww, k_h),   C = diag(C_ww, c_h),
+
+with k_h the hinge spring (N m/rad) and c_h the hinge damper (N m s/rad): the surface's own
+bending is the wing's (the plate's stiffness ties it to the wing in the locked modes), its
+rotation relative to the wing is resisted by the hinge spring only. The surface's inertia about
+its hinge is I_h = U_f^T M_fe U_f and its static unbalance S_h = sum m d (kg m, > 0 when the
+centre of mass lies aft of the hinge, the classic flutter-prone case). A balance mass m_b at
+(x_b, y_b) on the surface (usually ahead of the hinge, d_b < 0) moves by
+phi(x_b, y_b) zeta - d_b delta and adds its mass to every block.
+
+The aerodynamic box modes are the wing's (splined) and the deflections of
+:func:`asekit.aero.control_surface.deflection_modes`, side by side, so the GAFs and the p-k
+method (:mod:`asekit.aeroelastic.flutter`) take the surface as one more mode.
+
+Static aeroelasticity (Bisplinghoff, Ashley & Halfman, *Aeroelasticity*, 1955, Sec. 8-4): with
+the deflection held (an irreversible actuator), the wing's steady response to delta is
+(K_ww - q Q_ww(0)) zeta = q Q_wd(0) delta; the flexible rolling moment (or lift) is the rigid
+one plus that of zeta, and the reversal dynamic pressure q_R is where it crosses zero.
+
+Strip theory (a uniform wing, elastic axis e chords behind the aerodynamic centre) reverses
+only when the deflection's moment about the elastic axis is nose-down, e c_l,delta + c_m,delta
+< 0 (for a 25 % flap, e < 0.17 with the thin-airfoil c_l,delta = 3.83, c_m,delta = -0.65); a
+flat plate (e = 0.25) would gain effectiveness up to divergence. The lifting surface moves the
+deflection's centre of pressure aft as the effective aspect ratio falls, so a plate wing can
+reverse all the same: measured on the 0.3 m x 1.2 m aluminium plate of the examples, a
+full-span 25 % flap with the symmetric image (aspect ratio 8) gains lift up to divergence as
+strip theory says, while the same wing alone or loaded antisymmetrically (rolling) reverses
+just below divergence (q_R = 477-488 Pa against q_D = 515-540 Pa).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import linalg
+from scipy.optimize import brentq
+
+from asekit.aero.control_surface import HingedMesh, deflection_modes
+from asekit.aero.spline import BoxModes, fe_spline
+from asekit.aeroelastic.statespace import ModalArrays
+from asekit.structure.modes import mode_shapes_at
+from asekit.util.validate import in_range, integer, positive
+
+
+@dataclass(frozen=True)
+class BalanceMass:
+    """A concentrated mass (kg) at (x, y) (m) fixed to control surface ``surface`` (index),
+    moving with the wing and with the surface's rotation (a mass balance when ahead of the
+    hinge)."""
+
+    surface: int
+    x: float
+    y: float
+    mass: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "mass", positive("mass", self.mass))
+
+
+@dataclass(frozen=True)
+class FlapModel:
+    """A wing's modal model with hinge coordinates.
+
+    ``modal`` the :class:`ModalArrays` (wing modes first, in the wing model's order and with its
+    ``n_rigid``, then one coordinate per surface); ``box_modes`` the matching
+    :class:`BoxModes`; ``inertia`` (n_s,) about each hinge (kg m^2) and ``static_unbalance``
+    (n_s,) (kg m, > 0 centre of mass aft of the hinge), balance masses included;
+    ``hinge_frequency_hz`` (n_s,) sqrt(k_h / I_h) / 2 pi, the uncoupled hinge frequency;
+    ``n_wing`` the wing's modes; ``names`` of the surfaces.
+    """
+
+    modal: ModalArrays
+    box_modes: BoxModes
+    inertia: np.ndarray
+    static_unbalance: np.ndarray
+    hinge_frequency_hz: np.ndarray
+    n_wing: int
+    names: tuple
+
+
+def flap_rotation_vector(nodes: np.ndarray, hm: HingedMesh, index: int) -> np.ndarray:
+    """Unit rigid rotation (1 rad, trailing edge down) of surface ``index`` on the
+    finite-element degrees of freedom (w, theta_x, theta_y per node; ``nodes`` (n, 2) m):
+    w = -d, theta_x = dw/dy, theta_y = -dw/dx on the nodes aft of the hinge line inside the
+    surface's span, zero elsewhere. Nodes on the hinge line (|d| below 1e-9 of the chord)
+    carry half the rotation: their mass is shared by the wing and the surface (the lumped
+    view of a node on the cut; the structural mesh should have a line on the hinge).
+
+    Examples
+    --------
+    >>> from asekit.aero.boxes import TrapezoidSurface
+    >>> from asekit.aero.control_surface import ControlSurface, hinged_mesh
+    >>> hm = hinged_mesh(TrapezoidSurface((0, 0), 1.0, (0, 2.0), 1.0, 4, 2),
+    ...                  ControlSurface("f", 0.5, 0.5))
+    >>> flap_rotation_vector(np.array([[0.25, 1.0], [0.5, 1.0], [1.0, 1.0]]), hm, 0).tolist()
+    [0.0, 0.0, 0.0, 0.0, 0.0, 0.5, -0.5, 0.0, 1.0]
+    """
+    p = np.column_stack([np.asarray(nodes, float), np.zeros(len(nodes))])
+    d = hm.distance_aft(index, p)
+    s = hm.hinge_axis[index]
+    tol = 1e-9 * (float(np.ptp(hm.mesh.corners[:, :, 0])) + 1e-300)
+    along = (p - hm.hinge_point[index]) @ s            # position along the hinge line
+    inside = (along >= -tol) & (along <= _hinge_length(hm, index) + tol)
+    weight = np.where(d > tol, 1.0, np.where(d > -tol, 0.5, 0.0)) * inside
+    u = np.zeros(3 * len(p))
+    u[0::3] = -np.maximum(d, 0.0) * weight + 0.0          # no -0.0
+    u[1::3] = s[0] / np.hypot(s[0], s[1]) * weight       # dw/dy = s_x (w = -d)
+    u[2::3] = s[1] / np.hypot(s[0], s[1]) * weight       # -dw/dx = cos(Lambda_h)
+    return u
+
+
+def _hinge_length(hm: HingedMesh, index: int) -> float:
+    m = hm.on_surface[index]
+    c = hm.mesh.corners[m]
+    pts = np.concatenate([c[:, 0], c[:, 3]])
+    return float(np.max((pts - hm.hinge_point[index]) @ hm.hinge_axis[index]))
+
+
+def flap_modal_model(model, M_fe, hm: HingedMesh, hinge_stiffness, hinge_damping=0.0,
+                     balance=()) -> FlapModel:
+    """The wing's modal model with one hinge coordinate per control surface (module docstring).
+
+    Parameters
+    ----------
+    model : :class:`asekit.structure.modes.ModalModel` of the wing, the surfaces locked.
+    M_fe : (3 n_nodes, 3 n_nodes) finite-element mass matrix (kg, kg m, kg m^2 blocks) of the
+        same mesh, unsupported (:func:`asekit.case.pipeline.mass_and_stiffness`).
+    hm : the boxes with the surfaces (:func:`asekit.aero.control_surface.hinged_mesh`) in the
+        plate's plane.
+    hinge_stiffness : k_h per surface (N m/rad, >= 0; scalar or one per surface).
+    hinge_damping : c_h per surface (N m s/rad, >= 0).
+    balance : :class:`BalanceMass` items.
+
+    Returns
+    -------
+    FlapModel
+
+    Examples
+    --------
+    A clamped 0.3 m x 1.2 m, 2 mm aluminium plate with a 25 % aileron on its outboard half:
+    the uniform plate flap of 0.243 kg has S = m c_f / 2 = 9.1 g m and I = m c_f^2 / 3 =
+    0.46 g m^2 (the finite-element mass: 9.7 and 0.47).
+
+    >>> from asekit.aero.boxes import TrapezoidSurface
+    >>> from asekit.aero.control_surface import ControlSurface, hinged_mesh
+    >>> from asekit.geometry import Material, Planform, Thickness
+    >>> from asekit.structure.assembly import assemble, clamped_edge
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> from asekit.structure.modes import fixed_modal_model
+    >>> pm = panels_mesh([Planform((0, 0), 0.3, (0, 1.2), 0.3)], Thickness(0.002, 0.002), 8, [16])
+    >>> K, M = assemble(pm, Material(70e9, 0.3, 2700.0))
+    >>> model = fixed_modal_model(clamped_edge(pm, K, M), M, n_modes=4)
+    >>> hm = hinged_mesh(TrapezoidSurface((0, 0), 0.3, (0, 1.2), 0.3, 8, 16),
+    ...                  ControlSurface("aileron", 0.75, 0.75, 0.5, 1.0))
+    >>> fm = flap_modal_model(model, M, hm, 0.5)
+    >>> round(1e3 * float(fm.static_unbalance[0]), 2), round(1e3 * float(fm.inertia[0]), 3)
+    (9.68, 0.475)
+    """
+    n_s = len(hm.surfaces)
+    k_h = np.broadcast_to(np.asarray(hinge_stiffness, float), (n_s,)).copy()
+    c_h = np.broadcast_to(np.asarray(hinge_damping, float), (n_s,)).copy()
+    for nm, v in (("hinge_stiffness", k_h), ("hinge_damping", c_h)):
+        for x in v:
+            in_range(nm, x, 0.0, inclusive=True)
+    nodes = np.asarray(model.nodes, float)
+    phi = np.asarray(model.shapes, float).reshape(3 * len(nodes), -1)
+    uf = np.column_stack([flap_rotation_vector(nodes, hm, i) for i in range(n_s)])
+    basis = np.hstack([phi, uf])
+    n_w = phi.shape[1]
+    M = np.array(model.M, float)
+    mu = basis.T @ (M_fe @ uf)                                   # (n_w + n_s, n_s)
+    m_aug = np.zeros((n_w + n_s, n_w + n_s))
+    m_aug[:n_w, :n_w] = M
+    m_aug[:, n_w:] = mu
+    m_aug[n_w:, :n_w] = mu[:n_w].T
+    w_unit = np.zeros(3 * len(nodes))
+    w_unit[0::3] = 1.0
+    unbalance = -(w_unit @ (M_fe @ uf))                          # sum m d
+    inertia = np.diag(mu[n_w:]).copy()
+    for bm in balance:
+        if not isinstance(bm, BalanceMass) or not 0 <= bm.surface < n_s:
+            raise ValueError(f"balance must hold BalanceMass items with surface in [0, "
+                             f"{n_s - 1}], got {bm!r}")
+        h, _ = mode_shapes_at(model, np.array([[bm.x, bm.y]]))
+        d = float(hm.distance_aft(bm.surface, np.array([[bm.x, bm.y, 0.0]]))[0])
+        v = np.zeros(n_w + n_s)
+        v[:n_w] = h[0]
+        v[n_w + bm.surface] = -d
+        m_aug += bm.mass * np.outer(v, v)
+        unbalance[bm.surface] += bm.mass * d
+        inertia[bm.surface] += bm.mass * d * d
+    k_aug = np.zeros_like(m_aug)
+    k_aug[:n_w, :n_w] = model.K
+    k_aug[n_w:, n_w:] = np.diag(k_h)
+    c_aug = np.zeros_like(m_aug)
+    c_aug[:n_w, :n_w] = model.C
+    c_aug[n_w:, n_w:] = np.diag(c_h)
+    wing = fe_spline(model, hm.mesh)
+    flap = deflection_modes(hm)
+    box = BoxModes(np.hstack([wing.h_cp, flap.h_cp]), np.hstack([wing.dhdx_cp, flap.dhdx_cp]),
+                   np.hstack([wing.h_lp, flap.h_lp]))
+    f_h = np.sqrt(k_h / inertia) / (2.0 * math.pi)
+    return FlapModel(ModalArrays(m_aug, k_aug, c_aug, int(model.n_rigid)), box, inertia,
+                     unbalance, f_h, n_w, tuple(s.name for s in hm.surfaces))
+
+
+@dataclass(frozen=True)
+class StaticEffectiveness:
+    """Steady flexible-to-rigid effectiveness of each surface: ``dynamic_pressure`` (n_q,) Pa;
+    ``ratio`` (n_s, n_q) flexible over rigid rolling moment (or lift) per unit deflection;
+    ``reversal_q`` (n_s,) Pa (nan: none below the divergence or the search limit);
+    ``divergence_q`` Pa (nan: none found); ``what`` "rolling moment" or "lift"."""
+
+    dynamic_pressure: np.ndarray
+    ratio: np.ndarray
+    reversal_q: np.ndarray
+    divergence_q: float
+    what: str
+
+    def reversal_speed(self, density: float) -> np.ndarray:
+        """Reversal speeds sqrt(2 q_R / rho) (m/s) at air density ``density`` (kg/m^3)."""
+        rho = positive("density", density)
+        return np.sqrt(2.0 * self.reversal_q / rho)
+
+
+#: the images in the plane y = 0 of the steady solution: none (an isolated surface), a wall
+#: (symmetric loading: a symmetric deflection of both halves) or antisymmetric loading (the
+#: two ailerons of a wing deflected in opposite senses, the rolling case)
+IMAGES = ("none", "symmetric", "antisymmetric")
+
+
+def steady_generalised_forces(fm: FlapModel, hm: HingedMesh, mach: float,
+                              image: str = "none") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(Q0, lift, roll): the steady GAFs Q0 (n, n) per unit dynamic pressure (vortex lattice,
+    :mod:`asekit.aero.vlm`, with the ``image`` of :data:`IMAGES` in y = 0: the antisymmetric
+    normalwash matrix is D_self - D_image = 2 D_self - D_symmetric), and the lift (m^2) and
+    rolling moment about y = 0 (m^3, positive for lift at y > 0) of each coordinate per unit
+    dynamic pressure (of the half model when there is an image)."""
+    from asekit.aero.vlm import vlm_normalwash_matrix
+
+    if image not in IMAGES:
+        raise ValueError(f"image must be one of {IMAGES}, got {image!r}")
+    mesh = hm.mesh
+    d = vlm_normalwash_matrix(mesh, mach, False)
+    if image != "none":
+        d_sym = vlm_normalwash_matrix(mesh, mach, True)
+        d = d_sym if image == "symmetric" else 2.0 * d - d_sym
+    cp = np.linalg.solve(d, fm.box_modes.normalwash(0.0, 1.0).real)
+    q0 = fm.box_modes.h_lp.T @ (mesh.area[:, None] * cp)
+    lift = (mesh.area * mesh.normal[:, 2]) @ cp
+    roll = (mesh.area * mesh.normal[:, 2] * mesh.load_point[:, 1]) @ cp
+    return q0, lift, roll
+
+
+def static_effectiveness(fm: FlapModel, hm: HingedMesh, mach: float, q_max: float,
+                         n_q: int = 60, image: str = "none",
+                         what: str = "rolling moment") -> StaticEffectiveness:
+    """Flexible-to-rigid effectiveness against dynamic pressure and the reversal dynamic
+    pressure of every surface (module docstring), the surfaces held at their deflection
+    (hinge coordinates constrained) and the wing's rigid modes held (a clamped or
+    actuator-held wing).
+
+    Parameters
+    ----------
+    fm, hm : the model (:func:`flap_modal_model`) and its boxes.
+    mach : 0 <= M < 1 (vortex lattice).
+    q_max : the largest dynamic pressure searched (Pa, > 0).
+    n_q : points of the effectiveness curve (>= 2).
+    image : the image in y = 0 (:data:`IMAGES`): "antisymmetric" for the ailerons of a half
+        wing at a symmetry plane (rolling), "symmetric" for flaps, "none" for an isolated
+        surface.
+    what : "rolling moment" (about y = 0, a half wing's aileron) or "lift".
+
+    Returns
+    -------
+    StaticEffectiveness
+
+    Examples
+    --------
+    :func:`flap_modal_model`'s aluminium plate wing, isolated (no image): the aileron
+    reverses below the wing's divergence.
+
+    >>> from asekit.aero.boxes import TrapezoidSurface
+    >>> from asekit.aero.control_surface import ControlSurface, hinged_mesh
+    >>> from asekit.geometry import Material, Planform, Thickness
+    >>> from asekit.structure.assembly import assemble, clamped_edge
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> from asekit.structure.modes import fixed_modal_model
+    >>> pm = panels_mesh([Planform((0, 0), 0.3, (0, 1.2), 0.3)], Thickness(0.002, 0.002), 8, [16])
+    >>> K, M = assemble(pm, Material(70e9, 0.3, 2700.0))
+    >>> model = fixed_modal_model(clamped_edge(pm, K, M), M, n_modes=4)
+    >>> hm = hinged_mesh(TrapezoidSurface((0, 0), 0.3, (0, 1.2), 0.3, 8, 16),
+    ...                  ControlSurface("aileron", 0.75, 0.75, 0.5, 1.0))
+    >>> fm = flap_modal_model(model, M, hm, 0.5)
+    >>> se = static_effectiveness(fm, hm, 0.0, 2000.0)
+    >>> bool(0 < se.reversal_q[0] < se.divergence_q), float(se.ratio[0, 0])
+    (True, 1.0)
+    """
+    q_max = positive("q_max", q_max)
+    if what not in ("rolling moment", "lift"):
+        raise ValueError(f"what must be 'rolling moment' or 'lift', got {what!r}")
+    q0, lift, roll = steady_generalised_forces(fm, hm, mach, image)
+    r = roll if what == "rolling moment" else lift
+    nr, nw = fm.modal.n_rigid, fm.n_wing
+    w = np.arange(nr, nw)
+    f = np.arange(nw, nw + len(fm.names))
+    K = fm.modal.K[np.ix_(w, w)]
+    Qww = q0[np.ix_(w, w)]
+
+    def ratio(q, j):
+        zeta = np.linalg.solve(K - q * Qww, q * q0[w, f[j]])
+        return (r[f[j]] + r[w] @ zeta) / r[f[j]]
+
+    mu = linalg.eigvals(Qww, K)                       # Q x = mu K x, q = 1 / mu
+    mu = mu[np.abs(mu.imag) <= 1e-9 * np.maximum(np.abs(mu), 1e-300)].real
+    q_div = float(1.0 / mu[mu > 0].max()) if np.any(mu > 0) else math.nan
+    q_top = min(q_max, 0.999 * q_div) if math.isfinite(q_div) else q_max
+    qs = np.linspace(0.0, q_top, integer("n_q", n_q, low=2))
+    rat = np.array([[ratio(q, j) for q in qs] for j in range(len(f))])
+    q_r = np.full(len(f), math.nan)
+    for j in range(len(f)):
+        sign = np.flatnonzero(np.diff(np.sign(rat[j])) != 0)
+        if sign.size:
+            i = int(sign[0])
+            q_r[j] = brentq(lambda q: ratio(q, j), qs[i], qs[i + 1], xtol=1e-10 * q_top)
+    return StaticEffectiveness(qs, rat, q_r, q_div, what)
+
+
