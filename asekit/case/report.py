@@ -385,6 +385,7 @@ def _turbulence_lines(rows) -> list:
                    f"N0 {_cell(r['N0_per_s'])} /s); root bending RMS "
                    f"{_cell(r['rms_root_bending_Nm'])} N m (A-bar "
                    f"{_cell(r['A_bar_root_bending'])}, N0 {_cell(r['N0_root_bending_per_s'])} /s)")
+    return out
 
 
 def _control_lines(rows) -> list[str]:

@@ -72,7 +72,7 @@ def test_fingerprint_without_control_surfaces_is_unchanged_by_the_new_key():
     import json
     case = load_case(CASES_DIR / "agard445_6.toml")
     d = dataclasses.asdict(dataclasses.replace(case, structure=None))
-    for k in ("name", "reference", "source", "convergence", "control_surfaces"):
+    for k in ("name", "reference", "source", "convergence", "control_surfaces", "gust"):
         d.pop(k)
     old = hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
     assert case.fingerprint() == old
@@ -107,7 +107,7 @@ def test_pipeline_rows_physics(rows):
 
 
 def test_summary_lines_and_json_keys(rows):
-    a = report.Analysis(None, None, None, None, None, {}, rows)
+    a = report.Analysis(None, None, None, None, None, {}, control=rows)
     s = {"control_surfaces": [
         {"name": r.name, "mach": r.mach, "dCL_ddelta_per_rad": r.dCL_ddelta_per_rad,
          "dCL_dalpha_per_rad": r.dCL_dalpha_per_rad, "Ch_delta": r.Ch_delta,
