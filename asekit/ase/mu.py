@@ -39,6 +39,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import math
+
 import numpy as np
 
 KINDS = ("full", "complex", "real")
@@ -175,11 +177,6 @@ def _slices(blocks):
     return out
 
 
-def _unit(z):
-    a = np.abs(z)
-    return np.where(a > 0, z / np.where(a > 0, a, 1.0), 1.0)
-
-
 def _delta_of(a, w, blocks):
     """The perturbation aligning a (the input of Delta's output side) with w (Eq. 9.8)."""
     n = len(a)
@@ -229,46 +226,53 @@ def lower_bound(M, blocks, iterations: int = 200, starts: int = 4, seed: int = 0
     inits = [Vh[0].conj()] + [rng.standard_normal(n) + 1j * rng.standard_normal(n)
                               for _ in range(max(0, starts - 1))]
     best, best_D = 0.0, np.eye(n, dtype=complex)
+    sl = _slices(blocks)
     for b in inits:
         b = b / np.linalg.norm(b)
         w = b.copy()
-        for _ in range(int(iterations)):
+        for it in range(int(iterations)):
             a = M @ b
             if np.linalg.norm(a) == 0:
                 break
             a = a / np.linalg.norm(a)
-            z = _align(a, w, blocks)
+            z = _align(a, w, blocks, sl)
             w = M.conj().T @ z
             if np.linalg.norm(w) == 0:
                 break
             w = w / np.linalg.norm(w)
-            b = _align(w, a, blocks)
-            D = _delta_of(a, w, blocks)
-            r = _rho(M, D, real)
-            if r > best:
-                best, best_D = r, D
+            b_new = _align(w, a, blocks, sl)
+            done = np.linalg.norm(b_new - b) < 1e-10 * max(np.linalg.norm(b), 1e-300)
+            b = b_new
+            if done or it % 25 == 24:
+                D = _delta_of(a, w, blocks)
+                r = _rho(M, D, real)
+                if r > best:
+                    best, best_D = r, D
+            if done:
+                break
     return best, best_D
 
 
-def _align(x, y, blocks):
+def _align(x, y, blocks, slices=None):
     """Per block: x's direction scaled to y's norm (full), or x with y's block norms and
     phases matched for scalar blocks (Packard & Doyle 1993, Eqs 9.6-9.7)."""
     out = np.empty_like(x)
-    for blk, s in zip(blocks, _slices(blocks)):
+    for blk, s in zip(blocks, _slices(blocks) if slices is None else slices):
         xi, yi = x[s], y[s]
-        nx, ny = np.linalg.norm(xi), np.linalg.norm(yi)
-        if blk.kind == "full" or nx == 0:
+        if blk.kind == "full":
+            nx = math.sqrt(np.vdot(xi, xi).real)
+            ny = math.sqrt(np.vdot(yi, yi).real)
             out[s] = xi * (ny / nx) if nx > 0 else yi
         else:
-            q = np.vdot(yi, xi)
-            ph = _unit(np.array([q]))[0]
+            q = complex(np.vdot(yi, xi))
+            ph = q / abs(q) if q != 0 else 1.0
             if blk.kind == "real":
-                ph = 1.0 if np.real(ph) >= 0 else -1.0
+                ph = 1.0 if ph.real >= 0 else -1.0
             out[s] = ph * yi
     return out
 
 
-def mu_bounds(M, blocks, x0=None) -> MuBounds:
+def mu_bounds(M, blocks, x0=None, iterations: int = 200, starts: int = 4) -> MuBounds:
     """Both bounds of mu(M) for ``blocks`` (module docstring).
 
     Parameters
@@ -276,6 +280,7 @@ def mu_bounds(M, blocks, x0=None) -> MuBounds:
     M : (n, n) complex matrix, the loop seen by the perturbation (Delta's output to its input).
     blocks : sequence of :class:`Block` whose sizes add up to n.
     x0 : optional warm start of the upper bound's log scalings.
+    iterations, starts : of the lower bound's power iteration (:func:`lower_bound`).
 
     Returns
     -------
@@ -291,11 +296,11 @@ def mu_bounds(M, blocks, x0=None) -> MuBounds:
     """
     M, blocks = _check(M, blocks)
     up, d = upper_bound(M, blocks, x0)
-    lo, D = lower_bound(M, blocks)
+    lo, D = lower_bound(M, blocks, iterations, starts)
     return MuBounds(lower=float(min(lo, up)), upper=float(up), scaling=d, delta=D)
 
 
-def mu_frequency(Ms, blocks) -> dict:
+def mu_frequency(Ms, blocks, iterations: int = 100, starts: int = 2) -> dict:
     """Bounds of mu over a frequency grid: ``Ms`` (n_f, n, n) the loop matrix at each
     frequency. Warm starts the D-scaling from the previous frequency. Returns ``{"lower":
     (n_f,), "upper": (n_f,), "peak_upper": float, "i_peak": int}``.
@@ -315,7 +320,7 @@ def mu_frequency(Ms, blocks) -> dict:
     lo, up = np.zeros(len(Ms)), np.zeros(len(Ms))
     x = None
     for i, M in enumerate(Ms):
-        b = mu_bounds(M, blocks, x)
+        b = mu_bounds(M, blocks, x, iterations, starts)
         lo[i], up[i] = b.lower, b.upper
         x = np.array([np.log(b.scaling[g[0]]) for g in groups])
     i = int(np.argmax(up))
