@@ -37,9 +37,8 @@ Plain numpy/scipy; no toolbox needed.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
