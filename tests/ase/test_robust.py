@@ -22,7 +22,9 @@ def test_weights_from_table2():
     # critically damped 2nd order: (1 + x) exp(-x) = 0.02 at x = 5.834
     x = w.reference_rad_s * 0.025
     assert (1 + x) * math.exp(-x) == pytest.approx(0.02, rel=1e-3)
-    assert w.integral == pytest.approx(1e-3) and w.voltage == pytest.approx(math.radians(1) / 24)
+    assert w.integral == pytest.approx(1e-3) and w.voltage == pytest.approx(1e-3)
+    low = robust.weights_from_requirements(voltage_weight=1e-6, voltage_limit=24.0)
+    assert low.voltage == pytest.approx(math.radians(1) / 24)     # 1 deg may use the supply
     with pytest.raises(ValueError, match="model_fraction"):
         robust.weights_from_requirements(model_fraction=1.5)
 
