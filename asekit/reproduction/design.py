@@ -777,7 +777,8 @@ def hinf_quantities(data) -> list[Quantity]:
               Quantity("ase.design.hinf.mu_peak", mu["mu_peak"], "-",
                        f"upper bound at {mu['f_peak_hz']:.0f} Hz (lower "
                        f"{mu['mu_peak_lower']:.3g}); stable for {mu['margin']:.2g} x the "
-                       "stated uncertainty")]
+                       "stated uncertainty (complex bound of the real blocks, Mach-altitude "
+                       "as a multiplicative cover: conservative near the elastic modes)")]
     else:
         why = "not computed: python -m asekit reproduce --robust (about a minute)"
         q += [Quantity("ase.design.hinf.conditions_passed", None, "-", why, computed=False),
