@@ -96,3 +96,13 @@ def test_cover_block_small_gain():
     r = robust.robust_stability(A, B, C, lambda w: -4.0, unc, f, delay=0.0)
     L = np.array([-4.0 / (2j * np.pi * x + 1) for x in f])
     assert np.allclose(r["upper"], 0.5 * np.abs(L / (1 - L)), rtol=1e-6)
+
+
+def test_without_slycot_the_error_names_the_pip_line(monkeypatch):
+    import sys
+
+    from asekit.util.extras import MissingExtra
+    P, w = motor(), robust.weights_from_requirements()        # (python-control uses slycot)
+    monkeypatch.setitem(sys.modules, "slycot", None)          # import slycot -> ImportError
+    with pytest.raises(MissingExtra, match=r"pip install 'asekit-aero\[robust\]'"):
+        robust.hinf_2dof(P, w, delay=0.0)
