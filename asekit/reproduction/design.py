@@ -672,11 +672,51 @@ def design_hinf(data=None, weights=None):
 
     w = robust.weights_from_requirements(SETTLING, STEADY_ERROR, voltage_limit=V_MAX) \
         if weights is None else weights
-    m = fin_model(*HINF_CONDITION, data=data)
-    d = robust.hinf_2dof(ase.open_loop(m, 3), w, delay=HINF_DELAY,
-                         design_order=HINF_DESIGN_ORDER)
-    K = robust.reduce_controller(d.continuous, HINF_ORDER)
+    plant = ase.open_loop(fin_model(*HINF_CONDITION, data=data), 3)
+    d, K = _hinf_cached(plant, w)
     return robust.discretise(K, SAMPLE_TIME, name="H-infinity 2-DOF"), d
+
+
+def _hinf_cached(plant, w):
+    """(HinfDesign, reduced continuous controller), from the user cache when its fingerprint
+    (plant matrices, weights, orders, delay, the source of asekit.ase.robust) matches
+    (:mod:`asekit.util.cache`: atomic, checksummed); computed and cached otherwise."""
+    import dataclasses
+    import hashlib
+    import inspect
+    import json
+
+    import control as ct
+
+    from asekit.ase import robust
+    from asekit.util.cache import CacheError, load_npz, save_npz
+    from asekit.util.paths import user_cache_dir
+
+    h = hashlib.sha256()
+    for x in (plant.A, plant.B, plant.C, plant.D):
+        h.update(np.ascontiguousarray(np.asarray(x, float)).tobytes())
+    h.update(json.dumps([dataclasses.asdict(w), HINF_ORDER, HINF_DESIGN_ORDER, HINF_DELAY],
+                        sort_keys=True).encode())
+    h.update(inspect.getsource(robust).encode())
+    key = h.hexdigest()
+    path = user_cache_dir() / f"hinf_{key[:24]}.npz"
+    names = ("fA", "fB", "fC", "fD", "A", "B", "C", "D")
+    try:
+        arr, meta = load_npz(path, expect_metadata={"fingerprint": key})
+        full = ct.ss(*(arr[n] for n in names[:4]), inputs=["r", "y"], outputs=["u"])
+        K = ct.ss(*(arr[n] for n in names[4:]), inputs=["r", "y"], outputs=["u"])
+        return robust.HinfDesign(full, float(meta["gamma"]), w), K
+    except CacheError:
+        pass
+    d = robust.hinf_2dof(plant, w, delay=HINF_DELAY, design_order=HINF_DESIGN_ORDER)
+    K = robust.reduce_controller(d.continuous, HINF_ORDER)
+    mats = [np.asarray(x, float) for s in (d.continuous, K) for x in (s.A, s.B, s.C, s.D)]
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        save_npz(path, dict(zip(names, mats)), {"fingerprint": key, "gamma": d.gamma})
+    except OSError:
+        pass                                   # a read-only cache: computed each time
+    return d, K
 
 
 def _plant_A(model):

@@ -54,3 +54,17 @@ def test_mu_bound_agrees_with_the_sampled_conditions(data, hinf):
     # every nominal condition passes (the design's envelope)
     assert all(c.table2_pass for c in checks if c.case == "nominal")
     assert 130.0 < mu["f_peak_hz"] < 170.0
+
+
+def test_design_is_cached_bit_identically(data, hinf, tmp_path, monkeypatch):
+    """The synthesis is cached in the user cache: a cold design (empty cache directory) and a
+    warm one give the same controller to the bit."""
+    monkeypatch.setenv("ASEKIT_CACHE_DIR", str(tmp_path))
+    cold, _ = dz.design_hinf(data)
+    assert len(list(tmp_path.glob("hinf_*.npz"))) == 1
+    warm, d = dz.design_hinf(data)
+    for a, b in zip((cold.ss.A, cold.ss.B, cold.ss.C, cold.ss.D),
+                    (warm.ss.A, warm.ss.B, warm.ss.C, warm.ss.D)):
+        assert np.array_equal(np.asarray(a), np.asarray(b))
+    assert np.array_equal(np.asarray(warm.ss.A), np.asarray(hinf[0].ss.A))
+    assert d.continuous.nstates > warm.ss.nstates
