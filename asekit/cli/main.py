@@ -80,6 +80,8 @@ def _reproduce(args) -> int:
     _check_outputs(args.parser, args)
     if args.converged:             # read by asekit.reproduction.flutter.converged_study_requested
         os.environ["ASEKIT_CONVERGED_STUDY"] = "1"
+    if getattr(args, "robust", False):     # asekit.reproduction.design.robust_study_requested
+        os.environ["ASEKIT_ROBUST_STUDY"] = "1"
     import matplotlib
     matplotlib.use("Agg")
     from asekit.reproduction.driver import ChapterFailed, reproduce
@@ -127,6 +129,9 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--converged", action="store_true",
                      help="also compute the fin's mesh-converged flutter study if it is not "
                           "cached (about 8 min and 7 GB of memory the first time)")
+    rep.add_argument("--robust", action="store_true",
+                     help="also check the H-infinity design on the 45 conditions and compute "
+                          "its mu bound (about a minute)")
     rep.set_defaults(func=_reproduce, parser=rep)
     add_analyse(sub)
     add_sweep(sub)

@@ -19,6 +19,7 @@ EXTRAS = {
     "nbclient": "notebooks",
     "nbformat": "notebooks",
     "nbconvert": "notebooks",
+    "slycot": "robust",
 }
 
 

@@ -7,6 +7,10 @@ graded meshes extrapolated with an error bar) were added to the baseline on 2026
 ``python -m asekit reproduce --only flutter --json`` (two cold runs, bit-identical); no other
 value of the baseline changed.
 
+The six ``ase.design.hinf.*`` rows (issue 26: the H-infinity design; ``conditions_passed`` and
+``mu_peak`` are computed with ``reproduce --robust`` only) were added on 2026-12-03 from
+``python -m asekit reproduce --only design --json``; no other value changed.
+
 The two ``flutter.converged.*`` rows are computed only when their GAF database is already in
 the user cache (CI computes it first), so they are skipped when the baseline holds None.
 """
