@@ -16,7 +16,8 @@ deck's record (:class:`BdfModel`, with the Nastran ids) and :func:`deck_case` ma
 one reader per card (``_read_grids``, ``_read_pshell``, ``_read_celas``, ... each with the
 card's field table). Export (:func:`write_case_bdf`): a case -- declarative or imported -- as
 a deck that pyNastran reads and Nastran runs (SOL 103 or SOL 145 case control), its support
-written by kind (:data:`SUPPORT_CARDS`).
+written by kind (:data:`SUPPORT_CARDS`), its control surfaces as CAERO1 + CORD2R + AELIST +
+AESURF (:func:`_control_surface_cards`).
 
 Supported cards and what asekit makes of them
 ---------------------------------------------
@@ -26,7 +27,9 @@ constraints), CQUAD4 (corner thicknesses T1-T4; material angle THETA or MCID) wi
 SPC / SPC1, CELAS1 (PELAS) / CELAS2 springs to ground or between grids, RBE2 (a rigid region,
 e.g. the shaft), CAERO1 with PAERO1 (NSPAN/NCHORD or AEFACT LSPAN/LCHORD divisions),
 SPLINE1 / SPLINE4 with SET1 / AELIST (checked: every box must be splined), AERO / AEROS (REFC,
-RHOREF, SYMXZ), MKAERO1, FLFACT, FLUTTER (K, KE, PK, PKNL: :func:`deck_flutter` runs each
+RHOREF, SYMXZ), AESURF with its AELIST and hinge CORD2R (a rigid control surface of the case,
+:func:`_read_aesurf`; AESURFS and AELINK kept, :func:`_read_aelinks`), MKAERO1, FLFACT,
+FLUTTER (K, KE, PK, PKNL: :func:`deck_flutter` runs each
 card with its own method), EIGR / EIGRL (number of modes or the frequency range), TABDMP1 (G or CRIT modal damping), PARAM WTMASS. CTRIA3 is modelled as a
 degenerated MITC4 (its third node repeated: a collapsed quadrilateral, Bathe, *Finite Element
 Procedures*, 1996, Ch. 5), stiffer than the quadrilateral on coarse meshes but convergent
@@ -2593,7 +2596,9 @@ def case_bdf(case, sol: int | None = None, n_modes: int | None = None):
     uniform. Aerodynamics: one CAERO1 (PAERO1) per panel with the case's boxes, SPLINE1 (IPS)
     on all grids, AERO (REFC = 2 b, RHOREF = 1 so the FLFACT densities are in kg/m^3),
     MKAERO1 over the case's Mach and k, FLFACT densities / Machs / velocities and FLUTTER
-    (PK). Case control: SOL 103 (METHOD = EIGRL) or SOL 145 (also FMETHOD); ``sol`` None:
+    (PK); with ``control_surfaces`` the hinged boxes as one CAERO1 and per surface CORD2R +
+    AELIST + AESURF (:func:`_control_surface_cards`; ValueError for a hinge whose chord
+    fraction changes along the span). Case control: SOL 103 (METHOD = EIGRL) or SOL 145 (also FMETHOD); ``sol`` None:
     145 when the case has aero and flight conditions, else 103.
     """
     from pyNastran.bdf.case_control_deck import CaseControlDeck
