@@ -1638,6 +1638,12 @@ def _read_control_surfaces(deck: _Deck) -> dict:
         if s.label not in {f.label for f in found}:
             raise BdfError(f"AESURFS {s.aesid} LABEL = {s.label}: no AESURF of that label")
     links = _read_aelinks(model, found, deck.notes)
+    if found:
+        warnings.warn(f"{deck.name}: AESURF {', '.join(f.label for f in found)}: AESURF gives no "
+                      f"hinge stiffness, so the surfaces float free on their hinges (hinge "
+                      f"stiffness 0) in the flutter with the hinge degrees of freedom; set "
+                      f"case.control_surfaces[i].hinge_stiffness for a spring or actuator",
+                      BdfWarning, stacklevel=4)
     return {"control_surfaces": tuple(found), "aelinks": links} if found else {}
 
 

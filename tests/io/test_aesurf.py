@@ -82,6 +82,7 @@ def _aileron_deck(tmp_path, cards=AILERON, name="aileron.bdf"):
 def _read_deck(path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", B.UnsupportedCardWarning)
+        warnings.filterwarnings("ignore", ".*AESURF gives no hinge stiffness", B.BdfWarning)
         return B.read_deck(path)
 
 
@@ -113,10 +114,28 @@ def test_aesurf_reads_as_the_control_surface_of_its_boxes(tmp_path):
     assert s.aesurfs == (30, 30)
     assert bdf.aelinks == (("AILERON", (("AILERON", 1.0),)),)
     assert any("AELINK" in n for n in bdf.notes)
+    with pytest.warns(B.BdfWarning, match=r"AESURF AILERON: AESURF gives no hinge stiffness"):
+        B.read_deck(_aileron_deck(tmp_path, name="again.bdf"))
     (spec,) = B.deck_case(bdf).control_surfaces
     assert (spec.name, spec.panel, spec.kind, spec.hinge_stiffness) == ("AILERON", 0,
                                                                         "rigid", 0.0)
     assert spec.hinge_chord_fraction == pytest.approx((0.75, 0.75), abs=1e-12)
+
+
+def test_caero1_numbered_from_the_tip_gives_the_same_surface(tmp_path):
+    """A CAERO1 whose P1 is at the tip (its boxes numbered from the tip): the same aileron
+    (span fractions from the root), its AELIST the boxes of the first four strips."""
+    cards = tuple(c.replace("AELIST,20,1020,1024,1028,1032", "AELIST,20,1004,1008,1012,1016")
+                  for c in AILERON)
+    text = _aileron_deck(tmp_path, cards).read_text().replace(
+        f",0.0,0.0,0.0,{CHORD},0.0,{SPAN},0.0,{CHORD}", f",0.0,{SPAN},0.0,{CHORD},0.0,0.0,0.0,"
+                                                      f"{CHORD}")
+    assert f",0.0,{SPAN},0.0,{CHORD}," in text
+    p = tmp_path / "flipped.bdf"
+    p.write_text(text)
+    (s,) = _read_deck(p).control_surfaces
+    assert s.hinge_chord_fraction == pytest.approx((0.75, 0.75), abs=1e-12)
+    assert s.span_fraction == pytest.approx((0.5, 1.0), abs=1e-12)
 
 
 def test_imported_aileron_has_the_case_files_derivatives(tmp_path):
