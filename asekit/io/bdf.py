@@ -2509,6 +2509,21 @@ def _check_caero1_mesh(hm, case) -> None:
                          f"fraction for every surface (inboard = outboard)")
 
 
+def _aesurf_labels(case) -> list[str]:
+    """The surfaces' names as AESURF LABELs (capitals), each a Nastran label: 1-8 letters,
+    digits or underscores, a letter first, unique."""
+    out = []
+    for i, c in enumerate(case.control_surfaces):
+        lab = c.name.upper()
+        if not (1 <= len(lab) <= 8 and lab[0].isalpha() and lab.isascii()
+                and lab.replace("_", "").isalnum()) or lab in out:
+            raise ValueError(f"control_surface[{i}].name {c.name!r} is not a Nastran AESURF "
+                             f"LABEL for the export: 1-8 letters, digits or underscores, a "
+                             f"letter first, unique without case")
+        out.append(lab)
+    return out
+
+
 def _control_surface_cards(model, case, ids) -> None:
     """The control surfaces as Nastran's (MSC QRG AESURF): the hinged boxes
     (:func:`asekit.case.pipeline.control_surface_mesh`) as one CAERO1 (AEFACT divisions),
@@ -2518,6 +2533,7 @@ def _control_surface_cards(model, case, ids) -> None:
     CREFS its area). AESURF has no hinge stiffness, damping or balance field: those are not
     written (a re-import has a free hinge). AESURFS (the structural grids of a separately
     modelled surface) does not apply to asekit's rigid surfaces and is not written."""
+    labels = _aesurf_labels(case)
     hm = pl.control_surface_mesh(case)
     _check_caero1_mesh(hm, case)
     eid0 = 100001
@@ -2530,7 +2546,7 @@ def _control_surface_cards(model, case, ids) -> None:
         model.add_cord2r(sid, [float(v) for v in p], [float(v) for v in p + [0, 0, 1]],
                          [float(v) for v in p + x])
         model.add_aelist(sid, [eid0 + int(b) for b in np.flatnonzero(hm.on_surface[i])])
-        model.add_aesurf(sid, s.name.upper()[:8], sid, sid, crefc=hm.mean_chord(i),
+        model.add_aesurf(sid, labels[i], sid, sid, crefc=hm.mean_chord(i),
                          crefs=hm.surface_area(i))
 
 

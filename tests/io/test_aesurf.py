@@ -222,6 +222,29 @@ def test_control_surface_case_exports_and_reads_back(tmp_path, hinge, span):
     assert s2.span_fraction == pytest.approx(span, abs=1e-9)
 
 
+def test_two_surfaces_export_and_read_back(tmp_path):
+    """An inboard flap and an outboard aileron on one hinge line: two CORD2R / AELIST /
+    AESURF, read back to the same fractions (1e-9), in order."""
+    src = _declarative(k_h=0.5)
+    a = src.control_surfaces[0]
+    flap = dataclasses.replace(a, name="flap", span_fraction=(0.1, 0.45))
+    case = dataclasses.replace(src, control_surfaces=(flap, a))
+    bdf = _read_deck(B.write_case_bdf(case, tmp_path / "two.bdf"))
+    assert [s.label for s in bdf.control_surfaces] == ["FLAP", "AILERON"]
+    for s, c in zip(bdf.control_surfaces, case.control_surfaces):
+        assert s.hinge_chord_fraction == pytest.approx(c.hinge_chord_fraction, abs=1e-9)
+        assert s.span_fraction == pytest.approx(c.span_fraction, abs=1e-9)
+
+
+@pytest.mark.parametrize("name", ["inboard_aileron", "flap 1", "1flap"])
+def test_export_refuses_a_name_that_is_no_aesurf_label(name):
+    """AESURF LABEL is 1-8 characters, a letter first: the export names the key."""
+    src = _declarative()
+    cs = dataclasses.replace(src.control_surfaces[0], name=name)
+    with pytest.raises(ValueError, match=r"control_surface\[0\]\.name .* AESURF LABEL"):
+        B.case_bdf(dataclasses.replace(src, control_surfaces=(cs,)))
+
+
 def test_export_refuses_a_hinge_that_is_not_one_caero1(tmp_path):
     """A tapered hinge (inboard chord fraction != outboard) cannot be the AELIST boxes of one
     CAERO1: the export names the key."""
