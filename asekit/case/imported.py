@@ -71,6 +71,10 @@ class ImportedModel:
     deck : object
         The importer's own record of the source (e.g. :class:`asekit.io.bdf.BdfModel`, with the
         Nastran ids for the export); not part of the digest, equality or hash.
+    panels : tuple of TrapezoidSurface
+        The lifting surfaces the boxes were made of (e.g. the CAERO1 cards), for the control
+        surfaces' hinged boxes (:func:`asekit.case.pipeline.control_surface_mesh`); () when
+        not needed. In the digest when given.
 
     Attributes
     ----------
@@ -87,6 +91,7 @@ class ImportedModel:
     support: str = "the imported model's constraints"
     label: str = "imported model"
     deck: object = field(default=None, repr=False)
+    panels: tuple = ()
     digest: str = field(init=False, repr=False)
 
     def __post_init__(self):
@@ -108,6 +113,9 @@ class ImportedModel:
             for a in (self.boxes.corners, self.boxes.strip, self.boxes.surface):
                 _update(h, np.asarray(a))
         _update(h, np.asarray(self.damping_g if self.damping_g else [], float))
+        for p in self.panels:          # (absent: the digests of models without panels stay)
+            _update(h, np.r_[p.root_le, p.root_chord, p.tip_le, p.tip_chord, p.n_chord,
+                             p.n_span])
         object.__setattr__(self, "digest", h.hexdigest())
 
     def __eq__(self, other):

@@ -1328,12 +1328,17 @@ def control_surface_mesh(case: Case):
 
     if not case.control_surfaces:
         raise CaseError(f"{case.name}: the case has no [[control_surface]]")
-    if case.structure is not None or len(case.panels) != 1:
-        what = "an imported structure" if case.structure is not None else \
-            f"{len(case.panels)} panels"
+    if case.structure is not None:            # an imported deck: its one CAERO1 (AESURF)
+        panels = case.structure.panels
+        if len(panels) != 1:
+            raise CaseError(f"control_surface: control surfaces need one lifting surface (the "
+                            f"imported structure has {len(panels)} panels)")
+        surface = panels[0]
+    elif len(case.panels) != 1:
         raise CaseError(f"control_surface: control surfaces need a one-panel case file (this "
-                        f"case has {what})")
-    surface = panel_surfaces(case.panels, box_counts(case.panels, case.aero))[0]
+                        f"case has {len(case.panels)} panels)")
+    else:
+        surface = panel_surfaces(case.panels, box_counts(case.panels, case.aero))[0]
     specs = [ControlSurface(c.name, *c.hinge_chord_fraction, *c.span_fraction)
              for c in case.control_surfaces]
     try:

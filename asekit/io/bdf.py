@@ -16,7 +16,8 @@ deck's record (:class:`BdfModel`, with the Nastran ids) and :func:`deck_case` ma
 one reader per card (``_read_grids``, ``_read_pshell``, ``_read_celas``, ... each with the
 card's field table). Export (:func:`write_case_bdf`): a case -- declarative or imported -- as
 a deck that pyNastran reads and Nastran runs (SOL 103 or SOL 145 case control), its support
-written by kind (:data:`SUPPORT_CARDS`).
+written by kind (:data:`SUPPORT_CARDS`), its control surfaces as CAERO1 + CORD2R + AELIST +
+AESURF (:func:`_control_surface_cards`).
 
 Supported cards and what asekit makes of them
 ---------------------------------------------
@@ -26,7 +27,9 @@ constraints), CQUAD4 (corner thicknesses T1-T4; material angle THETA or MCID) wi
 SPC / SPC1, CELAS1 (PELAS) / CELAS2 springs to ground or between grids, RBE2 (a rigid region,
 e.g. the shaft), CAERO1 with PAERO1 (NSPAN/NCHORD or AEFACT LSPAN/LCHORD divisions),
 SPLINE1 / SPLINE4 with SET1 / AELIST (checked: every box must be splined), AERO / AEROS (REFC,
-RHOREF, SYMXZ), MKAERO1, FLFACT, FLUTTER (K, KE, PK, PKNL: :func:`deck_flutter` runs each
+RHOREF, SYMXZ), AESURF with its AELIST and hinge CORD2R (a rigid control surface of the case,
+:func:`_read_aesurf`; AESURFS and AELINK kept, :func:`_read_aelinks`), MKAERO1, FLFACT,
+FLUTTER (K, KE, PK, PKNL: :func:`deck_flutter` runs each
 card with its own method), EIGR / EIGRL (number of modes or the frequency range), TABDMP1 (G or CRIT modal damping), PARAM WTMASS. CTRIA3 is modelled as a
 degenerated MITC4 (its third node repeated: a collapsed quadrilateral, Bathe, *Finite Element
 Procedures*, 1996, Ch. 5), stiffer than the quadrilateral on coarse meshes but convergent
@@ -86,6 +89,7 @@ SUPPORTED_CARDS = ("GRID", "CORD2R", "CORD1R", "CORD2C", "CORD2S", "CQUAD4", "CT
                    "MAT1",
                    "MAT8", "CONM2", "SPC", "SPC1", "CELAS1", "CELAS2", "PELAS", "RBE2",
                    "CAERO1", "PAERO1", "AEFACT", "SPLINE1", "SPLINE4", "SET1", "AELIST", "AERO",
+                   "AESURF", "AESURFS", "AELINK",
                    "AEROS", "MKAERO1", "FLFACT", "FLUTTER", "EIGR", "EIGRL", "TABDMP1",
                    "PARAM", "ENDDATA")
 #: Element cards asekit cannot represent: a deck holding one of them is refused.
@@ -174,6 +178,8 @@ class BdfModel:
         global DOFs; rigid : (independent node index, component string, dependent node
         indices) per RBE2; ignored : the (card, count, first id) left out; notes; path : the
         file read; units : its unit system (a key of :data:`UNITS`).
+    control_surfaces : the AESURF cards (:class:`DeckControlSurface`); aelinks : the AELINK
+        cards as (dependent label, ((independent label, coefficient), ...)), kept, not applied.
     """
 
     mesh: PlateMesh
@@ -201,6 +207,8 @@ class BdfModel:
     fixed: tuple = ()
     rigid: tuple = ()
     ignored: tuple[tuple[str, int, object], ...] = ()
+    control_surfaces: tuple = ()
+    aelinks: tuple = ()
     notes: tuple[str, ...] = ()
     path: str = ""
     units: str = "SI"
@@ -1447,6 +1455,198 @@ def _check_splines(model, box_ids, notes):
                      "modes with its finite-element shape functions, not the surface spline")
 
 
+# ---------------------------------------------------------------------------------------------
+# control surfaces: AESURF, AELIST, AESURFS, AELINK and the hinge's CORD2R (issue 25)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class DeckControlSurface:
+    """An AESURF read and mapped onto its CAERO1 (SI, angles in rad): ``label``, ``aesurf_id``,
+    ``cid`` (CID1, the hinge system), ``aelist_id`` (ALID1), ``caero_id`` and ``caero_index``
+    (its position among the CAERO1 cards, sorted by id), ``hinge_chord_fraction`` (inboard,
+    outboard) and ``span_fraction`` (root to tip) of that panel, ``hinge_point`` and
+    ``hinge_axis`` (the CORD2R's origin and unit y axis, basic, m), ``eff``, ``ldw``, the
+    hinge-moment reference chord ``crefc`` (m) and area ``crefs`` (m^2), the deflection limits
+    ``pllim`` / ``pulim`` (rad), the hinge-moment limits ``hmllim`` / ``hmulim`` (N m, None
+    when blank) and the AESURFS grid lists (``aesurfs``: (SET1 of LIST1, SET1 of LIST2) or
+    None)."""
+
+    label: str
+    aesurf_id: int
+    cid: int
+    aelist_id: int
+    caero_id: int
+    caero_index: int
+    hinge_chord_fraction: tuple[float, float]
+    span_fraction: tuple[float, float]
+    hinge_point: tuple[float, float, float]
+    hinge_axis: tuple[float, float, float]
+    eff: float = 1.0
+    ldw: str = "LDW"
+    crefc: float = 1.0
+    crefs: float = 1.0
+    pllim: float = -0.5 * math.pi
+    pulim: float = 0.5 * math.pi
+    hmllim: float | None = None
+    hmulim: float | None = None
+    aesurfs: tuple[int, int] | None = None
+
+
+#: Relative tolerance (of the panel's chord) of the hinge line against the AELIST boxes' edge.
+HINGE_TOL = 1e-6
+
+
+def _caero1_of_boxes(model, a, ids: list[int]):
+    """(CAERO1 card, its index among the sorted CAERO1 ids) holding every box of ``ids``."""
+    for i, cid in enumerate(sorted(model.caeros)):
+        c = model.caeros[cid]
+        n = len(_caero1_boxes(c, 1.0)[1])
+        if all(cid <= b < cid + n for b in ids):
+            return c, i
+    raise BdfError(f"AESURF {a.aesurf_id} ALID1 = {a.aelist_id1}: the AELIST boxes {ids[:6]}"
+                   f"{'...' if len(ids) > 6 else ''} are not all boxes of one CAERO1")
+
+
+def _aelist_region(a, c, ids: list[int]):
+    """(span box range i0..i1 from P1, first chordwise box j0, NSPAN, NCHORD) of an AELIST
+    that is a chordwise-rectangular region reaching the trailing edge of CAERO1 ``c``."""
+    _, _, ns, nc = _caero1_boxes(c, 1.0)
+    ij = {divmod(b - c.eid, nc) for b in ids}
+    rows = sorted({i for i, _ in ij})
+    j0 = min(j for _, j in ij)
+    want = {(i, j) for i in range(rows[0], rows[-1] + 1) for j in range(j0, nc)}
+    if ij != want or j0 == 0:
+        raise BdfError(f"AESURF {a.aesurf_id} ALID1 = {a.aelist_id1}: AELIST {a.aelist_id1} must list a "
+                       f"rectangular block of CAERO1 {c.eid}'s boxes, whole spanwise strips "
+                       f"from one chordwise box to the trailing edge (not the leading-edge "
+                       f"box): asekit's control surface is the panel aft of a hinge line")
+    return rows[0], rows[-1], j0, ns, nc
+
+
+def _hinge_axis(deck: _Deck, a, c, pts) -> tuple[np.ndarray, np.ndarray]:
+    """The hinge system CID1's origin (deck units) and unit y axis (basic), checked to run
+    along the boxes' front edge through ``pts`` (its two ends, deck units) root to tip."""
+    model = deck.model
+    if int(a.cid1) not in model.coords or model.coords[int(a.cid1)].type != "CORD2R":
+        raise BdfError(f"AESURF {a.aesurf_id} CID1 = {a.cid1}: no CORD2R {a.cid1} (the hinge "
+                       f"system, its y axis the hinge line, MSC Nastran QRG AESURF)")
+    cs = model.coords[int(a.cid1)]
+    o = np.asarray(cs.origin, float)
+    y = np.asarray(cs.j, float)
+    y = y / np.linalg.norm(y)
+    chord = max(float(c.x12), float(c.x43))
+    off = [np.linalg.norm(np.cross(p - o, y)) for p in pts]
+    if max(off) > HINGE_TOL * chord or np.dot(pts[1] - pts[0], y) <= 0:
+        raise BdfError(f"AESURF {a.aesurf_id} CID1 = {a.cid1}: the y axis of CORD2R {a.cid1} "
+                       f"(origin {o.tolist()}, y {np.round(y, 6).tolist()}) is not the front "
+                       f"edge of the AELIST {a.aelist_id1} boxes from root to tip (off by "
+                       f"{max(off):.3g} deck units): asekit's hinge is that edge, pointing "
+                       f"outboard")
+    return o, y
+
+
+def _aesurfs_of(model, label: str):
+    """(LIST1, LIST2) SET1 ids of the AESURFS with label ``label``, or None."""
+    for s in getattr(model, "aesurfs", {}).values():
+        if s.label == label:
+            return int(s.list1), int(s.list2)
+    return None
+
+
+def _read_aesurf(deck: _Deck, a) -> DeckControlSurface:
+    """AESURF (with its AELIST of boxes and the CORD2R of its hinge) as a control surface of
+    one CAERO1 (MSC Nastran Quick Reference Guide, AESURF: the hinge line is the y axis of
+    CIDi, a positive deflection a right-handed rotation about it: trailing edge down for a y
+    axis pointing outboard, asekit's sense, :mod:`asekit.aero.control_surface`).
+
+    +--------+--------+--------+--------+--------+--------+--------+--------+--------+
+    |   1    |   2    |   3    |   4    |   5    |   6    |   7    |   8    |   9    |
+    +========+========+========+========+========+========+========+========+========+
+    | AESURF |   ID   | LABEL  |  CID1  | ALID1  |  CID2  | ALID2  |  EFF   |  LDW   |
+    +--------+--------+--------+--------+--------+--------+--------+--------+--------+
+    |        | CREFC  | CREFS  | PLLIM  | PULIM  | HMLLIM | HMULIM | TQLLIM | TQULIM |
+    +--------+--------+--------+--------+--------+--------+--------+--------+--------+
+    | AELIST |  SID   |   E1   |   E2   |   E3   |  ...   |        |        |        |
+    +--------+--------+--------+--------+--------+--------+--------+--------+--------+
+    """
+    model = deck.model
+    if a.cid2 is not None or a.aelist_id2 is not None:
+        raise BdfError(f"AESURF {a.aesurf_id} CID2 / ALID2: a second component is not supported "
+                       f"(one hinge line per surface; give each component its own AESURF)")
+    if a.tqllim is not None or a.tqulim is not None:
+        deck.notes.append(f"AESURF {a.aesurf_id} TQLLIM / TQULIM (deflection-dependent hinge-"
+                          f"moment limits) read and ignored")
+    if int(a.aelist_id1) not in model.aelists:
+        raise BdfError(f"AESURF {a.aesurf_id} ALID1 = {a.aelist_id1}: no AELIST {a.aelist_id1}")
+    ids = sorted(int(b) for b in model.aelists[int(a.aelist_id1)].elements)
+    c, index = _caero1_of_boxes(model, a, ids)
+    i0, i1, j0, ns, nc = _aelist_region(a, c, ids)
+    p1, _, _, p4 = (np.asarray(p, float) for p in c.get_points())
+    eta = _divisions(c, c.nspan, c.lspan_ref if c.lspan else None, "SPAN")
+    xi = float(_divisions(c, c.nchord, c.lchord_ref if c.lchord else None, "CHORD")[j0])
+    e0, e1 = float(eta[i0]), float(eta[i1 + 1])
+    pts = [p1 + e * (p4 - p1) + np.array([xi * (c.x12 + e * (c.x43 - c.x12)), 0.0, 0.0])
+           for e in (e0, e1)]
+    if p4[1] < p1[1]:                       # spanwise from the root (least y), as _boxes
+        e0, e1, pts = 1.0 - e1, 1.0 - e0, pts[::-1]
+    o, y = _hinge_axis(deck, a, c, pts)
+    L = deck.L
+    hm = [None if v is None else float(v) * deck.Mu * L ** 2 / deck.T ** 2
+          for v in (a.hmllim, a.hmulim)]
+    return DeckControlSurface(
+        str(a.label), int(a.aesurf_id), int(a.cid1), int(a.aelist_id1), int(c.eid), index, (xi, xi),
+        (e0, e1), tuple(float(v) for v in o * L), tuple(float(v) for v in y),
+        float(a.eff), str(a.ldw), float(a.crefc) * L, float(a.crefs) * L ** 2,
+        float(a.pllim), float(a.pulim), hm[0], hm[1], _aesurfs_of(model, str(a.label)))
+
+
+def _read_aelinks(model, surfaces, notes) -> tuple:
+    """AELINK: (label of the dependent, ((independent label, coefficient), ...)) kept and
+    reported; asekit deflects each surface on its own (the links are not applied).
+
+    +--------+-------+--------+-------+-------+-------+-------+-------+-------+
+    |   1    |   2   |   3    |   4   |   5   |   6   |   7   |   8   |   9   |
+    +========+=======+========+=======+=======+=======+=======+=======+=======+
+    | AELINK |  ID   | LABLD  | LABL1 |  C1   | LABL2 |  C2   | LABL3 |  C3   |
+    +--------+-------+--------+-------+-------+-------+-------+-------+-------+
+    """
+    labels = {s.label for s in surfaces}
+    out = []
+    for links in getattr(model, "aelinks", {}).values():
+        for k in links:
+            named = [k.label] + list(k.independent_labels)
+            missing = [n for n in named if n not in labels]
+            if missing:
+                raise BdfError(f"AELINK {k.aelink_id}: LABEL {missing[0]} is not an AESURF "
+                               f"label {sorted(labels)}")
+            out.append((str(k.label), tuple((str(n), float(v)) for n, v in
+                                            zip(k.independent_labels,
+                                                k.linking_coefficients))))
+    if out:
+        notes.append("AELINK read and kept, not applied: asekit reports each AESURF as its own "
+                     "control surface (" + "; ".join(
+                         f"{d} = " + " + ".join(f"{v:g} {n}" for n, v in ind)
+                         for d, ind in out) + ")")
+    return tuple(out)
+
+
+def _read_control_surfaces(deck: _Deck) -> dict:
+    """Every AESURF (:func:`_read_aesurf`) and AELINK: the keyword arguments of
+    :class:`BdfModel` they set."""
+    model = deck.model
+    found = [_read_aesurf(deck, model.aesurf[k]) for k in sorted(model.aesurf)]
+    for s in getattr(model, "aesurfs", {}).values():
+        if s.label not in {f.label for f in found}:
+            raise BdfError(f"AESURFS {s.aesid} LABEL = {s.label}: no AESURF of that label")
+    links = _read_aelinks(model, found, deck.notes)
+    if found:
+        warnings.warn(f"{deck.name}: AESURF {', '.join(f.label for f in found)}: AESURF gives no "
+                      f"hinge stiffness, so the surfaces float free on their hinges (hinge "
+                      f"stiffness 0) in the flutter with the hinge degrees of freedom; set "
+                      f"case.control_surfaces[i].hinge_stiffness for a spring or actuator",
+                      BdfWarning, stacklevel=4)
+    return {"control_surfaces": tuple(found), "aelinks": links} if found else {}
+
+
 def _flfact(model, f, v, name: str) -> tuple[int, np.ndarray]:
     sid = v if isinstance(v, (int, np.integer)) else getattr(v, "sid", v)
     if int(sid) not in model.flfacts:
@@ -1786,6 +1986,10 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
                                    f"GRID")
     n_modes, f_max = _read_eigen_method(model, deck)
     aero = _read_aero(deck)
+    if aero:
+        aero.update(_read_control_surfaces(deck))
+    elif deck.model.aesurf:
+        raise BdfError("AESURF without CAERO1 boxes")
     if ignored:
         warnings.warn(f"{path.name}: cards read but not represented by asekit: "
                       f"{_fmt(ignored)}", UnsupportedCardWarning, stacklevel=2)
@@ -1864,6 +2068,44 @@ def _modes_of(bdf: BdfModel) -> ModesSpec:
     return ModesSpec(count=None, f_max=bdf.f_max_hz or 1000.0, keep_rigid=False)
 
 
+def _surface_geometry(boxes: BoxMesh, i: int):
+    """(root LE, root chord, tip LE, tip chord, NCHORD, NSPAN, chord fractions, span fractions)
+    of surface ``i`` of a structured box mesh (root to tip, LE box first in each strip)."""
+    c = boxes.corners[boxes.surface == i]
+    st = boxes.strip[boxes.surface == i]
+    nc = int(np.sum(st == st[0]))
+    ns = c.shape[0] // nc
+    g = c.reshape(ns, nc, 4, 3)
+    r_le, r_c = g[0, 0, 0], g[0, -1, 1, 0] - g[0, 0, 0, 0]
+    t_le, t_c = g[-1, 0, 3], g[-1, -1, 2, 0] - g[-1, 0, 3, 0]
+    xi = np.concatenate([[0.0], (g[0, :, 1, 0] - r_le[0]) / r_c])
+    eta = np.concatenate([[0.0], (g[:, 0, 3, 1] - r_le[1]) / (t_le[1] - r_le[1])])
+    return r_le, float(r_c), t_le, float(t_c), nc, ns, xi, eta
+
+
+def _deck_panels(bdf: BdfModel) -> tuple:
+    """The CAERO1 panels as :class:`~asekit.aero.boxes.TrapezoidSurface` (their box counts),
+    for the control surfaces' hinged boxes (:func:`asekit.case.pipeline.control_surface_mesh`);
+    () without AESURF."""
+    from asekit.aero.boxes import TrapezoidSurface
+    if not bdf.control_surfaces:
+        return ()
+    out = []
+    for i, name in enumerate(bdf.boxes.surface_names):
+        r_le, r_c, t_le, t_c, nc, ns, _, _ = _surface_geometry(bdf.boxes, i)
+        out.append(TrapezoidSurface(tuple(r_le), r_c, tuple(t_le), t_c, nc, ns, name))
+    return tuple(out)
+
+
+def _control_specs(bdf: BdfModel) -> tuple:
+    """The AESURF cards as ``[[control_surface]]`` specs: rigid, on a free hinge (AESURF gives
+    no hinge stiffness: 0 N m/rad)."""
+    from asekit.case.schema import ControlSurfaceSpec
+    return tuple(ControlSurfaceSpec(s.label, s.caero_index, s.hinge_chord_fraction,
+                                    s.span_fraction, "rigid", 0.0, 0.0)
+                 for s in bdf.control_surfaces)
+
+
 def deck_case(bdf: BdfModel, name: str | None = None) -> Case:
     """A read deck as a :class:`~asekit.case.Case` of the pipeline.
 
@@ -1874,7 +2116,9 @@ def deck_case(bdf: BdfModel, name: str | None = None) -> Case:
     ``aero`` (its Mach numbers, the MKAERO1 k, REFC / 2, SYMXZ) and ``flight`` (its FLFACT
     densities x RHOREF and velocities); None without CAERO1 / FLUTTER. A PKNL request's
     matched (density, Mach, velocity) triples become the full grid density x Mach over all
-    velocities (a superset) for the pipeline's p-k. Every FLUTTER request, each with its own
+    velocities (a superset) for the pipeline's p-k. The AESURF cards become
+    ``control_surfaces`` (rigid, hinge stiffness 0: AESURF gives none), their CAERO1 panels
+    ``structure.panels``. Every FLUTTER request, each with its own
     method (K, KE, PK, PKNL at its matched points), is run by :func:`deck_flutter`.
 
     Parameters
@@ -1893,10 +2137,12 @@ def deck_case(bdf: BdfModel, name: str | None = None) -> Case:
     stem = Path(bdf.path).stem if bdf.path else "bdf"
     structure = ImportedModel(mesh=bdf.mesh, K=bdf.K, M=bdf.M, T=bdf.system.T, boxes=bdf.boxes,
                               damping_g=bdf.damping_g, support=_support_words(bdf),
-                              label=bdf.system.label, deck=bdf)
+                              label=bdf.system.label, deck=bdf,
+                              panels=_deck_panels(bdf))
     return Case(name=name or stem, panels=(), thickness=None, material=None,
                 support=SupportSpec(kind=IMPORTED_SUPPORT), aero=_aero_of(bdf),
                 flight=_flight_of(bdf), modes=_modes_of(bdf),
+                control_surfaces=_control_specs(bdf),
                 reference=f"Nastran deck {Path(bdf.path).name if bdf.path else ''} "
                           f"(units {bdf.units}, converted to SI)",
                 source=bdf.path or "", structure=structure)
@@ -2246,12 +2492,72 @@ def _panel_aero_cards(model, case, nn: int) -> None:
         start += 10 ** int(math.ceil(math.log10(ns * nc + 1)) + 1)
 
 
+#: first id of the hinge systems (CORD2R), AELISTs and AESURFs the export writes
+_AESURF_ID0 = 501
+
+
+def _check_caero1_mesh(hm, case) -> None:
+    """The hinged boxes must be one CAERO1: the same chord fractions in every strip."""
+    m = hm.mesh
+    nc = int(np.sum(m.strip == m.strip[0]))
+    g = m.corners.reshape(-1, nc, 4, 3)
+    xi = (g[:, :, 1, 0] - g[:, :1, 0, 0]) / (g[:, -1:, 1, 0] - g[:, :1, 0, 0])
+    if np.ptp(xi, axis=0).max() > 1e-9:
+        h = [list(c.hinge_chord_fraction) for c in case.control_surfaces]
+        raise ValueError(f"control_surface[].hinge_chord_fraction {h}: the export writes one "
+                         f"CAERO1 with AESURF boxes, which needs one constant hinge chord "
+                         f"fraction for every surface (inboard = outboard)")
+
+
+def _aesurf_labels(case) -> list[str]:
+    """The surfaces' names as AESURF LABELs (capitals), each a Nastran label: 1-8 letters,
+    digits or underscores, a letter first, unique."""
+    out = []
+    for i, c in enumerate(case.control_surfaces):
+        lab = c.name.upper()
+        if not (1 <= len(lab) <= 8 and lab[0].isalpha() and lab.isascii()
+                and lab.replace("_", "").isalnum()) or lab in out:
+            raise ValueError(f"control_surface[{i}].name {c.name!r} is not a Nastran AESURF "
+                             f"LABEL for the export: 1-8 letters, digits or underscores, a "
+                             f"letter first, unique without case")
+        out.append(lab)
+    return out
+
+
+def _control_surface_cards(model, case, ids) -> None:
+    """The control surfaces as Nastran's (MSC QRG AESURF): the hinged boxes
+    (:func:`asekit.case.pipeline.control_surface_mesh`) as one CAERO1 (AEFACT divisions),
+    and per surface a CORD2R whose y axis is the hinge line (origin at its inboard end, y
+    outboard, x aft in the plane, z up: a positive deflection is trailing edge down, asekit's
+    sense), an AELIST of its boxes and an AESURF (CREFC its mean chord aft of the hinge,
+    CREFS its area). AESURF has no hinge stiffness, damping or balance field: those are not
+    written (a re-import has a free hinge). AESURFS (the structural grids of a separately
+    modelled surface) does not apply to asekit's rigid surfaces and is not written."""
+    labels = _aesurf_labels(case)
+    hm = pl.control_surface_mesh(case)
+    _check_caero1_mesh(hm, case)
+    eid0 = 100001
+    _aero_cards(model, hm.mesh, eid0, ids)
+    for i, s in enumerate(hm.surfaces):
+        sid = _AESURF_ID0 + i
+        p = hm.hinge_point[i]
+        y = hm.hinge_axis[i]
+        x = np.array([y[1], -y[0], 0.0]) / math.hypot(y[0], y[1])
+        model.add_cord2r(sid, [float(v) for v in p], [float(v) for v in p + [0, 0, 1]],
+                         [float(v) for v in p + x])
+        model.add_aelist(sid, [eid0 + int(b) for b in np.flatnonzero(hm.on_surface[i])])
+        model.add_aesurf(sid, labels[i], sid, sid, crefc=hm.mean_chord(i),
+                         crefs=hm.surface_area(i))
+
+
 def _flutter_cards(model, case, ids) -> None:
     """Boxes (per panel, or the imported ones with AEFACT where not uniform), AERO (REFC =
     2 b, RHOREF = 1 so the FLFACT densities are in kg/m^3), MKAERO1 over the case's Mach and
     k, FLFACT densities / Machs / velocities and FLUTTER 20 (PK)."""
     a = case.aero
-    if case.structure is not None:
+    if case.control_surfaces:
+        _control_surface_cards(model, case, ids)
+    elif case.structure is not None:
         _aero_cards(model, pl.box_mesh(case), 100001, ids)
     else:
         _panel_aero_cards(model, case, len(ids))
@@ -2312,7 +2618,9 @@ def case_bdf(case, sol: int | None = None, n_modes: int | None = None):
     uniform. Aerodynamics: one CAERO1 (PAERO1) per panel with the case's boxes, SPLINE1 (IPS)
     on all grids, AERO (REFC = 2 b, RHOREF = 1 so the FLFACT densities are in kg/m^3),
     MKAERO1 over the case's Mach and k, FLFACT densities / Machs / velocities and FLUTTER
-    (PK). Case control: SOL 103 (METHOD = EIGRL) or SOL 145 (also FMETHOD); ``sol`` None:
+    (PK); with ``control_surfaces`` the hinged boxes as one CAERO1 and per surface CORD2R +
+    AELIST + AESURF (:func:`_control_surface_cards`; ValueError for a hinge whose chord
+    fraction changes along the span). Case control: SOL 103 (METHOD = EIGRL) or SOL 145 (also FMETHOD); ``sol`` None:
     145 when the case has aero and flight conditions, else 103.
     """
     from pyNastran.bdf.case_control_deck import CaseControlDeck
