@@ -29,8 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from asekit.aero.methods import (DLM_MACH_MAX, SUPERSONIC_MACH_MIN, TransonicWarning,
-                                 resolve_method)
+from asekit.aero.methods import DLM_MACH_MAX, SUPERSONIC_MACH_MIN, TransonicWarning, resolve_method
 from asekit.atmosphere import MAX_ALTITUDE, MIN_ALTITUDE, standard_atmosphere
 from asekit.case.schema import Case, CaseError
 
