@@ -394,7 +394,9 @@ def _row(case, fa, db, modal, p: ProfilePoint, cond, tn) -> TrajectoryRow:
                      f"{SUPERSONIC_MACH_MIN:g}: " + (f"aero.method {case.aero.method!r} "
                      "refuses it, not analysed" if refused else "linear theory not trusted"))
     if refused:
-        pass
+        if not gap:
+            notes.append(f"aero.method {case.aero.method!r} refuses M {p.mach:g} (outside its "
+                         "Mach range): not analysed")
     else:
         pts = _flutter_points([r for r in fa.results if r.condition == cond],
                               case.flight.velocities)
@@ -493,6 +495,31 @@ def min_margin(rows, key: str = "flutter_margin_pct"):
     return min(vals, key=lambda t: t[0]) if vals else (None, None)
 
 
+def gap_spans(rows) -> list[tuple[float, float]]:
+    """The time intervals (s) in which the Mach number, linear in time between the rows, lies
+    in the transonic gap DLM_MACH_MAX < M < SUPERSONIC_MACH_MIN.
+
+    Examples
+    --------
+    >>> rows = [TrajectoryRow(t, m, 0.0, 0.0, None, None, None, None, None, False)
+    ...         for t, m in ((0.0, 0.8), (1.0, 1.0), (2.0, 1.3))]
+    >>> [(round(a, 3), round(b, 3)) for a, b in gap_spans(rows)]
+    [(0.5, 1.0), (1.0, 1.5)]
+    """
+    out = []
+    for r0, r1 in zip(rows[:-1], rows[1:]):
+        m0, m1 = r0.mach, r1.mach
+        if m0 == m1:
+            lo, hi = (0.0, 1.0) if in_transonic_gap(m0) else (1.0, 0.0)
+        else:
+            a, b = ((DLM_MACH_MAX - m0) / (m1 - m0), (SUPERSONIC_MACH_MIN - m0) / (m1 - m0))
+            lo, hi = max(0.0, min(a, b)), min(1.0, max(a, b))
+        if hi > lo:
+            dt = r1.time_s - r0.time_s
+            out.append((r0.time_s + lo * dt, r0.time_s + hi * dt))
+    return out
+
+
 def plot_trajectory(rows, title: str = "Margins along the trajectory"):
     """Flutter and divergence margins (%) and the TN 4197 margin against time, the transonic
     gap shaded, and the dynamic pressure (kPa) below, in the project's style
@@ -515,15 +542,117 @@ def plot_trajectory(rows, title: str = "Margins along the trajectory"):
     ax.plot(t, 100 * (tn / flight - 1), "^:", color=THESIS_COLOR,
             label="flutter margin (NACA TN 4197)")
     ax.axhline(0.0, color="k", lw=0.8)
-    for r0, r1 in zip(rows[:-1], rows[1:]):
-        if r0.transonic_gap or r1.transonic_gap:
-            ax.axvspan(r0.time_s, r1.time_s, color="0.85", lw=0)
-            axq.axvspan(r0.time_s, r1.time_s, color="0.85", lw=0)
-    if any(r.transonic_gap for r in rows):
-        ax.axvspan(np.nan, np.nan, color="0.85", label="transonic gap (not analysed)")
+    spans = gap_spans(rows)
+    for t0, t1 in spans:
+        for a in (ax, axq):
+            a.axvspan(t0, t1, color="0.85", lw=0)
+    if spans:
+        ax.axvspan(np.nan, np.nan, color="0.85", label=f"transonic gap {DLM_MACH_MAX:g} < M < "
+                                                       f"{SUPERSONIC_MACH_MIN:g}")
     ax.set_ylabel("margin (%)")
     ax.legend(loc="best")
     axq.plot(t, speed / 1e3, "-", color=ASEKIT_COLOR)
     axq.set_ylabel("dynamic pressure (kPa)")
     axq.set_xlabel("time (s)")
     return fig, (ax, axq)
+
+
+#: The units of a row's JSON keys.
+UNITS = {"time_s": "s", "mach": "-", "altitude_m": "m", "dynamic_pressure_Pa": "Pa",
+         "flutter_speed_ms": "m/s", "flutter_margin_pct": "%", "divergence_margin_pct": "%",
+         "hinge_moment_Nm": "N m", "tn4197_flutter_speed_ms": "m/s"}
+
+
+def trajectory_json(case: Case, rows, profile: str = "") -> dict:
+    """The JSON document of ``asekit trajectory``: ``trajectory`` (one dict per row,
+    :meth:`TrajectoryRow.to_json`), ``units``, the case's name, the profile path, the smallest
+    margins and TN 4197's inputs and form."""
+    f_min, f_row = min_margin(rows)
+    d_min, d_row = min_margin(rows, "divergence_margin_pct")
+    return {"case": case.name, "profile": str(profile),
+            "trajectory": [r.to_json() for r in rows], "units": UNITS,
+            "min_flutter_margin_pct": f_min,
+            "min_flutter_margin_time_s": None if f_row is None else f_row.time_s,
+            "min_divergence_margin_pct": d_min,
+            "min_divergence_margin_time_s": None if d_row is None else d_row.time_s,
+            "tn4197": {"inputs": tn4197_inputs(case),
+                       "comparison": tn4197_comparison(case, rows),
+                       "form": "NACA TN 4197 (Martin 1958) with D_N = 24 eps gamma p0 / pi, "
+                               "eps = 0.25: V_f = a sqrt(G (t/c)^3 (A + 2) / (1.337 A^3 "
+                               "(lambda + 1) p)); clamped root assumed"}}
+
+
+def tn4197_comparison(case: Case, rows, tolerance: float = 0.2) -> str | None:
+    """One sentence comparing TN 4197's flutter speed with asekit's over the rows where both
+    are known: their ratio's range and the times where they differ by more than
+    ``tolerance`` (a fraction), with the likely reason (TN 4197 assumes a clamped plate: a
+    pitch-shaft support or a heavy point mass is outside its data). None without such rows.
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import FIN_FILE
+    >>> row = TrajectoryRow(1.0, 0.6, 0.0, 24800.0, 215.6, 5.9, 185.5, 0.88, 642.4, False)
+    >>> tn4197_comparison(load_case(FIN_FILE), [row])[:54]
+    'TN 4197 / asekit flutter speed 2.98 (2.98-2.98): they '
+    """
+    both = [(r.tn4197_flutter_speed_ms / r.flutter_speed_ms, r) for r in rows
+            if r.tn4197_flutter_speed_ms is not None and r.flutter_speed_ms is not None]
+    if not both:
+        return None
+    ratios = [x for x, _ in both]
+    off = [r.time_s for x, r in both if abs(x - 1.0) > tolerance]
+    text = (f"TN 4197 / asekit flutter speed {float(np.median(ratios)):.2f} "
+            f"({min(ratios):.2f}-{max(ratios):.2f}): ")
+    if not off:
+        return text + f"they agree within {100 * tolerance:g} % at every point"
+    why = ("TN 4197 is an empirical boundary for clamped-root plates; this case's "
+           f"{case.support.kind} support" + (" (its pitch spring's rigid-pitch flutter)"
+                                             if case.support.kind == "shaft" else "")
+           + " is outside its data")
+    return (text + f"they disagree by more than {100 * tolerance:g} % at t = "
+            + ", ".join(f"{t:g}" for t in off) + f" s; {why}")
+
+
+def _fmt(v, spec: str) -> str:
+    width = int(spec.lstrip("+").split(".")[0])
+    return "-".rjust(width) if v is None else format(v, spec)
+
+
+def format_trajectory(case: Case, rows) -> str:
+    """The table of ``asekit trajectory``: one line per point (time s, Mach, altitude m, q kPa,
+    U_f m/s, flutter and divergence margins %, hinge moment N m, TN 4197 U_f m/s, flags: G
+    transonic gap, X extrapolated in Mach), then the smallest margins, then the notes.
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import FIN_FILE
+    >>> row = TrajectoryRow(1.0, 0.6, 0.0, 24800.0, 215.6, 5.9, 185.5, 0.88, 642.4, False)
+    >>> print(format_trajectory(load_case(FIN_FILE), [row]).splitlines()[2])
+         1.00  0.600      0    24.80    215.6     +5.9   +185.5    0.880    642.4
+    """
+    head = (f"trajectory of {case.name}: flutter and divergence margins U / (M a) - 1, "
+            "NACA TN 4197 beside asekit\n"
+            f"{'time s':>9} {'Mach':>6} {'alt m':>6} {'q kPa':>8} {'U_f m/s':>8} "
+            f"{'flut %':>8} {'div %':>8} {'M_h N m':>8} {'TN4197':>8} flags")
+    lines = [head]
+    for r in rows:
+        flags = ("G" if r.transonic_gap else "") + ("X" if r.mach_extrapolated else "")
+        lines.append(f"{r.time_s:9.2f} {r.mach:6.3f} {r.altitude_m:6.0f} "
+                     f"{r.dynamic_pressure_Pa / 1e3:8.2f} {_fmt(r.flutter_speed_ms, '8.1f')} "
+                     f"{_fmt(r.flutter_margin_pct, '+8.1f')} "
+                     f"{_fmt(r.divergence_margin_pct, '+8.1f')} "
+                     f"{_fmt(r.hinge_moment_Nm, '8.3f')} "
+                     f"{_fmt(r.tn4197_flutter_speed_ms, '8.1f')} {flags}".rstrip())
+    f_min, f_row = min_margin(rows)
+    if f_min is not None:
+        lines.append(f"smallest flutter margin {f_min:+.1f} % at t = {f_row.time_s:g} s "
+                     f"(M {f_row.mach:g}, {f_row.altitude_m:g} m)"
+                     + (": flutter on the trajectory" if f_min < 0 else ""))
+    cmp = tn4197_comparison(case, rows)
+    if cmp:
+        lines.append(cmp)
+    lines.append("flags: G transonic gap 0.9 < M < 1.15, X flutter speed extrapolated in Mach")
+    lines += [f"t = {r.time_s:g} s: {r.note}" for r in rows if r.note]
+    return "\n".join(lines)
