@@ -71,6 +71,13 @@ def test_profile_errors_name_file_row_column(tmp_path, text, words):
         assert w in msg, (w, msg)
 
 
+def test_byte_order_mark_and_crlf_accepted(tmp_path):
+    path = tmp_path / "bom.csv"
+    path.write_bytes("time_s,mach,altitude_m\r\n0,0.5,10\r\n".encode("utf-8-sig"))
+    (p,) = read_profile(path)
+    assert (p.time_s, p.mach, p.altitude_m) == (0.0, 0.5, 10.0)
+
+
 def test_comment_lines_keep_row_numbers(tmp_path):
     text = "# a comment\ntime_s,mach,altitude_m\n0,0.5,0\n1,-1,0\n"
     with pytest.raises(ProfileError, match="row 4, column mach"):
