@@ -212,3 +212,24 @@ def test_tn4197_beside_asekit_on_the_fin(small_run):
 def test_no_points_refused(small_fin):
     with pytest.raises(ValueError, match="points"):
         trajectory(small_fin, [])
+
+
+def test_refused_gap_point_has_no_values(small_fin):
+    auto = dataclasses.replace(small_fin, aero=dataclasses.replace(small_fin.aero,
+                                                                   method="auto"))
+    (r,) = trajectory(auto, [ProfilePoint(0.0, 1.0, 0.0, 1.0, 1.0)])
+    assert r.transonic_gap and "refuses it" in r.note
+    assert (r.flutter_speed_ms, r.divergence_margin_pct, r.hinge_moment_Nm) == (None,) * 3
+    assert r.tn4197_flutter_speed_ms is not None and r.dynamic_pressure_Pa > 0
+
+
+@pytest.mark.slow
+def test_margins_equal_the_pipelines_on_the_whole_fin(fin_case):
+    """The shipped fin at its three altitudes and envelope top Mach 0.6: the trajectory's
+    margins are the pipeline's (``asekit analyse``'s margins table)."""
+    fa = P.flutter(fin_case)
+    rows = trajectory(fin_case, [ProfilePoint(float(i), 0.6, h)
+                                 for i, h in enumerate(fin_case.flight.altitudes)])
+    for r, m in zip(rows, fa.margins):
+        assert r.altitude_m == m["altitude_m"]
+        assert r.flutter_margin_pct == pytest.approx(100 * m["margin"], rel=1e-12)
