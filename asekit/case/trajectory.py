@@ -570,6 +570,8 @@ def trajectory_json(case: Case, rows, profile: str = "") -> dict:
     f_min, f_row = min_margin(rows)
     d_min, d_row = min_margin(rows, "divergence_margin_pct")
     return {"case": case.name, "profile": str(profile),
+            "analysed_machs": [float(m) for m in case.aero.machs],
+            "extrapolated_times_s": [r.time_s for r in rows if r.mach_extrapolated],
             "trajectory": [r.to_json() for r in rows], "units": UNITS,
             "min_flutter_margin_pct": f_min,
             "min_flutter_margin_time_s": None if f_row is None else f_row.time_s,
@@ -653,6 +655,9 @@ def format_trajectory(case: Case, rows) -> str:
     cmp = tn4197_comparison(case, rows)
     if cmp:
         lines.append(cmp)
+    lines.append("analysed Machs " + ", ".join(f"{m:g}" for m in case.aero.machs)
+                 + f" (aero.method {case.aero.method!r}); flutter speeds interpolated between "
+                 "them, extrapolated at most 0.05 beyond (flag X)")
     lines.append("flags: G transonic gap 0.9 < M < 1.15, X flutter speed extrapolated in Mach")
     lines += [f"t = {r.time_s:g} s: {r.note}" for r in rows if r.note]
     return "\n".join(lines)

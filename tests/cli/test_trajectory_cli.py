@@ -60,6 +60,7 @@ def test_trajectory_command(small_fin_file, tmp_path, capsys):
     assert rows[0]["hinge_moment_Nm"] > 0                     # Q_cc > 0: de-centering
     assert rows[1]["transonic_gap"] is True and rows[1]["flutter_speed_ms"] is None
     assert doc["units"]["dynamic_pressure_Pa"] == "Pa"
+    assert doc["analysed_machs"] == [0.5, 0.6] and doc["extrapolated_times_s"] == []
     assert "clamped" in doc["tn4197"]["comparison"]
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
