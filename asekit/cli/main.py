@@ -9,6 +9,8 @@ Commands (argparse subcommands; each sets ``func(args) -> exit code``, so more c
 * ``cases [--copy NAME DIR]``: the shipped case files (see :mod:`asekit.cli.cases`);
 * ``optimise CASE.toml DESIGN.toml [--json PATH] [--out-case PATH]``: minimum-mass design under
   the flutter margin (see :mod:`asekit.cli.optimise`);
+* ``trajectory CASE PROFILE.csv [--json PATH] [--plot PATH]``: margins, dynamic pressure and
+  hinge moment along a flight trajectory (see :mod:`asekit.cli.trajectory`);
 * ``--version``.
 
 Options of every command (before or after its name): ``-v/--verbose`` (the package's info
@@ -43,6 +45,7 @@ from asekit.cli.analyse import add_parser as add_analyse
 from asekit.cli.cases import add_parser as add_cases
 from asekit.cli.optimise import add_parser as add_optimise
 from asekit.cli.sweep import add_parser as add_sweep
+from asekit.cli.trajectory import add_parser as add_trajectory
 from asekit.util.version import __version__
 
 
@@ -137,6 +140,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_sweep(sub)
     add_cases(sub)
     add_optimise(sub)
+    add_trajectory(sub)
     _add_common(parser, top=True)
     seen = set()
     for p in sub.choices.values():              # also after the command (aliases: once)
