@@ -1,0 +1,89 @@
+"""The tabulated thickness field (``[thickness] kind = "table"``, issue 28): the case key's
+checks, the bilinear interpolation, and that a table equal to the linear root/tip law gives the
+same structure as the law itself."""
+
+import copy
+import tomllib
+
+import numpy as np
+import pytest
+
+from asekit.case import case_from_dict
+from asekit.case import pipeline as P
+from asekit.case.schema import CaseError
+from asekit.geometry import ThicknessTable
+from asekit.util.paths import FIN_FILE
+
+RAW = tomllib.loads(FIN_FILE.read_text())
+
+
+def _with(thickness: dict) -> dict:
+    raw = copy.deepcopy(RAW)
+    raw["thickness"] = thickness
+    return raw
+
+
+def _linear_table(root: float, tip: float, xc, eta) -> dict:
+    """The fin's law h = root + eta (tip - root), flat chordwise, sampled on the grids."""
+    return {"kind": "table", "x_over_c": list(xc), "eta": list(eta),
+            "values_m": [[root + e * (tip - root)] * len(xc) for e in eta]}
+
+
+def test_table_equal_to_linear_law_gives_the_same_structure():
+    # the fin's law (root 4 mm, tip 2 mm) sampled on an uneven 4 x 3 grid: bilinear
+    # interpolation of a law linear in eta is exact, so K and M agree to rounding.
+    base = case_from_dict(copy.deepcopy(RAW))
+    tab = case_from_dict(_with(_linear_table(0.004, 0.002, (0, 0.3, 1), (0, 0.25, 0.6, 1))))
+    Ka, Ma = P.mass_and_stiffness(base)
+    Kb, Mb = P.mass_and_stiffness(tab)
+    assert abs(Kb - Ka).max() <= 1e-14 * abs(Ka).max()
+    assert abs(Mb - Ma).max() <= 1e-14 * abs(Ma).max()
+    ma, mb = P.modal_model(base), P.modal_model(tab)
+    # matrices equal to ~2e-16; the FN2 eigen-solution amplifies that rounding to ~4e-12
+    # (measured; a dense scipy.linalg.eigh of the FN1 system moves by 1e-9), hence 1e-10 on
+    # the elastic frequencies rather than machine precision
+    el = slice(ma.n_rigid, None)
+    np.testing.assert_allclose(mb.frequencies_hz[el], ma.frequencies_hz[el], rtol=1e-10)
+    assert mb.n_rigid == ma.n_rigid
+
+
+def test_bilinear_interpolation_reproduces_the_table_and_a_bilinear_function():
+    f = lambda xi, eta: 0.003 + 0.001 * xi - 0.0015 * eta + 0.0005 * xi * eta  # noqa: E731
+    xc, eta = (0.0, 0.4, 1.0), (0.0, 0.2, 0.7, 1.0)
+    t = ThicknessTable(xc, eta, tuple(tuple(f(x, e) for x in xc) for e in eta))
+    rng = np.random.default_rng(1)
+    xi, et = rng.random(50), rng.random(50)
+    np.testing.assert_allclose(t.at(xi, et), f(xi, et), rtol=1e-14)     # exact on each cell
+    w = t.weights(xi, et)
+    np.testing.assert_allclose(w.sum(axis=(-2, -1)), 1.0, rtol=1e-14)   # partition of unity
+    assert float(t.at(0.4, 0.7)) == pytest.approx(f(0.4, 0.7), rel=1e-15)
+
+
+@pytest.mark.parametrize("thickness, message", [
+    ({"kind": "grid"}, r"thickness.kind must be one of 'linear', 'table'"),
+    ({"kind": "table", "eta": [0, 1], "values_m": [[0.004], [0.002]]},
+     r"thickness.x_over_c is missing"),
+    ({"kind": "table", "x_over_c": [0, 0.5], "eta": [0, 1], "values_m": [[1e-3] * 2] * 2},
+     r"thickness.x_over_c must start at 0 and end at 1"),
+    ({"kind": "table", "x_over_c": [0, 0.6, 0.5, 1], "eta": [0, 1], "values_m": [[1e-3] * 4] * 2},
+     r"thickness.x_over_c must be strictly ascending"),
+    ({"kind": "table", "x_over_c": [0, 1], "eta": [0, 1.5], "values_m": [[1e-3] * 2] * 2},
+     r"thickness.eta\[1\] must be"),
+    ({"kind": "table", "x_over_c": [0, 1], "eta": [0, 1], "values_m": [[1e-3] * 2]},
+     r"thickness.values_m must be a list of 2 rows"),
+    ({"kind": "table", "x_over_c": [0, 1], "eta": [0, 1], "values_m": [[1e-3] * 2, [1e-3]]},
+     r"thickness.values_m\[1\] must hold 2 numbers"),
+    ({"kind": "table", "x_over_c": [0, 1], "eta": [0, 1], "values_m": [[1e-3, -1], [1e-3] * 2]},
+     r"thickness.values_m\[0\]\[1\] must be > 0"),
+    ({"kind": "table", "x_over_c": [0, 1], "eta": [0, 1], "values_m": [[1e-3] * 2] * 2,
+      "root": 0.004}, r"thickness.root is not a known key"),
+])
+def test_table_errors_name_the_key(thickness, message):
+    with pytest.raises(CaseError, match=message):
+        case_from_dict(_with(thickness))
+
+
+def test_exact_pitch_inertia_refuses_a_table():
+    case = case_from_dict(_with(_linear_table(0.004, 0.002, (0, 1), (0, 1))))
+    with pytest.raises(CaseError, match="not a table"):
+        P.pitch_inertia_exact(case)
