@@ -108,7 +108,8 @@ class DesignVariable:
 class DesignProblem:
     """A parsed design file: ``variables``, ``objective`` ("mass"), ``flutter_margin`` (a
     fraction), ``max_iterations``, ``source`` (the file), ``table_max_step_m`` (m, the largest
-    difference of adjacent thickness-table values, None: unconstrained)."""
+    difference of adjacent thickness-table values, None: unconstrained), ``gradient_step``
+    (the central differences' relative step of the gradient check)."""
 
     variables: tuple[DesignVariable, ...]
     objective: str = "mass"
@@ -116,6 +117,7 @@ class DesignProblem:
     max_iterations: int = 40
     source: str = ""
     table_max_step_m: float | None = None
+    gradient_step: float = 1e-4
 
 
 def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default=None):
@@ -152,10 +154,10 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
         raise DesignError("a design file needs a [design] table")
     t = d["design"]
     unknown = set(t) - {"objective", "flutter_margin", "max_iterations", "variable",
-                        "table_max_step_m"}
+                        "table_max_step_m", "gradient_step"}
     if unknown:
         raise DesignError(f"design: unknown keys {sorted(unknown)} (known: objective, "
-                          f"flutter_margin, max_iterations, table_max_step_m, variable)")
+                          f"flutter_margin, gradient_step, max_iterations, table_max_step_m, variable)")
     objective = t.get("objective", "mass")
     if objective not in OBJECTIVES:
         raise DesignError(f"design.objective must be one of {list(OBJECTIVES)}, got {objective!r}")
@@ -181,7 +183,8 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
         raise DesignError(f"design.max_iterations must be an integer, got {iters!r}")
     step = (None if "table_max_step_m" not in t
             else _number(t, "table_max_step_m", "design", 0.0, 100.0))
-    return DesignProblem(tuple(out), objective, margin, int(iters), source, step)
+    gstep = _number(t, "gradient_step", "design", 1e-8, 0.1, 1e-4)
+    return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep)
 
 
 def table_index(path: str) -> tuple[int, int] | None:
@@ -649,7 +652,7 @@ def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
     check, t_check = None, 0.0
     if check_gradients:
         tc = time.perf_counter()
-        check = gradient_check(ev, x0)
+        check = gradient_check(ev, x0, ev.problem.gradient_step)
         t_check = time.perf_counter() - tc
     m0 = ev(x0).mass_kg
     history = []

@@ -174,3 +174,26 @@ def test_table_value_gradients_match_central_differences():
     e = ev(x0)
     assert np.all(np.isfinite(e.speeds_ms)) and np.all(e.d_speeds[:, 0] > 0)
     assert np.max(gradient_check(ev, x0)) < 1e-5
+
+
+@pytest.mark.parametrize("design, message", [
+    ({"gradient_step": 1.0}, r"design.gradient_step must be a number in \[1e-08, 0.1\]"),
+    ({"table_max_step_m": -0.001}, r"design.table_max_step_m must be a number in \[0, 100\]"),
+])
+def test_design_keys_of_the_field_name_the_key(design, message):
+    from asekit.case.design import DesignError
+    with pytest.raises(DesignError, match=message):
+        _problem("thickness.values_m", **design)
+
+
+def test_shipped_field_design_has_fifty_table_variables():
+    from asekit.case import load_case
+    from asekit.case.design import expand_variables, load_design
+    from asekit.util.paths import DATA_DIR
+    case = load_case(DATA_DIR / "cases" / "nalci2013_fin_field.toml")
+    problem = load_design(DATA_DIR / "designs" / "fin_min_mass_field.toml")
+    p = expand_variables(problem, case)
+    assert len(p.variables) == 50 and p.table_max_step_m == 0.0005
+    # the table samples the reference fin's law 4 - 2 eta mm (to the file's 1e-7 m)
+    t = case.thickness
+    np.testing.assert_allclose(t.values, [[0.004 - 0.002 * e] * 5 for e in t.eta], atol=5e-8)
