@@ -86,7 +86,7 @@ def test_table_design_on_a_linear_case_is_one_line_exit_2(capsys, no_work):
 
 @pytest.mark.slow
 def test_fin_thickness_field_end_to_end(tmp_path):
-    # 50 table variables (issue 28's "Done when"); ~3 min on the shared 2-core machine
+    # 50 table variables (issue 28's "Done when"); 110 s measured on the shared 2-core machine
     out, opt = tmp_path / "out.json", tmp_path / "opt.toml"
     assert main(["optimise", str(FIELD), str(FIELD_DESIGN), "--json", str(out),
                  "--out-case", str(opt)]) == 0
