@@ -241,6 +241,97 @@ class Thickness:
         """Maximum (section) thickness (m) at span fraction ``eta`` in [0, 1]."""
         return self.root + np.asarray(eta, float) * (self.tip - self.root)
 
+    @property
+    def is_table(self) -> bool:
+        """False: a root/tip law (:class:`ThicknessTable` says True)."""
+        return False
+
+
+def _grid(name: str, values) -> tuple[float, ...]:
+    v = tuple(float(x) for x in values)
+    if len(v) < 2 or v[0] != 0.0 or v[-1] != 1.0 or any(b <= a for a, b in zip(v, v[1:])):
+        raise ValueError(f"{name} must be strictly ascending from 0 to 1 with at least two "
+                         f"values, got {list(v)}")
+    return v
+
+
+def _hat_weights(grid: tuple[float, ...], t: np.ndarray) -> np.ndarray:
+    """(t.shape + (len(grid),)) piecewise-linear interpolation weights of ``t`` (clipped to
+    [0, 1]) on ``grid``: the hat functions, summing to one."""
+    g = np.asarray(grid)
+    t = np.clip(np.asarray(t, float), 0.0, 1.0)
+    i = np.clip(np.searchsorted(g, t, side="right") - 1, 0, g.size - 2)
+    f = (t - g[i]) / (g[i + 1] - g[i])
+    w = np.zeros(t.shape + (g.size,))
+    np.put_along_axis(w, i[..., None], (1.0 - f)[..., None], axis=-1)
+    np.put_along_axis(w, (i + 1)[..., None], f[..., None], axis=-1)
+    return w
+
+
+@dataclass(frozen=True)
+class ThicknessTable:
+    """Plate thickness tabulated over the panel and interpolated bilinearly (m):
+
+        h(xi, eta) = sum_ij values[i][j] H_i(eta) H_j(xi),
+
+    with xi the chord fraction, eta the span fraction (both in [0, 1]) and H the piecewise-linear
+    hat functions of the grids ``eta`` and ``x_over_c`` (each strictly ascending from 0 to 1).
+    ``values[i][j]`` (m, > 0) is the thickness at span station ``eta[i]`` and chord fraction
+    ``x_over_c[j]``. h is linear in the values, so dh/dvalues[i][j] = H_i(eta) H_j(xi)
+    (:meth:`weights`).
+
+    Examples
+    --------
+    >>> t = ThicknessTable((0.0, 1.0), (0.0, 1.0), ((0.004, 0.004), (0.002, 0.002)))
+    >>> float(t.at(0.3, 0.5)), t.root, t.tip
+    (0.003, 0.004, 0.002)
+    """
+
+    x_over_c: tuple[float, ...]
+    eta: tuple[float, ...]
+    values: tuple[tuple[float, ...], ...]
+
+    def __post_init__(self):
+        object.__setattr__(self, "x_over_c", _grid("x_over_c", self.x_over_c))
+        object.__setattr__(self, "eta", _grid("eta", self.eta))
+        rows = tuple(tuple(float(v) for v in row) for row in self.values)
+        if len(rows) != len(self.eta) or any(len(r) != len(self.x_over_c) for r in rows):
+            raise ValueError(f"values_m must hold {len(self.eta)} rows (one per eta) of "
+                             f"{len(self.x_over_c)} values (one per x_over_c)")
+        for i, r in enumerate(rows):
+            for j, v in enumerate(r):
+                positive(f"values_m[{i}][{j}]", v)
+        object.__setattr__(self, "values", rows)
+
+    @property
+    def is_table(self) -> bool:
+        return True
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(len(eta), len(x_over_c))."""
+        return len(self.eta), len(self.x_over_c)
+
+    @property
+    def root(self) -> float:
+        """The root section's maximum thickness (m)."""
+        return max(self.values[0])
+
+    @property
+    def tip(self) -> float:
+        """The tip section's maximum thickness (m)."""
+        return max(self.values[-1])
+
+    def weights(self, xi, eta) -> np.ndarray:
+        """dh/dvalues: (xi.shape + (n_eta, n_xc)) bilinear weights H_i(eta) H_j(xi)."""
+        xi, eta = np.broadcast_arrays(np.asarray(xi, float), np.asarray(eta, float))
+        return (_hat_weights(self.eta, eta)[..., :, None]
+                * _hat_weights(self.x_over_c, xi)[..., None, :])
+
+    def at(self, xi, eta) -> np.ndarray:
+        """h (m) at chord fraction ``xi`` and span fraction ``eta`` (clipped to [0, 1])."""
+        return np.einsum("...ij,ij->...", self.weights(xi, eta), np.asarray(self.values))
+
 
 #: The reference fin's law (flat, linear along the span) is a :class:`Thickness` with the
 #: default flat profile; the old name is kept.
@@ -251,21 +342,29 @@ LinearThickness = Thickness
 class ThicknessField:
     """h(x, y) (m) over a surface of one or more trapezoidal ``panels`` joined spanwise: the
     spanwise law of ``thickness`` runs over the whole span (first root to last tip), the
-    chord fraction is taken in the panel that holds the point."""
+    chord fraction is taken in the panel that holds the point. A :class:`ThicknessTable` is
+    interpolated at (chord fraction, span fraction)."""
 
     panels: tuple[Planform, ...]
-    thickness: Thickness
+    thickness: Thickness | ThicknessTable
 
-    def __call__(self, x, y) -> np.ndarray:
+    def fractions(self, x, y) -> tuple[np.ndarray, np.ndarray]:
+        """(xi, eta): the chord fraction in the panel holding (x, y) and the span fraction."""
         x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
         y0, y1 = self.panels[0].root_le[1], self.panels[-1].tip_le[1]
-        h = self.thickness.at((y - y0) / (y1 - y0))
-        if self.thickness.profile.is_flat:
-            return h
         xi = np.zeros_like(x)
         for i, p in enumerate(self.panels):
             sel = (y >= p.root_le[1] - 1e-12) if i else np.ones(y.shape, bool)
             xi = np.where(sel, (x - p.leading_edge_at(y)) / p.chord_at(y), xi)
+        return xi, (y - y0) / (y1 - y0)
+
+    def __call__(self, x, y) -> np.ndarray:
+        xi, eta = self.fractions(x, y)
+        if self.thickness.is_table:
+            return self.thickness.at(xi, eta)
+        h = self.thickness.at(eta)
+        if self.thickness.profile.is_flat:
+            return h
         return h * self.thickness.profile.at(xi)
 
 

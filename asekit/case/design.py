@@ -27,8 +27,15 @@ once), the p-k flutter point and dU_f (:mod:`asekit.aeroelastic.sensitivity`). T
 :func:`scipy.optimize.minimize` (SLSQP) with these gradients, on variables scaled by their
 baseline values.
 
-Supported variables: ``thickness.root``, ``thickness.tip`` (flat chordwise profile) and
-``point_mass[i].mass``. Supported structures: a ``shaft`` support (FN1 or FN2) or
+Supported variables: ``thickness.root``, ``thickness.tip`` (flat chordwise profile),
+``point_mass[i].mass`` and, for a tabulated thickness field (``[thickness] kind = "table"``),
+``thickness.values_m[i][j]`` (one table value) or ``thickness.values_m`` (the whole table,
+expanded to one variable per value, all with the given bounds). A table value enters the
+element matrices through the bilinear weights: dh_g / dvalues[i][j] = H_i(eta_g) H_j(xi_g) at
+every integration point g (:meth:`asekit.geometry.ThicknessTable.weights`), then the exact
+thickness derivatives of :mod:`asekit.structure.sensitivity`. ``design.table_max_step_m``
+bounds the difference of adjacent table values (a linear smoothness constraint,
+|v[i][j] - v[i+1][j]| and |v[i][j] - v[i][j+1]| <= the step, m) for manufacturability. Supported structures: a ``shaft`` support (FN1 or FN2) or
 ``clamped_root``, undamped (no ``[damping]``). Divergence, frequency separation and the servo
 requirements are not constraints yet.
 """
@@ -79,6 +86,8 @@ CONSTRAINT_SLACK = 1e-4
 #: re-analysis of ``asekit optimise``, which runs the case's own sweep.
 SWEEP_POINTS = 40
 _THICKNESS = ("thickness.root", "thickness.tip")
+_TABLE = "thickness.values_m"
+_TABLE_ENTRY = r"thickness\.values_m\[(\d+)\]\[(\d+)\]"
 
 
 class DesignError(ValueError):
@@ -98,13 +107,17 @@ class DesignVariable:
 @dataclass(frozen=True)
 class DesignProblem:
     """A parsed design file: ``variables``, ``objective`` ("mass"), ``flutter_margin`` (a
-    fraction), ``max_iterations``, ``source`` (the file)."""
+    fraction), ``max_iterations``, ``source`` (the file), ``table_max_step_m`` (m, the largest
+    difference of adjacent thickness-table values, None: unconstrained), ``gradient_step``
+    (the central differences' relative step of the gradient check)."""
 
     variables: tuple[DesignVariable, ...]
     objective: str = "mass"
     flutter_margin: float = 0.15
     max_iterations: int = 40
     source: str = ""
+    table_max_step_m: float | None = None
+    gradient_step: float = 1e-4
 
 
 def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default=None):
@@ -119,11 +132,12 @@ def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default
 
 def _variable_path(path, where: str) -> str:
     import re
-    if isinstance(path, str) and (path in _THICKNESS
+    if isinstance(path, str) and (path in _THICKNESS or path == _TABLE
+                                  or re.fullmatch(_TABLE_ENTRY, path)
                                   or re.fullmatch(r"point_mass\[\d+\]\.mass", path)):
         return path
-    raise DesignError(f"{where}.path must be one of {list(_THICKNESS)} or point_mass[i].mass, "
-                      f"got {path!r}")
+    raise DesignError(f"{where}.path must be one of {list(_THICKNESS)}, {_TABLE}, "
+                      f"{_TABLE}[i][j] or point_mass[i].mass, got {path!r}")
 
 
 def design_from_dict(d: dict, source: str = "") -> DesignProblem:
@@ -139,10 +153,11 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
     if not isinstance(d, dict) or not isinstance(d.get("design"), dict):
         raise DesignError("a design file needs a [design] table")
     t = d["design"]
-    unknown = set(t) - {"objective", "flutter_margin", "max_iterations", "variable"}
+    unknown = set(t) - {"objective", "flutter_margin", "max_iterations", "variable",
+                        "table_max_step_m", "gradient_step"}
     if unknown:
         raise DesignError(f"design: unknown keys {sorted(unknown)} (known: objective, "
-                          f"flutter_margin, max_iterations, variable)")
+                          f"flutter_margin, gradient_step, max_iterations, table_max_step_m, variable)")
     objective = t.get("objective", "mass")
     if objective not in OBJECTIVES:
         raise DesignError(f"design.objective must be one of {list(OBJECTIVES)}, got {objective!r}")
@@ -166,7 +181,62 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
     iters = _number(t, "max_iterations", "design", 1, 10000, 40)
     if iters != int(iters):
         raise DesignError(f"design.max_iterations must be an integer, got {iters!r}")
-    return DesignProblem(tuple(out), objective, margin, int(iters), source)
+    step = (None if "table_max_step_m" not in t
+            else _number(t, "table_max_step_m", "design", 0.0, 100.0))
+    gstep = _number(t, "gradient_step", "design", 1e-8, 0.1, 1e-4)
+    return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep)
+
+
+def table_index(path: str) -> tuple[int, int] | None:
+    """(i, j) of a ``thickness.values_m[i][j]`` path, None for any other path."""
+    import re
+    m = re.fullmatch(_TABLE_ENTRY, path)
+    return None if m is None else (int(m.group(1)), int(m.group(2)))
+
+
+def expand_variables(problem: DesignProblem, case: Case) -> DesignProblem:
+    """The problem with a whole-table variable ``thickness.values_m`` replaced by one variable
+    per table value (same bounds), row by row; DesignError when the case has no table, a
+    value is named twice or lies outside the table.
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import FIN_FILE
+    >>> import dataclasses
+    >>> from asekit.geometry import ThicknessTable
+    >>> t = ThicknessTable((0.0, 1.0), (0.0, 0.5, 1.0), ((4e-3,) * 2, (3e-3,) * 2, (2e-3,) * 2))
+    >>> case = dataclasses.replace(load_case(FIN_FILE), thickness=t)
+    >>> p = design_from_dict({"design": {"variable": [{"path": "thickness.values_m",
+    ...                                                "lower": 0.001, "upper": 0.008}]}})
+    >>> [v.path for v in expand_variables(p, case).variables][:3]
+    ['thickness.values_m[0][0]', 'thickness.values_m[0][1]', 'thickness.values_m[1][0]']
+    """
+    table = case.thickness if getattr(case.thickness, "is_table", False) else None
+    out = []
+    for k, v in enumerate(problem.variables):
+        if v.path != _TABLE and table_index(v.path) is None:
+            out.append(v)
+            continue
+        if table is None:
+            raise DesignError(f"design.variable[{k}].path {v.path!r} needs a thickness table "
+                              f"in the case ([thickness] kind = \"table\")")
+        n_eta, n_xc = table.shape
+        if v.path == _TABLE:
+            out += [DesignVariable(f"{_TABLE}[{i}][{j}]", v.lower, v.upper)
+                    for i in range(n_eta) for j in range(n_xc)]
+            continue
+        i, j = table_index(v.path)
+        if i >= n_eta or j >= n_xc:
+            raise DesignError(f"design.variable[{k}].path {v.path!r}: the case's table has "
+                              f"{n_eta} x {n_xc} values (indices from 0)")
+        out.append(v)
+    paths = [v.path for v in out]
+    twice = sorted({p for p in paths if paths.count(p) > 1})
+    if twice:
+        raise DesignError(f"design.variable: {twice[0]} is named twice (a whole-table variable "
+                          f"and one of its values?)")
+    return dataclasses.replace(problem, variables=tuple(out))
 
 
 def load_design(path) -> DesignProblem:
@@ -187,6 +257,9 @@ def case_value(case: Case, path: str) -> float:
         return float(case.thickness.root)
     if path == "thickness.tip":
         return float(case.thickness.tip)
+    ij = table_index(path)
+    if ij is not None:
+        return float(case.thickness.values[ij[0]][ij[1]])
     i = _point_index(path)
     if i >= len(case.point_masses):
         raise DesignError(f"{path}: the case has {len(case.point_masses)} point masses")
@@ -197,14 +270,20 @@ def with_values(case: Case, paths, values) -> Case:
     """The case with the design variables' keys set to ``values``."""
     th = case.thickness
     pms = list(case.point_masses)
+    table = [list(r) for r in th.values] if getattr(th, "is_table", False) else None
     for path, v in zip(paths, values):
-        if path == "thickness.root":
+        if table_index(path) is not None:
+            i, j = table_index(path)
+            table[i][j] = float(v)
+        elif path == "thickness.root":
             th = dataclasses.replace(th, root=float(v))
         elif path == "thickness.tip":
             th = dataclasses.replace(th, tip=float(v))
         else:
             i = _point_index(path)
             pms[i] = dataclasses.replace(pms[i], mass=float(v))
+    if table is not None:
+        th = dataclasses.replace(th, values=tuple(tuple(r) for r in table))
     return dataclasses.replace(case, thickness=th, point_masses=tuple(pms))
 
 
@@ -213,7 +292,10 @@ def set_case_values(raw: dict, paths, values) -> dict:
     import copy
     out = copy.deepcopy(raw)
     for path, v in zip(paths, values):
-        if path.startswith("thickness."):
+        if table_index(path) is not None:
+            i, j = table_index(path)
+            out["thickness"]["values_m"][i][j] = float(v)
+        elif path.startswith("thickness."):
             out.setdefault("thickness", {})[path.split(".")[1]] = float(v)
         else:
             out["point_mass"][_point_index(path)]["mass"] = float(v)
@@ -232,8 +314,13 @@ def check_case(case: Case, problem: DesignProblem) -> None:
     if d.modal_damping_ratio is not None or d.structural_g is not None:
         raise DesignError("damping: the optimiser's flutter derivatives are for an undamped "
                           "structure; remove [damping]")
-    if not getattr(case.thickness.profile, "is_flat", True):
+    table = getattr(case.thickness, "is_table", False)
+    if not table and not case.thickness.profile.is_flat:
         raise DesignError("thickness.profile must be 'flat' for the thickness variables")
+    for i, v in enumerate(problem.variables):
+        if table and v.path in _THICKNESS:
+            raise DesignError(f"design.variable[{i}].path {v.path!r}: the case's thickness is a "
+                              f"table; vary {_TABLE} or {_TABLE}[i][j]")
     if case.aero is None or case.flight is None or case.flight.envelope_mach is None \
             or case.flight.altitudes is None:
         raise DesignError("the case needs [aero], [flight] altitudes and [flight.envelope] "
@@ -294,6 +381,7 @@ class Evaluator:
     _memo: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        self.problem = expand_variables(self.problem, self.case)
         check_case(self.case, self.problem)
         base = P.modal_model(self.case)
         self.n_elastic = base.frequencies_hz.size - base.n_rigid
@@ -356,13 +444,25 @@ def _thickness_dh(mesh, parts, path: str):
     return out
 
 
+def _table_dh(mesh, parts, ij):
+    """dh/d(values_m[i][j]) at the stiffness and mass points: the bilinear weight
+    H_i(eta) H_j(xi) of the table value (:meth:`asekit.geometry.ThicknessTable.weights`)."""
+    field = mesh.thickness_field
+    out = []
+    for xy in (parts.xy_k, parts.xy_m):
+        xi, eta = field.fractions(xy[..., 0], xy[..., 1])
+        out.append(field.thickness.weights(xi, eta)[..., ij[0], ij[1]])
+    return out
+
+
 def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts):
     """Global dK, dM (fin DOFs) and d(mass) per design variable."""
     dK, dM, dm = [], [], []
     w_mass = parts.Mt[:, :, 0::3, 0::3].sum(axis=(2, 3))         # (ne, ng): rho w det per point
     for path in ev.paths:
-        if path in _THICKNESS:
-            dh_k, dh_m = _thickness_dh(mesh, parts, path)
+        if path in _THICKNESS or table_index(path) is not None:
+            dh_k, dh_m = (_thickness_dh(mesh, parts, path) if path in _THICKNESS
+                          else _table_dh(mesh, parts, table_index(path)))
             k, m = thickness_derivatives(mesh, parts, dh_k[None], dh_m[None])
             dK.append(k[0])
             dM.append(m[0])
@@ -504,6 +604,30 @@ def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.
     return err
 
 
+def smoothness_matrix(paths) -> np.ndarray:
+    """(n_pairs, n_var) D with (D v)_p = v_a - v_b for every pair of adjacent table values
+    (neighbours along eta or along x_over_c) that are both design variables."""
+    where = {table_index(p): k for k, p in enumerate(paths) if table_index(p) is not None}
+    rows = []
+    for (i, j), a in where.items():
+        for nb in ((i + 1, j), (i, j + 1)):
+            if nb in where:
+                r = np.zeros(len(paths))
+                r[a], r[where[nb]] = 1.0, -1.0
+                rows.append(r)
+    return np.array(rows).reshape(len(rows), len(paths))
+
+
+def smoothness_constraints(paths, x0: np.ndarray, step: float | None) -> list:
+    """SLSQP linear inequalities step -+ D (z x0) >= 0 (:func:`smoothness_matrix`) on the
+    scaled variables z = v / x0; none without a step or adjacent table variables."""
+    D = smoothness_matrix(paths)
+    if step is None or D.shape[0] == 0:
+        return []
+    A = np.vstack([-D, D]) * x0[None, :]
+    return [{"type": "ineq", "fun": lambda z: step + A @ z, "jac": lambda z: A}]
+
+
 def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
              progress=None, evaluator: Evaluator | None = None) -> DesignResult:
     """Minimise the mass subject to the flutter margin (module docstring) with SLSQP and the
@@ -528,7 +652,7 @@ def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
     check, t_check = None, 0.0
     if check_gradients:
         tc = time.perf_counter()
-        check = gradient_check(ev, x0)
+        check = gradient_check(ev, x0, ev.problem.gradient_step)
         t_check = time.perf_counter() - tc
     m0 = ev(x0).mass_kg
     history = []
@@ -551,13 +675,15 @@ def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
         if progress is not None:
             progress(row)
 
-    bounds = [(v.lower / x, v.upper / x) for v, x in zip(problem.variables, x0)]
+    variables = ev.problem.variables
+    bounds = [(v.lower / x, v.upper / x) for v, x in zip(variables, x0)]
+    constraints = [{"type": "ineq", "fun": cons, "jac": cons_jac}]
+    constraints += smoothness_constraints(ev.paths, x0, ev.problem.table_max_step_m)
     res = minimize(obj, np.ones(x0.size), jac=True, method="SLSQP", bounds=bounds,
-                   constraints=[{"type": "ineq", "fun": cons, "jac": cons_jac}],
+                   constraints=constraints,
                    options={"maxiter": problem.max_iterations, "ftol": 1e-6},
                    callback=record)
-    x = np.clip(res.x * x0, [v.lower for v in problem.variables],
-                [v.upper for v in problem.variables])
+    x = np.clip(res.x * x0, [v.lower for v in variables], [v.upper for v in variables])
     return DesignResult(paths=ev.paths, baseline=ev(x0), optimised=ev(x), history=tuple(history),
                         success=bool(res.success), message=str(res.message),
                         evaluations=ev.calls, seconds=time.perf_counter() - t0,

@@ -23,7 +23,14 @@ from asekit.aeroelastic.methods import FLUTTER_METHODS
 from asekit.atmosphere import MAX_ALTITUDE, MIN_ALTITUDE
 from asekit.case.imported import ImportedModel
 from asekit.case.resources import pk_problem, resource_problem
-from asekit.geometry import Material, OrthotropicMaterial, Planform, Thickness, chordwise_profile
+from asekit.geometry import (
+    Material,
+    OrthotropicMaterial,
+    Planform,
+    Thickness,
+    ThicknessTable,
+    chordwise_profile,
+)
 from asekit.rfa.methods import RFA_FITS
 from asekit.structure.mesh import Grading, Stations, check_stations, station_array
 from asekit.structure.supports import SUPPORTS
@@ -322,7 +329,7 @@ class Case:
 
     name: str
     panels: tuple[PanelSpec, ...]
-    thickness: Thickness
+    thickness: Thickness | ThicknessTable
     material: Material | OrthotropicMaterial
     support: SupportSpec
     aero: AeroSpec
@@ -613,7 +620,35 @@ def _check_sweep(i, rle, rc, tle, tc) -> None:
                             f" m)")
 
 
-def _thickness(t: _Table) -> Thickness:
+def _thickness_table(t: _Table) -> ThicknessTable:
+    """``[thickness] kind = "table"``: ``x_over_c`` and ``eta`` grids and ``values_m`` (one row
+    per eta of one value per x_over_c, m), bilinear over the panel (:class:`ThicknessTable`)."""
+    xc = t.numbers("x_over_c", required=True, min_length=2, low=0.0, high=1.0, low_open=False,
+                   ascending=True)
+    eta = t.numbers("eta", required=True, min_length=2, low=0.0, high=1.0, low_open=False,
+                    ascending=True)
+    for k, g in (("x_over_c", xc), ("eta", eta)):
+        if g[0] != 0.0 or g[-1] != 1.0:
+            raise CaseError(f"{t.key(k)} must start at 0 and end at 1 (the whole panel), "
+                            f"got {list(g)}")
+    rows = t.raw("values_m", required=True)
+    if not isinstance(rows, list) or len(rows) != len(eta):
+        raise CaseError(f"{t.key('values_m')} must be a list of {len(eta)} rows (one per eta), "
+                        f"got {rows!r}")
+    values = []
+    for i, row in enumerate(rows):
+        if not isinstance(row, list) or len(row) != len(xc):
+            raise CaseError(f"{t.key('values_m')}[{i}] must hold {len(xc)} numbers (one per "
+                            f"x_over_c), got {row!r}")
+        values.append(tuple(_number(f"{t.key('values_m')}[{i}][{j}]", v, 0.0, 100.0, True,
+                                    False, "m") for j, v in enumerate(row)))
+    t.done()
+    return ThicknessTable(xc, eta, tuple(values))
+
+
+def _thickness(t: _Table) -> Thickness | ThicknessTable:
+    if t.string("kind", ("linear", "table"), default="linear") == "table":
+        return _thickness_table(t)
     root = t.number("root", required=True, low=0.0, high=100.0, unit="m")
     tip = t.number("tip", required=True, low=0.0, high=100.0, unit="m")
     prof = t.raw("profile", "flat")

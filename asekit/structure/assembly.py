@@ -111,6 +111,8 @@ def plate_pitch_inertia(planform, thickness, density: float, axis_x: float) -> f
     True
     """
     positive("density", density)
+    if getattr(thickness, "is_table", False):
+        raise ValueError("plate_pitch_inertia needs a root/tip thickness law, not a table")
     if not getattr(getattr(thickness, "profile", None), "is_flat", True):
         raise ValueError("plate_pitch_inertia needs a flat chordwise thickness profile")
     p, t, rho = planform, thickness, float(density)

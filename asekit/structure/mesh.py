@@ -400,7 +400,8 @@ def structured_mesh(planform: Planform, thickness: LinearThickness, n_chord: int
     i, j = np.meshgrid(np.arange(n_chord), np.arange(n_span))
     n0 = (j * (n_chord + 1) + i).ravel()
     elements = np.stack([n0, n0 + 1, n0 + n_chord + 2, n0 + n_chord + 1], axis=1)
-    field = None if thickness.profile.is_flat else ThicknessField((planform,), thickness)
+    field = (None if not thickness.is_table and thickness.profile.is_flat
+             else ThicknessField((planform,), thickness))
     return PlateMesh(nodes=nodes, elements=elements.astype(np.int64),
                      thickness_root=thickness.root, thickness_tip=thickness.tip,
                      y_root=planform.root_le[1], span=planform.span,
@@ -459,7 +460,8 @@ def panels_mesh(panels, thickness: Thickness, n_chord: int, n_spans, chord_spaci
     return PlateMesh(nodes=nodes, elements=elements.astype(np.int64),
                      thickness_root=thickness.root, thickness_tip=thickness.tip,
                      y_root=y0, span=y1 - y0, n_chord=n_chord, n_span=n_stations,
-                     thickness_field=None if thickness.profile.is_flat and len(panels) == 1
+                     thickness_field=None if (not thickness.is_table and thickness.profile.is_flat
+                                             and len(panels) == 1)
                      else ThicknessField(panels, thickness))
 
 
