@@ -1,5 +1,5 @@
 """``python -m asekit optimise CASE.toml DESIGN.toml [--json PATH] [--out-case PATH]
-[--no-gradient-check]``: minimise the mass of a case's surface subject to its flutter margin
+[--report DIR] [--no-gradient-check]``: minimise the mass of a case's surface subject to its flutter margin
 (a design file, :mod:`asekit.case.design`), write the optimised case file and re-analyse it.
 
 The optimised design's margin is not the optimiser's own number: the written case (or, without
@@ -8,8 +8,10 @@ The optimised design's margin is not the optimiser's own number: the written cas
 ``design.baseline`` and ``design.optimised`` (``mass_kg``, ``flutter_margin_pct`` from the
 pipeline, ``predicted_margin_pct`` from the optimiser's chain, the variables' ``values``),
 ``design.gradient_check`` (``max_rel_error`` of the analytic gradients against central
-differences at the baseline, ``seconds``) and ``design.history`` (one row per iteration). Bad
-input gets one line and exit status 2.
+differences at the baseline, ``seconds``) and ``design.history`` (one row per iteration).
+``--report DIR`` writes the thickness field, V-g / V-f before and after (the pipeline's
+re-analysis) and the history as an HTML page (:mod:`asekit.case.design_report`). Bad input
+gets one line and exit status 2.
 """
 
 from __future__ import annotations
@@ -31,6 +33,8 @@ def add_parser(sub) -> None:
     p.add_argument("design", metavar="DESIGN.toml", help="the design file (see data/designs/)")
     p.add_argument("--json", metavar="PATH", help="write the results as JSON ('-': stdout)")
     p.add_argument("--out-case", metavar="PATH", help="write the optimised case file (TOML)")
+    p.add_argument("--report", metavar="DIR",
+                   help="write index.html, the figures (thickness, V-g, history) and summary.json")
     p.add_argument("--no-gradient-check", dest="gradient_check", action="store_false",
                    help="skip the finite-difference check of the gradients at the baseline")
     p.set_defaults(func=run)
@@ -83,6 +87,9 @@ def run(args) -> int:
         reason = outputs.check_file(opt, value, dash=opt == "--json")
         if reason:
             return _error(reason)
+    reason = outputs.check_dir("--report", getattr(args, "report", None), "the HTML report")
+    if reason:
+        return _error(reason)
     from asekit.case import load_case
     from asekit.case.design import DesignError, load_design, optimise, with_values
     from asekit.util.validate import read_toml
@@ -128,6 +135,11 @@ def run(args) -> int:
            "units": {"mass_kg": "kg", "flutter_margin_pct": "%", "seconds": "s",
                      "values": "the unit of each case key (thickness m, point mass kg)"}}
     text = json.dumps(doc, indent=2)
+    if getattr(args, "report", None):
+        from asekit.case import pipeline as P
+        from asekit.case.design_report import write_design_report
+        write_design_report(args.report, case, reanalysed, P.flutter(case),
+                            P.flutter(reanalysed), list(result.history), doc)
     if args.json == "-":
         print(text)
     elif args.json:

@@ -58,9 +58,11 @@ def test_missing_file_is_one_line_exit_2(tmp_path, capsys, no_work):
 
 @pytest.mark.slow
 def test_fin_minimum_mass_end_to_end(tmp_path, capsys):
-    out, opt = tmp_path / "out.json", tmp_path / "opt.toml"
+    out, opt, rep = tmp_path / "out.json", tmp_path / "opt.toml", tmp_path / "rep"
     assert main(["optimise", str(FIN), str(DESIGN), "--json", str(out),
-                 "--out-case", str(opt)]) == 0
+                 "--out-case", str(opt), "--report", str(rep)]) == 0
+    assert {"index.html", "thickness.png", "vg.png", "history.png", "summary.json"} <= {
+        p.name for p in rep.iterdir()}
     d = json.loads(out.read_text())["design"]
     # independent of the optimiser: the written file, loaded and analysed by the pipeline
     margins = [m["margin"] for m in P.flutter(load_case(opt)).margins]
