@@ -36,8 +36,11 @@ every integration point g (:meth:`asekit.geometry.ThicknessTable.weights`), then
 thickness derivatives of :mod:`asekit.structure.sensitivity`. ``design.table_max_step_m``
 bounds the difference of adjacent table values (a linear smoothness constraint,
 |v[i][j] - v[i+1][j]| and |v[i][j] - v[i][j+1]| <= the step, m) for manufacturability. Supported structures: a ``shaft`` support (FN1 or FN2) or
-``clamped_root``, undamped (no ``[damping]``). Divergence, frequency separation and the servo
-requirements are not constraints yet.
+``clamped_root``, undamped (no ``[damping]``). ``design.divergence_margin`` adds the divergence
+of the elastic modes at the top Mach as a constraint, U_D >= (1 + margin) M a per envelope
+altitude, written 1 - q_a mu >= 0 with mu = 1 / q_D and its analytic derivative
+(:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`). Frequency separation and the
+servo requirements are not constraints yet.
 """
 
 from __future__ import annotations
@@ -55,6 +58,7 @@ from asekit.aero.methods import AERO_METHODS, resolve_method
 from asekit.aero.spline import fe_spline, modal_forces
 from asekit.aeroelastic.flutter import pk_flutter, pk_instabilities
 from asekit.aeroelastic.sensitivity import (
+    divergence_sensitivity,
     extended_shapes,
     flutter_point,
     flutter_speed_sensitivity,
@@ -109,7 +113,9 @@ class DesignProblem:
     """A parsed design file: ``variables``, ``objective`` ("mass"), ``flutter_margin`` (a
     fraction), ``max_iterations``, ``source`` (the file), ``table_max_step_m`` (m, the largest
     difference of adjacent thickness-table values, None: unconstrained), ``gradient_step``
-    (the central differences' relative step of the gradient check)."""
+    (the central differences' relative step of the gradient check), ``divergence_margin`` (a
+    fraction: U_D >= (1 + margin) M a at every envelope altitude; None: divergence is reported,
+    not constrained)."""
 
     variables: tuple[DesignVariable, ...]
     objective: str = "mass"
@@ -118,6 +124,7 @@ class DesignProblem:
     source: str = ""
     table_max_step_m: float | None = None
     gradient_step: float = 1e-4
+    divergence_margin: float | None = None
 
 
 def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default=None):
@@ -154,10 +161,11 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
         raise DesignError("a design file needs a [design] table")
     t = d["design"]
     unknown = set(t) - {"objective", "flutter_margin", "max_iterations", "variable",
-                        "table_max_step_m", "gradient_step"}
+                        "table_max_step_m", "gradient_step", "divergence_margin"}
     if unknown:
-        raise DesignError(f"design: unknown keys {sorted(unknown)} (known: objective, "
-                          f"flutter_margin, gradient_step, max_iterations, table_max_step_m, variable)")
+        raise DesignError(f"design: unknown keys {sorted(unknown)} (known: divergence_margin, "
+                          f"objective, flutter_margin, gradient_step, max_iterations, "
+                          f"table_max_step_m, variable)")
     objective = t.get("objective", "mass")
     if objective not in OBJECTIVES:
         raise DesignError(f"design.objective must be one of {list(OBJECTIVES)}, got {objective!r}")
@@ -184,7 +192,9 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
     step = (None if "table_max_step_m" not in t
             else _number(t, "table_max_step_m", "design", 0.0, 100.0))
     gstep = _number(t, "gradient_step", "design", 1e-8, 0.1, 1e-4)
-    return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep)
+    div = (None if "divergence_margin" not in t
+           else _number(t, "divergence_margin", "design", 0.0, 10.0))
+    return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep, div)
 
 
 def table_index(path: str) -> tuple[int, int] | None:
@@ -351,7 +361,10 @@ class Evaluation:
 
     values : (n_var,) the design; mass_kg, d_mass (n_var,); speeds_ms (n_cond,) U_f per envelope
     altitude (NaN: no flutter in the velocity sweep); d_speeds (n_cond, n_var); envelope_ms
-    (n_cond,) M a; margins (n_cond,) U_f / (M a) - 1; frequencies_hz (n_cond,) at flutter.
+    (n_cond,) M a; margins (n_cond,) U_f / (M a) - 1; frequencies_hz (n_cond,) at flutter;
+    densities (n_cond,) kg/m^3; divergence_mu : 1 / q_D (1/Pa) of the elastic modes at the top
+    Mach (:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`; <= 0: no divergence,
+    NaN: no real eigenvalue), d_divergence_mu (n_var,).
     """
 
     values: np.ndarray
@@ -361,10 +374,21 @@ class Evaluation:
     d_speeds: np.ndarray
     envelope_ms: np.ndarray
     frequencies_hz: np.ndarray
+    densities: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    divergence_mu: float = math.nan
+    d_divergence_mu: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def margins(self) -> np.ndarray:
         return self.speeds_ms / self.envelope_ms - 1.0
+
+    @property
+    def divergence_speeds_ms(self) -> np.ndarray:
+        """U_D = sqrt(2 / (rho mu)) per envelope altitude (m/s; inf: no divergence)."""
+        mu = self.divergence_mu
+        if not mu > 0:
+            return np.full(self.densities.shape, math.inf)
+        return np.sqrt(2.0 / (self.densities * mu))
 
 
 @dataclass
@@ -543,11 +567,14 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
             "dC": np.zeros((n_var, n, n)), "dQ": gaf_derivative(Q, n)}
     conds = envelope_conditions(case)
     out = [_flutter(ev, mats, gaf, c.density) for c in conds]
+    div = divergence_sensitivity(mats["K"], Q[0, :n, :n], mats["dK"], mats["dQ"][:, 0])
     return Evaluation(values=values, mass_kg=mass, d_mass=d_mass,
                       speeds_ms=np.array([o[0] for o in out]),
                       d_speeds=np.array([o[2] for o in out]),
                       envelope_ms=np.array([ev.mach * c.speed_of_sound for c in conds]),
-                      frequencies_hz=np.array([o[1] for o in out]))
+                      frequencies_hz=np.array([o[1] for o in out]),
+                      densities=np.array([c.density for c in conds]),
+                      divergence_mu=div.mu, d_divergence_mu=div.d_mu)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -558,7 +585,22 @@ def _constraint(ev: Evaluator, e: Evaluation):
     flutter in the sweep counts as U_f = the sweep's last speed (a lower bound), gradient 0."""
     u = np.where(np.isnan(e.speeds_ms), ev.case.flight.velocities[-1], e.speeds_ms)
     scale = (1.0 + ev.problem.flutter_margin) * (1.0 + CONSTRAINT_SLACK) * e.envelope_ms
-    return u / scale - 1.0, e.d_speeds / scale[:, None]
+    g, dg = u / scale - 1.0, e.d_speeds / scale[:, None]
+    if ev.problem.divergence_margin is None:
+        return g, dg
+    gd, dgd = _divergence_constraint(ev.problem.divergence_margin, e)
+    return np.concatenate([g, gd]), np.vstack([dg, dgd])
+
+
+def _divergence_constraint(margin: float, e: Evaluation):
+    """g_a = 1 - q_a mu >= 0 per envelope altitude, q_a = rho_a ((1 + margin) (1 + slack) M a)^2
+    / 2 the dynamic pressure the divergence must exceed (q_D = 1 / mu >= q_a), and its gradient
+    -q_a dmu. Smooth where the design loses its divergence (mu through zero, q_D through
+    infinity); no real divergence eigenvalue (NaN mu) counts as none, gradient 0."""
+    q = 0.5 * e.densities * ((1.0 + margin) * (1.0 + CONSTRAINT_SLACK) * e.envelope_ms) ** 2
+    if not np.isfinite(e.divergence_mu):
+        return np.ones_like(q), np.zeros((q.size, e.d_mass.size))
+    return 1.0 - q * e.divergence_mu, -q[:, None] * e.d_divergence_mu[None, :]
 
 
 @dataclass(frozen=True)
@@ -590,8 +632,8 @@ class DesignResult:
 
 
 def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.ndarray:
-    """Max relative error per variable of the analytic d(mass) and dU_f against central
-    differences of the whole chain (step ``rel_step`` times the value)."""
+    """Max relative error per variable of the analytic d(mass), dU_f and dmu (the divergence
+    eigenvalue) against central differences of the whole chain (step ``rel_step`` times the value)."""
     e0 = ev(x0)
     err = np.zeros(x0.size)
     for j in range(x0.size):
@@ -600,6 +642,8 @@ def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.
         pairs = [(e0.d_mass[j], (ep.mass_kg - em.mass_kg) / (2 * h))]
         pairs += [(a, (b - c) / (2 * h)) for a, b, c in
                   zip(e0.d_speeds[:, j], ep.speeds_ms, em.speeds_ms) if np.isfinite(b - c)]
+        if np.isfinite(ep.divergence_mu - em.divergence_mu):
+            pairs.append((e0.d_divergence_mu[j], (ep.divergence_mu - em.divergence_mu) / (2 * h)))
         err[j] = max(abs(a - f) / max(abs(f), 1e-300) for a, f in pairs)
     return err
 

@@ -99,12 +99,45 @@ def test_chain_matches_the_pipeline_and_its_gradients_match_differences(ev):
     fa = P.flutter(CASE)
     for u, m in zip(e.speeds_ms, fa.margins):
         assert u == pytest.approx(m["flutter_speed_ms"], rel=1e-5)
+    # the divergence speed from mu = 1 / q_D is the pipeline's (divergence_speeds on the FN2
+    # model's elastic modes at the top Mach; measured agreement 3e-9 relative)
+    div = [d["speed_ms"] for d in fa.divergence if d["mach"] == 0.6]
+    assert np.all(np.isfinite(e.divergence_speeds_ms))
+    np.testing.assert_allclose(e.divergence_speeds_ms, div, rtol=1e-5)
     # mass: rho times the trapezoid's volume (linear thickness and chord), plus the point mass
     area_weighted_h = 0.15 * (0.156 * 0.004 / 3 + (0.156 * 0.002 + 0.078 * 0.004) / 6
                               + 0.078 * 0.002 / 3)
     assert e.mass_kg == pytest.approx(2700.0 * area_weighted_h + 0.01, rel=1e-12)
-    err = gradient_check(ev, x0)
+    err = gradient_check(ev, x0)        # d(mass), dU_f and dmu (divergence) per variable
     assert np.max(err) <= 1e-5, err
+
+
+def test_divergence_constraint_is_the_pipelines_margin(ev):
+    """g_a = 1 - q_a / q_D = 1 - (s M a / U_D)^2 with s = (1 + margin)(1 + slack), U_D from the
+    pipeline; its gradient is -q_a dmu (dmu checked against differences above)."""
+    from asekit.case.design import CONSTRAINT_SLACK, _constraint, _divergence_constraint
+    e = ev(np.array([0.004, 0.002, 0.01]))
+    # without design.divergence_margin only the flutter rows (one per envelope altitude)
+    assert _constraint(ev, e)[0].shape == (2,)
+    g, dg = _divergence_constraint(1.9, e)
+    div = [d["speed_ms"] for d in P.flutter(CASE).divergence if d["mach"] == 0.6]
+    need = 2.9 * (1 + CONSTRAINT_SLACK) * e.envelope_ms
+    np.testing.assert_allclose(g, 1 - (need / np.array(div)) ** 2, rtol=1e-6)
+    # 2.9 M a at sea level = 592 m/s > U_D = 577 m/s: violated there, met at 2500 m
+    assert g[0] < 0 < g[1]
+    q = 0.5 * e.densities * need ** 2
+    np.testing.assert_allclose(dg, -q[:, None] * e.d_divergence_mu[None, :], rtol=1e-12)
+
+
+def test_divergence_margin_key_is_checked():
+    p = design_from_dict({"design": {"divergence_margin": 0.15, "variable": [
+        {"path": "thickness.tip", "lower": 0.001, "upper": 0.004}]}})
+    assert p.divergence_margin == 0.15
+    assert design_from_dict({"design": {"variable": [
+        {"path": "thickness.tip", "lower": 0.001, "upper": 0.004}]}}).divergence_margin is None
+    with pytest.raises(DesignError, match=r"design.divergence_margin must be a number in \[0, 10\]"):
+        design_from_dict({"design": {"divergence_margin": -0.1, "variable": [
+            {"path": "thickness.tip", "lower": 0.001, "upper": 0.004}]}})
 
 
 @pytest.mark.slow
