@@ -28,7 +28,11 @@ once), the p-k flutter point and dU_f (:mod:`asekit.aeroelastic.sensitivity`). T
 baseline values.
 
 Supported variables: ``thickness.root``, ``thickness.tip`` (flat chordwise profile),
-``point_mass[i].mass`` and, for a tabulated thickness field (``[thickness] kind = "table"``),
+``point_mass[i].mass`` (kg), ``point_mass[i].position[0]`` and ``point_mass[i].position[1]``
+(its x, chordwise, and y, spanwise, m: dM/dx = m (N_x N^T + N N_x^T) through the shape
+functions of the element holding it, :func:`asekit.structure.sensitivity.\
+point_mass_position_derivative`; exact inside an element, one-sided where the mass crosses an
+element edge, as the bilinear N is only C0 there) and, for a tabulated thickness field (``[thickness] kind = "table"``),
 ``thickness.values_m[i][j]`` (one table value) or ``thickness.values_m`` (the whole table,
 expanded to one variable per value, all with the given bounds). A table value enters the
 element matrices through the bilinear weights: dh_g / dvalues[i][j] = H_i(eta_g) H_j(xi_g) at
@@ -73,6 +77,7 @@ from asekit.structure.sensitivity import (
     element_parts,
     mode_shape_derivatives,
     point_mass_derivative,
+    point_mass_position_derivative,
     reduce,
     thickness_derivatives,
 )
@@ -92,6 +97,7 @@ SWEEP_POINTS = 40
 _THICKNESS = ("thickness.root", "thickness.tip")
 _TABLE = "thickness.values_m"
 _TABLE_ENTRY = r"thickness\.values_m\[(\d+)\]\[(\d+)\]"
+_POINT_MASS = r"point_mass\[(\d+)\]\.(mass|position\[([01])\])"
 
 
 class DesignError(ValueError):
@@ -141,10 +147,11 @@ def _variable_path(path, where: str) -> str:
     import re
     if isinstance(path, str) and (path in _THICKNESS or path == _TABLE
                                   or re.fullmatch(_TABLE_ENTRY, path)
-                                  or re.fullmatch(r"point_mass\[\d+\]\.mass", path)):
+                                  or re.fullmatch(_POINT_MASS, path)):
         return path
     raise DesignError(f"{where}.path must be one of {list(_THICKNESS)}, {_TABLE}, "
-                      f"{_TABLE}[i][j] or point_mass[i].mass, got {path!r}")
+                      f"{_TABLE}[i][j], point_mass[i].mass or point_mass[i].position[k] "
+                      f"(k = 0: x, 1: y), got {path!r}")
 
 
 def design_from_dict(d: dict, source: str = "") -> DesignProblem:
@@ -261,6 +268,13 @@ def _point_index(path: str) -> int:
     return int(path[path.index("[") + 1:path.index("]")])
 
 
+def position_axis(path: str) -> int | None:
+    """0 (x) or 1 (y) of a ``point_mass[i].position[k]`` path, None for any other path."""
+    import re
+    m = re.fullmatch(_POINT_MASS, path)
+    return None if m is None or m.group(3) is None else int(m.group(3))
+
+
 def case_value(case: Case, path: str) -> float:
     """The current value of a design variable's key in ``case``."""
     if path == "thickness.root":
@@ -273,7 +287,9 @@ def case_value(case: Case, path: str) -> float:
     i = _point_index(path)
     if i >= len(case.point_masses):
         raise DesignError(f"{path}: the case has {len(case.point_masses)} point masses")
-    return float(case.point_masses[i].mass)
+    axis = position_axis(path)
+    pm = case.point_masses[i]
+    return float(pm.mass if axis is None else pm.position[axis])
 
 
 def with_values(case: Case, paths, values) -> Case:
@@ -290,8 +306,13 @@ def with_values(case: Case, paths, values) -> Case:
         elif path == "thickness.tip":
             th = dataclasses.replace(th, tip=float(v))
         else:
-            i = _point_index(path)
-            pms[i] = dataclasses.replace(pms[i], mass=float(v))
+            i, axis = _point_index(path), position_axis(path)
+            if axis is None:
+                pms[i] = dataclasses.replace(pms[i], mass=float(v))
+            else:
+                pos = list(pms[i].position)
+                pos[axis] = float(v)
+                pms[i] = dataclasses.replace(pms[i], position=tuple(pos))
     if table is not None:
         th = dataclasses.replace(th, values=tuple(tuple(r) for r in table))
     return dataclasses.replace(case, thickness=th, point_masses=tuple(pms))
@@ -308,7 +329,12 @@ def set_case_values(raw: dict, paths, values) -> dict:
         elif path.startswith("thickness."):
             out.setdefault("thickness", {})[path.split(".")[1]] = float(v)
         else:
-            out["point_mass"][_point_index(path)]["mass"] = float(v)
+            pm, axis = out["point_mass"][_point_index(path)], position_axis(path)
+            if axis is None:
+                pm["mass"] = float(v)
+            else:
+                pm["position"] = list(pm["position"])
+                pm["position"][axis] = float(v)
     return out
 
 
@@ -344,6 +370,33 @@ def check_case(case: Case, problem: DesignProblem) -> None:
         if not v.lower <= x0 <= v.upper:
             raise DesignError(f"design.variable[{i}] {v.path} = {x0:g} in the case lies outside "
                               f"its bounds [{v.lower:g}, {v.upper:g}]")
+    _check_positions(case, problem)
+
+
+def _check_positions(case: Case, problem: DesignProblem) -> None:
+    """Every point-mass position the bounds allow must lie on the plate: the corners of each
+    moved mass's box of positions (the panel is convex, so the box is then on it)."""
+    from asekit.structure.plate import locate_points
+    boxes: dict = {}
+    for i, v in enumerate(problem.variables):
+        axis = position_axis(v.path)
+        if axis is not None:
+            k = _point_index(v.path)
+            box = boxes.setdefault(k, [[p, p] for p in case.point_masses[k].position] + [[]])
+            box[axis] = [v.lower, v.upper]
+            box[2].append(i)
+    if not boxes:
+        return
+    mesh = P.structural_mesh(case)
+    for k, (xs, ys, idx) in boxes.items():
+        for corner in [(x, y) for x in xs for y in ys]:
+            try:
+                locate_points(mesh.nodes, mesh.elements, np.array([corner]))
+            except ValueError:
+                names = ", ".join(f"design.variable[{i}]" for i in idx)
+                raise DesignError(f"{names}: point_mass[{k}] at ({corner[0]:g}, {corner[1]:g}) m "
+                                  f"(a corner of its bounds) is off the plate; narrow the "
+                                  f"bounds to the planform") from None
 
 
 def envelope_conditions(case: Case) -> list:
@@ -491,11 +544,17 @@ def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts):
             dK.append(k[0])
             dM.append(m[0])
             dm.append(float(np.sum(w_mass * dh_m)))
-        else:
+        elif position_axis(path) is None:
             pm = case.point_masses[_point_index(path)]
             dM.append(point_mass_derivative(mesh, pm.position))
             dK.append(0 * dM[-1])
             dm.append(1.0)
+        else:
+            pm = case.point_masses[_point_index(path)]
+            dM.append(point_mass_position_derivative(mesh, pm.position, pm.mass, pm.inertia,
+                                                     position_axis(path)))
+            dK.append(0 * dM[-1])
+            dm.append(0.0)                  # moving a mass does not change the total
     mass = float(np.sum(w_mass * parts.h_m)) + sum(p.mass for p in case.point_masses)
     return dK, dM, mass, np.array(dm)
 
