@@ -5,8 +5,11 @@
 The optimised design's margin is not the optimiser's own number: the written case (or, without
 ``--out-case``, the same case built in memory) is analysed again by the case pipeline
 (:func:`asekit.case.pipeline.flutter`), like ``asekit analyse`` would. The JSON holds
-``design.baseline`` and ``design.optimised`` (``mass_kg``, ``flutter_margin_pct`` from the
-pipeline, ``predicted_margin_pct`` from the optimiser's chain, the variables' ``values``),
+``design.baseline`` and ``design.optimised`` (``mass_kg``, ``flutter_margin_pct``,
+``divergence_speed_ms``, ``divergence_margin_pct`` and ``meets_constraints`` from the pipeline,
+``predicted_margin_pct`` and ``predicted_divergence_speeds_ms`` from the optimiser's chain, the
+variables' ``values``), ``design.divergence_margin_required_pct`` (None: divergence checked
+against the flutter margin in the re-analysis only, not a constraint),
 ``design.gradient_check`` (``max_rel_error`` of the analytic gradients against central
 differences at the baseline, ``seconds``) and ``design.history`` (one row per iteration). Bad
 input gets one line and exit status 2.
@@ -136,7 +139,8 @@ def run(args) -> int:
                       if problem.divergence_margin is None else 100 * problem.divergence_margin,
                       "history": list(result.history)},
            "units": {"mass_kg": "kg", "flutter_margin_pct": "%", "seconds": "s",
-                     "values": "the unit of each case key (thickness m, point mass kg)"}}
+                     "values": "the unit of each case key (thickness m, point mass kg, "
+                               "point-mass position m)"}}
     text = json.dumps(doc, indent=2)
     if args.json == "-":
         print(text)
