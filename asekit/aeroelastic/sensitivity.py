@@ -39,6 +39,7 @@ Any consistent units (SI for the fin): rho in kg/m^3, U in m/s, p in 1/s, b in m
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -291,3 +292,76 @@ def flutter_speed_sensitivity(M, K, C, gaf: TabulatedGaf, density: float, speed:
 def correlate(vectors: np.ndarray, ref: np.ndarray) -> int:
     """Index of the column of ``vectors`` best correlated (MAC) with ``ref``."""
     return int(np.argmax(_mac(np.asarray(ref, complex), np.asarray(vectors, complex))))
+
+
+@dataclass(frozen=True)
+class DivergenceSensitivity:
+    """The static-divergence eigenvalue of the elastic modes and its derivatives.
+
+    mu : the largest real eigenvalue of Re Q(0) x = mu K x (m^2/N per modal unit, i.e. 1 / q);
+    mu > 0: divergence at q_D = 1 / mu (Pa), U_D = sqrt(2 q_D / rho); mu <= 0: no divergence.
+    d_mu : (n_var,) dmu/dtheta_j. ``mu`` is NaN (and ``d_mu`` zero) when no eigenvalue is real.
+    """
+
+    mu: float
+    d_mu: np.ndarray
+
+    def speed(self, density: float) -> float:
+        """U_D = sqrt(2 / (rho mu)) (m/s) at the density rho (kg/m^3); inf without divergence."""
+        return math.sqrt(2.0 / (density * self.mu)) if self.mu > 0 else math.inf
+
+    def d_speed(self, density: float) -> np.ndarray:
+        """dU_D/dtheta = -U_D dmu / (2 mu) (m/s per unit theta); zero without divergence."""
+        if not self.mu > 0:
+            return np.zeros_like(self.d_mu)
+        return -0.5 * self.speed(density) * self.d_mu / self.mu
+
+
+def divergence_sensitivity(K, Q0, dK, dQ0) -> DivergenceSensitivity:
+    """The divergence eigenvalue mu = 1 / q_D of the steady GAFs and its derivatives.
+
+    Divergence is det(K - q Re Q(0)) = 0 (thesis Eq. 3.13; :func:`asekit.aeroelastic.flutter.\
+divergence_speeds`), written here as the eigenproblem Re Q(0) x = mu K x with mu = 1 / q, so that
+    the quantity stays smooth where a design loses its divergence (mu passes through zero while q
+    passes through infinity). With the right and left eigenvectors v, w of the largest real mu
+    (w^H (Q0 - mu K) = 0), differentiating (Q0 - mu K) v = 0 and projecting on w gives
+
+        dmu/dtheta = w^H (dQ0 - mu dK) v / (w^H K v)
+
+    (the first-order perturbation of a simple eigenvalue of a non-symmetric pencil, e.g.
+    Wilkinson, *The Algebraic Eigenvalue Problem*, 1965, Ch. 2, Sec. 8-10), equivalent to
+    dq_D = -q_D^2 dmu = w^H (dK - q_D dQ0) v / (w^H Q0 v). dQ0 comes through the mode-shape
+    derivatives as the GAF derivative (:func:`gaf_derivative` at the table's first k).
+
+    Parameters
+    ----------
+    K : (n, n) modal stiffness of the elastic modes; Q0 : (n, n) their GAF at k = 0 (or the
+    table's nearest k; its real part is used); dK : (n_var, n, n); dQ0 : (n_var, n, n).
+
+    Returns
+    -------
+    :class:`DivergenceSensitivity`.
+
+    Examples
+    --------
+    One mode: Q0 = 2, K = 4: mu = 0.5 (q_D = 2), dmu/dK = -Q0 / K^2 = -0.125.
+
+    >>> s = divergence_sensitivity(np.array([[4.0]]), np.array([[2.0]]), np.ones((1, 1, 1)),
+    ...                            np.zeros((1, 1, 1)))
+    >>> float(s.mu), float(s.d_mu[0])
+    (0.5, -0.125)
+    """
+    from scipy import linalg
+    K = np.asarray(K, float)
+    Q0 = np.asarray(Q0).real
+    mu, wl, vr = linalg.eig(Q0, K, left=True, right=True)
+    real = np.flatnonzero(np.isfinite(mu)
+                          & (np.abs(mu.imag) <= 1e-9 * np.maximum(np.abs(mu), 1e-300)))
+    if real.size == 0:
+        return DivergenceSensitivity(mu=math.nan, d_mu=np.zeros(len(dK)))
+    i = real[np.argmax(mu[real].real)]
+    m, v, w = float(mu[i].real), vr[:, i], wl[:, i]
+    den = w.conj() @ K @ v
+    d = np.array([(w.conj() @ (np.asarray(b).real - m * np.asarray(a)) @ v / den).real
+                  for a, b in zip(dK, dQ0)])
+    return DivergenceSensitivity(mu=m, d_mu=d)

@@ -28,7 +28,11 @@ once), the p-k flutter point and dU_f (:mod:`asekit.aeroelastic.sensitivity`). T
 baseline values.
 
 Supported variables: ``thickness.root``, ``thickness.tip`` (flat chordwise profile),
-``point_mass[i].mass`` and, for a tabulated thickness field (``[thickness] kind = "table"``),
+``point_mass[i].mass`` (kg), ``point_mass[i].position[0]`` and ``point_mass[i].position[1]``
+(its x, chordwise, and y, spanwise, m: dM/dx = m (N_x N^T + N N_x^T) through the shape
+functions of the element holding it, :func:`asekit.structure.sensitivity.\
+point_mass_position_derivative`; exact inside an element, one-sided where the mass crosses an
+element edge, as the bilinear N is only C0 there) and, for a tabulated thickness field (``[thickness] kind = "table"``),
 ``thickness.values_m[i][j]`` (one table value) or ``thickness.values_m`` (the whole table,
 expanded to one variable per value, all with the given bounds). A table value enters the
 element matrices through the bilinear weights: dh_g / dvalues[i][j] = H_i(eta_g) H_j(xi_g) at
@@ -36,8 +40,11 @@ every integration point g (:meth:`asekit.geometry.ThicknessTable.weights`), then
 thickness derivatives of :mod:`asekit.structure.sensitivity`. ``design.table_max_step_m``
 bounds the difference of adjacent table values (a linear smoothness constraint,
 |v[i][j] - v[i+1][j]| and |v[i][j] - v[i][j+1]| <= the step, m) for manufacturability. Supported structures: a ``shaft`` support (FN1 or FN2) or
-``clamped_root``, undamped (no ``[damping]``). Divergence, frequency separation and the servo
-requirements are not constraints yet.
+``clamped_root``, undamped (no ``[damping]``). ``design.divergence_margin`` adds the divergence
+of the elastic modes at the top Mach as a constraint, U_D >= (1 + margin) M a per envelope
+altitude, written 1 - q_a mu >= 0 with mu = 1 / q_D and its analytic derivative
+(:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`). Frequency separation and the
+servo requirements are not constraints yet.
 """
 
 from __future__ import annotations
@@ -55,6 +62,7 @@ from asekit.aero.methods import AERO_METHODS, resolve_method
 from asekit.aero.spline import fe_spline, modal_forces
 from asekit.aeroelastic.flutter import pk_flutter, pk_instabilities
 from asekit.aeroelastic.sensitivity import (
+    divergence_sensitivity,
     extended_shapes,
     flutter_point,
     flutter_speed_sensitivity,
@@ -69,6 +77,7 @@ from asekit.structure.sensitivity import (
     element_parts,
     mode_shape_derivatives,
     point_mass_derivative,
+    point_mass_position_derivative,
     reduce,
     thickness_derivatives,
 )
@@ -88,6 +97,7 @@ SWEEP_POINTS = 40
 _THICKNESS = ("thickness.root", "thickness.tip")
 _TABLE = "thickness.values_m"
 _TABLE_ENTRY = r"thickness\.values_m\[(\d+)\]\[(\d+)\]"
+_POINT_MASS = r"point_mass\[(\d+)\]\.(mass|position\[([01])\])"
 
 
 class DesignError(ValueError):
@@ -109,7 +119,9 @@ class DesignProblem:
     """A parsed design file: ``variables``, ``objective`` ("mass"), ``flutter_margin`` (a
     fraction), ``max_iterations``, ``source`` (the file), ``table_max_step_m`` (m, the largest
     difference of adjacent thickness-table values, None: unconstrained), ``gradient_step``
-    (the central differences' relative step of the gradient check)."""
+    (the central differences' relative step of the gradient check), ``divergence_margin`` (a
+    fraction: U_D >= (1 + margin) M a at every envelope altitude; None: divergence is reported,
+    not constrained)."""
 
     variables: tuple[DesignVariable, ...]
     objective: str = "mass"
@@ -118,6 +130,7 @@ class DesignProblem:
     source: str = ""
     table_max_step_m: float | None = None
     gradient_step: float = 1e-4
+    divergence_margin: float | None = None
 
 
 def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default=None):
@@ -134,10 +147,11 @@ def _variable_path(path, where: str) -> str:
     import re
     if isinstance(path, str) and (path in _THICKNESS or path == _TABLE
                                   or re.fullmatch(_TABLE_ENTRY, path)
-                                  or re.fullmatch(r"point_mass\[\d+\]\.mass", path)):
+                                  or re.fullmatch(_POINT_MASS, path)):
         return path
     raise DesignError(f"{where}.path must be one of {list(_THICKNESS)}, {_TABLE}, "
-                      f"{_TABLE}[i][j] or point_mass[i].mass, got {path!r}")
+                      f"{_TABLE}[i][j], point_mass[i].mass or point_mass[i].position[k] "
+                      f"(k = 0: x, 1: y), got {path!r}")
 
 
 def design_from_dict(d: dict, source: str = "") -> DesignProblem:
@@ -154,10 +168,11 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
         raise DesignError("a design file needs a [design] table")
     t = d["design"]
     unknown = set(t) - {"objective", "flutter_margin", "max_iterations", "variable",
-                        "table_max_step_m", "gradient_step"}
+                        "table_max_step_m", "gradient_step", "divergence_margin"}
     if unknown:
-        raise DesignError(f"design: unknown keys {sorted(unknown)} (known: objective, "
-                          f"flutter_margin, gradient_step, max_iterations, table_max_step_m, variable)")
+        raise DesignError(f"design: unknown keys {sorted(unknown)} (known: divergence_margin, "
+                          f"objective, flutter_margin, gradient_step, max_iterations, "
+                          f"table_max_step_m, variable)")
     objective = t.get("objective", "mass")
     if objective not in OBJECTIVES:
         raise DesignError(f"design.objective must be one of {list(OBJECTIVES)}, got {objective!r}")
@@ -184,7 +199,9 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
     step = (None if "table_max_step_m" not in t
             else _number(t, "table_max_step_m", "design", 0.0, 100.0))
     gstep = _number(t, "gradient_step", "design", 1e-8, 0.1, 1e-4)
-    return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep)
+    div = (None if "divergence_margin" not in t
+           else _number(t, "divergence_margin", "design", 0.0, 10.0))
+    return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep, div)
 
 
 def table_index(path: str) -> tuple[int, int] | None:
@@ -251,6 +268,13 @@ def _point_index(path: str) -> int:
     return int(path[path.index("[") + 1:path.index("]")])
 
 
+def position_axis(path: str) -> int | None:
+    """0 (x) or 1 (y) of a ``point_mass[i].position[k]`` path, None for any other path."""
+    import re
+    m = re.fullmatch(_POINT_MASS, path)
+    return None if m is None or m.group(3) is None else int(m.group(3))
+
+
 def case_value(case: Case, path: str) -> float:
     """The current value of a design variable's key in ``case``."""
     if path == "thickness.root":
@@ -263,7 +287,9 @@ def case_value(case: Case, path: str) -> float:
     i = _point_index(path)
     if i >= len(case.point_masses):
         raise DesignError(f"{path}: the case has {len(case.point_masses)} point masses")
-    return float(case.point_masses[i].mass)
+    axis = position_axis(path)
+    pm = case.point_masses[i]
+    return float(pm.mass if axis is None else pm.position[axis])
 
 
 def with_values(case: Case, paths, values) -> Case:
@@ -280,8 +306,13 @@ def with_values(case: Case, paths, values) -> Case:
         elif path == "thickness.tip":
             th = dataclasses.replace(th, tip=float(v))
         else:
-            i = _point_index(path)
-            pms[i] = dataclasses.replace(pms[i], mass=float(v))
+            i, axis = _point_index(path), position_axis(path)
+            if axis is None:
+                pms[i] = dataclasses.replace(pms[i], mass=float(v))
+            else:
+                pos = list(pms[i].position)
+                pos[axis] = float(v)
+                pms[i] = dataclasses.replace(pms[i], position=tuple(pos))
     if table is not None:
         th = dataclasses.replace(th, values=tuple(tuple(r) for r in table))
     return dataclasses.replace(case, thickness=th, point_masses=tuple(pms))
@@ -298,7 +329,12 @@ def set_case_values(raw: dict, paths, values) -> dict:
         elif path.startswith("thickness."):
             out.setdefault("thickness", {})[path.split(".")[1]] = float(v)
         else:
-            out["point_mass"][_point_index(path)]["mass"] = float(v)
+            pm, axis = out["point_mass"][_point_index(path)], position_axis(path)
+            if axis is None:
+                pm["mass"] = float(v)
+            else:
+                pm["position"] = list(pm["position"])
+                pm["position"][axis] = float(v)
     return out
 
 
@@ -334,6 +370,33 @@ def check_case(case: Case, problem: DesignProblem) -> None:
         if not v.lower <= x0 <= v.upper:
             raise DesignError(f"design.variable[{i}] {v.path} = {x0:g} in the case lies outside "
                               f"its bounds [{v.lower:g}, {v.upper:g}]")
+    _check_positions(case, problem)
+
+
+def _check_positions(case: Case, problem: DesignProblem) -> None:
+    """Every point-mass position the bounds allow must lie on the plate: the corners of each
+    moved mass's box of positions (the panel is convex, so the box is then on it)."""
+    from asekit.structure.plate import locate_points
+    boxes: dict = {}
+    for i, v in enumerate(problem.variables):
+        axis = position_axis(v.path)
+        if axis is not None:
+            k = _point_index(v.path)
+            box = boxes.setdefault(k, [[p, p] for p in case.point_masses[k].position] + [[]])
+            box[axis] = [v.lower, v.upper]
+            box[2].append(i)
+    if not boxes:
+        return
+    mesh = P.structural_mesh(case)
+    for k, (xs, ys, idx) in boxes.items():
+        for corner in [(x, y) for x in xs for y in ys]:
+            try:
+                locate_points(mesh.nodes, mesh.elements, np.array([corner]))
+            except ValueError:
+                names = ", ".join(f"design.variable[{i}]" for i in idx)
+                raise DesignError(f"{names}: point_mass[{k}] at ({corner[0]:g}, {corner[1]:g}) m "
+                                  f"(a corner of its bounds) is off the plate; narrow the "
+                                  f"bounds to the planform") from None
 
 
 def envelope_conditions(case: Case) -> list:
@@ -351,7 +414,10 @@ class Evaluation:
 
     values : (n_var,) the design; mass_kg, d_mass (n_var,); speeds_ms (n_cond,) U_f per envelope
     altitude (NaN: no flutter in the velocity sweep); d_speeds (n_cond, n_var); envelope_ms
-    (n_cond,) M a; margins (n_cond,) U_f / (M a) - 1; frequencies_hz (n_cond,) at flutter.
+    (n_cond,) M a; margins (n_cond,) U_f / (M a) - 1; frequencies_hz (n_cond,) at flutter;
+    densities (n_cond,) kg/m^3; divergence_mu : 1 / q_D (1/Pa) of the elastic modes at the top
+    Mach (:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`; <= 0: no divergence,
+    NaN: no real eigenvalue), d_divergence_mu (n_var,).
     """
 
     values: np.ndarray
@@ -361,10 +427,21 @@ class Evaluation:
     d_speeds: np.ndarray
     envelope_ms: np.ndarray
     frequencies_hz: np.ndarray
+    densities: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    divergence_mu: float = math.nan
+    d_divergence_mu: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def margins(self) -> np.ndarray:
         return self.speeds_ms / self.envelope_ms - 1.0
+
+    @property
+    def divergence_speeds_ms(self) -> np.ndarray:
+        """U_D = sqrt(2 / (rho mu)) per envelope altitude (m/s; inf: no divergence)."""
+        mu = self.divergence_mu
+        if not mu > 0:
+            return np.full(self.densities.shape, math.inf)
+        return np.sqrt(2.0 / (self.densities * mu))
 
 
 @dataclass
@@ -467,11 +544,17 @@ def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts):
             dK.append(k[0])
             dM.append(m[0])
             dm.append(float(np.sum(w_mass * dh_m)))
-        else:
+        elif position_axis(path) is None:
             pm = case.point_masses[_point_index(path)]
             dM.append(point_mass_derivative(mesh, pm.position))
             dK.append(0 * dM[-1])
             dm.append(1.0)
+        else:
+            pm = case.point_masses[_point_index(path)]
+            dM.append(point_mass_position_derivative(mesh, pm.position, pm.mass, pm.inertia,
+                                                     position_axis(path)))
+            dK.append(0 * dM[-1])
+            dm.append(0.0)                  # moving a mass does not change the total
     mass = float(np.sum(w_mass * parts.h_m)) + sum(p.mass for p in case.point_masses)
     return dK, dM, mass, np.array(dm)
 
@@ -543,11 +626,14 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
             "dC": np.zeros((n_var, n, n)), "dQ": gaf_derivative(Q, n)}
     conds = envelope_conditions(case)
     out = [_flutter(ev, mats, gaf, c.density) for c in conds]
+    div = divergence_sensitivity(mats["K"], Q[0, :n, :n], mats["dK"], mats["dQ"][:, 0])
     return Evaluation(values=values, mass_kg=mass, d_mass=d_mass,
                       speeds_ms=np.array([o[0] for o in out]),
                       d_speeds=np.array([o[2] for o in out]),
                       envelope_ms=np.array([ev.mach * c.speed_of_sound for c in conds]),
-                      frequencies_hz=np.array([o[1] for o in out]))
+                      frequencies_hz=np.array([o[1] for o in out]),
+                      densities=np.array([c.density for c in conds]),
+                      divergence_mu=div.mu, d_divergence_mu=div.d_mu)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -558,7 +644,22 @@ def _constraint(ev: Evaluator, e: Evaluation):
     flutter in the sweep counts as U_f = the sweep's last speed (a lower bound), gradient 0."""
     u = np.where(np.isnan(e.speeds_ms), ev.case.flight.velocities[-1], e.speeds_ms)
     scale = (1.0 + ev.problem.flutter_margin) * (1.0 + CONSTRAINT_SLACK) * e.envelope_ms
-    return u / scale - 1.0, e.d_speeds / scale[:, None]
+    g, dg = u / scale - 1.0, e.d_speeds / scale[:, None]
+    if ev.problem.divergence_margin is None:
+        return g, dg
+    gd, dgd = _divergence_constraint(ev.problem.divergence_margin, e)
+    return np.concatenate([g, gd]), np.vstack([dg, dgd])
+
+
+def _divergence_constraint(margin: float, e: Evaluation):
+    """g_a = 1 - q_a mu >= 0 per envelope altitude, q_a = rho_a ((1 + margin) (1 + slack) M a)^2
+    / 2 the dynamic pressure the divergence must exceed (q_D = 1 / mu >= q_a), and its gradient
+    -q_a dmu. Smooth where the design loses its divergence (mu through zero, q_D through
+    infinity); no real divergence eigenvalue (NaN mu) counts as none, gradient 0."""
+    q = 0.5 * e.densities * ((1.0 + margin) * (1.0 + CONSTRAINT_SLACK) * e.envelope_ms) ** 2
+    if not np.isfinite(e.divergence_mu):
+        return np.ones_like(q), np.zeros((q.size, e.d_mass.size))
+    return 1.0 - q * e.divergence_mu, -q[:, None] * e.d_divergence_mu[None, :]
 
 
 @dataclass(frozen=True)
@@ -590,8 +691,8 @@ class DesignResult:
 
 
 def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.ndarray:
-    """Max relative error per variable of the analytic d(mass) and dU_f against central
-    differences of the whole chain (step ``rel_step`` times the value)."""
+    """Max relative error per variable of the analytic d(mass), dU_f and dmu (the divergence
+    eigenvalue) against central differences of the whole chain (step ``rel_step`` times the value)."""
     e0 = ev(x0)
     err = np.zeros(x0.size)
     for j in range(x0.size):
@@ -600,6 +701,8 @@ def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.
         pairs = [(e0.d_mass[j], (ep.mass_kg - em.mass_kg) / (2 * h))]
         pairs += [(a, (b - c) / (2 * h)) for a, b, c in
                   zip(e0.d_speeds[:, j], ep.speeds_ms, em.speeds_ms) if np.isfinite(b - c)]
+        if np.isfinite(ep.divergence_mu - em.divergence_mu):
+            pairs.append((e0.d_divergence_mu[j], (ep.divergence_mu - em.divergence_mu) / (2 * h)))
         err[j] = max(abs(a - f) / max(abs(f), 1e-300) for a, f in pairs)
     return err
 

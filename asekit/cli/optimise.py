@@ -5,8 +5,11 @@
 The optimised design's margin is not the optimiser's own number: the written case (or, without
 ``--out-case``, the same case built in memory) is analysed again by the case pipeline
 (:func:`asekit.case.pipeline.flutter`), like ``asekit analyse`` would. The JSON holds
-``design.baseline`` and ``design.optimised`` (``mass_kg``, ``flutter_margin_pct`` from the
-pipeline, ``predicted_margin_pct`` from the optimiser's chain, the variables' ``values``),
+``design.baseline`` and ``design.optimised`` (``mass_kg``, ``flutter_margin_pct``,
+``divergence_speed_ms``, ``divergence_margin_pct`` and ``meets_constraints`` from the pipeline,
+``predicted_margin_pct`` and ``predicted_divergence_speeds_ms`` from the optimiser's chain, the
+variables' ``values``), ``design.divergence_margin_required_pct`` (None: divergence checked
+against the flutter margin in the re-analysis only, not a constraint),
 ``design.gradient_check`` (``max_rel_error`` of the analytic gradients against central
 differences at the baseline, ``seconds``) and ``design.history`` (one row per iteration).
 ``--report DIR`` writes the thickness field, V-g / V-f before and after (the pipeline's
@@ -44,10 +47,13 @@ def _error(msg: str) -> int:
     return outputs.print_error(f"error: {msg}", 2, _log)
 
 
-def _reanalysis(case, margin: float) -> dict:
+def _reanalysis(case, margin: float, div_margin: float | None = None) -> dict:
     """The case pipeline's verdict: the smallest flutter margin (%) over the envelope altitudes,
-    the lowest divergence speed at the envelope's top Mach (None: none in the sweep), and
-    whether both clear (1 + margin) M a."""
+    the lowest divergence speed at the envelope's top Mach (None: none in the sweep), the
+    smallest divergence margin U_D / (M a) - 1 (%, None: no divergence), and whether the flutter
+    speeds clear (1 + margin) M a and the divergence speeds (1 + div_margin) M a (div_margin
+    None: the flutter margin)."""
+    div_margin = margin if div_margin is None else div_margin
     from asekit.case import pipeline as P
     fa = P.flutter(case)
     vals = [m["margin"] for m in fa.margins if m["margin"] is not None]
@@ -56,11 +62,13 @@ def _reanalysis(case, margin: float) -> dict:
     div = [d["speed_ms"] for d in fa.divergence if d["speed_ms"] is not None
            and abs(d["mach"] - top) < 1e-12 and lo <= d["altitude_m"] <= hi]
     env = {m["altitude_m"]: m["envelope_speed_ms"] for m in fa.margins}
-    div_ok = all(d["speed_ms"] is None or d["speed_ms"] >= (1 + margin) * env[d["altitude_m"]]
-                 for d in fa.divergence if abs(d["mach"] - top) < 1e-12
-                 and d["altitude_m"] in env)
+    dm = [d["speed_ms"] / env[d["altitude_m"]] - 1 for d in fa.divergence
+          if d["speed_ms"] is not None and abs(d["mach"] - top) < 1e-12
+          and d["altitude_m"] in env]
+    div_ok = all(m >= div_margin - 1e-9 for m in dm)
     pct = 100.0 * min(vals) if len(vals) == len(fa.margins) and vals else None
     return {"flutter_margin_pct": pct, "divergence_speed_ms": min(div) if div else None,
+            "divergence_margin_pct": 100.0 * min(dm) if dm else None,
             "meets_constraints": bool(pct is not None and pct >= 100 * margin - 1e-9
                                       and div_ok)}
 
@@ -69,6 +77,8 @@ def _block(ev, paths, verdict: dict) -> dict:
     import numpy as np
     return {"mass_kg": ev.mass_kg, **verdict,
             "predicted_margin_pct": float(np.nanmin(ev.margins) * 100),
+            "predicted_divergence_speeds_ms": [None if not np.isfinite(u) else float(u)
+                                               for u in ev.divergence_speeds_ms],
             "flutter_speeds_ms": [None if not np.isfinite(u) else float(u) for u in ev.speeds_ms],
             "envelope_speeds_ms": ev.envelope_ms.tolist(),
             "values": dict(zip(paths, ev.values.tolist()))}
@@ -115,8 +125,9 @@ def run(args) -> int:
         reanalysed = load_case(args.out_case)
     else:
         reanalysed = with_values(case, result.paths, result.optimised.values)
-    base = _block(result.baseline, result.paths, _reanalysis(case, problem.flutter_margin))
-    opt = _block(result.optimised, result.paths, _reanalysis(reanalysed, problem.flutter_margin))
+    margins = (problem.flutter_margin, problem.divergence_margin)
+    base = _block(result.baseline, result.paths, _reanalysis(case, *margins))
+    opt = _block(result.optimised, result.paths, _reanalysis(reanalysed, *margins))
     doc = {"design": {"baseline": base, "optimised": opt,
                       "gain": {"mass_kg": base["mass_kg"] - opt["mass_kg"],
                                "mass_pct": 100 * (1 - opt["mass_kg"] / base["mass_kg"])},
@@ -131,9 +142,12 @@ def run(args) -> int:
                                     "evaluations": result.evaluations,
                                     "seconds": result.seconds},
                       "flutter_margin_required_pct": 100 * problem.flutter_margin,
+                      "divergence_margin_required_pct": None
+                      if problem.divergence_margin is None else 100 * problem.divergence_margin,
                       "history": list(result.history)},
            "units": {"mass_kg": "kg", "flutter_margin_pct": "%", "seconds": "s",
-                     "values": "the unit of each case key (thickness m, point mass kg)"}}
+                     "values": "the unit of each case key (thickness m, point mass kg, "
+                               "point-mass position m)"}}
     text = json.dumps(doc, indent=2)
     if getattr(args, "report", None):
         from asekit.case import pipeline as P

@@ -44,12 +44,15 @@ import scipy.sparse.linalg as spla
 
 from asekit.structure.mesh import PlateMesh
 from asekit.structure.plate import (
+    DOF_PER_NODE,
     SHEAR_FACTOR,
     _check_geometry,
     _covariant_shear_rows,
     _jacobian,
     _thickness,
     gauss_points,
+    locate_points,
+    shape_functions,
 )
 
 #: Two eigenvalues closer than this (relative to the larger) count as repeated.
@@ -285,6 +288,62 @@ def point_mass_derivative(mesh: PlateMesh, position) -> sp.csr_matrix:
     """
     from asekit.structure.assembly import point_mass_matrix
     return point_mass_matrix(mesh, [(tuple(position), 1.0, (0.0, 0.0))])
+
+
+def point_mass_position_derivative(mesh: PlateMesh, position, mass: float,
+                                   inertia=(0.0, 0.0), axis: int = 0) -> sp.csr_matrix:
+    """dM/dx (``axis`` 0) or dM/dy (``axis`` 1) (3 n_nodes square, sparse, kg/m) of a point mass
+    moved on the plate.
+
+    The point mass enters M through the bilinear shape functions N(r, s) of the element holding
+    it (:func:`asekit.structure.assembly.point_mass_matrix`): M_pm = m N N^T on the w DOFs (and
+    I_xx N N^T, I_yy N N^T on the rotations), so moving it by dx changes
+
+        dM_pm/dx = m (N_x N^T + N N_x^T),   [N_x; N_y] = J^-1 [N_r; N_s],
+
+    J = [[x_r, y_r], [x_s, y_s]] the element's Jacobian at the point (the isoparametric chain
+    rule, e.g. Bathe, *Finite Element Procedures*, 1996, Eq. 5.25). Exact inside an element; N is
+    only C0 across element edges, so at an edge (or a node) this is the derivative of the element
+    that :func:`~asekit.structure.plate.locate_points` assigns the point to (one-sided).
+
+    Parameters
+    ----------
+    mesh : the plate mesh; position : (x, y) m; mass : kg; inertia : (I_xx, I_yy) kg m^2;
+    axis : 0 for x (chordwise), 1 for y (spanwise).
+
+    Returns
+    -------
+    scipy.sparse CSR matrix, per metre.
+
+    Examples
+    --------
+    A mass at the middle of a one-element plate: N = 1/4 at every node, and moving it along x
+    shifts mass from the x = 0 nodes to the x = 0.2 nodes; the total stays m (the sum is 0).
+
+    >>> from asekit.structure.mesh import rectangular_mesh
+    >>> dM = point_mass_position_derivative(rectangular_mesh(0.2, 0.1, 0.002, 1, 1),
+    ...                                     (0.1, 0.05), 2.0)
+    >>> round(float(dM.sum()), 12), round(float(dM.diagonal().max()), 12)
+    (0.0, 2.5)
+    """
+    if axis not in (0, 1):
+        raise ValueError(f"axis must be 0 (x) or 1 (y), got {axis!r}")
+    elem, rs = locate_points(mesh.nodes, mesh.elements, np.array(position, float).reshape(1, 2))
+    conn = mesh.elements[elem[0]]
+    N, dNr, dNs = shape_functions(rs[0, 0], rs[0, 1])
+    xy = mesh.nodes[conn, :2]
+    J = np.array([dNr @ xy, dNs @ xy])                      # [[x_r, y_r], [x_s, y_s]]
+    dN = np.linalg.solve(J, np.array([dNr, dNs]))[axis]    # N_x or N_y
+    dNN = np.outer(dN, N) + np.outer(N, dN)
+    n = DOF_PER_NODE * mesh.n_nodes
+    rows, cols, vals = [], [], []
+    for dof, value in ((0, mass), (1, inertia[0]), (2, inertia[1])):
+        d = DOF_PER_NODE * conn + dof
+        rows.append(np.repeat(d, 4))
+        cols.append(np.tile(d, 4))
+        vals.append((float(value) * dNN).ravel())
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(n, n))
 
 
 def reduce(T, A) -> sp.csr_matrix:

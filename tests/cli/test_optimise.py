@@ -33,7 +33,7 @@ def test_shipped_design_file_parses():
     from asekit.case.design import load_design
     p = load_design(DESIGN)
     assert [v.path for v in p.variables] == ["thickness.root", "thickness.tip"]
-    assert p.flutter_margin == 0.15
+    assert p.flutter_margin == 0.15 and p.divergence_margin == 0.15
 
 
 @pytest.mark.parametrize("text, fragment", [
@@ -74,6 +74,11 @@ def test_fin_minimum_mass_end_to_end(tmp_path, capsys):
     assert raw["thickness"]["tip"] == pytest.approx(d["optimised"]["values"]["thickness.tip"])
     assert d["optimised"]["mass_kg"] < d["baseline"]["mass_kg"]
     assert d["optimised"]["meets_constraints"] and not d["baseline"]["meets_constraints"]
+    # divergence is a constraint of the shipped design (divergence_margin = 0.15): the
+    # re-analysed divergence margin clears it, or the fin does not diverge in the sweep
+    dm = d["optimised"]["divergence_margin_pct"]
+    assert dm is None or dm >= 15.0 - 1e-9
+    assert d["divergence_margin_required_pct"] == 15.0
 
 
 FIELD = CASES_DIR / "nalci2013_fin_field.toml"
