@@ -18,6 +18,13 @@ each gust (:func:`~asekit.aeroelastic.gust.one_minus_cosine`) and the loads are 
 - hinge moment (N m): T_hinge@fin of the shaft (docs/conventions.md), the rigid pitch held
   at zero (a stiff actuator); None without a rigid pitch mode.
 
+A user-given gust profile (``gust.profile``, :class:`asekit.case.schema.GustProfile`) runs
+through the same path: its rows are interpolated by a not-a-knot cubic spline, which gives
+w_g and its derivatives w_g', w_g'' (the Roger form's gust terms need them); before the first
+row the air is at rest, after the last row the last velocity holds; the time step is that of a
+1-cos gust of the profile's duration (features shorter than it are smoothed by the
+first-order hold).
+
 - motor current (A): with ``[actuator]``, the gust in the closed AEM1 loop (motor-angle
   feedback, :mod:`asekit.ase.gust`), linear: without the voltage and current limits, so a peak
   above ``actuator.current_limit`` says the actuator would saturate. None without an actuator
@@ -65,18 +72,20 @@ STEPS_PER_PERIOD = 20
 
 @dataclass(frozen=True)
 class GustLoadCase:
-    """One 1-cos gust's loads: ``gradient_length`` H (m), ``t`` (s), ``w_gust`` (m/s), and the
+    """One gust's loads: ``gradient_length`` H (m; None for a user profile, then ``profile``
+    is its file name), ``t`` (s), ``w_gust`` (m/s), and the
     histories ``hinge_moment`` (N m, None without a rigid mode), ``root_shear`` (N),
     ``root_bending`` (N m), ``current`` (A, the AEM1 loop's motor current; None without an
     actuator), with their peaks (largest magnitude, signed)."""
 
-    gradient_length: float
+    gradient_length: float | None
     t: np.ndarray
     w_gust: np.ndarray
     hinge_moment: np.ndarray | None
     root_shear: np.ndarray
     root_bending: np.ndarray
     current: np.ndarray | None = None
+    profile: str | None = None
 
     @staticmethod
     def _peak(y) -> float | None:
@@ -151,6 +160,46 @@ def _current_loop(case: Case, g, rfa, ss):
     return loop if np.max(np.linalg.eigvals(loop.A).real) < 0 else None
 
 
+def _time_grid(t0: float, t1: float, settle: float, f_max: float) -> np.ndarray:
+    """Uniform times (s) from ``t0`` through a gust ending at ``t1`` and ``settle`` s beyond:
+    STEPS_PER_GRADIENT steps per half the gust's duration, STEPS_PER_PERIOD per period of the
+    highest mode (``f_max`` Hz), at most 200001 points."""
+    dt = min((t1 - t0) / (2 * STEPS_PER_GRADIENT), 1.0 / (STEPS_PER_PERIOD * max(f_max, 1e-9)))
+    nt = min(int(math.ceil((t1 - t0 + settle) / dt)) + 1, 200001)
+    return np.linspace(t0, t1 + settle, nt)
+
+
+def profile_gust(time, velocity, t) -> np.ndarray:
+    """A sampled gust velocity history and its derivatives at the times ``t`` (s): the
+    not-a-knot cubic spline through the rows (``time`` s, strictly ascending; ``velocity``
+    m/s); zero before the first row, the last velocity (and zero derivatives) after the last.
+
+    Returns
+    -------
+    (3, len(t)) array: w_g (m/s), w_g' (m/s^2), w_g'' (m/s^3), as
+    :func:`asekit.aeroelastic.gust.one_minus_cosine`.
+
+    Examples
+    --------
+    >>> w = profile_gust([0.0, 1.0, 2.0, 3.0], [0.0, 1.0, 4.0, 9.0], [0.5, 2.5, 4.0])
+    >>> np.round(w, 12) + 0.0                  # the spline is exact for t^2
+    array([[0.25, 6.25, 9.  ],
+           [1.  , 5.  , 0.  ],
+           [2.  , 2.  , 0.  ]])
+    """
+    from scipy.interpolate import CubicSpline
+
+    tp, wp = np.asarray(time, float), np.asarray(velocity, float)
+    tt = np.asarray(t, float).ravel()
+    spline = CubicSpline(tp, wp, bc_type="not-a-knot" if tp.size > 3 else "natural")
+    out = np.zeros((3, tt.size))
+    inside = (tt >= tp[0]) & (tt <= tp[-1])
+    for d in range(3):
+        out[d, inside] = spline(tt[inside], d)
+    out[0, tt > tp[-1]] = wp[-1]
+    return out
+
+
 def gust_loads(case: Case) -> GustLoads | None:
     """The discrete-gust loads of ``case`` (module docstring); None without ``[gust]``.
 
@@ -199,18 +248,22 @@ def gust_loads(case: Case) -> GustLoads | None:
     inert = _inertial_rows(case, modal, y_root)
     loop = _current_loop(case, g, rfa, ss)
     f_max = float(np.max(modal.frequencies_hz))
-    out = []
-    for H in g.gradient_lengths:
-        t_end = 2 * H / U + g.settle_time
-        dt = min(H / U / STEPS_PER_GRADIENT, 1.0 / (STEPS_PER_PERIOD * max(f_max, 1e-9)))
-        nt = min(int(math.ceil(t_end / dt)) + 1, 200001)
-        t = np.linspace(0.0, t_end, nt)
-        w = one_minus_cosine(t, U, H, g.design_velocity)
+
+    def run(t, w, H=None, name=None):
         resp = gust_response(ss, t, w)
         loads = load_histories(resp, lfit, inert, modal.n_rigid)
         cur = None if loop is None else closed_loop_gust_response(loop, t, w)["current"]
-        out.append(GustLoadCase(float(H), t, w[0], resp.hinge_moment if modal.n_rigid else None,
-                                loads[:, 0], loads[:, 1], cur))
+        return GustLoadCase(H, t, w[0], resp.hinge_moment if modal.n_rigid else None,
+                            loads[:, 0], loads[:, 1], cur, name)
+
+    out = []
+    for H in g.gradient_lengths:
+        t = _time_grid(0.0, 2 * H / U, g.settle_time, f_max)
+        out.append(run(t, one_minus_cosine(t, U, H, g.design_velocity), float(H)))
+    if g.profile is not None:
+        p = g.profile
+        t = _time_grid(p.time[0], p.time[-1], g.settle_time, f_max)
+        out.append(run(t, profile_gust(p.time, p.velocity, t), None, p.name))
     errs = {"modal": float(rfa.fit_error), "gust": gfit.fit_error, "loads": lfit.fit_error}
     turb = None
     if g.turbulence_sigma is not None:
@@ -258,8 +311,10 @@ def turbulence_json(result: GustLoads | None) -> list:
 
 
 def gust_json(result: GustLoads | None) -> list:
-    """The ``analyse --json`` ``"gust"`` rows: one per gradient distance, ``mach``,
-    ``altitude_m``, ``gust_length_m`` (the gradient distance H), ``peak_hinge_moment_Nm``
+    """The ``analyse --json`` ``"gust"`` rows: one per gradient distance, then one for the
+    ``gust.profile`` (``gust_length_m`` null, ``profile`` its file name; null in the 1-cos
+    rows), ``mach``, ``altitude_m``, ``gust_length_m`` (the gradient distance H),
+    ``peak_hinge_moment_Nm``
     (null without a rigid mode), ``peak_root_bending_Nm``, ``peak_root_shear_N``,
     ``peak_current_A`` (the linear AEM1 loop's motor current; null without an actuator)."""
     if result is None:
@@ -269,4 +324,4 @@ def gust_json(result: GustLoads | None) -> list:
              "peak_hinge_moment_Nm": c.peak_hinge_moment,
              "peak_root_bending_Nm": c.peak_root_bending,
              "peak_root_shear_N": c.peak_root_shear,
-             "peak_current_A": c.peak_current} for c in result.cases]
+             "peak_current_A": c.peak_current, "profile": c.profile} for c in result.cases]

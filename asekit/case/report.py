@@ -56,7 +56,9 @@ UNITS = {
     "settling_s": "s", "steady_error_pct": "%", "corner_overshoot_pct": "%",
     "fwtf_phase_margin_deg": "deg",
     "seconds": "s (wall-clock time per step)",
-    "gust_length_m": "m (the 1-cos gust's gradient distance H; the gust is 2 H long)",
+    "gust_length_m": "m (the 1-cos gust's gradient distance H; the gust is 2 H long; null for "
+                     "a gust.profile row)",
+    "profile": "the gust.profile file of the row (null for a 1-cos row)",
     "peak_hinge_moment_Nm": "N m (largest |T_hinge@fin|, signed; actuator clamped)",
     "peak_root_bending_Nm": "N m (largest |root bending moment|, signed; tip up > 0)",
     "peak_root_shear_N": "N (largest |root shear|, signed; up > 0)",
@@ -369,7 +371,8 @@ def _gust_lines(rows) -> list:
              "loads with the actuator clamped, current in the AEM1 loop):",
              "  H (m)   hinge moment (N m)   root bending (N m)   root shear (N)   current (A)"]
     for r in rows:
-        lines.append(f"  {r['gust_length_m']:<7g} {_cell(r['peak_hinge_moment_Nm']):>18}   "
+        h = f"{r['gust_length_m']:<7g}" if r["gust_length_m"] is not None else r["profile"]
+        lines.append(f"  {h} {_cell(r['peak_hinge_moment_Nm']):>18}   "
                      f"{_cell(r['peak_root_bending_Nm']):>18}   "
                      f"{_cell(r['peak_root_shear_N']):>14}   "
                      f"{_cell(r['peak_current_A']):>11}")
