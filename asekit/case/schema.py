@@ -346,6 +346,44 @@ def read_gust_profile(path, key: str = "gust.profile") -> GustProfile:
 
 
 @dataclass(frozen=True)
+class GustStation:
+    """A load monitoring station (``[[gust.station]]``): ``name``; the cut at the spanwise
+    fraction ``eta`` of the surface (0 the root, < 1); ``axis`` the chord fraction at the cut
+    of the torsion axis (parallel to y; default 0.25, the quarter chord)."""
+
+    name: str
+    eta: float
+    axis: float = 0.25
+
+
+#: At most this many ``[[gust.station]]`` tables.
+MAX_STATIONS = 50
+
+
+def _gust_stations(raw) -> tuple[GustStation, ...]:
+    """The ``[[gust.station]]`` tables, every key checked."""
+    if raw is None:
+        return ()
+    if not isinstance(raw, list) or not 1 <= len(raw) <= MAX_STATIONS:
+        raise CaseError(f"gust.station must be an array of 1 to {MAX_STATIONS} tables "
+                        f"([[gust.station]])")
+    out = []
+    for i, d in enumerate(raw):
+        t = _Table(d, f"gust.station[{i}]")
+        name = t.text("name", default="")
+        if not name.strip():
+            raise CaseError(f"gust.station[{i}].name must be a non-empty string, got {name!r}")
+        eta = t.number("eta", required=True, low=0.0, high=1.0, low_open=False, high_open=True)
+        axis = t.number("axis", default=0.25, low=0.0, high=1.0, low_open=False)
+        t.done()
+        out.append(GustStation(name, eta, axis))
+    names = [s.name for s in out]
+    if len(set(names)) != len(names):
+        raise CaseError(f"gust.station[].name must be unique, got {names}")
+    return tuple(out)
+
+
+@dataclass(frozen=True)
 class GustSpec:
     """Discrete 1-cos gusts (issue 27, :mod:`asekit.case.gust_loads`): gradient distances H (m;
     each gust 2 H long), the design gust velocity U_ds (m/s, true airspeed, upward), the flight
@@ -353,7 +391,8 @@ class GustSpec:
     0 m), the gust reference station x0 (m; default the most upstream leading edge) and the
     simulated time after the gust has passed (s); with ``[gust.turbulence]`` also continuous
     turbulence: RMS gust velocity sigma (m/s), scale length L (m, default 762 m = 2500 ft) and
-    spectrum ("von_karman" or "dryden")."""
+    spectrum ("von_karman" or "dryden"); a user-given gust ``profile``
+    (:class:`GustProfile`) and load monitoring ``stations`` (:class:`GustStation`)."""
 
     gradient_lengths: tuple[float, ...]
     design_velocity: float
@@ -365,6 +404,7 @@ class GustSpec:
     scale_length: float = 762.0
     spectrum: str = "von_karman"
     profile: GustProfile | None = None
+    stations: tuple[GustStation, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -1091,6 +1131,7 @@ def _gust(t: _Table | None, aero: AeroSpec, actuator: ActuatorSpec | None,
     if t is None:
         return None
     profile = _gust_profile(t, source)
+    stations = _gust_stations(t.raw("station"))
     lengths = t.numbers("gradient_lengths", required=profile is None, default=(), min_length=0,
                         low=0.0, high=1000.0, unit="m", ascending=True)
     if len(lengths) > 50:
@@ -1114,7 +1155,8 @@ def _gust(t: _Table | None, aero: AeroSpec, actuator: ActuatorSpec | None,
     if not aero.machs[0] <= mach <= aero.machs[-1]:
         raise CaseError(f"gust.mach must lie within aero.machs [{aero.machs[0]:g}, "
                         f"{aero.machs[-1]:g}], got {mach:g}")
-    return GustSpec(tuple(lengths), wds, mach, alt, x0, settle, sigma, scale, spectrum, profile)
+    return GustSpec(tuple(lengths), wds, mach, alt, x0, settle, sigma, scale, spectrum, profile,
+                    stations)
 
 
 def case_from_dict(d: dict, source: str = "") -> Case:
