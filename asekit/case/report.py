@@ -378,6 +378,21 @@ def _gust_lines(rows) -> list:
                      f"{_cell(r['peak_root_bending_Nm']):>18}   "
                      f"{_cell(r['peak_root_shear_N']):>14}   "
                      f"{_cell(r['peak_current_A']):>11}")
+    return lines + _station_lines(rows)
+
+
+def _station_lines(rows) -> list:
+    """The summary's lines of the ``[[gust.station]]`` peaks: per station the largest
+    magnitude (signed) over the gusts (none without stations)."""
+    names = list(rows[0].get("stations") or {})
+    if not names:
+        return []
+    lines = ["  station          shear (N)   bending (N m)   torsion (N m)   (worst gust)"]
+    for n in names:
+        worst = [max((r["stations"][n][k] for r in rows), key=abs)
+                 for k in ("peak_shear_N", "peak_bending_Nm", "peak_torsion_Nm")]
+        lines.append(f"  {n:<14} {_cell(worst[0]):>11}   {_cell(worst[1]):>13}   "
+                     f"{_cell(worst[2]):>13}")
     return lines
 
 

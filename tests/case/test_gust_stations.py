@@ -91,6 +91,11 @@ def test_station_json_rows(fin_stations):
         for v in r["stations"].values():
             assert set(v) == {"peak_shear_N", "peak_bending_Nm", "peak_torsion_Nm"}
             assert all(np.isfinite(x) for x in v.values())
+    from asekit.case.report import _gust_lines
+    lines = _gust_lines(gust_json(res))
+    assert lines[-4].startswith("  station") and lines[-1].startswith("  outer")
+    worst = max((c.station_peaks["outer"]["peak_shear_N"] for c in res.cases), key=abs)
+    assert f"{worst:.4g}" in lines[-1]
 
 
 def test_station_cuts_of_a_trapezoid():
