@@ -1137,7 +1137,7 @@ def _gust(t: _Table | None, aero: AeroSpec, actuator: ActuatorSpec | None,
     if len(lengths) > 50:
         raise CaseError(f"gust.gradient_lengths must hold at most 50 values, got {len(lengths)}")
     wds = t.number("design_velocity", required=bool(lengths), default=0.0, low=0.0,
-                   high=100.0, low_open=profile is None, unit="m/s")
+                   high=100.0, low_open=bool(lengths), unit="m/s")
     mach = t.number("mach", default=actuator.mach if actuator is not None else aero.machs[0],
                     low=0.0, low_open=False)
     alt = t.number("altitude", default=actuator.altitude if actuator is not None else 0.0,

@@ -100,3 +100,25 @@ def test_missing_profile_file_names_the_key(tmp_path, fin_dict):
         d = _case_dict(fin_dict, "x")
         del d["gust"]["profile"]
         case_from_dict(d, source=str(tmp_path / "c.toml"))
+
+
+def test_bad_profile_row_is_one_cli_line_exit_2_before_any_work(tmp_path, capsys,
+                                                                 monkeypatch):
+    # the command line: one line naming the case, the key, the file, the row and the column
+    # (exit 2), and no pipeline step runs
+    from asekit.case import pipeline as P
+    from asekit.cli.main import main
+    from asekit.util.paths import FIN_FILE
+
+    def ran(*a, **k):
+        pytest.fail("the pipeline ran")
+    for name in ("modal_model", "gaf_database", "flutter", "box_mesh"):
+        monkeypatch.setattr(P, name, ran)
+    (tmp_path / "g.csv").write_text("time_s,velocity_ms\n0,0\n0.01,1\n0.02,-250\n")
+    f = tmp_path / "c.toml"
+    f.write_text(FIN_FILE.read_text() + '\n[gust]\nprofile = "g.csv"\n')
+    assert main(["analyse", str(f), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.strip().splitlines() == [
+        "error: c.toml: gust.profile g.csv row 3 column velocity_ms must be a number within "
+        "[-100, 100] m/s, got '-250'"]
