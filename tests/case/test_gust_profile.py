@@ -35,6 +35,14 @@ def test_profile_sampling_a_one_minus_cosine_gives_its_peaks(fin_case):
     for key in ("peak_hinge_moment_Nm", "peak_root_bending_Nm", "peak_root_shear_N",
                 "peak_current_A"):
         assert pro[key] == pytest.approx(cos[key], rel=1e-6), key
+    # the report's figure names the profile's curve by its file
+    import matplotlib.pyplot as plt
+
+    from asekit.case.report_figures import fig_gust_histories
+    f = fig_gust_histories(type("A", (), {"case": case, "gust": res})())
+    labels = [t.get_text() for t in f.figure.axes[0].get_legend().get_texts()]
+    assert labels == ["H = 2 m", "one_minus_cosine.csv"] and "H = 2 m, one_minus" in f.alt
+    plt.close(f.figure)
 
 
 def test_profile_gust_derivatives_of_a_sampled_cosine():
