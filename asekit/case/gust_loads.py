@@ -351,6 +351,10 @@ def _turbulence(ss, lfit, inert, n_rigid, g, omega_max: float) -> dict:
         out["hinge_moment"] = spectral_statistics(w, fr["hinge_moment"], psd)
     out["root_shear"] = spectral_statistics(w, fr["loads"][:, 0], psd)
     out["root_bending"] = spectral_statistics(w, fr["loads"][:, 1], psd)
+    out["stations"] = {
+        st.name: {k: spectral_statistics(w, fr["loads"][:, 2 + 3 * i + j], psd)
+                  for j, k in enumerate(("shear", "bending", "torsion"))}
+        for i, st in enumerate(g.stations)}
     return out
 
 
@@ -359,7 +363,8 @@ def turbulence_json(result: GustLoads | None) -> list:
     ``altitude_m``, ``rms_hinge_moment_Nm``, ``A_bar_hinge`` (N m per m/s), ``N0_per_s`` (of
     the hinge moment; null without a rigid mode), ``rms_root_bending_Nm``,
     ``A_bar_root_bending`` (N m per m/s), ``N0_root_bending_per_s``, ``sigma_ms``,
-    ``scale_length_m``, ``spectrum``, ``omega_max`` (rad/s)."""
+    ``scale_length_m``, ``spectrum``, ``omega_max`` (rad/s), ``stations`` ({name:
+    {"rms_shear_N", "rms_bending_Nm", "rms_torsion_Nm"}} at the ``[[gust.station]]`` cuts)."""
     if result is None or result.turbulence is None:
         return []
     t = result.turbulence
@@ -370,7 +375,10 @@ def turbulence_json(result: GustLoads | None) -> list:
          "A_bar_hinge": None if h is None else h["A_bar"],
          "N0_per_s": None if h is None else h["N0_per_s"],
          "rms_root_bending_Nm": bend["rms"], "A_bar_root_bending": bend["A_bar"],
-         "N0_root_bending_per_s": bend["N0_per_s"], "omega_max": t["omega_max"]}
+         "N0_root_bending_per_s": bend["N0_per_s"], "omega_max": t["omega_max"],
+         "stations": {n: {"rms_shear_N": v["shear"]["rms"], "rms_bending_Nm": v["bending"]["rms"],
+                          "rms_torsion_Nm": v["torsion"]["rms"]}
+                      for n, v in t.get("stations", {}).items()}}
     return [g]
 
 

@@ -59,8 +59,9 @@ UNITS = {
     "gust_length_m": "m (the 1-cos gust's gradient distance H; the gust is 2 H long; null for "
                      "a gust.profile row)",
     "profile": "the gust.profile file of the row (null for a 1-cos row)",
-    "stations": "{[[gust.station]] name: peak_shear_N in N, peak_bending_Nm and "
-                "peak_torsion_Nm in N m (largest magnitude, signed; torsion nose up > 0)}",
+    "stations": "{[[gust.station]] name: peak_ (gust rows: largest magnitude, signed) or "
+                "rms_ (turbulence rows) shear_N in N, bending_Nm and torsion_Nm in N m "
+                "(torsion nose up > 0)}",
     "peak_hinge_moment_Nm": "N m (largest |T_hinge@fin|, signed; actuator clamped)",
     "peak_root_bending_Nm": "N m (largest |root bending moment|, signed; tip up > 0)",
     "peak_root_shear_N": "N (largest |root shear|, signed; up > 0)",
