@@ -15,8 +15,19 @@ each gust (:func:`~asekit.aeroelastic.gust.one_minus_cosine`) and the loads are 
   (-u^T M Phi zeta'' with u the unit translation w = 1);
 - root bending moment (N m): their moment about the root chord line y = y_root, positive when
   an upward load bends the tip up (u: w = y - y_root, theta_x = 1);
+- at each ``[[gust.station]]`` cut (:func:`station_cuts`): the shear, the bending moment about
+  the cut's chord line y = y_cut and the torsion about the line x = x_axis (parallel to y,
+  nose up > 0: u is w = -(x - x_axis), theta_y = 1) of the boxes and nodes on or outboard of
+  the cut, aerodynamic + inertial as at the root (a station at eta = 0 is the root);
 - hinge moment (N m): T_hinge@fin of the shaft (docs/conventions.md), the rigid pitch held
   at zero (a stiff actuator); None without a rigid pitch mode.
+
+A user-given gust profile (``gust.profile``, :class:`asekit.case.schema.GustProfile`) runs
+through the same path: its rows are interpolated by a not-a-knot cubic spline, which gives
+w_g and its derivatives w_g', w_g'' (the Roger form's gust terms need them); before the first
+row the air is at rest, after the last row the last velocity holds; the time step is that of a
+1-cos gust of the profile's duration (features shorter than it are smoothed by the
+first-order hold).
 
 - motor current (A): with ``[actuator]``, the gust in the closed AEM1 loop (motor-angle
   feedback, :mod:`asekit.ase.gust`), linear: without the voltage and current limits, so a peak
@@ -27,7 +38,7 @@ each gust (:func:`~asekit.aeroelastic.gust.one_minus_cosine`) and the loads are 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -65,18 +76,22 @@ STEPS_PER_PERIOD = 20
 
 @dataclass(frozen=True)
 class GustLoadCase:
-    """One 1-cos gust's loads: ``gradient_length`` H (m), ``t`` (s), ``w_gust`` (m/s), and the
+    """One gust's loads: ``gradient_length`` H (m; None for a user profile, then ``profile``
+    is its file name), ``t`` (s), ``w_gust`` (m/s), and the
     histories ``hinge_moment`` (N m, None without a rigid mode), ``root_shear`` (N),
     ``root_bending`` (N m), ``current`` (A, the AEM1 loop's motor current; None without an
-    actuator), with their peaks (largest magnitude, signed)."""
+    actuator), with their peaks (largest magnitude, signed); ``stations``: {name: (3, n_t)
+    shear (N), bending (N m), torsion (N m)} at the ``[[gust.station]]`` cuts."""
 
-    gradient_length: float
+    gradient_length: float | None
     t: np.ndarray
     w_gust: np.ndarray
     hinge_moment: np.ndarray | None
     root_shear: np.ndarray
     root_bending: np.ndarray
     current: np.ndarray | None = None
+    profile: str | None = None
+    stations: dict = field(default_factory=dict)
 
     @staticmethod
     def _peak(y) -> float | None:
@@ -97,6 +112,12 @@ class GustLoadCase:
     @property
     def peak_root_bending(self) -> float:
         return self._peak(self.root_bending)
+
+    @property
+    def station_peaks(self) -> dict:
+        """{station name: {"peak_shear_N", "peak_bending_Nm", "peak_torsion_Nm"}}."""
+        keys = ("peak_shear_N", "peak_bending_Nm", "peak_torsion_Nm")
+        return {n: {k: self._peak(h) for k, h in zip(keys, v)} for n, v in self.stations.items()}
 
 
 @dataclass(frozen=True)
@@ -124,18 +145,67 @@ class GustLoads:
         return max(self.cases, key=lambda c: abs(getattr(c, f"peak_{which}") or 0.0))
 
 
-def _load_weights(boxes, y_root: float) -> np.ndarray:
-    return np.column_stack([np.ones(boxes.n), boxes.load_point[:, 1] - y_root])
+def station_cuts(boxes, stations) -> list:
+    """The cuts of the monitoring stations (:class:`asekit.case.schema.GustStation`) on the
+    box mesh ``boxes``: one (y_cut, x_axis) in m per station, y_cut = y_root + eta (y_tip -
+    y_root) and x_axis = x_le + axis (x_te - x_le) at y_cut, the leading and trailing edges
+    interpolated linearly between the box corners' spanwise stations (exact for straight
+    edges).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> from asekit.case.schema import GustStation
+    >>> c = np.array([[[0, 0, 0], [1, 0, 0], [1.5, 1, 0], [0.5, 1, 0]]], float)
+    >>> station_cuts(SimpleNamespace(corners=c), [GustStation("mid", 0.5, 0.5)])
+    [(0.5, 0.75)]
+    """
+    xy = boxes.corners[:, :, :2].reshape(-1, 2)
+    y0, y1 = float(xy[:, 1].min()), float(xy[:, 1].max())
+    ys = np.unique(np.round(xy[:, 1], 12))
+    yr = np.round(xy[:, 1], 12)
+    le = np.array([xy[yr == y, 0].min() for y in ys])
+    te = np.array([xy[yr == y, 0].max() for y in ys])
+    out = []
+    for st in stations:
+        y = y0 + st.eta * (y1 - y0)
+        xl, xt = float(np.interp(y, ys, le)), float(np.interp(y, ys, te))
+        out.append((y, xl + st.axis * (xt - xl)))
+    return out
 
 
-def _inertial_rows(case: Case, modal, y_root: float) -> np.ndarray:
+def _outboard(y, y_cut: float, span: float) -> np.ndarray:
+    """1 where y lies on or outboard of the cut (within 1e-9 of the span), else 0."""
+    return (np.asarray(y) >= y_cut - 1e-9 * span).astype(float)
+
+
+def _load_weights(boxes, y_root: float, cuts=()) -> np.ndarray:
+    """Per-box weights of the summed loads: root shear, root bending, then per station cut
+    (y_cut, x_axis) the shear, bending about y = y_cut and torsion about x = x_axis (nose up
+    > 0) of the boxes on or outboard of the cut."""
+    p = boxes.load_point
+    cols = [np.ones(boxes.n), p[:, 1] - y_root]
+    span = float(np.ptp(boxes.corners[:, :, 1]))
+    for y_cut, x_a in cuts:
+        m = _outboard(p[:, 1], y_cut, span)
+        cols += [m, m * (p[:, 1] - y_cut), m * (x_a - p[:, 0])]
+    return np.column_stack(cols)
+
+
+def _inertial_rows(case: Case, modal, y_root: float, cuts=(), span: float = 1.0) -> np.ndarray:
     _, M = mass_and_stiffness(case)
     nodes = modal.nodes
     n = nodes.shape[0]
-    u = np.zeros((2, 3 * n))
+    u = np.zeros((2 + 3 * len(cuts), 3 * n))
     u[0, 0::3] = 1.0                                    # unit translation w = 1
     u[1, 0::3] = nodes[:, 1] - y_root                  # rotation about the root line:
     u[1, 1::3] = 1.0                                    # w = y - y_root, theta_x = dw/dy = 1
+    for i, (y_cut, x_a) in enumerate(cuts):            # the same, outboard of each cut, and
+        m = _outboard(nodes[:, 1], y_cut, span)        # a nose-up rotation about x = x_a:
+        r = 2 + 3 * i                                   # w = -(x - x_a), theta_y = 1
+        u[r, 0::3] = m
+        u[r + 1, 0::3], u[r + 1, 1::3] = m * (nodes[:, 1] - y_cut), m
+        u[r + 2, 0::3], u[r + 2, 2::3] = m * (x_a - nodes[:, 0]), m
     phi = modal.shapes.reshape(3 * n, -1)[:, modal.n_rigid:]
     return -(M @ u.T).T @ phi
 
@@ -149,6 +219,46 @@ def _current_loop(case: Case, g, rfa, ss):
     cond = ase_condition(case, g.mach, g.altitude, actuator=act, fit=lambda *_: rfa)
     loop = closed_loop_gust(cond.model, ctl, ss)
     return loop if np.max(np.linalg.eigvals(loop.A).real) < 0 else None
+
+
+def _time_grid(t0: float, t1: float, settle: float, f_max: float) -> np.ndarray:
+    """Uniform times (s) from ``t0`` through a gust ending at ``t1`` and ``settle`` s beyond:
+    STEPS_PER_GRADIENT steps per half the gust's duration, STEPS_PER_PERIOD per period of the
+    highest mode (``f_max`` Hz), at most 200001 points."""
+    dt = min((t1 - t0) / (2 * STEPS_PER_GRADIENT), 1.0 / (STEPS_PER_PERIOD * max(f_max, 1e-9)))
+    nt = min(int(math.ceil((t1 - t0 + settle) / dt)) + 1, 200001)
+    return np.linspace(t0, t1 + settle, nt)
+
+
+def profile_gust(time, velocity, t) -> np.ndarray:
+    """A sampled gust velocity history and its derivatives at the times ``t`` (s): the
+    not-a-knot cubic spline through the rows (``time`` s, strictly ascending; ``velocity``
+    m/s); zero before the first row, the last velocity (and zero derivatives) after the last.
+
+    Returns
+    -------
+    (3, len(t)) array: w_g (m/s), w_g' (m/s^2), w_g'' (m/s^3), as
+    :func:`asekit.aeroelastic.gust.one_minus_cosine`.
+
+    Examples
+    --------
+    >>> w = profile_gust([0.0, 1.0, 2.0, 3.0], [0.0, 1.0, 4.0, 9.0], [0.5, 2.5, 4.0])
+    >>> np.round(w, 12) + 0.0                  # the spline is exact for t^2
+    array([[0.25, 6.25, 9.  ],
+           [1.  , 5.  , 0.  ],
+           [2.  , 2.  , 0.  ]])
+    """
+    from scipy.interpolate import CubicSpline
+
+    tp, wp = np.asarray(time, float), np.asarray(velocity, float)
+    tt = np.asarray(t, float).ravel()
+    spline = CubicSpline(tp, wp, bc_type="not-a-knot" if tp.size > 3 else "natural")
+    out = np.zeros((3, tt.size))
+    inside = (tt >= tp[0]) & (tt <= tp[-1])
+    for d in range(3):
+        out[d, inside] = spline(tt[inside], d)
+    out[0, tt > tp[-1]] = wp[-1]
+    return out
 
 
 def gust_loads(case: Case) -> GustLoads | None:
@@ -180,8 +290,10 @@ def gust_loads(case: Case) -> GustLoads | None:
     x0 = float(np.min(boxes.corners[:, :, 0])) if g.x0 is None else g.x0
     ks = reduced_frequencies(case)
     method = a.kernel if a.method == "dlm" else a.method
+    cuts = station_cuts(boxes, g.stations)
+    span = float(np.ptp(boxes.corners[:, :, 1]))
     tab = gust_aero_tables(fe_spline(modal, boxes), boxes, g.mach, ks, b,
-                           _load_weights(boxes, y_root), x0, method, a.symmetry == "wall")
+                           _load_weights(boxes, y_root, cuts), x0, method, a.symmetry == "wall")
     rfa = rfa_kind(case.flutter.rfa).fit(ks, tab.Q, b, g.mach, case.flutter.lags)
     gfit = gust_fit(ks, tab.Qg, b, lag_roots=rfa.lag_roots, mach=g.mach)
     nk, nl, n = tab.QL.shape
@@ -196,21 +308,26 @@ def gust_loads(case: Case) -> GustLoads | None:
                         f"aeroelastic system (actuator clamped) is unstable there (largest "
                         f"Re pole {growth:.3g} 1/s: beyond flutter or divergence), so its gust "
                         f"loads are unbounded; choose a stable flight condition")
-    inert = _inertial_rows(case, modal, y_root)
+    inert = _inertial_rows(case, modal, y_root, cuts, span)
     loop = _current_loop(case, g, rfa, ss)
     f_max = float(np.max(modal.frequencies_hz))
-    out = []
-    for H in g.gradient_lengths:
-        t_end = 2 * H / U + g.settle_time
-        dt = min(H / U / STEPS_PER_GRADIENT, 1.0 / (STEPS_PER_PERIOD * max(f_max, 1e-9)))
-        nt = min(int(math.ceil(t_end / dt)) + 1, 200001)
-        t = np.linspace(0.0, t_end, nt)
-        w = one_minus_cosine(t, U, H, g.design_velocity)
+
+    def run(t, w, H=None, name=None):
         resp = gust_response(ss, t, w)
         loads = load_histories(resp, lfit, inert, modal.n_rigid)
         cur = None if loop is None else closed_loop_gust_response(loop, t, w)["current"]
-        out.append(GustLoadCase(float(H), t, w[0], resp.hinge_moment if modal.n_rigid else None,
-                                loads[:, 0], loads[:, 1], cur))
+        st = {s.name: loads[:, 2 + 3 * i:5 + 3 * i].T for i, s in enumerate(g.stations)}
+        return GustLoadCase(H, t, w[0], resp.hinge_moment if modal.n_rigid else None,
+                            loads[:, 0], loads[:, 1], cur, name, st)
+
+    out = []
+    for H in g.gradient_lengths:
+        t = _time_grid(0.0, 2 * H / U, g.settle_time, f_max)
+        out.append(run(t, one_minus_cosine(t, U, H, g.design_velocity), float(H)))
+    if g.profile is not None:
+        p = g.profile
+        t = _time_grid(p.time[0], p.time[-1], g.settle_time, f_max)
+        out.append(run(t, profile_gust(p.time, p.velocity, t), None, p.name))
     errs = {"modal": float(rfa.fit_error), "gust": gfit.fit_error, "loads": lfit.fit_error}
     turb = None
     if g.turbulence_sigma is not None:
@@ -234,6 +351,10 @@ def _turbulence(ss, lfit, inert, n_rigid, g, omega_max: float) -> dict:
         out["hinge_moment"] = spectral_statistics(w, fr["hinge_moment"], psd)
     out["root_shear"] = spectral_statistics(w, fr["loads"][:, 0], psd)
     out["root_bending"] = spectral_statistics(w, fr["loads"][:, 1], psd)
+    out["stations"] = {
+        st.name: {k: spectral_statistics(w, fr["loads"][:, 2 + 3 * i + j], psd)
+                  for j, k in enumerate(("shear", "bending", "torsion"))}
+        for i, st in enumerate(g.stations)}
     return out
 
 
@@ -242,7 +363,8 @@ def turbulence_json(result: GustLoads | None) -> list:
     ``altitude_m``, ``rms_hinge_moment_Nm``, ``A_bar_hinge`` (N m per m/s), ``N0_per_s`` (of
     the hinge moment; null without a rigid mode), ``rms_root_bending_Nm``,
     ``A_bar_root_bending`` (N m per m/s), ``N0_root_bending_per_s``, ``sigma_ms``,
-    ``scale_length_m``, ``spectrum``, ``omega_max`` (rad/s)."""
+    ``scale_length_m``, ``spectrum``, ``omega_max`` (rad/s), ``stations`` ({name:
+    {"rms_shear_N", "rms_bending_Nm", "rms_torsion_Nm"}} at the ``[[gust.station]]`` cuts)."""
     if result is None or result.turbulence is None:
         return []
     t = result.turbulence
@@ -253,15 +375,22 @@ def turbulence_json(result: GustLoads | None) -> list:
          "A_bar_hinge": None if h is None else h["A_bar"],
          "N0_per_s": None if h is None else h["N0_per_s"],
          "rms_root_bending_Nm": bend["rms"], "A_bar_root_bending": bend["A_bar"],
-         "N0_root_bending_per_s": bend["N0_per_s"], "omega_max": t["omega_max"]}
+         "N0_root_bending_per_s": bend["N0_per_s"], "omega_max": t["omega_max"],
+         "stations": {n: {"rms_shear_N": v["shear"]["rms"], "rms_bending_Nm": v["bending"]["rms"],
+                          "rms_torsion_Nm": v["torsion"]["rms"]}
+                      for n, v in t.get("stations", {}).items()}}
     return [g]
 
 
 def gust_json(result: GustLoads | None) -> list:
-    """The ``analyse --json`` ``"gust"`` rows: one per gradient distance, ``mach``,
-    ``altitude_m``, ``gust_length_m`` (the gradient distance H), ``peak_hinge_moment_Nm``
+    """The ``analyse --json`` ``"gust"`` rows: one per gradient distance, then one for the
+    ``gust.profile`` (``gust_length_m`` null, ``profile`` its file name; null in the 1-cos
+    rows), ``mach``, ``altitude_m``, ``gust_length_m`` (the gradient distance H),
+    ``peak_hinge_moment_Nm``
     (null without a rigid mode), ``peak_root_bending_Nm``, ``peak_root_shear_N``,
-    ``peak_current_A`` (the linear AEM1 loop's motor current; null without an actuator)."""
+    ``peak_current_A`` (the linear AEM1 loop's motor current; null without an actuator),
+    ``stations`` ({name: {"peak_shear_N", "peak_bending_Nm", "peak_torsion_Nm"}}, the
+    ``[[gust.station]]`` cuts' peaks; empty without stations)."""
     if result is None:
         return []
     return [{"mach": result.mach, "altitude_m": result.altitude,
@@ -269,4 +398,5 @@ def gust_json(result: GustLoads | None) -> list:
              "peak_hinge_moment_Nm": c.peak_hinge_moment,
              "peak_root_bending_Nm": c.peak_root_bending,
              "peak_root_shear_N": c.peak_root_shear,
-             "peak_current_A": c.peak_current} for c in result.cases]
+             "peak_current_A": c.peak_current, "profile": c.profile,
+             "stations": c.station_peaks} for c in result.cases]

@@ -56,7 +56,12 @@ UNITS = {
     "settling_s": "s", "steady_error_pct": "%", "corner_overshoot_pct": "%",
     "fwtf_phase_margin_deg": "deg",
     "seconds": "s (wall-clock time per step)",
-    "gust_length_m": "m (the 1-cos gust's gradient distance H; the gust is 2 H long)",
+    "gust_length_m": "m (the 1-cos gust's gradient distance H; the gust is 2 H long; null for "
+                     "a gust.profile row)",
+    "profile": "the gust.profile file of the row (null for a 1-cos row)",
+    "stations": "{[[gust.station]] name: peak_ (gust rows: largest magnitude, signed) or "
+                "rms_ (turbulence rows) shear_N in N, bending_Nm and torsion_Nm in N m "
+                "(torsion nose up > 0)}",
     "peak_hinge_moment_Nm": "N m (largest |T_hinge@fin|, signed; actuator clamped)",
     "peak_root_bending_Nm": "N m (largest |root bending moment|, signed; tip up > 0)",
     "peak_root_shear_N": "N (largest |root shear|, signed; up > 0)",
@@ -369,10 +374,26 @@ def _gust_lines(rows) -> list:
              "loads with the actuator clamped, current in the AEM1 loop):",
              "  H (m)   hinge moment (N m)   root bending (N m)   root shear (N)   current (A)"]
     for r in rows:
-        lines.append(f"  {r['gust_length_m']:<7g} {_cell(r['peak_hinge_moment_Nm']):>18}   "
+        h = f"{r['gust_length_m']:<7g}" if r["gust_length_m"] is not None else r["profile"]
+        lines.append(f"  {h} {_cell(r['peak_hinge_moment_Nm']):>18}   "
                      f"{_cell(r['peak_root_bending_Nm']):>18}   "
                      f"{_cell(r['peak_root_shear_N']):>14}   "
                      f"{_cell(r['peak_current_A']):>11}")
+    return lines + _station_lines(rows)
+
+
+def _station_lines(rows) -> list:
+    """The summary's lines of the ``[[gust.station]]`` peaks: per station the largest
+    magnitude (signed) over the gusts (none without stations)."""
+    names = list(rows[0].get("stations") or {})
+    if not names:
+        return []
+    lines = ["  station          shear (N)   bending (N m)   torsion (N m)   (worst gust)"]
+    for n in names:
+        worst = [max((r["stations"][n][k] for r in rows), key=abs)
+                 for k in ("peak_shear_N", "peak_bending_Nm", "peak_torsion_Nm")]
+        lines.append(f"  {n:<14} {_cell(worst[0]):>11}   {_cell(worst[1]):>13}   "
+                     f"{_cell(worst[2]):>13}")
     return lines
 
 

@@ -490,9 +490,14 @@ def fig_ase_steps(a) -> ReportFigure:
     return ReportFigure(fig, alt, SECTIONS[3])
 
 
+def _gust_label(c) -> str:
+    """A gust's name: "H = 1 m" for a 1-cos gust, the file name for a ``gust.profile``."""
+    return f"H = {c.gradient_length:g} m" if c.gradient_length is not None else c.profile
+
+
 def fig_gust_histories(a) -> ReportFigure:
     """Hinge moment, root bending moment and (with an actuator) motor current against time in
-    each 1-cos gust of ``[gust]`` (:mod:`asekit.case.gust_loads`)."""
+    each 1-cos gust of ``[gust]`` and its ``profile`` (:mod:`asekit.case.gust_loads`)."""
     g = a.gust
     rows = [("root_bending", "root bending (N m)")]
     if g.cases[0].hinge_moment is not None:
@@ -506,19 +511,18 @@ def fig_gust_histories(a) -> ReportFigure:
     axes = np.atleast_1d(axes)
     for c in g.cases:
         for ax, (name, _) in zip(axes, rows):
-            ax.plot(c.t * 1e3, getattr(c, name), label=f"H = {c.gradient_length:g} m")
+            ax.plot(c.t * 1e3, getattr(c, name), label=_gust_label(c))
     for ax, (_, label) in zip(axes, rows):
         ax.set_ylabel(label)
     axes[-1].set_xlabel("time (ms)")
     axes[0].legend(fontsize="small")
     tuned = g.tuned("root_bending")
-    lengths = ", ".join(f"{c.gradient_length:g}" for c in g.cases)
-    alt = (f"Loads in 1-cos gusts of gradient distance {lengths} m; the largest root bending "
-           f"{tuned.peak_root_bending:.3g} N m at H = {tuned.gradient_length:g} m")
+    names = ", ".join(_gust_label(c) for c in g.cases)
+    alt = (f"Loads in the gusts {names}; the largest root bending "
+           f"{tuned.peak_root_bending:.3g} N m in {_gust_label(tuned)}")
     if tuned.peak_hinge_moment is not None:
         h = g.tuned("hinge_moment")
-        alt += (f"; the largest hinge moment {h.peak_hinge_moment:.3g} N m at H = "
-                f"{h.gradient_length:g} m")
+        alt += f"; the largest hinge moment {h.peak_hinge_moment:.3g} N m in {_gust_label(h)}"
     return ReportFigure(fig, alt, SECTIONS[4])
 
 

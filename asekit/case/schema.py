@@ -15,6 +15,7 @@ import hashlib
 import json
 import math
 from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -258,6 +259,131 @@ class ActuatorSpec:
 
 
 @dataclass(frozen=True)
+class GustProfile:
+    """A user-given gust velocity history (``gust.profile``, a CSV file with the columns
+    ``time_s`` and ``velocity_ms``): ``name`` the file's name, ``time`` (s, strictly ascending)
+    and ``velocity`` (m/s, true airspeed, upward > 0) at the reference station x0."""
+
+    name: str
+    time: tuple[float, ...]
+    velocity: tuple[float, ...]
+
+
+#: Limits of a gust profile file: rows, time (s) and |velocity| (m/s).
+PROFILE_MAX_ROWS = 200000
+PROFILE_MAX_TIME = 600.0
+PROFILE_MAX_VELOCITY = 100.0
+
+
+def _profile_cell(where: str, col: str, text, low: float, high: float, unit: str) -> float:
+    try:
+        v = float(text)
+    except (TypeError, ValueError):
+        v = math.nan
+    if not (math.isfinite(v) and low <= v <= high):
+        raise CaseError(f"{where} column {col} must be a number within [{low:g}, {high:g}] "
+                        f"{unit}, got {text!r}")
+    return v
+
+
+def read_gust_profile(path, key: str = "gust.profile") -> GustProfile:
+    """Read and check a gust profile CSV (columns ``time_s``, ``velocity_ms``, a header row).
+
+    Parameters
+    ----------
+    path : str or Path of the CSV file; key : the case-file key named in errors.
+
+    Returns
+    -------
+    GustProfile
+        Every row checked: time in [0, 600] s, strictly ascending, velocity in [-100, 100] m/s,
+        2 to 200000 rows.
+
+    Raises
+    ------
+    CaseError
+        Naming the key, the file, the row (1 = the first data row) and the column.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "g.csv"
+    >>> _ = f.write_text("time_s,velocity_ms\\n0,0\\n0.1,2.5\\n0.2,0\\n")
+    >>> read_gust_profile(f).velocity
+    (0.0, 2.5, 0.0)
+    """
+    import csv
+
+    path = Path(path)
+    name = path.name
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.reader(fh))
+    except (OSError, UnicodeDecodeError) as e:
+        raise CaseError(f"{key}: cannot read {str(path)!r}: {e}") from None
+    rows = [r for r in rows if any(c.strip() for c in r)]
+    head = [c.strip() for c in rows[0]] if rows else []
+    if "time_s" not in head or "velocity_ms" not in head:
+        raise CaseError(f"{key} {name}: the first row must name the columns time_s and "
+                        f"velocity_ms, got {head}")
+    it, iv = head.index("time_s"), head.index("velocity_ms")
+    data = rows[1:]
+    if not 2 <= len(data) <= PROFILE_MAX_ROWS:
+        raise CaseError(f"{key} {name}: must hold 2 to {PROFILE_MAX_ROWS} data rows, "
+                        f"got {len(data)}")
+    t, w = [], []
+    for i, r in enumerate(data, start=1):
+        where = f"{key} {name} row {i}"
+        if len(r) != len(head):
+            raise CaseError(f"{where} must hold {len(head)} values, got {len(r)}")
+        t.append(_profile_cell(where, "time_s", r[it].strip(), 0.0, PROFILE_MAX_TIME, "s"))
+        w.append(_profile_cell(where, "velocity_ms", r[iv].strip(), -PROFILE_MAX_VELOCITY,
+                               PROFILE_MAX_VELOCITY, "m/s"))
+        if i > 1 and t[-1] <= t[-2]:
+            raise CaseError(f"{where} column time_s must exceed the previous row's "
+                            f"{t[-2]:g} s (times strictly ascending), got {t[-1]:g}")
+    return GustProfile(name, tuple(t), tuple(w))
+
+
+@dataclass(frozen=True)
+class GustStation:
+    """A load monitoring station (``[[gust.station]]``): ``name``; the cut at the spanwise
+    fraction ``eta`` of the surface (0 the root, < 1); ``axis`` the chord fraction at the cut
+    of the torsion axis (parallel to y; default 0.25, the quarter chord)."""
+
+    name: str
+    eta: float
+    axis: float = 0.25
+
+
+#: At most this many ``[[gust.station]]`` tables.
+MAX_STATIONS = 50
+
+
+def _gust_stations(raw) -> tuple[GustStation, ...]:
+    """The ``[[gust.station]]`` tables, every key checked."""
+    if raw is None:
+        return ()
+    if not isinstance(raw, list) or not 1 <= len(raw) <= MAX_STATIONS:
+        raise CaseError(f"gust.station must be an array of 1 to {MAX_STATIONS} tables "
+                        f"([[gust.station]])")
+    out = []
+    for i, d in enumerate(raw):
+        t = _Table(d, f"gust.station[{i}]")
+        name = t.text("name", default="")
+        if not name.strip():
+            raise CaseError(f"gust.station[{i}].name must be a non-empty string, got {name!r}")
+        eta = t.number("eta", required=True, low=0.0, high=1.0, low_open=False, high_open=True)
+        axis = t.number("axis", default=0.25, low=0.0, high=1.0, low_open=False)
+        t.done()
+        out.append(GustStation(name, eta, axis))
+    names = [s.name for s in out]
+    if len(set(names)) != len(names):
+        raise CaseError(f"gust.station[].name must be unique, got {names}")
+    return tuple(out)
+
+
+@dataclass(frozen=True)
 class GustSpec:
     """Discrete 1-cos gusts (issue 27, :mod:`asekit.case.gust_loads`): gradient distances H (m;
     each gust 2 H long), the design gust velocity U_ds (m/s, true airspeed, upward), the flight
@@ -265,7 +391,8 @@ class GustSpec:
     0 m), the gust reference station x0 (m; default the most upstream leading edge) and the
     simulated time after the gust has passed (s); with ``[gust.turbulence]`` also continuous
     turbulence: RMS gust velocity sigma (m/s), scale length L (m, default 762 m = 2500 ft) and
-    spectrum ("von_karman" or "dryden")."""
+    spectrum ("von_karman" or "dryden"); a user-given gust ``profile``
+    (:class:`GustProfile`) and load monitoring ``stations`` (:class:`GustStation`)."""
 
     gradient_lengths: tuple[float, ...]
     design_velocity: float
@@ -276,6 +403,8 @@ class GustSpec:
     turbulence_sigma: float | None = None
     scale_length: float = 762.0
     spectrum: str = "von_karman"
+    profile: GustProfile | None = None
+    stations: tuple[GustStation, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -988,14 +1117,27 @@ def _convergence(t: _Table | None) -> ConvergenceSpec:
     return spec
 
 
-def _gust(t: _Table | None, aero: AeroSpec, actuator: ActuatorSpec | None) -> GustSpec | None:
+def _gust_profile(t: _Table, source: str) -> GustProfile | None:
+    """``gust.profile``: a CSV path relative to the case file (:func:`read_gust_profile`)."""
+    if t.raw("profile") is None:
+        return None
+    rel = t.text("profile")
+    base = Path(source).parent if source else Path.cwd()
+    return read_gust_profile(base / rel, "gust.profile")
+
+
+def _gust(t: _Table | None, aero: AeroSpec, actuator: ActuatorSpec | None,
+          source: str = "") -> GustSpec | None:
     if t is None:
         return None
-    lengths = t.numbers("gradient_lengths", required=True, low=0.0, high=1000.0, unit="m",
-                        ascending=True)
+    profile = _gust_profile(t, source)
+    stations = _gust_stations(t.raw("station"))
+    lengths = t.numbers("gradient_lengths", required=profile is None, default=(), min_length=0,
+                        low=0.0, high=1000.0, unit="m", ascending=True)
     if len(lengths) > 50:
         raise CaseError(f"gust.gradient_lengths must hold at most 50 values, got {len(lengths)}")
-    wds = t.number("design_velocity", required=True, low=0.0, high=100.0, unit="m/s")
+    wds = t.number("design_velocity", required=bool(lengths), default=0.0, low=0.0,
+                   high=100.0, low_open=bool(lengths), unit="m/s")
     mach = t.number("mach", default=actuator.mach if actuator is not None else aero.machs[0],
                     low=0.0, low_open=False)
     alt = t.number("altitude", default=actuator.altitude if actuator is not None else 0.0,
@@ -1013,7 +1155,8 @@ def _gust(t: _Table | None, aero: AeroSpec, actuator: ActuatorSpec | None) -> Gu
     if not aero.machs[0] <= mach <= aero.machs[-1]:
         raise CaseError(f"gust.mach must lie within aero.machs [{aero.machs[0]:g}, "
                         f"{aero.machs[-1]:g}], got {mach:g}")
-    return GustSpec(lengths, wds, mach, alt, x0, settle, sigma, scale, spectrum)
+    return GustSpec(tuple(lengths), wds, mach, alt, x0, settle, sigma, scale, spectrum, profile,
+                    stations)
 
 
 def case_from_dict(d: dict, source: str = "") -> Case:
@@ -1043,7 +1186,7 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     actuator = _actuator(top.table("actuator"))
     flutter = _flutter(top.table("flutter"))
     convergence = _convergence(top.table("convergence"))
-    gust = _gust(top.table("gust"), aero, actuator)
+    gust = _gust(top.table("gust"), aero, actuator, source)
     fsi = top.table("flutter_speed_index")
     if fsi is not None:
         fsi_spec = FlutterIndexSpec(fsi.number("semichord", required=True, low=0.0, unit="m"),

@@ -105,7 +105,9 @@ def test_gust_json_rows(fin_gusts):
     assert [r["gust_length_m"] for r in rows] == [0.3, 40.0]
     for r in rows:
         assert set(r) == {"mach", "altitude_m", "gust_length_m", "peak_hinge_moment_Nm",
-                          "peak_root_bending_Nm", "peak_root_shear_N", "peak_current_A"}
+                          "peak_root_bending_Nm", "peak_root_shear_N", "peak_current_A",
+                          "profile", "stations"}
+        assert r["profile"] is None and r["stations"] == {}      # 1-cos rows, no stations
         assert r["mach"] == 0.5 and r["altitude_m"] == 0.0
         assert np.isfinite(r["peak_current_A"])                  # the fin has an [actuator]
         assert all(np.isfinite(r[k]) for k in ("peak_hinge_moment_Nm", "peak_root_bending_Nm"))
