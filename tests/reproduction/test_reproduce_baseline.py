@@ -11,6 +11,13 @@ The six ``ase.design.hinf.*`` rows (issue 26: the H-infinity design; ``condition
 ``mu_peak`` are computed with ``reproduce --robust`` only) were added on 2026-12-03 from
 ``python -m asekit reproduce --only design --json``; no other value changed.
 
+Eight p-k rows moved by 1.8e-9 to 5.3e-7 relative on 2026-12-03 with issue 23's batched,
+secant-accelerated k-iteration (its tolerance is 1e-7 relative in frequency, so the converged
+roots may move by that much): ``flutter.damping.pk``, ``flutter.structural_g.pk``,
+``flutter.pk.M075.h2500``, ``flutter.ha145b.pk``, ``flutter.extrapolated.pk.*`` (3) and
+``flutter.root_locus.minimum_state6.*.error_vs_pk_pct``; they were updated from the CI run's
+values (bit-identical runs on one machine); no verdict changed.
+
 The two ``flutter.converged.*`` rows are computed only when their GAF database is already in
 the user cache (CI computes it first), so they are skipped when the baseline holds None.
 """
