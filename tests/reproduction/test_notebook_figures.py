@@ -50,7 +50,7 @@ REPORT = "import json; print(json.dumps(_asekit_probe))"
 
 
 def _execute(path: Path):
-    """Execute ``path`` with the inline backend; returns (executed notebook, probe record)."""
+    """Execute ``path`` with the inline backend and the probe cells; returns the notebook."""
     nb = nbformat.read(path, as_version=4)
     nb.cells.insert(0, nbformat.v4.new_code_cell(PROBE))
     nb.cells.append(nbformat.v4.new_code_cell(REPORT))
@@ -64,6 +64,19 @@ def _execute(path: Path):
                                      kernel_name="python3",
                                      resources={"metadata": {"path": str(path.parent)}})
     client.execute(env=env)
+    return nb
+
+
+def _execute_probed(path: Path):
+    """:func:`_execute`, once more in a fresh kernel if the first run's client waited for a
+    cell past its timeout or lost its kernel: seen once in CI (2026-12-03), a kernel idle in
+    its event loop while nbclient still waited for the cell's reply (a lost message, not the
+    notebook: the same notebook passed in the default run's nbval). A notebook that hangs or
+    dies twice fails."""
+    try:
+        nb = _execute(path)
+    except (nbclient.exceptions.CellTimeoutError, nbclient.exceptions.DeadKernelError):
+        nb = _execute(path)
     text = "".join(o.get("text", "") for o in nb.cells[-1].outputs if o.get("name") == "stdout")
     return nb, json.loads(text)
 
@@ -75,7 +88,7 @@ def _images(cell) -> int:
 @pytest.mark.slow
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_every_figure_is_displayed_by_the_cell_that_draws_it(path):
-    nb, probe = _execute(path)
+    nb, probe = _execute_probed(path)
     code = [c for c in nb.cells[1:-1] if c.cell_type == "code" and c.source.strip()]
     assert code, f"{path.name}: no code cells"
     assert len(probe) == len(code) + 1, "the probe did not see every cell"
