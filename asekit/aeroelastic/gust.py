@@ -2,7 +2,7 @@
 (issue 27).
 
 The modal equation of :mod:`asekit.aeroelastic.statespace` (thesis Eq. 2.44) gains the gust
-force of the Roger-fitted gust column (:mod:`asekit.rfa.gust`, Q~_g with coefficients A_g):
+force of the Roger-fitted gust column (:mod:`asekit.rfa.gust`, Q~_g with coefficients A_g)::
 
     (s^2 M + s C + K - q Q~(s)) zeta = T_act + q Q~_g(s) w_g(s) / U,
 
@@ -308,7 +308,7 @@ def load_histories(resp: GustResponse, load_fit, inertial_rows, n_rigid: int = 0
     The aerodynamic load rows Q_L (n_loads, n) and their gust part Q_Lg (n_loads) (from
     :func:`asekit.aero.gust.gust_aero_tables`) are fitted together in Roger form, ``load_fit``
     a :class:`asekit.rfa.gust.GustFit` of the columns ``[Q_L.reshape(n_k, -1), Q_Lg]`` (row
-    major: load r, mode j at column r n + j; then the n_loads gust columns). In time (p = s b/U)
+    major: load r, mode j at column r n + j; then the n_loads gust columns). In time (p = s b/U)::
 
         L_aero = q [A0 zeta + (b/U) A1 zeta' + (b/U)^2 A2 zeta'' + sum_n y_n]
                  + q [A0g w/U + A1g b w'/U^2 + A2g b^2 w''/U^3 + sum_n A_gn x_gn],
