@@ -2666,16 +2666,7 @@ def _aero_cards(model, boxes: BoxMesh, eid0: int, set_nodes: list[int]):
     start = eid0
     aef = 1
     for i in range(len(boxes.surface_names)):
-        c = boxes.corners[boxes.surface == i]
-        st = boxes.strip[boxes.surface == i]
-        nc = int(np.sum(st == st[0]))
-        ns = c.shape[0] // nc
-        g = c.reshape(ns, nc, 4, 3)
-        r_le, r_c = g[0, 0, 0], g[0, -1, 1, 0] - g[0, 0, 0, 0]
-        t_le, t_c = g[-1, 0, 3], g[-1, -1, 2, 0] - g[-1, 0, 3, 0]
-        xi = np.concatenate([[0.0], (g[0, :, 1, 0] - r_le[0]) / r_c])
-        span = t_le[1] - r_le[1]
-        eta = np.concatenate([[0.0], (g[:, 0, 3, 1] - r_le[1]) / span])
+        r_le, r_c, t_le, t_c, nc, ns, xi, eta = _surface_geometry(boxes, i)
         kw = {}
         if np.allclose(xi, np.linspace(0, 1, nc + 1), atol=1e-9):
             kw["nchord"] = nc
