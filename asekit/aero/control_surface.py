@@ -47,7 +47,7 @@ from asekit.util.validate import in_range, integer
 
 __all__ = ["ControlSurface", "HingedMesh", "hinged_mesh", "deflection_modes", "hinge_moments",
            "steady_control_derivatives", "ControlDerivatives", "glauert_flap_effectiveness",
-           "oscillatory_control_coefficients"]
+           "oscillatory_control_coefficients", "thin_airfoil_flap_derivatives"]
 
 
 @dataclass(frozen=True)
@@ -407,3 +407,31 @@ def glauert_flap_effectiveness(flap_chord_fraction: float) -> float:
     e = in_range("flap_chord_fraction", flap_chord_fraction, 0.0, high=1.0)
     th = np.arccos(1.0 - 2.0 * (1.0 - e))
     return float(1.0 - (th - np.sin(th)) / np.pi)
+
+
+def thin_airfoil_flap_derivatives(flap_chord_fraction: float) -> tuple[float, float, float]:
+    """Thin-airfoil (2-D, incompressible) lift and moment slopes of an airfoil with a plain
+    flap of chord fraction E, from the Fourier coefficients of the flap's camber line,
+    A_0 = delta (pi - theta_h) / pi, A_n = 2 delta sin(n theta_h) / (n pi), with
+    c_l = pi (2 A_0 + A_1) and c_m,c/4 = pi (A_2 - A_1) / 4 (Glauert, *The Elements of
+    Aerofoil and Airscrew Theory*, 1926, Ch. VII; Abbott & von Doenhoff, *Theory of Wing
+    Sections*, 1959, Sec. 8.7):
+
+        c_l,alpha = 2 pi,   c_l,delta = 2 (pi - theta_h + sin theta_h),
+        c_m,delta = -(1/2) sin theta_h (1 - cos theta_h)   (about the quarter chord),
+
+    with cos theta_h = 1 - 2 x_h / c, x_h / c = 1 - E, per radian.
+
+    Returns
+    -------
+    (c_l_alpha, c_l_delta, c_m_delta) per rad; c_m nose up positive.
+
+    Examples
+    --------
+    >>> [round(v, 3) for v in thin_airfoil_flap_derivatives(0.25)]
+    [6.283, 3.826, -0.65]
+    """
+    e = in_range("flap_chord_fraction", flap_chord_fraction, 0.0, high=1.0)
+    th = float(np.arccos(1.0 - 2.0 * (1.0 - e)))
+    return (2.0 * np.pi, float(2.0 * (np.pi - th + np.sin(th))),
+            float(-0.5 * np.sin(th) * (1.0 - np.cos(th))))
