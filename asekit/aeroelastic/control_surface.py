@@ -40,6 +40,11 @@ reverse all the same: measured on the 0.3 m x 1.2 m aluminium plate of the examp
 full-span 25 % flap with the symmetric image (aspect ratio 8) gains lift up to divergence as
 strip theory says, while the same wing alone or loaded antisymmetrically (rolling) reverses
 just below divergence (q_R = 477-488 Pa against q_D = 515-540 Pa).
+
+The strip-theory closed forms are :func:`strip_theory_effectiveness` and
+:func:`strip_theory_reversal_q`; on a uniform torsion beam with its elastic axis 5 % of the chord
+behind the quarter chord, the vortex lattice's q_R tends to them as the aspect ratio grows
+(+7 % at aspect ratio 10, -0.3 % at 40: tests/aeroelastic/test_reversal_strip_theory.py).
 """
 
 from __future__ import annotations
