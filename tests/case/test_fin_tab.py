@@ -30,8 +30,8 @@ def test_shipped_fin_tab_case_reads_and_its_tab_is_on_element_lines():
     the chord over the inboard 4/7 of the span: the modes of the locked fin are the thesis
     fin's (the same structure: nalci2013_fin.toml); the tab's static unbalance and inertia
     are those of a thin plate strip (S = m c_f / 2, I = m c_f^2 / 3 with its mean chord
-    c_f and mass m from its area and mean thickness), within 25 % (the 6 x 7 mesh's nodes on
-    the hinge shared half-half, the thickness tapering across it)."""
+    c_f and mass m from its area and mean thickness), within 10 % (measured -5.3 % and -3.9 %:
+    the 6 x 7 mesh's nodes on the hinge shared half-half, the thickness tapering across it)."""
     case = load_case(FIN_TAB)
     (cs,) = case.control_surfaces
     assert cs.name == "tab" and cs.panel == 0 and cs.hinge_stiffness == 20.0
@@ -42,8 +42,8 @@ def test_shipped_fin_tab_case_reads_and_its_tab_is_on_element_lines():
     area, c_f = hm.surface_area(0), hm.mean_chord(0)
     t_mean = 0.004 - 0.002 * (4 / 7) / 2              # root 4 mm to 2 mm at the tip, linear
     m = 2700.0 * t_mean * area
-    assert fm.static_unbalance[0] == pytest.approx(m * c_f / 2, rel=0.25)
-    assert fm.inertia[0] == pytest.approx(m * c_f ** 2 / 3, rel=0.25)
+    assert fm.static_unbalance[0] == pytest.approx(m * c_f / 2, rel=0.10)
+    assert fm.inertia[0] == pytest.approx(m * c_f ** 2 / 3, rel=0.10)
 
 
 def test_fin_tab_derivatives():
