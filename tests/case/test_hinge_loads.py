@@ -100,3 +100,26 @@ def test_without_an_envelope_the_top_of_the_sweep_and_no_supersonic_points():
     assert sorted({r.mach for r in env}) == [0.1, 0.3]
     assert sorted({r.altitude for r in env}) == [0.0, 1000.0]
     assert np.all([r.basis == "envelope" for r in env])
+
+
+def test_report_figure_of_the_hinge_moments(fin_rows):
+    """The report's servo-sizing figure: one series per surface and Mach through the origin,
+    its last point the largest q of that Mach, the alt text quoting the largest |H|."""
+    from types import SimpleNamespace
+
+    import matplotlib.pyplot as plt
+
+    from asekit.case.report_figures import SECTIONS, fig_control_hinge_moments
+    a = SimpleNamespace(case=SimpleNamespace(name="nalci2013_fin_tab"), control_hinge=fin_rows)
+    rf = fig_control_hinge_moments(a)
+    try:
+        assert rf.section == SECTIONS[-1]
+        lines = rf.figure.axes[0].get_lines()
+        series = [ln for ln in lines if ln.get_label().startswith("tab")]
+        assert [ln.get_label() for ln in series] == ["tab, M 0.4", "tab, M 0.6"]
+        x, y = series[1].get_data()
+        assert x[0] == 0.0 and y[0] == 0.0
+        assert y[-1] == pytest.approx(fin_rows[1].hinge_moment_per_delta * math.pi / 180)
+        assert "largest" in rf.alt and "M 0.6" in rf.alt
+    finally:
+        plt.close(rf.figure)
