@@ -47,7 +47,8 @@ from asekit.util.validate import in_range, integer
 
 __all__ = ["ControlSurface", "HingedMesh", "hinged_mesh", "deflection_modes", "hinge_moments",
            "steady_control_derivatives", "ControlDerivatives", "glauert_flap_effectiveness",
-           "oscillatory_control_coefficients"]
+           "oscillatory_control_coefficients", "thin_airfoil_flap_derivatives",
+           "dimensional_hinge_moments"]
 
 
 @dataclass(frozen=True)
@@ -407,3 +408,64 @@ def glauert_flap_effectiveness(flap_chord_fraction: float) -> float:
     e = in_range("flap_chord_fraction", flap_chord_fraction, 0.0, high=1.0)
     th = np.arccos(1.0 - 2.0 * (1.0 - e))
     return float(1.0 - (th - np.sin(th)) / np.pi)
+
+
+def thin_airfoil_flap_derivatives(flap_chord_fraction: float) -> tuple[float, float, float]:
+    """Thin-airfoil (2-D, incompressible) lift and moment slopes of an airfoil with a plain
+    flap of chord fraction E, from the Fourier coefficients of the flap's camber line,
+    A_0 = delta (pi - theta_h) / pi, A_n = 2 delta sin(n theta_h) / (n pi), with
+    c_l = pi (2 A_0 + A_1) and c_m,c/4 = pi (A_2 - A_1) / 4 (Glauert, *The Elements of
+    Aerofoil and Airscrew Theory*, 1926, Ch. VII; Abbott & von Doenhoff, *Theory of Wing
+    Sections*, 1959, Sec. 8.7):
+
+        c_l,alpha = 2 pi,   c_l,delta = 2 (pi - theta_h + sin theta_h),
+        c_m,delta = -(1/2) sin theta_h (1 - cos theta_h)   (about the quarter chord),
+
+    with cos theta_h = 1 - 2 x_h / c, x_h / c = 1 - E, per radian.
+
+    Returns
+    -------
+    (c_l_alpha, c_l_delta, c_m_delta) per rad; c_m nose up positive.
+
+    Examples
+    --------
+    >>> [round(v, 3) for v in thin_airfoil_flap_derivatives(0.25)]
+    [6.283, 3.826, -0.65]
+    """
+    e = in_range("flap_chord_fraction", flap_chord_fraction, 0.0, high=1.0)
+    th = float(np.arccos(1.0 - 2.0 * (1.0 - e)))
+    return (2.0 * np.pi, float(2.0 * (np.pi - th + np.sin(th))),
+            float(-0.5 * np.sin(th) * (1.0 - np.cos(th))))
+
+
+def dimensional_hinge_moments(hm: HingedMesh, d: ControlDerivatives,
+                              dynamic_pressure: float) -> tuple[np.ndarray, np.ndarray]:
+    """Hinge moments per unit deflection and per unit incidence of every surface at dynamic
+    pressure q (Pa): H_delta = q S_f c_f C_h,delta and H_alpha = q S_f c_f C_h,alpha (N m/rad),
+    the definition C_h = H / (q S_f c_f) of the module docstring inverted, with S_f the
+    surface's area and c_f its mean chord aft of the hinge. A rigid surface's hinge moment is
+    linear in q at a fixed Mach; the actuator holding the surface applies -H (trailing edge
+    down positive).
+
+    Parameters
+    ----------
+    hm : the boxes with the surfaces (:func:`hinged_mesh`).
+    d : their steady derivatives (:func:`steady_control_derivatives`) at the Mach of q.
+    dynamic_pressure : q (Pa, >= 0).
+
+    Returns
+    -------
+    (H_delta, H_alpha) : (n_surfaces,) arrays, N m/rad.
+
+    Examples
+    --------
+    >>> panel = TrapezoidSurface((0, 0), 1.0, (0, 3.0), 1.0, 8, 12)
+    >>> hm = hinged_mesh(panel, ControlSurface("f", .75, .75))
+    >>> d = steady_control_derivatives(hm, 0.0, symmetric=True)
+    >>> h_d, h_a = dimensional_hinge_moments(hm, d, 1000.0)
+    >>> bool(np.isclose(h_d[0], 1000.0 * 0.75 * 0.25 * d.Ch_delta[0])), bool(h_a[0] < 0)
+    (True, True)
+    """
+    q = in_range("dynamic_pressure", dynamic_pressure, 0.0, inclusive=True)
+    sc = np.array([hm.surface_area(i) * hm.mean_chord(i) for i in range(len(hm.surfaces))])
+    return q * sc * np.asarray(d.Ch_delta, float), q * sc * np.asarray(d.Ch_alpha, float)

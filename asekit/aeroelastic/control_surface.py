@@ -40,6 +40,11 @@ reverse all the same: measured on the 0.3 m x 1.2 m aluminium plate of the examp
 full-span 25 % flap with the symmetric image (aspect ratio 8) gains lift up to divergence as
 strip theory says, while the same wing alone or loaded antisymmetrically (rolling) reverses
 just below divergence (q_R = 477-488 Pa against q_D = 515-540 Pa).
+
+The strip-theory closed forms are :func:`strip_theory_effectiveness` and
+:func:`strip_theory_reversal_q`; on a uniform torsion beam with its elastic axis 5 % of the chord
+behind the quarter chord, the vortex lattice's q_R tends to them as the aspect ratio grows
+(+7 % at aspect ratio 10, -0.3 % at 40: tests/aeroelastic/test_reversal_strip_theory.py).
 """
 
 from __future__ import annotations
@@ -342,3 +347,115 @@ def static_effectiveness(fm: FlapModel, hm: HingedMesh, mach: float, q_max: floa
     return StaticEffectiveness(qs, rat, q_r, q_div, what)
 
 
+
+
+
+def _strip_g(what: str, lam: float) -> float:
+    """The span integral factor of strip theory: tan(L)/L (lift) or
+    2 (1 - cos L) / (L^2 cos L) (rolling moment); 1 at L = 0, infinite at L = pi/2."""
+    if lam < 1e-4:                                   # series: 1 + L^2/3 and 1 + 5 L^2/12
+        return 1.0 + lam * lam * (1.0 / 3.0 if what == "lift" else 5.0 / 12.0)
+    if what == "lift":
+        return math.tan(lam) / lam
+    return 2.0 * (1.0 - math.cos(lam)) / (lam * lam * math.cos(lam))
+
+
+def _strip_inputs(gj, chord, span, e, cl_alpha, cl_delta, cm_delta, what):
+    vals = tuple(positive(n, v) for n, v in (("gj", gj), ("chord", chord), ("span", span),
+                                            ("e", e), ("cl_alpha", cl_alpha),
+                                            ("cl_delta", cl_delta)))
+    if what not in ("rolling moment", "lift"):
+        raise ValueError(f"what must be 'rolling moment' or 'lift', got {what!r}")
+    return vals + (float(cm_delta),)
+
+
+def strip_theory_effectiveness(q, gj: float, chord: float, span: float, e: float,
+                               cl_alpha: float, cl_delta: float, cm_delta: float,
+                               what: str = "rolling moment") -> np.ndarray:
+    """Closed-form (strip-theory) flexible-to-rigid effectiveness of a full-span control
+    surface on a uniform straight wing clamped at y = 0, the surface held at its deflection
+    (Bisplinghoff, Ashley & Halfman, *Aeroelasticity*, 1955, Sec. 8-4; Hodges & Pierce,
+    *Introduction to Structural Dynamics and Aeroelasticity*, 2002, Sec. 3.4, whose typical
+    section is the rigid-in-span limit).
+
+    Derivation (written out here). With the twist theta(y) (nose up), the section lift and
+    moment about the elastic axis are L' = q c (a theta + c_l,delta delta) and
+    M' = e c L' + q c^2 c_m,delta delta; torsional equilibrium GJ theta'' + M' = 0 with
+    theta(0) = 0, theta'(l) = 0 gives, with lambda^2 = q c^2 e a / GJ and
+    theta_p = -(e c_l,delta + c_m,delta) delta / (e a),
+
+        theta(y) = theta_p (1 - cos(lambda y) - tan(lambda l) sin(lambda y)),
+
+    and the flexible over rigid lift and rolling moment (about y = 0), L = lambda l,
+
+        ratio = 1 - (e c_l,delta + c_m,delta) / (e c_l,delta) (1 - g(L)),
+        g = tan(L) / L  (lift),   g = 2 (1 - cos L) / (L^2 cos L)  (rolling moment).
+
+    Divergence is at L = pi/2, q_D = pi^2 GJ / (4 c^2 e a l^2).
+
+    Parameters
+    ----------
+    q : dynamic pressure(s) (Pa, >= 0, below q_D).
+    gj : torsional stiffness (N m^2, > 0).
+    chord, span : c and l (m, > 0).
+    e : distance of the elastic axis behind the aerodynamic centre, in chords (> 0).
+    cl_alpha, cl_delta : section lift slopes (per rad, > 0).
+    cm_delta : section moment slope about the aerodynamic centre (per rad, nose up positive;
+        < 0 for a trailing-edge flap).
+    what : "rolling moment" (about y = 0) or "lift".
+
+    Returns
+    -------
+    ndarray : the ratio at each q (nan at and above divergence).
+
+    Examples
+    --------
+    A flat plate (elastic axis at mid-chord, e = 0.25) with a 25 % flap gains effectiveness:
+
+    >>> r = strip_theory_effectiveness([0.0, 1000.0], 100.0, 0.1, 2.0, 0.25, 2 * math.pi,
+    ...                                3.826, -0.6495)
+    >>> [round(float(v), 3) for v in r]
+    [1.0, 1.113]
+    """
+    gj, c, ln, e, a, cl_d, cm_d = _strip_inputs(gj, chord, span, e, cl_alpha, cl_delta,
+                                                cm_delta, what)
+    qs = np.atleast_1d(np.asarray(q, float))
+    if qs.size == 0 or not np.all(np.isfinite(qs)) or np.any(qs < 0):
+        raise ValueError(f"q must be finite dynamic pressures >= 0 (Pa), got {q}")
+    lam = ln * c * np.sqrt(qs * e * a / gj)
+    g = np.array([_strip_g(what, x) if x < 0.5 * math.pi else math.nan for x in lam])
+    return 1.0 - (e * cl_d + cm_d) / (e * cl_d) * (1.0 - g)
+
+
+def strip_theory_reversal_q(gj: float, chord: float, span: float, e: float, cl_alpha: float,
+                            cl_delta: float, cm_delta: float,
+                            what: str = "rolling moment") -> float:
+    """Closed-form (strip-theory) reversal dynamic pressure of a uniform straight wing clamped
+    at y = 0 with a full-span control surface held at its deflection: the zero of
+    :func:`strip_theory_effectiveness` (same model and parameters), where
+    g(L) = c_m,delta / (e c_l,delta + c_m,delta) with L = lambda l in (0, pi/2), so that
+    q_R = L^2 GJ / (c^2 e a l^2). A root exists only when e c_l,delta + c_m,delta < 0 (the
+    deflection's lift acts behind the elastic axis).
+
+    Returns
+    -------
+    float : q_R (Pa), nan when the surface does not reverse below divergence.
+
+    Examples
+    --------
+    A 25 % flap (thin-airfoil slopes), the elastic axis 5 % of the chord behind the quarter
+    chord, GJ = 100 N m^2, c = 0.1 m, l = 2 m:
+
+    >>> round(strip_theory_reversal_q(100.0, 0.1, 2.0, 0.05, 2 * math.pi, 3.826, -0.6495))
+    5667
+    >>> math.isnan(strip_theory_reversal_q(100.0, 0.1, 2.0, 0.25, 2 * math.pi, 3.826, -0.6495))
+    True
+    """
+    gj, c, ln, e, a, cl_d, cm_d = _strip_inputs(gj, chord, span, e, cl_alpha, cl_delta,
+                                                cm_delta, what)
+    s = e * cl_d + cm_d
+    if s >= 0.0 or cm_d / s <= 1.0:
+        return math.nan
+    r = cm_d / s
+    lam = brentq(lambda x: _strip_g(what, x) - r, 1e-6, 0.5 * math.pi - 1e-12, xtol=1e-14)
+    return lam * lam * gj / (c * c * e * a * ln * ln)

@@ -1502,3 +1502,83 @@ def control_surface_flutter(case: Case) -> tuple[ControlSurfaceFlutterRow, ...]:
                 float(m), c.altitude, c.density, None if f is None else float(f.speed),
                 None if f is None else float(f.frequency_hz), mode, bool(start)))
     return tuple(rows)
+
+
+# ---------------------------------------------------------------------------------------------
+# control surfaces: hinge moments over the envelope for servo sizing (issue 25)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class HingeLoadRow:
+    """The rigid hinge moments of one control surface at one flight point: ``mach``,
+    ``altitude`` (m, None for a density-only condition), ``density`` (kg/m^3), ``speed_ms``
+    (m/s), ``dynamic_pressure`` (Pa), ``hinge_moment_per_delta`` and
+    ``hinge_moment_per_alpha`` (N m/rad, H = q S_f c_f C_h; the actuator holding the surface
+    applies -H), ``basis`` "envelope" or "sweep top"."""
+
+    name: str
+    mach: float
+    altitude: float | None
+    density: float
+    speed_ms: float
+    dynamic_pressure: float
+    hinge_moment_per_delta: float
+    hinge_moment_per_alpha: float
+    basis: str
+
+
+def _hinge_load_points(case: Case) -> list[tuple[float, float | None, float, float, str]]:
+    """(Mach, altitude, density, speed, basis) of the hinge-load points: with
+    ``[flight.envelope]`` its Mach ends and the ``aero.machs`` inside it, at its altitude ends
+    (else the case's altitudes), U = M a(h); without, every ``aero.machs`` at every flight
+    condition at the top of the velocity sweep. Machs >= 1 are left out (vortex lattice)."""
+    from asekit.atmosphere import standard_atmosphere
+
+    env_m, env_h = case.flight.envelope_mach, case.flight.envelope_altitude
+    conds = flight_conditions(case)
+    if env_m is not None:
+        machs = sorted({*env_m, *(m for m in case.aero.machs if env_m[0] <= m <= env_m[1])})
+        alts = sorted(set(env_h)) if env_h is not None else sorted(
+            {c.altitude for c in conds if c.altitude is not None})
+        if alts:
+            out = []
+            for h in alts:
+                atm = standard_atmosphere(h)
+                out += [(float(m), float(h), float(atm.density), float(m * atm.speed_of_sound),
+                         "envelope") for m in machs if m < 1.0]
+            return out
+    u = float(max(case.flight.velocities))
+    return [(float(m), c.altitude, float(c.density), u, "sweep top")
+            for m in case.aero.machs if m < 1.0 for c in conds]
+
+
+@_memo_with_warnings
+@_door("the hinge moments over the envelope (vortex lattice)", _CONTROL)
+def control_surface_hinge_loads(case: Case) -> tuple[HingeLoadRow, ...]:
+    """Rigid hinge moments of every control surface per unit deflection and per unit
+    incidence over the flight envelope, for servo (actuator) sizing:
+    H = q S_f c_f C_h (:func:`asekit.aero.control_surface.dimensional_hinge_moments`) with
+    C_h from the vortex lattice at each point's Mach
+    (:func:`asekit.aero.control_surface.steady_control_derivatives`, the wall's image when
+    ``aero.symmetry = "wall"``) and q = rho U^2 / 2 at the points of
+    :func:`_hinge_load_points` (the envelope's corners and the analysed Machs inside it, or
+    the top of the velocity sweep without an envelope).
+
+    Returns
+    -------
+    tuple of HingeLoadRow
+        Point by point (altitude, then Mach), surface by surface. Memoised on the case.
+    """
+    from asekit.aero.control_surface import dimensional_hinge_moments, steady_control_derivatives
+
+    hm = control_surface_mesh(case)
+    wall = case.aero.symmetry == "wall"
+    derivs = {}
+    rows = []
+    for m, h, rho, u, basis in _hinge_load_points(case):
+        if m not in derivs:
+            derivs[m] = steady_control_derivatives(hm, m, symmetric=wall)
+        q = 0.5 * rho * u * u
+        h_d, h_a = dimensional_hinge_moments(hm, derivs[m], q)
+        rows += [HingeLoadRow(s.name, m, h, rho, u, q, float(h_d[i]), float(h_a[i]), basis)
+                 for i, s in enumerate(hm.surfaces)]
+    return tuple(rows)

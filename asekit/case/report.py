@@ -63,6 +63,16 @@ UNITS = {
                 "rms_ (turbulence rows) shear_N in N, bending_Nm and torsion_Nm in N m "
                 "(torsion nose up > 0)}",
     "peak_hinge_moment_Nm": "N m (largest |T_hinge@fin|, signed; actuator clamped)",
+    "dynamic_pressure_pa": "Pa",
+    "hinge_moment_per_delta_Nm_per_rad": "N m/rad (H = q S_f c_f C_h_delta, trailing edge down "
+                                         "> 0; the actuator applies -H)",
+    "hinge_moment_per_alpha_Nm_per_rad": "N m/rad (H = q S_f c_f C_h_alpha)",
+    "max_abs_hinge_moment_per_delta_Nm_per_rad": "N m/rad (largest |H_delta| over the points, "
+                                                 "signed)",
+    "max_abs_hinge_moment_per_alpha_Nm_per_rad": "N m/rad (largest |H_alpha| over the points, "
+                                                 "signed)",
+    "basis": "'envelope' (the envelope's corners and Machs, U = M a(h)) or 'sweep top' (the "
+             "top of the velocity sweep)",
     "peak_root_bending_Nm": "N m (largest |root bending moment|, signed; tip up > 0)",
     "peak_root_shear_N": "N (largest |root shear|, signed; up > 0)",
     "peak_current_A": "A (motor current of the linear AEM1 loop, no power limits; null "
@@ -99,6 +109,7 @@ class Analysis:
     gust: object = None
     control: tuple = ()
     control_flutter: tuple = ()
+    control_hinge: tuple = ()
 
 
 @contextlib.contextmanager
@@ -152,10 +163,14 @@ def run_analysis(case: Case, progress: bool = False) -> Analysis:
         with _stage("flutter with the hinge degrees of freedom", progress):
             control_flutter = P.control_surface_flutter(case)
         sec["control_surface_flutter"] = time.perf_counter() - t
+        t = time.perf_counter()
+        with _stage("hinge moments over the envelope", progress):
+            control_hinge = P.control_surface_hinge_loads(case)
+        sec["control_surface_hinge_loads"] = time.perf_counter() - t
     else:
-        control_flutter = ()
+        control_flutter = control_hinge = ()
     return Analysis(case, modal, db, fa, ase, sec, gust=gust, control=control,
-                    control_flutter=control_flutter)
+                    control_flutter=control_flutter, control_hinge=control_hinge)
 
 
 def _f(v):
@@ -227,6 +242,7 @@ def summary(a: Analysis) -> dict:
              "speed_ms": _f(r.speed_ms), "frequency_hz": _f(r.frequency_hz), "mode": r.mode,
              "unstable_at_first_point": r.unstable_at_first_point}
             for r in a.control_flutter]
+        out.update(hinge_load_json(getattr(a, "control_hinge", ())))
     out["critical"] = critical_condition(out)
     return out
 
@@ -441,6 +457,50 @@ def _control_flutter_lines(rows) -> list[str]:
     return out
 
 
+def hinge_load_json(rows) -> dict:
+    """The hinge-moment keys of the analysis JSON (issue 25, servo sizing) from
+    :func:`asekit.case.pipeline.control_surface_hinge_loads` rows:
+    ``control_surface_hinge_moments`` (one row per surface and point) and
+    ``control_surface_servo_sizing`` (per surface, the largest |H_delta| and |H_alpha| over
+    the points, signed, and where). Empty without rows."""
+    if not rows:
+        return {}
+    pts = [{"name": r.name, "mach": r.mach, "altitude_m": r.altitude, "density": r.density,
+            "speed_ms": r.speed_ms, "dynamic_pressure_pa": r.dynamic_pressure,
+            "hinge_moment_per_delta_Nm_per_rad": r.hinge_moment_per_delta,
+            "hinge_moment_per_alpha_Nm_per_rad": r.hinge_moment_per_alpha, "basis": r.basis}
+           for r in rows]
+    sizing = []
+    for name in dict.fromkeys(r.name for r in rows):
+        mine = [r for r in rows if r.name == name]
+        wd = max(mine, key=lambda r: abs(r.hinge_moment_per_delta))
+        wa = max(mine, key=lambda r: abs(r.hinge_moment_per_alpha))
+        sizing.append({"name": name, "basis": wd.basis,
+                       "max_abs_hinge_moment_per_delta_Nm_per_rad": wd.hinge_moment_per_delta,
+                       "mach": wd.mach, "altitude_m": wd.altitude,
+                       "dynamic_pressure_pa": wd.dynamic_pressure,
+                       "max_abs_hinge_moment_per_alpha_Nm_per_rad": wa.hinge_moment_per_alpha})
+    return {"control_surface_hinge_moments": pts, "control_surface_servo_sizing": sizing}
+
+
+def _hinge_load_lines(rows) -> list[str]:
+    """The servo-sizing block of the summary: per surface the largest hinge moments per degree
+    of deflection and of incidence over the envelope (or the sweep's top)."""
+    if not rows:
+        return []
+    out = ["", "hinge moments for servo sizing (rigid; largest over the envelope, N m per deg)",
+           f"{'surface':>10} {'H/delta':>9} {'H/alpha':>9} {'Mach':>6} {'alt m':>7} "
+           f"{'q Pa':>9}  basis"]
+    deg = math.pi / 180.0
+    for r in rows:
+        alt = "-" if r["altitude_m"] is None else f"{r['altitude_m']:.0f}"
+        out.append(f"{r['name'][:10]:>10} "
+                   f"{r['max_abs_hinge_moment_per_delta_Nm_per_rad'] * deg:>9.4g} "
+                   f"{r['max_abs_hinge_moment_per_alpha_Nm_per_rad'] * deg:>9.4g} "
+                   f"{r['mach']:>6.3g} {alt:>7} {r['dynamic_pressure_pa']:>9.4g}  {r['basis']}")
+    return out
+
+
 def format_summary(s: dict, width: int = 100) -> str:
     """A plain-text summary of :func:`summary` that fits ``width`` columns."""
     lines = textwrap.wrap(f"case {s['case']}" + (f"  ({s['reference']})" if s.get("reference")
@@ -501,6 +561,7 @@ def format_summary(s: dict, width: int = 100) -> str:
     lines += _gust_lines(s.get("gust")) + _turbulence_lines(s.get("turbulence"))
     lines += _control_lines(s.get("control_surfaces", ()))
     lines += _control_flutter_lines(s.get("control_surface_flutter", ()))
+    lines += _hinge_load_lines(s.get("control_surface_servo_sizing", ()))
     for n in s["notes"]:
         lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")

@@ -549,6 +549,34 @@ def fig_control_effectiveness(a) -> ReportFigure:
     return ReportFigure(fig, alt, SECTIONS[5])
 
 
+def fig_control_hinge_moments(a) -> ReportFigure:
+    """Hinge moment per degree of deflection of each control surface at the envelope's points
+    (or the sweep's top) against dynamic pressure, one marker series per surface and Mach,
+    joined to the origin (a rigid surface's H = q S_f c_f C_h is linear in q at one Mach)."""
+    fig, ax = new_figure(f"{a.case.name}: hinge moments for servo sizing",
+                         figsize=(7.0, 4.4), layout="constrained")
+    deg = math.pi / 180.0
+    parts = []
+    for name in dict.fromkeys(r.name for r in a.control_hinge):
+        for m in dict.fromkeys(r.mach for r in a.control_hinge if r.name == name):
+            rows = sorted((r for r in a.control_hinge if r.name == name and r.mach == m),
+                          key=lambda r: r.dynamic_pressure)
+            q = [0.0] + [r.dynamic_pressure for r in rows]
+            h = [0.0] + [r.hinge_moment_per_delta * deg for r in rows]
+            ax.plot(q, h, marker="o", label=f"{name}, M {m:g}")
+        worst = max((r for r in a.control_hinge if r.name == name),
+                    key=lambda r: abs(r.hinge_moment_per_delta))
+        parts.append(f"{name}: largest {worst.hinge_moment_per_delta * deg:.4g} N m per deg at "
+                     f"M {worst.mach:g}, q {worst.dynamic_pressure:.4g} Pa")
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_xlabel("dynamic pressure (Pa)")
+    ax.set_ylabel("hinge moment per deflection (N m/deg)")
+    ax.legend()
+    alt = ("Rigid hinge moment per degree of control deflection against dynamic pressure at the "
+           "envelope's points; " + "; ".join(parts))
+    return ReportFigure(fig, alt, SECTIONS[5])
+
+
 def figures(a) -> dict:
     """{file name: :class:`ReportFigure`} of the report, in page order: the Mach figure, V-g /
     V-f and root locus at every analysed Mach, the planform and mode shapes, and with an
@@ -566,4 +594,6 @@ def figures(a) -> dict:
         out["gust_histories"] = fig_gust_histories(a)
     if getattr(a, "control", ()):
         out["control_effectiveness"] = fig_control_effectiveness(a)
+    if getattr(a, "control_hinge", ()):
+        out["control_hinge_moments"] = fig_control_hinge_moments(a)
     return out
