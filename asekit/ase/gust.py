@@ -111,3 +111,26 @@ def closed_loop_gust_response(loop: ClosedLoopGust, t, gust) -> dict:
     x = np.atleast_2d(x).reshape(tt.size, n)
     return {"current": x @ loop.current_row, "theta": x @ loop.theta_row,
             "hinge_moment": x @ loop.hinge_row + gu.T @ loop.hinge_gust}
+
+
+def closed_loop_gust_frequency_response(loop: ClosedLoopGust, omega) -> dict:
+    """Frequency responses of the loop per unit gust velocity (w_g = e^{i omega t} m/s, so
+    u_g = [1, i omega, -omega^2] w_g): ``current`` (A per m/s), ``theta`` (rad per m/s),
+    ``hinge_moment`` (N m per m/s), each (n_w,) complex, from
+    x = (i omega I - A)^-1 G u_g.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> loop = ClosedLoopGust(np.array([[-2.0]]), np.array([[4.0, 0.0, 0.0]]),
+    ...                       np.array([1.0]), np.array([0.0]), np.array([0.0]), np.zeros(3))
+    >>> complex(closed_loop_gust_frequency_response(loop, [0.0])["current"][0])   # 4 / 2
+    (2+0j)
+    """
+    w = finite_array("omega", omega).ravel()
+    n = loop.A.shape[0]
+    u = np.stack([np.ones_like(w), 1j * w, -w ** 2], axis=1).astype(complex)
+    x = np.stack([np.linalg.solve(1j * wi * np.eye(n) - loop.A, loop.G @ ui)
+                  for wi, ui in zip(w, u)])
+    return {"current": x @ loop.current_row, "theta": x @ loop.theta_row,
+            "hinge_moment": x @ loop.hinge_row + u @ loop.hinge_gust}

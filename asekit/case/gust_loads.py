@@ -50,10 +50,15 @@ from asekit.aeroelastic.gust import (
     gust_state_space,
     load_histories,
     one_minus_cosine,
+    response_covariance,
     spectral_statistics,
     turbulence_psd,
 )
-from asekit.ase.gust import closed_loop_gust, closed_loop_gust_response
+from asekit.ase.gust import (
+    closed_loop_gust,
+    closed_loop_gust_frequency_response,
+    closed_loop_gust_response,
+)
 from asekit.atmosphere import standard_atmosphere
 from asekit.case.pipeline import (
     actuator_setup,
@@ -331,7 +336,7 @@ def gust_loads(case: Case) -> GustLoads | None:
     errs = {"modal": float(rfa.fit_error), "gust": gfit.fit_error, "loads": lfit.fit_error}
     turb = None
     if g.turbulence_sigma is not None:
-        turb = _turbulence(ss, lfit, inert, modal.n_rigid, g, float(np.max(ks)) * U / b)
+        turb = _turbulence(ss, lfit, inert, modal.n_rigid, g, float(np.max(ks)) * U / b, loop)
     return GustLoads(g.mach, g.altitude, U, rho, g.design_velocity, x0, tuple(out), errs, turb)
 
 
@@ -340,21 +345,34 @@ def gust_loads(case: Case) -> GustLoads | None:
 TURBULENCE_POINTS = 4000
 
 
-def _turbulence(ss, lfit, inert, n_rigid, g, omega_max: float) -> dict:
-    """RMS, A-bar, N0 of the loads in continuous turbulence (module docstring)."""
+def _turbulence(ss, lfit, inert, n_rigid, g, omega_max: float, loop=None) -> dict:
+    """RMS, A-bar, N0 of the loads in continuous turbulence (module docstring); with the AEM1
+    ``loop`` the motor current's too. Also ``spectra`` ({"omega" rad/s, "psd" the gust's,
+    and per load its one-sided response PSD |H|^2 Phi per rad/s}) and ``covariance`` ({"names",
+    "matrix"}: the joint covariance of the hinge moment (when present) and the root bending,
+    :func:`asekit.aeroelastic.gust.response_covariance`, for the correlated-load ellipse)."""
     w0 = min(1e-3 * ss.velocity / g.scale_length, 1e-6 * omega_max)
     w = np.concatenate([[0.0], np.geomspace(w0, omega_max, TURBULENCE_POINTS)])
     fr = gust_frequency_response(ss, w, lfit, inert, n_rigid)
     psd = turbulence_psd(w, ss.velocity, g.scale_length, g.turbulence_sigma, g.spectrum)
     out = {"omega_max": omega_max}
+    H = {"root_bending": fr["loads"][:, 1]}
     if "hinge_moment" in fr:
+        H = {"hinge_moment": fr["hinge_moment"], **H}
         out["hinge_moment"] = spectral_statistics(w, fr["hinge_moment"], psd)
     out["root_shear"] = spectral_statistics(w, fr["loads"][:, 0], psd)
     out["root_bending"] = spectral_statistics(w, fr["loads"][:, 1], psd)
+    if loop is not None:
+        H["current"] = closed_loop_gust_frequency_response(loop, w)["current"]
+        out["current"] = spectral_statistics(w, H["current"], psd)
     out["stations"] = {
         st.name: {k: spectral_statistics(w, fr["loads"][:, 2 + 3 * i + j], psd)
                   for j, k in enumerate(("shear", "bending", "torsion"))}
         for i, st in enumerate(g.stations)}
+    out["spectra"] = {"omega": w, "psd": psd, **{k: np.abs(h) ** 2 * psd for k, h in H.items()}}
+    pair = [k for k in ("hinge_moment", "root_bending") if k in H]
+    out["covariance"] = {"names": tuple(pair), "matrix": response_covariance(
+        w, np.column_stack([H[k] for k in pair]), psd)}
     return out
 
 

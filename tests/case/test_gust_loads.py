@@ -222,3 +222,61 @@ def test_minimum_state_and_roger_fits_agree(fin_case):
     for key in ("peak_hinge_moment_Nm", "peak_root_bending_Nm", "peak_root_shear_N",
                 "peak_current_A"):
         assert rows[1][key] == pytest.approx(rows[0][key], rel=0.02), key
+
+
+# --- correlated loads and the report's turbulence figures (issue 27) -------------------------
+def test_correlated_load_ellipse_projections_are_the_rms_values(fin_gusts):
+    # Hoblit (Gust Loads on Aircraft, 1988, Ch. 7): the one-sigma equal-probability ellipse of
+    # two jointly Gaussian loads has its extreme projection on each axis equal to that load's
+    # RMS, and on any direction u equal to sqrt(u^T C u). The covariance's diagonal comes from
+    # the cross-spectra (response_covariance); the RMS values from spectral_statistics
+    # separately, so a wrong covariance (a missing 1/2, a conjugate on the wrong factor) fails.
+    from asekit.aeroelastic.gust import correlated_load_ellipse
+    _, res = fin_gusts
+    t = res.turbulence
+    assert t["covariance"]["names"] == ("hinge_moment", "root_bending")
+    C = t["covariance"]["matrix"]
+    e = correlated_load_ellipse(C, 20001)
+    assert np.max(np.abs(e[0])) == pytest.approx(t["hinge_moment"]["rms"], rel=1e-6)
+    assert np.max(np.abs(e[1])) == pytest.approx(t["root_bending"]["rms"], rel=1e-6)
+    rho = C[0, 1] / np.sqrt(C[0, 0] * C[1, 1])
+    assert -1 < rho < 1 and abs(rho) > 0.05              # correlated, not degenerate
+    for ang in np.linspace(0, np.pi, 7):
+        u = np.array([np.cos(ang), np.sin(ang)])
+        assert np.max(u @ e) == pytest.approx(np.sqrt(u @ C @ u), rel=1e-6)
+
+
+def test_turbulence_current_of_a_very_long_scale_holds_the_hinge_moment(fin_gusts):
+    # With L = 100 km the turbulence is quasi-static for the AEM1 loop (as the slow 1-cos gust
+    # above): the motor holds the hinge moment, K_t I N eta = -T_hinge, so the RMS current is the
+    # RMS hinge moment over K_t N eta (thesis Eqs. 2.30-2.37), within the same 3 %.
+    case, res = fin_gusts
+    act, _, _ = P.actuator_setup(case)
+    tr = act.transmission
+    t = res.turbulence
+    held = t["hinge_moment"]["rms"] / (tr.ratio * tr.efficiency * act.motor.torque_constant)
+    assert t["current"]["rms"] == pytest.approx(held, rel=0.03)
+    sp = t["spectra"]
+    from scipy.integrate import trapezoid
+    assert np.sqrt(trapezoid(sp["current"], sp["omega"])) == pytest.approx(
+        t["current"]["rms"], rel=1e-12)
+
+
+def test_turbulence_report_figures(fin_gusts):
+    import matplotlib.pyplot as plt
+
+    from asekit.case.report_figures import figures_of_gust
+    case, res = fin_gusts
+    a = type("A", (), {"case": case, "gust": res})()
+    figs = figures_of_gust(a)
+    assert list(figs) == ["gust_histories", "gust_psd", "gust_ellipse"]
+    psd, ell = figs["gust_psd"], figs["gust_ellipse"]
+    labels = [ax.get_ylabel() for ax in psd.figure.axes]
+    assert len(labels) == 3 and "(N m)^2/Hz" in labels[0] and "A^2/Hz" in labels[2]
+    assert psd.figure.axes[-1].get_xlabel() == "frequency (Hz)"
+    ax = ell.figure.axes[0]
+    assert ax.get_xlabel() == "hinge moment (N m)" and "(N m)" in ax.get_ylabel()
+    assert f"{res.turbulence['hinge_moment']['rms']:.3g}" in ell.alt
+    for f in figs.values():
+        assert f.section == "Gust loads" and f.figure._suptitle.get_text()
+        plt.close(f.figure)
