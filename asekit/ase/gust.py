@@ -24,7 +24,9 @@ voltage clip |V| <= I_lim R of thesis Eqs. 4.14-4.15 or a current regulator, the
 clip), a piecewise-affine loop propagated exactly (:class:`asekit.servo.piecewise.
 PiecewiseAffineLoop`) with the gust input held first-order (linear over each step, as
 scipy.signal.lsim's first-order hold) by an exosystem u' = du, du' = 0 appended to the state
-and reset at every step; without binding limits it is the linear response.
+and reset at every step; without binding limits it is the linear response. Up to the sample
+before the linear demand first comes within 5 % of a limit (:data:`NEAR_LIMIT`) the loop is
+linear and lsim's states are kept; the exact propagation starts there.
 """
 
 from __future__ import annotations
@@ -179,6 +181,30 @@ def closed_loop_gust_frequency_response(loop: ClosedLoopGust, omega) -> dict:
             "hinge_moment": x @ loop.hinge_row + u @ loop.hinge_gust}
 
 
+#: A limit counts as near when the linear demand comes within this fraction of the half-width
+#: of its band (lo, hi) at a sample: from the sample before, the loop is propagated exactly.
+NEAR_LIMIT = 0.05
+
+
+def _first_near_limit(pw, X, loop, t, gust):
+    """Fill X[:, :n] with the linear loop's states (lsim, first-order hold) and return the
+    first sample before the PD demand comes within NEAR_LIMIT of a bound (None if never)."""
+    from scipy.signal import lsim
+
+    n = loop.A.shape[0]
+    _, _, x = lsim((loop.A, loop.G, np.eye(n), np.zeros((n, 3))), gust.T, t, interp=True)
+    X[:, :n] = np.atleast_2d(x).reshape(t.size, n)
+    val = pw.values(X.T)
+    near = np.zeros(t.size, bool)
+    for lo, hi in ((1, 2), (3, 4)):
+        if lo in val:
+            m = NEAR_LIMIT * 0.5 * np.abs(val[hi] - val[lo])
+            near |= (val[0] < val[lo] + m) | (val[0] > val[hi] - m)
+    if not near.any():
+        return None
+    return max(int(np.argmax(near)) - 1, 0)
+
+
 def limited_gust_response(loop: ClosedLoopGust, actuator, limits, t, gust) -> dict:
     """Response from rest of the loop with the actuator's power limits to the gust inputs
     ``gust`` (3, n_t) at the uniformly spaced times ``t`` (s) (module docstring).
@@ -233,9 +259,16 @@ def limited_gust_response(loop: ClosedLoopGust, actuator, limits, t, gust) -> di
     h = float(steps[0])
     X = np.zeros((tt.size, n + 6))
     du = np.diff(gu, axis=1).T / h
-    x = np.zeros(n + 6)
+    X[:, n:n + 3] = gu.T
+    X[:-1, n + 3:] = du
+    j0 = _first_near_limit(pw, X, loop, tt, gu)
+    if j0 is None:                                  # no limit comes near: the linear loop
+        volt = X @ demand
+        return {"current": X[:, :n] @ loop.current_row, "voltage": volt, "demand": volt,
+                "theta": X[:, :n] @ loop.theta_row, "saturated": False}
+    x = X[j0].copy()
     saturated = False
-    for j in range(tt.size - 1):
+    for j in range(j0, tt.size - 1):
         x = np.concatenate([x[:n], gu[:, j], du[j]])
         X[j] = x
         a = pw.active(x)
