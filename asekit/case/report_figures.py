@@ -576,8 +576,8 @@ def fig_gust_ellipse(a) -> ReportFigure:
     e = correlated_load_ellipse(cov)
     fig, ax = new_figure(f"{a.case.name}: correlated loads, M {g.mach:g}, {g.altitude:g} m",
                          figsize=(7.0, 5.4), layout="constrained")
-    ax.plot(e[0], e[1], "k", label=f"turbulence, 1 sigma (rho {rho:.2f})")
-    ax.plot([sx, -sx, rho * sx, -rho * sx], [rho * sy, -rho * sy, sy, -sy], "ko", ms=4)
+    ax.plot(e[0], e[1], "k", lw=2.0, zorder=5, label=f"turbulence, 1 sigma (rho {rho:.2f})")
+    ax.plot([sx, -sx, rho * sx, -rho * sx], [rho * sy, -rho * sy, sy, -sy], "ko", ms=4, zorder=6)
     for c in g.cases:
         line, = ax.plot(c.hinge_moment, c.root_bending, lw=0.8, alpha=0.7,
                         label=f"1-cos {_gust_label(c)}")
