@@ -415,7 +415,9 @@ def turbulence_json(result: GustLoads | None) -> list:
     ``altitude_m``, ``rms_hinge_moment_Nm``, ``A_bar_hinge`` (N m per m/s), ``N0_per_s`` (of
     the hinge moment; null without a rigid mode), ``rms_root_bending_Nm``,
     ``A_bar_root_bending`` (N m per m/s), ``N0_root_bending_per_s``, ``sigma_ms``,
-    ``scale_length_m``, ``spectrum``, ``omega_max`` (rad/s), ``stations`` ({name:
+    ``scale_length_m``, ``spectrum``, ``omega_max`` (rad/s), ``rms_current_A`` (the linear
+    AEM1 loop's motor current; null without an actuator or when that loop is unstable),
+    ``stations`` ({name:
     {"rms_shear_N", "rms_bending_Nm", "rms_torsion_Nm"}} at the ``[[gust.station]]`` cuts)."""
     if result is None or result.turbulence is None:
         return []
@@ -428,6 +430,7 @@ def turbulence_json(result: GustLoads | None) -> list:
          "N0_per_s": None if h is None else h["N0_per_s"],
          "rms_root_bending_Nm": bend["rms"], "A_bar_root_bending": bend["A_bar"],
          "N0_root_bending_per_s": bend["N0_per_s"], "omega_max": t["omega_max"],
+         "rms_current_A": t["current"]["rms"] if "current" in t else None,
          "stations": {n: {"rms_shear_N": v["shear"]["rms"], "rms_bending_Nm": v["bending"]["rms"],
                           "rms_torsion_Nm": v["torsion"]["rms"]}
                       for n, v in t.get("stations", {}).items()}}

@@ -79,6 +79,7 @@ UNITS = {
     "peak_current_aem2_A": "A (the linear AEM2 loop, fin-root feedback; null where unstable)",
     "peak_current_aem2_limited_A": "A (the power-limited AEM2 loop; null where unstable)",
     "saturated_aem2": "bool (a power limit bound in the AEM2 loop; null where unstable)",
+    "rms_current_A": "A (RMS motor current of the linear AEM1 loop in continuous turbulence)",
     "rms_hinge_moment_Nm": "N m (RMS in continuous turbulence)",
     "A_bar_hinge": "N m per m/s (RMS hinge moment / RMS gust velocity)",
     "N0_per_s": "1/s (zero up-crossings of the hinge moment per second)",

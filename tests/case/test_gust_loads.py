@@ -259,6 +259,7 @@ def test_turbulence_current_of_a_very_long_scale_holds_the_hinge_moment(fin_gust
     t = res.turbulence
     held = t["hinge_moment"]["rms"] / (tr.ratio * tr.efficiency * act.motor.torque_constant)
     assert t["current"]["rms"] == pytest.approx(held, rel=0.03)
+    assert turbulence_json(res)[0]["rms_current_A"] == t["current"]["rms"]
     sp = t["spectra"]
     from scipy.integrate import trapezoid
     assert np.sqrt(trapezoid(sp["current"], sp["omega"])) == pytest.approx(
