@@ -497,7 +497,9 @@ def _gust_label(c) -> str:
 
 def fig_gust_histories(a) -> ReportFigure:
     """Hinge moment, root bending moment and (with an actuator) motor current against time in
-    each 1-cos gust of ``[gust]`` and its ``profile`` (:mod:`asekit.case.gust_loads`)."""
+    each 1-cos gust of ``[gust]`` and its ``profile`` (:mod:`asekit.case.gust_loads`), the
+    tuned gust (largest hinge moment) drawn thicker; in the current panel the actuator's
+    current limit (dotted) and, for a gust that saturates, the power-limited current (dashed)."""
     g = a.gust
     rows = [("root_bending", "root bending (N m)")]
     if g.cases[0].hinge_moment is not None:
@@ -509,9 +511,27 @@ def fig_gust_histories(a) -> ReportFigure:
                            figsize=(7.0, 2.2 * len(rows) + 0.8), layout="constrained",
                            sharex=True)
     axes = np.atleast_1d(axes)
+    tuned_h = g.tuned("hinge_moment") if g.cases[0].hinge_moment is not None else None
     for c in g.cases:
+        lines = {}
         for ax, (name, _) in zip(axes, rows):
-            ax.plot(c.t * 1e3, getattr(c, name), label=_gust_label(c))
+            lab = _gust_label(c) + (" (tuned)" if c is tuned_h else "")
+            lines[name], = ax.plot(c.t * 1e3, getattr(c, name), label=lab,
+                                   lw=2.0 if c is tuned_h else 1.2)
+        lim = c.servo.get("AEM1", {})
+        if "current" in lines and lim.get("saturated"):
+            axes[-1].plot(c.t * 1e3, lim["current_limited"], "--",
+                          color=lines["current"].get_color(), lw=1.0)
+    sat = [c for c in g.cases if c.servo.get("AEM1", {}).get("saturated")]
+    if g.cases[0].current is not None:
+        _, _, plim = P.actuator_setup(a.case)
+        peak = max(abs(c.peak_current) for c in g.cases)
+        i_lim = plim.current_limit
+        if i_lim is not None and (sat or peak > 0.5 * i_lim):
+            for sgn in (1, -1):
+                axes[-1].axhline(sgn * i_lim, color="k", ls=":", lw=0.8)
+            top = 1.3 * max(peak, i_lim)      # a runaway limited current stays off-scale
+            axes[-1].set_ylim(-top, top)
     for ax, (_, label) in zip(axes, rows):
         ax.set_ylabel(label)
     axes[-1].set_xlabel("time (ms)")
@@ -523,6 +543,10 @@ def fig_gust_histories(a) -> ReportFigure:
     if tuned.peak_hinge_moment is not None:
         h = g.tuned("hinge_moment")
         alt += f"; the largest hinge moment {h.peak_hinge_moment:.3g} N m in {_gust_label(h)}"
+    if g.cases[0].current is not None and "AEM1" in g.cases[0].servo:
+        alt += ("; the power-limited AEM1 loop saturates in " + ", ".join(
+            _gust_label(c) for c in sat) if sat else
+            "; the AEM1 loop stays within the actuator's power limits")
     return ReportFigure(fig, alt, SECTIONS[4])
 
 

@@ -193,6 +193,7 @@ def test_report_figure(fin_gusts):
     a = type("A", (), {"case": case, "gust": res})()
     f = fig_gust_histories(a)
     assert len(f.figure.axes) == 3 and "largest hinge moment" in f.alt
+    assert "stays within the actuator's power limits" in f.alt
     assert f.section == "Gust loads"
     plt.close(f.figure)
 
@@ -319,7 +320,8 @@ def test_tight_current_limit_bounds_the_gust_voltage(fin_case):
     i_lim = 0.5 * abs(short["peak_current_A"])
     act = dataclasses.replace(fin_case.actuator, current_limit=i_lim)
     case = dataclasses.replace(base, actuator=act)
-    rows = gust_json(gust_loads(case))
+    res = gust_loads(case)
+    rows = gust_json(res)
     a, _, lim = P.actuator_setup(case)
     for r in rows:
         assert r["saturated"] is True
@@ -328,3 +330,12 @@ def test_tight_current_limit_bounds_the_gust_voltage(fin_case):
     assert abs(r0["peak_current_limited_A"]) < abs(r0["peak_current_A"])
     assert abs(r0["peak_deflection_limited_deg"]) < 15.0
     assert abs(r1["peak_current_A"]) > 1.4 * i_lim and abs(r1["peak_deflection_limited_deg"]) > 15
+    # the report's histories mark the limit and the limited current, and say which gusts saturate
+    import matplotlib.pyplot as plt
+
+    from asekit.case.report_figures import fig_gust_histories
+    f = fig_gust_histories(type("A", (), {"case": case, "gust": res})())
+    assert "saturates in H = 0.3 m, H = 40 m" in f.alt
+    lo, hi = f.figure.axes[-1].get_ylim()
+    assert hi == pytest.approx(1.3 * abs(r0["peak_current_A"]))     # the runaway off-scale
+    plt.close(f.figure)
