@@ -498,7 +498,7 @@ def _gust_label(c) -> str:
 def fig_gust_histories(a) -> ReportFigure:
     """Hinge moment, root bending moment and (with an actuator) motor current against time in
     each 1-cos gust of ``[gust]`` and its ``profile`` (:mod:`asekit.case.gust_loads`), the
-    tuned gust (largest hinge moment) drawn thicker; in the current panel the actuator's
+    tuned gust (largest hinge moment, named in the alt text) drawn thicker; in the current panel the actuator's
     current limit (dotted) and, for a gust that saturates, the power-limited current (dashed)."""
     g = a.gust
     rows = [("root_bending", "root bending (N m)")]
@@ -515,8 +515,7 @@ def fig_gust_histories(a) -> ReportFigure:
     for c in g.cases:
         lines = {}
         for ax, (name, _) in zip(axes, rows):
-            lab = _gust_label(c) + (" (tuned)" if c is tuned_h else "")
-            lines[name], = ax.plot(c.t * 1e3, getattr(c, name), label=lab,
+            lines[name], = ax.plot(c.t * 1e3, getattr(c, name), label=_gust_label(c),
                                    lw=2.0 if c is tuned_h else 1.2)
         lim = c.servo.get("AEM1", {})
         if "current" in lines and lim.get("saturated"):
