@@ -536,3 +536,89 @@ def dryden_realisation(t, velocity: float, scale_length: float, sigma: float,
     w = lfilter(np.ravel(numd), dend, noise)
     wd = np.gradient(w, dt)
     return np.vstack([w, wd, np.gradient(wd, dt)])
+
+
+# ---------------------------------------------------------------------------------------------
+# correlated loads in continuous turbulence
+# ---------------------------------------------------------------------------------------------
+def response_covariance(omega, transfers, psd) -> np.ndarray:
+    """Joint covariance of several responses to the same continuous turbulence (Hoblit,
+    *Gust Loads on Aircraft*, AIAA 1988, Ch. 7, correlated loads):
+
+        C_ij = int_0^inf Re(H_i(omega) conj(H_j(omega))) Phi(omega) d omega,
+
+    (the one-sided cross-spectrum's real part; its diagonal is sigma_i^2 of
+    :func:`spectral_statistics`), by the trapezoidal rule over ``omega``.
+
+    Parameters
+    ----------
+    omega : (n_w,) ascending rad/s; transfers : (n_w, m) responses per unit gust velocity;
+    psd : (n_w,) one-sided gust PSD ((m/s)^2 / (rad/s)).
+
+    Returns
+    -------
+    (m, m) symmetric covariance (products of the responses' units).
+
+    Examples
+    --------
+    >>> w = np.linspace(0, 1, 1001)
+    >>> H = np.column_stack([np.ones(w.size), 2j * np.ones(w.size)])   # 90 deg apart
+    >>> np.round(response_covariance(w, H, np.ones(w.size)), 12) + 0.0
+    array([[1., 0.],
+           [0., 4.]])
+    """
+    from scipy.integrate import trapezoid
+
+    w = finite_array("omega", omega).ravel()
+    H = np.asarray(transfers)
+    H = H.reshape(w.size, -1) if H.ndim == 1 else H
+    p = finite_array("psd", psd).ravel()
+    if H.shape[0] != w.size or p.size != w.size or w.size < 2 or np.any(np.diff(w) <= 0):
+        raise ValueError("omega, transfers (n_w, m) and psd must have the same length n_w >= "
+                         "2, omega strictly ascending")
+    cross = np.einsum("wi,wj->wij", H, np.conj(H)).real * p[:, None, None]
+    C = trapezoid(cross, w, axis=0)
+    return 0.5 * (C + C.T)
+
+
+def correlated_load_ellipse(covariance, n_points: int = 361, scale: float = 1.0
+                            ) -> np.ndarray:
+    """The equal-probability ellipse of two jointly Gaussian loads (Hoblit 1988, Ch. 7: the
+    design-load ellipse of the correlated-load method), x^T C^-1 x = scale^2:
+
+        x(t) = scale sigma_x cos t,
+        y(t) = scale sigma_y (rho cos t + sqrt(1 - rho^2) sin t),   0 <= t <= 2 pi,
+
+    rho = C_xy / (sigma_x sigma_y). Its extreme projection on x is scale sigma_x (at
+    y = rho scale sigma_y) and on y scale sigma_y (at x = rho scale sigma_x); on any direction
+    u it is scale sqrt(u^T C u).
+
+    Parameters
+    ----------
+    covariance : (2, 2) covariance (:func:`response_covariance`), positive semi-definite;
+    n_points : points on the closed curve (>= 4); scale : the ellipse's level in sigmas (> 0).
+
+    Returns
+    -------
+    (2, n_points) x and y, the first point repeated at the end.
+
+    Examples
+    --------
+    >>> e = correlated_load_ellipse([[4.0, 3.0], [3.0, 9.0]], 721)
+    >>> round(float(e[0].max()), 6), round(float(e[1].max()), 6)     # sigma_x, sigma_y
+    (2.0, 3.0)
+    """
+    C = finite_array("covariance", covariance)
+    if C.shape != (2, 2):
+        raise ValueError(f"covariance must be (2, 2), got {C.shape}")
+    if int(n_points) < 4:
+        raise ValueError(f"n_points must be >= 4, got {n_points}")
+    s = positive("scale", scale)
+    sx, sy = math.sqrt(max(C[0, 0], 0.0)), math.sqrt(max(C[1, 1], 0.0))
+    if sx == 0 or sy == 0:
+        rho = 0.0
+    else:
+        rho = float(np.clip(0.5 * (C[0, 1] + C[1, 0]) / (sx * sy), -1.0, 1.0))
+    t = np.linspace(0.0, 2 * np.pi, int(n_points))
+    return s * np.vstack([sx * np.cos(t),
+                          sy * (rho * np.cos(t) + math.sqrt(1 - rho ** 2) * np.sin(t))])

@@ -29,10 +29,13 @@ row the air is at rest, after the last row the last velocity holds; the time ste
 1-cos gust of the profile's duration (features shorter than it are smoothed by the
 first-order hold).
 
-- motor current (A): with ``[actuator]``, the gust in the closed AEM1 loop (motor-angle
-  feedback, :mod:`asekit.ase.gust`), linear: without the voltage and current limits, so a peak
-  above ``actuator.current_limit`` says the actuator would saturate. None without an actuator
-  (or when that loop is unstable).
+- motor current (A) and voltage (V): with ``[actuator]``, the gust in the closed AEM1 loop
+  (motor-angle feedback) and the AEM2 loop (fin-root feedback) (:mod:`asekit.ase.gust`),
+  linear (without the voltage and current limits, so a peak above ``actuator.current_limit``
+  says the actuator would saturate) and with the actuator's supply and current limits (as
+  the servo chapter models them: the voltage clip |V| <= I_lim R, then the supply clip;
+  time domain, exact piecewise-affine propagation). None without an actuator or for a loop
+  that is unstable at the gust's condition.
 """
 
 from __future__ import annotations
@@ -50,10 +53,16 @@ from asekit.aeroelastic.gust import (
     gust_state_space,
     load_histories,
     one_minus_cosine,
+    response_covariance,
     spectral_statistics,
     turbulence_psd,
 )
-from asekit.ase.gust import closed_loop_gust, closed_loop_gust_response
+from asekit.ase.gust import (
+    closed_loop_gust,
+    closed_loop_gust_frequency_response,
+    closed_loop_gust_response,
+    limited_gust_response,
+)
 from asekit.atmosphere import standard_atmosphere
 from asekit.case.pipeline import (
     actuator_setup,
@@ -81,7 +90,10 @@ class GustLoadCase:
     histories ``hinge_moment`` (N m, None without a rigid mode), ``root_shear`` (N),
     ``root_bending`` (N m), ``current`` (A, the AEM1 loop's motor current; None without an
     actuator), with their peaks (largest magnitude, signed); ``stations``: {name: (3, n_t)
-    shear (N), bending (N m), torsion (N m)} at the ``[[gust.station]]`` cuts."""
+    shear (N), bending (N m), torsion (N m)} at the ``[[gust.station]]`` cuts; ``servo``:
+    {"AEM1", "AEM2": {"current", "voltage" (linear loop: A, V demand), "current_limited",
+    "voltage_limited", "theta_limited" (with the actuator's power limits: A, applied V), "saturated" (bool)}}
+    for each loop that is stable at the gust's condition (empty without an actuator)."""
 
     gradient_length: float | None
     t: np.ndarray
@@ -92,6 +104,7 @@ class GustLoadCase:
     current: np.ndarray | None = None
     profile: str | None = None
     stations: dict = field(default_factory=dict)
+    servo: dict = field(default_factory=dict)
 
     @staticmethod
     def _peak(y) -> float | None:
@@ -104,6 +117,12 @@ class GustLoadCase:
     @property
     def peak_current(self) -> float | None:
         return self._peak(self.current)
+
+    def servo_peak(self, topology: str, what: str):
+        """Peak (largest magnitude, signed) of ``servo[topology][what]``; the ``saturated``
+        flag as is; None when that loop was not run (no actuator, or unstable)."""
+        h = self.servo.get(topology, {}).get(what)
+        return h if what == "saturated" or h is None else self._peak(h)
 
     @property
     def peak_root_shear(self) -> float:
@@ -210,15 +229,33 @@ def _inertial_rows(case: Case, modal, y_root: float, cuts=(), span: float = 1.0)
     return -(M @ u.T).T @ phi
 
 
-def _current_loop(case: Case, g, rfa, ss):
-    """The AEM1 loop with the gust (:func:`asekit.ase.gust.closed_loop_gust`) at the gust's
-    condition, with the same fit as ``ss``; None without an actuator or if it is unstable."""
+def _servo_loops(case: Case, g, rfa, ss) -> dict:
+    """The AEM1 and AEM2 loops with the gust (:func:`asekit.ase.gust.closed_loop_gust`) at the
+    gust's condition, with the same fit as ``ss``, each with its actuator and power limits:
+    {topology: (loop, actuator, limits)} for the loops that are stable; empty without an
+    actuator."""
     if case.actuator is None:
-        return None
-    act, ctl, _ = actuator_setup(case)
+        return {}
+    act, ctl, lim = actuator_setup(case)
     cond = ase_condition(case, g.mach, g.altitude, actuator=act, fit=lambda *_: rfa)
-    loop = closed_loop_gust(cond.model, ctl, ss)
-    return loop if np.max(np.linalg.eigvals(loop.A).real) < 0 else None
+    out = {}
+    for topology in ("AEM1", "AEM2"):
+        loop = closed_loop_gust(cond.model, ctl, ss, topology)
+        if np.max(np.linalg.eigvals(loop.A).real) < 0:
+            out[topology] = (loop, cond.model.actuator, lim)
+    return out
+
+
+def _servo_histories(loops: dict, t, w) -> dict:
+    """Linear and power-limited current and voltage of each loop of :func:`_servo_loops`."""
+    out = {}
+    for topology, (loop, act, lim) in loops.items():
+        lin = closed_loop_gust_response(loop, t, w)
+        sat = limited_gust_response(loop, act, lim, t, w)
+        out[topology] = {"current": lin["current"], "voltage": lin["voltage"],
+                         "current_limited": sat["current"], "voltage_limited": sat["voltage"],
+                         "theta_limited": sat["theta"], "saturated": sat["saturated"]}
+    return out
 
 
 def _time_grid(t0: float, t1: float, settle: float, f_max: float) -> np.ndarray:
@@ -309,16 +346,18 @@ def gust_loads(case: Case) -> GustLoads | None:
                         f"Re pole {growth:.3g} 1/s: beyond flutter or divergence), so its gust "
                         f"loads are unbounded; choose a stable flight condition")
     inert = _inertial_rows(case, modal, y_root, cuts, span)
-    loop = _current_loop(case, g, rfa, ss)
+    loops = _servo_loops(case, g, rfa, ss)
+    loop = loops.get("AEM1", (None,))[0]
     f_max = float(np.max(modal.frequencies_hz))
 
     def run(t, w, H=None, name=None):
         resp = gust_response(ss, t, w)
         loads = load_histories(resp, lfit, inert, modal.n_rigid)
-        cur = None if loop is None else closed_loop_gust_response(loop, t, w)["current"]
+        servo = _servo_histories(loops, t, w)
+        cur = servo["AEM1"]["current"] if "AEM1" in servo else None
         st = {s.name: loads[:, 2 + 3 * i:5 + 3 * i].T for i, s in enumerate(g.stations)}
         return GustLoadCase(H, t, w[0], resp.hinge_moment if modal.n_rigid else None,
-                            loads[:, 0], loads[:, 1], cur, name, st)
+                            loads[:, 0], loads[:, 1], cur, name, st, servo)
 
     out = []
     for H in g.gradient_lengths:
@@ -331,7 +370,7 @@ def gust_loads(case: Case) -> GustLoads | None:
     errs = {"modal": float(rfa.fit_error), "gust": gfit.fit_error, "loads": lfit.fit_error}
     turb = None
     if g.turbulence_sigma is not None:
-        turb = _turbulence(ss, lfit, inert, modal.n_rigid, g, float(np.max(ks)) * U / b)
+        turb = _turbulence(ss, lfit, inert, modal.n_rigid, g, float(np.max(ks)) * U / b, loop)
     return GustLoads(g.mach, g.altitude, U, rho, g.design_velocity, x0, tuple(out), errs, turb)
 
 
@@ -340,21 +379,34 @@ def gust_loads(case: Case) -> GustLoads | None:
 TURBULENCE_POINTS = 4000
 
 
-def _turbulence(ss, lfit, inert, n_rigid, g, omega_max: float) -> dict:
-    """RMS, A-bar, N0 of the loads in continuous turbulence (module docstring)."""
+def _turbulence(ss, lfit, inert, n_rigid, g, omega_max: float, loop=None) -> dict:
+    """RMS, A-bar, N0 of the loads in continuous turbulence (module docstring); with the AEM1
+    ``loop`` the motor current's too. Also ``spectra`` ({"omega" rad/s, "psd" the gust's,
+    and per load its one-sided response PSD |H|^2 Phi per rad/s}) and ``covariance`` ({"names",
+    "matrix"}: the joint covariance of the hinge moment (when present) and the root bending,
+    :func:`asekit.aeroelastic.gust.response_covariance`, for the correlated-load ellipse)."""
     w0 = min(1e-3 * ss.velocity / g.scale_length, 1e-6 * omega_max)
     w = np.concatenate([[0.0], np.geomspace(w0, omega_max, TURBULENCE_POINTS)])
     fr = gust_frequency_response(ss, w, lfit, inert, n_rigid)
     psd = turbulence_psd(w, ss.velocity, g.scale_length, g.turbulence_sigma, g.spectrum)
     out = {"omega_max": omega_max}
+    H = {"root_bending": fr["loads"][:, 1]}
     if "hinge_moment" in fr:
+        H = {"hinge_moment": fr["hinge_moment"], **H}
         out["hinge_moment"] = spectral_statistics(w, fr["hinge_moment"], psd)
     out["root_shear"] = spectral_statistics(w, fr["loads"][:, 0], psd)
     out["root_bending"] = spectral_statistics(w, fr["loads"][:, 1], psd)
+    if loop is not None:
+        H["current"] = closed_loop_gust_frequency_response(loop, w)["current"]
+        out["current"] = spectral_statistics(w, H["current"], psd)
     out["stations"] = {
         st.name: {k: spectral_statistics(w, fr["loads"][:, 2 + 3 * i + j], psd)
                   for j, k in enumerate(("shear", "bending", "torsion"))}
         for i, st in enumerate(g.stations)}
+    out["spectra"] = {"omega": w, "psd": psd, **{k: np.abs(h) ** 2 * psd for k, h in H.items()}}
+    pair = [k for k in ("hinge_moment", "root_bending") if k in H]
+    out["covariance"] = {"names": tuple(pair), "matrix": response_covariance(
+        w, np.column_stack([H[k] for k in pair]), psd)}
     return out
 
 
@@ -363,7 +415,9 @@ def turbulence_json(result: GustLoads | None) -> list:
     ``altitude_m``, ``rms_hinge_moment_Nm``, ``A_bar_hinge`` (N m per m/s), ``N0_per_s`` (of
     the hinge moment; null without a rigid mode), ``rms_root_bending_Nm``,
     ``A_bar_root_bending`` (N m per m/s), ``N0_root_bending_per_s``, ``sigma_ms``,
-    ``scale_length_m``, ``spectrum``, ``omega_max`` (rad/s), ``stations`` ({name:
+    ``scale_length_m``, ``spectrum``, ``omega_max`` (rad/s), ``rms_current_A`` (the linear
+    AEM1 loop's motor current; null without an actuator or when that loop is unstable),
+    ``stations`` ({name:
     {"rms_shear_N", "rms_bending_Nm", "rms_torsion_Nm"}} at the ``[[gust.station]]`` cuts)."""
     if result is None or result.turbulence is None:
         return []
@@ -376,10 +430,15 @@ def turbulence_json(result: GustLoads | None) -> list:
          "N0_per_s": None if h is None else h["N0_per_s"],
          "rms_root_bending_Nm": bend["rms"], "A_bar_root_bending": bend["A_bar"],
          "N0_root_bending_per_s": bend["N0_per_s"], "omega_max": t["omega_max"],
+         "rms_current_A": t["current"]["rms"] if "current" in t else None,
          "stations": {n: {"rms_shear_N": v["shear"]["rms"], "rms_bending_Nm": v["bending"]["rms"],
                           "rms_torsion_Nm": v["torsion"]["rms"]}
                       for n, v in t.get("stations", {}).items()}}
     return [g]
+
+
+def _deg(v):
+    return None if v is None else math.degrees(v)
 
 
 def gust_json(result: GustLoads | None) -> list:
@@ -389,6 +448,11 @@ def gust_json(result: GustLoads | None) -> list:
     ``peak_hinge_moment_Nm``
     (null without a rigid mode), ``peak_root_bending_Nm``, ``peak_root_shear_N``,
     ``peak_current_A`` (the linear AEM1 loop's motor current; null without an actuator),
+    ``peak_voltage_V`` (its PD voltage demand), ``peak_current_limited_A`` and
+    ``peak_voltage_limited_V``, ``peak_deflection_limited_deg`` (the AEM1 loop with the actuator's supply and current limits,
+    :func:`asekit.ase.gust.limited_gust_response`; applied voltage), ``saturated`` (a limit
+    bound), ``peak_current_aem2_A``, ``peak_current_aem2_limited_A``, ``saturated_aem2`` (the
+    same for the AEM2 loop; null where a loop is unstable or there is no actuator),
     ``stations`` ({name: {"peak_shear_N", "peak_bending_Nm", "peak_torsion_Nm"}}, the
     ``[[gust.station]]`` cuts' peaks; empty without stations)."""
     if result is None:
@@ -399,4 +463,12 @@ def gust_json(result: GustLoads | None) -> list:
              "peak_root_bending_Nm": c.peak_root_bending,
              "peak_root_shear_N": c.peak_root_shear,
              "peak_current_A": c.peak_current, "profile": c.profile,
+             "peak_voltage_V": c.servo_peak("AEM1", "voltage"),
+             "peak_current_limited_A": c.servo_peak("AEM1", "current_limited"),
+             "peak_voltage_limited_V": c.servo_peak("AEM1", "voltage_limited"),
+             "peak_deflection_limited_deg": _deg(c.servo_peak("AEM1", "theta_limited")),
+             "saturated": c.servo_peak("AEM1", "saturated"),
+             "peak_current_aem2_A": c.servo_peak("AEM2", "current"),
+             "peak_current_aem2_limited_A": c.servo_peak("AEM2", "current_limited"),
+             "saturated_aem2": c.servo_peak("AEM2", "saturated"),
              "stations": c.station_peaks} for c in result.cases]

@@ -77,6 +77,19 @@ UNITS = {
     "peak_root_shear_N": "N (largest |root shear|, signed; up > 0)",
     "peak_current_A": "A (motor current of the linear AEM1 loop, no power limits; null "
                       "without an actuator)",
+    # gust rows: the servo loops (issue 27)
+    "peak_voltage_V": "V (PD voltage demand of the linear AEM1 loop)",
+    "peak_current_limited_A": "A (motor current of the AEM1 loop with the actuator's supply "
+                              "and current limits, time domain)",
+    "peak_voltage_limited_V": "V (applied motor voltage of the power-limited AEM1 loop)",
+    "peak_deflection_limited_deg": "deg (largest |transmission angle| of the power-limited "
+                                   "AEM1 loop; beyond the 15 deg stop the actuator cannot "
+                                   "hold the gust)",
+    "saturated": "bool (a power limit bound in the AEM1 loop)",
+    "peak_current_aem2_A": "A (the linear AEM2 loop, fin-root feedback; null where unstable)",
+    "peak_current_aem2_limited_A": "A (the power-limited AEM2 loop; null where unstable)",
+    "saturated_aem2": "bool (a power limit bound in the AEM2 loop; null where unstable)",
+    "rms_current_A": "A (RMS motor current of the linear AEM1 loop in continuous turbulence)",
     "rms_hinge_moment_Nm": "N m (RMS in continuous turbulence)",
     "A_bar_hinge": "N m per m/s (RMS hinge moment / RMS gust velocity)",
     "N0_per_s": "1/s (zero up-crossings of the hinge moment per second)",
@@ -387,14 +400,18 @@ def _gust_lines(rows) -> list:
     if not rows:
         return []
     lines = ["", f"1-cos gusts at M {rows[0]['mach']:g}, {rows[0]['altitude_m']:g} m (peaks; "
-             "loads with the actuator clamped, current in the AEM1 loop):",
-             "  H (m)   hinge moment (N m)   root bending (N m)   root shear (N)   current (A)"]
+             "loads with the actuator clamped, current in the AEM1 loop, linear and "
+             "power-limited):",
+             "  H (m)   hinge moment (N m)   root bending (N m)   root shear (N)   current (A)"
+             "   limited (A)"]
     for r in rows:
         h = f"{r['gust_length_m']:<7g}" if r["gust_length_m"] is not None else r["profile"]
+        sat = " saturated" if r.get("saturated") else ""
         lines.append(f"  {h} {_cell(r['peak_hinge_moment_Nm']):>18}   "
                      f"{_cell(r['peak_root_bending_Nm']):>18}   "
                      f"{_cell(r['peak_root_shear_N']):>14}   "
-                     f"{_cell(r['peak_current_A']):>11}")
+                     f"{_cell(r['peak_current_A']):>11}   "
+                     f"{_cell(r.get('peak_current_limited_A')):>11}{sat}")
     return lines + _station_lines(rows)
 
 

@@ -497,7 +497,9 @@ def _gust_label(c) -> str:
 
 def fig_gust_histories(a) -> ReportFigure:
     """Hinge moment, root bending moment and (with an actuator) motor current against time in
-    each 1-cos gust of ``[gust]`` and its ``profile`` (:mod:`asekit.case.gust_loads`)."""
+    each 1-cos gust of ``[gust]`` and its ``profile`` (:mod:`asekit.case.gust_loads`), the
+    tuned gust (largest hinge moment, named in the alt text) drawn thicker; in the current panel the actuator's
+    current limit (dotted) and, for a gust that saturates, the power-limited current (dashed)."""
     g = a.gust
     rows = [("root_bending", "root bending (N m)")]
     if g.cases[0].hinge_moment is not None:
@@ -509,9 +511,26 @@ def fig_gust_histories(a) -> ReportFigure:
                            figsize=(7.0, 2.2 * len(rows) + 0.8), layout="constrained",
                            sharex=True)
     axes = np.atleast_1d(axes)
+    tuned_h = g.tuned("hinge_moment") if g.cases[0].hinge_moment is not None else None
     for c in g.cases:
+        lines = {}
         for ax, (name, _) in zip(axes, rows):
-            ax.plot(c.t * 1e3, getattr(c, name), label=_gust_label(c))
+            lines[name], = ax.plot(c.t * 1e3, getattr(c, name), label=_gust_label(c),
+                                   lw=2.0 if c is tuned_h else 1.2)
+        lim = c.servo.get("AEM1", {})
+        if "current" in lines and lim.get("saturated"):
+            axes[-1].plot(c.t * 1e3, lim["current_limited"], "--",
+                          color=lines["current"].get_color(), lw=1.0)
+    sat = [c for c in g.cases if c.servo.get("AEM1", {}).get("saturated")]
+    if g.cases[0].current is not None:
+        _, _, plim = P.actuator_setup(a.case)
+        peak = max(abs(c.peak_current) for c in g.cases)
+        i_lim = plim.current_limit
+        if i_lim is not None and (sat or peak > 0.5 * i_lim):
+            for sgn in (1, -1):
+                axes[-1].axhline(sgn * i_lim, color="k", ls=":", lw=0.8)
+            top = 1.3 * max(peak, i_lim)      # a runaway limited current stays off-scale
+            axes[-1].set_ylim(-top, top)
     for ax, (_, label) in zip(axes, rows):
         ax.set_ylabel(label)
     axes[-1].set_xlabel("time (ms)")
@@ -523,7 +542,91 @@ def fig_gust_histories(a) -> ReportFigure:
     if tuned.peak_hinge_moment is not None:
         h = g.tuned("hinge_moment")
         alt += f"; the largest hinge moment {h.peak_hinge_moment:.3g} N m in {_gust_label(h)}"
+    if g.cases[0].current is not None and "AEM1" in g.cases[0].servo:
+        alt += ("; the power-limited AEM1 loop saturates in " + ", ".join(
+            _gust_label(c) for c in sat) if sat else
+            "; the AEM1 loop stays within the actuator's power limits")
     return ReportFigure(fig, alt, SECTIONS[4])
+
+
+#: The turbulence loads of the report's PSD figure: (key, axis label, unit of the PSD).
+_TURBULENCE_LOADS = (("hinge_moment", "hinge moment", "(N m)^2/Hz"),
+                     ("root_bending", "root bending", "(N m)^2/Hz"),
+                     ("current", "motor current (AEM1)", "A^2/Hz"))
+
+
+def fig_gust_psd(a) -> ReportFigure:
+    """One-sided PSDs (per Hz: 2 pi times the per-rad/s PSD) of the hinge moment, root
+    bending moment and (with an actuator) AEM1 motor current in the ``[gust.turbulence]``
+    spectrum, against frequency (Hz), with each load's RMS in the legend."""
+    g = a.gust
+    t = g.turbulence
+    sp = t["spectra"]
+    rows = [r for r in _TURBULENCE_LOADS if r[0] in sp]
+    f = sp["omega"][1:] / (2 * np.pi)
+    spec = a.case.gust.spectrum.replace("_", " ")
+    fig, axes = new_figure(f"{a.case.name}: {spec} turbulence, sigma_w "
+                           f"{a.case.gust.turbulence_sigma:g} m/s, L {a.case.gust.scale_length:g}"
+                           f" m, M {g.mach:g}, {g.altitude:g} m", nrows=len(rows),
+                           figsize=(7.0, 2.2 * len(rows) + 0.8), layout="constrained",
+                           sharex=True)
+    axes = np.atleast_1d(axes)
+    parts = []
+    for ax, (key, label, unit) in zip(axes, rows):
+        rms = t[key]["rms"]
+        ax.loglog(f, 2 * np.pi * sp[key][1:], label=f"RMS {rms:.3g}")
+        ax.set_ylabel(f"{label}\nPSD ({unit})")
+        ax.legend(fontsize="small")
+        parts.append(f"{label} RMS {rms:.3g}, N0 {t[key]['N0_per_s']:.3g}/s")
+    axes[-1].set_xlabel("frequency (Hz)")
+    alt = "Power spectral densities of the loads in continuous turbulence: " + "; ".join(parts)
+    return ReportFigure(fig, alt, SECTIONS[4])
+
+
+def fig_gust_ellipse(a) -> ReportFigure:
+    """Correlated loads, hinge moment against root bending moment: the equal-probability
+    ellipse (one sigma) of their joint covariance in turbulence
+    (:func:`asekit.aeroelastic.gust.correlated_load_ellipse`, Hoblit 1988 Ch. 7) with the
+    RMS values marked, and each 1-cos gust's path (hinge moment, root bending)(t) with its
+    peak hinge moment and peak root bending points overlaid. Needs a rigid pitch mode (the
+    hinge moment) and ``[gust.turbulence]``."""
+    from asekit.aeroelastic.gust import correlated_load_ellipse
+
+    g = a.gust
+    cov = g.turbulence["covariance"]["matrix"]
+    sx, sy = math.sqrt(cov[0, 0]), math.sqrt(cov[1, 1])
+    rho = cov[0, 1] / (sx * sy) if sx * sy > 0 else 0.0
+    e = correlated_load_ellipse(cov)
+    fig, ax = new_figure(f"{a.case.name}: correlated loads, M {g.mach:g}, {g.altitude:g} m",
+                         figsize=(7.0, 5.4), layout="constrained")
+    ax.plot(e[0], e[1], "k", lw=2.0, zorder=5, label=f"turbulence, 1 sigma (rho {rho:.2f})")
+    ax.plot([sx, -sx, rho * sx, -rho * sx], [rho * sy, -rho * sy, sy, -sy], "ko", ms=4, zorder=6)
+    for c in g.cases:
+        line, = ax.plot(c.hinge_moment, c.root_bending, lw=0.8, alpha=0.7,
+                        label=f"1-cos {_gust_label(c)}")
+        ih = int(np.argmax(np.abs(c.hinge_moment)))
+        ib = int(np.argmax(np.abs(c.root_bending)))
+        ax.plot(c.hinge_moment[[ih, ib]], c.root_bending[[ih, ib]], "s",
+                color=line.get_color(), ms=5)
+    ax.set_xlabel("hinge moment (N m)")
+    ax.set_ylabel("root bending moment (N m)")
+    ax.legend(fontsize="small")
+    alt = (f"Hinge moment against root bending moment: the one-sigma turbulence ellipse "
+           f"(RMS {sx:.3g} N m and {sy:.3g} N m, correlation {rho:.2f}) and the 1-cos gusts' "
+           f"load paths, their peak points marked")
+    return ReportFigure(fig, alt, SECTIONS[4])
+
+
+def figures_of_gust(a) -> dict:
+    """The report's gust figures: the 1-cos histories, and with ``[gust.turbulence]`` the
+    load PSDs and (with a hinge moment) the correlated-load ellipse."""
+    out = {"gust_histories": fig_gust_histories(a)}
+    t = a.gust.turbulence
+    if t is not None and "spectra" in t:
+        out["gust_psd"] = fig_gust_psd(a)
+        if t["covariance"]["names"][:1] == ("hinge_moment",):
+            out["gust_ellipse"] = fig_gust_ellipse(a)
+    return out
 
 
 def fig_control_effectiveness(a) -> ReportFigure:
@@ -591,7 +694,7 @@ def figures(a) -> dict:
         out["ase_bode"] = fig_ase_bode(a)
         out["ase_steps"] = fig_ase_steps(a)
     if getattr(a, "gust", None) is not None:
-        out["gust_histories"] = fig_gust_histories(a)
+        out.update(figures_of_gust(a))
     if getattr(a, "control", ()):
         out["control_effectiveness"] = fig_control_effectiveness(a)
     if getattr(a, "control_hinge", ()):

@@ -286,6 +286,14 @@ class TrajectoryRow:
         the point has no flutter, divergence or hinge-moment value.
     mach_extrapolated : bool
         The flutter speed is extrapolated (at most 0.05) beyond the analysed Machs.
+    deflection_rate_deg_s : float or None
+        The commanded deflection's rate (deg/s; :func:`deflection_rates`), None without an
+        actuator power demand.
+    motor_current_A, motor_voltage_V, actuator_power_W : float or None
+        The actuator's quasi-steady demand to drive the fin at that rate against the steady
+        hinge moment (:func:`asekit.servo.simulate.quasi_steady_demand`: the case's
+        ``[actuator]`` motor and transmission; P = V I, W); None without ``[actuator]`` or
+        without a hinge moment.
     note : str or None
         Why a value is missing, or a bound of the margin.
     """
@@ -302,6 +310,10 @@ class TrajectoryRow:
     transonic_gap: bool
     mach_extrapolated: bool = False
     note: str | None = None
+    deflection_rate_deg_s: float | None = None
+    motor_current_A: float | None = None
+    motor_voltage_V: float | None = None
+    actuator_power_W: float | None = None
 
     def to_json(self) -> dict:
         """The row as a JSON-ready dict (the names of the attributes)."""
@@ -485,8 +497,45 @@ def trajectory(case: Case, points, progress: bool = False) -> tuple[TrajectoryRo
     conds = {c.altitude: c for c in P.flight_conditions(tc)}
     tn = tn4197_inputs(case)
     rows = tuple(_row(tc, fa, db, modal, p, conds[p.altitude_m], tn) for p in points)
+    rows = _with_power(case, points, rows)
     _log.info("trajectory of %s: %d points at %d altitudes", case.name, len(points), len(alts))
     return rows
+
+
+def deflection_rates(points) -> np.ndarray:
+    """The commanded deflection's rate (deg/s) at each point: ``numpy.gradient`` of the
+    deflection (deg; a point without one counts 0, as the hinge moment does) against time
+    (second-order differences inside, one-sided at the ends; exact for a linear ramp); zero
+    for a single point.
+
+    Examples
+    --------
+    >>> pts = [ProfilePoint(t, 0.5, 0.0, 0.0, d) for t, d in ((0, 0), (1, 2), (2, 4))]
+    >>> deflection_rates(pts)
+    array([2., 2., 2.])
+    """
+    t = np.array([p.time_s for p in points], float)
+    d = np.array([p.deflection_deg or 0.0 for p in points], float)
+    return np.gradient(d, t) if t.size > 1 else np.zeros(t.size)
+
+
+def _with_power(case: Case, points, rows) -> tuple:
+    """The rows with the actuator's quasi-steady power demand (:class:`TrajectoryRow`)."""
+    if case.actuator is None:
+        return rows
+    from asekit.case.pipeline import actuator_setup
+    from asekit.servo.simulate import quasi_steady_demand
+    act, _, _ = actuator_setup(case)
+    out = []
+    for r, rate in zip(rows, deflection_rates(points)):
+        if r.hinge_moment_Nm is None:
+            out.append(r)
+            continue
+        d = quasi_steady_demand(act, r.hinge_moment_Nm, math.radians(rate))
+        out.append(dataclasses.replace(
+            r, deflection_rate_deg_s=float(rate), motor_current_A=float(d["current"]),
+            motor_voltage_V=float(d["voltage"]), actuator_power_W=float(d["power"])))
+    return tuple(out)
 
 
 def min_margin(rows, key: str = "flutter_margin_pct"):
@@ -522,10 +571,14 @@ def gap_spans(rows) -> list[tuple[float, float]]:
 
 def plot_trajectory(rows, title: str = "Margins along the trajectory"):
     """Flutter and divergence margins (%) and the TN 4197 margin against time, the transonic
-    gap shaded, and the dynamic pressure (kPa) below, in the project's style
+    gap shaded, the dynamic pressure (kPa) below, and with an actuator power demand
+    (``actuator_power_W``) a third panel of it (W), in the project's style
     (:func:`asekit.util.plotting.new_figure`); returns (fig, axes)."""
     from asekit.util.plotting import ASEKIT_COLOR, THESIS_COLOR, new_figure
-    fig, (ax, axq) = new_figure(title, nrows=2, figsize=(7.0, 6.0), sharex=True)
+    power = any(r.actuator_power_W is not None for r in rows)
+    fig, axes = new_figure(title, nrows=3 if power else 2, figsize=(7.0, 8.4 if power else 6.0),
+                           sharex=True)
+    ax, axq = axes[0], axes[1]
     t = np.array([r.time_s for r in rows])
 
     def series(vals):
@@ -544,7 +597,7 @@ def plot_trajectory(rows, title: str = "Margins along the trajectory"):
     ax.axhline(0.0, color="k", lw=0.8)
     spans = gap_spans(rows)
     for t0, t1 in spans:
-        for a in (ax, axq):
+        for a in axes:
             a.axvspan(t0, t1, color="0.85", lw=0)
     if spans:
         ax.axvspan(np.nan, np.nan, color="0.85", label=f"transonic gap {DLM_MACH_MAX:g} < M < "
@@ -553,14 +606,21 @@ def plot_trajectory(rows, title: str = "Margins along the trajectory"):
     ax.legend(loc="best")
     axq.plot(t, speed / 1e3, "-", color=ASEKIT_COLOR)
     axq.set_ylabel("dynamic pressure (kPa)")
-    axq.set_xlabel("time (s)")
-    return fig, (ax, axq)
+    if power:
+        axp = axes[2]
+        axp.plot(t, series([r.actuator_power_W for r in rows]), "o-", color=ASEKIT_COLOR)
+        axp.axhline(0.0, color="k", lw=0.8)
+        axp.set_ylabel("actuator power V I (W)")
+    axes[-1].set_xlabel("time (s)")
+    return fig, tuple(axes)
 
 
 #: The units of a row's JSON keys.
 UNITS = {"time_s": "s", "mach": "-", "altitude_m": "m", "dynamic_pressure_Pa": "Pa",
          "flutter_speed_ms": "m/s", "flutter_margin_pct": "%", "divergence_margin_pct": "%",
-         "hinge_moment_Nm": "N m", "tn4197_flutter_speed_ms": "m/s"}
+         "hinge_moment_Nm": "N m", "tn4197_flutter_speed_ms": "m/s",
+         "deflection_rate_deg_s": "deg/s", "motor_current_A": "A", "motor_voltage_V": "V",
+         "actuator_power_W": "W (V I, quasi-steady; > 0 drawn from the supply)"}
 
 
 def trajectory_json(case: Case, rows, profile: str = "") -> dict:
@@ -623,7 +683,8 @@ def _fmt(v, spec: str) -> str:
 
 def format_trajectory(case: Case, rows) -> str:
     """The table of ``asekit trajectory``: one line per point (time s, Mach, altitude m, q kPa,
-    U_f m/s, flutter and divergence margins %, hinge moment N m, TN 4197 U_f m/s, flags: G
+    U_f m/s, flutter and divergence margins %, hinge moment N m, TN 4197 U_f m/s, actuator
+    power W, flags: G
     transonic gap, X extrapolated in Mach), then the smallest margins, then the notes.
 
     Examples
@@ -632,12 +693,12 @@ def format_trajectory(case: Case, rows) -> str:
     >>> from asekit.util.paths import FIN_FILE
     >>> row = TrajectoryRow(1.0, 0.6, 0.0, 24800.0, 215.6, 5.9, 185.5, 0.88, 642.4, False)
     >>> print(format_trajectory(load_case(FIN_FILE), [row]).splitlines()[2])
-         1.00  0.600      0    24.80    215.6     +5.9   +185.5    0.880    642.4
+         1.00  0.600      0    24.80    215.6     +5.9   +185.5    0.880    642.4        -
     """
     head = (f"trajectory of {case.name}: flutter and divergence margins U / (M a) - 1, "
             "NACA TN 4197 beside asekit\n"
             f"{'time s':>9} {'Mach':>6} {'alt m':>6} {'q kPa':>8} {'U_f m/s':>8} "
-            f"{'flut %':>8} {'div %':>8} {'M_h N m':>8} {'TN4197':>8} flags")
+            f"{'flut %':>8} {'div %':>8} {'M_h N m':>8} {'TN4197':>8} {'P W':>8} flags")
     lines = [head]
     for r in rows:
         flags = ("G" if r.transonic_gap else "") + ("X" if r.mach_extrapolated else "")
@@ -646,7 +707,8 @@ def format_trajectory(case: Case, rows) -> str:
                      f"{_fmt(r.flutter_margin_pct, '+8.1f')} "
                      f"{_fmt(r.divergence_margin_pct, '+8.1f')} "
                      f"{_fmt(r.hinge_moment_Nm, '8.3f')} "
-                     f"{_fmt(r.tn4197_flutter_speed_ms, '8.1f')} {flags}".rstrip())
+                     f"{_fmt(r.tn4197_flutter_speed_ms, '8.1f')} "
+                     f"{_fmt(r.actuator_power_W, '8.3f')} {flags}".rstrip())
     f_min, f_row = min_margin(rows)
     if f_min is not None:
         lines.append(f"smallest flutter margin {f_min:+.1f} % at t = {f_row.time_s:g} s "

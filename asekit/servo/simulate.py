@@ -218,6 +218,41 @@ def holding_current(params: ActuatorParameters, hinge_moment_fin: float) -> floa
     return -hinge_moment_fin / (tr.ratio * tr.efficiency * params.motor.torque_constant)
 
 
+def quasi_steady_demand(params: ActuatorParameters, hinge_moment_fin, rate) -> dict:
+    """Motor current, voltage and electrical power that drive the fin at the angular rate
+    ``rate`` against the hinge moment ``hinge_moment_fin``, quasi-steady: Eqs. (2.30)-(2.37)
+    with the acceleration and dI/dt set to zero (inertia and inductance neglected, as the
+    thesis's Sec. 4 torque sizing),
+
+        K_t I = c N omega - T_hinge / (N eta),     V = R I + K_b N omega,     P = V I,
+
+    omega the transmission output (= fin) rate, T_hinge positive along positive rotation.
+
+    Parameters
+    ----------
+    params : motor and transmission; hinge_moment_fin : N m (scalar or array);
+    rate : fin rate omega (rad/s), broadcast with ``hinge_moment_fin``.
+
+    Returns
+    -------
+    dict ``current`` (A), ``voltage`` (V), ``power`` (W: V I, > 0 drawn from the supply).
+
+    Examples
+    --------
+    >>> from asekit.servo.actuator import ActuatorParameters
+    >>> d = quasi_steady_demand(ActuatorParameters(), -1.0, 0.0)     # holding 1 N m
+    >>> round(float(d["current"]), 4) == round(holding_current(ActuatorParameters(), -1.0), 4)
+    True
+    """
+    m, tr = params.motor, params.transmission
+    N, eta = tr.ratio, tr.efficiency
+    om = np.asarray(rate, float)
+    cur = (m.viscous_damping * N * om - np.asarray(hinge_moment_fin, float) / (N * eta)) \
+        / m.torque_constant
+    volt = m.resistance * cur + m.back_emf_constant * N * om
+    return {"current": cur, "voltage": volt, "power": volt * cur}
+
+
 @dataclass(frozen=True)
 class SteadyHingeMoment:
     """Steady aerodynamic hinge moment q Q_cc theta (N m) (thesis Eqs. 4.6, Sec. 4.3).

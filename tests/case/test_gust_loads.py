@@ -106,7 +106,10 @@ def test_gust_json_rows(fin_gusts):
     for r in rows:
         assert set(r) == {"mach", "altitude_m", "gust_length_m", "peak_hinge_moment_Nm",
                           "peak_root_bending_Nm", "peak_root_shear_N", "peak_current_A",
-                          "profile", "stations"}
+                          "profile", "stations", "peak_voltage_V", "peak_current_limited_A",
+                          "peak_voltage_limited_V", "saturated", "peak_current_aem2_A",
+                          "peak_deflection_limited_deg",
+                          "peak_current_aem2_limited_A", "saturated_aem2"}
         assert r["profile"] is None and r["stations"] == {}      # 1-cos rows, no stations
         assert r["mach"] == 0.5 and r["altitude_m"] == 0.0
         assert np.isfinite(r["peak_current_A"])                  # the fin has an [actuator]
@@ -190,6 +193,7 @@ def test_report_figure(fin_gusts):
     a = type("A", (), {"case": case, "gust": res})()
     f = fig_gust_histories(a)
     assert len(f.figure.axes) == 3 and "largest hinge moment" in f.alt
+    assert "stays within the actuator's power limits" in f.alt
     assert f.section == "Gust loads"
     plt.close(f.figure)
 
@@ -222,3 +226,116 @@ def test_minimum_state_and_roger_fits_agree(fin_case):
     for key in ("peak_hinge_moment_Nm", "peak_root_bending_Nm", "peak_root_shear_N",
                 "peak_current_A"):
         assert rows[1][key] == pytest.approx(rows[0][key], rel=0.02), key
+
+
+# --- correlated loads and the report's turbulence figures (issue 27) -------------------------
+def test_correlated_load_ellipse_projections_are_the_rms_values(fin_gusts):
+    # Hoblit (Gust Loads on Aircraft, 1988, Ch. 7): the one-sigma equal-probability ellipse of
+    # two jointly Gaussian loads has its extreme projection on each axis equal to that load's
+    # RMS, and on any direction u equal to sqrt(u^T C u). The covariance's diagonal comes from
+    # the cross-spectra (response_covariance); the RMS values from spectral_statistics
+    # separately, so a wrong covariance (a missing 1/2, a conjugate on the wrong factor) fails.
+    from asekit.aeroelastic.gust import correlated_load_ellipse
+    _, res = fin_gusts
+    t = res.turbulence
+    assert t["covariance"]["names"] == ("hinge_moment", "root_bending")
+    C = t["covariance"]["matrix"]
+    e = correlated_load_ellipse(C, 20001)
+    assert np.max(np.abs(e[0])) == pytest.approx(t["hinge_moment"]["rms"], rel=1e-6)
+    assert np.max(np.abs(e[1])) == pytest.approx(t["root_bending"]["rms"], rel=1e-6)
+    rho = C[0, 1] / np.sqrt(C[0, 0] * C[1, 1])
+    assert -1 < rho < 1 and abs(rho) > 0.05              # correlated, not degenerate
+    for ang in np.linspace(0, np.pi, 7):
+        u = np.array([np.cos(ang), np.sin(ang)])
+        assert np.max(u @ e) == pytest.approx(np.sqrt(u @ C @ u), rel=1e-6)
+
+
+def test_turbulence_current_of_a_very_long_scale_holds_the_hinge_moment(fin_gusts):
+    # With L = 100 km the turbulence is quasi-static for the AEM1 loop (as the slow 1-cos gust
+    # above): the motor holds the hinge moment, K_t I N eta = -T_hinge, so the RMS current is the
+    # RMS hinge moment over K_t N eta (thesis Eqs. 2.30-2.37), within the same 3 %.
+    case, res = fin_gusts
+    act, _, _ = P.actuator_setup(case)
+    tr = act.transmission
+    t = res.turbulence
+    held = t["hinge_moment"]["rms"] / (tr.ratio * tr.efficiency * act.motor.torque_constant)
+    assert t["current"]["rms"] == pytest.approx(held, rel=0.03)
+    assert turbulence_json(res)[0]["rms_current_A"] == t["current"]["rms"]
+    sp = t["spectra"]
+    from scipy.integrate import trapezoid
+    assert np.sqrt(trapezoid(sp["current"], sp["omega"])) == pytest.approx(
+        t["current"]["rms"], rel=1e-12)
+
+
+def test_turbulence_report_figures(fin_gusts):
+    import matplotlib.pyplot as plt
+
+    from asekit.case.report_figures import figures_of_gust
+    case, res = fin_gusts
+    a = type("A", (), {"case": case, "gust": res})()
+    figs = figures_of_gust(a)
+    assert list(figs) == ["gust_histories", "gust_psd", "gust_ellipse"]
+    psd, ell = figs["gust_psd"], figs["gust_ellipse"]
+    labels = [ax.get_ylabel() for ax in psd.figure.axes]
+    assert len(labels) == 3 and "(N m)^2/Hz" in labels[0] and "A^2/Hz" in labels[2]
+    assert psd.figure.axes[-1].get_xlabel() == "frequency (Hz)"
+    ax = ell.figure.axes[0]
+    assert ax.get_xlabel() == "hinge moment (N m)" and "(N m)" in ax.get_ylabel()
+    assert f"{res.turbulence['hinge_moment']['rms']:.3g}" in ell.alt
+    for f in figs.values():
+        assert f.section == "Gust loads" and f.figure._suptitle.get_text()
+        plt.close(f.figure)
+
+
+def test_power_limited_current_in_the_gust_rows(fin_gusts):
+    # the fin's actuator (thesis Table 16: 24 V, 10 A as the voltage clip |V| <= I_lim R) in a
+    # 10 m/s gust: the linear AEM1 demand stays far below both limits, so the limited run
+    # (exact piecewise-affine propagation) equals the linear one (lsim) and nothing saturates;
+    # the fin's AEM2 loop has a growing pole at M 0.5, sea level (the thesis's AEM2 finding,
+    # Ch. 5), so its rows are null rather than an unbounded number.
+    case, res = fin_gusts
+    act, _, lim = P.actuator_setup(case)
+    for r, c in zip(gust_json(res), res.cases):
+        assert abs(r["peak_voltage_V"]) < lim.current_limit * act.motor.resistance
+        assert r["saturated"] is False
+        assert r["peak_current_limited_A"] == pytest.approx(r["peak_current_A"], rel=1e-6)
+        np.testing.assert_allclose(c.servo["AEM1"]["voltage_limited"],
+                                   c.servo["AEM1"]["voltage"], rtol=0,
+                                   atol=1e-6 * abs(r["peak_voltage_V"]))
+        assert "AEM2" not in c.servo and r["peak_current_aem2_A"] is None
+        assert r["saturated_aem2"] is None
+
+
+def test_tight_current_limit_bounds_the_gust_voltage(fin_case):
+    # a current limit at half the linear demand of a short gust (H = 0.3 m: a dynamic peak,
+    # about 0.16 A), and below the holding current of a long one (H = 40 m: about 0.40 A to
+    # hold the quasi-static hinge moment, thesis Eqs. 2.30-2.37). Both rows say saturated and
+    # the applied voltage never exceeds I_lim R (Eqs. 4.14-4.15). In the short gust the
+    # limited loop still returns the fin (a smaller current peak, a larger deflection); in the
+    # long gust the motor cannot hold the hinge moment and the fin is blown past the 15 deg
+    # stop (thesis Table 2), which the deflection key reports.
+    base = dataclasses.replace(fin_case, gust=GustSpec((0.3, 40.0), 10.0, 0.5, 0.0,
+                                                       settle_time=0.02))
+    short = gust_json(gust_loads(base))[0]
+    i_lim = 0.5 * abs(short["peak_current_A"])
+    act = dataclasses.replace(fin_case.actuator, current_limit=i_lim)
+    case = dataclasses.replace(base, actuator=act)
+    res = gust_loads(case)
+    rows = gust_json(res)
+    a, _, lim = P.actuator_setup(case)
+    for r in rows:
+        assert r["saturated"] is True
+        assert abs(r["peak_voltage_limited_V"]) <= i_lim * a.motor.resistance * (1 + 1e-12)
+    r0, r1 = rows
+    assert abs(r0["peak_current_limited_A"]) < abs(r0["peak_current_A"])
+    assert abs(r0["peak_deflection_limited_deg"]) < 15.0
+    assert abs(r1["peak_current_A"]) > 1.4 * i_lim and abs(r1["peak_deflection_limited_deg"]) > 15
+    # the report's histories mark the limit and the limited current, and say which gusts saturate
+    import matplotlib.pyplot as plt
+
+    from asekit.case.report_figures import fig_gust_histories
+    f = fig_gust_histories(type("A", (), {"case": case, "gust": res})())
+    assert "saturates in H = 0.3 m, H = 40 m" in f.alt
+    lo, hi = f.figure.axes[-1].get_ylim()
+    assert hi == pytest.approx(1.3 * abs(r0["peak_current_A"]))     # the runaway off-scale
+    plt.close(f.figure)

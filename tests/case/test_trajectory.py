@@ -13,10 +13,12 @@ from asekit.case.trajectory import (
     ProfileError,
     ProfilePoint,
     method_refuses,
+    plot_trajectory,
     read_profile,
     tn4197_flutter_speed,
     tn4197_inputs,
     trajectory,
+    trajectory_json,
 )
 from asekit.util.paths import DATA_DIR
 
@@ -233,3 +235,37 @@ def test_margins_equal_the_pipelines_on_the_whole_fin(fin_case):
     for r, m in zip(rows, fa.margins):
         assert r.altitude_m == m["altitude_m"]
         assert r.flutter_margin_pct == pytest.approx(100 * m["margin"], rel=1e-12)
+
+
+# --------------------------------------------------------------------------------------------
+# the actuator's power demand (issue 27)
+# --------------------------------------------------------------------------------------------
+def test_actuator_power_demand_by_hand(small_fin, small_run):
+    # The quasi-steady motor of thesis Eqs. (2.30)-(2.37) (acceleration and dI/dt zero):
+    # K_t I = c N omega - T_hinge / (N eta), V = R I + K_b N omega, P = V I. small_run's
+    # commanded deflections are 1, 0, 0, 0, 0, 0 deg at t = 0..5 s, so the rate at t = 0 is
+    # the one-sided difference -1 deg/s and at t = 5 s it is 0: there the motor only holds
+    # the hinge moment and the power is the copper loss R I^2 with I = -T_hinge / (K_t N eta).
+    rows, _ = small_run
+    act, _, _ = P.actuator_setup(small_fin)
+    m, tr = act.motor, act.transmission
+    N, eta = tr.ratio, tr.efficiency
+    r0, r5 = rows[0], rows[5]
+    assert r0.deflection_rate_deg_s == pytest.approx(-1.0, rel=1e-12)
+    om = math.radians(-1.0)
+    cur = (m.viscous_damping * N * om - r0.hinge_moment_Nm / (N * eta)) / m.torque_constant
+    volt = m.resistance * cur + m.back_emf_constant * N * om
+    assert r0.motor_current_A == pytest.approx(cur, rel=1e-12)
+    assert r0.motor_voltage_V == pytest.approx(volt, rel=1e-12)
+    assert r0.actuator_power_W == pytest.approx(volt * cur, rel=1e-12)
+    assert r5.deflection_rate_deg_s == 0.0
+    hold = -r5.hinge_moment_Nm / (m.torque_constant * N * eta)
+    assert r5.actuator_power_W == pytest.approx(m.resistance * hold ** 2, rel=1e-12)
+    assert rows[1].actuator_power_W is None        # no hinge moment, no power
+    j = trajectory_json(small_fin, rows)
+    assert j["units"]["actuator_power_W"].startswith("W")
+    assert j["trajectory"][0]["actuator_power_W"] == r0.actuator_power_W
+    import matplotlib.pyplot as plt
+    fig, axes = plot_trajectory(rows)
+    assert len(axes) == 3 and axes[2].get_ylabel() == "actuator power V I (W)"
+    plt.close(fig)
