@@ -129,10 +129,7 @@ def _fitted_to_support(mesh: PlateMesh, s) -> PlateMesh:
     (``support.region_fit = "snap"``: :func:`asekit.structure.mesh.snap_to_circle`; issue 23)."""
     if s.kind != "shaft" or s.radius is None or s.option("region_fit", "nodes") != "snap":
         return mesh
-    try:
-        return snap_to_circle(mesh, s.axis_point, s.radius)
-    except ValueError as exc:
-        raise CaseError(f"support.region_fit = \"snap\": {exc}") from None
+    return snap_to_circle(mesh, s.axis_point, s.radius)     # its inputs checked by the schema
 
 
 @_door("assembling K and M", _STRUCTURE)

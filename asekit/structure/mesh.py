@@ -14,6 +14,7 @@ root, an edge -- so that a few hundred elements resolve what uniform refinement 
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -532,9 +533,14 @@ def snap_to_circle(mesh: PlateMesh, centre, radius: float) -> PlateMesh:
     Raises
     ------
     ValueError
-        ``radius`` not positive or ``centre`` not two finite numbers; or the move would invert
-        an element (a mesh too coarse for the circle: at least a few elements across the radius
-        are needed), naming the elements.
+        ``radius`` not positive or ``centre`` not two finite numbers.
+
+    Warns
+    -----
+    UserWarning
+        When a node is left where it is because its move would invert an element (or it is
+        the centre): a mesh too coarse, or too anisotropic, near the circle. The region is then
+        a staircase at those nodes (still the same limit under refinement, at order 1 there).
 
     Examples
     --------
@@ -550,14 +556,21 @@ def snap_to_circle(mesh: PlateMesh, centre, radius: float) -> PlateMesh:
     v = mesh.nodes - c
     dist = np.hypot(v[:, 0], v[:, 1])
     move = _cut_edge_nodes(mesh, dist - radius)
-    if np.any(dist[move] <= 1e-12 * radius):
-        raise ValueError(f"fitting the circle of radius {radius:g} m would move its centre node: "
-                         f"the mesh is too coarse there (refine it or grade it toward the circle)")
+    held = move[dist[move] <= 1e-12 * radius]            # a node at the centre cannot move
+    move = np.setdiff1d(move, held)
     nodes = np.array(mesh.nodes, float, copy=True)
     nodes[move] = c + v[move] * (radius / dist[move])[:, None]
-    bad = _inverted_elements(nodes, mesh.elements)
-    if bad.size:
-        raise ValueError(f"fitting the circle of radius {radius:g} m inverts elements "
-                         f"{bad[:10].tolist()}: the mesh is too coarse there (refine it or grade "
-                         f"it toward the circle)")
+    for _ in range(mesh.n_nodes):                        # undo the moves that invert elements
+        bad = _inverted_elements(nodes, mesh.elements)
+        back = np.intersect1d(np.unique(mesh.elements[bad]), move)
+        if back.size == 0:
+            break
+        nodes[back] = mesh.nodes[back]
+        held = np.union1d(held, back)
+        move = np.setdiff1d(move, back)
+    if held.size:
+        warnings.warn(f"fitting the circle of radius {radius:g} m: {held.size} of "
+                      f"{held.size + move.size} nodes of cut edges not moved (moving them would "
+                      f"invert an element); the region is a staircase there: refine the mesh or "
+                      f"grade it toward the circle", stacklevel=2)
     return replace(mesh, nodes=nodes)
