@@ -43,6 +43,31 @@ g 96x64     253.31 /  9.9 / 278     255.39 / 12.1 / 350
 g 192x128   254.59 / 23.2 / 558     256.64 / 24.2 / 549
 =========== ======================= =======================
 
+Measured 2026-12-03 with the snapped sequence (``support.region_fit = "snap"``: the shaft
+region's circle fitted by the nodes, ``asekit.structure.mesh.snap_to_circle``), boxes 14 x 10,
+same machine (speed m/s / CPU s / peak MB, cold):
+
+=========== =======================
+mesh        boxes 14 x 10
+=========== =======================
+u 96x112    246.06 /  8.3 / 333
+g 48x32     250.90 /  4.7 / 268
+g 64x48     252.81 /  4.3 / 271
+g 96x64     253.31 /  7.8 / 274
+g 192x128   254.59 / 16.2 / 555
+s 32x24     254.79 /  3.3 / 268
+s 64x48     255.05 /  4.2 / 271
+s 128x96    255.24 / 10.7 / 354
+=========== =======================
+
+The snapped sequence moves 0.26 and 0.19 m/s per halving (order 0.46, limit 255.75 m/s: the
+remaining error is small but not yet asymptotic); the graded one 2.41 and 1.28 (order 0.91,
+limit 256.04). Both limits lie 1.0-1.2 % above the 253.1 m/s of issue 23, whose uniform
+sequence is pre-asymptotic (below); every graded or snapped mesh from 64 x 48 (graded) or
+32 x 24 (snapped) is within 0.5 % of both 253.1 (g 64x48: -0.11 %) and 256.0 (s 32x24:
+-0.49 %) at 3-5 s CPU and 270 MB. The boxes are the other, independent half of the error
+(``bench_converged_sources.py``): +2.1 m/s from 14 x 10 to 28 x 20 on every structure.
+
 Graded order 0.91 (0.93), limit 256.0 (258.0) m/s; the uniform 96/192/384 speeds of issue 23
 (246.1, 250.7, 252.3 at 14 x 10) give order 1.52, limit 253.1. The two disagree because the
 flutter speed follows the shaft region's effective radius (about 18 m/s per mm: 244.6 and 262.5

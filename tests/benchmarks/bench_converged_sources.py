@@ -133,11 +133,14 @@ def richardson(u1: float, u2: float, u3: float) -> tuple[float, float]:
 
 
 def boxes_study(fin) -> None:
-    base = with_shaft_grading(fin, 64, 48)
-    u = [flutter(with_boxes(base, *b), f"graded 64x48, boxes {b[0]}x{b[1]}")
-         for b in ((7, 5), (14, 10), (28, 20), (56, 40))]
-    p, lim = richardson(*u[-3:])
-    print(f"  boxes: order {p:.2f}, limit {lim:.2f} m/s ({lim - u[1]:+.2f} beyond 14x10)")
+    for fit in ("nodes", "snap"):
+        base = with_shaft(with_shaft_grading(fin, 64, 48), region_fit=fit)
+        u = [flutter(with_boxes(base, *b), f"graded 64x48 {fit}, boxes {b[0]}x{b[1]}")
+             for b in ((7, 5), (14, 10), (28, 20), (56, 40))]
+        for i in (0, 1):
+            p, lim = richardson(*u[i:i + 3])
+            print(f"  boxes ({fit}), meshes {i + 1}-{i + 3}: order {p:.2f}, limit {lim:.2f} m/s "
+                  f"({lim - u[1]:+.2f} beyond 14x10)")
 
 
 def rim_study() -> None:
