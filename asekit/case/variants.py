@@ -173,7 +173,9 @@ def with_shaft_grading(case: Case, n_chord: int, n_span: int, ratio: float = 25.
     (half-width 0.15 r / span). The single-node shaft clusters toward the axis's chord fraction
     and the root. Beyond the plateau the element size grows linearly (a geometric progression)
     to ``ratio`` times the finest over ``ramp_chord`` of the chord / ``ramp_span`` of the span
-    (fractions), then stays: :func:`asekit.structure.mesh.graded_stations`.
+    (fractions), then stays: :func:`asekit.structure.mesh.graded_stations`. The band's node
+    lines still cut the circle (a staircase region); ``with_shaft(case, region_fit="snap")``
+    also fits the circle by the nodes (:func:`asekit.structure.mesh.snap_to_circle`).
 
     Examples
     --------

@@ -23,7 +23,9 @@ in Computational Science and Engineering", 1998, Ch. 5):
 
 * uniform: 24x28, 48x56, 96x112 (``--fine``: also 192x224 and 384x448, minutes and GBs);
 * graded toward the shaft region's edge and the root (``with_shaft_grading``, ratio 25,
-  ramps 0.15 chord / 0.2 span): 48x32, 96x64, 192x128, plus 64x48.
+  ramps 0.15 chord / 0.2 span): 48x32, 96x64, 192x128, plus 64x48;
+* snapped: graded as above with the region's circle fitted by the nodes
+  (``with_shaft(case, region_fit="snap")``): 32x24, 64x48, 128x96.
 
 Prints speed (m/s), frequency (Hz), CPU (s, user + system of the run's process, imports
 included), peak resident memory (MB) per mesh; the order and the Richardson limit of each
