@@ -44,7 +44,7 @@ from asekit.structure.assembly import (
     plate_pitch_inertia,
     point_mass_matrix,
 )
-from asekit.structure.mesh import PlateMesh, panels_mesh
+from asekit.structure.mesh import PlateMesh, panels_mesh, snap_to_circle
 from asekit.structure.modes import InPlaneModes, ModalModel, fixed_modal_model, with_damping
 from asekit.structure.modes import inplane_modes as _inplane_modes
 from asekit.structure.supports import support_kind
@@ -118,9 +118,18 @@ def structural_mesh(case: Case) -> PlateMesh:
     """
     if case.structure is not None:
         return case.structure.mesh
-    return panels_mesh([p.planform for p in case.panels], case.thickness,
+    mesh = panels_mesh([p.planform for p in case.panels], case.thickness,
                        case.panels[0].n_chord, [p.n_span for p in case.panels],
                        case.panels[0].chord_spacing, [p.span_spacing for p in case.panels])
+    return _fitted_to_support(mesh, case.support)
+
+
+def _fitted_to_support(mesh: PlateMesh, s) -> PlateMesh:
+    """``mesh`` with its nodes fitted to the rigid shaft region's circle when the case asks
+    (``support.region_fit = "snap"``: :func:`asekit.structure.mesh.snap_to_circle`; issue 23)."""
+    if s.kind != "shaft" or s.radius is None or s.option("region_fit", "nodes") != "snap":
+        return mesh
+    return snap_to_circle(mesh, s.axis_point, s.radius)     # its inputs checked by the schema
 
 
 @_door("assembling K and M", _STRUCTURE)

@@ -94,14 +94,19 @@ def with_boxes(case: Case, n_chord: int | None = None, n_span: int | None = None
 def with_shaft(case: Case, **changes) -> Case:
     """The shaft-supported ``case`` with support fields changed, e.g. ``model="FN1"`` (spring to
     ground, no rigid mode: ``modes.keep_rigid`` turns False) or ``radius=0.005`` (a rigid shaft
-    region of 5 mm instead of the single node; ``radius=None`` the single node)."""
+    region of 5 mm instead of the single node; ``radius=None`` the single node) or
+    ``region_fit="snap"`` (the mesh's nodes fitted to that region's circle)."""
     s = case.support
     if s.kind != "shaft":
         raise CaseError(f"with_shaft needs support.kind = \"shaft\", got {s.kind!r}")
     unknown = sorted(set(changes) - {"axis_point", "torsional_stiffness", "bending_stiffness",
-                                     "model", "radius", "fictitious_inertia_factor"})
+                                     "model", "radius", "fictitious_inertia_factor",
+                                     "region_fit"})
     if unknown:
         raise CaseError(f"support.{unknown[0]} is not a shaft key")
+    if "region_fit" in changes:                 # a kind's own key: held in spec.options
+        case = _with_region_fit(case, changes.pop("region_fit"))
+        s = case.support
     if changes.get("model", s.model) not in ("FN1", "FN2"):
         raise CaseError(f"support.model must be 'FN1' or 'FN2', got {changes['model']!r}")
     r = changes.get("radius", s.radius)
@@ -113,6 +118,19 @@ def with_shaft(case: Case, **changes) -> Case:
     if case.actuator is not None and not modes.keep_rigid:
         case = replace(case, actuator=None)      # the actuator drives the rigid mode
     return replace(case, support=s, modes=modes)
+
+
+def _with_region_fit(case: Case, fit: str) -> Case:
+    """``case`` with ``support.region_fit`` set (:data:`asekit.structure.supports.REGION_FITS`;
+    the default "nodes" is not stored, as the case loader does)."""
+    from asekit.structure.supports import REGION_FITS
+    if fit not in REGION_FITS:
+        raise CaseError(f"support.region_fit must be one of {', '.join(map(repr, REGION_FITS))}, "
+                        f"got {fit!r}")
+    opts = tuple((k, v) for k, v in case.support.options if k != "region_fit")
+    if fit != "nodes":
+        opts = tuple(sorted(opts + (("region_fit", fit),)))
+    return replace(case, support=replace(case.support, options=opts))
 
 
 def with_modes(case: Case, f_max: float | None = None, count: int | None = None) -> Case:
@@ -155,7 +173,9 @@ def with_shaft_grading(case: Case, n_chord: int, n_span: int, ratio: float = 25.
     (half-width 0.15 r / span). The single-node shaft clusters toward the axis's chord fraction
     and the root. Beyond the plateau the element size grows linearly (a geometric progression)
     to ``ratio`` times the finest over ``ramp_chord`` of the chord / ``ramp_span`` of the span
-    (fractions), then stays: :func:`asekit.structure.mesh.graded_stations`.
+    (fractions), then stays: :func:`asekit.structure.mesh.graded_stations`. The band's node
+    lines still cut the circle (a staircase region); ``with_shaft(case, region_fit="snap")``
+    also fits the circle by the nodes (:func:`asekit.structure.mesh.snap_to_circle`).
 
     Examples
     --------

@@ -207,6 +207,7 @@ def _parse_shaft(t, root) -> dict:
     model = t.string("model", ("FN1", "FN2"), default="FN2")
     region = t.raw("region", "single_node")
     fif = t.number("fictitious_inertia_factor", default=1.0e6, low=1.0, high=1e12)
+    fit = t.string("region_fit", REGION_FITS, default="nodes")
     t.done()
     if region == "single_node":
         radius = None
@@ -221,8 +222,19 @@ def _parse_shaft(t, root) -> dict:
         raise ValueError(f"support.axis_point {list(axis)} must lie on the root chord "
                          f"(y = {root.root_le[1]:g} m, x in [{root.root_le[0]:g}, "
                          f"{root.root_le[0] + root.root_chord:g}] m)")
-    return {"axis_point": axis, "torsional_stiffness": k, "bending_stiffness": kb,
-            "model": model, "radius": radius, "fictitious_inertia_factor": fif}
+    if fit != "nodes" and radius is None:
+        raise ValueError(f"support.region_fit = {fit!r} needs a rigid shaft region "
+                         f"(support.region a radius in m), got region = \"single_node\"")
+    out = {"axis_point": axis, "torsional_stiffness": k, "bending_stiffness": kb,
+           "model": model, "radius": radius, "fictitious_inertia_factor": fif}
+    return out if fit == "nodes" else {**out, "region_fit": fit}     # options: only if not default
+
+
+#: How a rigid shaft region meets the mesh (``support.region_fit``): ``"nodes"`` every node
+#: within the radius as the mesh has it (a staircase of the circle), ``"snap"`` the mesh's nodes
+#: fitted to the circle first (:func:`asekit.structure.mesh.snap_to_circle`, applied by the
+#: case pipeline's structural mesh).
+REGION_FITS = ("nodes", "snap")
 
 
 def _shaft_region(spec) -> tuple[str, float]:
