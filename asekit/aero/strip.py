@@ -29,7 +29,7 @@ import numpy as np
 from scipy.special import hankel2
 
 from asekit.aero.validity import check_k
-from asekit.util.validate import finite_array, positive, real
+from asekit.util.validate import finite, finite_array, positive
 
 
 def theodorsen(k) -> np.ndarray:
@@ -85,7 +85,7 @@ def strip_gaf(w, theta, widths, semichord, a: float, k) -> np.ndarray:
     if np.any(dy <= 0):
         raise ValueError("widths must be > 0 (m)")
     b = positive("semichord", semichord)
-    a = real("a", a)
+    a = finite("a", a)
     ks = check_k(k)
     rho, U = 2.0, 1.0                               # q = rho U^2 / 2 = 1
     out = np.empty((ks.size, W.shape[1], W.shape[1]), complex)

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from asekit.util.validate import finite_array, integer, positive, real
+from asekit.util.validate import finite, finite_array, integer, positive
 
 #: degrees of freedom per node: ux, uy, uz, rx, ry, rz (global frame).
 NODE_DOF = 6
@@ -81,7 +81,7 @@ class BeamSection:
     def __post_init__(self):
         for name in ("ea", "gj", "ei_flap", "ei_chord", "mass", "polar_inertia"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
-        d = real("mass_offset", self.mass_offset)
+        d = finite("mass_offset", self.mass_offset)
         object.__setattr__(self, "mass_offset", d)
         if self.polar_inertia < self.mass * d * d * (1 - 1e-12):
             raise ValueError(f"polar_inertia must be >= mass * mass_offset^2 = "
@@ -224,10 +224,17 @@ def straight_beam(root, direction, stations, sections) -> StraightBeam:
     if st.size < 2 or st[0] != 0.0 or np.any(np.diff(st) <= 0):
         raise ValueError(f"stations must hold >= 2 strictly ascending distances from 0 (m), "
                          f"got {st.tolist()}")
-    secs = (sections,) * (st.size - 1) if isinstance(sections, BeamSection) else tuple(sections)
-    if len(secs) != st.size - 1 or not all(isinstance(s, BeamSection) for s in secs):
-        raise ValueError(f"sections must be one BeamSection or {st.size - 1} of them "
-                         f"(one per element), got {len(secs)}")
+    if isinstance(sections, BeamSection):
+        secs = (sections,) * (st.size - 1)
+    elif isinstance(sections, (list, tuple)):
+        secs = tuple(sections)
+    else:
+        secs = None
+    if secs is None or len(secs) != st.size - 1 or not all(isinstance(s, BeamSection)
+                                                          for s in secs):
+        got = type(sections).__name__ if secs is None else f"{len(secs)} items"
+        raise ValueError(f"sections must be one BeamSection or a list of {st.size - 1} of them "
+                         f"(one per element), got {got}")
     return StraightBeam(r, e1, st, secs)
 
 

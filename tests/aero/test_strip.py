@@ -72,5 +72,7 @@ def test_strip_gaf_refuses_bad_input():
         strip_gaf([[1.0, 0.0]], [[0.0]], [1.0], 0.5, 0.0, [0.1])
     with pytest.raises(ValueError, match="semichord"):
         strip_gaf([[1.0]], [[0.0]], [1.0], 0.0, 0.0, [0.1])
+    with pytest.raises(ValueError, match="a must be a finite number"):
+        strip_gaf([[1.0]], [[0.0]], [1.0], 0.5, float("nan"), [0.1])
     with pytest.raises(ValueError, match="k"):
         strip_gaf([[1.0]], [[0.0]], [1.0], 0.5, 0.0, [-0.1])

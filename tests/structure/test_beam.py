@@ -198,6 +198,8 @@ def test_modes_are_mass_normalised_and_clamped():
     (dict(ea=-1.0), "ea"),
     (dict(polar_inertia=0.5, mass_offset=0.5), "polar_inertia must be >= mass"),
     (dict(mass=float("nan")), "mass"),
+    (dict(mass_offset=float("inf")), "mass_offset must be a finite number"),
+    (dict(gj="stiff"), "gj"),
 ])
 def test_section_refuses_bad_values(kwargs, match):
     base = dict(ea=1e9, gj=1e6, ei_flap=1e7, ei_chord=1e8, mass=30.0, polar_inertia=8.0,
@@ -217,5 +219,7 @@ def test_beam_refuses_bad_geometry():
         straight_beam((0, 0), (0, 0), [0.0, 1.0], sec)
     with pytest.raises(ValueError, match="sections"):
         straight_beam((0, 0), (0, 1), [0.0, 1.0, 2.0], [sec])
+    with pytest.raises(ValueError, match="sections .* got NoneType"):
+        straight_beam((0, 0), (0, 1), [0.0, 1.0], None)
     with pytest.raises(ValueError, match="n_modes"):
         beam_modes(straight_beam((0, 0), (0, 1), [0.0, 1.0], sec), 7)
