@@ -156,6 +156,64 @@ def element_matrices(section: BeamSection, length: float) -> tuple[np.ndarray, n
 
 
 @dataclass(frozen=True)
+class PointMass:
+    """A rigid mass attached to a beam node with an offset (MSC Nastran's CONM2 idea).
+
+    Parameters
+    ----------
+    node : index of the beam node it is attached to (0 = root).
+    mass : mass (kg), >= 0.
+    offset : (3,) vector from the node to the mass's centre, global axes (m).
+    inertia : (3, 3) symmetric positive semi-definite inertia tensor about the mass's own
+        centre, global axes (kg m^2), or (3,) its diagonal; default zero.
+
+    Its 6 x 6 mass matrix on the node's (u, r) is T^T diag(m, m, m) T + [[0, 0], [0, J]] with
+    the rigid-link kinematics u_c = u + r x o = T (u, r), T = [I, -[o x]] (Przemieniecki,
+    *Theory of Matrix Structural Analysis*, 1968, Sec. 11.7, offset masses).
+
+    Examples
+    --------
+    >>> pm = PointMass(3, 2.0, (0.5, 0.0, 0.0))
+    >>> m6 = pm.matrix()
+    >>> float(m6[2, 4]), float(m6[4, 4])      # uz-ry coupling -m o_x, ry inertia m o_x^2
+    (-1.0, 0.5)
+    """
+
+    node: int
+    mass: float
+    offset: tuple = (0.0, 0.0, 0.0)
+    inertia: tuple = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        object.__setattr__(self, "node", integer("node", self.node, low=0))
+        m = finite("mass", self.mass)
+        if m < 0:
+            raise ValueError(f"mass must be >= 0 kg, got {m}")
+        object.__setattr__(self, "mass", m)
+        o = finite_array("offset", self.offset).ravel()
+        if o.size != 3:
+            raise ValueError(f"offset must be a 3-vector (m), got {o.size} values")
+        object.__setattr__(self, "offset", tuple(o.tolist()))
+        j = finite_array("inertia", self.inertia)
+        j = np.diag(j.ravel()) if j.size == 3 else j
+        scale = 1e-12 * max(float(np.abs(j).max(initial=0.0)), 1.0)
+        if (j.shape != (3, 3) or not np.allclose(j, j.T, rtol=0, atol=scale)
+                or np.linalg.eigvalsh(j).min() < -scale):
+            raise ValueError("inertia must be a (3,) diagonal or a symmetric positive "
+                             "semi-definite (3, 3) tensor (kg m^2)")
+        object.__setattr__(self, "inertia", tuple(map(tuple, j.tolist())))
+
+    def matrix(self) -> np.ndarray:
+        """The 6 x 6 mass matrix on the node's (ux, uy, uz, rx, ry, rz)."""
+        o = np.asarray(self.offset)
+        skew = np.array([[0.0, -o[2], o[1]], [o[2], 0.0, -o[0]], [-o[1], o[0], 0.0]])
+        T = np.hstack([np.eye(3), -skew])
+        out = self.mass * T.T @ T
+        out[3:, 3:] += np.asarray(self.inertia)
+        return out
+
+
+@dataclass(frozen=True)
 class StraightBeam:
     """A straight beam along a reference (elastic) axis in the (x, y) plane.
 
@@ -166,12 +224,14 @@ class StraightBeam:
     stations : (n_nodes,) distances of the nodes from the root along the axis (m), ascending,
         the first 0.
     sections : tuple of :class:`BeamSection`, one per element (n_nodes - 1).
+    point_masses : tuple of :class:`PointMass` on its nodes (default none).
     """
 
     root: np.ndarray
     direction: np.ndarray
     stations: np.ndarray
     sections: tuple
+    point_masses: tuple = ()
 
     @property
     def n_nodes(self) -> int:
@@ -190,7 +250,7 @@ class StraightBeam:
         return self.root[None, :] + self.stations[:, None] * self.direction[None, :]
 
 
-def straight_beam(root, direction, stations, sections) -> StraightBeam:
+def straight_beam(root, direction, stations, sections, point_masses=()) -> StraightBeam:
     """A straight beam along an axis in the surface's plane, nodes at ``stations``.
 
     Parameters
@@ -200,6 +260,7 @@ def straight_beam(root, direction, stations, sections) -> StraightBeam:
         e.g. (0, 1) for an unswept wing along +y, (sin L, cos L) swept by L).
     stations : ascending distances along the axis from the root (m), the first 0, >= 2.
     sections : one :class:`BeamSection` for the whole beam, or one per element.
+    point_masses : :class:`PointMass` es on the nodes (their ``node`` < number of stations).
 
     Returns
     -------
@@ -235,7 +296,12 @@ def straight_beam(root, direction, stations, sections) -> StraightBeam:
         got = type(sections).__name__ if secs is None else f"{len(secs)} items"
         raise ValueError(f"sections must be one BeamSection or a list of {st.size - 1} of them "
                          f"(one per element), got {got}")
-    return StraightBeam(r, e1, st, secs)
+    pms = tuple(point_masses)
+    for i, pm in enumerate(pms):
+        if not isinstance(pm, PointMass) or pm.node >= st.size:
+            raise ValueError(f"point_masses[{i}] must be a PointMass on a node in "
+                             f"[0, {st.size - 1}], got {pm!r}")
+    return StraightBeam(r, e1, st, secs, pms)
 
 
 def uniform_beam(root, direction, length: float, n_elements: int,
@@ -256,7 +322,8 @@ def uniform_beam(root, direction, length: float, n_elements: int,
 def assemble(beam: StraightBeam) -> tuple[np.ndarray, np.ndarray]:
     """Global stiffness and mass matrices (6 n_nodes square, dense), DOFs (ux, uy, uz, rx, ry,
     rz) per node in the global frame: K = sum T^T K_e T with T = blockdiag(R, R, R, R), R the
-    frame's rows (e1, e2, e3).
+    frame's rows (e1, e2, e3); the point masses' 6 x 6 matrices (:meth:`PointMass.matrix`)
+    added on their nodes.
 
     Examples
     --------
@@ -274,6 +341,9 @@ def assemble(beam: StraightBeam) -> tuple[np.ndarray, np.ndarray]:
         dofs = np.arange(NODE_DOF * e, NODE_DOF * (e + 2))
         K[np.ix_(dofs, dofs)] += T.T @ ke @ T
         M[np.ix_(dofs, dofs)] += T.T @ me @ T
+    for pm in beam.point_masses:
+        dofs = np.arange(NODE_DOF * pm.node, NODE_DOF * (pm.node + 1))
+        M[np.ix_(dofs, dofs)] += pm.matrix()
     return K, M
 
 
