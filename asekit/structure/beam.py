@@ -351,6 +351,8 @@ def assemble(beam: StraightBeam) -> tuple[np.ndarray, np.ndarray]:
 class BeamModes:
     """Normal modes of a beam clamped at its root node.
 
+    Attributes
+    ----------
     frequencies_hz : (n_modes,) ascending natural frequencies (Hz).
     shapes : (n_nodes, 6, n_modes) global (ux, uy, uz, rx, ry, rz) per node and unit modal
         coordinate, mass-normalised (phi^T M phi = I); the root node's rows are zero.
