@@ -28,6 +28,11 @@ once), the p-k flutter point and dU_f (:mod:`asekit.aeroelastic.sensitivity`). T
 baseline values.
 
 Supported variables: ``thickness.root``, ``thickness.tip`` (flat chordwise profile),
+``material.youngs_modulus`` (Pa; isotropic, nu fixed, so dK/dE = K / E),
+``material.density`` (kg/m^3; dM/drho = M_plate / rho, d(mass)/drho = plate mass / rho),
+``support.torsional_stiffness`` and ``support.bending_stiffness`` (N m/rad; a shaft support,
+the latter only where the case has the bending spring: each adds k e e^T to the supported
+system's stiffness on the shaft's pitch / bending coordinate, so dK_r = e e^T there, no mass),
 ``point_mass[i].mass`` (kg), ``point_mass[i].position[0]`` and ``point_mass[i].position[1]``
 (its x, chordwise, and y, spanwise, m: dM/dx = m (N_x N^T + N N_x^T) through the shape
 functions of the element holding it, :func:`asekit.structure.sensitivity.\
@@ -56,6 +61,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 
 from asekit.aero.gaf import TabulatedGaf
 from asekit.aero.methods import AERO_METHODS, resolve_method
@@ -74,12 +80,15 @@ from asekit.case.schema import Case, CaseError
 from asekit.structure.assembly import clamped_edge, shaft_support
 from asekit.structure.modes import ModalModel, normal_modes, select_modes
 from asekit.structure.sensitivity import (
+    density_derivative,
     element_parts,
     mode_shape_derivatives,
     point_mass_derivative,
     point_mass_position_derivative,
     reduce,
+    scatter,
     thickness_derivatives,
+    youngs_modulus_derivative,
 )
 from asekit.util.validate import read_toml
 
@@ -95,6 +104,11 @@ CONSTRAINT_SLACK = 1e-4
 #: re-analysis of ``asekit optimise``, which runs the case's own sweep.
 SWEEP_POINTS = 40
 _THICKNESS = ("thickness.root", "thickness.tip")
+#: isotropic material keys: dK/dE = K / E (nu fixed), dM/drho = M_plate / rho
+_MATERIAL = ("material.youngs_modulus", "material.density")
+#: shaft springs: they enter only the supported system's K (d K_r = e e^T on the shaft's pitch or
+#: bending coordinate)
+_SUPPORT = ("support.torsional_stiffness", "support.bending_stiffness")
 _TABLE = "thickness.values_m"
 _TABLE_ENTRY = r"thickness\.values_m\[(\d+)\]\[(\d+)\]"
 _POINT_MASS = r"point_mass\[(\d+)\]\.(mass|position\[([01])\])"
@@ -145,13 +159,14 @@ def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default
 
 def _variable_path(path, where: str) -> str:
     import re
-    if isinstance(path, str) and (path in _THICKNESS or path == _TABLE
+    if isinstance(path, str) and (path in _THICKNESS or path == _TABLE or path in _MATERIAL
+                                  or path in _SUPPORT
                                   or re.fullmatch(_TABLE_ENTRY, path)
                                   or re.fullmatch(_POINT_MASS, path)):
         return path
-    raise DesignError(f"{where}.path must be one of {list(_THICKNESS)}, {_TABLE}, "
-                      f"{_TABLE}[i][j], point_mass[i].mass or point_mass[i].position[k] "
-                      f"(k = 0: x, 1: y), got {path!r}")
+    raise DesignError(f"{where}.path must be one of {list(_THICKNESS + _MATERIAL + _SUPPORT)}, "
+                      f"{_TABLE}, {_TABLE}[i][j], point_mass[i].mass or "
+                      f"point_mass[i].position[k] (k = 0: x, 1: y), got {path!r}")
 
 
 def design_from_dict(d: dict, source: str = "") -> DesignProblem:
@@ -281,6 +296,8 @@ def case_value(case: Case, path: str) -> float:
         return float(case.thickness.root)
     if path == "thickness.tip":
         return float(case.thickness.tip)
+    if path in _MATERIAL or path in _SUPPORT:
+        return _section_value(case, path)
     ij = table_index(path)
     if ij is not None:
         return float(case.thickness.values[ij[0]][ij[1]])
@@ -292,13 +309,33 @@ def case_value(case: Case, path: str) -> float:
     return float(pm.mass if axis is None else pm.position[axis])
 
 
+def _section_value(case: Case, path: str) -> float:
+    """A material or support key's value; DesignError where the case has no such number."""
+    section, key = path.split(".")
+    obj = getattr(case, section)
+    v = getattr(obj, key, None)
+    if section == "material" and not hasattr(obj, "youngs_modulus"):
+        raise DesignError(f"{path}: the material variables need an isotropic material "
+                          f"(material.kind = 'isotropic')")
+    if section == "support" and obj.kind != "shaft":
+        raise DesignError(f"{path}: needs a shaft support (support.kind = 'shaft'), got "
+                          f"{obj.kind!r}")
+    if v is None:
+        raise DesignError(f"{path}: the case has no {path} to vary (add it to the case file)")
+    return float(v)
+
+
 def with_values(case: Case, paths, values) -> Case:
     """The case with the design variables' keys set to ``values``."""
     th = case.thickness
     pms = list(case.point_masses)
     table = [list(r) for r in th.values] if getattr(th, "is_table", False) else None
     for path, v in zip(paths, values):
-        if table_index(path) is not None:
+        if path in _MATERIAL or path in _SUPPORT:
+            section, key = path.split(".")
+            case = dataclasses.replace(case, **{section: dataclasses.replace(
+                getattr(case, section), **{key: float(v)})})
+        elif table_index(path) is not None:
             i, j = table_index(path)
             table[i][j] = float(v)
         elif path == "thickness.root":
@@ -326,8 +363,9 @@ def set_case_values(raw: dict, paths, values) -> dict:
         if table_index(path) is not None:
             i, j = table_index(path)
             out["thickness"]["values_m"][i][j] = float(v)
-        elif path.startswith("thickness."):
-            out.setdefault("thickness", {})[path.split(".")[1]] = float(v)
+        elif path.split(".")[0] in ("thickness", "material", "support"):
+            section, key = path.split(".")
+            out.setdefault(section, {})[key] = float(v)
         else:
             pm, axis = out["point_mass"][_point_index(path)], position_axis(path)
             if axis is None:
@@ -532,10 +570,13 @@ def _table_dh(mesh, parts, ij):
     return out
 
 
-def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts):
-    """Global dK, dM (fin DOFs) and d(mass) per design variable."""
+def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts, K, M):
+    """Global dK, dM (fin DOFs) and d(mass) per design variable (a shaft spring's are zero
+    here: it acts on the supported system only, :func:`_support_derivative`)."""
     dK, dM, dm = [], [], []
     w_mass = parts.Mt[:, :, 0::3, 0::3].sum(axis=(2, 3))         # (ne, ng): rho w det per point
+    plate_mass = float(np.sum(w_mass * parts.h_m))
+    zero = 0 * M
     for path in ev.paths:
         if path in _THICKNESS or table_index(path) is not None:
             dh_k, dh_m = (_thickness_dh(mesh, parts, path) if path in _THICKNESS
@@ -544,6 +585,18 @@ def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts):
             dK.append(k[0])
             dM.append(m[0])
             dm.append(float(np.sum(w_mass * dh_m)))
+        elif path == "material.youngs_modulus":
+            dK.append(youngs_modulus_derivative(K, case.material))
+            dM.append(zero)
+            dm.append(0.0)
+        elif path == "material.density":
+            dK.append(zero)
+            dM.append(density_derivative(scatter(mesh, parts.mass()), case.material))
+            dm.append(plate_mass / float(case.material.density))
+        elif path in _SUPPORT:
+            dK.append(zero)
+            dM.append(zero)
+            dm.append(0.0)
         elif position_axis(path) is None:
             pm = case.point_masses[_point_index(path)]
             dM.append(point_mass_derivative(mesh, pm.position))
@@ -555,8 +608,20 @@ def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts):
                                                      position_axis(path)))
             dK.append(0 * dM[-1])
             dm.append(0.0)                  # moving a mass does not change the total
-    mass = float(np.sum(w_mass * parts.h_m)) + sum(p.mass for p in case.point_masses)
+    mass = plate_mass + sum(p.mass for p in case.point_masses)
     return dK, dM, mass, np.array(dm)
+
+
+def _support_derivative(system, path: str):
+    """dK_r of a shaft spring in the FN1 system's coordinates: e_s e_s^T on the shaft's pitch
+    coordinate (``support.torsional_stiffness``; :func:`asekit.structure.assembly.shaft_support`
+    adds k there) or on the bending coordinate, the last one (``support.bending_stiffness``);
+    None for any other variable. The springs carry no mass."""
+    if path not in _SUPPORT:
+        return None
+    n = system.K.shape[0]
+    i = system.shaft_index if path == "support.torsional_stiffness" else n - 1
+    return sp.csr_matrix(([1.0], ([i], [i])), shape=(n, n))
 
 
 def _gafs(ev: Evaluator, mesh, shapes: np.ndarray) -> np.ndarray:
@@ -608,10 +673,14 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
     mesh = P.structural_mesh(case)
     K, M = P.mass_and_stiffness(case)
     parts = element_parts(mesh, case.material)
-    dK, dM, mass, d_mass = _matrix_derivatives(ev, case, mesh, parts)
+    dK, dM, mass, d_mass = _matrix_derivatives(ev, case, mesh, parts, K, M)
     system = _system(case, mesh, K, M)
     lam, q = _elastic_modes(system, M, ev.n_elastic)
     dKr = [reduce(system.T, a) for a in dK]
+    for j, path in enumerate(ev.paths):
+        extra = _support_derivative(system, path)
+        if extra is not None:
+            dKr[j] = dKr[j] + extra
     dMr = [reduce(system.T, a) for a in dM]
     dlam, dq = mode_shape_derivatives(system.K, system.M, lam, q, dKr, dMr)
     n = lam.size
