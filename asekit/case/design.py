@@ -48,8 +48,10 @@ bounds the difference of adjacent table values (a linear smoothness constraint,
 ``clamped_root``, undamped (no ``[damping]``). ``design.divergence_margin`` adds the divergence
 of the elastic modes at the top Mach as a constraint, U_D >= (1 + margin) M a per envelope
 altitude, written 1 - q_a mu >= 0 with mu = 1 / q_D and its analytic derivative
-(:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`). Frequency separation and the
-servo requirements are not constraints yet.
+(:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`). ``design.frequency_separation``
+(with ``design.frequency_separation_modes`` = n, default 2) asks f_{i+1} / f_i - 1 >= the value
+for the first n elastic modes (:func:`separation_constraint`, Fox-Kapoor eigenvalue
+derivatives). The servo requirements are not constraints yet.
 """
 
 from __future__ import annotations
@@ -135,7 +137,8 @@ class DesignProblem:
     difference of adjacent thickness-table values, None: unconstrained), ``gradient_step``
     (the central differences' relative step of the gradient check), ``divergence_margin`` (a
     fraction: U_D >= (1 + margin) M a at every envelope altitude; None: divergence is reported,
-    not constrained)."""
+    not constrained), ``frequency_separation`` (a fraction: f_{i+1} / f_i - 1 >= it for the
+    first ``frequency_separation_modes`` elastic modes; None: not constrained)."""
 
     variables: tuple[DesignVariable, ...]
     objective: str = "mass"
@@ -145,6 +148,8 @@ class DesignProblem:
     table_max_step_m: float | None = None
     gradient_step: float = 1e-4
     divergence_margin: float | None = None
+    frequency_separation: float | None = None
+    frequency_separation_modes: int = 2
 
 
 def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default=None):
@@ -183,10 +188,12 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
         raise DesignError("a design file needs a [design] table")
     t = d["design"]
     unknown = set(t) - {"objective", "flutter_margin", "max_iterations", "variable",
-                        "table_max_step_m", "gradient_step", "divergence_margin"}
+                        "table_max_step_m", "gradient_step", "divergence_margin",
+                        "frequency_separation", "frequency_separation_modes"}
     if unknown:
         raise DesignError(f"design: unknown keys {sorted(unknown)} (known: divergence_margin, "
-                          f"objective, flutter_margin, gradient_step, max_iterations, "
+                          f"objective, flutter_margin, frequency_separation, "
+                          f"frequency_separation_modes, gradient_step, max_iterations, "
                           f"table_max_step_m, variable)")
     objective = t.get("objective", "mass")
     if objective not in OBJECTIVES:
@@ -216,7 +223,22 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
     gstep = _number(t, "gradient_step", "design", 1e-8, 0.1, 1e-4)
     div = (None if "divergence_margin" not in t
            else _number(t, "divergence_margin", "design", 0.0, 10.0))
-    return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep, div)
+    sep, n_sep = _separation(t)
+    return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep, div,
+                         sep, n_sep)
+
+
+def _separation(t: dict) -> tuple[float | None, int]:
+    """``design.frequency_separation`` (a fraction in [0, 10] or absent) and
+    ``design.frequency_separation_modes`` (an integer in [2, 50], default 2)."""
+    sep = (None if "frequency_separation" not in t
+           else _number(t, "frequency_separation", "design", 0.0, 10.0))
+    n = _number(t, "frequency_separation_modes", "design", 2, 50, 2)
+    if n != int(n):
+        raise DesignError(f"design.frequency_separation_modes must be an integer, got {n!r}")
+    if sep is None and "frequency_separation_modes" in t:
+        raise DesignError("design.frequency_separation_modes needs design.frequency_separation")
+    return sep, int(n)
 
 
 def table_index(path: str) -> tuple[int, int] | None:
@@ -453,7 +475,8 @@ class Evaluation:
     values : (n_var,) the design; mass_kg, d_mass (n_var,); speeds_ms (n_cond,) U_f per envelope
     altitude (NaN: no flutter in the velocity sweep); d_speeds (n_cond, n_var); envelope_ms
     (n_cond,) M a; margins (n_cond,) U_f / (M a) - 1; frequencies_hz (n_cond,) at flutter;
-    densities (n_cond,) kg/m^3; divergence_mu : 1 / q_D (1/Pa) of the elastic modes at the top
+    densities (n_cond,) kg/m^3; eigenvalues (n,) omega_i^2 (rad^2/s^2) of the elastic modes and
+    d_eigenvalues (n_var, n) (Fox-Kapoor); divergence_mu : 1 / q_D (1/Pa) of the elastic modes at the top
     Mach (:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`; <= 0: no divergence,
     NaN: no real eigenvalue), d_divergence_mu (n_var,).
     """
@@ -468,6 +491,13 @@ class Evaluation:
     densities: np.ndarray = field(default_factory=lambda: np.zeros(0))
     divergence_mu: float = math.nan
     d_divergence_mu: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    eigenvalues: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    d_eigenvalues: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+
+    @property
+    def elastic_frequencies_hz(self) -> np.ndarray:
+        """f_i = sqrt(lambda_i) / 2 pi of the elastic modes (Hz)."""
+        return np.sqrt(np.maximum(self.eigenvalues, 0.0)) / (2 * math.pi)
 
     @property
     def margins(self) -> np.ndarray:
@@ -500,6 +530,10 @@ class Evaluator:
         check_case(self.case, self.problem)
         base = P.modal_model(self.case)
         self.n_elastic = base.frequencies_hz.size - base.n_rigid
+        n_sep = self.problem.frequency_separation_modes
+        if self.problem.frequency_separation is not None and n_sep > self.n_elastic:
+            raise DesignError(f"design.frequency_separation_modes = {n_sep}: the case has "
+                              f"{self.n_elastic} elastic modes (modes.count / modes.f_max)")
         a = self.case.aero
         mach = self.mach
         spec = AERO_METHODS[resolve_method(a.method, mach)]
@@ -702,7 +736,8 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
                       envelope_ms=np.array([ev.mach * c.speed_of_sound for c in conds]),
                       frequencies_hz=np.array([o[1] for o in out]),
                       densities=np.array([c.density for c in conds]),
-                      divergence_mu=div.mu, d_divergence_mu=div.d_mu)
+                      divergence_mu=div.mu, d_divergence_mu=div.d_mu,
+                      eigenvalues=np.asarray(lam, float), d_eigenvalues=np.asarray(dlam, float))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -714,10 +749,39 @@ def _constraint(ev: Evaluator, e: Evaluation):
     u = np.where(np.isnan(e.speeds_ms), ev.case.flight.velocities[-1], e.speeds_ms)
     scale = (1.0 + ev.problem.flutter_margin) * (1.0 + CONSTRAINT_SLACK) * e.envelope_ms
     g, dg = u / scale - 1.0, e.d_speeds / scale[:, None]
-    if ev.problem.divergence_margin is None:
-        return g, dg
-    gd, dgd = _divergence_constraint(ev.problem.divergence_margin, e)
-    return np.concatenate([g, gd]), np.vstack([dg, dgd])
+    if ev.problem.divergence_margin is not None:
+        gd, dgd = _divergence_constraint(ev.problem.divergence_margin, e)
+        g, dg = np.concatenate([g, gd]), np.vstack([dg, dgd])
+    if ev.problem.frequency_separation is not None:
+        gs, dgs = separation_constraint(ev.problem.frequency_separation,
+                                        ev.problem.frequency_separation_modes, e)
+        g, dg = np.concatenate([g, gs]), np.vstack([dg, dgs])
+    return g, dg
+
+
+def separation_constraint(separation: float, n_modes: int, e: Evaluation):
+    """g_i = sqrt(lambda_{i+1} / lambda_i) / ((1 + s)(1 + slack)) - 1 >= 0, i = 0 .. n - 2:
+    f_{i+1} / f_i - 1 >= s for the first ``n_modes`` elastic modes (in ascending order), and
+    its gradient from the eigenvalue derivatives (Fox & Kapoor 1968, Eq. 8):
+    dg_i = r_i / (2 (1 + s)(1 + slack)) (dlambda_{i+1} / lambda_{i+1} - dlambda_i / lambda_i),
+    r_i = f_{i+1} / f_i. Smooth while the modes stay distinct (at a crossing the ascending
+    order swaps, and the separation is zero there anyway).
+
+    Examples
+    --------
+    >>> e = Evaluation(values=np.zeros(1), mass_kg=1.0, d_mass=np.zeros(1), speeds_ms=np.zeros(0),
+    ...                d_speeds=np.zeros((0, 1)), envelope_ms=np.zeros(0),
+    ...                frequencies_hz=np.zeros(0), eigenvalues=np.array([1.0, 4.0]),
+    ...                d_eigenvalues=np.array([[1.0, 0.0]]))
+    >>> g, dg = separation_constraint(0.5, 2, e)         # f2 / f1 = 2 >= 1.5
+    >>> round(float(g[0]), 4), round(float(dg[0, 0]), 4)
+    (0.3332, -0.6666)
+    """
+    lam, dlam = e.eigenvalues[:n_modes], e.d_eigenvalues[:, :n_modes]
+    scale = (1.0 + separation) * (1.0 + CONSTRAINT_SLACK)
+    r = np.sqrt(lam[1:] / lam[:-1])
+    dr = 0.5 * r[None, :] * (dlam[:, 1:] / lam[1:] - dlam[:, :-1] / lam[:-1])
+    return r / scale - 1.0, (dr / scale).T
 
 
 def _divergence_constraint(margin: float, e: Evaluation):
@@ -760,8 +824,8 @@ class DesignResult:
 
 
 def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.ndarray:
-    """Max relative error per variable of the analytic d(mass), dU_f and dmu (the divergence
-    eigenvalue) against central differences of the whole chain (step ``rel_step`` times the value)."""
+    """Max relative error per variable of the analytic d(mass), dU_f, dlambda (the elastic
+    modes' eigenvalues) and dmu (the divergence eigenvalue) against central differences of the whole chain (step ``rel_step`` times the value)."""
     e0 = ev(x0)
     err = np.zeros(x0.size)
     for j in range(x0.size):
@@ -770,6 +834,8 @@ def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.
         pairs = [(e0.d_mass[j], (ep.mass_kg - em.mass_kg) / (2 * h))]
         pairs += [(a, (b - c) / (2 * h)) for a, b, c in
                   zip(e0.d_speeds[:, j], ep.speeds_ms, em.speeds_ms) if np.isfinite(b - c)]
+        pairs += [(a, (b - c) / (2 * h)) for a, b, c in
+                  zip(e0.d_eigenvalues[j], ep.eigenvalues, em.eigenvalues)]
         if np.isfinite(ep.divergence_mu - em.divergence_mu):
             pairs.append((e0.d_divergence_mu[j], (ep.divergence_mu - em.divergence_mu) / (2 * h)))
         err[j] = max(abs(a - f) / max(abs(f), 1e-300) for a, f in pairs)

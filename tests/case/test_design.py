@@ -6,6 +6,7 @@ command-line test marked slow.
 """
 
 import copy
+import dataclasses
 import tomllib
 
 import numpy as np
@@ -302,3 +303,55 @@ def test_shaft_variable_without_its_spring_is_refused():
         {"path": "support.bending_stiffness", "lower": 100.0, "upper": 1e5}]}})
     with pytest.raises(DesignError, match=r"support.bending_stiffness: the case has no "):
         Evaluator(CASE, p)
+
+
+@pytest.mark.parametrize("extra, message", [
+    ({"frequency_separation": -0.1}, r"design.frequency_separation must be a number in \[0, 10\]"),
+    ({"frequency_separation": "big"}, r"design.frequency_separation must be a number"),
+    ({"frequency_separation": 0.2, "frequency_separation_modes": 1},
+     r"design.frequency_separation_modes must be a number in \[2, 50\]"),
+    ({"frequency_separation": 0.2, "frequency_separation_modes": 2.5},
+     r"design.frequency_separation_modes must be an integer"),
+    ({"frequency_separation_modes": 3},
+     r"design.frequency_separation_modes needs design.frequency_separation"),
+])
+def test_frequency_separation_keys_are_checked(extra, message):
+    d = {"design": {**extra, "variable": [
+        {"path": "thickness.tip", "lower": 0.001, "upper": 0.004}]}}
+    with pytest.raises(DesignError, match=message):
+        design_from_dict(d)
+
+
+def test_frequency_separation_needs_enough_modes():
+    p = design_from_dict({"design": {"frequency_separation": 0.2, "frequency_separation_modes": 4,
+                                     "variable": [{"path": "thickness.tip", "lower": 0.001,
+                                                   "upper": 0.004}]}})
+    with pytest.raises(DesignError, match=r"design.frequency_separation_modes = 4: the case has "
+                                          r"3 elastic modes"):
+        Evaluator(CASE, p)
+
+
+def test_frequency_separation_constraint_and_its_gradient(ev):
+    """The separation rows are f_{i+1} / f_i / ((1 + s)(1 + slack)) - 1 with the pipeline's
+    elastic frequencies (FN2 model; the optimiser's FN1 modes agree to O(J_fin / I_f)), and
+    their gradient (Fox-Kapoor dlambda, checked against differences in gradient_check) matches
+    central differences of the rows themselves to 1e-5 relative."""
+    from asekit.case.design import CONSTRAINT_SLACK, separation_constraint
+    x0 = np.array([0.004, 0.002, 0.01])
+    e = ev(x0)
+    model = P.modal_model(CASE)
+    f = model.frequencies_hz[model.n_rigid:]
+    np.testing.assert_allclose(e.elastic_frequencies_hz, f, rtol=1e-5)
+    g, dg = separation_constraint(0.2, 3, e)
+    np.testing.assert_allclose(g, f[1:] / f[:-1] / (1.2 * (1 + CONSTRAINT_SLACK)) - 1, rtol=1e-5)
+    for j in range(x0.size):
+        h = 1e-4 * x0[j]
+        gp = separation_constraint(0.2, 3, ev(x0 + h * np.eye(3)[j]))[0]
+        gm = separation_constraint(0.2, 3, ev(x0 - h * np.eye(3)[j]))[0]
+        fd = (gp - gm) / (2 * h)
+        np.testing.assert_allclose(dg[:, j], fd, rtol=1e-5)
+    # in the optimiser's constraint vector after the flutter rows
+    from asekit.case.design import _constraint
+    ev2 = Evaluator(CASE, dataclasses.replace(PROBLEM, frequency_separation=0.2,
+                                              frequency_separation_modes=3))
+    assert _constraint(ev2, ev2(x0))[0].shape == (2 + 2,)
