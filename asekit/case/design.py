@@ -94,7 +94,11 @@ from asekit.structure.sensitivity import (
 )
 from asekit.util.validate import read_toml
 
-OBJECTIVES = ("mass",)
+OBJECTIVES = ("mass", "flutter_speed")
+#: A constraint counts as active at the optimum where its normalised row g (the value the
+#: optimiser keeps >= 0: e.g. U_f / ((1 + margin)(1 + slack) M a) - 1, or (step - |dv|) / step
+#: for the smoothness of a thickness table) is at most this.
+ACTIVE_TOL = 1e-3
 #: The optimiser asks for U_f >= (1 + margin) M a (1 + CONSTRAINT_SLACK): the re-analysis by the
 #: case pipeline (FN2 modes, its own GAF database) differs from the optimiser's chain (FN1 modes,
 #: the same boxes) by ~1e-7 relative, and SLSQP meets an active constraint only to its tolerance.
@@ -804,7 +808,9 @@ class DesignResult:
     min_margin_pct); success, message : the optimiser's verdict; evaluations : chain
     evaluations; seconds : wall time; gradient_check : (n_var,) max relative error of the
     analytic gradients (mass and flutter speeds) against central differences at the baseline
-    (None when not checked); gradient_check_seconds : the time of those differences.
+    (None when not checked); gradient_check_seconds : the time of those differences;
+    constraints : the constraint activity at the optimum, one dict per constraint
+    (:func:`constraint_activity`).
     """
 
     paths: tuple[str, ...]
@@ -817,6 +823,7 @@ class DesignResult:
     seconds: float
     gradient_check: np.ndarray | None = None
     gradient_check_seconds: float = 0.0
+    constraints: tuple[dict, ...] = ()
 
     @property
     def max_rel_error(self) -> float | None:
@@ -824,8 +831,9 @@ class DesignResult:
 
 
 def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.ndarray:
-    """Max relative error per variable of the analytic d(mass), dU_f, dlambda (the elastic
-    modes' eigenvalues) and dmu (the divergence eigenvalue) against central differences of the whole chain (step ``rel_step`` times the value)."""
+    """Max relative error per variable of the analytic d(mass), dU_f, dmu (the divergence
+    eigenvalue) and, with a frequency-separation constraint, dlambda of its modes (the elastic
+    eigenvalues) against central differences of the whole chain (step ``rel_step`` times the value)."""
     e0 = ev(x0)
     err = np.zeros(x0.size)
     for j in range(x0.size):
@@ -834,8 +842,10 @@ def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.
         pairs = [(e0.d_mass[j], (ep.mass_kg - em.mass_kg) / (2 * h))]
         pairs += [(a, (b - c) / (2 * h)) for a, b, c in
                   zip(e0.d_speeds[:, j], ep.speeds_ms, em.speeds_ms) if np.isfinite(b - c)]
-        pairs += [(a, (b - c) / (2 * h)) for a, b, c in
-                  zip(e0.d_eigenvalues[j], ep.eigenvalues, em.eigenvalues)]
+        if ev.problem.frequency_separation is not None:
+            n_sep = ev.problem.frequency_separation_modes
+            pairs += [(a, (b - c) / (2 * h)) for a, b, c in
+                      zip(e0.d_eigenvalues[j, :n_sep], ep.eigenvalues, em.eigenvalues)]
         if np.isfinite(ep.divergence_mu - em.divergence_mu):
             pairs.append((e0.d_divergence_mu[j], (ep.divergence_mu - em.divergence_mu) / (2 * h)))
         err[j] = max(abs(a - f) / max(abs(f), 1e-300) for a, f in pairs)
@@ -866,10 +876,127 @@ def smoothness_constraints(paths, x0: np.ndarray, step: float | None) -> list:
     return [{"type": "ineq", "fun": lambda z: step + A @ z, "jac": lambda z: A}]
 
 
+def constraint_names(ev: Evaluator, e: Evaluation) -> list[tuple[str, float, float]]:
+    """(name, value, bound) of each row of :func:`_constraint`, in its order: the flutter margin
+    per envelope altitude (U_f / (M a) - 1 against ``flutter_margin``), the divergence margin
+    (U_D / (M a) - 1; inf: no divergence), the frequency separations (f_{i+1} / f_i - 1)."""
+    pr = ev.problem
+    alts = [c.altitude for c in envelope_conditions(ev.case)]
+    u = np.where(np.isnan(e.speeds_ms), ev.case.flight.velocities[-1], e.speeds_ms)
+    rows = [(f"flutter_margin[{a:g} m]", float(m), pr.flutter_margin)
+            for a, m in zip(alts, u / e.envelope_ms - 1.0)]
+    if pr.divergence_margin is not None:
+        rows += [(f"divergence_margin[{a:g} m]", float(ud / ue - 1.0), pr.divergence_margin)
+                 for a, ud, ue in zip(alts, e.divergence_speeds_ms, e.envelope_ms)]
+    if pr.frequency_separation is not None:
+        f = e.elastic_frequencies_hz[:pr.frequency_separation_modes]
+        rows += [(f"frequency_separation[f{i + 2}/f{i + 1}]", float(f[i + 1] / f[i] - 1.0),
+                  pr.frequency_separation) for i in range(f.size - 1)]
+    return rows
+
+
+def constraint_activity(ev: Evaluator, e: Evaluation, multipliers=None,
+                        epigraph: float | None = None,
+                        baseline_mass: float | None = None) -> tuple[dict, ...]:
+    """The constraints at the design ``e``: one dict {name, value, bound, active, multiplier}
+    per constraint, ``active`` where the normalised row g <= :data:`ACTIVE_TOL`.
+
+    Values are the physical ones (margins and separations as fractions, the smoothness steps and
+    their bound in m, the mass in kg). ``multipliers`` are SLSQP's KKT multipliers in its order
+    (the mass equality first, then :func:`_constraint`'s rows, then the smoothness rows -D, +D)
+    for the scaled problem (variables over their baseline values, rows as normalised here);
+    None: not reported. With the ``flutter_speed`` objective, ``epigraph`` is the maximised
+    smallest margin t: the flutter rows are U_f / (M a) - 1 - t >= 0, bound t, and the mass
+    equality (bound ``baseline_mass``, kg) leads the list.
+    """
+    mult = None if multipliers is None else list(np.asarray(multipliers, float))
+    out = []
+
+    def take(n):
+        if mult is None:
+            return [None] * n
+        got, mult[:n] = mult[:n], []
+        return [float(m) for m in got]
+
+    if epigraph is not None:
+        out.append({"name": "mass_kg (equality)", "value": e.mass_kg, "bound": baseline_mass,
+                    "active": True, "multiplier": take(1)[0]})
+    g = _constraint(ev, e)[0]
+    names = constraint_names(ev, e)
+    if epigraph is not None:
+        n_f = len(envelope_conditions(ev.case))
+        names[:n_f] = [(nm, v, epigraph) for nm, v, _ in names[:n_f]]
+        g = g.copy()
+        g[:n_f] = np.array([v for _, v, _ in names[:n_f]]) - epigraph
+    for (name, value, bound), gi, m in zip(names, g, take(len(names))):
+        out.append({"name": name, "value": value if math.isfinite(value) else None,
+                    "bound": bound, "active": bool(gi <= ACTIVE_TOL), "multiplier": m})
+    step = ev.problem.table_max_step_m
+    D = smoothness_matrix(ev.paths)
+    if step is not None and D.shape[0]:
+        ms = take(2 * D.shape[0])
+        for r, dv in enumerate(D @ e.values):
+            a, b = (ev.paths[k] for k in np.flatnonzero(D[r]))
+            m = None if ms[0] is None else ms[r] + ms[r + D.shape[0]]
+            out.append({"name": f"table_step[{a} - {b}]", "value": float(abs(dv)),
+                        "bound": step, "active": bool((step - abs(dv)) / step <= ACTIVE_TOL),
+                        "multiplier": m})
+    return tuple(out)
+
+
+def _mass_problem(ev: Evaluator, x0: np.ndarray, m0: float):
+    """SLSQP's (objective, constraints, z0, bounds) of the minimum-mass problem on z = v / x0."""
+    def obj(z):
+        e = ev(z * x0)
+        return e.mass_kg / m0, e.d_mass * x0 / m0
+
+    cons = [{"type": "ineq", "fun": lambda z: _constraint(ev, ev(z * x0))[0],
+             "jac": lambda z: _constraint(ev, ev(z * x0))[1] * x0[None, :]}]
+    cons += smoothness_constraints(ev.paths, x0, ev.problem.table_max_step_m)
+    bounds = [(v.lower / x, v.upper / x) for v, x in zip(ev.problem.variables, x0)]
+    return obj, cons, np.ones(x0.size), bounds
+
+
+def _flutter_speed_problem(ev: Evaluator, x0: np.ndarray, m0: float):
+    """SLSQP's (objective, constraints, y0, bounds) of the maximum-flutter-speed problem: on
+    y = (z, t), z = v / x0, maximise t subject to U_f,a / (M a) - 1 - t >= 0 at every envelope
+    altitude (t is then the smallest margin, the epigraph form of max min), the mass equal to
+    the baseline's (mass / m0 - 1 = 0) and the other constraints of the design (divergence,
+    frequency separation, smoothness) on z."""
+    n, n_f = x0.size, len(envelope_conditions(ev.case))
+    fm = ev.problem.flutter_margin
+
+    def rows(y):
+        e = ev(y[:n] * x0)
+        g, dg = _constraint(ev, e)
+        s = (1.0 + fm) * (1.0 + CONSTRAINT_SLACK)
+        g, dg = g.copy(), dg * x0[None, :]
+        g[:n_f], dg[:n_f] = (g[:n_f] + 1.0) * s - 1.0 - y[n], dg[:n_f] * s   # margin - t
+        dt = np.zeros((g.size, 1))
+        dt[:n_f] = -1.0
+        return g, np.hstack([dg, dt])
+
+    def pad(c):
+        return {"type": c["type"], "fun": lambda y: c["fun"](y[:n]),
+                "jac": lambda y: np.hstack([c["jac"](y[:n]), np.zeros((c["jac"](y[:n]).shape[0],
+                                                                        1))])}
+
+    cons = [{"type": "eq", "fun": lambda y: np.array([ev(y[:n] * x0).mass_kg / m0 - 1.0]),
+             "jac": lambda y: np.append(ev(y[:n] * x0).d_mass * x0 / m0, 0.0)[None, :]},
+            {"type": "ineq", "fun": lambda y: rows(y)[0], "jac": lambda y: rows(y)[1]}]
+    cons += [pad(c) for c in smoothness_constraints(ev.paths, x0, ev.problem.table_max_step_m)]
+    t0 = float(np.min(ev(x0).margins))
+    bounds = [(v.lower / x, v.upper / x) for v, x in zip(ev.problem.variables, x0)]
+    return (lambda y: (-y[n], -np.eye(n + 1)[n]), cons, np.append(np.ones(n), t0),
+            bounds + [(None, None)])
+
+
 def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
              progress=None, evaluator: Evaluator | None = None) -> DesignResult:
-    """Minimise the mass subject to the flutter margin (module docstring) with SLSQP and the
-    analytic gradients; variables scaled by their baseline values.
+    """Minimise the mass subject to the flutter margin (``objective = "mass"``), or maximise the
+    smallest envelope flutter margin at the baseline's mass (``"flutter_speed"``,
+    :func:`_flutter_speed_problem`), with SLSQP and the analytic gradients; variables scaled by
+    their baseline values; the other constraints (module docstring) in both.
 
     Parameters
     ----------
@@ -881,7 +1008,7 @@ def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
 
     Returns
     -------
-    :class:`DesignResult`.
+    :class:`DesignResult` with the constraint activity at the optimum.
     """
     from scipy.optimize import minimize
     t0 = time.perf_counter()
@@ -894,35 +1021,28 @@ def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
         t_check = time.perf_counter() - tc
     m0 = ev(x0).mass_kg
     history = []
+    n = x0.size
 
-    def obj(z):
-        e = ev(z * x0)
-        return e.mass_kg / m0, e.d_mass * x0 / m0
-
-    def cons(z):
-        return _constraint(ev, ev(z * x0))[0]
-
-    def cons_jac(z):
-        return _constraint(ev, ev(z * x0))[1] * x0[None, :]
-
-    def record(z):
-        e = ev(z * x0)
-        row = {"iteration": len(history) + 1, "values": (z * x0).tolist(),
+    def record(y):
+        e = ev(y[:n] * x0)
+        row = {"iteration": len(history) + 1, "values": (y[:n] * x0).tolist(),
                "mass_kg": e.mass_kg, "min_margin_pct": float(np.nanmin(e.margins) * 100)}
         history.append(row)
         if progress is not None:
             progress(row)
 
+    speed = ev.problem.objective == "flutter_speed"
+    obj, constraints, y0, bounds = (_flutter_speed_problem if speed else _mass_problem)(ev, x0, m0)
+    res = minimize(obj, y0, jac=True, method="SLSQP", bounds=bounds, constraints=constraints,
+                   options={"maxiter": problem.max_iterations, "ftol": 1e-6 if not speed
+                            else 1e-9}, callback=record)
     variables = ev.problem.variables
-    bounds = [(v.lower / x, v.upper / x) for v, x in zip(variables, x0)]
-    constraints = [{"type": "ineq", "fun": cons, "jac": cons_jac}]
-    constraints += smoothness_constraints(ev.paths, x0, ev.problem.table_max_step_m)
-    res = minimize(obj, np.ones(x0.size), jac=True, method="SLSQP", bounds=bounds,
-                   constraints=constraints,
-                   options={"maxiter": problem.max_iterations, "ftol": 1e-6},
-                   callback=record)
-    x = np.clip(res.x * x0, [v.lower for v in variables], [v.upper for v in variables])
-    return DesignResult(paths=ev.paths, baseline=ev(x0), optimised=ev(x), history=tuple(history),
+    x = np.clip(res.x[:n] * x0, [v.lower for v in variables], [v.upper for v in variables])
+    opt = ev(x)
+    activity = constraint_activity(ev, opt, res.get("multipliers"),
+                                   float(res.x[n]) if speed else None, m0)
+    return DesignResult(paths=ev.paths, baseline=ev(x0), optimised=opt, history=tuple(history),
                         success=bool(res.success), message=str(res.message),
                         evaluations=ev.calls, seconds=time.perf_counter() - t0,
-                        gradient_check=check, gradient_check_seconds=t_check)
+                        gradient_check=check, gradient_check_seconds=t_check,
+                        constraints=activity)

@@ -37,7 +37,7 @@ def test_shipped_design_file_parses():
 
 
 @pytest.mark.parametrize("text, fragment", [
-    ("[design]\nobjective = 'drag'\n", "design.objective must be one of ['mass']"),
+    ("[design]\nobjective = 'drag'\n", "design.objective must be one of ['mass', 'flutter_speed']"),
     ("[design]\n[[design.variable]]\npath = 'thickness.tip'\nlower = 0.003\nupper = 0.006\n",
      "thickness.tip = 0.002 in the case lies outside its bounds"),
     ("[design\n", "design.toml"),
