@@ -53,7 +53,9 @@ def _error(msg: str) -> int:
 
 def _reanalysis(case, margin: float, div_margin: float | None = None,
                 separation: float | None = None, n_sep: int = 2) -> dict:
-    """The case pipeline's verdict: the smallest flutter margin (%) over the envelope altitudes,
+    """The case pipeline's verdict: the smallest flutter margin (%) over the envelope altitudes
+    (an altitude without flutter in the sweep counts with its lower bound, the sweep's last
+    speed over M a - 1; ``flutter_margin_is_lower_bound`` says when that bound is the smallest),
     the lowest divergence speed at the envelope's top Mach (None: none in the sweep), the
     smallest divergence margin U_D / (M a) - 1 (%, None: no divergence), and whether the flutter
     speeds clear (1 + margin) M a and the divergence speeds (1 + div_margin) M a (div_margin
@@ -63,7 +65,11 @@ def _reanalysis(case, margin: float, div_margin: float | None = None,
     div_margin = margin if div_margin is None else div_margin
     from asekit.case import pipeline as P
     fa = P.flutter(case)
-    vals = [m["margin"] for m in fa.margins if m["margin"] is not None]
+    # an altitude without flutter up to the sweep's last speed counts with its lower bound
+    vals = [m["margin"] if m["margin"] is not None else m.get("margin_lower_bound")
+            for m in fa.margins]
+    vals = [v for v in vals if v is not None]
+    exact = [m["margin"] for m in fa.margins if m["margin"] is not None]
     top = case.flight.envelope_mach[1]
     lo, hi = case.flight.envelope_altitude or (-float("inf"), float("inf"))
     div = [d["speed_ms"] for d in fa.divergence if d["speed_ms"] is not None
@@ -79,7 +85,10 @@ def _reanalysis(case, margin: float, div_margin: float | None = None,
         model = P.modal_model(case)
         f = model.frequencies_hz[model.n_rigid:][:n_sep]
         sep = 100.0 * float(min(f[1:] / f[:-1] - 1.0))
-    return {"flutter_margin_pct": pct, "divergence_speed_ms": min(div) if div else None,
+    return {"flutter_margin_pct": pct,
+            "flutter_margin_is_lower_bound": bool(pct is not None
+                                                  and (not exact or min(vals) < min(exact))),
+            "divergence_speed_ms": min(div) if div else None,
             "divergence_margin_pct": 100.0 * min(dm) if dm else None,
             "frequency_separation_pct": sep,
             "meets_constraints": bool(pct is not None and pct >= 100 * margin - 1e-9
