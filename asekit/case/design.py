@@ -30,6 +30,10 @@ baseline values.
 Supported variables: ``thickness.root``, ``thickness.tip`` (flat chordwise profile),
 ``material.youngs_modulus`` (Pa; isotropic, nu fixed, so dK/dE = K / E),
 ``material.density`` (kg/m^3; dM/drho = M_plate / rho, d(mass)/drho = plate mass / rho),
+for an orthotropic material ``material.e1``, ``e2``, ``g12``, ``g13``, ``g23`` (Pa) and
+``material.fibre_angle_deg`` (deg): K is linear in the constitutive matrices Q and G, so dK is
+the stiffness assembled with dQ, dG (:func:`asekit.structure.sensitivity.\
+orthotropic_derivative`; nu12 held fixed; a written g12 keeps g13 and g23 where they were),
 ``support.torsional_stiffness`` and ``support.bending_stiffness`` (N m/rad; a shaft support,
 the latter only where the case has the bending spring: each adds k e e^T to the supported
 system's stiffness on the shaft's pitch / bending coordinate, so dK_r = e e^T there, no mass),
@@ -85,6 +89,7 @@ from asekit.structure.sensitivity import (
     density_derivative,
     element_parts,
     mode_shape_derivatives,
+    orthotropic_stiffness_derivative,
     point_mass_derivative,
     point_mass_position_derivative,
     reduce,
@@ -112,6 +117,11 @@ SWEEP_POINTS = 40
 _THICKNESS = ("thickness.root", "thickness.tip")
 #: isotropic material keys: dK/dE = K / E (nu fixed), dM/drho = M_plate / rho
 _MATERIAL = ("material.youngs_modulus", "material.density")
+#: orthotropic material keys (Pa; the fibre angle in degrees as in the case file): dK from the
+#: derivatives of the constitutive matrices (:func:`asekit.structure.sensitivity.\
+#: orthotropic_stiffness_derivative`); ``material.density`` serves both kinds
+_ORTHO = ("material.e1", "material.e2", "material.g12", "material.g13", "material.g23",
+          "material.fibre_angle_deg")
 #: shaft springs: they enter only the supported system's K (d K_r = e e^T on the shaft's pitch or
 #: bending coordinate)
 _SUPPORT = ("support.torsional_stiffness", "support.bending_stiffness")
@@ -169,11 +179,12 @@ def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default
 def _variable_path(path, where: str) -> str:
     import re
     if isinstance(path, str) and (path in _THICKNESS or path == _TABLE or path in _MATERIAL
-                                  or path in _SUPPORT
+                                  or path in _SUPPORT or path in _ORTHO
                                   or re.fullmatch(_TABLE_ENTRY, path)
                                   or re.fullmatch(_POINT_MASS, path)):
         return path
-    raise DesignError(f"{where}.path must be one of {list(_THICKNESS + _MATERIAL + _SUPPORT)}, "
+    raise DesignError(f"{where}.path must be one of "
+                      f"{list(_THICKNESS + _MATERIAL + _ORTHO + _SUPPORT)}, "
                       f"{_TABLE}, {_TABLE}[i][j], point_mass[i].mass or "
                       f"point_mass[i].position[k] (k = 0: x, 1: y), got {path!r}")
 
@@ -214,7 +225,8 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
         if path in seen:
             raise DesignError(f"{where}.path {path!r} is given twice")
         seen.add(path)
-        lo, hi = _number(v, "lower", where, 0.0), _number(v, "upper", where, 0.0)
+        low = -360.0 if path == "material.fibre_angle_deg" else 0.0      # deg; else >= 0
+        lo, hi = _number(v, "lower", where, low), _number(v, "upper", where, low)
         if not lo < hi:
             raise DesignError(f"{where}: lower ({lo:g}) must be below upper ({hi:g})")
         out.append(DesignVariable(path, lo, hi))
@@ -322,7 +334,7 @@ def case_value(case: Case, path: str) -> float:
         return float(case.thickness.root)
     if path == "thickness.tip":
         return float(case.thickness.tip)
-    if path in _MATERIAL or path in _SUPPORT:
+    if path in _MATERIAL or path in _SUPPORT or path in _ORTHO:
         return _section_value(case, path)
     ij = table_index(path)
     if ij is not None:
@@ -340,9 +352,16 @@ def _section_value(case: Case, path: str) -> float:
     section, key = path.split(".")
     obj = getattr(case, section)
     v = getattr(obj, key, None)
-    if section == "material" and not hasattr(obj, "youngs_modulus"):
-        raise DesignError(f"{path}: the material variables need an isotropic material "
-                          f"(material.kind = 'isotropic')")
+    iso = hasattr(obj, "youngs_modulus")
+    if path == "material.youngs_modulus" and not iso:
+        raise DesignError(f"{path}: needs an isotropic material (material.kind = 'isotropic'; "
+                          f"an orthotropic one varies material.e1, e2, g12, g13, g23, "
+                          f"fibre_angle_deg)")
+    if path in _ORTHO and iso:
+        raise DesignError(f"{path}: needs an orthotropic material (material.kind = "
+                          f"'orthotropic'; an isotropic one varies material.youngs_modulus)")
+    if path == "material.fibre_angle_deg":
+        return math.degrees(float(obj.fibre_angle))
     if section == "support" and obj.kind != "shaft":
         raise DesignError(f"{path}: needs a shaft support (support.kind = 'shaft'), got "
                           f"{obj.kind!r}")
@@ -357,8 +376,10 @@ def with_values(case: Case, paths, values) -> Case:
     pms = list(case.point_masses)
     table = [list(r) for r in th.values] if getattr(th, "is_table", False) else None
     for path, v in zip(paths, values):
-        if path in _MATERIAL or path in _SUPPORT:
+        if path in _MATERIAL or path in _SUPPORT or path in _ORTHO:
             section, key = path.split(".")
+            key, v = (("fibre_angle", math.radians(v)) if key == "fibre_angle_deg"
+                      else (key, v))
             case = dataclasses.replace(case, **{section: dataclasses.replace(
                 getattr(case, section), **{key: float(v)})})
         elif table_index(path) is not None:
@@ -391,6 +412,10 @@ def set_case_values(raw: dict, paths, values) -> dict:
             out["thickness"]["values_m"][i][j] = float(v)
         elif path.split(".")[0] in ("thickness", "material", "support"):
             section, key = path.split(".")
+            if path == "material.g12":
+                # g13 and g23 default to g12 in the case format: keep them where they were
+                for k in ("g13", "g23"):
+                    out["material"].setdefault(k, out["material"]["g12"])
             out.setdefault(section, {})[key] = float(v)
         else:
             pm, axis = out["point_mass"][_point_index(path)], position_axis(path)
@@ -631,6 +656,13 @@ def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts, K, M):
             dK.append(zero)
             dM.append(density_derivative(scatter(mesh, parts.mass()), case.material))
             dm.append(plate_mass / float(case.material.density))
+        elif path in _ORTHO:
+            name = path.split(".")[1]
+            unit = math.pi / 180.0 if name == "fibre_angle_deg" else 1.0      # per degree
+            dK.append(unit * orthotropic_stiffness_derivative(
+                mesh, case.material, "fibre_angle" if name == "fibre_angle_deg" else name))
+            dM.append(zero)
+            dm.append(0.0)
         elif path in _SUPPORT:
             dK.append(zero)
             dM.append(zero)
@@ -830,14 +862,34 @@ class DesignResult:
         return None if self.gradient_check is None else float(np.max(self.gradient_check))
 
 
+def variable_scales(problem: DesignProblem, x0: np.ndarray) -> np.ndarray:
+    """The optimiser's variable scales: |baseline value|, or the bounds' width where the
+    baseline is 0 (a fibre angle, a point mass starting at zero). SLSQP works on v / scale;
+    the gradient check's step is ``rel_step`` times the scale.
+
+    Examples
+    --------
+    >>> p = design_from_dict({"design": {"variable": [
+    ...     {"path": "thickness.tip", "lower": 0.001, "upper": 0.004},
+    ...     {"path": "point_mass[0].mass", "lower": 0.0, "upper": 0.05}]}})
+    >>> variable_scales(p, np.array([0.002, 0.0])).tolist()
+    [0.002, 0.05]
+    """
+    x0 = np.asarray(x0, float)
+    width = np.array([v.upper - v.lower for v in problem.variables])
+    return np.where(x0 != 0.0, np.abs(x0), width)
+
+
 def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.ndarray:
     """Max relative error per variable of the analytic d(mass), dU_f, dmu (the divergence
     eigenvalue) and, with a frequency-separation constraint, dlambda of its modes (the elastic
-    eigenvalues) against central differences of the whole chain (step ``rel_step`` times the value)."""
+    eigenvalues) against central differences of the whole chain (step ``rel_step`` times the
+    value, or the bounds' width where the value is 0: :func:`variable_scales`)."""
     e0 = ev(x0)
+    scale = variable_scales(ev.problem, x0)
     err = np.zeros(x0.size)
     for j in range(x0.size):
-        h = rel_step * x0[j]
+        h = rel_step * scale[j]
         ep, em = ev(x0 + h * np.eye(x0.size)[j]), ev(x0 - h * np.eye(x0.size)[j])
         pairs = [(e0.d_mass[j], (ep.mass_kg - em.mass_kg) / (2 * h))]
         pairs += [(a, (b - c) / (2 * h)) for a, b, c in
@@ -944,33 +996,35 @@ def constraint_activity(ev: Evaluator, e: Evaluation, multipliers=None,
     return tuple(out)
 
 
-def _mass_problem(ev: Evaluator, x0: np.ndarray, m0: float):
-    """SLSQP's (objective, constraints, z0, bounds) of the minimum-mass problem on z = v / x0."""
+def _mass_problem(ev: Evaluator, sc: np.ndarray, m0: float, xb: np.ndarray):
+    """SLSQP's (objective, constraints, z0, bounds) of the minimum-mass problem on z = v / sc
+    (:func:`variable_scales`; xb the baseline values)."""
     def obj(z):
-        e = ev(z * x0)
-        return e.mass_kg / m0, e.d_mass * x0 / m0
+        e = ev(z * sc)
+        return e.mass_kg / m0, e.d_mass * sc / m0
 
-    cons = [{"type": "ineq", "fun": lambda z: _constraint(ev, ev(z * x0))[0],
-             "jac": lambda z: _constraint(ev, ev(z * x0))[1] * x0[None, :]}]
-    cons += smoothness_constraints(ev.paths, x0, ev.problem.table_max_step_m)
-    bounds = [(v.lower / x, v.upper / x) for v, x in zip(ev.problem.variables, x0)]
-    return obj, cons, np.ones(x0.size), bounds
+    cons = [{"type": "ineq", "fun": lambda z: _constraint(ev, ev(z * sc))[0],
+             "jac": lambda z: _constraint(ev, ev(z * sc))[1] * sc[None, :]}]
+    cons += smoothness_constraints(ev.paths, sc, ev.problem.table_max_step_m)
+    bounds = [(v.lower / x, v.upper / x) for v, x in zip(ev.problem.variables, sc)]
+    return obj, cons, xb / sc, bounds
 
 
-def _flutter_speed_problem(ev: Evaluator, x0: np.ndarray, m0: float):
+def _flutter_speed_problem(ev: Evaluator, sc: np.ndarray, m0: float, xb: np.ndarray):
     """SLSQP's (objective, constraints, y0, bounds) of the maximum-flutter-speed problem: on
-    y = (z, t), z = v / x0, maximise t subject to U_f,a / (M a) - 1 - t >= 0 at every envelope
-    altitude (t is then the smallest margin, the epigraph form of max min), the mass equal to
+    y = (z, t), z = v / sc (:func:`variable_scales`), maximise t subject to
+    U_f,a / (M a) - 1 - t >= 0 at every envelope altitude (t is then the smallest margin, the
+    epigraph form of max min), the mass equal to
     the baseline's (mass / m0 - 1 = 0) and the other constraints of the design (divergence,
     frequency separation, smoothness) on z."""
-    n, n_f = x0.size, len(envelope_conditions(ev.case))
+    n, n_f = sc.size, len(envelope_conditions(ev.case))
     fm = ev.problem.flutter_margin
 
     def rows(y):
-        e = ev(y[:n] * x0)
+        e = ev(y[:n] * sc)
         g, dg = _constraint(ev, e)
         s = (1.0 + fm) * (1.0 + CONSTRAINT_SLACK)
-        g, dg = g.copy(), dg * x0[None, :]
+        g, dg = g.copy(), dg * sc[None, :]
         g[:n_f], dg[:n_f] = (g[:n_f] + 1.0) * s - 1.0 - y[n], dg[:n_f] * s   # margin - t
         dt = np.zeros((g.size, 1))
         dt[:n_f] = -1.0
@@ -981,13 +1035,13 @@ def _flutter_speed_problem(ev: Evaluator, x0: np.ndarray, m0: float):
                 "jac": lambda y: np.hstack([c["jac"](y[:n]), np.zeros((c["jac"](y[:n]).shape[0],
                                                                         1))])}
 
-    cons = [{"type": "eq", "fun": lambda y: np.array([ev(y[:n] * x0).mass_kg / m0 - 1.0]),
-             "jac": lambda y: np.append(ev(y[:n] * x0).d_mass * x0 / m0, 0.0)[None, :]},
+    cons = [{"type": "eq", "fun": lambda y: np.array([ev(y[:n] * sc).mass_kg / m0 - 1.0]),
+             "jac": lambda y: np.append(ev(y[:n] * sc).d_mass * sc / m0, 0.0)[None, :]},
             {"type": "ineq", "fun": lambda y: rows(y)[0], "jac": lambda y: rows(y)[1]}]
-    cons += [pad(c) for c in smoothness_constraints(ev.paths, x0, ev.problem.table_max_step_m)]
-    t0 = float(np.min(ev(x0).margins))
-    bounds = [(v.lower / x, v.upper / x) for v, x in zip(ev.problem.variables, x0)]
-    return (lambda y: (-y[n], -np.eye(n + 1)[n]), cons, np.append(np.ones(n), t0),
+    cons += [pad(c) for c in smoothness_constraints(ev.paths, sc, ev.problem.table_max_step_m)]
+    t0 = float(np.min(ev(xb).margins))
+    bounds = [(v.lower / x, v.upper / x) for v, x in zip(ev.problem.variables, sc)]
+    return (lambda y: (-y[n], -np.eye(n + 1)[n]), cons, np.append(xb / sc, t0),
             bounds + [(None, None)])
 
 
@@ -1022,22 +1076,24 @@ def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
     m0 = ev(x0).mass_kg
     history = []
     n = x0.size
+    sc = variable_scales(ev.problem, x0)
 
     def record(y):
-        e = ev(y[:n] * x0)
-        row = {"iteration": len(history) + 1, "values": (y[:n] * x0).tolist(),
+        e = ev(y[:n] * sc)
+        row = {"iteration": len(history) + 1, "values": (y[:n] * sc).tolist(),
                "mass_kg": e.mass_kg, "min_margin_pct": float(np.nanmin(e.margins) * 100)}
         history.append(row)
         if progress is not None:
             progress(row)
 
     speed = ev.problem.objective == "flutter_speed"
-    obj, constraints, y0, bounds = (_flutter_speed_problem if speed else _mass_problem)(ev, x0, m0)
+    obj, constraints, y0, bounds = (_flutter_speed_problem if speed else _mass_problem)(ev, sc, m0,
+                                                                                        x0)
     res = minimize(obj, y0, jac=True, method="SLSQP", bounds=bounds, constraints=constraints,
                    options={"maxiter": problem.max_iterations, "ftol": 1e-6 if not speed
                             else 1e-9}, callback=record)
     variables = ev.problem.variables
-    x = np.clip(res.x[:n] * x0, [v.lower for v in variables], [v.upper for v in variables])
+    x = np.clip(res.x[:n] * sc, [v.lower for v in variables], [v.upper for v in variables])
     opt = ev(x)
     activity = constraint_activity(ev, opt, res.get("multipliers"),
                                    float(res.x[n]) if speed else None, m0)
