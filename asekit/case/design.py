@@ -28,6 +28,15 @@ once), the p-k flutter point and dU_f (:mod:`asekit.aeroelastic.sensitivity`). T
 baseline values.
 
 Supported variables: ``thickness.root``, ``thickness.tip`` (flat chordwise profile),
+``material.youngs_modulus`` (Pa; isotropic, nu fixed, so dK/dE = K / E),
+``material.density`` (kg/m^3; dM/drho = M_plate / rho, d(mass)/drho = plate mass / rho),
+for an orthotropic material ``material.e1``, ``e2``, ``g12``, ``g13``, ``g23`` (Pa) and
+``material.fibre_angle_deg`` (deg): K is linear in the constitutive matrices Q and G, so dK is
+the stiffness assembled with dQ, dG (:func:`asekit.structure.sensitivity.\
+orthotropic_derivative`; nu12 held fixed; a written g12 keeps g13 and g23 where they were),
+``support.torsional_stiffness`` and ``support.bending_stiffness`` (N m/rad; a shaft support,
+the latter only where the case has the bending spring: each adds k e e^T to the supported
+system's stiffness on the shaft's pitch / bending coordinate, so dK_r = e e^T there, no mass),
 ``point_mass[i].mass`` (kg), ``point_mass[i].position[0]`` and ``point_mass[i].position[1]``
 (its x, chordwise, and y, spanwise, m: dM/dx = m (N_x N^T + N N_x^T) through the shape
 functions of the element holding it, :func:`asekit.structure.sensitivity.\
@@ -43,8 +52,10 @@ bounds the difference of adjacent table values (a linear smoothness constraint,
 ``clamped_root``, undamped (no ``[damping]``). ``design.divergence_margin`` adds the divergence
 of the elastic modes at the top Mach as a constraint, U_D >= (1 + margin) M a per envelope
 altitude, written 1 - q_a mu >= 0 with mu = 1 / q_D and its analytic derivative
-(:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`). Frequency separation and the
-servo requirements are not constraints yet.
+(:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`). ``design.frequency_separation``
+(with ``design.frequency_separation_modes`` = n, default 2) asks f_{i+1} / f_i - 1 >= the value
+for the first n elastic modes (:func:`separation_constraint`, Fox-Kapoor eigenvalue
+derivatives). The servo requirements are not constraints yet.
 """
 
 from __future__ import annotations
@@ -56,6 +67,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 
 from asekit.aero.gaf import TabulatedGaf
 from asekit.aero.methods import AERO_METHODS, resolve_method
@@ -74,16 +86,24 @@ from asekit.case.schema import Case, CaseError
 from asekit.structure.assembly import clamped_edge, shaft_support
 from asekit.structure.modes import ModalModel, normal_modes, select_modes
 from asekit.structure.sensitivity import (
+    density_derivative,
     element_parts,
     mode_shape_derivatives,
+    orthotropic_stiffness_derivative,
     point_mass_derivative,
     point_mass_position_derivative,
     reduce,
+    scatter,
     thickness_derivatives,
+    youngs_modulus_derivative,
 )
 from asekit.util.validate import read_toml
 
-OBJECTIVES = ("mass",)
+OBJECTIVES = ("mass", "flutter_speed")
+#: A constraint counts as active at the optimum where its normalised row g (the value the
+#: optimiser keeps >= 0: e.g. U_f / ((1 + margin)(1 + slack) M a) - 1, or (step - |dv|) / step
+#: for the smoothness of a thickness table) is at most this.
+ACTIVE_TOL = 1e-3
 #: The optimiser asks for U_f >= (1 + margin) M a (1 + CONSTRAINT_SLACK): the re-analysis by the
 #: case pipeline (FN2 modes, its own GAF database) differs from the optimiser's chain (FN1 modes,
 #: the same boxes) by ~1e-7 relative, and SLSQP meets an active constraint only to its tolerance.
@@ -95,6 +115,16 @@ CONSTRAINT_SLACK = 1e-4
 #: re-analysis of ``asekit optimise``, which runs the case's own sweep.
 SWEEP_POINTS = 40
 _THICKNESS = ("thickness.root", "thickness.tip")
+#: isotropic material keys: dK/dE = K / E (nu fixed), dM/drho = M_plate / rho
+_MATERIAL = ("material.youngs_modulus", "material.density")
+#: orthotropic material keys (Pa; the fibre angle in degrees as in the case file): dK from the
+#: derivatives of the constitutive matrices (:func:`asekit.structure.sensitivity.\
+#: orthotropic_stiffness_derivative`); ``material.density`` serves both kinds
+_ORTHO = ("material.e1", "material.e2", "material.g12", "material.g13", "material.g23",
+          "material.fibre_angle_deg")
+#: shaft springs: they enter only the supported system's K (d K_r = e e^T on the shaft's pitch or
+#: bending coordinate)
+_SUPPORT = ("support.torsional_stiffness", "support.bending_stiffness")
 _TABLE = "thickness.values_m"
 _TABLE_ENTRY = r"thickness\.values_m\[(\d+)\]\[(\d+)\]"
 _POINT_MASS = r"point_mass\[(\d+)\]\.(mass|position\[([01])\])"
@@ -121,7 +151,8 @@ class DesignProblem:
     difference of adjacent thickness-table values, None: unconstrained), ``gradient_step``
     (the central differences' relative step of the gradient check), ``divergence_margin`` (a
     fraction: U_D >= (1 + margin) M a at every envelope altitude; None: divergence is reported,
-    not constrained)."""
+    not constrained), ``frequency_separation`` (a fraction: f_{i+1} / f_i - 1 >= it for the
+    first ``frequency_separation_modes`` elastic modes; None: not constrained)."""
 
     variables: tuple[DesignVariable, ...]
     objective: str = "mass"
@@ -131,6 +162,8 @@ class DesignProblem:
     table_max_step_m: float | None = None
     gradient_step: float = 1e-4
     divergence_margin: float | None = None
+    frequency_separation: float | None = None
+    frequency_separation_modes: int = 2
 
 
 def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default=None):
@@ -145,13 +178,15 @@ def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default
 
 def _variable_path(path, where: str) -> str:
     import re
-    if isinstance(path, str) and (path in _THICKNESS or path == _TABLE
+    if isinstance(path, str) and (path in _THICKNESS or path == _TABLE or path in _MATERIAL
+                                  or path in _SUPPORT or path in _ORTHO
                                   or re.fullmatch(_TABLE_ENTRY, path)
                                   or re.fullmatch(_POINT_MASS, path)):
         return path
-    raise DesignError(f"{where}.path must be one of {list(_THICKNESS)}, {_TABLE}, "
-                      f"{_TABLE}[i][j], point_mass[i].mass or point_mass[i].position[k] "
-                      f"(k = 0: x, 1: y), got {path!r}")
+    raise DesignError(f"{where}.path must be one of "
+                      f"{list(_THICKNESS + _MATERIAL + _ORTHO + _SUPPORT)}, "
+                      f"{_TABLE}, {_TABLE}[i][j], point_mass[i].mass or "
+                      f"point_mass[i].position[k] (k = 0: x, 1: y), got {path!r}")
 
 
 def design_from_dict(d: dict, source: str = "") -> DesignProblem:
@@ -168,10 +203,12 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
         raise DesignError("a design file needs a [design] table")
     t = d["design"]
     unknown = set(t) - {"objective", "flutter_margin", "max_iterations", "variable",
-                        "table_max_step_m", "gradient_step", "divergence_margin"}
+                        "table_max_step_m", "gradient_step", "divergence_margin",
+                        "frequency_separation", "frequency_separation_modes"}
     if unknown:
         raise DesignError(f"design: unknown keys {sorted(unknown)} (known: divergence_margin, "
-                          f"objective, flutter_margin, gradient_step, max_iterations, "
+                          f"objective, flutter_margin, frequency_separation, "
+                          f"frequency_separation_modes, gradient_step, max_iterations, "
                           f"table_max_step_m, variable)")
     objective = t.get("objective", "mass")
     if objective not in OBJECTIVES:
@@ -188,7 +225,8 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
         if path in seen:
             raise DesignError(f"{where}.path {path!r} is given twice")
         seen.add(path)
-        lo, hi = _number(v, "lower", where, 0.0), _number(v, "upper", where, 0.0)
+        low = -360.0 if path == "material.fibre_angle_deg" else 0.0      # deg; else >= 0
+        lo, hi = _number(v, "lower", where, low), _number(v, "upper", where, low)
         if not lo < hi:
             raise DesignError(f"{where}: lower ({lo:g}) must be below upper ({hi:g})")
         out.append(DesignVariable(path, lo, hi))
@@ -201,7 +239,22 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
     gstep = _number(t, "gradient_step", "design", 1e-8, 0.1, 1e-4)
     div = (None if "divergence_margin" not in t
            else _number(t, "divergence_margin", "design", 0.0, 10.0))
-    return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep, div)
+    sep, n_sep = _separation(t)
+    return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep, div,
+                         sep, n_sep)
+
+
+def _separation(t: dict) -> tuple[float | None, int]:
+    """``design.frequency_separation`` (a fraction in [0, 10] or absent) and
+    ``design.frequency_separation_modes`` (an integer in [2, 50], default 2)."""
+    sep = (None if "frequency_separation" not in t
+           else _number(t, "frequency_separation", "design", 0.0, 10.0))
+    n = _number(t, "frequency_separation_modes", "design", 2, 50, 2)
+    if n != int(n):
+        raise DesignError(f"design.frequency_separation_modes must be an integer, got {n!r}")
+    if sep is None and "frequency_separation_modes" in t:
+        raise DesignError("design.frequency_separation_modes needs design.frequency_separation")
+    return sep, int(n)
 
 
 def table_index(path: str) -> tuple[int, int] | None:
@@ -281,6 +334,8 @@ def case_value(case: Case, path: str) -> float:
         return float(case.thickness.root)
     if path == "thickness.tip":
         return float(case.thickness.tip)
+    if path in _MATERIAL or path in _SUPPORT or path in _ORTHO:
+        return _section_value(case, path)
     ij = table_index(path)
     if ij is not None:
         return float(case.thickness.values[ij[0]][ij[1]])
@@ -292,13 +347,42 @@ def case_value(case: Case, path: str) -> float:
     return float(pm.mass if axis is None else pm.position[axis])
 
 
+def _section_value(case: Case, path: str) -> float:
+    """A material or support key's value; DesignError where the case has no such number."""
+    section, key = path.split(".")
+    obj = getattr(case, section)
+    v = getattr(obj, key, None)
+    iso = hasattr(obj, "youngs_modulus")
+    if path == "material.youngs_modulus" and not iso:
+        raise DesignError(f"{path}: needs an isotropic material (material.kind = 'isotropic'; "
+                          f"an orthotropic one varies material.e1, e2, g12, g13, g23, "
+                          f"fibre_angle_deg)")
+    if path in _ORTHO and iso:
+        raise DesignError(f"{path}: needs an orthotropic material (material.kind = "
+                          f"'orthotropic'; an isotropic one varies material.youngs_modulus)")
+    if path == "material.fibre_angle_deg":
+        return math.degrees(float(obj.fibre_angle))
+    if section == "support" and obj.kind != "shaft":
+        raise DesignError(f"{path}: needs a shaft support (support.kind = 'shaft'), got "
+                          f"{obj.kind!r}")
+    if v is None:
+        raise DesignError(f"{path}: the case has no {path} to vary (add it to the case file)")
+    return float(v)
+
+
 def with_values(case: Case, paths, values) -> Case:
     """The case with the design variables' keys set to ``values``."""
     th = case.thickness
     pms = list(case.point_masses)
     table = [list(r) for r in th.values] if getattr(th, "is_table", False) else None
     for path, v in zip(paths, values):
-        if table_index(path) is not None:
+        if path in _MATERIAL or path in _SUPPORT or path in _ORTHO:
+            section, key = path.split(".")
+            key, v = (("fibre_angle", math.radians(v)) if key == "fibre_angle_deg"
+                      else (key, v))
+            case = dataclasses.replace(case, **{section: dataclasses.replace(
+                getattr(case, section), **{key: float(v)})})
+        elif table_index(path) is not None:
             i, j = table_index(path)
             table[i][j] = float(v)
         elif path == "thickness.root":
@@ -326,8 +410,13 @@ def set_case_values(raw: dict, paths, values) -> dict:
         if table_index(path) is not None:
             i, j = table_index(path)
             out["thickness"]["values_m"][i][j] = float(v)
-        elif path.startswith("thickness."):
-            out.setdefault("thickness", {})[path.split(".")[1]] = float(v)
+        elif path.split(".")[0] in ("thickness", "material", "support"):
+            section, key = path.split(".")
+            if path == "material.g12":
+                # g13 and g23 default to g12 in the case format: keep them where they were
+                for k in ("g13", "g23"):
+                    out["material"].setdefault(k, out["material"]["g12"])
+            out.setdefault(section, {})[key] = float(v)
         else:
             pm, axis = out["point_mass"][_point_index(path)], position_axis(path)
             if axis is None:
@@ -415,7 +504,8 @@ class Evaluation:
     values : (n_var,) the design; mass_kg, d_mass (n_var,); speeds_ms (n_cond,) U_f per envelope
     altitude (NaN: no flutter in the velocity sweep); d_speeds (n_cond, n_var); envelope_ms
     (n_cond,) M a; margins (n_cond,) U_f / (M a) - 1; frequencies_hz (n_cond,) at flutter;
-    densities (n_cond,) kg/m^3; divergence_mu : 1 / q_D (1/Pa) of the elastic modes at the top
+    densities (n_cond,) kg/m^3; eigenvalues (n,) omega_i^2 (rad^2/s^2) of the elastic modes and
+    d_eigenvalues (n_var, n) (Fox-Kapoor); divergence_mu : 1 / q_D (1/Pa) of the elastic modes at the top
     Mach (:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`; <= 0: no divergence,
     NaN: no real eigenvalue), d_divergence_mu (n_var,).
     """
@@ -430,6 +520,13 @@ class Evaluation:
     densities: np.ndarray = field(default_factory=lambda: np.zeros(0))
     divergence_mu: float = math.nan
     d_divergence_mu: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    eigenvalues: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    d_eigenvalues: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+
+    @property
+    def elastic_frequencies_hz(self) -> np.ndarray:
+        """f_i = sqrt(lambda_i) / 2 pi of the elastic modes (Hz)."""
+        return np.sqrt(np.maximum(self.eigenvalues, 0.0)) / (2 * math.pi)
 
     @property
     def margins(self) -> np.ndarray:
@@ -462,6 +559,10 @@ class Evaluator:
         check_case(self.case, self.problem)
         base = P.modal_model(self.case)
         self.n_elastic = base.frequencies_hz.size - base.n_rigid
+        n_sep = self.problem.frequency_separation_modes
+        if self.problem.frequency_separation is not None and n_sep > self.n_elastic:
+            raise DesignError(f"design.frequency_separation_modes = {n_sep}: the case has "
+                              f"{self.n_elastic} elastic modes (modes.count / modes.f_max)")
         a = self.case.aero
         mach = self.mach
         spec = AERO_METHODS[resolve_method(a.method, mach)]
@@ -532,10 +633,13 @@ def _table_dh(mesh, parts, ij):
     return out
 
 
-def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts):
-    """Global dK, dM (fin DOFs) and d(mass) per design variable."""
+def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts, K, M):
+    """Global dK, dM (fin DOFs) and d(mass) per design variable (a shaft spring's are zero
+    here: it acts on the supported system only, :func:`_support_derivative`)."""
     dK, dM, dm = [], [], []
     w_mass = parts.Mt[:, :, 0::3, 0::3].sum(axis=(2, 3))         # (ne, ng): rho w det per point
+    plate_mass = float(np.sum(w_mass * parts.h_m))
+    zero = 0 * M
     for path in ev.paths:
         if path in _THICKNESS or table_index(path) is not None:
             dh_k, dh_m = (_thickness_dh(mesh, parts, path) if path in _THICKNESS
@@ -544,6 +648,25 @@ def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts):
             dK.append(k[0])
             dM.append(m[0])
             dm.append(float(np.sum(w_mass * dh_m)))
+        elif path == "material.youngs_modulus":
+            dK.append(youngs_modulus_derivative(K, case.material))
+            dM.append(zero)
+            dm.append(0.0)
+        elif path == "material.density":
+            dK.append(zero)
+            dM.append(density_derivative(scatter(mesh, parts.mass()), case.material))
+            dm.append(plate_mass / float(case.material.density))
+        elif path in _ORTHO:
+            name = path.split(".")[1]
+            unit = math.pi / 180.0 if name == "fibre_angle_deg" else 1.0      # per degree
+            dK.append(unit * orthotropic_stiffness_derivative(
+                mesh, case.material, "fibre_angle" if name == "fibre_angle_deg" else name))
+            dM.append(zero)
+            dm.append(0.0)
+        elif path in _SUPPORT:
+            dK.append(zero)
+            dM.append(zero)
+            dm.append(0.0)
         elif position_axis(path) is None:
             pm = case.point_masses[_point_index(path)]
             dM.append(point_mass_derivative(mesh, pm.position))
@@ -555,8 +678,20 @@ def _matrix_derivatives(ev: Evaluator, case: Case, mesh, parts):
                                                      position_axis(path)))
             dK.append(0 * dM[-1])
             dm.append(0.0)                  # moving a mass does not change the total
-    mass = float(np.sum(w_mass * parts.h_m)) + sum(p.mass for p in case.point_masses)
+    mass = plate_mass + sum(p.mass for p in case.point_masses)
     return dK, dM, mass, np.array(dm)
+
+
+def _support_derivative(system, path: str):
+    """dK_r of a shaft spring in the FN1 system's coordinates: e_s e_s^T on the shaft's pitch
+    coordinate (``support.torsional_stiffness``; :func:`asekit.structure.assembly.shaft_support`
+    adds k there) or on the bending coordinate, the last one (``support.bending_stiffness``);
+    None for any other variable. The springs carry no mass."""
+    if path not in _SUPPORT:
+        return None
+    n = system.K.shape[0]
+    i = system.shaft_index if path == "support.torsional_stiffness" else n - 1
+    return sp.csr_matrix(([1.0], ([i], [i])), shape=(n, n))
 
 
 def _gafs(ev: Evaluator, mesh, shapes: np.ndarray) -> np.ndarray:
@@ -608,10 +743,14 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
     mesh = P.structural_mesh(case)
     K, M = P.mass_and_stiffness(case)
     parts = element_parts(mesh, case.material)
-    dK, dM, mass, d_mass = _matrix_derivatives(ev, case, mesh, parts)
+    dK, dM, mass, d_mass = _matrix_derivatives(ev, case, mesh, parts, K, M)
     system = _system(case, mesh, K, M)
     lam, q = _elastic_modes(system, M, ev.n_elastic)
     dKr = [reduce(system.T, a) for a in dK]
+    for j, path in enumerate(ev.paths):
+        extra = _support_derivative(system, path)
+        if extra is not None:
+            dKr[j] = dKr[j] + extra
     dMr = [reduce(system.T, a) for a in dM]
     dlam, dq = mode_shape_derivatives(system.K, system.M, lam, q, dKr, dMr)
     n = lam.size
@@ -633,7 +772,8 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
                       envelope_ms=np.array([ev.mach * c.speed_of_sound for c in conds]),
                       frequencies_hz=np.array([o[1] for o in out]),
                       densities=np.array([c.density for c in conds]),
-                      divergence_mu=div.mu, d_divergence_mu=div.d_mu)
+                      divergence_mu=div.mu, d_divergence_mu=div.d_mu,
+                      eigenvalues=np.asarray(lam, float), d_eigenvalues=np.asarray(dlam, float))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -645,10 +785,39 @@ def _constraint(ev: Evaluator, e: Evaluation):
     u = np.where(np.isnan(e.speeds_ms), ev.case.flight.velocities[-1], e.speeds_ms)
     scale = (1.0 + ev.problem.flutter_margin) * (1.0 + CONSTRAINT_SLACK) * e.envelope_ms
     g, dg = u / scale - 1.0, e.d_speeds / scale[:, None]
-    if ev.problem.divergence_margin is None:
-        return g, dg
-    gd, dgd = _divergence_constraint(ev.problem.divergence_margin, e)
-    return np.concatenate([g, gd]), np.vstack([dg, dgd])
+    if ev.problem.divergence_margin is not None:
+        gd, dgd = _divergence_constraint(ev.problem.divergence_margin, e)
+        g, dg = np.concatenate([g, gd]), np.vstack([dg, dgd])
+    if ev.problem.frequency_separation is not None:
+        gs, dgs = separation_constraint(ev.problem.frequency_separation,
+                                        ev.problem.frequency_separation_modes, e)
+        g, dg = np.concatenate([g, gs]), np.vstack([dg, dgs])
+    return g, dg
+
+
+def separation_constraint(separation: float, n_modes: int, e: Evaluation):
+    """g_i = sqrt(lambda_{i+1} / lambda_i) / ((1 + s)(1 + slack)) - 1 >= 0, i = 0 .. n - 2:
+    f_{i+1} / f_i - 1 >= s for the first ``n_modes`` elastic modes (in ascending order), and
+    its gradient from the eigenvalue derivatives (Fox & Kapoor 1968, Eq. 8):
+    dg_i = r_i / (2 (1 + s)(1 + slack)) (dlambda_{i+1} / lambda_{i+1} - dlambda_i / lambda_i),
+    r_i = f_{i+1} / f_i. Smooth while the modes stay distinct (at a crossing the ascending
+    order swaps, and the separation is zero there anyway).
+
+    Examples
+    --------
+    >>> e = Evaluation(values=np.zeros(1), mass_kg=1.0, d_mass=np.zeros(1), speeds_ms=np.zeros(0),
+    ...                d_speeds=np.zeros((0, 1)), envelope_ms=np.zeros(0),
+    ...                frequencies_hz=np.zeros(0), eigenvalues=np.array([1.0, 4.0]),
+    ...                d_eigenvalues=np.array([[1.0, 0.0]]))
+    >>> g, dg = separation_constraint(0.5, 2, e)         # f2 / f1 = 2 >= 1.5
+    >>> round(float(g[0]), 4), round(float(dg[0, 0]), 4)
+    (0.3332, -0.6666)
+    """
+    lam, dlam = e.eigenvalues[:n_modes], e.d_eigenvalues[:, :n_modes]
+    scale = (1.0 + separation) * (1.0 + CONSTRAINT_SLACK)
+    r = np.sqrt(lam[1:] / lam[:-1])
+    dr = 0.5 * r[None, :] * (dlam[:, 1:] / lam[1:] - dlam[:, :-1] / lam[:-1])
+    return r / scale - 1.0, (dr / scale).T
 
 
 def _divergence_constraint(margin: float, e: Evaluation):
@@ -671,7 +840,9 @@ class DesignResult:
     min_margin_pct); success, message : the optimiser's verdict; evaluations : chain
     evaluations; seconds : wall time; gradient_check : (n_var,) max relative error of the
     analytic gradients (mass and flutter speeds) against central differences at the baseline
-    (None when not checked); gradient_check_seconds : the time of those differences.
+    (None when not checked); gradient_check_seconds : the time of those differences;
+    constraints : the constraint activity at the optimum, one dict per constraint
+    (:func:`constraint_activity`).
     """
 
     paths: tuple[str, ...]
@@ -684,23 +855,49 @@ class DesignResult:
     seconds: float
     gradient_check: np.ndarray | None = None
     gradient_check_seconds: float = 0.0
+    constraints: tuple[dict, ...] = ()
 
     @property
     def max_rel_error(self) -> float | None:
         return None if self.gradient_check is None else float(np.max(self.gradient_check))
 
 
+def variable_scales(problem: DesignProblem, x0: np.ndarray) -> np.ndarray:
+    """The optimiser's variable scales: |baseline value|, or the bounds' width where the
+    baseline is 0 (a fibre angle, a point mass starting at zero). SLSQP works on v / scale;
+    the gradient check's step is ``rel_step`` times the scale.
+
+    Examples
+    --------
+    >>> p = design_from_dict({"design": {"variable": [
+    ...     {"path": "thickness.tip", "lower": 0.001, "upper": 0.004},
+    ...     {"path": "point_mass[0].mass", "lower": 0.0, "upper": 0.05}]}})
+    >>> variable_scales(p, np.array([0.002, 0.0])).tolist()
+    [0.002, 0.05]
+    """
+    x0 = np.asarray(x0, float)
+    width = np.array([v.upper - v.lower for v in problem.variables])
+    return np.where(x0 != 0.0, np.abs(x0), width)
+
+
 def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.ndarray:
-    """Max relative error per variable of the analytic d(mass), dU_f and dmu (the divergence
-    eigenvalue) against central differences of the whole chain (step ``rel_step`` times the value)."""
+    """Max relative error per variable of the analytic d(mass), dU_f, dmu (the divergence
+    eigenvalue) and, with a frequency-separation constraint, dlambda of its modes (the elastic
+    eigenvalues) against central differences of the whole chain (step ``rel_step`` times the
+    value, or the bounds' width where the value is 0: :func:`variable_scales`)."""
     e0 = ev(x0)
+    scale = variable_scales(ev.problem, x0)
     err = np.zeros(x0.size)
     for j in range(x0.size):
-        h = rel_step * x0[j]
+        h = rel_step * scale[j]
         ep, em = ev(x0 + h * np.eye(x0.size)[j]), ev(x0 - h * np.eye(x0.size)[j])
         pairs = [(e0.d_mass[j], (ep.mass_kg - em.mass_kg) / (2 * h))]
         pairs += [(a, (b - c) / (2 * h)) for a, b, c in
                   zip(e0.d_speeds[:, j], ep.speeds_ms, em.speeds_ms) if np.isfinite(b - c)]
+        if ev.problem.frequency_separation is not None:
+            n_sep = ev.problem.frequency_separation_modes
+            pairs += [(a, (b - c) / (2 * h)) for a, b, c in
+                      zip(e0.d_eigenvalues[j, :n_sep], ep.eigenvalues, em.eigenvalues)]
         if np.isfinite(ep.divergence_mu - em.divergence_mu):
             pairs.append((e0.d_divergence_mu[j], (ep.divergence_mu - em.divergence_mu) / (2 * h)))
         err[j] = max(abs(a - f) / max(abs(f), 1e-300) for a, f in pairs)
@@ -731,10 +928,129 @@ def smoothness_constraints(paths, x0: np.ndarray, step: float | None) -> list:
     return [{"type": "ineq", "fun": lambda z: step + A @ z, "jac": lambda z: A}]
 
 
+def constraint_names(ev: Evaluator, e: Evaluation) -> list[tuple[str, float, float]]:
+    """(name, value, bound) of each row of :func:`_constraint`, in its order: the flutter margin
+    per envelope altitude (U_f / (M a) - 1 against ``flutter_margin``), the divergence margin
+    (U_D / (M a) - 1; inf: no divergence), the frequency separations (f_{i+1} / f_i - 1)."""
+    pr = ev.problem
+    alts = [c.altitude for c in envelope_conditions(ev.case)]
+    u = np.where(np.isnan(e.speeds_ms), ev.case.flight.velocities[-1], e.speeds_ms)
+    rows = [(f"flutter_margin[{a:g} m]", float(m), pr.flutter_margin)
+            for a, m in zip(alts, u / e.envelope_ms - 1.0)]
+    if pr.divergence_margin is not None:
+        rows += [(f"divergence_margin[{a:g} m]", float(ud / ue - 1.0), pr.divergence_margin)
+                 for a, ud, ue in zip(alts, e.divergence_speeds_ms, e.envelope_ms)]
+    if pr.frequency_separation is not None:
+        f = e.elastic_frequencies_hz[:pr.frequency_separation_modes]
+        rows += [(f"frequency_separation[f{i + 2}/f{i + 1}]", float(f[i + 1] / f[i] - 1.0),
+                  pr.frequency_separation) for i in range(f.size - 1)]
+    return rows
+
+
+def constraint_activity(ev: Evaluator, e: Evaluation, multipliers=None,
+                        epigraph: float | None = None,
+                        baseline_mass: float | None = None) -> tuple[dict, ...]:
+    """The constraints at the design ``e``: one dict {name, value, bound, active, multiplier}
+    per constraint, ``active`` where the normalised row g <= :data:`ACTIVE_TOL`.
+
+    Values are the physical ones (margins and separations as fractions, the smoothness steps and
+    their bound in m, the mass in kg). ``multipliers`` are SLSQP's KKT multipliers in its order
+    (the mass equality first, then :func:`_constraint`'s rows, then the smoothness rows -D, +D)
+    for the scaled problem (variables over their baseline values, rows as normalised here);
+    None: not reported. With the ``flutter_speed`` objective, ``epigraph`` is the maximised
+    smallest margin t: the flutter rows are U_f / (M a) - 1 - t >= 0, bound t, and the mass
+    equality (bound ``baseline_mass``, kg) leads the list.
+    """
+    mult = None if multipliers is None else list(np.asarray(multipliers, float))
+    out = []
+
+    def take(n):
+        if mult is None:
+            return [None] * n
+        got, mult[:n] = mult[:n], []
+        return [float(m) for m in got]
+
+    if epigraph is not None:
+        out.append({"name": "mass_kg (equality)", "value": e.mass_kg, "bound": baseline_mass,
+                    "active": True, "multiplier": take(1)[0]})
+    g = _constraint(ev, e)[0]
+    names = constraint_names(ev, e)
+    if epigraph is not None:
+        n_f = len(envelope_conditions(ev.case))
+        names[:n_f] = [(nm, v, epigraph) for nm, v, _ in names[:n_f]]
+        g = g.copy()
+        g[:n_f] = np.array([v for _, v, _ in names[:n_f]]) - epigraph
+    for (name, value, bound), gi, m in zip(names, g, take(len(names))):
+        out.append({"name": name, "value": value if math.isfinite(value) else None,
+                    "bound": bound, "active": bool(gi <= ACTIVE_TOL), "multiplier": m})
+    step = ev.problem.table_max_step_m
+    D = smoothness_matrix(ev.paths)
+    if step is not None and D.shape[0]:
+        ms = take(2 * D.shape[0])
+        for r, dv in enumerate(D @ e.values):
+            a, b = (ev.paths[k] for k in np.flatnonzero(D[r]))
+            m = None if ms[0] is None else ms[r] + ms[r + D.shape[0]]
+            out.append({"name": f"table_step[{a} - {b}]", "value": float(abs(dv)),
+                        "bound": step, "active": bool((step - abs(dv)) / step <= ACTIVE_TOL),
+                        "multiplier": m})
+    return tuple(out)
+
+
+def _mass_problem(ev: Evaluator, sc: np.ndarray, m0: float, xb: np.ndarray):
+    """SLSQP's (objective, constraints, z0, bounds) of the minimum-mass problem on z = v / sc
+    (:func:`variable_scales`; xb the baseline values)."""
+    def obj(z):
+        e = ev(z * sc)
+        return e.mass_kg / m0, e.d_mass * sc / m0
+
+    cons = [{"type": "ineq", "fun": lambda z: _constraint(ev, ev(z * sc))[0],
+             "jac": lambda z: _constraint(ev, ev(z * sc))[1] * sc[None, :]}]
+    cons += smoothness_constraints(ev.paths, sc, ev.problem.table_max_step_m)
+    bounds = [(v.lower / x, v.upper / x) for v, x in zip(ev.problem.variables, sc)]
+    return obj, cons, xb / sc, bounds
+
+
+def _flutter_speed_problem(ev: Evaluator, sc: np.ndarray, m0: float, xb: np.ndarray):
+    """SLSQP's (objective, constraints, y0, bounds) of the maximum-flutter-speed problem: on
+    y = (z, t), z = v / sc (:func:`variable_scales`), maximise t subject to
+    U_f,a / (M a) - 1 - t >= 0 at every envelope altitude (t is then the smallest margin, the
+    epigraph form of max min), the mass equal to
+    the baseline's (mass / m0 - 1 = 0) and the other constraints of the design (divergence,
+    frequency separation, smoothness) on z."""
+    n, n_f = sc.size, len(envelope_conditions(ev.case))
+    fm = ev.problem.flutter_margin
+
+    def rows(y):
+        e = ev(y[:n] * sc)
+        g, dg = _constraint(ev, e)
+        s = (1.0 + fm) * (1.0 + CONSTRAINT_SLACK)
+        g, dg = g.copy(), dg * sc[None, :]
+        g[:n_f], dg[:n_f] = (g[:n_f] + 1.0) * s - 1.0 - y[n], dg[:n_f] * s   # margin - t
+        dt = np.zeros((g.size, 1))
+        dt[:n_f] = -1.0
+        return g, np.hstack([dg, dt])
+
+    def pad(c):
+        return {"type": c["type"], "fun": lambda y: c["fun"](y[:n]),
+                "jac": lambda y: np.hstack([c["jac"](y[:n]), np.zeros((c["jac"](y[:n]).shape[0],
+                                                                        1))])}
+
+    cons = [{"type": "eq", "fun": lambda y: np.array([ev(y[:n] * sc).mass_kg / m0 - 1.0]),
+             "jac": lambda y: np.append(ev(y[:n] * sc).d_mass * sc / m0, 0.0)[None, :]},
+            {"type": "ineq", "fun": lambda y: rows(y)[0], "jac": lambda y: rows(y)[1]}]
+    cons += [pad(c) for c in smoothness_constraints(ev.paths, sc, ev.problem.table_max_step_m)]
+    t0 = float(np.min(ev(xb).margins))
+    bounds = [(v.lower / x, v.upper / x) for v, x in zip(ev.problem.variables, sc)]
+    return (lambda y: (-y[n], -np.eye(n + 1)[n]), cons, np.append(xb / sc, t0),
+            bounds + [(None, None)])
+
+
 def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
              progress=None, evaluator: Evaluator | None = None) -> DesignResult:
-    """Minimise the mass subject to the flutter margin (module docstring) with SLSQP and the
-    analytic gradients; variables scaled by their baseline values.
+    """Minimise the mass subject to the flutter margin (``objective = "mass"``), or maximise the
+    smallest envelope flutter margin at the baseline's mass (``"flutter_speed"``,
+    :func:`_flutter_speed_problem`), with SLSQP and the analytic gradients; variables scaled by
+    their baseline values; the other constraints (module docstring) in both.
 
     Parameters
     ----------
@@ -746,7 +1062,7 @@ def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
 
     Returns
     -------
-    :class:`DesignResult`.
+    :class:`DesignResult` with the constraint activity at the optimum.
     """
     from scipy.optimize import minimize
     t0 = time.perf_counter()
@@ -759,35 +1075,30 @@ def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
         t_check = time.perf_counter() - tc
     m0 = ev(x0).mass_kg
     history = []
+    n = x0.size
+    sc = variable_scales(ev.problem, x0)
 
-    def obj(z):
-        e = ev(z * x0)
-        return e.mass_kg / m0, e.d_mass * x0 / m0
-
-    def cons(z):
-        return _constraint(ev, ev(z * x0))[0]
-
-    def cons_jac(z):
-        return _constraint(ev, ev(z * x0))[1] * x0[None, :]
-
-    def record(z):
-        e = ev(z * x0)
-        row = {"iteration": len(history) + 1, "values": (z * x0).tolist(),
+    def record(y):
+        e = ev(y[:n] * sc)
+        row = {"iteration": len(history) + 1, "values": (y[:n] * sc).tolist(),
                "mass_kg": e.mass_kg, "min_margin_pct": float(np.nanmin(e.margins) * 100)}
         history.append(row)
         if progress is not None:
             progress(row)
 
+    speed = ev.problem.objective == "flutter_speed"
+    obj, constraints, y0, bounds = (_flutter_speed_problem if speed else _mass_problem)(ev, sc, m0,
+                                                                                        x0)
+    res = minimize(obj, y0, jac=True, method="SLSQP", bounds=bounds, constraints=constraints,
+                   options={"maxiter": problem.max_iterations, "ftol": 1e-6 if not speed
+                            else 1e-9}, callback=record)
     variables = ev.problem.variables
-    bounds = [(v.lower / x, v.upper / x) for v, x in zip(variables, x0)]
-    constraints = [{"type": "ineq", "fun": cons, "jac": cons_jac}]
-    constraints += smoothness_constraints(ev.paths, x0, ev.problem.table_max_step_m)
-    res = minimize(obj, np.ones(x0.size), jac=True, method="SLSQP", bounds=bounds,
-                   constraints=constraints,
-                   options={"maxiter": problem.max_iterations, "ftol": 1e-6},
-                   callback=record)
-    x = np.clip(res.x * x0, [v.lower for v in variables], [v.upper for v in variables])
-    return DesignResult(paths=ev.paths, baseline=ev(x0), optimised=ev(x), history=tuple(history),
+    x = np.clip(res.x[:n] * sc, [v.lower for v in variables], [v.upper for v in variables])
+    opt = ev(x)
+    activity = constraint_activity(ev, opt, res.get("multipliers"),
+                                   float(res.x[n]) if speed else None, m0)
+    return DesignResult(paths=ev.paths, baseline=ev(x0), optimised=opt, history=tuple(history),
                         success=bool(res.success), message=str(res.message),
                         evaluations=ev.calls, seconds=time.perf_counter() - t0,
-                        gradient_check=check, gradient_check_seconds=t_check)
+                        gradient_check=check, gradient_check_seconds=t_check,
+                        constraints=activity)

@@ -1,5 +1,6 @@
 """The report of ``asekit optimise --report DIR`` (issue 28): the thickness field before and
-after, V-g / V-f before and after at the critical flight condition, and the optimiser's history,
+after, V-g / V-f before and after at the critical flight condition, the constraint activity at
+the optimum (a table) and the optimiser's history,
 written with the JSON as an HTML page (the figures' alt texts as captions).
 
 Every number drawn comes from the case pipeline's re-analysis of the baseline and the optimised
@@ -143,9 +144,29 @@ def write_design_report(directory, base, opt, fa_base, fa_opt, history, doc: dic
             f"<title>{html.escape(base.name)}: design optimisation</title></head><body>"
             f"<h1>{html.escape(base.name)}: design optimisation</h1>"
             "<table><tr><th></th><th>baseline</th><th>optimised</th></tr>" + rows + "</table>"
+            + constraint_table(d.get("constraints", ())) +
             '<p><a href="summary.json">summary.json</a> (the whole result)</p>'
             f"<h2>{SECTION}</h2>{body}</body></html>\n")
     return write_text_atomic(out / "index.html", page)
+
+
+def constraint_table(constraints) -> str:
+    """The constraint activity at the optimum (``design.constraints`` of the JSON) as an HTML
+    table: name, value, bound, active, KKT multiplier; empty without constraints.
+
+    >>> constraint_table([{"name": "flutter_margin[0 m]", "value": 0.15, "bound": 0.15,
+    ...                    "active": True, "multiplier": 0.5}]).count("<tr>")
+    2
+    """
+    if not constraints:
+        return ""
+    head = ("<h2>Constraints at the optimum</h2><table><tr><th>constraint</th><th>value</th>"
+            "<th>bound</th><th>active</th><th>multiplier</th></tr>")
+    rows = "".join(
+        "<tr>" + "".join(f"<td>{html.escape(_fmt(c.get(k)))}</td>"
+                         for k in ("name", "value", "bound", "active", "multiplier")) + "</tr>"
+        for c in constraints)
+    return head + rows + "</table>"
 
 
 def _fmt(v) -> str:

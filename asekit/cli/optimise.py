@@ -11,7 +11,11 @@ The optimised design's margin is not the optimiser's own number: the written cas
 variables' ``values``), ``design.divergence_margin_required_pct`` (None: divergence checked
 against the flutter margin in the re-analysis only, not a constraint),
 ``design.gradient_check`` (``max_rel_error`` of the analytic gradients against central
-differences at the baseline, ``seconds``) and ``design.history`` (one row per iteration).
+differences at the baseline, ``seconds``), ``design.objective``, ``design.gain`` (mass saved,
+the smallest flutter margin's gain in points, the flutter speeds' in %), ``design.constraints``
+(per constraint at the optimum: ``name``, ``value``, ``bound``, ``active``, ``multiplier``;
+:func:`asekit.case.design.constraint_activity`) and ``design.history`` (one row per
+iteration).
 ``--report DIR`` writes the thickness field, V-g / V-f before and after (the pipeline's
 re-analysis) and the history as an HTML page (:mod:`asekit.case.design_report`). Bad input
 gets one line and exit status 2.
@@ -47,16 +51,25 @@ def _error(msg: str) -> int:
     return outputs.print_error(f"error: {msg}", 2, _log)
 
 
-def _reanalysis(case, margin: float, div_margin: float | None = None) -> dict:
-    """The case pipeline's verdict: the smallest flutter margin (%) over the envelope altitudes,
+def _reanalysis(case, margin: float, div_margin: float | None = None,
+                separation: float | None = None, n_sep: int = 2) -> dict:
+    """The case pipeline's verdict: the smallest flutter margin (%) over the envelope altitudes
+    (an altitude without flutter in the sweep counts with its lower bound, the sweep's last
+    speed over M a - 1; ``flutter_margin_is_lower_bound`` says when that bound is the smallest),
     the lowest divergence speed at the envelope's top Mach (None: none in the sweep), the
     smallest divergence margin U_D / (M a) - 1 (%, None: no divergence), and whether the flutter
     speeds clear (1 + margin) M a and the divergence speeds (1 + div_margin) M a (div_margin
-    None: the flutter margin)."""
+    None: the flutter margin), and, with a ``separation``, the first ``n_sep`` elastic modes'
+    f_{i+1} / f_i - 1 of the pipeline's modal model (``frequency_separation_pct``, the smallest)
+    against it."""
     div_margin = margin if div_margin is None else div_margin
     from asekit.case import pipeline as P
     fa = P.flutter(case)
-    vals = [m["margin"] for m in fa.margins if m["margin"] is not None]
+    # an altitude without flutter up to the sweep's last speed counts with its lower bound
+    vals = [m["margin"] if m["margin"] is not None else m.get("margin_lower_bound")
+            for m in fa.margins]
+    vals = [v for v in vals if v is not None]
+    exact = [m["margin"] for m in fa.margins if m["margin"] is not None]
     top = case.flight.envelope_mach[1]
     lo, hi = case.flight.envelope_altitude or (-float("inf"), float("inf"))
     div = [d["speed_ms"] for d in fa.divergence if d["speed_ms"] is not None
@@ -67,10 +80,20 @@ def _reanalysis(case, margin: float, div_margin: float | None = None) -> dict:
           and d["altitude_m"] in env]
     div_ok = all(m >= div_margin - 1e-9 for m in dm)
     pct = 100.0 * min(vals) if len(vals) == len(fa.margins) and vals else None
-    return {"flutter_margin_pct": pct, "divergence_speed_ms": min(div) if div else None,
+    sep = None
+    if separation is not None:
+        model = P.modal_model(case)
+        f = model.frequencies_hz[model.n_rigid:][:n_sep]
+        sep = 100.0 * float(min(f[1:] / f[:-1] - 1.0))
+    return {"flutter_margin_pct": pct,
+            "flutter_margin_is_lower_bound": bool(pct is not None
+                                                  and (not exact or min(vals) < min(exact))),
+            "divergence_speed_ms": min(div) if div else None,
             "divergence_margin_pct": 100.0 * min(dm) if dm else None,
+            "frequency_separation_pct": sep,
             "meets_constraints": bool(pct is not None and pct >= 100 * margin - 1e-9
-                                      and div_ok)}
+                                      and div_ok and (sep is None
+                                                      or sep >= 100 * separation - 1e-7))}
 
 
 def _block(ev, paths, verdict: dict) -> dict:
@@ -82,6 +105,23 @@ def _block(ev, paths, verdict: dict) -> dict:
             "flutter_speeds_ms": [None if not np.isfinite(u) else float(u) for u in ev.speeds_ms],
             "envelope_speeds_ms": ev.envelope_ms.tolist(),
             "values": dict(zip(paths, ev.values.tolist()))}
+
+
+def _pct(v) -> str:
+    return "none" if v is None else f"{v:+.2f} %"
+
+
+def _gain(base: dict, opt: dict) -> dict:
+    """Mass saved (kg, %) and the smallest flutter margin's gain (percentage points, re-analysed;
+    None where a margin is undefined) and the flutter speed's at each envelope altitude (%, the
+    optimiser's chain)."""
+    bm, om = base["flutter_margin_pct"], opt["flutter_margin_pct"]
+    speeds = [None if b is None or o is None else 100.0 * (o / b - 1.0)
+              for b, o in zip(base["flutter_speeds_ms"], opt["flutter_speeds_ms"])]
+    return {"mass_kg": base["mass_kg"] - opt["mass_kg"],
+            "mass_pct": 100 * (1 - opt["mass_kg"] / base["mass_kg"]),
+            "flutter_margin_points": None if bm is None or om is None else om - bm,
+            "flutter_speeds_pct": speeds}
 
 
 def _write_case(args, raw: dict, result) -> None:
@@ -125,12 +165,17 @@ def run(args) -> int:
         reanalysed = load_case(args.out_case)
     else:
         reanalysed = with_values(case, result.paths, result.optimised.values)
-    margins = (problem.flutter_margin, problem.divergence_margin)
+    speed = problem.objective == "flutter_speed"
+    # with the flutter_speed objective the flutter margin is maximised, not required
+    need = -1.0 if speed else problem.flutter_margin
+    margins = (need, problem.divergence_margin if problem.divergence_margin is not None
+               or not speed else problem.flutter_margin, problem.frequency_separation,
+               problem.frequency_separation_modes)
     base = _block(result.baseline, result.paths, _reanalysis(case, *margins))
     opt = _block(result.optimised, result.paths, _reanalysis(reanalysed, *margins))
-    doc = {"design": {"baseline": base, "optimised": opt,
-                      "gain": {"mass_kg": base["mass_kg"] - opt["mass_kg"],
-                               "mass_pct": 100 * (1 - opt["mass_kg"] / base["mass_kg"])},
+    doc = {"design": {"objective": problem.objective, "baseline": base, "optimised": opt,
+                      "gain": _gain(base, opt),
+                      "constraints": list(result.constraints),
                       "gradient_check": {"max_rel_error": result.max_rel_error,
                                          "per_variable": None if result.gradient_check is None
                                          else dict(zip(result.paths,
@@ -141,7 +186,8 @@ def run(args) -> int:
                                     "iterations": len(result.history),
                                     "evaluations": result.evaluations,
                                     "seconds": result.seconds},
-                      "flutter_margin_required_pct": 100 * problem.flutter_margin,
+                      "flutter_margin_required_pct": None if speed
+                      else 100 * problem.flutter_margin,
                       "divergence_margin_required_pct": None
                       if problem.divergence_margin is None else 100 * problem.divergence_margin,
                       "history": list(result.history)},
@@ -158,9 +204,10 @@ def run(args) -> int:
         print(text)
     elif args.json:
         Path(args.json).write_text(text + "\n")
+    need_text = "maximised" if speed else f"required {100 * problem.flutter_margin:+.0f} %"
     print(f"mass {base['mass_kg']:.5g} -> {opt['mass_kg']:.5g} kg, min flutter margin "
-          f"{base['flutter_margin_pct']:+.2f} % -> {opt['flutter_margin_pct']:+.2f} % (required "
-          f"{100 * problem.flutter_margin:+.0f} %, re-analysed), gradient check "
+          f"{_pct(base['flutter_margin_pct'])} -> {_pct(opt['flutter_margin_pct'])} "
+          f"({need_text}, re-analysed), gradient check "
           f"{result.max_rel_error if result.max_rel_error is not None else float('nan'):.2g}",
           file=sys.stderr)
     return 0

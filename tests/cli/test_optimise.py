@@ -37,7 +37,7 @@ def test_shipped_design_file_parses():
 
 
 @pytest.mark.parametrize("text, fragment", [
-    ("[design]\nobjective = 'drag'\n", "design.objective must be one of ['mass']"),
+    ("[design]\nobjective = 'drag'\n", "design.objective must be one of ['mass', 'flutter_speed']"),
     ("[design]\n[[design.variable]]\npath = 'thickness.tip'\nlower = 0.003\nupper = 0.006\n",
      "thickness.tip = 0.002 in the case lies outside its bounds"),
     ("[design\n", "design.toml"),
@@ -107,3 +107,86 @@ def test_fin_thickness_field_end_to_end(tmp_path):
     v = np.array(written.thickness.values)       # the smoothness bound holds in the file
     step = 0.0005 * (1 + 1e-6)
     assert np.abs(np.diff(v, axis=0)).max() <= step and np.abs(np.diff(v, axis=1)).max() <= step
+
+
+def _small_fin(tmp_path):
+    """The small fin of tests/case/test_design.py (4 x 4 elements, 3 elastic modes, 6 x 6
+    boxes) as a case file."""
+    from asekit.case.toml_writer import dumps
+    raw = tomllib.loads(FIN.read_text())
+    raw["panel"][0].update(n_chord=4, n_span=4)
+    raw["modes"] = {"count": 3, "keep_rigid": True}
+    raw["aero"].update(machs=[0.4, 0.6], boxes=[{"n_chord": 6, "n_span": 6}],
+                       reduced_frequencies=[0.001, 0.1, 0.2, 0.3, 0.45, 0.6, 0.8])
+    raw["flight"].update(altitudes=[0.0, 2500.0],
+                         velocities={"min": 120.0, "max": 420.0, "step": 20.0})
+    raw.pop("actuator", None)
+    path = tmp_path / "small.toml"
+    path.write_text(dumps(raw))
+    return path
+
+
+def test_flutter_speed_objective_json_and_constraint_table(tmp_path, capsys):
+    """objective = "flutter_speed" with a frequency separation through the command line: the
+    JSON's design.constraints (mass equality, the flutter rows against the maximised margin,
+    the separation), the gain at equal mass re-analysed from the written case, and the
+    report's constraint table."""
+    case = _small_fin(tmp_path)
+    design = tmp_path / "design.toml"
+    design.write_text("[design]\nobjective = 'flutter_speed'\nfrequency_separation = 0.5\n"
+                      "max_iterations = 30\n"
+                      "[[design.variable]]\npath = 'thickness.root'\nlower = 0.0015\n"
+                      "upper = 0.008\n"
+                      "[[design.variable]]\npath = 'thickness.tip'\nlower = 0.001\n"
+                      "upper = 0.006\n")
+    out, opt, rep = tmp_path / "out.json", tmp_path / "opt.toml", tmp_path / "rep"
+    assert main(["optimise", str(case), str(design), "--json", str(out), "--out-case", str(opt),
+                 "--report", str(rep), "--no-gradient-check"]) == 0
+    d = json.loads(out.read_text())["design"]
+    assert d["objective"] == "flutter_speed" and d["flutter_margin_required_pct"] is None
+    names = [c["name"] for c in d["constraints"]]
+    assert names == ["mass_kg (equality)", "flutter_margin[0 m]", "flutter_margin[2500 m]",
+                     "frequency_separation[f2/f1]"]            # modes = 2 by default
+    assert all(set(c) == {"name", "value", "bound", "active", "multiplier"}
+               for c in d["constraints"])
+    # equal mass, a higher smallest margin: the pipeline's re-analysis of the written file
+    assert d["optimised"]["mass_kg"] == pytest.approx(d["baseline"]["mass_kg"], rel=1e-6)
+    margins = [m["margin"] for m in P.flutter(load_case(opt)).margins]
+    assert d["optimised"]["flutter_margin_pct"] == pytest.approx(100 * min(margins), abs=1e-9)
+    assert d["gain"]["flutter_margin_points"] > 5.0
+    assert d["optimised"]["frequency_separation_pct"] >= 50.0 - 1e-7
+    assert d["optimised"]["meets_constraints"]
+    page = (rep / "index.html").read_text()
+    assert "Constraints at the optimum" in page and "frequency_separation[f2/f1]" in page
+    assert "maximised" in capsys.readouterr().err
+
+
+SPEED_DESIGN = DATA_DIR / "designs" / "fin_max_flutter_speed.toml"
+
+
+def test_shipped_flutter_speed_design_parses():
+    from asekit.case.design import load_design
+    p = load_design(SPEED_DESIGN)
+    assert p.objective == "flutter_speed" and p.frequency_separation == 0.5
+    assert [v.path for v in p.variables] == ["thickness.root", "thickness.tip"]
+
+
+@pytest.mark.slow
+def test_fin_maximum_flutter_speed_end_to_end(tmp_path):
+    """The fin at its own mass: the written case, re-analysed by the pipeline, has the
+    baseline's mass (1^T M_ww 1 of the pipeline's mass matrix) to 1e-6 and a higher flutter
+    speed at every envelope altitude (at 5000 m none up to the sweep's 460 m/s)."""
+    out, opt = tmp_path / "out.json", tmp_path / "opt.toml"
+    assert main(["optimise", str(FIN), str(SPEED_DESIGN), "--json", str(out),
+                 "--out-case", str(opt), "--no-gradient-check"]) == 0
+    d = json.loads(out.read_text())["design"]
+
+    def mass(case):
+        return float(P.mass_and_stiffness(case)[1][0::3, 0::3].sum())
+    base, new = load_case(FIN), load_case(opt)
+    assert mass(new) == pytest.approx(mass(base), rel=1e-6)
+    for b, n in zip(P.flutter(base).margins, P.flutter(new).margins):
+        speed = n["flutter_speed_ms"] or n["flutter_speed_lower_bound_ms"]
+        assert speed > b["flutter_speed_ms"]
+    assert d["gain"]["flutter_margin_points"] > 0
+    assert d["optimised"]["meets_constraints"]
