@@ -69,9 +69,12 @@ def test_low_speed_loops_are_stable_with_thesis_like_margins(rows_15):
         assert 0 < r.effective_inertia < hinge_inertia
         assert 70 < r.phase_margin_deg < 85
         assert r.dynamic_pressure == pytest.approx(0.5 * 1.225 * 15.0 ** 2, rel=1e-3)
-    aem2 = rows_15[1]
-    assert aem2.settling_time_s is not None and aem2.settling_time_s < 0.05
-    assert aem2.steady_error < 0.01          # the surface's own angle is fed back
+    for r in rows_15:                        # the fed-back angle settles (2 %) fast
+        assert r.settling_time_s is not None and r.settling_time_s < 0.05
+    aem1, aem2 = rows_15
+    # AEM2 feeds back the surface's own angle: it holds it; AEM1 holds the hinge angle, the
+    # wing's twist under the aileron's load stays in the surface's angle (2.6 % measured)
+    assert aem2.steady_error < 0.01 < aem1.steady_error
 
 
 def test_above_the_locked_aileron_flutter_speed_the_loop_is_unstable():
