@@ -538,6 +538,26 @@ def _hinge_load_lines(rows) -> list[str]:
     return out
 
 
+def _control_ase_lines(rows) -> list[str]:
+    """The summary block of the actuator loop on a control surface (issue 25): one line per
+    topology of the ``control_surface_ase`` JSON rows."""
+    if not rows:
+        return []
+    r0 = rows[0]
+    out = ["", f"actuator on {r0['name']} (thesis servo, System 3) at {r0['speed_ms']:g} m/s, "
+               f"Mach {r0['mach']:g}, {r0['altitude_m']:g} m",
+           f"{'loop':>5} {'stable':>6} {'max Re p':>9} {'PM deg':>7} {'f_c Hz':>7} "
+           f"{'settle ms':>9} {'over %':>7} {'error %':>7}"]
+    for r in rows:
+        pm = "-" if r["phase_margin_deg"] is None else f"{r['phase_margin_deg']:.1f}"
+        fc = "-" if r["crossover_hz"] is None else f"{r['crossover_hz']:.1f}"
+        ts = "-" if r["settling_s"] is None else f"{1e3 * r['settling_s']:.1f}"
+        out.append(f"{r['topology']:>5} {'yes' if r['stable'] else 'NO':>6} "
+                   f"{r['max_real_pole']:>9.3g} {pm:>7} {fc:>7} {ts:>9} "
+                   f"{r['overshoot_pct']:>7.2f} {r['steady_error_pct']:>7.2f}")
+    return out
+
+
 def format_summary(s: dict, width: int = 100) -> str:
     """A plain-text summary of :func:`summary` that fits ``width`` columns."""
     lines = textwrap.wrap(f"case {s['case']}" + (f"  ({s['reference']})" if s.get("reference")
@@ -599,6 +619,7 @@ def format_summary(s: dict, width: int = 100) -> str:
     lines += _control_lines(s.get("control_surfaces", ()))
     lines += _control_flutter_lines(s.get("control_surface_flutter", ()))
     lines += _hinge_load_lines(s.get("control_surface_servo_sizing", ()))
+    lines += _control_ase_lines(s.get("control_surface_ase", ()))
     for n in s["notes"]:
         lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")

@@ -90,3 +90,11 @@ def test_json_rows_and_units(rows_15):
             assert k in report.UNITS or k == "name", k
         assert math.isfinite(r["phase_margin_deg"])
     assert report.control_ase_json(()) == {}
+
+
+def test_summary_lines(rows_15):
+    j = report.control_ase_json(rows_15)["control_surface_ase"]
+    lines = report._control_ase_lines(j)
+    assert lines[1].startswith("actuator on aileron") and "15 m/s" in lines[1]
+    assert lines[3].split()[:2] == ["AEM1", "yes"] and lines[4].split()[:2] == ["AEM2", "yes"]
+    assert report._control_ase_lines(()) == []
