@@ -139,6 +139,30 @@ def surface_angle_row(wing_model, hm, surface: int, order) -> np.ndarray:
     hm : :class:`asekit.aero.control_surface.HingedMesh` of the surfaces.
     surface : the actuated surface's index.
     order : the mode order of :func:`hinge_actuated_modal`.
+
+    Returns
+    -------
+    (n_modes,) row: 1 for the hinge (first), the wing modes' rotations about the hinge axis.
+
+    Examples
+    --------
+    The clamped plate wing of :func:`hinge_actuated_modal`: its first bending mode barely
+    rotates the aileron about its (spanwise) hinge, its first torsion mode does.
+
+    >>> from asekit.aero.boxes import TrapezoidSurface
+    >>> from asekit.aero.control_surface import ControlSurface, hinged_mesh
+    >>> from asekit.geometry import Material, Planform, Thickness
+    >>> from asekit.structure.assembly import assemble, clamped_edge
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> from asekit.structure.modes import fixed_modal_model
+    >>> pm = panels_mesh([Planform((0, 0), 0.3, (0, 1.2), 0.3)], Thickness(0.002, 0.002), 8, [16])
+    >>> K, M = assemble(pm, Material(70e9, 0.3, 2700.0))
+    >>> model = fixed_modal_model(clamped_edge(pm, K, M), M, n_modes=3)
+    >>> hm = hinged_mesh(TrapezoidSurface((0, 0), 0.3, (0, 1.2), 0.3, 8, 16),
+    ...                  ControlSurface("aileron", 0.75, 0.75, 0.5, 1.0))
+    >>> row = surface_angle_row(model, hm, 0, actuated_order(3, 1, 0))
+    >>> float(row[0]), bool(abs(row[1]) < 0.1 * max(abs(row[2:])))
+    (1.0, True)
     """
     from asekit.aeroelastic.control_surface import _hinge_length
 
@@ -178,6 +202,18 @@ def flap_ase_model(modal: ModalArrays, rfa, density: float, velocity: float,
     -------
     AeroservoelasticModel
         ``effective_fin_inertia`` is the surface's J_eff (kg m^2).
+
+    Examples
+    --------
+    A surface of 0.5 g m^2 about its hinge on a locked wing, the air off (a zero fit): the
+    actuator's load inertia is that of the surface.
+
+    >>> from asekit.rfa.roger import roger_fit
+    >>> modal = ModalArrays(np.array([[5e-4]]), np.zeros((1, 1)), np.zeros((1, 1)), 1)
+    >>> rfa = roger_fit(np.array([0.0, 0.5, 1.0]), np.zeros((3, 1, 1), complex), 0.15, n_lags=1)
+    >>> m = flap_ase_model(modal, rfa, 1.225, 20.0, np.array([1.0]))
+    >>> round(m.effective_fin_inertia, 6), m.actuator.fin_inertia == m.effective_fin_inertia
+    (0.0005, True)
     """
     row = np.asarray(surface_row, float).ravel()
     if row.size != modal.n_modes or abs(row[0] - 1.0) > 1e-12:
