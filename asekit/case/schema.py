@@ -1128,9 +1128,14 @@ def _actuator(t: _Table | None) -> ActuatorSpec | None:
     return ActuatorSpec(**vals)
 
 
-def _check_surface_actuators(surfaces, aero) -> None:
-    """At most one actuated control surface, its Mach within aero.machs (issue 25)."""
+def _check_surface_actuators(surfaces, aero, rigid_mode: bool) -> None:
+    """At most one actuated control surface, its Mach within aero.machs, on a wing without a
+    rigid mode (the hinge is the loop's one prescribed coordinate; issue 25)."""
     act = [i for i, c in enumerate(surfaces) if c.actuator is not None]
+    if act and rigid_mode:
+        raise CaseError(f"control_surface[{act[0]}].actuator needs a wing without a rigid mode "
+                        "(a clamped support, or modes.keep_rigid = false): the surface's hinge "
+                        "is the loop's one actuated coordinate")
     if len(act) > 1:
         raise CaseError(f"control_surface[{act[1]}].actuator: only one control surface may "
                         f"carry the actuator (control_surface[{act[0]}] has one)")
@@ -1243,7 +1248,8 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     else:
         fsi_spec = None
     top.done()
-    _check_surface_actuators(surfaces, aero)
+    _check_surface_actuators(surfaces, aero,
+                             SUPPORTS[support.kind].has_rigid_mode(support) and modes.keep_rigid)
     if actuator is not None and not (SUPPORTS[support.kind].has_rigid_mode(support)
                                      and modes.keep_rigid):
         raise CaseError("actuator needs support.kind = \"shaft\" with model \"FN2\" and "

@@ -98,3 +98,12 @@ def test_summary_lines(rows_15):
     assert lines[1].startswith("actuator on aileron") and "15 m/s" in lines[1]
     assert lines[3].split()[:2] == ["AEM1", "yes"] and lines[4].split()[:2] == ["AEM2", "yes"]
     assert report._control_ase_lines(()) == []
+
+
+def test_actuated_surface_on_a_fin_with_its_rigid_pitch_mode_is_refused():
+    """The thesis fin with a tab keeps its rigid pitch mode (the shaft's actuator): the tab's
+    actuator cannot be a second prescribed coordinate; the error names the key."""
+    d = tomllib.loads((CASES_DIR / "nalci2013_fin_tab.toml").read_text())
+    d["control_surface"][0]["actuator"] = {"speed": 100.0, "mach": 0.5}
+    with pytest.raises(CaseError, match=r"control_surface\[0\]\.actuator needs a wing without"):
+        case_from_dict(d)
