@@ -1591,3 +1591,111 @@ def control_surface_hinge_loads(case: Case) -> tuple[HingeLoadRow, ...]:
         rows += [HingeLoadRow(s.name, m, h, rho, u, q, float(h_d[i]), float(h_a[i]), basis)
                  for i, s in enumerate(hm.surfaces)]
     return tuple(rows)
+
+
+# ---------------------------------------------------------------------------------------------
+# control surfaces: the ASE loop with the actuator on a surface's hinge (issue 25)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ControlSurfaceAseRow:
+    """The closed loop of the actuator on control surface ``name`` at one flight condition
+    (``[control_surface.actuator]``) for one ``topology`` (AEM1: hinge-angle feedback; AEM2:
+    the surface's angle in the air): ``stable`` and ``max_real_pole`` (1/s) of the linear
+    closed loop, ``effective_inertia`` J_eff (kg m^2) the actuator's load, the forward path's
+    smallest ``phase_margin_deg``, ``gain_margin_db`` (inf: no phase crossover) and
+    ``crossover_hz`` (FWTF 2 for AEM1, FWTF 3 for AEM2, thesis Sec. 5.2), and of a power-limited
+    step of ``step_deg`` the 2 % ``settling_time_s`` of the fed-back angle (AEM1 the hinge
+    angle, AEM2 the surface's angle; None: not settled in 0.2 s), the ``overshoot`` (fraction)
+    and ``steady_error`` (fraction, at 0.2 s) of the surface's angle in the air (under AEM1 the
+    wing's twist under the surface's load stays in it)."""
+
+    name: str
+    topology: str
+    mach: float
+    altitude: float
+    speed_ms: float
+    dynamic_pressure: float
+    stable: bool
+    max_real_pole: float
+    effective_inertia: float
+    phase_margin_deg: float
+    gain_margin_db: float
+    crossover_hz: float | None
+    step_deg: float
+    settling_time_s: float | None
+    overshoot: float
+    steady_error: float
+
+
+_CONTROL_ASE = ("check [control_surface.actuator] (speed, mach, altitude) and the "
+                "[[control_surface]] keys")
+
+
+@_door("the control surface's actuator loop", _CONTROL_ASE)
+def control_surface_ase_condition(case: Case):
+    """The ASE model of the case's actuated control surface (:mod:`asekit.ase.flap`) at its
+    ``[control_surface.actuator]`` condition: the GAFs of the wing's modes and the surfaces'
+    deflections at that Mach (the case's ``aero.method``; computed, not cached), reordered
+    hinge first and fitted by the case's RFA (``flutter.rfa``, ``flutter.lags``).
+
+    Returns
+    -------
+    (index, spec, AeroservoelasticModel)
+        The actuated surface's index, its ``[[control_surface]]`` spec and the model (thesis
+        actuator, its load the surface's effective inertia).
+    """
+    from asekit.aero.gaf import build_gaf_database
+    from asekit.ase import flap
+
+    act = [i for i, c in enumerate(case.control_surfaces) if c.actuator is not None]
+    if not act:
+        raise CaseError(f"{case.name}: no [[control_surface]] has an actuator "
+                        "([control_surface.actuator])")
+    i = act[0]
+    spec = case.control_surfaces[i]
+    a = spec.actuator
+    hm = control_surface_mesh(case)
+    fm = control_surface_model(case)
+    modal, order = flap.hinge_actuated_modal(fm, i)
+    row = flap.surface_angle_row(modal_model(case), hm, i, order)
+    ae = case.aero
+    method = ae.kernel if ae.method == "dlm" else ae.method
+    db = build_gaf_database(fm.box_modes, hm.mesh, [a.mach], reduced_frequencies(case),
+                            ae.reference_semichord, 0, symmetric=ae.symmetry == "wall",
+                            method=method, progress=False)
+    g = db.at(a.mach)
+    rfa = rfa_kind(case.flutter.rfa).fit(g.k, flap.reorder_modes(g.Q, order), db.b_ref, a.mach,
+                                         case.flutter.lags)
+    rho = float(standard_atmosphere(a.altitude).density)
+    return i, spec, flap.flap_ase_model(modal, rfa, rho, a.speed, row, mach=a.mach)
+
+
+@_memo_with_warnings
+def control_surface_ase(case: Case) -> tuple[ControlSurfaceAseRow, ...]:
+    """The AEM1 and AEM2 loops of the actuated control surface
+    (:func:`control_surface_ase_condition`, System 3 PD of thesis Table 17, power limits of
+    Table 16): linear closed-loop poles, forward-path margins and a power-limited step.
+    Empty when no surface carries an actuator. Memoised on the case."""
+    if not any(c.actuator is not None for c in case.control_surfaces):
+        return ()
+    _, spec, m = control_surface_ase_condition(case)
+    a = spec.actuator
+    step = math.radians(a.step_deg)
+    rows = []
+    for topo, which in (("AEM1", 2), ("AEM2", 3)):
+        loop = ase_mod.closed_loop(m, SYSTEM_3, topo)
+        maxre = float(np.linalg.eigvals(np.asarray(loop.A)).real.max())
+        cr = ase_mod.crossovers(ase_mod.forward_path(m, SYSTEM_3, which))
+        sim = ase_mod.simulate_closed_loop(m, SYSTEM_3, step, topo, limits=THESIS_LIMITS,
+                                           t_final=0.2)
+        y = sim.fin_root
+        fed_back = sim.theta if topo == "AEM1" else y
+        ts = float(metrics.settling_time(sim.t, fed_back, step, step, band=0.02))
+        rows.append(ControlSurfaceAseRow(
+            spec.name, topo, float(a.mach), float(a.altitude), float(a.speed),
+            0.5 * m.density * m.velocity ** 2, maxre < 0, maxre, m.effective_fin_inertia,
+            cr.phase_margin_deg, cr.gain_margin_db,
+            float(cr.gain_crossovers_hz[-1]) if cr.gain_crossovers_hz.size else None,
+            float(a.step_deg), ts if math.isfinite(ts) else None,
+            float(metrics.overshoot(y, step)), float(abs(y[-1] - step) / step)))
+    return tuple(rows)

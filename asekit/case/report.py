@@ -105,6 +105,18 @@ UNITS = {
     "hinge_inertia": "kg m^2 (about the hinge)",
     "static_unbalance": "kg m (> 0: centre of mass aft of the hinge)",
 }
+# the actuator loop on a control surface (issue 25, control_surface_ase rows)
+UNITS.update({
+    "topology": "'AEM1' (hinge-angle feedback) or 'AEM2' (the surface's angle in the air)",
+    "stable": "true when every closed-loop pole has Re < 0",
+    "effective_inertia_kgm2": "kg m^2 (the surface's inertia about its hinge seen by the "
+                              "actuator, the wing's modes and apparent air mass included)",
+    "phase_margin_deg": "deg (smallest, of FWTF 2 for AEM1 and FWTF 3 for AEM2)",
+    "gain_margin_db": "dB (at the first phase crossover; null: none)",
+    "crossover_hz": "Hz (highest gain crossover of the forward path)",
+    "step_deg": "deg (the power-limited step command)",
+    "overshoot_pct": "% (of the surface's angle over the step)",
+})
 
 
 @dataclass(frozen=True)
@@ -123,6 +135,7 @@ class Analysis:
     control: tuple = ()
     control_flutter: tuple = ()
     control_hinge: tuple = ()
+    control_ase: tuple = ()
 
 
 @contextlib.contextmanager
@@ -182,8 +195,15 @@ def run_analysis(case: Case, progress: bool = False) -> Analysis:
         sec["control_surface_hinge_loads"] = time.perf_counter() - t
     else:
         control_flutter = control_hinge = ()
+    control_ase = ()
+    if any(c.actuator is not None for c in case.control_surfaces):
+        t = time.perf_counter()
+        with _stage("the actuator loop on the control surface", progress):
+            control_ase = P.control_surface_ase(case)
+        sec["control_surface_ase"] = time.perf_counter() - t
     return Analysis(case, modal, db, fa, ase, sec, gust=gust, control=control,
-                    control_flutter=control_flutter, control_hinge=control_hinge)
+                    control_flutter=control_flutter, control_hinge=control_hinge,
+                    control_ase=control_ase)
 
 
 def _f(v):
@@ -256,6 +276,7 @@ def summary(a: Analysis) -> dict:
              "unstable_at_first_point": r.unstable_at_first_point}
             for r in a.control_flutter]
         out.update(hinge_load_json(getattr(a, "control_hinge", ())))
+        out.update(control_ase_json(getattr(a, "control_ase", ())))
     out["critical"] = critical_condition(out)
     return out
 
@@ -500,6 +521,22 @@ def hinge_load_json(rows) -> dict:
     return {"control_surface_hinge_moments": pts, "control_surface_servo_sizing": sizing}
 
 
+def control_ase_json(rows) -> dict:
+    """The ``control_surface_ase`` key of the analysis JSON (issue 25): one row per topology
+    of :func:`asekit.case.pipeline.control_surface_ase` (empty without an actuated surface)."""
+    if not rows:
+        return {}
+    return {"control_surface_ase": [
+        {"name": r.name, "topology": r.topology, "mach": r.mach, "altitude_m": r.altitude,
+         "speed_ms": r.speed_ms, "dynamic_pressure_pa": r.dynamic_pressure,
+         "stable": r.stable, "max_real_pole": r.max_real_pole,
+         "effective_inertia_kgm2": r.effective_inertia,
+         "phase_margin_deg": _f(r.phase_margin_deg), "gain_margin_db": _f(r.gain_margin_db),
+         "crossover_hz": _f(r.crossover_hz), "step_deg": r.step_deg,
+         "settling_s": _f(r.settling_time_s), "overshoot_pct": 100.0 * r.overshoot,
+         "steady_error_pct": 100.0 * r.steady_error} for r in rows]}
+
+
 def _hinge_load_lines(rows) -> list[str]:
     """The servo-sizing block of the summary: per surface the largest hinge moments per degree
     of deflection and of incidence over the envelope (or the sweep's top)."""
@@ -515,6 +552,26 @@ def _hinge_load_lines(rows) -> list[str]:
                    f"{r['max_abs_hinge_moment_per_delta_Nm_per_rad'] * deg:>9.4g} "
                    f"{r['max_abs_hinge_moment_per_alpha_Nm_per_rad'] * deg:>9.4g} "
                    f"{r['mach']:>6.3g} {alt:>7} {r['dynamic_pressure_pa']:>9.4g}  {r['basis']}")
+    return out
+
+
+def _control_ase_lines(rows) -> list[str]:
+    """The summary block of the actuator loop on a control surface (issue 25): one line per
+    topology of the ``control_surface_ase`` JSON rows."""
+    if not rows:
+        return []
+    r0 = rows[0]
+    out = ["", f"actuator on {r0['name']} (thesis servo, System 3) at {r0['speed_ms']:g} m/s, "
+               f"Mach {r0['mach']:g}, {r0['altitude_m']:g} m",
+           f"{'loop':>5} {'stable':>6} {'max Re p':>9} {'PM deg':>7} {'f_c Hz':>7} "
+           f"{'settle ms':>9} {'over %':>7} {'error %':>7}"]
+    for r in rows:
+        pm = "-" if r["phase_margin_deg"] is None else f"{r['phase_margin_deg']:.1f}"
+        fc = "-" if r["crossover_hz"] is None else f"{r['crossover_hz']:.1f}"
+        ts = "-" if r["settling_s"] is None else f"{1e3 * r['settling_s']:.1f}"
+        out.append(f"{r['topology']:>5} {'yes' if r['stable'] else 'NO':>6} "
+                   f"{r['max_real_pole']:>9.3g} {pm:>7} {fc:>7} {ts:>9} "
+                   f"{r['overshoot_pct']:>7.2f} {r['steady_error_pct']:>7.2f}")
     return out
 
 
@@ -579,6 +636,7 @@ def format_summary(s: dict, width: int = 100) -> str:
     lines += _control_lines(s.get("control_surfaces", ()))
     lines += _control_flutter_lines(s.get("control_surface_flutter", ()))
     lines += _hinge_load_lines(s.get("control_surface_servo_sizing", ()))
+    lines += _control_ase_lines(s.get("control_surface_ase", ()))
     for n in s["notes"]:
         lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")

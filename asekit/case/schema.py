@@ -160,6 +160,21 @@ class ControlSurfaceSpec:
     hinge_stiffness: float = 0.0
     hinge_damping: float = 0.0
     mass_balance: tuple[tuple[tuple[float, float], float], ...] = ()
+    actuator: SurfaceActuatorSpec | None = None
+
+
+@dataclass(frozen=True)
+class SurfaceActuatorSpec:
+    """The servo-actuator on a control surface's hinge (``[control_surface.actuator]``,
+    issue 25; :mod:`asekit.ase.flap`): the ASE loop's flight condition, airspeed ``speed``
+    (m/s) at ``mach`` (the GAFs' Mach number, within aero.machs) and ``altitude`` (m), and the
+    step command ``step_deg`` (deg). The motor, transmission and PD gains are asekit's
+    defaults (thesis Tables 12 and 17: the Faulhaber drive and System 3)."""
+
+    speed: float
+    mach: float = 0.0
+    altitude: float = 0.0
+    step_deg: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -500,6 +515,9 @@ class Case:
             d.pop("gust")
         if not self.control_surfaces:       # (likewise: cases without control surfaces)
             d.pop("control_surfaces")
+        for cs in d.get("control_surfaces", ()):   # (and surfaces without an actuator)
+            if cs.get("actuator") is None:
+                cs.pop("actuator", None)
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
 
 
@@ -917,8 +935,24 @@ def _one_control_surface(t: _Table, i: int, panels) -> ControlSurfaceSpec:
     c_h = t.number("hinge_damping", 0.0, low=0.0, low_open=False, high=1e12,
                    unit="N m s/rad")
     balance = _mass_balance(t, path, panels)
+    actuator = _surface_actuator(t.table("actuator"))
     t.done()
-    return ControlSurfaceSpec(name, panel, hinge, span, kind, k_h, c_h, balance)
+    return ControlSurfaceSpec(name, panel, hinge, span, kind, k_h, c_h, balance, actuator)
+
+
+def _surface_actuator(t: _Table | None) -> SurfaceActuatorSpec | None:
+    """``[control_surface.actuator]`` (its Mach is checked against aero.machs by
+    case_from_dict)."""
+    if t is None:
+        return None
+    spec = SurfaceActuatorSpec(
+        speed=t.number("speed", required=True, low=0.0, high=1e4, unit="m/s"),
+        mach=t.number("mach", default=0.0, low=0.0, low_open=False),
+        altitude=t.number("altitude", default=0.0, low=MIN_ALTITUDE, low_open=False,
+                          high=MAX_ALTITUDE, unit="m"),
+        step_deg=t.number("step_deg", default=1.0, low=0.0, high=15.0, unit="deg"))
+    t.done()
+    return spec
 
 
 def _control_surfaces(raw, panels) -> tuple[ControlSurfaceSpec, ...]:
@@ -1094,6 +1128,24 @@ def _actuator(t: _Table | None) -> ActuatorSpec | None:
     return ActuatorSpec(**vals)
 
 
+def _check_surface_actuators(surfaces, aero, rigid_mode: bool) -> None:
+    """At most one actuated control surface, its Mach within aero.machs, on a wing without a
+    rigid mode (the hinge is the loop's one prescribed coordinate; issue 25)."""
+    act = [i for i, c in enumerate(surfaces) if c.actuator is not None]
+    if act and rigid_mode:
+        raise CaseError(f"control_surface[{act[0]}].actuator needs a wing without a rigid mode "
+                        "(a clamped support, or modes.keep_rigid = false): the surface's hinge "
+                        "is the loop's one actuated coordinate")
+    if len(act) > 1:
+        raise CaseError(f"control_surface[{act[1]}].actuator: only one control surface may "
+                        f"carry the actuator (control_surface[{act[0]}] has one)")
+    for i in act:
+        m = surfaces[i].actuator.mach
+        if not aero.machs[0] <= m <= aero.machs[-1]:
+            raise CaseError(f"control_surface[{i}].actuator.mach must lie within aero.machs "
+                            f"[{aero.machs[0]:g}, {aero.machs[-1]:g}], got {m:g}")
+
+
 def _flutter(t: _Table | None) -> FlutterSpec:
     if t is None:
         return FlutterSpec()
@@ -1196,6 +1248,8 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     else:
         fsi_spec = None
     top.done()
+    _check_surface_actuators(surfaces, aero,
+                             SUPPORTS[support.kind].has_rigid_mode(support) and modes.keep_rigid)
     if actuator is not None and not (SUPPORTS[support.kind].has_rigid_mode(support)
                                      and modes.keep_rigid):
         raise CaseError("actuator needs support.kind = \"shaft\" with model \"FN2\" and "

@@ -97,6 +97,7 @@ def test_inboard_and_outboard_ailerons_superpose_to_the_full_span_one():
     d = tomllib.loads(AILERON.read_text())
     d["aero"]["machs"] = [0.0]
     full = dict(d["control_surface"][0], span_fraction=[0.0, 1.0])
+    full.pop("actuator")                        # (one surface only may carry it)
     inboard = dict(full, name="inboard", span_fraction=[0.0, 0.5])
     outboard = dict(full, name="outboard", span_fraction=[0.5, 1.0])
     two = case_from_dict(dict(d, control_surface=[inboard, outboard]))
