@@ -65,7 +65,8 @@ TOL = 0.01
 @dataclass(frozen=True)
 class AfsDesign:
     """One design: ``controller`` (StateSpace), ``boundary`` (:class:`asekit.ase.afs.Boundary`),
-    ``margins`` (:class:`asekit.ase.margins.NyquistMargins` at the check speed), ``release``
+    ``margins`` (:class:`asekit.ase.margins.NyquistMargins` at the check speed; None for the
+    PD-only reference), ``release``
     (:class:`asekit.ase.afs.AfsSimulation` at the check speed)."""
 
     name: str
@@ -112,10 +113,11 @@ def _pk(fam: afs.SpeedFamily):
     return (None, None) if f is None else (float(f.speed), float(f.frequency_hz))
 
 
-def _design(fam, name, K, check_speed) -> AfsDesign:
+def _design(fam, name, K, check_speed, margins: bool = True) -> AfsDesign:
     b = afs.stability_boundary(lambda u: afs.closed_loop_matrix(fam.model(u), K), GRID, tol=TOL)
     m = fam.model(check_speed)
-    marg = nyquist_margins(afs.loop_at_input(m, K), points_per_decade=50)
+    marg = (nyquist_margins(afs.loop_at_input(m, K), points_per_decade=50) if margins
+            else None)
     sim = afs.simulate_release(m, K, root_twist=RELEASE_TWIST, t_final=0.1)
     return AfsDesign(name, K, b, marg, sim)
 
@@ -132,7 +134,7 @@ def compute() -> AfsStudy:
                                          lowpass_hz=LOWPASS_HZ)
     lqg = afs.lqg_controller(fam.model(LQG_DESIGN_FACTOR * ol.speed), *LQG_WEIGHTS)
     pd = afs.classical_controller(SYSTEM_3.gain, SYSTEM_3.kp, SYSTEM_3.kd, 0.0)
-    designs = {n: _design(fam, n, K, check) for n, K in
+    designs = {n: _design(fam, n, K, check, margins=n != "pd") for n, K in
                (("classical", classical), ("lqg", lqg), ("pd", pd))}
     pk_speed, pk_f = _pk(fam)
     return AfsStudy(fam, ol, pk_speed, pk_f, check, designs)
