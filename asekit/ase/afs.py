@@ -28,6 +28,11 @@ grid (the first grid point where g > 0 and the one before it) and bisected to ``
 grid brackets the first crossing (a root that crosses and returns between two grid points is not
 seen).
 
+A processor running the controller (sampled every T, its voltage applied one or more samples
+later) changes the loop: :func:`sampled_closed_loop_matrix` gives the exact one-sample
+transition matrix (zero-order-hold plant, Tustin controller, delay chain), whose eigenvalues z
+take the place of lambda (growth rate ln|z| / T, :func:`sampled_growth_rate`).
+
 Margins are those of the loop broken at the actuator input: L(s) = -K(s) P(s) (voltage to
 voltage), SISO whatever the number of sensors, so Nyquist-counted margins
 (:func:`asekit.ase.margins.nyquist_margins`, open-loop unstable poles counted) apply
@@ -48,7 +53,8 @@ from asekit.ase.loop import FIN_ROOT, AeroservoelasticModel, _plant, build_model
 from asekit.util.validate import finite, positive
 
 __all__ = ["SpeedFamily", "Boundary", "MEASUREMENTS", "AfsSimulation", "locked_matrix",
-           "plant", "closed_loop_matrix", "growth_rate", "stability_boundary", "loop_at_input",
+           "plant", "closed_loop_matrix", "sampled_closed_loop_matrix", "growth_rate",
+           "sampled_growth_rate", "stability_boundary", "loop_at_input",
            "classical_controller", "lqg_controller", "simulate_release"]
 
 #: Plant outputs a flutter-suppression controller may measure (rad, rad/s).
@@ -189,6 +195,67 @@ def closed_loop_matrix(model: AeroservoelasticModel, controller: ct.StateSpace) 
     return np.vstack([top, np.hstack([Bk @ Cy, Ak])])
 
 
+def sampled_closed_loop_matrix(model: AeroservoelasticModel, controller: ct.StateSpace,
+                               sample_time: float, delay_samples: int = 1) -> np.ndarray:
+    """One-sample transition matrix of the plant under the controller run by a processor.
+
+    The plant is discretised exactly with a zero-order hold over ``sample_time`` T
+    (x_{k+1} = Ad x_k + Bd d_k, Ad = e^{A T}, Bd = int_0^T e^{A s} ds B, from the matrix
+    exponential of [[A, B], [0, 0]] T), the continuous controller by Tustin's rule
+    (:func:`control.c2d`), and the voltage computed from the sample y_k is applied
+    ``delay_samples`` samples later (one sample of computation, exact in discrete time: a chain
+    of held voltages d). State [x, x_k, d_1 .. d_nd] (Franklin, Powell & Workman, "Digital
+    Control of Dynamic Systems", 3rd ed., Secs. 4.3 and 6.3). Stable when every eigenvalue lies
+    inside the unit circle; ln|z| / T is the growth rate comparable with Re lambda.
+
+    Parameters
+    ----------
+    model : AeroservoelasticModel
+    controller : control.StateSpace (continuous, see :func:`closed_loop_matrix`)
+    sample_time : float
+        T (s), > 0.
+    delay_samples : int
+        Computational delay in samples, >= 0.
+
+    Returns
+    -------
+    ndarray (n_plant + n_controller + delay_samples, same)
+    """
+    from scipy.linalg import expm
+
+    ts = positive("sample_time", sample_time)
+    nd = int(delay_samples)
+    if nd != delay_samples or nd < 0:
+        raise ValueError(f"delay_samples must be an integer >= 0, got {delay_samples!r}")
+    p = plant(model)
+    sel = _controller_rows(controller, p)
+    A, B, Cy = np.array(p.A), np.array(p.B), sel @ np.array(p.C)
+    n = A.shape[0]
+    M = np.zeros((n + 1, n + 1))
+    M[:n, :n], M[:n, n:] = A * ts, B * ts
+    E = expm(M)
+    Ad, Bd = E[:n, :n], E[:n, n:]
+    kd = ct.c2d(ct.ss(controller.A, controller.B, controller.C, controller.D), ts, "tustin")
+    Ak, Bk, Ck, Dk = (np.array(m, dtype=float) for m in (kd.A, kd.B, kd.C, kd.D))
+    nk = Ak.shape[0]
+    u_row = np.hstack([(Dk @ Cy)[0], Ck[0] if nk else np.zeros(0)])   # u_k on [x, x_k]
+    N = n + nk + nd
+    P = np.zeros((N, N))
+    P[:n, :n] = Ad
+    if nk:
+        P[n:n + nk, :n] = Bk @ Cy
+        P[n:n + nk, n:n + nk] = Ak
+    if nd == 0:
+        P[:n, :n + nk] += Bd @ u_row[None, :]
+        return P
+    i_d = n + nk                     # d_1: the voltage applied during this sample
+    P[:n, i_d] = Bd[:, 0]
+    for q in range(nd - 1):
+        P[i_d + q, i_d + q + 1] = 1.0
+    P[i_d + nd - 1, :n + nk] = u_row
+    return P
+
+
 def growth_rate(A: np.ndarray) -> tuple[float, float]:
     """(max Re lambda (1/s), |Im| / (2 pi) of that root (Hz)) of the eigenvalues of ``A``.
 
@@ -203,7 +270,26 @@ def growth_rate(A: np.ndarray) -> tuple[float, float]:
     return float(lam[i].real), float(abs(lam[i].imag) / (2 * math.pi))
 
 
-def stability_boundary(matrix_at, velocities, tol: float = 1e-3) -> Boundary:
+def sampled_growth_rate(P: np.ndarray, sample_time: float) -> tuple[float, float]:
+    """(max ln|z| / T (1/s), |arg z| / (2 pi T) of that root (Hz)) of the eigenvalues z of a
+    one-sample transition matrix: the discrete counterpart of :func:`growth_rate`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> z = np.exp((0.5 + 2j * np.pi * 10.0) * 1e-3)
+    >>> g, f = sampled_growth_rate(np.diag([z, z.conjugate()]), 1e-3)
+    >>> round(g, 9), round(f, 9)
+    (0.5, 10.0)
+    """
+    z = np.linalg.eigvals(np.asarray(P, complex))
+    i = int(np.argmax(np.abs(z)))
+    return (float(math.log(abs(z[i])) / sample_time),
+            float(abs(np.angle(z[i])) / (2 * math.pi * sample_time)))
+
+
+def stability_boundary(matrix_at, velocities, tol: float = 1e-3,
+                       sample_time: float | None = None) -> Boundary:
     """First airspeed at which ``matrix_at(U)`` has an eigenvalue with Re > 0.
 
     Parameters
@@ -214,6 +300,9 @@ def stability_boundary(matrix_at, velocities, tol: float = 1e-3) -> Boundary:
         Ascending airspeeds (m/s, > 0) scanned for the first unstable one.
     tol : float
         Bisection tolerance on the airspeed (m/s), > 0.
+    sample_time : float, optional
+        When given, ``matrix_at`` returns one-sample transition matrices
+        (:func:`sampled_closed_loop_matrix`) and the growth rate is ln|z| / T.
 
     Returns
     -------
@@ -233,16 +322,23 @@ def stability_boundary(matrix_at, velocities, tol: float = 1e-3) -> Boundary:
     if U.size < 1 or np.any(~np.isfinite(U)) or np.any(U <= 0) or np.any(np.diff(U) <= 0):
         raise ValueError("velocities must be ascending, finite and > 0")
     positive("tol", tol)
+    if sample_time is None:
+        rate = growth_rate
+    else:
+        positive("sample_time", sample_time)
+
+        def rate(P):
+            return sampled_growth_rate(P, sample_time)
     prev = None
     for u in U:
-        g, f = growth_rate(matrix_at(float(u)))
+        g, f = rate(matrix_at(float(u)))
         if g > 0:
             if prev is None:
                 return Boundary(float(u), f, (), True)
             lo, hi = prev, float(u)
             while hi - lo > tol:
                 mid = 0.5 * (lo + hi)
-                gm, fm = growth_rate(matrix_at(mid))
+                gm, fm = rate(matrix_at(mid))
                 lo, hi, f = (lo, mid, fm) if gm > 0 else (mid, hi, f)
             return Boundary(hi, f, (prev, float(u)), False)
         prev = float(u)

@@ -22,6 +22,9 @@ open-loop flutter speed (just above it). Definitions of the reported numbers:
 * ``ase.afs.closed_loop_flutter_ms``: first right-half-plane root of the classical loop;
 * ``ase.afs.gain_margin_db``: the smaller of |lower| and upper Nyquist gain margins (dB) of the
   classical loop at the check speed; ``ase.afs.phase_margin_deg``: its phase margin;
+* ``ase.afs.sampled_5khz_flutter_ms``: the classical loop's boundary with the controller run
+  at 5 kHz (Tustin) and one sample of computational delay; ``ase.afs.stable_at_1khz``: whether
+  it is stable at the check speed when run at the thesis's 1 kHz with one sample of delay;
 * ``ase.afs.lqg.*``: the same for the LQG design; ``ase.afs.*.peak_voltage_v`` /
   ``peak_current_a``: peaks of the release at the check speed.
 """
@@ -60,6 +63,8 @@ RATE_GAIN, LOWPASS_HZ = 5.0, 300.0
 LQG_WEIGHTS = (1e4, 1e4, 1.0)
 #: Bisection tolerance (m/s).
 TOL = 0.01
+#: The processor: sample times (s) checked with one sample of computational delay.
+FAST_SAMPLE, THESIS_SAMPLE = 2e-4, 1e-3
 
 
 @dataclass(frozen=True)
@@ -67,13 +72,18 @@ class AfsDesign:
     """One design: ``controller`` (StateSpace), ``boundary`` (:class:`asekit.ase.afs.Boundary`),
     ``margins`` (:class:`asekit.ase.margins.NyquistMargins` at the check speed; None for the
     PD-only reference), ``release``
-    (:class:`asekit.ase.afs.AfsSimulation` at the check speed)."""
+    (:class:`asekit.ase.afs.AfsSimulation` at the check speed), ``sampled_fast`` (the boundary
+    with the controller run at :data:`FAST_SAMPLE` with one sample of delay, Tustin),
+    ``stable_thesis_rate`` (the loop at :data:`THESIS_SAMPLE` with one sample of delay stable at
+    the check speed)."""
 
     name: str
     controller: object
     boundary: afs.Boundary
     margins: object
     release: afs.AfsSimulation
+    sampled_fast: afs.Boundary | None = None
+    stable_thesis_rate: bool | None = None
 
     @property
     def gain_margin_db(self) -> float:
@@ -119,7 +129,14 @@ def _design(fam, name, K, check_speed, margins: bool = True) -> AfsDesign:
     marg = (nyquist_margins(afs.loop_at_input(m, K), points_per_decade=50) if margins
             else None)
     sim = afs.simulate_release(m, K, root_twist=RELEASE_TWIST, t_final=0.1)
-    return AfsDesign(name, K, b, marg, sim)
+    if not margins:
+        return AfsDesign(name, K, b, marg, sim)
+    fast = afs.stability_boundary(
+        lambda u: afs.sampled_closed_loop_matrix(fam.model(u), K, FAST_SAMPLE, 1), GRID,
+        tol=TOL, sample_time=FAST_SAMPLE)
+    slow = afs.sampled_growth_rate(afs.sampled_closed_loop_matrix(m, K, THESIS_SAMPLE, 1),
+                                   THESIS_SAMPLE)[0] < 0
+    return AfsDesign(name, K, b, marg, sim, fast, bool(slow))
 
 
 def compute() -> AfsStudy:
@@ -174,7 +191,15 @@ def quantities(study: AfsStudy) -> list[Quantity]:
               Quantity(f"ase.afs.{key}peak_voltage_v", float(np.max(np.abs(d.release.voltage))),
                        "V", rel + ("; demand clipped" if d.release.saturated else "")),
               Quantity(f"ase.afs.{key}peak_current_a", float(np.max(np.abs(d.release.current))),
-                       "A", rel)]
+                       "A", rel),
+              Quantity(f"ase.afs.{key}sampled_5khz_flutter_ms", d.sampled_fast.speed, "m/s",
+                       "controller at 5 kHz (Tustin), one sample of delay"
+                       + ("; unstable at the first airspeed" if d.sampled_fast.at_first_point
+                          else "")),
+              Quantity(f"ase.afs.{key}stable_at_1khz", d.stable_thesis_rate, "-",
+                       f"at {study.check_speed:.1f} m/s, 1 kHz with one sample of delay (the "
+                       "thesis's processor)" + ("" if d.stable_thesis_rate else
+                                                ": the continuous design does not survive it"))]
     return q
 
 

@@ -193,3 +193,58 @@ def test_refusals(family):
         afs.lqg_controller(m, 1.0, 1.0, 1.0, measurements=("zeta1",))
     with pytest.raises(ValueError, match="root_twist"):
         afs.simulate_release(m, afs.classical_controller(1.0, 1.0, 0.0, 0.0), root_twist=0.0)
+
+
+# ---------------------------------------------------------------------------------------------
+# the processor: sampling and computational delay
+# ---------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("delay", [0, 1, 2])
+def test_sampled_loop_matches_chapter_5_sampled_matrix(family, delay):
+    # a static position law u = Kc Kp (0 - theta) through sampled_closed_loop_matrix against
+    # asekit.ase.loop.closed_loop_sampled_matrix (its own ZOH plant, delay chain and
+    # DigitalController): the same eigenvalues
+    from asekit.servo.controllers import DigitalController
+
+    m = family.model(230.0)
+    g = 400.0
+    K = ct.ss(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[-g]], inputs=["theta"])
+    mine = np.linalg.eigvals(afs.sampled_closed_loop_matrix(m, K, 1e-3, delay))
+    d = DigitalController(ct.ss(np.zeros((0, 0)), np.zeros((0, 3)), np.zeros((1, 0)),
+                                [[g, -g, 0.0]], dt=1e-3))
+    phi, _ = ase.closed_loop_sampled_matrix(ase.sampled_plant(m, "AEM1", 1e-3, substeps=1), d,
+                                            delay)
+    ref = np.linalg.eigvals(phi)
+    assert mine.size == ref.size
+    np.testing.assert_allclose(np.sort(np.abs(mine)), np.sort(np.abs(ref)), rtol=1e-8,
+                               atol=1e-12)
+
+
+def test_fast_sampling_recovers_the_continuous_boundary(family):
+    # T = 20 us, no delay: the sampled classical loop's boundary within 0.5 % of the continuous
+    K = afs.classical_controller(10.0, 275.0, 1.0, 5.0, lowpass_hz=300.0)
+    cont = _boundary(family, K, tol=0.5).speed
+    ts = 2e-5
+    samp = afs.stability_boundary(
+        lambda u: afs.sampled_closed_loop_matrix(family.model(u), K, ts, 0), GRID, tol=0.5,
+        sample_time=ts)
+    assert samp.speed == pytest.approx(cont, rel=5e-3)
+
+
+def test_one_millisecond_delay_destabilises_the_continuous_designs(family, open_loop):
+    # 1 kHz with one sample of delay: half a sample of ZOH plus one of computation, 1.5 ms,
+    # about 78 deg of lag at the 144 Hz flutter frequency; the classical law designed in
+    # continuous time is unstable already at the first airspeed of the grid
+    K = afs.classical_controller(10.0, 275.0, 1.0, 5.0, lowpass_hz=300.0)
+    b = afs.stability_boundary(
+        lambda u: afs.sampled_closed_loop_matrix(family.model(u), K, 1e-3, 1), GRID,
+        sample_time=1e-3)
+    assert b.at_first_point
+
+
+def test_sampled_refusals(family):
+    m = family.model(200.0)
+    K = afs.classical_controller(1.0, 1.0, 0.0, 0.0)
+    with pytest.raises(ValueError, match="sample_time"):
+        afs.sampled_closed_loop_matrix(m, K, 0.0)
+    with pytest.raises(ValueError, match="delay_samples"):
+        afs.sampled_closed_loop_matrix(m, K, 1e-3, -1)
