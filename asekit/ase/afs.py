@@ -50,6 +50,7 @@ import control as ct
 import numpy as np
 
 from asekit.ase.loop import FIN_ROOT, AeroservoelasticModel, _plant, build_model
+from asekit.util.blas import small_dense
 from asekit.util.validate import finite, positive
 
 __all__ = ["SpeedFamily", "Boundary", "MEASUREMENTS", "AfsSimulation", "locked_matrix",
@@ -288,6 +289,7 @@ def sampled_growth_rate(P: np.ndarray, sample_time: float) -> tuple[float, float
             float(abs(np.angle(z[i])) / (2 * math.pi * sample_time)))
 
 
+@small_dense
 def stability_boundary(matrix_at, velocities, tol: float = 1e-3,
                        sample_time: float | None = None) -> Boundary:
     """First airspeed at which ``matrix_at(U)`` has an eigenvalue with Re > 0.
@@ -506,6 +508,7 @@ class AfsSimulation:
         return float(b / a)
 
 
+@small_dense
 def simulate_release(model: AeroservoelasticModel, controller: ct.StateSpace,
                      root_twist: float = math.radians(1.0), t_final: float = 0.2,
                      step: float = 2e-5, supply_voltage: float = 24.0,

@@ -44,6 +44,7 @@ from asekit.case import pipeline
 from asekit.reproduction.driver import Quantity
 from asekit.reproduction.fin import fin_case
 from asekit.servo.actuator import SYSTEM_3
+from asekit.util.blas import small_dense
 from asekit.util.plotting import new_figure
 
 MACH, ALTITUDE = 0.5, 0.0
@@ -139,6 +140,7 @@ def _design(fam, name, K, check_speed, margins: bool = True) -> AfsDesign:
     return AfsDesign(name, K, b, marg, sim, fast, bool(slow))
 
 
+@small_dense
 def compute() -> AfsStudy:
     """Run the study (about ten seconds)."""
     fam = family()
@@ -203,6 +205,7 @@ def quantities(study: AfsStudy) -> list[Quantity]:
     return q
 
 
+@small_dense
 def fig_root_locus(study: AfsStudy, velocities=None):
     """Eigenvalues of the locked fin and of the classical and LQG closed loops against airspeed
     (the flutter branch crossing into the right half plane), in Hz against 1/s."""
