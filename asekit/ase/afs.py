@@ -56,7 +56,9 @@ from asekit.util.validate import finite, positive
 __all__ = ["SpeedFamily", "Boundary", "MEASUREMENTS", "AfsSimulation", "locked_matrix",
            "plant", "closed_loop_matrix", "sampled_closed_loop_matrix", "growth_rate",
            "sampled_growth_rate", "stability_boundary", "loop_at_input",
-           "classical_controller", "lqg_controller", "simulate_release"]
+           "classical_controller", "lqg_controller", "discrete_lqg_controller",
+           "sampled_loop_at_input", "sampled_phase_margin", "sampled_gain_margins",
+           "simulate_release"]
 
 #: Plant outputs a flutter-suppression controller may measure (rad, rad/s).
 MEASUREMENTS = ("theta", "omega", FIN_ROOT, "fin_root_rate")
@@ -212,7 +214,9 @@ def sampled_closed_loop_matrix(model: AeroservoelasticModel, controller: ct.Stat
     Parameters
     ----------
     model : AeroservoelasticModel
-    controller : control.StateSpace (continuous, see :func:`closed_loop_matrix`)
+    controller : control.StateSpace
+        Continuous (see :func:`closed_loop_matrix`; discretised by Tustin's rule) or discrete
+        with dt = ``sample_time`` (used as it is).
     sample_time : float
         T (s), > 0.
     delay_samples : int
@@ -236,7 +240,14 @@ def sampled_closed_loop_matrix(model: AeroservoelasticModel, controller: ct.Stat
     M[:n, :n], M[:n, n:] = A * ts, B * ts
     E = expm(M)
     Ad, Bd = E[:n, :n], E[:n, n:]
-    kd = ct.c2d(ct.ss(controller.A, controller.B, controller.C, controller.D), ts, "tustin")
+    if controller.isdtime(strict=True):
+        if abs(float(controller.dt) - ts) > 1e-12 * ts:
+            raise ValueError(f"controller.dt must equal sample_time = {ts:g} s, got "
+                             f"{controller.dt}")
+        kd = controller
+    else:
+        kd = ct.c2d(ct.ss(controller.A, controller.B, controller.C, controller.D), ts,
+                    "tustin")
     Ak, Bk, Ck, Dk = (np.array(m, dtype=float) for m in (kd.A, kd.B, kd.C, kd.D))
     nk = Ak.shape[0]
     u_row = np.hstack([(Dk @ Cy)[0], Ck[0] if nk else np.zeros(0)])   # u_k on [x, x_k]
@@ -476,6 +487,170 @@ def lqg_controller(model: AeroservoelasticModel, weight_root: float, weight_thet
     L = S @ Cm.T @ np.linalg.inv(V)
     return ct.ss(A - B @ K - L @ Cm, L, -K, np.zeros((1, len(measurements))),
                  inputs=list(measurements), outputs=["voltage"], name="LQG AFS")
+
+
+def discrete_lqg_controller(model: AeroservoelasticModel, sample_time: float,
+                            weight_root: float, weight_theta: float, weight_voltage: float = 1.0,
+                            input_noise: float = 1.0, measurement_noise: float = 1e-8,
+                            measurements: tuple = ("theta", FIN_ROOT)) -> ct.StateSpace:
+    """LQG regulator of the sampled plant with one sample of computational delay.
+
+    Design model: the plant discretised with a zero-order hold over T, x_{k+1} = Ad x_k + Bd d_k,
+    with d_k the voltage applied during sample k, computed one sample earlier: d_{k+1} = u_k.
+    Discrete LQR on [x; d] (weights as :func:`lqg_controller`), u_k = -K [x^_k; d_k], and the
+    steady-state Kalman predictor [x^; d]_{k+1} = Aa [x^; d]_k + Ba u_k + L (y_k - Ca [x^; d]_k)
+    (Franklin, Powell & Workman, "Digital Control of Dynamic Systems", 3rd ed., Secs. 8.3 and
+    9.5). The delay is in the design model, so the loop is the one
+    :func:`sampled_closed_loop_matrix` builds with ``delay_samples=1``.
+
+    Parameters
+    ----------
+    model : AeroservoelasticModel
+        The plant at the design airspeed.
+    sample_time : float
+        T (s), > 0.
+    weight_root, weight_theta, weight_voltage, input_noise, measurement_noise, measurements
+        As :func:`lqg_controller`.
+
+    Returns
+    -------
+    control.StateSpace
+        Discrete (dt = T), inputs ``measurements``, output ``voltage`` (to apply next sample).
+    """
+    from scipy.linalg import expm, solve_discrete_are
+
+    ts = positive("sample_time", sample_time)
+    cont = lqg_controller(model, weight_root, weight_theta, weight_voltage, input_noise,
+                          measurement_noise, measurements)          # checks every argument
+    del cont
+    p = plant(model)
+    names = list(p.output_labels)
+    A, B, C = np.array(p.A), np.array(p.B), np.array(p.C)
+    n = A.shape[0]
+    M = np.zeros((n + 1, n + 1))
+    M[:n, :n], M[:n, n:] = A * ts, B * ts
+    E = expm(M)
+    Aa = np.zeros((n + 1, n + 1))
+    Aa[:n, :n], Aa[:n, n:] = E[:n, :n], E[:n, n:]
+    Ba = np.zeros((n + 1, 1))
+    Ba[n, 0] = 1.0
+    c_th, c_r = C[names.index("theta")], C[names.index(FIN_ROOT)]
+    Q = np.zeros((n + 1, n + 1))
+    Q[:n, :n] = (weight_root * np.outer(c_r - c_th, c_r - c_th)
+                 + weight_theta * np.outer(c_th, c_th))
+    Q += 1e-12 * np.eye(n + 1)
+    R = np.array([[weight_voltage]])
+    P = solve_discrete_are(Aa, Ba, Q, R)
+    K = np.linalg.solve(R + Ba.T @ P @ Ba, Ba.T @ P @ Aa)
+    Ca = np.hstack([C[[names.index(m) for m in measurements]], np.zeros((len(measurements), 1))])
+    bd = np.concatenate([E[:n, n], [0.0]])
+    W = input_noise * np.outer(bd, bd) + 1e-12 * np.eye(n + 1)
+    V = measurement_noise * np.eye(len(measurements))
+    S = solve_discrete_are(Aa.T, Ca.T, W, V)
+    L = Aa @ S @ Ca.T @ np.linalg.inv(Ca @ S @ Ca.T + V)
+    return ct.ss(Aa - Ba @ K - L @ Ca, L, -K, np.zeros((1, len(measurements))), ts,
+                 inputs=list(measurements), outputs=["voltage"], name="discrete LQG AFS")
+
+
+def sampled_loop_at_input(model: AeroservoelasticModel, controller: ct.StateSpace,
+                          sample_time: float, delay_samples: int = 1) -> ct.StateSpace:
+    """The sampled loop broken at the actuator input, L(z) = -z^-nd K(z) P(z) (V -> V,
+    discrete, dt = T): ZOH plant, the controller as in :func:`sampled_closed_loop_matrix`,
+    ``delay_samples`` = nd samples of delay. Its closed loop 1 / (1 + L) has the eigenvalues of
+    :func:`sampled_closed_loop_matrix`."""
+    ts = positive("sample_time", sample_time)
+    nd = int(delay_samples)
+    if nd != delay_samples or nd < 0:
+        raise ValueError(f"delay_samples must be an integer >= 0, got {delay_samples!r}")
+    p = plant(model)
+    sel = _controller_rows(controller, p)
+    pd = ct.c2d(ct.ss(p.A, p.B, sel @ np.array(p.C), sel @ np.array(p.D)), ts, "zoh")
+    if controller.isdtime(strict=True):
+        kd = ct.ss(controller.A, controller.B, controller.C, controller.D, ts)
+    else:
+        kd = ct.c2d(ct.ss(controller.A, controller.B, controller.C, controller.D), ts, "tustin")
+    loop = ct.series(pd, ct.ss(kd.A, kd.B, -np.array(kd.C), -np.array(kd.D), ts))
+    if nd:
+        delay = ct.ss(np.eye(nd, k=1), np.eye(nd)[:, -1:], np.eye(nd)[:1], 0.0, ts)
+        loop = ct.series(loop, delay)
+    return loop
+
+
+@small_dense
+def sampled_phase_margin(loop: ct.StateSpace, points: int = 5000) -> float | None:
+    """Smallest phase margin (deg) of a discrete SISO loop L(e^{j w T}) over its gain crossovers
+    |L| = 1 in 0 < w < pi / T (located on a grid of ``points`` and refined by Brent's method);
+    None when |L| never crosses 1. PM = 180 deg + arg L, wrapped to (-180, 180].
+
+    Examples
+    --------
+    >>> import control as ct
+    >>> L = ct.ss([[0.5]], [[1.0]], [[0.8]], [[0.0]], 0.01)   # 0.8 / (z - 0.5)
+    >>> round(sampled_phase_margin(L), 2)      # |e^{j theta} - 0.5| = 0.8 at cos theta = 0.61
+    97.9
+    """
+    from scipy.optimize import brentq
+
+    if not loop.isdtime() or loop.ninputs != 1 or loop.noutputs != 1:
+        raise ValueError("loop must be a discrete SISO system")
+    ts = float(loop.dt)
+    A, B, C = np.array(loop.A), np.array(loop.B), np.array(loop.C)
+    D = float(np.array(loop.D).ravel()[0])
+    n = A.shape[0]
+
+    def L(w):
+        w = np.atleast_1d(np.asarray(w, float))
+        out = np.empty(w.shape, complex)
+        for s in range(0, w.size, 512):
+            z = np.exp(1j * w[s:s + 512] * ts)
+            m = z[:, None, None] * np.eye(n) - A
+            out[s:s + 512] = (C @ np.linalg.solve(m, np.broadcast_to(B, (z.size, n, 1))))[:, 0, 0]
+        return out + D
+
+    w = np.linspace(1e-6, 1.0, points) * (math.pi / ts)
+    mag = np.abs(L(w)) - 1.0
+    pms = []
+    for i in np.nonzero(np.sign(mag[:-1]) != np.sign(mag[1:]))[0]:
+        wc = brentq(lambda x: abs(L(x)[0]) - 1.0, w[i], w[i + 1], xtol=1e-10)
+        pm = 180.0 + math.degrees(np.angle(L(wc)[0]))
+        pms.append((pm + 180.0) % 360.0 - 180.0)
+    return None if not pms else float(min(pms, key=abs))
+
+
+def sampled_gain_margins(matrix_for_gain, k_max: float = 100.0, tol: float = 1e-4):
+    """Gain margins of a sampled loop from its eigenvalues: the interval of controller gain
+    factors k around 1 in which ``matrix_for_gain(k)`` (a one-sample transition matrix with the
+    controller's output scaled by k) has every eigenvalue inside the unit circle, bisected on
+    |ln k| to ``tol`` (no frequency response needed; phase margins are not defined this way).
+
+    Returns
+    -------
+    (lower, upper) : linear factors (lower 0 when stable down to k = 1 / k_max, upper inf when
+    stable up to k_max), or None when the loop is unstable at k = 1.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> lo, hi = sampled_gain_margins(lambda k: np.array([[0.5 - 0.3 * k]]))
+    >>> round(lo, 3), round(hi, 3)
+    (0.0, 5.0)
+    """
+    def stable(k):
+        return np.max(np.abs(np.linalg.eigvals(matrix_for_gain(k)))) < 1.0
+
+    if not stable(1.0):
+        return None
+    ends = []
+    for far in (1.0 / k_max, k_max):
+        if stable(far):
+            ends.append(0.0 if far < 1 else math.inf)
+            continue
+        a, b = 0.0, math.log(far)                  # stable at exp(a), unstable at exp(b)
+        while abs(b - a) > tol:
+            m = 0.5 * (a + b)
+            a, b = (m, b) if stable(math.exp(m)) else (a, m)
+        ends.append(math.exp(a))
+    return tuple(ends)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -18,6 +18,7 @@ from asekit.ase import afs
 from asekit.ase import loop as ase
 from asekit.ase.margins import nyquist_margins
 from asekit.servo.actuator import SYSTEM_3
+from asekit.util.blas import one_blas_thread
 
 GRID = np.array([150.0, 200.0, 250.0, 300.0, 350.0, 400.0])
 
@@ -135,7 +136,8 @@ def _margins_ok(family, K, speed):
     # 50 points per decade: the crossings are then located by Brent's method, and
     # nyquist_margins checks its count against the closed-loop eigenvalues (measured: the same
     # margins to 1e-13 as with its default 400, in a third of the time on the 74-state LQG loop)
-    m = nyquist_margins(afs.loop_at_input(family.model(speed), K), points_per_decade=50)
+    with one_blas_thread():              # many small solves: one BLAS thread on a shared machine
+        m = nyquist_margins(afs.loop_at_input(family.model(speed), K), points_per_decade=50)
     assert m.closed_loop_stable
     assert m.lower_gain_margin_db <= -6.0 and m.upper_gain_margin_db >= 6.0
     assert m.phase_margin_deg >= 45.0
@@ -248,3 +250,49 @@ def test_sampled_refusals(family):
         afs.sampled_closed_loop_matrix(m, K, 0.0)
     with pytest.raises(ValueError, match="delay_samples"):
         afs.sampled_closed_loop_matrix(m, K, 1e-3, -1)
+
+
+def test_sampled_margins_at_fast_sampling_are_the_continuous_ones(family, open_loop):
+    # the sampled loop's margins (frequency response on the unit circle; gain margins from the
+    # eigenvalues with the controller scaled) at 50 kHz, no delay, against nyquist_margins of
+    # the continuous loop (another path): ZOH + Tustin lag ~ w T / 2 = 0.5 deg at 140 Hz
+    K = afs.classical_controller(10.0, 275.0, 1.0, 5.0, lowpass_hz=300.0)
+    m = family.model(1.05 * open_loop.speed)
+    cont = nyquist_margins(afs.loop_at_input(m, K), points_per_decade=50)
+    ts = 2e-5
+    pm = afs.sampled_phase_margin(afs.sampled_loop_at_input(m, K, ts, 0))
+    assert pm == pytest.approx(cont.phase_margin_deg, abs=1.0)
+
+    def scaled(k):
+        Kk = ct.ss(K.A, K.B, k * np.array(K.C), k * np.array(K.D), inputs=list(K.input_labels))
+        return afs.sampled_closed_loop_matrix(m, Kk, ts, 0)
+
+    lo, hi = afs.sampled_gain_margins(scaled, k_max=1e3, tol=1e-5)
+    assert lo == pytest.approx(cont.lower_gain_margin, rel=0.02)
+    # continuous: no upper limit; sampled, a loop always has one (the phase lag of ZOH and
+    # Tustin grows to the Nyquist frequency), here far above the 6 dB asked (measured 42 dB)
+    assert cont.upper_gain_margin == math.inf and 20 * math.log10(hi) > 30.0
+
+
+def test_discrete_lqg_suppresses_flutter_at_1khz_with_delay(family, open_loop):
+    # designed on the 1 kHz ZOH plant with its one-sample delay at 1.35 x the open-loop speed:
+    # +20 % at least, 6 dB / 45 deg at 1.05 x, where the continuous designs fail at 1 kHz
+    ts = 1e-3
+    K = afs.discrete_lqg_controller(family.model(1.35 * open_loop.speed), ts, 1e4, 1e4, 1.0)
+    assert K.isdtime() and float(K.dt) == ts
+    b = afs.stability_boundary(
+        lambda u: afs.sampled_closed_loop_matrix(family.model(u), K, ts, 1), GRID, tol=1.0,
+        sample_time=ts)
+    assert not b.at_first_point and b.speed >= 1.2 * open_loop.speed
+    m = family.model(1.05 * open_loop.speed)
+    assert afs.sampled_phase_margin(afs.sampled_loop_at_input(m, K, ts, 1)) >= 45.0
+
+    def scaled(k):
+        Kk = ct.ss(K.A, K.B, k * np.array(K.C), k * np.array(K.D), ts,
+                   inputs=list(K.input_labels))
+        return afs.sampled_closed_loop_matrix(m, Kk, ts, 1)
+
+    lo, hi = afs.sampled_gain_margins(scaled, tol=1e-3)
+    assert 20 * math.log10(lo) <= -6.0 and 20 * math.log10(hi) >= 6.0
+    with pytest.raises(ValueError, match="controller.dt"):
+        afs.sampled_closed_loop_matrix(m, K, 2e-3, 1)
