@@ -58,7 +58,7 @@ __all__ = ["SpeedFamily", "Boundary", "MEASUREMENTS", "AfsSimulation", "locked_m
            "sampled_growth_rate", "stability_boundary", "loop_at_input",
            "classical_controller", "lqg_controller", "discrete_lqg_controller",
            "sampled_loop_at_input", "sampled_phase_margin", "sampled_gain_margins",
-           "simulate_release"]
+           "simulate_release", "simulate_release_sampled"]
 
 #: Plant outputs a flutter-suppression controller may measure (rad, rad/s).
 MEASUREMENTS = ("theta", "omega", FIN_ROOT, "fin_root_rate")
@@ -754,6 +754,87 @@ def simulate_release(model: AeroservoelasticModel, controller: ct.StateSpace,
                          theta=Y[:, names.index("theta")], voltage=np.clip(ud, -vmax, vmax),
                          voltage_demand=ud, current=Y[:, names.index("current")],
                          voltage_limit=float(vmax))
+
+
+@small_dense
+def simulate_release_sampled(model: AeroservoelasticModel, controller: ct.StateSpace,
+                             sample_time: float, delay_samples: int = 1,
+                             root_twist: float = math.radians(1.0), t_final: float = 0.2,
+                             substeps: int = 10, supply_voltage: float = 24.0,
+                             current_limit: float = 10.0) -> AfsSimulation:
+    """:func:`simulate_release` with the controller run by a processor: sampled every
+    ``sample_time`` T (a discrete controller with dt = T, or a continuous one discretised by
+    Tustin's rule), its voltage clipped to +-min(V_supply, I_lim R) and applied
+    ``delay_samples`` samples later, held over each sample (ZOH); the plant propagated exactly
+    over T / ``substeps`` (histories on that grid).
+
+    Returns
+    -------
+    AfsSimulation
+        ``voltage_demand`` is the controller's output (before the clip) in force over each
+        sample.
+    """
+    from scipy.linalg import expm
+
+    ts = positive("sample_time", sample_time)
+    nd = int(delay_samples)
+    if nd != delay_samples or nd < 0:
+        raise ValueError(f"delay_samples must be an integer >= 0, got {delay_samples!r}")
+    finite("root_twist", root_twist)
+    if root_twist == 0:
+        raise ValueError("root_twist must be nonzero")
+    for n_, v in (("t_final", t_final), ("supply_voltage", supply_voltage),
+                  ("current_limit", current_limit)):
+        positive(n_, v)
+    m_sub = int(substeps)
+    if m_sub < 1:
+        raise ValueError(f"substeps must be >= 1, got {substeps!r}")
+    p = plant(model)
+    sel = _controller_rows(controller, p)
+    names = list(p.output_labels)
+    A, B, Cp = np.array(p.A), np.array(p.B), np.array(p.C)
+    Cy = sel @ Cp
+    n = A.shape[0]
+    M = np.zeros((n + 1, n + 1))
+    M[:n, :n], M[:n, n:] = A * ts / m_sub, B * ts / m_sub
+    E = expm(M)
+    Ad, Bd = E[:n, :n], E[:n, n]
+    if controller.isdtime(strict=True):
+        if abs(float(controller.dt) - ts) > 1e-12 * ts:
+            raise ValueError(f"controller.dt must equal sample_time = {ts:g} s")
+        kd = controller
+    else:
+        kd = ct.c2d(ct.ss(controller.A, controller.B, controller.C, controller.D), ts,
+                    "tustin")
+    Ak, Bk, Ck, Dk = (np.array(x, dtype=float) for x in (kd.A, kd.B, kd.C, kd.D))
+    x = np.zeros(n)
+    x[_first_elastic_state(model)] = 1.0
+    x *= root_twist / float(Cp[names.index(FIN_ROOT)] @ x)
+    xk = np.zeros(Ak.shape[0])
+    held = [0.0] * nd
+    vmax = min(supply_voltage, current_limit * model.actuator.motor.resistance)
+    n_s = int(math.ceil(t_final / ts - 1e-9))
+    X = np.empty((n_s * m_sub, n))
+    v_app = np.empty(n_s * m_sub)
+    v_dem = np.empty(n_s * m_sub)
+    for k in range(n_s):
+        y = Cy @ x
+        u = float((Ck @ xk + Dk @ y)[0]) if Ak.size else float((Dk @ y)[0])
+        xk = Ak @ xk + Bk @ y
+        if nd:
+            d, held = held[0], held[1:] + [u]
+        else:
+            d = u
+        va = float(np.clip(d, -vmax, vmax))
+        for j in range(m_sub):
+            X[k * m_sub + j] = x
+            x = Ad @ x + Bd * va
+        v_app[k * m_sub:(k + 1) * m_sub] = va
+        v_dem[k * m_sub:(k + 1) * m_sub] = d
+    Y = X @ Cp.T
+    return AfsSimulation(t=np.arange(n_s * m_sub) * ts / m_sub, fin_root=Y[:, names.index(FIN_ROOT)],
+                         theta=Y[:, names.index("theta")], voltage=v_app, voltage_demand=v_dem,
+                         current=Y[:, names.index("current")], voltage_limit=float(vmax))
 
 
 def _first_elastic_state(model: AeroservoelasticModel) -> int:
