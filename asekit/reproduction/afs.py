@@ -25,7 +25,11 @@ open-loop flutter speed (just above it). Definitions of the reported numbers:
 * ``ase.afs.sampled_5khz_flutter_ms``: the classical loop's boundary with the controller run
   at 5 kHz (Tustin) and one sample of computational delay; ``ase.afs.stable_at_1khz``: whether
   it is stable at the check speed when run at the thesis's 1 kHz with one sample of delay;
-* ``ase.afs.lqg.*``: the same for the LQG design; ``ase.afs.*.peak_voltage_v`` /
+* ``ase.afs.lqg.*``: the same for the LQG design;
+* ``ase.afs.dlqg_1khz.*``: a discrete LQG designed on the 1 kHz zero-order-hold plant with its
+  one sample of computational delay (:func:`asekit.ase.afs.discrete_lqg_controller`): its
+  boundary, gain margins from the eigenvalues with its gain scaled, phase margin on the unit
+  circle and the sampled release at the check speed; ``ase.afs.*.peak_voltage_v`` /
   ``peak_current_a``: peaks of the release at the check speed.
 """
 
@@ -34,6 +38,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import control as ct
 import numpy as np
 
 from asekit.aeroelastic.flutter import first_of, pk_flutter, pk_instabilities
@@ -95,6 +100,26 @@ class AfsDesign:
 
 
 @dataclass(frozen=True)
+class DigitalDesign:
+    """The discrete LQG run at :data:`THESIS_SAMPLE` with one sample of delay: ``controller``
+    (discrete StateSpace), ``boundary``, ``gain_margins`` (lower, upper linear factors, from
+    the eigenvalues), ``phase_margin_deg`` (unit circle), ``release`` (sampled, at the check
+    speed)."""
+
+    controller: object
+    boundary: afs.Boundary
+    gain_margins: tuple
+    phase_margin_deg: float | None
+    release: afs.AfsSimulation
+
+    @property
+    def gain_margin_db(self) -> float:
+        lo, hi = self.gain_margins
+        return float(min(-20 * math.log10(lo) if lo > 0 else math.inf,
+                         20 * math.log10(hi) if math.isfinite(hi) else math.inf))
+
+
+@dataclass(frozen=True)
 class AfsStudy:
     """``family``, ``open_loop`` (Boundary of the locked fin), ``pk_speed`` (m/s) and
     ``pk_frequency_hz`` of the same fin, ``check_speed`` (m/s), ``designs`` {name: AfsDesign}."""
@@ -105,6 +130,7 @@ class AfsStudy:
     pk_frequency_hz: float | None
     check_speed: float
     designs: dict
+    digital: DigitalDesign | None = None
 
 
 def family(mach: float = MACH, altitude: float = ALTITUDE) -> afs.SpeedFamily:
@@ -156,7 +182,26 @@ def compute() -> AfsStudy:
     designs = {n: _design(fam, n, K, check, margins=n != "pd") for n, K in
                (("classical", classical), ("lqg", lqg), ("pd", pd))}
     pk_speed, pk_f = _pk(fam)
-    return AfsStudy(fam, ol, pk_speed, pk_f, check, designs)
+    return AfsStudy(fam, ol, pk_speed, pk_f, check, designs,
+                    _digital(fam, LQG_DESIGN_FACTOR * ol.speed, check))
+
+
+def _digital(fam, design_speed, check_speed) -> DigitalDesign:
+    ts = THESIS_SAMPLE
+    K = afs.discrete_lqg_controller(fam.model(design_speed), ts, *LQG_WEIGHTS)
+    b = afs.stability_boundary(lambda u: afs.sampled_closed_loop_matrix(fam.model(u), K, ts, 1),
+                               GRID, tol=TOL, sample_time=ts)
+    m = fam.model(check_speed)
+
+    def scaled(k):
+        Kk = ct.ss(K.A, K.B, k * np.array(K.C), k * np.array(K.D), ts,
+                   inputs=list(K.input_labels))
+        return afs.sampled_closed_loop_matrix(m, Kk, ts, 1)
+
+    gm = afs.sampled_gain_margins(scaled, tol=1e-4)
+    pm = afs.sampled_phase_margin(afs.sampled_loop_at_input(m, K, ts, 1))
+    sim = afs.simulate_release_sampled(m, K, ts, 1, root_twist=RELEASE_TWIST, t_final=0.1)
+    return DigitalDesign(K, b, gm, pm, sim)
 
 
 def _gain(study: AfsStudy, d: AfsDesign):
@@ -202,7 +247,28 @@ def quantities(study: AfsStudy) -> list[Quantity]:
                        f"at {study.check_speed:.1f} m/s, 1 kHz with one sample of delay (the "
                        "thesis's processor)" + ("" if d.stable_thesis_rate else
                                                 ": the continuous design does not survive it"))]
+    q += _digital_rows(study)
     return q
+
+
+def _digital_rows(study: AfsStudy) -> list[Quantity]:
+    d = study.digital
+    gain = _gain(study, d)
+    at = f"at {study.check_speed:.1f} m/s, 1 kHz with one sample of delay"
+    r = d.release
+    rel = f"{math.degrees(RELEASE_TWIST):g} deg root-twist release {at}, 24 V / 10 A clip"
+    return [Quantity("ase.afs.dlqg_1khz.closed_loop_flutter_ms", d.boundary.speed, "m/s",
+                     f"discrete LQG on the 1 kHz ZOH plant with its delay, designed at "
+                     f"{LQG_DESIGN_FACTOR:g} x open loop"
+                     + (f"; +{gain:.1f} % over the open loop" if gain is not None else "")),
+            Quantity("ase.afs.dlqg_1khz.gain_margin_db", d.gain_margin_db, "dB",
+                     f"min(|lower|, upper) {at}, from the eigenvalues with the gain scaled"),
+            Quantity("ase.afs.dlqg_1khz.phase_margin_deg", d.phase_margin_deg, "deg",
+                     f"{at}, loop broken at the actuator input, unit circle"),
+            Quantity("ase.afs.dlqg_1khz.peak_voltage_v", float(np.max(np.abs(r.voltage))), "V",
+                     rel + ("; demand clipped" if r.saturated else "")),
+            Quantity("ase.afs.dlqg_1khz.peak_current_a", float(np.max(np.abs(r.current))), "A",
+                     rel)]
 
 
 @small_dense

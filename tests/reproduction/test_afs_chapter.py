@@ -57,3 +57,13 @@ def test_processor_rows(study, rows):
     for pre in ("", "lqg."):
         assert rows[f"ase.afs.{pre}sampled_5khz_flutter_ms"].asekit >= 1.2 * ol
         assert rows[f"ase.afs.{pre}stable_at_1khz"].asekit is False
+
+
+def test_discrete_lqg_rows(rows):
+    # the discrete LQG at the thesis's 1 kHz with one sample of delay meets the targets
+    ol = rows["ase.afs.open_loop_flutter_ms"].asekit
+    assert rows["ase.afs.dlqg_1khz.closed_loop_flutter_ms"].asekit >= 1.2 * ol
+    assert rows["ase.afs.dlqg_1khz.gain_margin_db"].asekit >= 6.0
+    assert rows["ase.afs.dlqg_1khz.phase_margin_deg"].asekit >= 45.0
+    assert rows["ase.afs.dlqg_1khz.peak_voltage_v"].asekit <= 24.0
+    assert rows["ase.afs.dlqg_1khz.peak_current_a"].asekit <= 10.0
