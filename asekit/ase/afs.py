@@ -58,7 +58,7 @@ __all__ = ["SpeedFamily", "Boundary", "MEASUREMENTS", "AfsSimulation", "locked_m
            "sampled_growth_rate", "stability_boundary", "loop_at_input",
            "classical_controller", "lqg_controller", "discrete_lqg_controller",
            "sampled_loop_at_input", "sampled_phase_margin", "sampled_gain_margins",
-           "simulate_release", "simulate_release_sampled"]
+           "simulate_release", "simulate_release_sampled", "Quantisers", "quantise"]
 
 #: Plant outputs a flutter-suppression controller may measure (rad, rad/s).
 MEASUREMENTS = ("theta", "omega", FIN_ROOT, "fin_root_rate")
@@ -756,17 +756,81 @@ def simulate_release(model: AeroservoelasticModel, controller: ct.StateSpace,
                          voltage_limit=float(vmax))
 
 
+@dataclass(frozen=True)
+class Quantisers:
+    """Digital word lengths of the processor loop (None: ideal).
+
+    Attributes
+    ----------
+    encoder_resolution : float or None
+        Step (rad) of the transmission angle ``theta`` (a motor encoder of c counts per motor
+        revolution behind the ratio N: 2 pi / (c N)); ``omega`` is then the backward difference
+        of the quantised angle over one sample.
+    adc_bits, adc_range : int or None, float
+        Word length and full scale +-adc_range (rad) of the converter reading the fin-root
+        pitch (and its rate, full scale adc_range / T).
+    dac_bits, dac_range : int or None, float
+        Word length and full scale +-dac_range (V) of the voltage demand.
+    """
+
+    encoder_resolution: float | None = None
+    adc_bits: int | None = None
+    adc_range: float = math.pi
+    dac_bits: int | None = None
+    dac_range: float = 24.0
+
+    def __post_init__(self):
+        if self.encoder_resolution is not None:
+            positive("encoder_resolution", self.encoder_resolution)
+        for n, b in (("adc_bits", self.adc_bits), ("dac_bits", self.dac_bits)):
+            if b is not None and not (isinstance(b, int) and 2 <= b <= 32):
+                raise ValueError(f"{n} must be an integer in [2, 32], got {b!r}")
+        positive("adc_range", self.adc_range)
+        positive("dac_range", self.dac_range)
+
+
+def quantise(x, step: float, full_scale: float = math.inf):
+    """Mid-tread quantiser: ``step`` round(x / step), saturated at +-full_scale.
+
+    Examples
+    --------
+    >>> float(quantise(0.26, 0.1)), float(quantise(-3.0, 0.5, full_scale=1.0))
+    (0.30000000000000004, -1.0)
+    """
+    return np.clip(step * np.round(np.asarray(x, float) / step), -full_scale, full_scale)
+
+
+def _measure(y, names, q: Quantisers, ts, prev_theta):
+    """The processor's sample of the measurements ``y`` (named ``names``) under ``q``."""
+    y = np.array(y, float)
+    th = None
+    for i, n in enumerate(names):
+        if n == "theta" and q.encoder_resolution is not None:
+            y[i] = th = float(quantise(y[i], q.encoder_resolution))
+        elif n in (FIN_ROOT, "fin_root_rate") and q.adc_bits is not None:
+            fs = q.adc_range if n == FIN_ROOT else q.adc_range / ts
+            y[i] = float(quantise(y[i], 2 * fs / 2 ** q.adc_bits, fs))
+    if q.encoder_resolution is not None and "omega" in names:
+        th = th if th is not None else float(quantise(y[names.index("theta")],
+                                                      q.encoder_resolution))
+        y[names.index("omega")] = (th - prev_theta) / ts
+    return y, th
+
+
 @small_dense
 def simulate_release_sampled(model: AeroservoelasticModel, controller: ct.StateSpace,
                              sample_time: float, delay_samples: int = 1,
                              root_twist: float = math.radians(1.0), t_final: float = 0.2,
                              substeps: int = 10, supply_voltage: float = 24.0,
-                             current_limit: float = 10.0) -> AfsSimulation:
+                             current_limit: float = 10.0,
+                             quantisers: Quantisers | None = None) -> AfsSimulation:
     """:func:`simulate_release` with the controller run by a processor: sampled every
     ``sample_time`` T (a discrete controller with dt = T, or a continuous one discretised by
     Tustin's rule), its voltage clipped to +-min(V_supply, I_lim R) and applied
     ``delay_samples`` samples later, held over each sample (ZOH); the plant propagated exactly
-    over T / ``substeps`` (histories on that grid).
+    over T / ``substeps`` (histories on that grid). With ``quantisers`` the samples pass the
+    encoder and the ADC and the demand the DAC (:class:`Quantisers`): the loop is then
+    nonlinear and may settle in a quantisation limit cycle instead of at rest.
 
     Returns
     -------
@@ -817,9 +881,18 @@ def simulate_release_sampled(model: AeroservoelasticModel, controller: ct.StateS
     X = np.empty((n_s * m_sub, n))
     v_app = np.empty(n_s * m_sub)
     v_dem = np.empty(n_s * m_sub)
+    meas = list(kd.input_labels) if controller.isdtime(strict=True) else list(
+        controller.input_labels)
+    prev_th = 0.0
     for k in range(n_s):
         y = Cy @ x
+        if quantisers is not None:
+            y, th = _measure(y, meas, quantisers, ts, prev_th)
+            prev_th = prev_th if th is None else th
         u = float((Ck @ xk + Dk @ y)[0]) if Ak.size else float((Dk @ y)[0])
+        if quantisers is not None and quantisers.dac_bits is not None:
+            u = float(quantise(u, 2 * quantisers.dac_range / 2 ** quantisers.dac_bits,
+                               quantisers.dac_range))
         xk = Ak @ xk + Bk @ y
         if nd:
             d, held = held[0], held[1:] + [u]

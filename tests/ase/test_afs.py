@@ -316,3 +316,45 @@ def test_sampled_release_at_fast_sampling_is_the_continuous_release(family, open
         np.abs(ref.fin_root))
     with pytest.raises(ValueError, match="substeps"):
         afs.simulate_release_sampled(m, K, 1e-3, substeps=0)
+
+
+# ---------------------------------------------------------------------------------------------
+# word lengths: the quantisation-induced limit cycle
+# ---------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def dlqg(family, open_loop):
+    return afs.discrete_lqg_controller(family.model(1.35 * open_loop.speed), 1e-3, 1e4, 1e4, 1.0)
+
+
+def test_fine_quantisers_are_the_ideal_loop(family, open_loop, dlqg):
+    m = family.model(1.05 * open_loop.speed)
+    kw = dict(root_twist=math.radians(0.1), t_final=0.05)
+    ideal = afs.simulate_release_sampled(m, dlqg, 1e-3, 1, **kw)
+    fine = afs.simulate_release_sampled(m, dlqg, 1e-3, 1, quantisers=afs.Quantisers(
+        encoder_resolution=1e-13, adc_bits=32, dac_bits=32), **kw)
+    np.testing.assert_allclose(fine.fin_root, ideal.fin_root, rtol=0,
+                               atol=1e-6 * np.max(np.abs(ideal.fin_root)))
+
+
+def test_adc_quantisation_sustains_a_limit_cycle(family, open_loop, dlqg):
+    # ideal loop: the release decays to nothing; with a 10-bit fin-root ADC (step 2 pi / 1024)
+    # the motion persists at a fraction of a few quanta and stays bounded (no growth, no clip)
+    m = family.model(1.05 * open_loop.speed)
+    kw = dict(root_twist=math.radians(0.1), t_final=0.4)
+    ideal = afs.simulate_release_sampled(m, dlqg, 1e-3, 1, **kw)
+    q = afs.Quantisers(adc_bits=10)
+    quant = afs.simulate_release_sampled(m, dlqg, 1e-3, 1, quantisers=q, **kw)
+    step = 2 * math.pi / 2 ** 10
+    last = ideal.t >= 0.3
+    amp_ideal = np.ptp(ideal.fin_root[last]) / 2
+    amp_q = np.ptp(quant.fin_root[last]) / 2
+    assert amp_ideal < 1e-3 * step
+    assert 0.1 * step < amp_q < 10 * step
+    assert not quant.saturated
+
+
+def test_quantiser_refusals():
+    with pytest.raises(ValueError, match="adc_bits"):
+        afs.Quantisers(adc_bits=1)
+    with pytest.raises(ValueError, match="encoder_resolution"):
+        afs.Quantisers(encoder_resolution=0.0)
