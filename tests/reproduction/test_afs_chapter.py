@@ -67,3 +67,11 @@ def test_discrete_lqg_rows(rows):
     assert rows["ase.afs.dlqg_1khz.phase_margin_deg"].asekit >= 45.0
     assert rows["ase.afs.dlqg_1khz.peak_voltage_v"].asekit <= 24.0
     assert rows["ase.afs.dlqg_1khz.peak_current_a"].asekit <= 10.0
+
+
+def test_quantised_rows(rows):
+    # the word lengths keep the loop moving (the ideal release decays to rest), boundedly:
+    # a fraction of a degree, inside the supply
+    amp = rows["ase.afs.dlqg_1khz.quantised_lco_amplitude_deg"].asekit
+    assert 0.01 < amp < 1.0
+    assert 0.0 < rows["ase.afs.dlqg_1khz.quantised_peak_voltage_v"].asekit <= 24.0
