@@ -293,3 +293,25 @@ def _quantised_rows(study: AfsStudy) -> list[Quantity]:
                      f"half peak-to-peak fin-root pitch, {amp / quantum:.2f} ADC steps; " + what),
             Quantity("ase.afs.dlqg_1khz.quantised_peak_voltage_v",
                      float(np.max(np.abs(r.voltage[last]))), "V", what)]
+
+
+@small_dense
+def fig_root_locus(study: AfsStudy, velocities=None):
+    """Eigenvalues of the locked fin and of the classical and LQG closed loops against airspeed
+    (the flutter branch crossing into the right half plane), in Hz against 1/s."""
+    U = np.linspace(150.0, 330.0, 19) if velocities is None else np.asarray(velocities)
+    fig, ax = new_figure(f"Root locus over {U[0]:.0f}-{U[-1]:.0f} m/s, M 0.5 sea level")
+    sets = [("locked fin (open loop)", lambda u: afs.locked_matrix(study.family, u))]
+    for n in ("classical", "lqg"):
+        K = study.designs[n].controller
+        sets.append((f"{n} AFS", lambda u, K=K: afs.closed_loop_matrix(study.family.model(u), K)))
+    for (label, A_of), mk in zip(sets, ("o", "s", "^")):
+        lam = np.concatenate([np.linalg.eigvals(A_of(u)) for u in U])
+        keep = (lam.imag > 2 * math.pi * 50) & (lam.imag < 2 * math.pi * 250)
+        ax.scatter(lam.real[keep], lam.imag[keep] / (2 * math.pi), s=8, marker=mk, label=label)
+    ax.axvline(0.0, color="k", lw=0.8)
+    ax.set_xlim(-400, 200)
+    ax.set_xlabel("real part (1/s)")
+    ax.set_ylabel("frequency (Hz)")
+    ax.legend()
+    return fig

@@ -75,3 +75,9 @@ def test_quantised_rows(rows):
     amp = rows["ase.afs.dlqg_1khz.quantised_lco_amplitude_deg"].asekit
     assert 0.01 < amp < 1.0
     assert 0.0 < rows["ase.afs.dlqg_1khz.quantised_peak_voltage_v"].asekit <= 24.0
+
+
+def test_root_locus_figure(study):
+    fig = study_mod.fig_root_locus(study, velocities=[200.0, 300.0])
+    ax = fig.axes[0]
+    assert len(ax.collections) == 3 and ax.get_xlabel() == "real part (1/s)"
