@@ -278,7 +278,7 @@ def test_discrete_lqg_suppresses_flutter_at_1khz_with_delay(family, open_loop):
     # designed on the 1 kHz ZOH plant with its one-sample delay at 1.35 x the open-loop speed:
     # +20 % at least, 6 dB / 45 deg at 1.05 x, where the continuous designs fail at 1 kHz
     ts = 1e-3
-    K = afs.discrete_lqg_controller(family.model(1.35 * open_loop.speed), ts, 1e4, 1e4, 1.0)
+    K = afs.discrete_lqg_controller(family.model(1.35 * open_loop.speed), ts, 1e4, 1e4, 0.1)
     assert K.isdtime() and float(K.dt) == ts
     b = afs.stability_boundary(
         lambda u: afs.sampled_closed_loop_matrix(family.model(u), K, ts, 1), GRID, tol=1.0,
@@ -323,7 +323,7 @@ def test_sampled_release_at_fast_sampling_is_the_continuous_release(family, open
 # ---------------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def dlqg(family, open_loop):
-    return afs.discrete_lqg_controller(family.model(1.35 * open_loop.speed), 1e-3, 1e4, 1e4, 1.0)
+    return afs.discrete_lqg_controller(family.model(1.35 * open_loop.speed), 1e-3, 1e4, 1e4, 0.1)
 
 
 def test_fine_quantisers_are_the_ideal_loop(family, open_loop, dlqg):
