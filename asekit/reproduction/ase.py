@@ -36,6 +36,7 @@ from asekit.ase import loop as ase
 from asekit.ase import metrics
 from asekit.ase.margins import NyquistMargins, nyquist_margins
 from asekit.case import pipeline
+from asekit.reproduction import afs as afs_study
 from asekit.reproduction.driver import ChapterResult, Quantity
 from asekit.reproduction.fin import CORNERS, fin_case
 from asekit.servo.actuator import SYSTEM_3, PDController
@@ -187,7 +188,11 @@ def quantities(ch: AseChapter) -> tuple[Quantity, ...]:
 
 def run(figures: bool = False) -> ChapterResult:
     ch = compute()
-    return ChapterResult("ase", quantities(ch), all_figures(ch) if figures else {})
+    study = afs_study.compute()                     # issue 26: active flutter suppression
+    figs = all_figures(ch) if figures else {}
+    if figures:
+        figs["afs_root_locus"] = afs_study.fig_root_locus(study)
+    return ChapterResult("ase", tuple(quantities(ch)) + tuple(afs_study.quantities(study)), figs)
 
 
 def all_figures(ch: AseChapter) -> dict:

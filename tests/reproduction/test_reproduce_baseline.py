@@ -11,6 +11,12 @@ The six ``ase.design.hinf.*`` rows (issue 26: the H-infinity design; ``condition
 ``mu_peak`` are computed with ``reproduce --robust`` only) were added on 2026-12-03 from
 ``python -m asekit reproduce --only design --json``; no other value changed.
 
+The twenty-four ``ase.afs.*`` rows (issue 26: active flutter suppression, the open- and
+closed-loop flutter boundaries, margins, release peaks, the sampled loops, the 1 kHz discrete LQG
+and its quantisation-induced oscillation) were added on 2026-12-03 from
+``python -m asekit reproduce --only ase --json`` (three runs, bit-identical); no other value
+changed.
+
 Eight p-k rows moved by 1.8e-9 to 5.3e-7 relative on 2026-12-03 with issue 23's batched,
 secant-accelerated k-iteration (its tolerance is 1e-7 relative in frequency, so the converged
 roots may move by that much): ``flutter.damping.pk``, ``flutter.structural_g.pk``,
