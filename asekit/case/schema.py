@@ -830,10 +830,30 @@ def _support(t: _Table, panels) -> SupportSpec:
         raise
     except ValueError as exc:             # the kind's own checks name their key path
         raise CaseError(str(exc)) from None
+    _check_support_points(fields.get("points") or (), panels)
     known = {f.name for f in dataclasses.fields(SupportSpec)} - {"kind", "options"}
     extra = tuple(sorted((k, v) for k, v in fields.items() if k not in known))
     return SupportSpec(kind=kind, options=extra,
                        **{k: v for k, v in fields.items() if k in known})
+
+
+def _check_support_points(points, panels) -> None:
+    """Refuse a support point (``support.points``, (x, y) m) that is off the plate, naming it
+    and the plate's x range at its y (or the plate's y range)."""
+    y0, y1 = panels[0].planform.root_le[1], panels[-1].planform.tip_le[1]
+    for i, (x, y) in enumerate(points):
+        if _on_planform(panels, x, y):
+            continue
+        if not y0 <= y <= y1:
+            where = f"y must lie in [{y0:g}, {y1:g}] m"
+        else:
+            pf = next(p.planform for p in panels if p.planform.root_le[1] <= y
+                      <= p.planform.tip_le[1])
+            e = (y - pf.root_le[1]) / pf.span
+            x_le = pf.root_le[0] + e * (pf.tip_le[0] - pf.root_le[0])
+            c = pf.root_chord + e * (pf.tip_chord - pf.root_chord)
+            where = f"at y = {y:g} m, x must lie in [{x_le:g}, {x_le + c:g}] m"
+        raise CaseError(f"support.points[{i}] = [{x:g}, {y:g}] m is off the plate: {where}")
 
 
 def _on_planform(panels, x: float, y: float) -> bool:

@@ -275,6 +275,129 @@ def _fixed_modal_model(system):
     return modal_model
 
 
+# ---------------------------------------------------------------------------------------------
+# "partial": nodes at listed points and on parts of the named edges (Nastran SPC1 on some grids)
+# ---------------------------------------------------------------------------------------------
+#: Conditions of the ``"partial"`` kind and the local DOFs (0 w, 1 theta_x, 2 theta_y) they fix:
+#: ``"clamped"`` every DOF (Nastran SPC1 123456 on a plate grid: the in-plane and drilling
+#: freedoms asekit's bending plate does not have are held anyway), ``"pinned"`` the deflection
+#: w only (SPC1 3: the grid held, free to rotate).
+PARTIAL_CONDITIONS = {"clamped": (0, 1, 2), "pinned": (0,)}
+
+
+def _point_list(key: str, value) -> tuple[tuple[float, float], ...]:
+    """``value`` as ((x, y), ...) m; ValueError naming ``key`` otherwise."""
+    ok = isinstance(value, list) and len(value) > 0
+    pts = []
+    for i, p in enumerate(value if ok else ()):
+        if not (isinstance(p, list) and len(p) == 2 and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
+                and abs(v) <= 1e4 for v in p)):
+            raise ValueError(f"{key}[{i}] must be a point [x, y] of two finite numbers in m "
+                             f"(|value| <= 1e4), got {p!r}")
+        pts.append((float(p[0]), float(p[1])))
+    if not ok:
+        raise ValueError(f"{key} must be a non-empty list of points [[x, y], ...] in m, "
+                         f"got {value!r}")
+    return tuple(pts)
+
+
+def _fraction_range(key: str, value) -> tuple[float, float]:
+    """``value`` as a (start, end) pair of fractions 0 <= start <= end <= 1."""
+    if not (isinstance(value, list) and len(value) == 2 and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+            and 0.0 <= value[0] <= value[1] <= 1.0):
+        raise ValueError(f"{key} must be a range [start, end] of fractions with "
+                         f"0 <= start <= end <= 1, got {value!r}")
+    return float(value[0]), float(value[1])
+
+
+def _parse_partial(t, root) -> dict:
+    condition = t.string("condition", tuple(PARTIAL_CONDITIONS), default="clamped")
+    points = t.raw("points")
+    out = {"condition": condition}
+    if points is not None:
+        out["points"] = _point_list(t.key("points"), points)
+    for edge in PLANFORM_EDGES:
+        r = t.raw(edge)
+        if r is not None:
+            out[edge] = _fraction_range(t.key(edge), r)
+    t.done()
+    if len(out) == 1:
+        raise ValueError(f"support.kind = \"partial\" needs {t.key('points')} and/or a range of "
+                         f"one of the edges ({', '.join(t.key(e) for e in PLANFORM_EDGES)})")
+    return out
+
+
+def partial_support_nodes(mesh: PlateMesh, points=(), ranges=(), tol: float = 1e-9,
+                          ) -> np.ndarray:
+    """Nodes held by a ``"partial"`` support: the node nearest to each of ``points``
+    ((x, y) m, Euclidean distance; ties go to the lower node number) and the nodes of the named
+    edges (:data:`PLANFORM_EDGES`) whose fraction along the edge lies in a range.
+
+    Parameters
+    ----------
+    mesh : a structured mesh (:func:`asekit.structure.mesh.structured_mesh` or ``panels_mesh``).
+    points : iterable of (x, y) m.
+    ranges : iterable of (edge, (start, end)): along ``root`` and ``tip`` the fraction is the
+        chord fraction (x - x_le) / c of the edge's nodes, along ``leading_edge`` and
+        ``trailing_edge`` the span fraction (y - y_min) / (y_max - y_min); ``tol`` widens each
+        range (relative).
+
+    Returns
+    -------
+    Sorted unique node indices. ValueError naming ``support.<edge>`` when a range holds no
+    node.
+
+    Examples
+    --------
+    >>> from asekit.geometry import Planform
+    >>> from asekit.structure.mesh import structured_mesh
+    >>> from asekit.geometry import Thickness
+    >>> m = structured_mesh(Planform((0.0, 0.0), 1.0, (0.0, 1.0), 1.0), Thickness(0.01, 0.01),
+    ...                     4, 2)
+    >>> partial_support_nodes(m, points=[(0.26, 0.0)], ranges=[("root", (0.5, 1.0))]).tolist()
+    [1, 2, 3, 4]
+    """
+    held = [int(np.argmin(np.hypot(*(mesh.nodes - np.asarray(p, float)).T))) for p in points]
+    y = mesh.nodes[:, 1]
+    for edge, (a, b) in ranges:
+        nodes = planform_edge_nodes(mesh, edge)
+        if edge in ("root", "tip"):
+            x = mesh.nodes[nodes, 0]
+            frac = (x - x.min()) / np.ptp(x)
+        else:
+            frac = (y[nodes] - y.min()) / np.ptp(y)
+        sel = nodes[(frac >= a - tol) & (frac <= b + tol)]
+        if sel.size == 0:
+            raise ValueError(f"support.{edge} = [{a:g}, {b:g}] holds no node of the mesh (its "
+                             f"nodes there are at fractions "
+                             f"{np.array2string(np.sort(frac), precision=4)}); widen the range")
+        held.extend(int(n) for n in sel)
+    return np.unique(np.asarray(held, dtype=np.int64))
+
+
+def _partial_system(mesh, K, M, spec) -> SupportedSystem:
+    ranges = [(e, spec.option(e)) for e in PLANFORM_EDGES if spec.option(e) is not None]
+    nodes = partial_support_nodes(mesh, spec.option("points", ()), ranges)
+    condition = spec.option("condition", "clamped")
+    dofs = PARTIAL_CONDITIONS[condition]
+    if condition == "pinned" and np.linalg.matrix_rank(
+            np.column_stack([np.ones(nodes.size), mesh.nodes[nodes]]), tol=1e-9) < 3:
+        raise ValueError(f"support.condition = \"pinned\" holds {nodes.size} node(s) on one line "
+                         f"(nodes {nodes.tolist()}): the plate can still rotate about it; pin at "
+                         f"least three nodes not on a line or use condition = \"clamped\"")
+    fixed = (DOF_PER_NODE * nodes[:, None] + np.asarray(dofs)).ravel()
+    n = K.shape[0]
+    free = np.setdiff1d(np.arange(n), fixed)
+    T = sp.csr_matrix((np.ones(free.size), (free, np.arange(free.size))), shape=(n, free.size))
+    K, M = sp.csr_matrix(K), sp.csr_matrix(M)
+    return SupportedSystem(K=(T.T @ K @ T).tocsr(), M=(T.T @ M @ T).tocsr(), T=T,
+                           shaft_index=None, ground_index=None, fictitious_inertia=0.0,
+                           shaft_nodes=np.array([], dtype=np.int64), mesh=mesh,
+                           label=f"plate {condition} at nodes {nodes.tolist()}")
+
+
 #: The support kinds of a case file, by ``support.kind``.
 SUPPORTS: dict[str, SupportKind] = {s.name: s for s in (
     SupportKind("clamped_root", "every degree of freedom of the root-chord nodes fixed",
@@ -284,6 +407,9 @@ SUPPORTS: dict[str, SupportKind] = {s.name: s for s in (
     SupportKind("shaft", "the thesis's pitch shaft (FN2: rigid pitch mode + elastic modes; "
                 "FN1: spring to ground)", _parse_shaft, _shaft_system, _shaft_modal_model,
                 has_rigid_mode=lambda spec: spec.model == "FN2"),
+    SupportKind("partial", "clamped or pinned nodes nearest to listed points and on parts of "
+                "the root, tip, leading and trailing edges", _parse_partial, _partial_system,
+                _fixed_modal_model(_partial_system)),
 )}
 
 
