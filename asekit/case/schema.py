@@ -769,10 +769,13 @@ def _thickness_table(t: _Table) -> ThicknessTable:
         if not isinstance(row, list) or len(row) != len(xc):
             raise CaseError(f"{t.key('values_m')}[{i}] must hold {len(xc)} numbers (one per "
                             f"x_over_c), got {row!r}")
-        values.append(tuple(_number(f"{t.key('values_m')}[{i}][{j}]", v, 0.0, 100.0, True,
+        values.append(tuple(_number(f"{t.key('values_m')}[{i}][{j}]", v, 0.0, 100.0, False,
                                     False, "m") for j, v in enumerate(row)))
     t.done()
-    return ThicknessTable(xc, eta, tuple(values))
+    try:                                   # a cell of zeros (no plate there) names values_m
+        return ThicknessTable(xc, eta, tuple(values))
+    except ValueError as exc:
+        raise CaseError(f"{t.path}.{exc}") from None
 
 
 def _thickness(t: _Table) -> Thickness | ThicknessTable:
