@@ -283,6 +283,9 @@ def _fixed_modal_model(system):
 #: freedoms asekit's bending plate does not have are held anyway), ``"pinned"`` the deflection
 #: w only (SPC1 3: the grid held, free to rotate).
 PARTIAL_CONDITIONS = {"clamped": (0, 1, 2), "pinned": (0,)}
+#: ``condition = "springs"``: each held node gets grounded springs ``springs = [k_w, k_theta_x,
+#: k_theta_y]`` (N/m, N m/rad, N m/rad; Nastran CELAS2 to ground on DOFs 3, 4, 5) instead.
+PARTIAL_SPRINGS = "springs"
 
 
 def _point_list(key: str, value) -> tuple[tuple[float, float], ...]:
@@ -313,9 +316,20 @@ def _fraction_range(key: str, value) -> tuple[float, float]:
 
 
 def _parse_partial(t, root) -> dict:
-    condition = t.string("condition", tuple(PARTIAL_CONDITIONS), default="clamped")
+    condition = t.string("condition", (*PARTIAL_CONDITIONS, PARTIAL_SPRINGS), default="clamped")
     points = t.raw("points")
     out = {"condition": condition}
+    springs = t.numbers("springs", length=3, low=0.0, high=1e15, low_open=False,
+                        unit="N/m, N m/rad, N m/rad")
+    if (springs is None) != (condition != PARTIAL_SPRINGS):
+        raise ValueError(f"{t.key('springs')} = [k_w, k_theta_x, k_theta_y] (N/m, N m/rad, "
+                         f"N m/rad) is needed with, and only with, {t.key('condition')} = "
+                         f"\"springs\" (got condition = {condition!r})")
+    if springs is not None:
+        if max(springs) <= 0.0:
+            raise ValueError(f"{t.key('springs')} must have one stiffness > 0, got "
+                             f"{list(springs)}")
+        out["springs"] = tuple(springs)
     if points is not None:
         out["points"] = _point_list(t.key("points"), points)
     for edge in PLANFORM_EDGES:
@@ -377,25 +391,70 @@ def partial_support_nodes(mesh: PlateMesh, points=(), ranges=(), tol: float = 1e
     return np.unique(np.asarray(held, dtype=np.int64))
 
 
+def rigid_restraint(nodes_xy: np.ndarray, k_w, k_theta_x, k_theta_y) -> np.ndarray:
+    """The 3 x 3 stiffness that grounded springs at nodes (x, y) m give the plate's rigid-body
+    motions w = a + b x + c y (so theta_x = dw/dy = c, theta_y = -dw/dx = -b):
+
+        R = sum_n k_w [1, x, y]^T [1, x, y] + k_theta_x e_c e_c^T + k_theta_y e_b e_b^T,
+
+    in (a, b, c). The plate keeps a rigid-body mode exactly when R is singular (a clamped node
+    is the limit of infinite springs). ``k_*`` are scalars or per-node arrays.
+
+    Examples
+    --------
+    >>> bool(np.linalg.eigvalsh(rigid_restraint(np.array([[0.0, 0], [1, 0]]), 1.0, 0, 0))[0]
+    ...      < 1e-12)        # two pinned nodes: rotation about their line is free
+    True
+    """
+    xy = np.asarray(nodes_xy, float).reshape(-1, 2)
+    k_w, k_tx, k_ty = (np.broadcast_to(np.asarray(k, float), (xy.shape[0],))
+                       for k in (k_w, k_theta_x, k_theta_y))
+    a = np.column_stack([np.ones(xy.shape[0]), xy])
+    R = (a * k_w[:, None]).T @ a
+    R[2, 2] += k_tx.sum()
+    R[1, 1] += k_ty.sum()
+    return R
+
+
+def _check_rigid_restraint(mesh, nodes, k, condition) -> None:
+    """Refuse held nodes that leave a rigid-body mode (``R`` of :func:`rigid_restraint`
+    singular, relative to the mesh's size)."""
+    xy = mesh.nodes[nodes] - mesh.nodes.mean(axis=0)
+    L = float(np.ptp(mesh.nodes, axis=0).max())
+    scale = np.diag([1.0, 1.0 / L, 1.0 / L])             # a, b L, c L: same units
+    R = scale @ rigid_restraint(xy, *k) @ scale
+    ev = np.linalg.eigvalsh(R)
+    if ev[0] <= 1e-9 * max(ev[-1], 1e-300):
+        raise ValueError(f"support.condition = \"{condition}\" at nodes {nodes.tolist()} leaves a "
+                         f"rigid-body motion of the plate free (e.g. a rotation about the line "
+                         f"of pinned nodes); hold at least three nodes not on a line, clamp, or "
+                         f"add rotational springs")
+
+
 def _partial_system(mesh, K, M, spec) -> SupportedSystem:
     ranges = [(e, spec.option(e)) for e in PLANFORM_EDGES if spec.option(e) is not None]
     nodes = partial_support_nodes(mesh, spec.option("points", ()), ranges)
     condition = spec.option("condition", "clamped")
-    dofs = PARTIAL_CONDITIONS[condition]
-    if condition == "pinned" and np.linalg.matrix_rank(
-            np.column_stack([np.ones(nodes.size), mesh.nodes[nodes]]), tol=1e-9) < 3:
-        raise ValueError(f"support.condition = \"pinned\" holds {nodes.size} node(s) on one line "
-                         f"(nodes {nodes.tolist()}): the plate can still rotate about it; pin at "
-                         f"least three nodes not on a line or use condition = \"clamped\"")
-    fixed = (DOF_PER_NODE * nodes[:, None] + np.asarray(dofs)).ravel()
     n = K.shape[0]
-    free = np.setdiff1d(np.arange(n), fixed)
-    T = sp.csr_matrix((np.ones(free.size), (free, np.arange(free.size))), shape=(n, free.size))
     K, M = sp.csr_matrix(K), sp.csr_matrix(M)
+    if condition == PARTIAL_SPRINGS:                  # grounded springs: K + sum k e e^T
+        k = np.asarray(spec.option("springs"), float)
+        _check_rigid_restraint(mesh, nodes, k, condition)
+        dofs = (DOF_PER_NODE * nodes[:, None] + np.arange(DOF_PER_NODE)).ravel()
+        K = (K + sp.csr_matrix((np.tile(k, nodes.size), (dofs, dofs)), shape=K.shape)).tocsr()
+        T = sp.identity(n, format="csr")
+        label = f"plate on springs {k.tolist()} at nodes {nodes.tolist()}"
+    else:
+        if condition == "pinned":
+            _check_rigid_restraint(mesh, nodes, (1.0, 0.0, 0.0), condition)
+        fixed = (DOF_PER_NODE * nodes[:, None] + np.asarray(PARTIAL_CONDITIONS[condition])).ravel()
+        free = np.setdiff1d(np.arange(n), fixed)
+        T = sp.csr_matrix((np.ones(free.size), (free, np.arange(free.size))),
+                          shape=(n, free.size))
+        label = f"plate {condition} at nodes {nodes.tolist()}"
     return SupportedSystem(K=(T.T @ K @ T).tocsr(), M=(T.T @ M @ T).tocsr(), T=T,
                            shaft_index=None, ground_index=None, fictitious_inertia=0.0,
-                           shaft_nodes=np.array([], dtype=np.int64), mesh=mesh,
-                           label=f"plate {condition} at nodes {nodes.tolist()}")
+                           shaft_nodes=np.array([], dtype=np.int64), mesh=mesh, label=label)
 
 
 #: The support kinds of a case file, by ``support.kind``.
@@ -407,8 +466,8 @@ SUPPORTS: dict[str, SupportKind] = {s.name: s for s in (
     SupportKind("shaft", "the thesis's pitch shaft (FN2: rigid pitch mode + elastic modes; "
                 "FN1: spring to ground)", _parse_shaft, _shaft_system, _shaft_modal_model,
                 has_rigid_mode=lambda spec: spec.model == "FN2"),
-    SupportKind("partial", "clamped or pinned nodes nearest to listed points and on parts of "
-                "the root, tip, leading and trailing edges", _parse_partial, _partial_system,
+    SupportKind("partial", "clamped, pinned or spring-supported nodes nearest to listed points "
+                "and on parts of the root, tip, leading and trailing edges", _parse_partial, _partial_system,
                 _fixed_modal_model(_partial_system)),
 )}
 
