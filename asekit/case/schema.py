@@ -112,7 +112,9 @@ class SupportSpec:
         "FN1" (spring to ground), ``radius`` None for the single-node shaft or the radius (m) of
         a rigid shaft region, ``fictitious_inertia_factor``), or ``"imported"`` (the
         constraints, rigid links and springs of ``Case.structure``, e.g. a deck's SPC / RBE2 /
-        CELAS, applied as they are; not a case-file kind).
+        CELAS, applied as they are; not a case-file kind). ``"partial"`` (nodes at listed
+        points and on parts of the edges, clamped, pinned or on springs) keeps its keys in
+        ``options`` (:mod:`asekit.structure.supports`).
     options : the keys of any other kind, as sorted (key, value) pairs (values hashable).
     """
 

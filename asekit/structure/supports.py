@@ -17,6 +17,11 @@ bounding rectangle:
 
 Edges are named ``x0`` (x = x_min, the leading edge for flow along +x), ``x1`` (x = x_max),
 ``y0`` (y = y_min) and ``y1`` (y = y_max).
+
+The case file's ``"partial"`` kind (:func:`partial_support_nodes`) holds only some nodes, as a
+Nastran SPC1 on chosen grids: the nodes nearest to listed points and those on parts of the
+named edges, clamped, pinned (w only) or on grounded springs; a support that leaves a rigid-body
+motion free is refused (:func:`rigid_restraint`).
 """
 
 from __future__ import annotations
