@@ -268,6 +268,20 @@ def _hat_weights(grid: tuple[float, ...], t: np.ndarray) -> np.ndarray:
     return w
 
 
+def _check_table_cells(rows) -> None:
+    """Refuse a thickness table with a cell (between neighbouring eta and x_over_c stations)
+    whose four corner values are all zero: h = 0 over an area of the plate, which has no
+    stiffness there. Zero at an edge or on a line (a sharp leading or trailing edge, the corner
+    thicknesses of Nastran's bevelled CQUAD4 rows) is allowed: h > 0 inside every cell."""
+    v = np.asarray(rows, float)
+    empty = (v[:-1, :-1] == 0) & (v[1:, :-1] == 0) & (v[:-1, 1:] == 0) & (v[1:, 1:] == 0)
+    if empty.any():
+        i, j = (int(k) for k in np.argwhere(empty)[0])
+        raise ValueError(f"values_m[{i}..{i + 1}][{j}..{j + 1}] are all zero: the plate would "
+                         f"have no thickness between those stations; at least one corner of "
+                         f"every cell must be > 0")
+
+
 @dataclass(frozen=True)
 class ThicknessTable:
     """Plate thickness tabulated over the panel and interpolated bilinearly (m):
@@ -276,8 +290,8 @@ class ThicknessTable:
 
     with xi the chord fraction, eta the span fraction (both in [0, 1]) and H the piecewise-linear
     hat functions of the grids ``eta`` and ``x_over_c`` (each strictly ascending from 0 to 1).
-    ``values[i][j]`` (m, > 0) is the thickness at span station ``eta[i]`` and chord fraction
-    ``x_over_c[j]``. h is linear in the values, so dh/dvalues[i][j] = H_i(eta) H_j(xi)
+    ``values[i][j]`` (m, >= 0; zero allowed at a sharp edge, but every cell of the grid needs a
+    corner > 0) is the thickness at span station ``eta[i]`` and chord fraction ``x_over_c[j]``. h is linear in the values, so dh/dvalues[i][j] = H_i(eta) H_j(xi)
     (:meth:`weights`).
 
     Examples
@@ -300,7 +314,9 @@ class ThicknessTable:
                              f"{len(self.x_over_c)} values (one per x_over_c)")
         for i, r in enumerate(rows):
             for j, v in enumerate(r):
-                positive(f"values_m[{i}][{j}]", v)
+                if not (math.isfinite(v) and v >= 0.0):
+                    raise ValueError(f"values_m[{i}][{j}] must be a finite number >= 0, got {v!r}")
+        _check_table_cells(rows)
         object.__setattr__(self, "values", rows)
 
     @property

@@ -112,7 +112,9 @@ class SupportSpec:
         "FN1" (spring to ground), ``radius`` None for the single-node shaft or the radius (m) of
         a rigid shaft region, ``fictitious_inertia_factor``), or ``"imported"`` (the
         constraints, rigid links and springs of ``Case.structure``, e.g. a deck's SPC / RBE2 /
-        CELAS, applied as they are; not a case-file kind).
+        CELAS, applied as they are; not a case-file kind). ``"partial"`` (nodes at listed
+        points and on parts of the edges, clamped, pinned or on springs) keeps its keys in
+        ``options`` (:mod:`asekit.structure.supports`).
     options : the keys of any other kind, as sorted (key, value) pairs (values hashable).
     """
 
@@ -787,10 +789,13 @@ def _thickness_table(t: _Table) -> ThicknessTable:
         if not isinstance(row, list) or len(row) != len(xc):
             raise CaseError(f"{t.key('values_m')}[{i}] must hold {len(xc)} numbers (one per "
                             f"x_over_c), got {row!r}")
-        values.append(tuple(_number(f"{t.key('values_m')}[{i}][{j}]", v, 0.0, 100.0, True,
+        values.append(tuple(_number(f"{t.key('values_m')}[{i}][{j}]", v, 0.0, 100.0, False,
                                     False, "m") for j, v in enumerate(row)))
     t.done()
-    return ThicknessTable(xc, eta, tuple(values))
+    try:                                   # a cell of zeros (no plate there) names values_m
+        return ThicknessTable(xc, eta, tuple(values))
+    except ValueError as exc:
+        raise CaseError(f"{t.path}.{exc}") from None
 
 
 def _thickness(t: _Table) -> Thickness | ThicknessTable:
@@ -848,10 +853,30 @@ def _support(t: _Table, panels) -> SupportSpec:
         raise
     except ValueError as exc:             # the kind's own checks name their key path
         raise CaseError(str(exc)) from None
+    _check_support_points(fields.get("points") or (), panels)
     known = {f.name for f in dataclasses.fields(SupportSpec)} - {"kind", "options"}
     extra = tuple(sorted((k, v) for k, v in fields.items() if k not in known))
     return SupportSpec(kind=kind, options=extra,
                        **{k: v for k, v in fields.items() if k in known})
+
+
+def _check_support_points(points, panels) -> None:
+    """Refuse a support point (``support.points``, (x, y) m) that is off the plate, naming it
+    and the plate's x range at its y (or the plate's y range)."""
+    y0, y1 = panels[0].planform.root_le[1], panels[-1].planform.tip_le[1]
+    for i, (x, y) in enumerate(points):
+        if _on_planform(panels, x, y):
+            continue
+        if not y0 <= y <= y1:
+            where = f"y must lie in [{y0:g}, {y1:g}] m"
+        else:
+            pf = next(p.planform for p in panels if p.planform.root_le[1] <= y
+                      <= p.planform.tip_le[1])
+            e = (y - pf.root_le[1]) / pf.span
+            x_le = pf.root_le[0] + e * (pf.tip_le[0] - pf.root_le[0])
+            c = pf.root_chord + e * (pf.tip_chord - pf.root_chord)
+            where = f"at y = {y:g} m, x must lie in [{x_le:g}, {x_le + c:g}] m"
+        raise CaseError(f"support.points[{i}] = [{x:g}, {y:g}] m is off the plate: {where}")
 
 
 def _on_planform(panels, x: float, y: float) -> bool:

@@ -78,7 +78,11 @@ from asekit.structure.assembly import SupportedSystem, element_dofs, pitch_inert
 from asekit.structure.mesh import PlateMesh
 from asekit.structure.modes import MIN_OUT_OF_PLANE
 from asekit.structure.plate import DOF_PER_NODE, consistent_mass, mitc4_stiffness, shape_functions
-from asekit.structure.supports import planform_edge_supports
+from asekit.structure.supports import (
+    PLANFORM_EDGES,
+    partial_support_nodes,
+    planform_edge_supports,
+)
 
 #: length, mass and time of one deck unit in SI (m, kg, s).
 UNITS = {"SI": (1.0, 1.0, 1.0), "mm-t-s": (1e-3, 1e3, 1.0),
@@ -2459,9 +2463,28 @@ def _shaft_cards(model, case, ids, eid: int) -> int:
     return eid + 2
 
 
+def _partial_cards(model, case, ids, eid: int) -> int:
+    """``support.kind = "partial"`` (:func:`asekit.structure.supports.partial_support_nodes`):
+    SPC1 345 on the held grids (clamped), SPC1 3 (pinned), or CELAS2 to ground on DOFs 3, 4, 5
+    with k_w, k_theta_x, k_theta_y (springs; a zero stiffness writes no card)."""
+    s, mesh = case.support, pl.structural_mesh(case)
+    ranges = [(e, s.option(e)) for e in PLANFORM_EDGES if s.option(e) is not None]
+    nodes = partial_support_nodes(mesh, s.option("points", ()), ranges)
+    condition = s.option("condition", "clamped")
+    if condition != "springs":
+        model.add_spc1(1, "345" if condition == "clamped" else "3", [ids[i] for i in nodes])
+        return eid
+    for i in nodes:
+        for c, k in zip((3, 4, 5), s.option("springs")):
+            if k > 0.0:
+                model.add_celas2(eid, float(k), [ids[i], 0], c, 0)
+                eid += 1
+    return eid
+
+
 #: The BDF cards of each support kind of a case (``case.support.kind``).
 SUPPORT_CARDS = {"clamped_root": _clamped_root_cards, "edges": _edges_cards,
-                 "shaft": _shaft_cards}
+                 "shaft": _shaft_cards, "partial": _partial_cards}
 
 
 def _support_cards(model, case, ids, eid: int) -> int:

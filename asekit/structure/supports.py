@@ -17,6 +17,11 @@ bounding rectangle:
 
 Edges are named ``x0`` (x = x_min, the leading edge for flow along +x), ``x1`` (x = x_max),
 ``y0`` (y = y_min) and ``y1`` (y = y_max).
+
+The case file's ``"partial"`` kind (:func:`partial_support_nodes`) holds only some nodes, as a
+Nastran SPC1 on chosen grids: the nodes nearest to listed points and those on parts of the
+named edges, clamped, pinned (w only) or on grounded springs; a support that leaves a rigid-body
+motion free is refused (:func:`rigid_restraint`).
 """
 
 from __future__ import annotations
@@ -275,6 +280,188 @@ def _fixed_modal_model(system):
     return modal_model
 
 
+# ---------------------------------------------------------------------------------------------
+# "partial": nodes at listed points and on parts of the named edges (Nastran SPC1 on some grids)
+# ---------------------------------------------------------------------------------------------
+#: Conditions of the ``"partial"`` kind and the local DOFs (0 w, 1 theta_x, 2 theta_y) they fix:
+#: ``"clamped"`` every DOF (Nastran SPC1 123456 on a plate grid: the in-plane and drilling
+#: freedoms asekit's bending plate does not have are held anyway), ``"pinned"`` the deflection
+#: w only (SPC1 3: the grid held, free to rotate).
+PARTIAL_CONDITIONS = {"clamped": (0, 1, 2), "pinned": (0,)}
+#: ``condition = "springs"``: each held node gets grounded springs ``springs = [k_w, k_theta_x,
+#: k_theta_y]`` (N/m, N m/rad, N m/rad; Nastran CELAS2 to ground on DOFs 3, 4, 5) instead.
+PARTIAL_SPRINGS = "springs"
+
+
+def _point_list(key: str, value) -> tuple[tuple[float, float], ...]:
+    """``value`` as ((x, y), ...) m; ValueError naming ``key`` otherwise."""
+    ok = isinstance(value, list) and len(value) > 0
+    pts = []
+    for i, p in enumerate(value if ok else ()):
+        if not (isinstance(p, list) and len(p) == 2 and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
+                and abs(v) <= 1e4 for v in p)):
+            raise ValueError(f"{key}[{i}] must be a point [x, y] of two finite numbers in m "
+                             f"(|value| <= 1e4), got {p!r}")
+        pts.append((float(p[0]), float(p[1])))
+    if not ok:
+        raise ValueError(f"{key} must be a non-empty list of points [[x, y], ...] in m, "
+                         f"got {value!r}")
+    return tuple(pts)
+
+
+def _fraction_range(key: str, value) -> tuple[float, float]:
+    """``value`` as a (start, end) pair of fractions 0 <= start <= end <= 1."""
+    if not (isinstance(value, list) and len(value) == 2 and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+            and 0.0 <= value[0] <= value[1] <= 1.0):
+        raise ValueError(f"{key} must be a range [start, end] of fractions with "
+                         f"0 <= start <= end <= 1, got {value!r}")
+    return float(value[0]), float(value[1])
+
+
+def _parse_partial(t, root) -> dict:
+    condition = t.string("condition", (*PARTIAL_CONDITIONS, PARTIAL_SPRINGS), default="clamped")
+    points = t.raw("points")
+    out = {"condition": condition}
+    springs = t.numbers("springs", length=3, low=0.0, high=1e15, low_open=False,
+                        unit="N/m, N m/rad, N m/rad")
+    if (springs is None) != (condition != PARTIAL_SPRINGS):
+        raise ValueError(f"{t.key('springs')} = [k_w, k_theta_x, k_theta_y] (N/m, N m/rad, "
+                         f"N m/rad) is needed with, and only with, {t.key('condition')} = "
+                         f"\"springs\" (got condition = {condition!r})")
+    if springs is not None:
+        if max(springs) <= 0.0:
+            raise ValueError(f"{t.key('springs')} must have one stiffness > 0, got "
+                             f"{list(springs)}")
+        out["springs"] = tuple(springs)
+    if points is not None:
+        out["points"] = _point_list(t.key("points"), points)
+    for edge in PLANFORM_EDGES:
+        r = t.raw(edge)
+        if r is not None:
+            out[edge] = _fraction_range(t.key(edge), r)
+    t.done()
+    if len(out) == 1:
+        raise ValueError(f"support.kind = \"partial\" needs {t.key('points')} and/or a range of "
+                         f"one of the edges ({', '.join(t.key(e) for e in PLANFORM_EDGES)})")
+    return out
+
+
+def partial_support_nodes(mesh: PlateMesh, points=(), ranges=(), tol: float = 1e-9,
+                          ) -> np.ndarray:
+    """Nodes held by a ``"partial"`` support: the node nearest to each of ``points``
+    ((x, y) m, Euclidean distance; ties go to the lower node number) and the nodes of the named
+    edges (:data:`PLANFORM_EDGES`) whose fraction along the edge lies in a range.
+
+    Parameters
+    ----------
+    mesh : a structured mesh (:func:`asekit.structure.mesh.structured_mesh` or ``panels_mesh``).
+    points : iterable of (x, y) m.
+    ranges : iterable of (edge, (start, end)): along ``root`` and ``tip`` the fraction is the
+        chord fraction (x - x_le) / c of the edge's nodes, along ``leading_edge`` and
+        ``trailing_edge`` the span fraction (y - y_min) / (y_max - y_min); ``tol`` widens each
+        range (relative).
+
+    Returns
+    -------
+    Sorted unique node indices. ValueError naming ``support.<edge>`` when a range holds no
+    node.
+
+    Examples
+    --------
+    >>> from asekit.geometry import Planform
+    >>> from asekit.structure.mesh import structured_mesh
+    >>> from asekit.geometry import Thickness
+    >>> m = structured_mesh(Planform((0.0, 0.0), 1.0, (0.0, 1.0), 1.0), Thickness(0.01, 0.01),
+    ...                     4, 2)
+    >>> partial_support_nodes(m, points=[(0.26, 0.0)], ranges=[("root", (0.5, 1.0))]).tolist()
+    [1, 2, 3, 4]
+    """
+    held = [int(np.argmin(np.hypot(*(mesh.nodes - np.asarray(p, float)).T))) for p in points]
+    y = mesh.nodes[:, 1]
+    for edge, (a, b) in ranges:
+        nodes = planform_edge_nodes(mesh, edge)
+        if edge in ("root", "tip"):
+            x = mesh.nodes[nodes, 0]
+            frac = (x - x.min()) / np.ptp(x)
+        else:
+            frac = (y[nodes] - y.min()) / np.ptp(y)
+        sel = nodes[(frac >= a - tol) & (frac <= b + tol)]
+        if sel.size == 0:
+            raise ValueError(f"support.{edge} = [{a:g}, {b:g}] holds no node of the mesh (its "
+                             f"nodes there are at fractions "
+                             f"{np.array2string(np.sort(frac), precision=4)}); widen the range")
+        held.extend(int(n) for n in sel)
+    return np.unique(np.asarray(held, dtype=np.int64))
+
+
+def rigid_restraint(nodes_xy: np.ndarray, k_w, k_theta_x, k_theta_y) -> np.ndarray:
+    """The 3 x 3 stiffness that grounded springs at nodes (x, y) m give the plate's rigid-body
+    motions w = a + b x + c y (so theta_x = dw/dy = c, theta_y = -dw/dx = -b):
+
+        R = sum_n k_w [1, x, y]^T [1, x, y] + k_theta_x e_c e_c^T + k_theta_y e_b e_b^T,
+
+    in (a, b, c). The plate keeps a rigid-body mode exactly when R is singular (a clamped node
+    is the limit of infinite springs). ``k_*`` are scalars or per-node arrays.
+
+    Examples
+    --------
+    >>> bool(np.linalg.eigvalsh(rigid_restraint(np.array([[0.0, 0], [1, 0]]), 1.0, 0, 0))[0]
+    ...      < 1e-12)        # two pinned nodes: rotation about their line is free
+    True
+    """
+    xy = np.asarray(nodes_xy, float).reshape(-1, 2)
+    k_w, k_tx, k_ty = (np.broadcast_to(np.asarray(k, float), (xy.shape[0],))
+                       for k in (k_w, k_theta_x, k_theta_y))
+    a = np.column_stack([np.ones(xy.shape[0]), xy])
+    R = (a * k_w[:, None]).T @ a
+    R[2, 2] += k_tx.sum()
+    R[1, 1] += k_ty.sum()
+    return R
+
+
+def _check_rigid_restraint(mesh, nodes, k, condition) -> None:
+    """Refuse held nodes that leave a rigid-body mode (``R`` of :func:`rigid_restraint`
+    singular, relative to the mesh's size)."""
+    xy = mesh.nodes[nodes] - mesh.nodes.mean(axis=0)
+    L = float(np.ptp(mesh.nodes, axis=0).max())
+    scale = np.diag([1.0, 1.0 / L, 1.0 / L])             # a, b L, c L: same units
+    R = scale @ rigid_restraint(xy, *k) @ scale
+    ev = np.linalg.eigvalsh(R)
+    if ev[0] <= 1e-9 * max(ev[-1], 1e-300):
+        raise ValueError(f"support.condition = \"{condition}\" at nodes {nodes.tolist()} leaves a "
+                         f"rigid-body motion of the plate free (e.g. a rotation about the line "
+                         f"of pinned nodes); hold at least three nodes not on a line, clamp, or "
+                         f"add rotational springs")
+
+
+def _partial_system(mesh, K, M, spec) -> SupportedSystem:
+    ranges = [(e, spec.option(e)) for e in PLANFORM_EDGES if spec.option(e) is not None]
+    nodes = partial_support_nodes(mesh, spec.option("points", ()), ranges)
+    condition = spec.option("condition", "clamped")
+    n = K.shape[0]
+    K, M = sp.csr_matrix(K), sp.csr_matrix(M)
+    if condition == PARTIAL_SPRINGS:                  # grounded springs: K + sum k e e^T
+        k = np.asarray(spec.option("springs"), float)
+        _check_rigid_restraint(mesh, nodes, k, condition)
+        dofs = (DOF_PER_NODE * nodes[:, None] + np.arange(DOF_PER_NODE)).ravel()
+        K = (K + sp.csr_matrix((np.tile(k, nodes.size), (dofs, dofs)), shape=K.shape)).tocsr()
+        T = sp.identity(n, format="csr")
+        label = f"plate on springs {k.tolist()} at nodes {nodes.tolist()}"
+    else:
+        if condition == "pinned":
+            _check_rigid_restraint(mesh, nodes, (1.0, 0.0, 0.0), condition)
+        fixed = (DOF_PER_NODE * nodes[:, None] + np.asarray(PARTIAL_CONDITIONS[condition])).ravel()
+        free = np.setdiff1d(np.arange(n), fixed)
+        T = sp.csr_matrix((np.ones(free.size), (free, np.arange(free.size))),
+                          shape=(n, free.size))
+        label = f"plate {condition} at nodes {nodes.tolist()}"
+    return SupportedSystem(K=(T.T @ K @ T).tocsr(), M=(T.T @ M @ T).tocsr(), T=T,
+                           shaft_index=None, ground_index=None, fictitious_inertia=0.0,
+                           shaft_nodes=np.array([], dtype=np.int64), mesh=mesh, label=label)
+
+
 #: The support kinds of a case file, by ``support.kind``.
 SUPPORTS: dict[str, SupportKind] = {s.name: s for s in (
     SupportKind("clamped_root", "every degree of freedom of the root-chord nodes fixed",
@@ -284,6 +471,9 @@ SUPPORTS: dict[str, SupportKind] = {s.name: s for s in (
     SupportKind("shaft", "the thesis's pitch shaft (FN2: rigid pitch mode + elastic modes; "
                 "FN1: spring to ground)", _parse_shaft, _shaft_system, _shaft_modal_model,
                 has_rigid_mode=lambda spec: spec.model == "FN2"),
+    SupportKind("partial", "clamped, pinned or spring-supported nodes nearest to listed points "
+                "and on parts of the root, tip, leading and trailing edges", _parse_partial, _partial_system,
+                _fixed_modal_model(_partial_system)),
 )}
 
 
