@@ -121,6 +121,9 @@ def structural_mesh(case: Case) -> PlateMesh:
     """
     if case.structure is not None:
         return case.structure.mesh
+    if case.beam is not None:
+        raise CaseError(f"{case.name}: a [[beam]] case has no plate mesh (its structure is the "
+                        f"beam: asekit.case.pipeline.case_beam)")
     mesh = panels_mesh([p.planform for p in case.panels], case.thickness,
                        case.panels[0].n_chord, [p.n_span for p in case.panels],
                        case.panels[0].chord_spacing, [p.span_spacing for p in case.panels])

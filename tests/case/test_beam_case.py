@@ -193,3 +193,18 @@ def test_beam_cases_refuse_plate_only_tables():
     d = _raw()
     d["panel"][0]["n_chord"] = 4
     _refused(d, "panel[0].n_chord is not a known key")
+
+
+def test_analyse_runs_the_goland_case_with_json_and_report(tmp_path, case_flutter):
+    """`asekit analyse` on the shipped stick model: one JSON flutter row (the pipeline's
+    crossing) and a report with the beam's planform and mode figures."""
+    import json
+
+    from asekit.cli.main import main
+    out, rep = tmp_path / "g.json", tmp_path / "rep"
+    assert main(["analyse", str(GOLAND), "--quiet", "--json", str(out), "--report",
+                 str(rep)]) == 0
+    (row,) = json.loads(out.read_text())["flutter"]
+    assert row["density"] == 1.02 and row["speed_ms"] == pytest.approx(
+        case_flutter.flutter.speed, rel=1e-12)
+    assert {"planform.png", "modes.png", "index.html"} <= {p.name for p in rep.iterdir()}
