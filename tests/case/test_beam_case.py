@@ -208,3 +208,10 @@ def test_analyse_runs_the_goland_case_with_json_and_report(tmp_path, case_flutte
     assert row["density"] == 1.02 and row["speed_ms"] == pytest.approx(
         case_flutter.flutter.speed, rel=1e-12)
     assert {"planform.png", "modes.png", "index.html"} <= {p.name for p in rep.iterdir()}
+
+
+def test_the_mesh_study_of_a_beam_case_is_refused_in_one_line(capsys):
+    from asekit.cli.main import main
+    assert main(["analyse", str(GOLAND), "--quiet", "--convergence"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "[[beam]]" in err and "--convergence" in err
