@@ -1226,16 +1226,13 @@ def _beam_axis(t: _Table):
 
 def _beam_sections(t: _Table, n_seg: int):
     """One section tuple per segment; every property a number or a list of n_seg numbers."""
-    cols = []
-    for k, low, unit in BEAM_PROPERTIES:
-        v = t.raw(k, required=True)
-        n = None if isinstance(v, (int, float)) and not isinstance(v, bool) else n_seg
-        cols.append(t.numbers(k, required=True, length=n, low=low, high=1e15, unit=unit))
-    v = t.raw("mass_offset", 0.0)
-    n = None if isinstance(v, (int, float)) and not isinstance(v, bool) else n_seg
-    cols.append(t.numbers("mass_offset", default=0.0, length=n, low=-1e4, high=1e4,
-                          low_open=False, unit="m"))
-    cols = [c * n_seg if len(c) == 1 else c for c in cols]
+    def column(k, default, low, high, low_open, unit):
+        if isinstance(t.raw(k, default, required=default is None), list):
+            return t.numbers(k, length=n_seg, low=low, high=high, low_open=low_open, unit=unit)
+        return (t.number(k, default, required=default is None, low=low, high=high,
+                         low_open=low_open, unit=unit),) * n_seg
+    cols = [column(k, None, low, 1e15, True, unit) for k, low, unit in BEAM_PROPERTIES]
+    cols.append(column("mass_offset", 0.0, -1e4, 1e4, False, "m"))
     for i in range(n_seg):
         m, ip, d = cols[4][i], cols[5][i], cols[6][i]
         if ip < m * d * d * (1 - 1e-12):

@@ -215,3 +215,18 @@ def test_the_mesh_study_of_a_beam_case_is_refused_in_one_line(capsys):
     assert main(["analyse", str(GOLAND), "--quiet", "--convergence"]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "[[beam]]" in err and "--convergence" in err
+
+
+def test_modes_below_f_max_and_a_sweep_over_a_beam_key():
+    """modes.f_max keeps the beam modes below it (7.66 and 15.2 Hz below 20 Hz); the sweep's
+    key paths reach [[beam]] like any table (asekit.sweep.set_key, then the loader's checks)."""
+    from asekit.sweep import set_key
+    d = _raw()
+    d["modes"] = {"f_max": 20.0}
+    assert P.modal_model(case_from_dict(d)).frequencies_hz.size == 2
+    d = _raw()
+    set_key(d, "beam[0].gj", 2 * 0.987e6)
+    f = P.modal_model(case_from_dict(d)).frequencies_hz
+    assert f[1] > P.modal_model(load_case(GOLAND)).frequencies_hz[1] * 1.2   # stiffer torsion
+    set_key(d, "beam[0].gj", -1.0)
+    _refused(d, "beam[0].gj must be > 0")
