@@ -469,7 +469,7 @@ def _load_matching(path: Path, fp: str, settings: dict, n_modes: int):
 def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetric: bool = False,
                         method: str = "quartic", progress: bool = True, rebuild: bool = False,
                         cache_dir=None, path=None, metadata: dict | None = None,
-                        entries: GafEntryCache | None = None) -> GafDatabase:
+                        entries: GafEntryCache | None = None, spline=None) -> GafDatabase:
     """The GAF database of a ``ModalModel`` on ``boxes`` over ``machs`` x ``ks``, from a cache
     when one matches, else computed (tqdm bar) and written atomically.
 
@@ -483,8 +483,14 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
     ``gaf_entries/`` next to the database file, or ``entries``): a failed or interrupted build
     resumes where it stopped, and a database over other Machs of the same request reuses
     them. ``rebuild`` recomputes the entries too.
+
+    ``spline`` : a named pair ``(name, fn)`` with ``fn(model, boxes) -> BoxModes`` in place of
+    :func:`asekit.aero.spline.fe_spline` (e.g. a stick model's beam-to-box spline,
+    :func:`asekit.aero.beam_spline.beam_box_modes`); its name enters the fingerprint.
     """
     settings = database_settings(machs, ks, b_ref, boxes, symmetric, method)
+    if spline is not None:
+        settings = {**settings, "spline": spline[0]}
     fp = mode_set_fingerprint(model, settings)
     n = len(model.frequencies_hz)
     if path is not None:
@@ -515,7 +521,8 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
     _log.info("GAF database: computing %d Mach x %d reduced frequencies (%s)",
               np.size(machs), np.size(ks), method)
     t0 = time.perf_counter()
-    db = build_gaf_database(fe_spline(model, boxes), boxes, machs, ks, b_ref, model.n_rigid,
+    box_modes = fe_spline(model, boxes) if spline is None else spline[1](model, boxes)
+    db = build_gaf_database(box_modes, boxes, machs, ks, b_ref, model.n_rigid,
                             symmetric, method, progress, meta, entries=entries)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)

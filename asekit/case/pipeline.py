@@ -18,8 +18,10 @@ from functools import lru_cache
 
 import numpy as np
 
+from asekit.aero.beam_spline import beam_spline_matrices
 from asekit.aero.boxes import check_matrix_memory, mesh_surfaces
 from asekit.aero.gaf import GafDatabase, cached_gaf_database
+from asekit.aero.spline import BoxModes
 from asekit.aeroelastic.flutter import Instability, PkResult, divergence_speeds, first_of
 from asekit.aeroelastic.methods import flutter_method
 from asekit.aeroelastic.statespace import fin_outputs
@@ -44,6 +46,7 @@ from asekit.structure.assembly import (
     plate_pitch_inertia,
     point_mass_matrix,
 )
+from asekit.structure.beam import NODE_DOF, BeamSection, StraightBeam, beam_modes, straight_beam
 from asekit.structure.mesh import PlateMesh, panels_mesh, snap_to_circle
 from asekit.structure.modes import InPlaneModes, ModalModel, fixed_modal_model, with_damping
 from asekit.structure.modes import inplane_modes as _inplane_modes
@@ -118,6 +121,9 @@ def structural_mesh(case: Case) -> PlateMesh:
     """
     if case.structure is not None:
         return case.structure.mesh
+    if case.beam is not None:
+        raise CaseError(f"{case.name}: a [[beam]] case has no plate mesh (its structure is the "
+                        f"beam: asekit.case.pipeline.case_beam)")
     mesh = panels_mesh([p.planform for p in case.panels], case.thickness,
                        case.panels[0].n_chord, [p.n_span for p in case.panels],
                        case.panels[0].chord_spacing, [p.span_spacing for p in case.panels])
@@ -262,6 +268,8 @@ def modal_model(case: Case) -> ModalModel:
     """
     if case.structure is not None:
         return imported_modal_model(case)
+    if case.beam is not None:
+        return beam_modal_model(case)
     mesh = structural_mesh(case)
     K, M = mass_and_stiffness(case)
     s, md = case.support, case.modes
@@ -425,6 +433,103 @@ def imported_box_mesh(case: Case):
 
 
 # ---------------------------------------------------------------------------------------------
+# a stick model (case.beam: [[beam]], issue 24): the structure kind chosen at the seam
+# ---------------------------------------------------------------------------------------------
+_BEAM = "check beam[0] (stations, section properties, n_elements) and modes.count / f_max"
+
+
+@lru_cache(maxsize=16)
+def case_beam(case: Case) -> StraightBeam:
+    """The case's ``[[beam]]`` as a :class:`~asekit.structure.beam.StraightBeam` (each segment
+    between ``stations`` cut into ``n_elements`` equal elements); memoised on the case.
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import CASES_DIR
+    >>> case_beam(load_case(CASES_DIR / "goland_wing.toml")).n_nodes      # 32 elements
+    33
+    """
+    b = case.beam
+    stations, sections = [0.0], []
+    for i, sec in enumerate(b.sections):
+        s0, s1 = b.stations[i] * b.length, b.stations[i + 1] * b.length
+        stations.extend(np.linspace(s0, s1, b.n_elements + 1)[1:].tolist())
+        sections.extend([BeamSection(*sec)] * b.n_elements)
+    return straight_beam(b.root, b.direction, stations, sections)
+
+
+def _beam_full_shapes(model: ModalModel) -> np.ndarray:
+    """(6 n_nodes, n_modes) beam displacement vectors of a beam ModalModel's (uz, rx, ry)
+    shapes (ux, uy and rz, in the plane, move no box)."""
+    n_nodes, _, n_modes = model.shapes.shape
+    full = np.zeros((n_nodes, NODE_DOF, n_modes))
+    full[:, 2:5, :] = model.shapes
+    return full.reshape(NODE_DOF * n_nodes, n_modes)
+
+
+def _structure_spline(case: Case):
+    """None for a plate (the FE shape functions), or the beam-to-box spline's named pair for
+    :func:`asekit.aero.gaf.cached_gaf_database`."""
+    if case.beam is None:
+        return None
+    beam = case_beam(case)
+
+    def spline(model, boxes):
+        try:
+            g_cp, gx_cp = beam_spline_matrices(beam, boxes.control_point)
+            g_lp, _ = beam_spline_matrices(beam, boxes.load_point)
+        except ValueError as exc:
+            raise CaseError(f"beam[0] / panel: {exc}") from None
+        phi = _beam_full_shapes(model)
+        return BoxModes(g_cp @ phi, gx_cp @ phi, g_lp @ phi)
+    return ("beam (asekit.aero.beam_spline)", spline)
+
+
+@_door("the modal model (beam eigenproblem)", _BEAM)
+def beam_modal_model(case: Case) -> ModalModel:
+    """The modal model (n_rigid = 0) of a stick-model case: the lowest ``modes.count`` modes
+    of the clamped beam (:func:`asekit.structure.beam.beam_modes`), or those below
+    ``modes.f_max`` (Hz), mass-normalised; ``nodes`` the beam's (x, y) node points and
+    ``shapes`` their (uz, rx, ry), the plate's (w, theta_x, theta_y) in the global frame;
+    no elements. Modal damping from ``[damping]``.
+
+    Examples
+    --------
+    >>> from asekit.case import load_case
+    >>> from asekit.util.paths import CASES_DIR
+    >>> m = modal_model(load_case(CASES_DIR / "goland_wing.toml"))
+    >>> m.label, [round(float(f), 2) for f in m.frequencies_hz]
+    ('beam, 32 elements, clamped root', [7.66, 15.23, 38.82])
+    """
+    beam = case_beam(case)
+    md = case.modes
+    n_max = NODE_DOF * (beam.n_nodes - 1)
+    n = min(md.count, n_max) if md.count is not None else n_max
+    if md.count is not None and md.count > n_max:
+        raise CaseError(f"modes.count must be <= {n_max} (6 x the {beam.n_nodes - 1} beam "
+                        f"elements), got {md.count}")
+    modes = beam_modes(beam, n)
+    keep = (modes.frequencies_hz <= md.f_max if md.count is None
+            else np.ones(n, bool))
+    if not keep.any():
+        raise CaseError(f"modes: no beam mode below modes.f_max = {md.f_max:g} Hz; raise f_max "
+                        f"or give modes.count")
+    f = modes.frequencies_hz[keep]
+    shapes = modes.shapes[:, 2:5, :][:, :, keep]
+    m = f.size
+    model = ModalModel(f, np.eye(m), np.diag((2 * math.pi * f) ** 2), np.zeros((m, m)), 0, 0.0,
+                       beam.nodes[:, :2].copy(), np.ascontiguousarray(shapes),
+                       np.zeros((0, 4), int),
+                       f"beam, {beam.n_nodes - 1} elements, clamped root")
+    d = case.damping
+    try:
+        return _read_only(with_damping(model, d.modal_damping_ratio, d.structural_g))
+    except ValueError as exc:
+        raise CaseError(str(exc)) from None
+
+
+# ---------------------------------------------------------------------------------------------
 # aerodynamics
 # ---------------------------------------------------------------------------------------------
 @lru_cache(maxsize=16)
@@ -569,7 +674,7 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True,
                                reduced_frequencies(case), a.reference_semichord,
                                symmetric=a.symmetry == "wall", method=method,
                                progress=progress, rebuild=not cache, path=path,
-                               metadata={"case": case.name})
+                               metadata={"case": case.name}, spline=_structure_spline(case))
 
 
 # ---------------------------------------------------------------------------------------------

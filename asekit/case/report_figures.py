@@ -688,8 +688,11 @@ def figures(a) -> dict:
     for i, m in enumerate(_machs(a)):
         out[f"vg_{i}"] = fig_vg_mach(a, m)              # i: the Mach's rank, ascending
         out[f"root_locus_{i}"] = fig_root_locus_mach(a, m)
-    out["planform"] = fig_planform(a)
-    out["modes"] = fig_modes(a)
+    if getattr(a.case, "beam", None) is not None:       # a stick model (issue 24)
+        out["planform"], out["modes"] = fig_beam_planform(a), fig_beam_modes(a)
+    else:
+        out["planform"] = fig_planform(a)
+        out["modes"] = fig_modes(a)
     if a.ase is not None:
         out["ase_bode"] = fig_ase_bode(a)
         out["ase_steps"] = fig_ase_steps(a)
@@ -700,3 +703,53 @@ def figures(a) -> dict:
     if getattr(a, "control_hinge", ()):
         out["control_hinge_moments"] = fig_control_hinge_moments(a)
     return out
+
+
+# ---------------------------------------------------------------------------------------------
+# stick models ([[beam]], issue 24)
+# ---------------------------------------------------------------------------------------------
+def fig_beam_planform(a) -> ReportFigure:
+    """A stick model's planform: the aerodynamic boxes (orange) and the beam's elastic axis
+    with its nodes (black)."""
+    from matplotlib.collections import LineCollection
+    beam = P.case_beam(a.case)
+    boxes = P.box_mesh(a.case).corners
+    fig, ax = new_figure(f"{a.case.name}: beam axis and aerodynamic boxes",
+                         figsize=(6.0, 5.0), layout="constrained")
+    ax.add_collection(LineCollection(_outlines(boxes), colors="C1", lw=1.0))
+    nodes = beam.nodes
+    ax.plot(nodes[:, 1], nodes[:, 0], "k.-", lw=1.4, ms=4, label="beam (elastic axis)")
+    ax.set_xlabel("y (m)")
+    ax.set_ylabel("x (m)")
+    ax.set_aspect("equal")
+    ax.autoscale()
+    ax.invert_yaxis()
+    ax.legend(loc="lower right")
+    alt = (f"Planform of {a.case.name}: {len(boxes)} aerodynamic boxes (orange) and the beam's "
+           f"elastic axis with its {beam.n_nodes} nodes (black), from ({nodes[0, 0]:.4g}, "
+           f"{nodes[0, 1]:.4g}) m to ({nodes[-1, 0]:.4g}, {nodes[-1, 1]:.4g}) m")
+    return ReportFigure(fig, alt, SECTIONS[2])
+
+
+def fig_beam_modes(a) -> ReportFigure:
+    """A stick model's modes along the axis: the deflection w and the nose-up twist (the
+    rotation about the axis), each normalised to its largest magnitude over the modes."""
+    m = a.modal
+    beam = P.case_beam(a.case)
+    s = beam.stations
+    e1 = beam.direction
+    w = m.shapes[:, 0, :]
+    twist = e1[0] * m.shapes[:, 1, :] + e1[1] * m.shapes[:, 2, :]
+    fig, (ax1, ax2) = new_figure(f"{a.case.name}: beam mode shapes along the axis", nrows=2,
+                                 figsize=(6.0, 5.5), sharex=True, layout="constrained")
+    for j in range(m.frequencies_hz.size):
+        lab = f"{mode_label(j, m.n_rigid)}: {m.frequencies_hz[j]:.4g} Hz"
+        ax1.plot(s, w[:, j] / max(np.abs(w).max(), 1e-300), label=lab)
+        ax2.plot(s, twist[:, j] / max(np.abs(twist).max(), 1e-300), label=lab)
+    ax1.set_ylabel("w / max|w| (-)")
+    ax2.set_ylabel("twist / max|twist| (-)")
+    ax2.set_xlabel("distance along the axis (m)")
+    ax1.legend(fontsize=8)
+    alt = (f"Mode shapes of the {m.frequencies_hz.size} kept beam modes along the axis: "
+           f"deflection (top) and nose-up twist (bottom), each normalised over all modes")
+    return ReportFigure(fig, alt, SECTIONS[2])

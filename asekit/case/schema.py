@@ -492,6 +492,7 @@ class Case:
     reference: str = ""
     source: str = field(default="", compare=False)
     structure: ImportedModel | None = None
+    beam: BeamSpec | None = None
 
     @classmethod
     def from_toml(cls, path) -> "Case":
@@ -520,6 +521,8 @@ class Case:
         for cs in d.get("control_surfaces", ()):   # (and surfaces without an actuator)
             if cs.get("actuator") is None:
                 cs.pop("actuator", None)
+        if self.beam is None:               # (likewise: plate cases)
+            d.pop("beam")
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
 
 
@@ -703,7 +706,7 @@ def _panel_mesh(t: _Table):
     return counts[0], counts[1], chord, span
 
 
-def _panels(raw) -> tuple[PanelSpec, ...]:
+def _panels(raw, structural: bool = True) -> tuple[PanelSpec, ...]:
     if raw is None:
         raise CaseError("panel is missing: give at least one [[panel]] table")
     if not isinstance(raw, list) or not raw:
@@ -715,7 +718,8 @@ def _panels(raw) -> tuple[PanelSpec, ...]:
         tle = t.numbers("tip_leading_edge", required=True, length=2, unit="m")
         rc = t.number("root_chord", required=True, low=0.0, high=1e4, unit="m")
         tc = t.number("tip_chord", required=True, low=0.0, high=1e4, unit="m")
-        nc, ns, chord, span = _panel_mesh(t)
+        # a beam case's panels are the aerodynamic planform only: no structural mesh keys
+        nc, ns, chord, span = _panel_mesh(t) if structural else (1, 1, None, None)
         t.done()
         if tle[1] <= rle[1]:
             raise CaseError(f"panel[{i}].tip_leading_edge y ({tle[1]:g} m) must exceed "
@@ -1236,6 +1240,162 @@ def _gust(t: _Table | None, aero: AeroSpec, actuator: ActuatorSpec | None,
                     stations)
 
 
+# ---------------------------------------------------------------------------------------------
+# [[beam]]: a stick model in place of the plate structure (issue 24)
+# ---------------------------------------------------------------------------------------------
+#: the section properties of a [[beam]] table: (key, low bound (open), unit); each a number
+#: (uniform) or a list with one value per segment between stations
+BEAM_PROPERTIES = (("ea", 0.0, "N"), ("gj", 0.0, "N m^2"), ("ei_flap", 0.0, "N m^2"),
+                   ("ei_chord", 0.0, "N m^2"), ("mass_per_length", 0.0, "kg/m"),
+                   ("polar_inertia", 0.0, "kg m"))
+#: the largest number of beam elements (a dense 6 (n + 1) eigenproblem)
+MAX_BEAM_ELEMENTS = 2000
+
+
+@dataclass(frozen=True)
+class BeamSpec:
+    """A straight beam along a reference (elastic) axis in the (x, y) plane, clamped at its
+    root: the structure of a stick-model case (``[[beam]]``, docs/case-format.md).
+
+    Attributes
+    ----------
+    root : (x, y) of the axis's root point (m).
+    direction : (dx, dy) unit vector along the axis.
+    length : axis length (m), > 0.
+    stations : fractions of the length at the segment ends, 0 first, 1 last, ascending.
+    n_elements : equal elements per segment (>= 1).
+    sections : one (ea, gj, ei_flap, ei_chord, mass, polar_inertia, mass_offset) tuple per
+        segment (SI: N, N m^2, N m^2, N m^2, kg/m, kg m, m; the mass axis ``mass_offset`` aft
+        of the elastic axis), the arguments of :class:`asekit.structure.beam.BeamSection`.
+    """
+
+    root: tuple[float, float]
+    direction: tuple[float, float]
+    length: float
+    stations: tuple[float, ...]
+    n_elements: int
+    sections: tuple[tuple[float, ...], ...]
+
+
+def _beam_axis(t: _Table):
+    """(direction, length) of a [[beam]] table: ``tip`` or ``sweep_deg`` with ``length``."""
+    root = t.numbers("root", required=True, length=2, unit="m")
+    tip = t.numbers("tip", length=2, unit="m")
+    sweep = t.number("sweep_deg", low=-MAX_EDGE_SWEEP_DEG, high=MAX_EDGE_SWEEP_DEG,
+                     low_open=False, unit="deg")
+    length = t.number("length", low=0.0, high=1e4, unit="m")
+    if tip is not None and (sweep is not None or length is not None):
+        raise CaseError(f"{t.path}: give tip, or sweep_deg and length, not both")
+    if tip is None:
+        if length is None:
+            raise CaseError(f"{t.path}: give the axis as tip = [x, y] (m) or as length (m) "
+                            f"with sweep_deg (default 0)")
+        a = math.radians(sweep or 0.0)
+        return root, (math.sin(a), math.cos(a)), length
+    dx, dy = tip[0] - root[0], tip[1] - root[1]
+    length = math.hypot(dx, dy)
+    if dy <= 0 or math.degrees(math.atan2(abs(dx), dy)) > MAX_EDGE_SWEEP_DEG:
+        raise CaseError(f"{t.key('tip')} {list(tip)} must lie outboard of root {list(root)} "
+                        f"(greater y) with the axis swept by at most {MAX_EDGE_SWEEP_DEG:g} "
+                        f"deg")
+    return root, (dx / length, dy / length), length
+
+
+def _beam_sections(t: _Table, n_seg: int):
+    """One section tuple per segment; every property a number or a list of n_seg numbers."""
+    def column(k, default, low, high, low_open, unit):
+        if isinstance(t.raw(k, default, required=default is None), list):
+            return t.numbers(k, length=n_seg, low=low, high=high, low_open=low_open, unit=unit)
+        return (t.number(k, default, required=default is None, low=low, high=high,
+                         low_open=low_open, unit=unit),) * n_seg
+    cols = [column(k, None, low, 1e15, True, unit) for k, low, unit in BEAM_PROPERTIES]
+    cols.append(column("mass_offset", 0.0, -1e4, 1e4, False, "m"))
+    for i in range(n_seg):
+        m, ip, d = cols[4][i], cols[5][i], cols[6][i]
+        if ip < m * d * d * (1 - 1e-12):
+            raise CaseError(f"{t.key('polar_inertia')} (segment {i}) must be >= "
+                            f"mass_per_length * mass_offset^2 = {m * d * d:g} kg m (the inertia "
+                            f"about the mass axis cannot be negative), got {ip:g}")
+    return tuple(tuple(c[i] for c in cols) for i in range(n_seg))
+
+
+def _beam(raw, panels) -> BeamSpec | None:
+    """The case's [[beam]] (one table), its stations and sections checked, the panels' corners
+    on the axis's span (the beam-to-box spline needs every box between root and tip)."""
+    if raw is None:
+        return None
+    if not isinstance(raw, list) or len(raw) != 1:
+        raise CaseError("beam must be one [[beam]] table (one straight beam; several beams "
+                        "are not supported yet)")
+    t = _Table(raw[0], "beam[0]")
+    root, e1, length = _beam_axis(t)
+    st = t.numbers("stations", default=[0.0, 1.0], min_length=2, low=0.0, high=1.0,
+                   low_open=False, ascending=True)
+    if st[0] != 0.0 or st[-1] != 1.0:
+        raise CaseError(f"{t.key('stations')} must run from 0 to 1 (fractions of the axis "
+                        f"length), got {list(st)}")
+    n_el = t.integer("n_elements", 8, high=MAX_BEAM_ELEMENTS)
+    if n_el * (len(st) - 1) > MAX_BEAM_ELEMENTS:
+        raise CaseError(f"{t.key('n_elements')} x segments = {n_el * (len(st) - 1)} must be "
+                        f"<= {MAX_BEAM_ELEMENTS} elements")
+    sections = _beam_sections(t, len(st) - 1)
+    t.done()
+    tol = 1e-9 * length
+    for i, p in enumerate(panels):
+        for c in p.planform.corners:
+            s = (c[0] - root[0]) * e1[0] + (c[1] - root[1]) * e1[1]
+            if s < -tol or s > length + tol:
+                raise CaseError(f"panel[{i}] corner {[float(c[0]), float(c[1])]} m lies at "
+                                f"{s:.6g} m along beam[0]'s axis, outside the beam [0, "
+                                f"{length:.6g}] m: the beam-to-box spline needs every box "
+                                f"between the beam's root and tip")
+    return BeamSpec(tuple(root), tuple(e1), length, tuple(st), n_el, sections)
+
+
+def _structure_kind(top: _Table) -> bool:
+    """True for a beam case: a case has [thickness], [material] and [support] (the panels'
+    plate structure) or one [[beam]], never both, never neither."""
+    plate = [k for k in ("thickness", "material", "support") if top.has(k)]
+    if top.has("beam"):
+        if plate:
+            raise CaseError(f"beam and {', '.join(plate)}: a case has either the panels' "
+                            f"plate structure ([thickness], [material], [support]) or a "
+                            f"[[beam]], not both")
+        for k in ("point_mass", "control_surface", "gust", "actuator"):
+            if top.has(k):
+                raise CaseError(f"{k} is not supported with [[beam]] yet (stick models: "
+                                f"modes, GAFs and flutter only)")
+        return True
+    if not plate:
+        raise CaseError("the case has no structure: give [thickness], [material] and "
+                        "[support] (the panels' plate structure) or one [[beam]]")
+    return False
+
+
+def _beam_case(top: _Table, name: str, reference: str, source: str) -> Case:
+    """The rest of case_from_dict for a stick-model case (after [case])."""
+    panels = _panels(top.raw("panel", None, required=False), structural=False)
+    beam = _beam(top.raw("beam"), panels)
+    support = SupportSpec("clamped_root")
+    damping = _damping(top.table("damping"))
+    modes = _modes(top.table("modes"), support)
+    aero = _aero(top.table("aero", required=True), panels)
+    check_resources(panels, aero)
+    flight = _flight(top.table("flight", required=True))
+    n_cond = len(flight.altitudes if flight.altitudes is not None else flight.densities)
+    problem = pk_problem(len(aero.machs), n_cond, flight.velocities)
+    if problem is not None:
+        raise CaseError(problem)
+    flutter = _flutter(top.table("flutter"))
+    convergence = _convergence(top.table("convergence"))
+    if top.has("flutter_speed_index"):
+        raise CaseError("flutter_speed_index is not supported with [[beam]] yet")
+    top.done()
+    return Case(name=name, panels=panels, thickness=None, material=None, support=support,
+                aero=aero, flight=flight, modes=modes, damping=damping, flutter=flutter,
+                convergence=convergence, reference=reference, source=source, beam=beam)
+
+
 def case_from_dict(d: dict, source: str = "") -> Case:
     """Build and check a :class:`Case` from the parsed TOML dictionary ``d``."""
     top = _Table(d, "")
@@ -1245,6 +1405,8 @@ def case_from_dict(d: dict, source: str = "") -> Case:
         raise CaseError("case.name is missing or empty")
     reference = info.text("reference", "")
     info.done()
+    if _structure_kind(top):
+        return _beam_case(top, name, reference, source)
     panels = _panels(top.raw("panel", None, required=False))
     thickness = _thickness(top.table("thickness", required=True))
     material = _material(top.table("material", required=True))

@@ -123,6 +123,9 @@ def run(args) -> int:
     )
     study = getattr(args, "convergence", False) or case.convergence.enabled
     try:
+        if study and getattr(case, "beam", None) is not None:
+            raise CaseError("--convergence / convergence.enabled: the mesh study of a [[beam]] "
+                            "case is not supported yet (plate cases only)")
         if study:                       # the study's meshes checked before any computation
             from asekit.case import convergence
             convergence.check_study(case)
