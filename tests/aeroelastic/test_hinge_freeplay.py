@@ -98,11 +98,12 @@ def test_describing_function_lco_band(wing):
     assert harmonic_balance(at(1.05 * uh), conn).unbounded
 
 
-@pytest.mark.slow
 def test_exact_simulation_matches_harmonic_balance(wing):
     """At an airspeed inside the LCO band the exact piecewise-linear time integration settles
-    on an oscillation whose first-harmonic hinge amplitude is within 15 % of the harmonic
-    balance's (the describing function keeps the first harmonic only)."""
+    on an oscillation whose first-harmonic hinge amplitude is within 5 % of the harmonic
+    balance's and its frequency within 5 % (measured at 0.8 U_h = 10.61 m/s, 0.5 deg gap:
+    0.967 deg / 3.00 Hz against 0.976 deg / 3.02 Hz; the describing function keeps the first
+    harmonic only)."""
     fm, gaf, fit, h, at = wing
     kh = hinge_spring(fm.modal, h)
     conn = hinge_connection(fm.modal, h, GAP)
@@ -119,4 +120,4 @@ def test_exact_simulation_matches_harmonic_balance(wing):
           f"{td.frequency_hz:.3f} Hz ({td.kind})")
     assert td.kind == "lco"
     assert td.frequency_hz == pytest.approx(lc.frequency_hz, rel=0.05)
-    assert td.amplitude == pytest.approx(lc.amplitude, rel=0.15)
+    assert td.amplitude == pytest.approx(lc.amplitude, rel=0.05)
