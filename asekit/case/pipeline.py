@@ -1804,3 +1804,90 @@ def control_surface_ase(case: Case) -> tuple[ControlSurfaceAseRow, ...]:
             float(a.step_deg), ts if math.isfinite(ts) else None,
             float(metrics.overshoot(y, step)), float(abs(y[-1] - step) / step)))
     return tuple(rows)
+
+
+# ---------------------------------------------------------------------------------------------
+# control surfaces: freeplay in the hinge (issue 25, asekit.aeroelastic.hinge_freeplay)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ControlSurfaceFreeplayRow:
+    """Harmonic-balance LCOs of one control surface with a freeplay gap in its hinge spring at
+    one Mach and the first flight condition's ``density`` (kg/m^3): ``freeplay_deg`` the gap's
+    half-width; ``lco_onset_speed_ms`` the lowest airspeed of ``flight.velocities`` (refined
+    to 0.01 m/s) with a limit cycle or an unstable rest position inside the gap (None: none
+    in the sweep); ``lco_at_first_point`` True when already there at the sweep's first speed
+    (the onset lies below the sweep); ``linear_flutter_speed_ms`` the flutter speed with the
+    full hinge spring in the same state-space model (above it the oscillation is unbounded;
+    None: none in the sweep)."""
+
+    name: str
+    mach: float
+    density: float
+    freeplay_deg: float
+    lco_onset_speed_ms: float | None
+    lco_at_first_point: bool
+    linear_flutter_speed_ms: float | None
+
+
+def _freeplay_onset(at, conn, speeds) -> tuple:
+    """(onset speed or None, at the first point) of the harmonic-balance LCO over ``speeds``."""
+    from asekit.aeroelastic.nonlinear import bisect_onset, harmonic_balance
+
+    def has(u):
+        r = harmonic_balance(at(u), conn)
+        return bool(r.lcos) or r.inside_band_unstable
+    if has(speeds[0]):
+        return float(speeds[0]), True
+    for lo, hi in zip(speeds[:-1], speeds[1:]):
+        if has(hi):
+            return float(bisect_onset(has, lo, hi, 0.01)), False
+    return None, False
+
+
+@_memo_with_warnings
+@_door("the hinge-freeplay limit cycles", _CONTROL)
+def control_surface_freeplay(case: Case) -> tuple[ControlSurfaceFreeplayRow, ...]:
+    """LCO onset of every control surface with ``freeplay_deg`` > 0, at every ``aero.machs``,
+    the first flight condition, over ``flight.velocities``: the wing with that surface's hinge
+    spring as a freeplay :class:`~asekit.aeroelastic.nonlinear.Connection`
+    (:func:`asekit.aeroelastic.hinge_freeplay.hinge_connected_system`, the other surfaces on
+    their linear springs), the GAFs of :func:`control_surface_flutter`'s modes fitted by the
+    case's RFA (``flutter.rfa``, ``flutter.lags``), harmonic balance per airspeed. Empty when
+    no surface has freeplay. Memoised on the case."""
+    from asekit.aero.gaf import build_gaf_database
+    from asekit.aeroelastic import hinge_freeplay as hf
+
+    spec = [(i, c) for i, c in enumerate(case.control_surfaces) if c.freeplay_deg > 0]
+    if not spec:
+        return ()
+    hm = control_surface_mesh(case)
+    fm = control_surface_model(case)
+    if fm.modal.n_rigid:
+        raise CaseError("control_surface[].freeplay_deg needs a wing without a rigid mode "
+                        "(support.kind clamped)")
+    a = case.aero
+    method = a.kernel if a.method == "dlm" else a.method
+    db = build_gaf_database(fm.box_modes, hm.mesh, a.machs, reduced_frequencies(case),
+                            a.reference_semichord, 0, symmetric=a.symmetry == "wall",
+                            method=method, progress=False)
+    U = np.sort(np.asarray(case.flight.velocities, float))
+    rho = flight_conditions(case)[0].density
+    rows = []
+    for mach in a.machs:
+        g = db.at(mach)
+        fit = rfa_kind(case.flutter.rfa).fit(g.k, g.Q, db.b_ref, mach, case.flutter.lags)
+        for i, c in spec:
+            h = fm.n_wing + i
+
+            def at(u, h=h, fit=fit):
+                return hf.hinge_connected_system(fm.modal, fit, rho, u, h)
+            conn = hf.hinge_connection(fm.modal, h, math.radians(c.freeplay_deg))
+            onset, first = _freeplay_onset(at, conn, U)
+            try:
+                uf, _ = hf.connected_flutter_speed(at, conn.stiffness, float(U[0]),
+                                                   float(U[-1]), n=U.size)
+            except ValueError:                    # unstable at the first speed already
+                uf = float(U[0])
+            rows.append(ControlSurfaceFreeplayRow(c.name, float(mach), float(rho),
+                                                  float(c.freeplay_deg), onset, first, uf))
+    return tuple(rows)

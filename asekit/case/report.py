@@ -117,6 +117,14 @@ UNITS.update({
     "step_deg": "deg (the power-limited step command)",
     "overshoot_pct": "% (of the surface's angle over the step)",
 })
+# freeplay in a control surface's hinge (issue 25, control_surfaces rows with freeplay_deg > 0)
+UNITS.update({
+    "freeplay_deg": "deg (half-width of the hinge's freeplay gap)",
+    "lco_onset_speed_ms": "m/s (lowest speed of the sweep with a harmonic-balance LCO)",
+    "lco_at_first_point": "true when the LCO exists at the sweep's first speed already",
+    "freeplay_linear_flutter_speed_ms": "m/s (state-space flutter with the full hinge spring; "
+                                        "LCO unbounded above)",
+})
 
 
 @dataclass(frozen=True)
@@ -136,6 +144,7 @@ class Analysis:
     control_flutter: tuple = ()
     control_hinge: tuple = ()
     control_ase: tuple = ()
+    control_freeplay: tuple = ()
 
 
 @contextlib.contextmanager
@@ -193,8 +202,14 @@ def run_analysis(case: Case, progress: bool = False) -> Analysis:
         with _stage("hinge moments over the envelope", progress):
             control_hinge = P.control_surface_hinge_loads(case)
         sec["control_surface_hinge_loads"] = time.perf_counter() - t
+        control_freeplay = ()
+        if any(c.freeplay_deg > 0 for c in case.control_surfaces):
+            t = time.perf_counter()
+            with _stage("hinge freeplay limit cycles", progress):
+                control_freeplay = P.control_surface_freeplay(case)
+            sec["control_surface_freeplay"] = time.perf_counter() - t
     else:
-        control_flutter = control_hinge = ()
+        control_flutter = control_hinge = control_freeplay = ()
     control_ase = ()
     if any(c.actuator is not None for c in case.control_surfaces):
         t = time.perf_counter()
@@ -203,7 +218,7 @@ def run_analysis(case: Case, progress: bool = False) -> Analysis:
         sec["control_surface_ase"] = time.perf_counter() - t
     return Analysis(case, modal, db, fa, ase, sec, gust=gust, control=control,
                     control_flutter=control_flutter, control_hinge=control_hinge,
-                    control_ase=control_ase)
+                    control_ase=control_ase, control_freeplay=control_freeplay)
 
 
 def _f(v):
@@ -268,7 +283,8 @@ def summary(a: Analysis) -> dict:
              "dCL_dalpha_per_rad": r.dCL_dalpha_per_rad, "Ch_delta": r.Ch_delta,
              "Ch_alpha": r.Ch_alpha, "reversal_speed_ms": _f(r.reversal_speed_ms),
              "divergence_speed_ms": _f(r.divergence_speed_ms), "density": r.density,
-             "hinge_inertia": r.inertia, "static_unbalance": r.static_unbalance}
+             "hinge_inertia": r.inertia, "static_unbalance": r.static_unbalance,
+             **freeplay_json(getattr(a, "control_freeplay", ()), r.name, r.mach)}
             for r in a.control]
         out["control_surface_flutter"] = [
             {"mach": r.mach, "altitude_m": r.altitude, "density": r.density,
@@ -493,6 +509,17 @@ def _control_flutter_lines(rows) -> list[str]:
         out.append(f"{r['mach']:>6.3g} {r['density']:>10.4g} {sp:>9} "
                    f"{_cell(r['frequency_hz'], '{:.2f}'):>8}  {mode}")
     return out
+
+
+def freeplay_json(rows, name: str, mach: float) -> dict:
+    """The hinge-freeplay keys of the control_surfaces row of surface ``name`` at ``mach``
+    (:func:`asekit.case.pipeline.control_surface_freeplay`); {} when it has no freeplay."""
+    for r in rows:
+        if r.name == name and r.mach == mach:
+            return {"freeplay_deg": r.freeplay_deg, "lco_onset_speed_ms": _f(r.lco_onset_speed_ms),
+                    "lco_at_first_point": r.lco_at_first_point,
+                    "freeplay_linear_flutter_speed_ms": _f(r.linear_flutter_speed_ms)}
+    return {}
 
 
 def hinge_load_json(rows) -> dict:

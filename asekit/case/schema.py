@@ -152,7 +152,8 @@ class ControlSurfaceSpec:
     the panel; ``kind`` "rigid" (a rigid surface rotating about its hinge, as Nastran's
     AESURF); ``hinge_stiffness`` N m/rad and ``hinge_damping`` N m s/rad of the hinge;
     ``mass_balance``: ((x, y) m, mass kg) pairs fixed to the surface
-    (:mod:`asekit.aeroelastic.control_surface`)."""
+    (:mod:`asekit.aeroelastic.control_surface`); ``freeplay_deg`` the half-width (deg) of a
+    freeplay gap in the hinge spring (0: none; :mod:`asekit.aeroelastic.hinge_freeplay`)."""
 
     name: str
     panel: int
@@ -163,6 +164,7 @@ class ControlSurfaceSpec:
     hinge_damping: float = 0.0
     mass_balance: tuple[tuple[tuple[float, float], float], ...] = ()
     actuator: SurfaceActuatorSpec | None = None
+    freeplay_deg: float = 0.0          # hinge freeplay half-width (deg), 0: none
 
 
 @dataclass(frozen=True)
@@ -965,8 +967,13 @@ def _one_control_surface(t: _Table, i: int, panels) -> ControlSurfaceSpec:
                    unit="N m s/rad")
     balance = _mass_balance(t, path, panels)
     actuator = _surface_actuator(t.table("actuator"))
+    freeplay = t.number("freeplay_deg", 0.0, low=0.0, low_open=False, high=10.0, unit="deg")
+    if freeplay > 0 and k_h <= 0:
+        raise CaseError(f"{path}.freeplay_deg = {freeplay:g} needs {path}.hinge_stiffness > 0 "
+                        "(the freeplay is in the hinge spring)")
     t.done()
-    return ControlSurfaceSpec(name, panel, hinge, span, kind, k_h, c_h, balance, actuator)
+    return ControlSurfaceSpec(name, panel, hinge, span, kind, k_h, c_h, balance, actuator,
+                              freeplay)
 
 
 def _surface_actuator(t: _Table | None) -> SurfaceActuatorSpec | None:
