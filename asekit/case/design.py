@@ -164,6 +164,11 @@ class DesignProblem:
     divergence_margin: float | None = None
     frequency_separation: float | None = None
     frequency_separation_modes: int = 2
+    # issue 28, ASE margins (asekit.case.design_ase): the AEM1 loop's smallest phase margin
+    # (deg) and its gain margin (dB) at [actuator.condition] must be >= these; None: not
+    # constrained
+    phase_margin_deg: float | None = None
+    gain_margin_db: float | None = None
 
 
 def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default=None):
@@ -204,12 +209,13 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
     t = d["design"]
     unknown = set(t) - {"objective", "flutter_margin", "max_iterations", "variable",
                         "table_max_step_m", "gradient_step", "divergence_margin",
-                        "frequency_separation", "frequency_separation_modes"}
+                        "frequency_separation", "frequency_separation_modes",
+                        "phase_margin_deg", "gain_margin_db"}
     if unknown:
         raise DesignError(f"design: unknown keys {sorted(unknown)} (known: divergence_margin, "
                           f"objective, flutter_margin, frequency_separation, "
-                          f"frequency_separation_modes, gradient_step, max_iterations, "
-                          f"table_max_step_m, variable)")
+                          f"frequency_separation_modes, gain_margin_db, gradient_step, "
+                          f"max_iterations, phase_margin_deg, table_max_step_m, variable)")
     objective = t.get("objective", "mass")
     if objective not in OBJECTIVES:
         raise DesignError(f"design.objective must be one of {list(OBJECTIVES)}, got {objective!r}")
@@ -240,8 +246,21 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
     div = (None if "divergence_margin" not in t
            else _number(t, "divergence_margin", "design", 0.0, 10.0))
     sep, n_sep = _separation(t)
+    pm, gm = _ase_bounds(t)
     return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep, div,
-                         sep, n_sep)
+                         sep, n_sep, pm, gm)
+
+
+def _ase_bounds(t: dict) -> tuple[float | None, float | None]:
+    """``design.phase_margin_deg`` (deg, in (0, 180]) and ``design.gain_margin_db`` (dB, in
+    (0, 100]), each absent (None) or a lower bound on the AEM1 loop's margin."""
+    out = []
+    for key, hi in (("phase_margin_deg", 180.0), ("gain_margin_db", 100.0)):
+        v = None if key not in t else _number(t, key, "design", 0.0, hi)
+        if v is not None and v <= 0.0:
+            raise DesignError(f"design.{key} must be a number in (0, {hi:g}], got {v!r}")
+        out.append(v)
+    return out[0], out[1]
 
 
 def _separation(t: dict) -> tuple[float | None, int]:
@@ -522,6 +541,9 @@ class Evaluation:
     d_divergence_mu: np.ndarray = field(default_factory=lambda: np.zeros(0))
     eigenvalues: np.ndarray = field(default_factory=lambda: np.zeros(0))
     d_eigenvalues: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    #: the AEM1 margins and their gradients (:class:`asekit.case.design_ase.AseMargins`) when
+    #: the problem constrains them, else None
+    ase: object = None
 
     @property
     def elastic_frequencies_hz(self) -> np.ndarray:
@@ -552,11 +574,14 @@ class Evaluator:
     n_elastic: int = 0
     operators: tuple = ()
     calls: int = 0
+    ase_operators: tuple = ()
     _memo: dict = field(default_factory=dict)
 
     def __post_init__(self):
         self.problem = expand_variables(self.problem, self.case)
         check_case(self.case, self.problem)
+        if _has_ase(self.problem):
+            _check_ase_case(self.case, self.problem)
         base = P.modal_model(self.case)
         self.n_elastic = base.frequencies_hz.size - base.n_rigid
         n_sep = self.problem.frequency_separation_modes
@@ -575,6 +600,8 @@ class Evaluator:
                                             P.reduced_frequencies(self.case),
                                             a.reference_semichord, a.symmetry == "wall",
                                             a.kernel if a.method == "dlm" else "quartic")
+        if _has_ase(self.problem):
+            self.ase_operators = _ase_operators(self.case, self.problem)
 
     @property
     def mach(self) -> float:
@@ -590,6 +617,36 @@ class Evaluator:
             self.calls += 1
             self._memo[key] = evaluate(self, np.array(key))
         return self._memo[key]
+
+
+def _has_ase(problem: DesignProblem) -> bool:
+    return problem.phase_margin_deg is not None or problem.gain_margin_db is not None
+
+
+def _ase_key(problem: DesignProblem) -> str:
+    return "phase_margin_deg" if problem.phase_margin_deg is not None else "gain_margin_db"
+
+
+def _check_ase_case(case: Case, problem: DesignProblem) -> None:
+    """DesignError naming the design key when the case has no ASE loop to constrain."""
+    key = _ase_key(problem)
+    if case.actuator is None:
+        raise DesignError(f"design.{key}: the case has no [actuator] (no ASE loop)")
+    if case.support.kind != "shaft" or not case.modes.keep_rigid:
+        raise DesignError(f"design.{key}: the ASE loop needs a shaft support with "
+                          "modes.keep_rigid = true (the rigid pitch mode)")
+
+
+def _ase_operators(case: Case, problem: DesignProblem):
+    """The aerodynamic operators at the actuator's Mach for the margin constraints; a
+    DesignError naming the design key when the case cannot have them."""
+    from asekit.case.design_ase import _operators
+
+    key = _ase_key(problem)
+    try:
+        return _operators(case, case.actuator.mach)
+    except CaseError as exc:
+        raise DesignError(f"design.{key}: {exc}") from None
 
 
 def _system(case: Case, mesh, K, M):
@@ -766,6 +823,10 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
     conds = envelope_conditions(case)
     out = [_flutter(ev, mats, gaf, c.density) for c in conds]
     div = divergence_sensitivity(mats["K"], Q[0, :n, :n], mats["dK"], mats["dQ"][:, 0])
+    ase = None
+    if _has_ase(ev.problem):
+        from asekit.case.design_ase import ase_margins
+        ase = ase_margins(ev.case, ev.paths, values, operators=ev.ase_operators)
     return Evaluation(values=values, mass_kg=mass, d_mass=d_mass,
                       speeds_ms=np.array([o[0] for o in out]),
                       d_speeds=np.array([o[2] for o in out]),
@@ -773,7 +834,8 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
                       frequencies_hz=np.array([o[1] for o in out]),
                       densities=np.array([c.density for c in conds]),
                       divergence_mu=div.mu, d_divergence_mu=div.d_mu,
-                      eigenvalues=np.asarray(lam, float), d_eigenvalues=np.asarray(dlam, float))
+                      eigenvalues=np.asarray(lam, float), d_eigenvalues=np.asarray(dlam, float),
+                      ase=ase)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -792,7 +854,29 @@ def _constraint(ev: Evaluator, e: Evaluation):
         gs, dgs = separation_constraint(ev.problem.frequency_separation,
                                         ev.problem.frequency_separation_modes, e)
         g, dg = np.concatenate([g, gs]), np.vstack([dg, dgs])
+    if _has_ase(ev.problem):
+        ga, dga = ase_margin_constraints(ev.problem, e)
+        g, dg = np.concatenate([g, ga]), np.vstack([dg, dga])
     return g, dg
+
+
+def ase_margin_constraints(problem: DesignProblem, e: Evaluation):
+    """g = PM / (PM_req (1 + slack)) - 1 >= 0 and g = GM / (GM_req (1 + slack)) - 1 >= 0 for
+    the AEM1 loop's smallest phase margin (deg) and its gain margin (dB)
+    (``design.phase_margin_deg``, ``design.gain_margin_db``, the rows that are set, in that
+    order), with the gradients of :mod:`asekit.case.design_ase`. No phase crossover (GM = inf)
+    counts as g = 1, gradient 0; likewise no gain crossover for the phase margin."""
+    a, n_var = e.ase, e.d_mass.size
+    g, dg = [], []
+    for req, val, dval in ((problem.phase_margin_deg, a.phase_margin_deg, a.d_phase_margin_deg),
+                           (problem.gain_margin_db, a.gain_margin_db, a.d_gain_margin_db)):
+        if req is None:
+            continue
+        s = req * (1.0 + CONSTRAINT_SLACK)
+        finite_val = math.isfinite(val)
+        g.append(val / s - 1.0 if finite_val else 1.0)
+        dg.append(np.asarray(dval) / s if finite_val else np.zeros(n_var))
+    return np.array(g), np.array(dg).reshape(len(g), n_var)
 
 
 def separation_constraint(separation: float, n_modes: int, e: Evaluation):
@@ -898,6 +982,9 @@ def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.
             n_sep = ev.problem.frequency_separation_modes
             pairs += [(a, (b - c) / (2 * h)) for a, b, c in
                       zip(e0.d_eigenvalues[j, :n_sep], ep.eigenvalues, em.eigenvalues)]
+        if e0.ase is not None and np.isfinite(ep.ase.phase_margin_deg - em.ase.phase_margin_deg):
+            pairs.append((e0.ase.d_phase_margin_deg[j],
+                          (ep.ase.phase_margin_deg - em.ase.phase_margin_deg) / (2 * h)))
         if np.isfinite(ep.divergence_mu - em.divergence_mu):
             pairs.append((e0.d_divergence_mu[j], (ep.divergence_mu - em.divergence_mu) / (2 * h)))
         err[j] = max(abs(a - f) / max(abs(f), 1e-300) for a, f in pairs)
@@ -944,6 +1031,10 @@ def constraint_names(ev: Evaluator, e: Evaluation) -> list[tuple[str, float, flo
         f = e.elastic_frequencies_hz[:pr.frequency_separation_modes]
         rows += [(f"frequency_separation[f{i + 2}/f{i + 1}]", float(f[i + 1] / f[i] - 1.0),
                   pr.frequency_separation) for i in range(f.size - 1)]
+    if pr.phase_margin_deg is not None:
+        rows.append(("phase_margin_deg[AEM1]", e.ase.phase_margin_deg, pr.phase_margin_deg))
+    if pr.gain_margin_db is not None:
+        rows.append(("gain_margin_db[AEM1]", e.ase.gain_margin_db, pr.gain_margin_db))
     return rows
 
 
