@@ -55,7 +55,12 @@ altitude, written 1 - q_a mu >= 0 with mu = 1 / q_D and its analytic derivative
 (:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`). ``design.frequency_separation``
 (with ``design.frequency_separation_modes`` = n, default 2) asks f_{i+1} / f_i - 1 >= the value
 for the first n elastic modes (:func:`separation_constraint`, Fox-Kapoor eigenvalue
-derivatives). The servo requirements are not constraints yet.
+derivatives). ``design.phase_margin_deg`` and ``design.gain_margin_db`` (deg, dB; > 0) bound
+the AEM1 loop's smallest phase margin and its gain margin at ``[actuator.condition]`` from
+below (:func:`ase_margin_constraints`; the margins and their gradients of
+:func:`asekit.case.design_ase.ase_margins`, on the aerodynamic operators at the actuator's
+Mach, formed once); they need ``[actuator]`` and a shaft support with ``modes.keep_rigid``.
+The servo requirements of Table 2 are not constraints yet.
 """
 
 from __future__ import annotations
