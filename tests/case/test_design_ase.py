@@ -107,3 +107,34 @@ def test_optimised_design_meets_the_phase_margin_when_reanalysed():
     assert P.ase(opt).crossovers[2].phase_margin_deg >= req
     assert ase_margins(opt, PATHS).phase_margin_deg >= req
     assert min(m["margin"] for m in P.flutter(opt).margins if m["margin"] is not None) >= 0.15
+
+
+@pytest.mark.slow
+def test_optimise_command_reports_the_reanalysed_phase_margin(tmp_path):
+    """``asekit optimise`` with design.phase_margin_deg: the JSON's phase_margin_deg is the
+    pipeline's FWTF 2 re-analysis of the written case; the baseline misses the requirement
+    (meets_constraints false), the optimum meets it."""
+    import json
+
+    from asekit.case import load_case
+    from asekit.case.toml_writer import dumps
+    from asekit.cli.main import main
+    raw = _raw()
+    raw["flight"].update(altitudes=[0.0], velocities={"min": 120.0, "max": 420.0, "step": 20.0})
+    case = tmp_path / "small.toml"
+    case.write_text(dumps(raw))
+    design = tmp_path / "design.toml"
+    design.write_text("[design]\nphase_margin_deg = 80.5\nmax_iterations = 15\n"
+                      "[[design.variable]]\npath = 'thickness.root'\nlower = 0.0015\n"
+                      "upper = 0.008\n"
+                      "[[design.variable]]\npath = 'thickness.tip'\nlower = 0.001\n"
+                      "upper = 0.006\n")
+    out, opt = tmp_path / "out.json", tmp_path / "opt.toml"
+    assert main(["optimise", str(case), str(design), "--json", str(out), "--out-case", str(opt),
+                 "--no-gradient-check"]) == 0
+    d = json.loads(out.read_text())["design"]
+    assert d["baseline"]["phase_margin_deg"] < 80.5 and not d["baseline"]["meets_constraints"]
+    assert d["optimised"]["phase_margin_deg"] >= 80.5 and d["optimised"]["meets_constraints"]
+    ref = P.ase(load_case(opt)).crossovers[2].phase_margin_deg
+    assert d["optimised"]["phase_margin_deg"] == pytest.approx(ref, abs=1e-9)
+    assert "phase_margin_deg[AEM1]" in [c["name"] for c in d["constraints"]]
