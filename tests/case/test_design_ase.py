@@ -10,7 +10,7 @@ import pytest
 
 from asekit.case import case_from_dict
 from asekit.case import pipeline as P
-from asekit.case.design_ase import _operators, ase_margins
+from asekit.case.design import _ase_aero_operators, ase_margins
 from asekit.case.schema import CaseError
 from asekit.util.paths import FIN_FILE
 
@@ -32,7 +32,7 @@ CASE = case_from_dict(copy.deepcopy(_raw()), "small fin with actuator")
 
 @pytest.fixture(scope="module")
 def ops():
-    return _operators(CASE, CASE.actuator.mach)
+    return _ase_aero_operators(CASE, CASE.actuator.mach)
 
 
 def test_margin_derivatives_match_central_differences(ops):
