@@ -44,11 +44,11 @@ def test_margin_derivatives_match_central_differences(ops):
     assert r.phase_margin_deg == pytest.approx(ref, abs=0.05)
     for j in range(len(PATHS)):
         e = np.zeros(len(PATHS))
-        e[j] = 1e-6 * r.values[j]
+        e[j] = 1e-5 * r.values[j]        # 1e-6 is round-off limited (3e-5 on the tip)
         up = ase_margins(CASE, PATHS, r.values + e, operators=ops).phase_margin_deg
         down = ase_margins(CASE, PATHS, r.values - e, operators=ops).phase_margin_deg
         fd = (up - down) / (2 * e[j])
-        assert r.d_phase_margin_deg[j] == pytest.approx(fd, rel=1e-4), PATHS[j]
+        assert r.d_phase_margin_deg[j] == pytest.approx(fd, rel=1e-5), PATHS[j]
 
 
 def test_needs_an_actuator():
