@@ -55,7 +55,12 @@ altitude, written 1 - q_a mu >= 0 with mu = 1 / q_D and its analytic derivative
 (:func:`asekit.aeroelastic.sensitivity.divergence_sensitivity`). ``design.frequency_separation``
 (with ``design.frequency_separation_modes`` = n, default 2) asks f_{i+1} / f_i - 1 >= the value
 for the first n elastic modes (:func:`separation_constraint`, Fox-Kapoor eigenvalue
-derivatives). The servo requirements are not constraints yet.
+derivatives). ``design.phase_margin_deg`` and ``design.gain_margin_db`` (deg, dB; > 0) bound
+the AEM1 loop's smallest phase margin and its gain margin at ``[actuator.condition]`` from
+below (:func:`ase_margin_constraints`; the margins and their gradients of
+:func:`ase_margins`, on the aerodynamic operators at the actuator's
+Mach, formed once); they need ``[actuator]`` and a shaft support with ``modes.keep_rigid``.
+The servo requirements of Table 2 are not constraints yet.
 """
 
 from __future__ import annotations
@@ -63,6 +68,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+import types
 import warnings
 from dataclasses import dataclass, field
 
@@ -79,10 +85,14 @@ from asekit.aeroelastic.sensitivity import (
     flutter_point,
     flutter_speed_sensitivity,
     gaf_derivative,
+    modal_matrix_derivative,
 )
 from asekit.aeroelastic.statespace import modal_arrays
+from asekit.ase.loop_sensitivity import aem1_margin_sensitivity
+from asekit.atmosphere import standard_atmosphere
 from asekit.case import pipeline as P
 from asekit.case.schema import Case, CaseError
+from asekit.rfa.roger import roger_fit, roger_fit_derivative
 from asekit.structure.assembly import clamped_edge, shaft_support
 from asekit.structure.modes import ModalModel, normal_modes, select_modes
 from asekit.structure.sensitivity import (
@@ -164,6 +174,11 @@ class DesignProblem:
     divergence_margin: float | None = None
     frequency_separation: float | None = None
     frequency_separation_modes: int = 2
+    # issue 28, ASE margins (:func:`ase_margins`): the AEM1 loop's smallest phase margin
+    # (deg) and its gain margin (dB) at [actuator.condition] must be >= these; None: not
+    # constrained
+    phase_margin_deg: float | None = None
+    gain_margin_db: float | None = None
 
 
 def _number(d: dict, key: str, where: str, low=-math.inf, high=math.inf, default=None):
@@ -204,12 +219,13 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
     t = d["design"]
     unknown = set(t) - {"objective", "flutter_margin", "max_iterations", "variable",
                         "table_max_step_m", "gradient_step", "divergence_margin",
-                        "frequency_separation", "frequency_separation_modes"}
+                        "frequency_separation", "frequency_separation_modes",
+                        "phase_margin_deg", "gain_margin_db"}
     if unknown:
         raise DesignError(f"design: unknown keys {sorted(unknown)} (known: divergence_margin, "
                           f"objective, flutter_margin, frequency_separation, "
-                          f"frequency_separation_modes, gradient_step, max_iterations, "
-                          f"table_max_step_m, variable)")
+                          f"frequency_separation_modes, gain_margin_db, gradient_step, "
+                          f"max_iterations, phase_margin_deg, table_max_step_m, variable)")
     objective = t.get("objective", "mass")
     if objective not in OBJECTIVES:
         raise DesignError(f"design.objective must be one of {list(OBJECTIVES)}, got {objective!r}")
@@ -240,8 +256,21 @@ def design_from_dict(d: dict, source: str = "") -> DesignProblem:
     div = (None if "divergence_margin" not in t
            else _number(t, "divergence_margin", "design", 0.0, 10.0))
     sep, n_sep = _separation(t)
+    pm, gm = _ase_bounds(t)
     return DesignProblem(tuple(out), objective, margin, int(iters), source, step, gstep, div,
-                         sep, n_sep)
+                         sep, n_sep, pm, gm)
+
+
+def _ase_bounds(t: dict) -> tuple[float | None, float | None]:
+    """``design.phase_margin_deg`` (deg, in (0, 180]) and ``design.gain_margin_db`` (dB, in
+    (0, 100]), each absent (None) or a lower bound on the AEM1 loop's margin."""
+    out = []
+    for key, hi in (("phase_margin_deg", 180.0), ("gain_margin_db", 100.0)):
+        v = None if key not in t else _number(t, key, "design", 0.0, hi)
+        if v is not None and v <= 0.0:
+            raise DesignError(f"design.{key} must be a number in (0, {hi:g}], got {v!r}")
+        out.append(v)
+    return out[0], out[1]
 
 
 def _separation(t: dict) -> tuple[float | None, int]:
@@ -522,6 +551,9 @@ class Evaluation:
     d_divergence_mu: np.ndarray = field(default_factory=lambda: np.zeros(0))
     eigenvalues: np.ndarray = field(default_factory=lambda: np.zeros(0))
     d_eigenvalues: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    #: the AEM1 margins and their gradients (:class:`AseMargins`) when
+    #: the problem constrains them, else None
+    ase: object = None
 
     @property
     def elastic_frequencies_hz(self) -> np.ndarray:
@@ -552,11 +584,14 @@ class Evaluator:
     n_elastic: int = 0
     operators: tuple = ()
     calls: int = 0
+    ase_operators: tuple = ()
     _memo: dict = field(default_factory=dict)
 
     def __post_init__(self):
         self.problem = expand_variables(self.problem, self.case)
         check_case(self.case, self.problem)
+        if _has_ase(self.problem):
+            _check_ase_case(self.case, self.problem)
         base = P.modal_model(self.case)
         self.n_elastic = base.frequencies_hz.size - base.n_rigid
         n_sep = self.problem.frequency_separation_modes
@@ -575,6 +610,8 @@ class Evaluator:
                                             P.reduced_frequencies(self.case),
                                             a.reference_semichord, a.symmetry == "wall",
                                             a.kernel if a.method == "dlm" else "quartic")
+        if _has_ase(self.problem):
+            self.ase_operators = _ase_operators(self.case, self.problem)
 
     @property
     def mach(self) -> float:
@@ -590,6 +627,34 @@ class Evaluator:
             self.calls += 1
             self._memo[key] = evaluate(self, np.array(key))
         return self._memo[key]
+
+
+def _has_ase(problem: DesignProblem) -> bool:
+    return problem.phase_margin_deg is not None or problem.gain_margin_db is not None
+
+
+def _ase_key(problem: DesignProblem) -> str:
+    return "phase_margin_deg" if problem.phase_margin_deg is not None else "gain_margin_db"
+
+
+def _check_ase_case(case: Case, problem: DesignProblem) -> None:
+    """DesignError naming the design key when the case has no ASE loop to constrain."""
+    key = _ase_key(problem)
+    if case.actuator is None:
+        raise DesignError(f"design.{key}: the case has no [actuator] (no ASE loop)")
+    if case.support.kind != "shaft" or not case.modes.keep_rigid:
+        raise DesignError(f"design.{key}: the ASE loop needs a shaft support with "
+                          "modes.keep_rigid = true (the rigid pitch mode)")
+
+
+def _ase_operators(case: Case, problem: DesignProblem):
+    """The aerodynamic operators at the actuator's Mach for the margin constraints; a
+    DesignError naming the design key when the case cannot have them."""
+    key = _ase_key(problem)
+    try:
+        return _ase_aero_operators(case, case.actuator.mach)
+    except CaseError as exc:
+        raise DesignError(f"design.{key}: {exc}") from None
 
 
 def _system(case: Case, mesh, K, M):
@@ -766,6 +831,9 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
     conds = envelope_conditions(case)
     out = [_flutter(ev, mats, gaf, c.density) for c in conds]
     div = divergence_sensitivity(mats["K"], Q[0, :n, :n], mats["dK"], mats["dQ"][:, 0])
+    ase = None
+    if _has_ase(ev.problem):
+        ase = ase_margins(ev.case, ev.paths, values, operators=ev.ase_operators)
     return Evaluation(values=values, mass_kg=mass, d_mass=d_mass,
                       speeds_ms=np.array([o[0] for o in out]),
                       d_speeds=np.array([o[2] for o in out]),
@@ -773,7 +841,8 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
                       frequencies_hz=np.array([o[1] for o in out]),
                       densities=np.array([c.density for c in conds]),
                       divergence_mu=div.mu, d_divergence_mu=div.d_mu,
-                      eigenvalues=np.asarray(lam, float), d_eigenvalues=np.asarray(dlam, float))
+                      eigenvalues=np.asarray(lam, float), d_eigenvalues=np.asarray(dlam, float),
+                      ase=ase)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -792,7 +861,29 @@ def _constraint(ev: Evaluator, e: Evaluation):
         gs, dgs = separation_constraint(ev.problem.frequency_separation,
                                         ev.problem.frequency_separation_modes, e)
         g, dg = np.concatenate([g, gs]), np.vstack([dg, dgs])
+    if _has_ase(ev.problem):
+        ga, dga = ase_margin_constraints(ev.problem, e)
+        g, dg = np.concatenate([g, ga]), np.vstack([dg, dga])
     return g, dg
+
+
+def ase_margin_constraints(problem: DesignProblem, e: Evaluation):
+    """g = PM / (PM_req (1 + slack)) - 1 >= 0 and g = GM / (GM_req (1 + slack)) - 1 >= 0 for
+    the AEM1 loop's smallest phase margin (deg) and its gain margin (dB)
+    (``design.phase_margin_deg``, ``design.gain_margin_db``, the rows that are set, in that
+    order), with the gradients of :func:`ase_margins`. No phase crossover (GM = inf)
+    counts as g = 1, gradient 0; likewise no gain crossover for the phase margin."""
+    a, n_var = e.ase, e.d_mass.size
+    g, dg = [], []
+    for req, val, dval in ((problem.phase_margin_deg, a.phase_margin_deg, a.d_phase_margin_deg),
+                           (problem.gain_margin_db, a.gain_margin_db, a.d_gain_margin_db)):
+        if req is None:
+            continue
+        s = req * (1.0 + CONSTRAINT_SLACK)
+        finite_val = math.isfinite(val)
+        g.append(val / s - 1.0 if finite_val else 1.0)
+        dg.append(np.asarray(dval) / s if finite_val else np.zeros(n_var))
+    return np.array(g), np.array(dg).reshape(len(g), n_var)
 
 
 def separation_constraint(separation: float, n_modes: int, e: Evaluation):
@@ -898,6 +989,9 @@ def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.
             n_sep = ev.problem.frequency_separation_modes
             pairs += [(a, (b - c) / (2 * h)) for a, b, c in
                       zip(e0.d_eigenvalues[j, :n_sep], ep.eigenvalues, em.eigenvalues)]
+        if e0.ase is not None and np.isfinite(ep.ase.phase_margin_deg - em.ase.phase_margin_deg):
+            pairs.append((e0.ase.d_phase_margin_deg[j],
+                          (ep.ase.phase_margin_deg - em.ase.phase_margin_deg) / (2 * h)))
         if np.isfinite(ep.divergence_mu - em.divergence_mu):
             pairs.append((e0.d_divergence_mu[j], (ep.divergence_mu - em.divergence_mu) / (2 * h)))
         err[j] = max(abs(a - f) / max(abs(f), 1e-300) for a, f in pairs)
@@ -944,6 +1038,10 @@ def constraint_names(ev: Evaluator, e: Evaluation) -> list[tuple[str, float, flo
         f = e.elastic_frequencies_hz[:pr.frequency_separation_modes]
         rows += [(f"frequency_separation[f{i + 2}/f{i + 1}]", float(f[i + 1] / f[i] - 1.0),
                   pr.frequency_separation) for i in range(f.size - 1)]
+    if pr.phase_margin_deg is not None:
+        rows.append(("phase_margin_deg[AEM1]", e.ase.phase_margin_deg, pr.phase_margin_deg))
+    if pr.gain_margin_db is not None:
+        rows.append(("gain_margin_db[AEM1]", e.ase.gain_margin_db, pr.gain_margin_db))
     return rows
 
 
@@ -1102,3 +1200,169 @@ def optimise(case: Case, problem: DesignProblem, check_gradients: bool = True,
                         evaluations=ev.calls, seconds=time.perf_counter() - t0,
                         gradient_check=check, gradient_check_seconds=t_check,
                         constraints=activity)
+
+
+# ---------------------------------------------------------------------------------------------
+# the ASE loop's margins and their derivatives (issue 28, design.phase_margin_deg /
+# design.gain_margin_db)
+# ---------------------------------------------------------------------------------------------
+# The ASE loop's gain and phase margins and their design derivatives for a case (issue 28).
+#
+# The chain of :mod:`asekit.case.design` (plate matrices and their derivatives, the elastic modes
+# of the shaft-supported fin with the transmission held, FN1, and Nelson's mode-shape derivatives)
+# is extended by the rigid pitch mode r (unit nose-up rotation about the shaft, the FN2 model's
+# first mode, independent of thickness, material and masses) to the modal basis [r, Phi] of the
+# aeroservoelastic model:
+#
+#     M_a = [r, Phi]^T M [r, Phi],   K_a = diag(0, Lambda),                                  (1)
+#
+# (the rigid rotation strains neither plate nor shaft spring; the elastic modes are
+# mass-normalised, Phi^T M Phi = I). Its derivatives follow from Nelson's dPhi, dLambda
+# (:func:`asekit.aeroelastic.sensitivity.modal_matrix_derivative`, dr = 0), the GAF derivatives
+# dQ from the extended mode table [r, Phi, 0, dPhi_j] through the case's boxes and the DLM
+# operators at the actuator's Mach (:func:`asekit.aeroelastic.sensitivity.gaf_derivative`), the
+# Roger coefficients' derivatives dA_j = fit(dQ) (:func:`asekit.rfa.roger.roger_fit_derivative`)
+# and the AEM1 loop's dF and margins (:mod:`asekit.ase.loop_sensitivity`).
+#
+# This modal basis is the "held-transmission elastic modes + rigid attachment mode" form of the
+# thesis's Eq. (2.60); the case pipeline's FN2 model (fictitious-mass method) gives elastic modes
+# that differ from these by O(J_fin / I_f) (:mod:`asekit.case.design`), so the margins here agree
+# with :func:`asekit.case.pipeline.ase`'s to that order, not to round-off. Undamped structures
+# (no ``[damping]``), shaft supports with a rigid mode (FN2, ``modes.keep_rigid``), Roger fits.
+
+
+@dataclass(frozen=True)
+class AseMargins:
+    """The AEM1 loop's margins at a design and their derivatives per design variable.
+
+    Attributes
+    ----------
+    paths : the design variables' case-key paths.
+    values : (n_var,) their values.
+    phase_margin_deg : the smallest phase margin (deg); d_phase_margin_deg : (n_var,) its
+        derivative (deg per unit of each variable).
+    gain_crossover_hz : where it is read (Hz).
+    gain_margin_db : gain margin at the first phase crossover (dB; inf without one);
+        d_gain_margin_db : (n_var,) its derivative (zero without one).
+    sensitivity : the full :class:`asekit.ase.margin_sensitivity.MarginSensitivity`.
+    """
+
+    paths: tuple
+    values: np.ndarray
+    phase_margin_deg: float
+    d_phase_margin_deg: np.ndarray
+    gain_crossover_hz: float
+    gain_margin_db: float
+    d_gain_margin_db: np.ndarray
+    sensitivity: object
+
+
+def _ase_modal(case: Case, paths, n_elastic: int, rigid: np.ndarray):
+    """M_a, K_a (Eq. 1), their derivatives, and the mode tables [r, Phi] and derivatives."""
+    mesh = P.structural_mesh(case)
+    K, M = P.mass_and_stiffness(case)
+    parts = element_parts(mesh, case.material)
+    ev = types.SimpleNamespace(paths=tuple(paths))
+    dK, dM, _, _ = _matrix_derivatives(ev, case, mesh, parts, K, M)
+    system = _system(case, mesh, K, M)
+    lam, q = _elastic_modes(system, M, n_elastic)
+    dKr = [reduce(system.T, a) for a in dK]
+    for j, path in enumerate(paths):
+        extra = _support_derivative(system, path)
+        if extra is not None:
+            dKr[j] = dKr[j] + extra
+    dlam, dq = mode_shape_derivatives(system.K, system.M, lam, q, dKr,
+                                      [reduce(system.T, a) for a in dM])
+    n = lam.size
+    shapes = np.concatenate([rigid[:, :, None], (system.T @ q).reshape(mesh.n_nodes, 3, n)], 2)
+    dshapes = np.array([np.concatenate([np.zeros_like(rigid)[:, :, None],
+                                        (system.T @ d).reshape(mesh.n_nodes, 3, n)], 2)
+                        for d in dq])
+    Phi = shapes.reshape(-1, n + 1)
+    dPhi = dshapes.reshape(len(dq), -1, n + 1)
+    Ma = Phi.T @ (M @ Phi)
+    dMa = modal_matrix_derivative(Phi, M, dPhi, dM)
+    Ka = np.zeros((n + 1, n + 1))
+    Ka[1:, 1:] = np.diag(lam)
+    dKa = np.zeros((len(dq), n + 1, n + 1))
+    for j, d in enumerate(dlam):
+        dKa[j, 1:, 1:] = np.diag(d)
+    return mesh, Ma, Ka, dMa, dKa, shapes, dshapes
+
+
+def _ase_aero_operators(case: Case, mach: float):
+    a = case.aero
+    spec = AERO_METHODS[resolve_method(a.method, mach)]
+    if spec.operators is None or not spec.structure_independent:
+        raise CaseError(f"aero.method = {a.method!r} at M {mach:g}: the margin derivatives "
+                        "need a structure-independent aerodynamic operator (dlm, supersonic, "
+                        "piston)")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return spec.operators(P.box_mesh(case), mach, P.reduced_frequencies(case),
+                              a.reference_semichord, a.symmetry == "wall",
+                              a.kernel if a.method == "dlm" else "quartic")
+
+
+def ase_margins(case: Case, paths, values=None, operators=None) -> AseMargins:
+    """AEM1 gain and phase margins of ``case`` (at ``[actuator.condition]``) with the design
+    variables ``paths`` set to ``values``, and their analytic derivatives (module docstring).
+
+    Parameters
+    ----------
+    case : Case
+        A case with ``[actuator]``, a shaft support with a rigid mode (FN2, ``modes.keep_rigid``)
+        and no ``[damping]``.
+    paths : sequence of str
+        Design-variable case-key paths (those of :mod:`asekit.case.design`).
+    values : sequence of float, optional
+        Their values (default: the case's).
+    operators : optional
+        The aerodynamic operators at the actuator's Mach (formed once and reused across calls:
+        the boxes do not change with the design); default: formed here.
+
+    Returns
+    -------
+    :class:`AseMargins`.
+
+    Raises
+    ------
+    CaseError
+        No ``[actuator]``, no rigid mode, damping, or a structure-dependent aero method.
+    """
+    if case.actuator is None:
+        raise CaseError("the case has no [actuator]: no ASE loop to differentiate")
+    if case.damping is not None and (case.damping.modal_damping_ratio or case.damping.structural_g):
+        raise CaseError("[damping]: the margin derivatives need an undamped structure")
+    base = P.modal_model(case)
+    if base.n_rigid != 1:
+        raise CaseError("support.model / modes.keep_rigid: the ASE loop needs the rigid pitch "
+                        "mode (FN2 with modes.keep_rigid = true)")
+    paths = tuple(paths)
+    if values is not None:
+        case = with_values(case, paths, values)
+    values = np.array([case_value(case, p) for p in paths])
+    act, ctl, _ = P.actuator_setup(case)
+    a = case.actuator
+    ops = _ase_aero_operators(case, a.mach) if operators is None else operators
+    n_el = base.frequencies_hz.size - 1
+    rigid = np.asarray(base.shapes)[:, :, 0]        # unit pitch about the shaft, (n_nodes, 3)
+    mesh, Ma, Ka, dMa, dKa, shapes, dshapes = _ase_modal(case, paths, n_el, rigid)
+    n = n_el + 1
+    Q = _gafs(types.SimpleNamespace(case=case, operators=ops), mesh,
+                extended_shapes(shapes, dshapes))
+    dQ = gaf_derivative(Q, n)
+    k, b = P.reduced_frequencies(case), case.aero.reference_semichord
+    fit = roger_fit(k, Q[:, :n, :n], b, n_lags=case.flutter.lags, mach=a.mach)
+    dA = [roger_fit_derivative(fit, d) for d in dQ]
+    atm = standard_atmosphere(a.altitude)
+    rho, U = float(atm.density), a.mach * float(atm.speed_of_sound)
+    s = aem1_margin_sensitivity(Ma, Ka, np.zeros_like(Ma), fit, rho, U, act, ctl,
+                                dM=list(dMa), dK=list(dKa), dA=dA)
+    i = int(np.argmin(s.phase_margins_deg)) if s.phase_margins_deg.size else None
+    pm = float(s.phase_margins_deg[i]) if i is not None else float("inf")
+    dpm = s.d_phase_margins_deg[:, i] if i is not None else np.zeros(len(paths))
+    wc = float(s.gain_crossovers_rad_s[i]) / (2 * np.pi) if i is not None else float("nan")
+    gm = float(s.gain_margins_db[0]) if s.gain_margins_db.size else float("inf")
+    dgm = s.d_gain_margins_db[:, 0] if s.gain_margins_db.size else np.zeros(len(paths))
+    return AseMargins(paths, values, pm, np.asarray(dpm), wc, gm, np.asarray(dgm), s)

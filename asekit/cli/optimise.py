@@ -96,6 +96,25 @@ def _reanalysis(case, margin: float, div_margin: float | None = None,
                                                       or sep >= 100 * separation - 1e-7))}
 
 
+def _ase_verdict(case, problem, verdict: dict) -> dict:
+    """With ``design.phase_margin_deg`` / ``design.gain_margin_db``: the pipeline's own AEM1
+    margins (FWTF 2 of :func:`asekit.case.pipeline.ase`, FN2 modes) as ``phase_margin_deg`` and
+    ``gain_margin_db`` (None: no crossover, i.e. infinite), and ``meets_constraints`` also
+    requiring them (issue 28). Without those keys ``verdict`` unchanged."""
+    pm_req, gm_req = problem.phase_margin_deg, problem.gain_margin_db
+    if pm_req is None and gm_req is None:
+        return verdict
+    import math
+
+    from asekit.case import pipeline as P
+    c = P.ase(case).crossovers[2]
+    pm, gm = c.phase_margin_deg, c.gain_margin_db
+    ok = (pm_req is None or pm >= pm_req - 1e-6) and (gm_req is None or gm >= gm_req - 1e-6)
+    return {**verdict, "phase_margin_deg": pm if math.isfinite(pm) else None,
+            "gain_margin_db": gm if math.isfinite(gm) else None,
+            "meets_constraints": bool(verdict["meets_constraints"] and ok)}
+
+
 def _block(ev, paths, verdict: dict) -> dict:
     import numpy as np
     return {"mass_kg": ev.mass_kg, **verdict,
@@ -171,8 +190,10 @@ def run(args) -> int:
     margins = (need, problem.divergence_margin if problem.divergence_margin is not None
                or not speed else problem.flutter_margin, problem.frequency_separation,
                problem.frequency_separation_modes)
-    base = _block(result.baseline, result.paths, _reanalysis(case, *margins))
-    opt = _block(result.optimised, result.paths, _reanalysis(reanalysed, *margins))
+    base = _block(result.baseline, result.paths,
+                  _ase_verdict(case, problem, _reanalysis(case, *margins)))
+    opt = _block(result.optimised, result.paths,
+                 _ase_verdict(reanalysed, problem, _reanalysis(reanalysed, *margins)))
     doc = {"design": {"objective": problem.objective, "baseline": base, "optimised": opt,
                       "gain": _gain(base, opt),
                       "constraints": list(result.constraints),

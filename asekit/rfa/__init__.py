@@ -22,8 +22,15 @@ from asekit.rfa.minimum_state import (
                                       minimum_state_fit_database,
                                       reduced_frequency_weights,
 )
-from asekit.rfa.roger import RogerFit, default_lag_roots, design_rows, roger_fit, roger_fit_database
+from asekit.rfa.roger import (
+    RogerFit,
+    default_lag_roots,
+    design_rows,
+    roger_fit,
+    roger_fit_database,
+    roger_fit_derivative,
+)
 
 __all__ = ["RogerFit", "MinimumStateFit", "default_lag_roots", "default_ms_roots",
-           "design_rows", "roger_fit", "roger_fit_database",
+           "design_rows", "roger_fit", "roger_fit_database", "roger_fit_derivative",
            "minimum_state_fit", "minimum_state_fit_database", "reduced_frequency_weights"]

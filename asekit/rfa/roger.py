@@ -259,3 +259,56 @@ def roger_fit_database(database, mach: float, interpolate: bool = False, **kwarg
     :meth:`~asekit.aero.gaf.GafDatabase.at`); ``kwargs`` go to :func:`roger_fit`."""
     g = database.at(mach, interpolate=interpolate)
     return roger_fit(g.k, g.Q, database.b_ref, mach=mach, **kwargs)
+
+
+def roger_fit_derivative(fit: RogerFit, dQ) -> np.ndarray:
+    """Derivative of a Roger fit's coefficients with respect to a design parameter.
+
+    For fixed lag roots, weights and k points the fit of Eqs. (2.17)-(2.24) (and its
+    equality-constrained variant) is a linear least-squares solve A = G^+ [Re Q; Im Q], so its
+    derivative is the same solve applied to the derivative of the data (issue 28):
+
+        dA_j / dtheta = fit(dQ / dtheta)  (lags fixed),
+
+    exact, not a finite difference. (Default lag roots depend on k only, never on Q.)
+
+    Parameters
+    ----------
+    fit : :class:`RogerFit`
+        The fit at the design point (its k, lag roots, weights and constraint are reused).
+    dQ : (n_k, n, n) complex
+        dQ/dtheta at the fit's k (e.g. :func:`asekit.aeroelastic.sensitivity.gaf_derivative`).
+
+    Returns
+    -------
+    (N + 3, n, n) real: dA0/dtheta, ..., dA_{N+2}/dtheta.
+
+    Examples
+    --------
+    The fit is linear: the derivative of the fit of Q + t dQ is the fit of dQ.
+
+    >>> k = np.linspace(0.0, 1.0, 8)
+    >>> Q = (1.0 + 0.5j * k - 0.2 * k ** 2)[:, None, None] * np.ones((1, 1, 1))
+    >>> f = roger_fit(k, Q, 1.0, n_lags=2)
+    >>> dA = roger_fit_derivative(f, 2.0 * Q)
+    >>> bool(np.allclose(dA, 2.0 * f.A))
+    True
+    """
+    dQ = finite_array("dQ", dQ, complex_values=True)
+    if dQ.shape != fit.Q.shape:
+        raise ValueError(f"dQ must have the fit's data shape {fit.Q.shape}, got {dQ.shape}")
+    kr, ki = design_rows(fit.k, fit.lag_roots)
+    w = np.ones(fit.k.size) if fit.weights is None else np.asarray(fit.weights, float)
+    sw = np.sqrt(w)[:, None]
+    G = np.vstack([kr * sw, ki * sw])
+    nk, n = fit.k.size, fit.n_modes
+    rhs = np.vstack([dQ.real.reshape(nk, -1) * sw, dQ.imag.reshape(nk, -1) * sw])
+    n_coef = G.shape[1]
+    if fit.constrained_k0:
+        C = kr[:1]
+        kkt = np.block([[G.T @ G, C.T], [C, np.zeros((1, 1))]])
+        coef = np.linalg.lstsq(kkt, np.vstack([G.T @ rhs, dQ[0].real.reshape(1, -1)]),
+                               rcond=None)[0][:n_coef]
+    else:
+        coef = np.linalg.lstsq(G, rhs, rcond=None)[0]
+    return coef.reshape(n_coef, n, n)
