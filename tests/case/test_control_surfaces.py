@@ -65,8 +65,8 @@ def test_missing_keys_and_overlapping_surfaces():
 
 
 def test_fingerprint_without_control_surfaces_is_unchanged_by_the_new_key():
-    """A case without [[control_surface]] (and without [[beam]]) hashes as before the keys existed (its GAF and result
-    caches stay valid): the empty tuple is left out of the digest."""
+    """A case without [[control_surface]] (and without [[beam]]) hashes as before the keys
+    existed (its GAF and result caches stay valid): the empty tuple is left out of the digest."""
     import dataclasses
     import hashlib
     import json
