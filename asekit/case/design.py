@@ -93,7 +93,7 @@ from asekit.atmosphere import standard_atmosphere
 from asekit.case import pipeline as P
 from asekit.case.schema import Case, CaseError
 from asekit.rfa.roger import roger_fit, roger_fit_derivative
-from asekit.structure.assembly import clamped_edge, shaft_support
+from asekit.structure.assembly import clamped_edge, rigid_pitch_vector, shaft_support
 from asekit.structure.modes import ModalModel, normal_modes, select_modes
 from asekit.structure.sensitivity import (
     density_derivative,
@@ -554,6 +554,10 @@ class Evaluation:
     #: the AEM1 margins and their gradients (:class:`AseMargins`) when
     #: the problem constrains them, else None
     ase: object = None
+    #: the fin's pitch inertia about the shaft axis (kg m^2, plate and point masses: r^T M r
+    #: with the rigid pitch vector r; NaN without a shaft) and its gradient (n_var,)
+    pitch_inertia_kgm2: float = math.nan
+    d_pitch_inertia: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def elastic_frequencies_hz(self) -> np.ndarray:
@@ -802,6 +806,16 @@ def _flutter(ev: Evaluator, mats: dict, gaf: TabulatedGaf, density: float):
     return U, s.frequency_hz, s.d_speed
 
 
+def _pitch_inertia(case: Case, mesh, M, dM) -> tuple[float, np.ndarray]:
+    """The fin's pitch inertia about the shaft axis, J = r^T M r, and dJ_j = r^T dM_j r, with
+    the rigid pitch vector r (:func:`asekit.structure.assembly.rigid_pitch_vector`; M and dM
+    on the fin's DOFs, point masses included). (NaN, NaN...) without a shaft support."""
+    if case.support.kind != "shaft":
+        return math.nan, np.full(len(dM), math.nan)
+    r = rigid_pitch_vector(mesh, case.support.axis_point[0])
+    return float(r @ (M @ r)), np.array([float(r @ (d @ r)) for d in dM])
+
+
 def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
     """One evaluation of the chain (module docstring) at the design ``values``."""
     case = with_values(ev.case, ev.paths, values)
@@ -831,6 +845,7 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
     conds = envelope_conditions(case)
     out = [_flutter(ev, mats, gaf, c.density) for c in conds]
     div = divergence_sensitivity(mats["K"], Q[0, :n, :n], mats["dK"], mats["dQ"][:, 0])
+    J, dJ = _pitch_inertia(case, mesh, M, dM)
     ase = None
     if _has_ase(ev.problem):
         ase = ase_margins(ev.case, ev.paths, values, operators=ev.ase_operators)
@@ -842,7 +857,7 @@ def evaluate(ev: Evaluator, values: np.ndarray) -> Evaluation:
                       densities=np.array([c.density for c in conds]),
                       divergence_mu=div.mu, d_divergence_mu=div.d_mu,
                       eigenvalues=np.asarray(lam, float), d_eigenvalues=np.asarray(dlam, float),
-                      ase=ase)
+                      ase=ase, pitch_inertia_kgm2=J, d_pitch_inertia=dJ)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -972,9 +987,9 @@ def variable_scales(problem: DesignProblem, x0: np.ndarray) -> np.ndarray:
 
 
 def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.ndarray:
-    """Max relative error per variable of the analytic d(mass), dU_f, dmu (the divergence
-    eigenvalue) and, with a frequency-separation constraint, dlambda of its modes (the elastic
-    eigenvalues) against central differences of the whole chain (step ``rel_step`` times the
+    """Max relative error per variable of the analytic d(mass), d(pitch inertia), dU_f, dmu (the
+    divergence eigenvalue) and, with a frequency-separation constraint, dlambda of its modes
+    (the elastic eigenvalues) against central differences of the whole chain (step ``rel_step`` times the
     value, or the bounds' width where the value is 0: :func:`variable_scales`)."""
     e0 = ev(x0)
     scale = variable_scales(ev.problem, x0)
@@ -995,6 +1010,12 @@ def gradient_check(ev: Evaluator, x0: np.ndarray, rel_step: float = 1e-4) -> np.
         if np.isfinite(ep.divergence_mu - em.divergence_mu):
             pairs.append((e0.d_divergence_mu[j], (ep.divergence_mu - em.divergence_mu) / (2 * h)))
         err[j] = max(abs(a - f) / max(abs(f), 1e-300) for a, f in pairs)
+        if np.isfinite(e0.pitch_inertia_kgm2):
+            # relative to |fd|, floored at 1e-6 J per unit relative change of the variable where
+            # J does not depend on it (a mass moved spanwise: the differences are round-off)
+            fd = (ep.pitch_inertia_kgm2 - em.pitch_inertia_kgm2) / (2 * h)
+            floor = 1e-6 * e0.pitch_inertia_kgm2 / scale[j]
+            err[j] = max(err[j], abs(e0.d_pitch_inertia[j] - fd) / max(abs(fd), floor))
     return err
 
 
