@@ -414,8 +414,8 @@ def turbulence_json(result: GustLoads | None) -> list:
     """The ``analyse --json`` ``"turbulence"`` rows (one per flight condition): ``mach``,
     ``altitude_m``, ``rms_hinge_moment_Nm``, ``A_bar_hinge`` (N m per m/s), ``N0_per_s`` (of
     the hinge moment; null without a rigid mode), ``rms_root_bending_Nm``,
-    ``A_bar_root_bending`` (N m per m/s), ``N0_root_bending_per_s``, ``sigma_ms``,
-    ``scale_length_m``, ``spectrum``, ``omega_max`` (rad/s), ``rms_current_A`` (the linear
+    ``A_bar_root_bending`` (N m per m/s), ``N0_root_bending_per_s``, ``omega_max`` (rad/s),
+    ``rms_current_A`` (the linear
     AEM1 loop's motor current; null without an actuator or when that loop is unstable),
     ``stations`` ({name:
     {"rms_shear_N", "rms_bending_Nm", "rms_torsion_Nm"}} at the ``[[gust.station]]`` cuts)."""
