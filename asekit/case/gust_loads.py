@@ -415,10 +415,10 @@ def turbulence_json(result: GustLoads | None) -> list:
     ``altitude_m``, ``rms_hinge_moment_Nm``, ``A_bar_hinge`` (N m per m/s), ``N0_per_s`` (of
     the hinge moment; null without a rigid mode), ``rms_root_bending_Nm``,
     ``A_bar_root_bending`` (N m per m/s), ``N0_root_bending_per_s``, ``omega_max`` (rad/s),
-    ``rms_current_A`` (the linear
-    AEM1 loop's motor current; null without an actuator or when that loop is unstable),
-    ``stations`` ({name:
-    {"rms_shear_N", "rms_bending_Nm", "rms_torsion_Nm"}} at the ``[[gust.station]]`` cuts)."""
+    ``rms_current_A`` (the linear AEM1 loop's motor current; null without an actuator or when
+    that loop is unstable), ``stations`` ({name: {"rms_shear_N", "rms_bending_Nm",
+    "rms_torsion_Nm"}} at the ``[[gust.station]]`` cuts). The turbulence's own parameters
+    (sigma, scale length, spectrum) are the case's ``[gust.turbulence]`` inputs."""
     if result is None or result.turbulence is None:
         return []
     t = result.turbulence
