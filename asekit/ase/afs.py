@@ -49,7 +49,13 @@ from dataclasses import dataclass
 import control as ct
 import numpy as np
 
-from asekit.ase.loop import FIN_ROOT, AeroservoelasticModel, _plant, build_model
+from asekit.ase.loop import (
+    FIN_ROOT,
+    AeroservoelasticModel,
+    _plant,
+    build_model,
+    with_fin_root_rate,
+)
 from asekit.util.blas import small_dense
 from asekit.util.validate import finite, positive
 
@@ -138,15 +144,7 @@ def plant(model: AeroservoelasticModel) -> ct.StateSpace:
     The fin-root rate is C_r (A z + B u) + D_r0 omega (the root row C_r z + D_r0 theta
     differentiated along Eq. 2.63), the construction of :func:`asekit.ase.loop.closed_loop`.
     """
-    fin = model.aeroelastic
-    ir = list(fin.output_labels).index(FIN_ROOT)
-    Cr, Dr = np.array(fin.C[ir:ir + 1]), np.array(fin.D[ir:ir + 1])
-    rate_C = Cr @ np.array(fin.A)
-    rate_D = Cr @ np.array(fin.B) + np.array([[0.0, Dr[0, 0], 0.0]])
-    fin2 = ct.ss(fin.A, fin.B, np.vstack([fin.C, rate_C]), np.vstack([fin.D, rate_D]),
-                 states=list(fin.state_labels), inputs=list(fin.input_labels),
-                 outputs=list(fin.output_labels) + ["fin_root_rate"], name="aeroelastic")
-    p = _plant(model, fin2)
+    p = _plant(model, with_fin_root_rate(model.aeroelastic))
     names = list(p.output_labels)
     idx = [names.index(o) for o in MEASUREMENTS + ("current",)]
     C, D = np.array(p.C)[idx], np.array(p.D)[idx]

@@ -240,6 +240,34 @@ def forward_path(model: AeroservoelasticModel, controller: PDController, which: 
                  name=f"FWTF{which}")
 
 
+def with_fin_root_rate(fin: ct.StateSpace) -> ct.StateSpace:
+    """The aeroelastic system ``fin`` (Eq. 2.63, inputs [theta, omega, alpha]) with one more
+    output, ``fin_root_rate`` (rad/s): the fin-root pitch row C_r z + D_r0 theta differentiated
+    along the state equation,
+
+        d/dt (C_r z + D_r0 theta) = C_r (A z + B u) + D_r0 omega,
+
+    so that a rate feedback stays proper (used by :func:`closed_loop` for AEM2 and by the active
+    flutter suppression plant).
+
+    Examples
+    --------
+    >>> import control as ct
+    >>> fin = ct.ss([[-1.0]], [[1.0, 0.0, 0.0]], [[2.0]], [[0.5, 0.0, 0.0]],
+    ...             inputs=["theta", "omega", "alpha"], outputs=["fin_root_pitch"])
+    >>> out = with_fin_root_rate(fin)
+    >>> out.output_labels, float(out.C[1, 0]), out.D[1].tolist()
+    (['fin_root_pitch', 'fin_root_rate'], -2.0, [2.0, 0.5, 0.0])
+    """
+    ir = list(fin.output_labels).index(FIN_ROOT)
+    Cr, Dr = np.array(fin.C[ir:ir + 1]), np.array(fin.D[ir:ir + 1])
+    rate_C = Cr @ np.array(fin.A)
+    rate_D = Cr @ np.array(fin.B) + np.array([[0.0, Dr[0, 0], 0.0]])
+    return ct.ss(fin.A, fin.B, np.vstack([fin.C, rate_C]), np.vstack([fin.D, rate_D]),
+                 states=list(fin.state_labels), inputs=list(fin.input_labels),
+                 outputs=list(fin.output_labels) + ["fin_root_rate"], name="aeroelastic")
+
+
 def closed_loop(model: AeroservoelasticModel, controller: PDController, topology: str,
                 outputs: list[str] | None = None) -> ct.StateSpace:
     """Linear closed loop from ``theta_cmd`` (rad) to ``outputs`` (default: transmission angle,
@@ -253,15 +281,7 @@ def closed_loop(model: AeroservoelasticModel, controller: PDController, topology
     _check_topology(topology)
     _check_controller(controller)
     fin = model.aeroelastic
-    # fin-root rate output: d/dt (C_r z + D_r0 theta) = C_r (A z + B u) + D_r0 omega
-    ir = list(fin.output_labels).index(FIN_ROOT)
-    Cr, Dr = np.array(fin.C[ir:ir + 1]), np.array(fin.D[ir:ir + 1])
-    rate_C = Cr @ np.array(fin.A)
-    rate_D = Cr @ np.array(fin.B) + np.array([[0.0, Dr[0, 0], 0.0]])
-    fin2 = ct.ss(fin.A, fin.B, np.vstack([fin.C, rate_C]), np.vstack([fin.D, rate_D]),
-                 states=list(fin.state_labels), inputs=list(fin.input_labels),
-                 outputs=list(fin.output_labels) + ["fin_root_rate"], name="aeroelastic")
-    plant = _plant(model, fin2)
+    plant = _plant(model, with_fin_root_rate(fin))
     fb, fb_rate = ("theta", "omega") if topology == "AEM1" else (FIN_ROOT, "fin_root_rate")
     kc, kp, kd = controller.gain, controller.kp, controller.kd
     # PD with the derivative on the feedback rate only (a step's derivative impulse is absent):
