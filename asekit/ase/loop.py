@@ -517,6 +517,61 @@ def _fb_rows(model: AeroservoelasticModel):
 # ---------------------------------------------------------------------------------------------
 # exact (matrix-exponential) integration of the piecewise-affine power-limited loop
 # ---------------------------------------------------------------------------------------------
+def actuated_state_matrix(A, B, Ch, Dh, motor, ratio: float, efficiency: float,
+                          inertia_at_motor: float):
+    """The actuator + aeroelastic state matrix F of x' = F x + g V, x = [theta, omega, I, z]
+    (Eqs. 2.30-2.37 with Eq. 2.63), dtype-generic so that a complex step can pass through it.
+
+    With the hinge moment T0 = C_h z + D_h0 theta + D_h1 omega (the acceleration term already in
+    the motor-side inertia ``inertia_at_motor``, kg m^2, Eq. 2.33):
+
+        theta' = omega
+        omega' = alpha = (K_t I + T0 / (N eta) - c N omega) / (N J_total@motor)
+        I'     = (-R I - K_b N omega) / L           (+ V / L, the input)
+        z'     = A z + B [theta, omega, alpha]
+
+    Parameters
+    ----------
+    A, B : (nz, nz), (nz, 3) the aeroelastic system (inputs theta, omega, alpha).
+    Ch, Dh : (nz,), (3,) the hinge-moment row (N m).
+    motor : :class:`asekit.servo.actuator.DCMotor` (R, L, K_t, K_b, c).
+    ratio, efficiency : the transmission's N and eta.
+    inertia_at_motor : kg m^2.
+
+    Returns
+    -------
+    F : (3 + nz, 3 + nz); arow : (3 + nz,) alpha = arow x; hm_row : (3 + nz,) T0 = hm_row x.
+
+    Examples
+    --------
+    >>> from asekit.servo.actuator import DCMotor
+    >>> F, arow, hm = actuated_state_matrix(np.zeros((0, 0)), np.zeros((0, 3)), np.zeros(0),
+    ...                                     np.zeros(3), DCMotor(), 10.0, 1.0, 1e-5)
+    >>> F.shape, float(F[0, 1])
+    ((3, 3), 1.0)
+    """
+    m, N, eta = motor, ratio, efficiency
+    nz = A.shape[0]
+    n = 3 + nz
+    dtype = np.result_type(A, B, Ch, Dh, float)
+    hm_row = np.zeros(n, dtype=dtype)
+    hm_row[0], hm_row[1], hm_row[3:] = Dh[0], Dh[1], Ch
+    nj = N * inertia_at_motor
+    arow = hm_row / (N * eta) / nj
+    arow[1] -= m.viscous_damping * N / nj
+    arow[2] += m.torque_constant / nj
+    F = np.zeros((n, n), dtype=np.result_type(dtype, arow))
+    F[0, 1] = 1.0
+    F[1] = arow
+    F[2, 1] = -m.back_emf_constant * N / m.inductance
+    F[2, 2] = -m.resistance / m.inductance
+    F[3:, 3:] = A
+    F[3:, 0] += B[:, 0]
+    F[3:, 1] += B[:, 1]
+    F[3:] += np.outer(B[:, 2], arow)
+    return F, arow, hm_row
+
+
 def _loop_matrices(model: AeroservoelasticModel, controller: PDController, command: float,
                    topology: str):
     """The closed loop of :func:`simulate_closed_loop` as x' = F x + g V (V the applied
@@ -542,23 +597,8 @@ def _loop_matrices(model: AeroservoelasticModel, controller: PDController, comma
     ih = model.output_index("hinge_moment")
     Ch, Dh = model.output_C[ih], model.output_D[ih]
     Cr, Dr = _fb_rows(model)
-    nz = A.shape[0]
-    n = 3 + nz
-    hm_row = np.zeros(n)
-    hm_row[0], hm_row[1], hm_row[3:] = Dh[0], Dh[1], Ch
-    nj = N * act.inertia_at_motor
-    arow = hm_row / (N * eta) / nj
-    arow[1] -= m.viscous_damping * N / nj
-    arow[2] += m.torque_constant / nj
-    F = np.zeros((n, n))
-    F[0, 1] = 1.0
-    F[1] = arow
-    F[2, 1] = -m.back_emf_constant * N / m.inductance
-    F[2, 2] = -m.resistance / m.inductance
-    F[3:, 3:] = A
-    F[3:, 0] += B[:, 0]
-    F[3:, 1] += B[:, 1]
-    F[3:] += np.outer(B[:, 2], arow)
+    F, arow, hm_row = actuated_state_matrix(A, B, Ch, Dh, m, N, eta, act.inertia_at_motor)
+    n = F.shape[0]
     g = np.zeros(n)
     g[2] = 1.0 / m.inductance
     if topology == "AEM2":

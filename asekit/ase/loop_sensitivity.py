@@ -39,6 +39,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from asekit.ase.loop import actuated_state_matrix
 from asekit.ase.margin_sensitivity import MarginSensitivity, margin_sensitivities
 from asekit.rfa.roger import RogerFit
 from asekit.servo.actuator import ActuatorParameters, PDController
@@ -117,28 +118,15 @@ def _aeroelastic(M, K, C, A, Dl, El, roots, b, rho, U):
 
 
 def _loop(M, K, C, A, Dl, El, roots, b, rho, U, actuator, controller):
-    """F, g, c of Eq. (1) (complex-safe), as :func:`asekit.ase.loop._loop_matrices` (AEM1)."""
+    """F, g, c of Eq. (1) (complex-safe: F from :func:`asekit.ase.loop.actuated_state_matrix`,
+    the matrix of the time simulation, with J_eff = -D_h[2] from the complex-step model)."""
     As, Bs, Ch, Dh = _aeroelastic(M, K, C, A, Dl, El, roots, b, rho, U)
     m, tr = actuator.motor, actuator.transmission
     N, eta = tr.ratio, tr.efficiency
     j_eff = -Dh[2]
-    nj = N * (m.rotor_inertia + tr.inertia + j_eff / (N * N * eta))       # Eq. (2.33)
-    nz = As.shape[0]
-    n = 3 + nz
-    hm = np.zeros(n, dtype=As.dtype)
-    hm[0], hm[1], hm[3:] = Dh[0], Dh[1], Ch
-    arow = hm / (N * eta) / nj
-    arow[1] -= m.viscous_damping * N / nj
-    arow[2] += m.torque_constant / nj
-    F = np.zeros((n, n), dtype=As.dtype)
-    F[0, 1] = 1.0
-    F[1] = arow
-    F[2, 1] = -m.back_emf_constant * N / m.inductance
-    F[2, 2] = -m.resistance / m.inductance
-    F[3:, 3:] = As
-    F[3:, 0] += Bs[:, 0]
-    F[3:, 1] += Bs[:, 1]
-    F[3:] += np.outer(Bs[:, 2], arow)
+    j_motor = m.rotor_inertia + tr.inertia + j_eff / (N * N * eta)          # Eq. (2.33)
+    F, _, _ = actuated_state_matrix(As, Bs, Ch, Dh, m, N, eta, j_motor)
+    n = F.shape[0]
     g = np.zeros((n, 1))
     g[2, 0] = 1.0 / m.inductance
     c = np.zeros((1, n))
