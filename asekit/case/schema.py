@@ -1379,11 +1379,10 @@ def _structure_kind(top: _Table) -> bool:
     return False
 
 
-def _beam_case(top: _Table, name: str, reference: str, source: str) -> Case:
-    """The rest of case_from_dict for a stick-model case (after [case])."""
-    panels = _panels(top.raw("panel", None, required=False), structural=False)
-    beam = _beam(top.raw("beam"), panels)
-    support = SupportSpec("clamped_root")
+def _common_tables(top: _Table, panels, support) -> dict:
+    """The tables a plate case and a stick-model case share, parsed and cross-checked:
+    [damping], [modes], [aero] (with the resources it needs), [flight] (with the p-k grid's
+    size), [flutter] and [convergence], as the Case fields of the same names."""
     damping = _damping(top.table("damping"))
     modes = _modes(top.table("modes"), support)
     aero = _aero(top.table("aero", required=True), panels)
@@ -1393,14 +1392,22 @@ def _beam_case(top: _Table, name: str, reference: str, source: str) -> Case:
     problem = pk_problem(len(aero.machs), n_cond, flight.velocities)
     if problem is not None:
         raise CaseError(problem)
-    flutter = _flutter(top.table("flutter"))
-    convergence = _convergence(top.table("convergence"))
+    return {"damping": damping, "modes": modes, "aero": aero, "flight": flight,
+            "flutter": _flutter(top.table("flutter")),
+            "convergence": _convergence(top.table("convergence"))}
+
+
+def _beam_case(top: _Table, name: str, reference: str, source: str) -> Case:
+    """The rest of case_from_dict for a stick-model case (after [case])."""
+    panels = _panels(top.raw("panel", None, required=False), structural=False)
+    beam = _beam(top.raw("beam"), panels)
+    support = SupportSpec("clamped_root")
+    common = _common_tables(top, panels, support)
     if top.has("flutter_speed_index"):
         raise CaseError("flutter_speed_index is not supported with [[beam]] yet")
     top.done()
     return Case(name=name, panels=panels, thickness=None, material=None, support=support,
-                aero=aero, flight=flight, modes=modes, damping=damping, flutter=flutter,
-                convergence=convergence, reference=reference, source=source, beam=beam)
+                reference=reference, source=source, beam=beam, **common)
 
 
 def case_from_dict(d: dict, source: str = "") -> Case:
@@ -1420,18 +1427,9 @@ def case_from_dict(d: dict, source: str = "") -> Case:
     support = _support(top.table("support", required=True), panels)
     masses = _point_masses(top.raw("point_mass"), panels)
     surfaces = _control_surfaces(top.raw("control_surface"), panels)
-    damping = _damping(top.table("damping"))
-    modes = _modes(top.table("modes"), support)
-    aero = _aero(top.table("aero", required=True), panels)
-    check_resources(panels, aero)
-    flight = _flight(top.table("flight", required=True))
-    n_cond = len(flight.altitudes if flight.altitudes is not None else flight.densities)
-    problem = pk_problem(len(aero.machs), n_cond, flight.velocities)
-    if problem is not None:
-        raise CaseError(problem)
+    common = _common_tables(top, panels, support)
+    aero, modes = common["aero"], common["modes"]
     actuator = _actuator(top.table("actuator"))
-    flutter = _flutter(top.table("flutter"))
-    convergence = _convergence(top.table("convergence"))
     gust = _gust(top.table("gust"), aero, actuator, source)
     fsi = top.table("flutter_speed_index")
     if fsi is not None:
@@ -1452,11 +1450,9 @@ def case_from_dict(d: dict, source: str = "") -> Case:
         raise CaseError(f"actuator.condition.mach must lie within aero.machs "
                         f"[{aero.machs[0]:g}, {aero.machs[-1]:g}], got {actuator.mach:g}")
     return Case(name=name, panels=panels, thickness=thickness, material=material,
-                support=support, aero=aero, flight=flight, modes=modes, damping=damping,
-                point_masses=masses, actuator=actuator, control_surfaces=surfaces,
-                flutter_index=fsi_spec,
-                flutter=flutter, convergence=convergence, gust=gust, reference=reference,
-                source=source)
+                support=support, point_masses=masses, actuator=actuator,
+                control_surfaces=surfaces, flutter_index=fsi_spec, gust=gust,
+                reference=reference, source=source, **common)
 
 
 def load_case(path) -> Case:
