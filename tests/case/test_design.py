@@ -11,6 +11,7 @@ import tomllib
 
 import numpy as np
 import pytest
+from small_cases import small_fin_raw
 
 from asekit.case import case_from_dict
 from asekit.case import pipeline as P
@@ -30,20 +31,7 @@ from asekit.util.paths import FIN_FILE
 pytestmark = pytest.mark.usefixtures("session_gaf_cache")
 
 
-def _small_raw() -> dict:
-    raw = tomllib.loads(FIN_FILE.read_text())
-    raw["panel"][0].update(n_chord=4, n_span=4)
-    raw["modes"] = {"count": 3, "keep_rigid": True}
-    raw["aero"].update(machs=[0.4, 0.6], boxes=[{"n_chord": 6, "n_span": 6}],
-                       reduced_frequencies=[0.001, 0.1, 0.2, 0.3, 0.45, 0.6, 0.8])
-    raw["flight"].update(altitudes=[0.0, 2500.0],
-                         velocities={"min": 120.0, "max": 420.0, "step": 20.0})
-    raw["point_mass"] = [{"position": [0.12, 0.14], "mass": 0.01}]
-    raw.pop("actuator")
-    return raw
-
-
-RAW = _small_raw()
+RAW = small_fin_raw()
 CASE = case_from_dict(copy.deepcopy(RAW), "small fin")
 PROBLEM = design_from_dict({"design": {"flutter_margin": 0.15, "max_iterations": 20, "variable": [
     {"path": "thickness.root", "lower": 0.0015, "upper": 0.008},

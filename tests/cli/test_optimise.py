@@ -9,6 +9,7 @@ import tomllib
 
 import numpy as np
 import pytest
+from small_cases import small_fin_raw
 
 from asekit.case import load_case
 from asekit.case import pipeline as P
@@ -113,14 +114,7 @@ def _small_fin(tmp_path):
     """The small fin of tests/case/test_design.py (4 x 4 elements, 3 elastic modes, 6 x 6
     boxes) as a case file."""
     from asekit.case.toml_writer import dumps
-    raw = tomllib.loads(FIN.read_text())
-    raw["panel"][0].update(n_chord=4, n_span=4)
-    raw["modes"] = {"count": 3, "keep_rigid": True}
-    raw["aero"].update(machs=[0.4, 0.6], boxes=[{"n_chord": 6, "n_span": 6}],
-                       reduced_frequencies=[0.001, 0.1, 0.2, 0.3, 0.45, 0.6, 0.8])
-    raw["flight"].update(altitudes=[0.0, 2500.0],
-                         velocities={"min": 120.0, "max": 420.0, "step": 20.0})
-    raw.pop("actuator", None)
+    raw = small_fin_raw(point_mass=False)
     path = tmp_path / "small.toml"
     path.write_text(dumps(raw))
     return path
