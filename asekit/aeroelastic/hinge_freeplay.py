@@ -33,10 +33,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from asekit.aeroelastic.nonlinear import ConnectedSystem, Connection, growth_rate
 from asekit.aeroelastic.statespace import aeroelastic_matrices, modal_arrays
+from asekit.util.roots import first_crossing
 from asekit.util.validate import in_range, integer
 
 
@@ -166,14 +166,9 @@ def connected_flutter_speed(system_at, stiffness: float, u_lo: float, u_hi: floa
     def sig(u):
         return growth_rate(system_at(u), k, min_frequency_hz)[0]
 
-    us = np.linspace(u_lo, u_hi, n)
-    s = np.array([sig(u) for u in us])
-    if s[0] > 0:
-        raise ValueError(f"already unstable at u_lo = {u_lo:g} m/s with k = {k:g} N m/rad")
-    idx = np.nonzero(s > 0)[0]
-    if idx.size == 0:
+    uf = first_crossing(sig, np.linspace(u_lo, u_hi, n), xtol=1e-6, rtol=1e-10,
+                        at_start=f"already unstable at u_lo = {u_lo:g} m/s with k = {k:g} N m/rad")
+    if uf is None:
         return None, None
-    i = idx[0]
-    uf = brentq(sig, us[i - 1], us[i], xtol=1e-6, rtol=1e-10)
     w = growth_rate(system_at(uf), k, min_frequency_hz)[1]
     return float(uf), float(w / (2 * math.pi))

@@ -42,10 +42,10 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq
 from scipy.special import hankel2
 
 from asekit.aeroelastic.nonlinear import ConnectedSystem
+from asekit.util.roots import first_crossing
 from asekit.util.validate import in_range, integer, positive
 
 JONES_A = (0.165, 0.335)
@@ -251,15 +251,10 @@ def flutter_speed(sec: TypicalSection, u_lo: float, u_hi: float, n: int = 60):
     def sig(u):
         ev = np.linalg.eigvals(state_matrix(sec, u))
         return float(np.max(ev.real))
-    us = np.linspace(u_lo, u_hi, n)
-    s = np.array([sig(u) for u in us])
-    if s[0] > 0:
-        raise ValueError(f"the section is already unstable at u_lo = {u_lo:g} m/s")
-    idx = np.nonzero(s > 0)[0]
-    if idx.size == 0:
+    uf = first_crossing(sig, np.linspace(u_lo, u_hi, n), xtol=1e-8,
+                        at_start=f"the section is already unstable at u_lo = {u_lo:g} m/s")
+    if uf is None:
         return None
-    i = idx[0]
-    uf = brentq(sig, us[i - 1], us[i], xtol=1e-8)
     ev = np.linalg.eigvals(state_matrix(sec, uf))
     j = np.argmax(ev.real)
     return float(uf), float(abs(ev[j].imag) / (2 * math.pi))
