@@ -71,6 +71,7 @@ from asekit.aero.spline import fe_spline, modal_forces
 from asekit.aeroelastic.flutter import divergence_speeds
 from asekit.atmosphere import standard_atmosphere
 from asekit.case import pipeline as P
+from asekit.case.envelope import flutter_points, start_kind
 from asekit.case.schema import CaseError, _number, _Table, case_from_dict
 from asekit.util.blas import one_blas_thread
 from asekit.util.conventions import mode_number
@@ -831,8 +832,8 @@ def _envelope_outputs(case, fa) -> dict:
     """min_flutter_speed, envelope_margin (each the value or its bounds, from the flutter
     points and margins of the case summary, :func:`asekit.case.pipeline.flutter`) and
     matched_mach of one sample."""
-    speeds = [(k, u) for _, u, k in P._flutter_points(list(fa.results), case.flight.velocities)]
-    if any(r.unstable_at_start and "flutter" not in P._start_kind(r) for r in fa.results):
+    speeds = [(k, u) for _, u, k in flutter_points(list(fa.results), case.flight.velocities)]
+    if any(r.unstable_at_start and "flutter" not in start_kind(r) for r in fa.results):
         speeds.append((None, None))              # divergence at the first speed: U_f unknown
     u, u_up, _ = bounded_minimum(speeds)
     margins = [next(((k, m[key]) for k, key in _MARGIN_KEYS if m[key] is not None),

@@ -27,6 +27,7 @@ from pathlib import Path
 
 from asekit.case import pipeline as P
 from asekit.case import report_figures as RF
+from asekit.case.envelope import across_sonic, start_kind
 from asekit.case.gust_loads import gust_json, gust_loads, turbulence_json
 from asekit.case.schema import Case
 from asekit.util.conventions import mode_label, mode_number
@@ -238,7 +239,7 @@ def summary(a: Analysis) -> dict:
                "unstable_at_first_point": bool(r.unstable_at_start),
                "speed_upper_bound_ms": None}
         if r.unstable_at_start:
-            kind = P._start_kind(r)
+            kind = start_kind(r)
             row["speed_upper_bound_ms"] = float(c.flight.velocities[0])
             row["mode"] = mode_number(r.start_mode, r.pk.n_rigid)
             row["note"] = (f"unstable at the first point of the sweep: {kind} at or below "
@@ -307,7 +308,7 @@ def _where(alt, rho=None) -> str:
 def _nearest_row(rows, altitude, mach):
     """The flutter row at ``altitude`` nearest in Mach to ``mach`` on the same side of M 1."""
     here = [r for r in rows if r["altitude_m"] == altitude and r["mode"] is not None
-            and (r["mach"] == mach or not P._across_sonic(r["mach"], mach))]
+            and (r["mach"] == mach or not across_sonic(r["mach"], mach))]
     return min(here, key=lambda r: abs(r["mach"] - mach), default=None)
 
 

@@ -3,7 +3,7 @@ text that says what it shows.
 
 - the flutter and divergence speeds against Mach, one colour per flight condition, with the
   flight speed U = M a(h), the envelope, the match points and the transonic gap left open
-  (speeds are never joined across M 1: :func:`asekit.case.pipeline._across_sonic`);
+  (speeds are never joined across M 1: :func:`asekit.case.envelope.across_sonic`);
 - per analysed Mach, V-g and V-f of every flight condition (small multiples: one column per
   condition, colours per mode through :func:`asekit.util.plotting.plot_vg`) and the root locus
   (one colour per condition), the flutter points starred;
@@ -28,6 +28,7 @@ import numpy as np
 from asekit.aero.methods import DLM_MACH_MAX, SUPERSONIC_MACH_MIN
 from asekit.ase import loop as ase_mod
 from asekit.case import pipeline as P
+from asekit.case.envelope import across_sonic, flutter_points, start_kind
 from asekit.util.conventions import mode_label
 from asekit.util.plotting import new_figure, plot_vg
 
@@ -69,7 +70,7 @@ def flutter_phrase(r, velocities) -> str:
     """What the p-k sweep of one condition found, in words: ``"mode 2 crosses g = 0 at
     218.1 m/s (140.9 Hz)"``, unstable at the first point, or no flutter up to the last one."""
     if r.unstable_at_start:
-        return (f"{P._start_kind(r)} at or below {velocities[0]:g} m/s, the first point "
+        return (f"{start_kind(r)} at or below {velocities[0]:g} m/s, the first point "
                 f"({mode_label(r.start_mode, r.pk.n_rigid)})")
     f = r.flutter
     if f is None:
@@ -98,7 +99,7 @@ def _broken_line(points):
     M 1, so that matplotlib never draws a line across the transonic gap."""
     xs, ys = [], []
     for i, (m, u) in enumerate(points):
-        if i and P._across_sonic(points[i - 1][0], m):
+        if i and across_sonic(points[i - 1][0], m):
             xs.append(np.nan)
             ys.append(np.nan)
         xs.append(m)
@@ -123,7 +124,7 @@ def _envelope_covers(case, c) -> bool:
 def _plot_condition_speeds(ax, a, c, color):
     """Flutter (solid, bounds as triangles) and divergence (dashed) speeds of one condition."""
     U = a.case.flight.velocities
-    pts = P._flutter_points([r for r in a.flutter.results if r.condition == c], U)
+    pts = flutter_points([r for r in a.flutter.results if r.condition == c], U)
     x, y = _broken_line([(m, u if kind == "value" else np.nan) for m, u, kind in pts])
     ax.plot(x, y, "-o", color=color, ms=5)
     for kind, marker in (("upper", "v"), ("lower", "^")):

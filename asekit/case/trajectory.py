@@ -10,7 +10,7 @@ column and row and names the file, row and column of a bad value.
 (:func:`asekit.case.pipeline.flutter` with the profile's altitudes as ``flight.altitudes``: the
 same GAF database at the case's ``aero.machs``, the same flutter method and sweep), and at each
 point takes the flutter speed at the point's Mach as the pipeline's margins do
-(:func:`asekit.case.pipeline._margin`: linear in Mach between the analysed Machs, extrapolated
+(:func:`asekit.case.envelope.flutter_margin`: linear in Mach between the analysed Machs, extrapolated
 at most 0.05 beyond them, never across M 1). So at a case's own altitude and envelope top Mach
 the trajectory's margin is the pipeline's. A point in the transonic gap
 (:data:`asekit.aero.methods.DLM_MACH_MAX` < M < :data:`asekit.aero.methods.SUPERSONIC_MACH_MIN`)
@@ -31,6 +31,7 @@ import numpy as np
 
 from asekit.aero.methods import DLM_MACH_MAX, SUPERSONIC_MACH_MIN, TransonicWarning, resolve_method
 from asekit.atmosphere import MAX_ALTITUDE, MIN_ALTITUDE, standard_atmosphere
+from asekit.case.envelope import across_sonic, flutter_margin, flutter_points, interpolate_speed
 from asekit.case.schema import Case, CaseError
 
 _log = logging.getLogger(__name__)
@@ -369,10 +370,9 @@ def _trajectory_case(case: Case, altitudes) -> Case:
 def _q_cc(case: Case, db, modal, mach: float):
     """Re Q_cc at ``mach`` (m^3/rad), the database's lowest k, interpolated between the
     database's Machs on the same side of M 1; None without a rigid pitch mode or outside."""
-    from asekit.case.pipeline import _across_sonic
     if modal.n_rigid < 1 or case.support.kind != "shaft":
         return None, "no rigid pitch mode (a shaft support with modes.keep_rigid)"
-    side = [m for m in db.machs if not _across_sonic(m, mach)]
+    side = [m for m in db.machs if not across_sonic(m, mach)]
     if not side or not min(side) <= mach <= max(side):
         return None, f"M {mach:g} outside the GAF database's Machs on its side of M 1"
     return float(db.at(mach, interpolate=True).Q[0, 0, 0].real), None
@@ -380,20 +380,18 @@ def _q_cc(case: Case, db, modal, mach: float):
 
 def _divergence_margin(fa, cond, mach: float, u: float):
     """100 (U_D / U - 1) at ``mach`` from the pipeline's divergence speeds at ``cond``
-    (linear in Mach as the flutter speeds, :func:`asekit.case.pipeline._interp_speed`)."""
-    from asekit.case.pipeline import _interp_speed
+    (linear in Mach as the flutter speeds, :func:`asekit.case.envelope.interpolate_speed`)."""
     pts = [(d["mach"], d["speed_ms"]) for d in fa.divergence
            if d["density"] == cond.density and d["speed_ms"] is not None]
     if not pts:
         return None, "no static divergence at the analysed Machs"
-    ud = _interp_speed(pts, mach)
+    ud = interpolate_speed(pts, mach)
     if ud is None:
         return None, "divergence speed not known at this Mach"
     return 100.0 * (ud / u - 1.0), None
 
 
 def _row(case, fa, db, modal, p: ProfilePoint, cond, tn) -> TrajectoryRow:
-    from asekit.case.pipeline import _across_sonic, _flutter_points, _margin
     u = p.mach * cond.speed_of_sound
     q = 0.5 * cond.density * u ** 2
     notes = []
@@ -410,12 +408,12 @@ def _row(case, fa, db, modal, p: ProfilePoint, cond, tn) -> TrajectoryRow:
             notes.append(f"aero.method {case.aero.method!r} refuses M {p.mach:g} (outside its "
                          "Mach range): not analysed")
     else:
-        pts = _flutter_points([r for r in fa.results if r.condition == cond],
+        pts = flutter_points([r for r in fa.results if r.condition == cond],
                               case.flight.velocities)
-        m = _margin(cond, pts, p.mach)
+        m = flutter_margin(cond, pts, p.mach)
         uf = m["flutter_speed_ms"]
         margin = None if m["margin"] is None else 100.0 * m["margin"]
-        side = [x for x, _, _ in pts if not _across_sonic(x, p.mach)]
+        side = [x for x, _, _ in pts if not across_sonic(x, p.mach)]
         extrap = bool(side) and uf is not None and not min(side) <= p.mach <= max(side)
         if extrap:
             notes.append(f"U_f extrapolated from the analysed Machs {min(side):g}-"
@@ -450,7 +448,7 @@ def trajectory(case: Case, points, progress: bool = False) -> tuple[TrajectoryRo
     The case is analysed by :func:`asekit.case.pipeline.flutter` with ``flight.altitudes`` the
     profile's altitudes (its velocity sweep, GAF database at ``aero.machs``, flutter method
     unchanged); at each point the flutter speed at the point's Mach is the pipeline's
-    (:func:`asekit.case.pipeline._margin`), the divergence speed is interpolated in Mach
+    (:func:`asekit.case.envelope.flutter_margin`), the divergence speed is interpolated in Mach
     between the analysed Machs alike, and the margins are U / (M a) - 1 with a the speed of
     sound at the point's altitude. The steady hinge moment is q Re Q_cc(M, k_min) (alpha +
     delta) (thesis Eq. 4.6) for a case with a rigid pitch mode: an all-movable fin's incidence

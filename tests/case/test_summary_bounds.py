@@ -13,6 +13,7 @@ import json
 import pytest
 
 from asekit.atmosphere import standard_atmosphere
+from asekit.case import envelope as E
 from asekit.case import load_case
 from asekit.case import pipeline as P
 from asekit.case import report as R
@@ -81,14 +82,14 @@ def test_fin_sweep_above_flutter_margin_is_an_upper_bound(fin_from_300):
 def test_margin_inside_the_envelope_when_the_bound_is_below_the_envelope_speed():
     """An upper bound below the envelope speed: flutter inside the envelope, margin < 0."""
     c = P.FlightCondition(0.0, 1.225, 340.3)
-    m = P._margin(c, [(0.6, 150.0, "upper")], 0.6)
+    m = E.flutter_margin(c, [(0.6, 150.0, "upper")], 0.6)
     assert m["margin_upper_bound"] == pytest.approx(150.0 / (0.6 * 340.3) - 1)
     assert m["note"].endswith("inside the envelope")
-    assert P._match_point(c, [(0.6, 150.0, "upper")])["no_match"].endswith(
+    assert E.match_point(c, [(0.6, 150.0, "upper")])["no_match"].endswith(
         "inside the envelope")
-    m = P._margin(c, [(0.4, 500.0, "lower"), (0.6, 480.0, "lower")], 0.6)
+    m = E.flutter_margin(c, [(0.4, 500.0, "lower"), (0.6, 480.0, "lower")], 0.6)
     assert m["margin_lower_bound"] == pytest.approx(480.0 / (0.6 * 340.3) - 1)
-    assert P._margin(c, [(0.4, 250.0, "value"), (0.6, 230.0, "value")], 0.6)["margin"] == \
+    assert E.flutter_margin(c, [(0.4, 250.0, "value"), (0.6, 230.0, "value")], 0.6)["margin"] == \
         pytest.approx(230.0 / (0.6 * 340.3) - 1, rel=1e-12)
 
 
@@ -100,12 +101,12 @@ def test_match_point_is_never_interpolated_across_mach_one():
     c = P.FlightCondition(0.0, 1.225, 340.3)
     a = c.speed_of_sound
     pts = [(0.5, 400.0, "value"), (0.9, 350.0, "value"), (1.5, 420.0, "value")]
-    m = P._match_point(c, pts)      # d = U/a - M: +0.675, +0.129, -0.266
+    m = E.match_point(c, pts)      # d = U/a - M: +0.675, +0.129, -0.266
     assert m["matched_mach"] is None
     assert m["match_across_sonic"] == [0.9, 1.5]
     assert "between M 0.9 and M 1.5, across M 1" in m["no_match"]
     pts = [(0.5, 400.0, "value"), (0.9, 280.0, "value"), (1.5, 420.0, "value")]
-    m = P._match_point(c, pts)      # d: +0.675, -0.077: the crossing lies below M 0.9
+    m = E.match_point(c, pts)      # d: +0.675, -0.077: the crossing lies below M 0.9
     d0, d1 = 400.0 / a - 0.5, 280.0 / a - 0.9
     assert m["matched_mach"] == pytest.approx(0.5 + 0.4 * d0 / (d0 - d1), rel=1e-12)
     assert m["match_across_sonic"] is None
@@ -114,16 +115,16 @@ def test_match_point_is_never_interpolated_across_mach_one():
 def test_margin_is_never_interpolated_or_extrapolated_across_mach_one():
     c = P.FlightCondition(0.0, 1.225, 340.3)
     pts = [(0.8, 300.0, "value"), (1.2, 500.0, "value")]
-    assert P._margin(c, pts, 1.0)["margin"] is None            # M 1 itself: unknown
-    m = P._margin(c, pts, 0.84)                                 # 0.8 on its side, 0.04 away
+    assert E.flutter_margin(c, pts, 1.0)["margin"] is None            # M 1 itself: unknown
+    m = E.flutter_margin(c, pts, 0.84)                                 # 0.8 on its side, 0.04 away
     assert m["flutter_speed_ms"] == pytest.approx(300.0)
-    assert P._margin(c, pts, 0.95)["margin"] is None            # 0.15 from 0.8: too far
-    assert "same side of M 1" in P._margin(c, pts, 0.95)["note"]
+    assert E.flutter_margin(c, pts, 0.95)["margin"] is None            # 0.15 from 0.8: too far
+    assert "same side of M 1" in E.flutter_margin(c, pts, 0.95)["note"]
 
 
 def test_margin_text_says_inside_or_outside_the_envelope():
     c = P.FlightCondition(0.0, 1.225, 340.3)
-    inside = R._margin_text(P._margin(c, [(0.6, 150.0, "value")], 0.6))
+    inside = R._margin_text(E.flutter_margin(c, [(0.6, 150.0, "value")], 0.6))
     assert "flutter inside the envelope by 26.5 %" in inside     # 150 / 204.18 - 1 = -26.5 %
-    outside = R._margin_text(P._margin(c, [(0.6, 250.0, "value")], 0.6))
+    outside = R._margin_text(E.flutter_margin(c, [(0.6, 250.0, "value")], 0.6))
     assert "flutter outside the envelope by 22.4 %" in outside   # 250 / 204.18 - 1 = +22.4 %
