@@ -1,0 +1,386 @@
+"""Nastran stick-model decks (CBAR beams) in: the structure of a bar deck as 3-D frame matrices.
+
+:func:`read_stick_deck` reads, through pyNastran, a deck whose structure is made of bars:
+
+- GRID (basic position through any CORD2R/CORD1R/CORD2C/CORD2S of CP; displacement system CD
+  rectangular; permanent constraints PS),
+- CBAR (orientation vector X1-X3 in GA's displacement system, or G0; OFFT blank, GGG, or the
+  old integer flag 1 "X1-X3 is a vector"; pin flags PA/PB and offsets WA/WB refused),
+- PBAR (A, I1, I2, J, NSM; I12 refused) with MAT1 (E, G, RHO),
+- CMASS2 (scalar mass on a grid component, or between two), CONM2 (mass and inertia with
+  offset, CID 0 or blank),
+- SPC1 / SPC (zero enforced value) of the case control's SPC set, PARAM COUPMASS (> 0: the
+  consistent bar mass, else lumped), PARAM WTMASS.
+
+The element is :mod:`asekit.structure.frame` (Przemieniecki 1968 Eqs. 5.116 and 11.41, rotated
+by the direction cosines, Eq. 6.26). Every grid carries six DOFs (T1, T2, T3, R1, R2, R3) in its
+displacement system CD, as Nastran's g-set: with R_cd the rows of CD's axes in basic, the
+basic-frame matrices become K_cd = T^T K_basic T, T = diag(R_cd^T, R_cd^T) per grid.
+Massless DOFs are condensed statically (exact for them: no inertia) before the eigen-solution.
+
+Other structural cards (CBEAM, CROD, RBE2, RBE3, shells, ...) are refused with the card and its
+first id; an unsupported field is refused with card, id and field. Aerodynamic and solution
+cards are read elsewhere (:mod:`asekit.io.bdf`); here they are ignored.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import scipy.linalg as sla
+
+from asekit.io.bdf import UNITS, BdfError, _need_pynastran
+from asekit.structure.frame import BarSection, global_bar_matrices
+
+#: structural cards a stick deck may hold (others are refused).
+STICK_CARDS = ("GRID", "CORD2R", "CORD1R", "CORD2C", "CORD2S", "CBAR", "PBAR", "MAT1",
+               "CMASS2", "CONM2", "SPC", "SPC1")
+
+#: structural cards refused in a stick deck (asekit cannot represent them here).
+REFUSED_CARDS = ("CBEAM", "PBEAM", "PBARL", "PBEAML", "CROD", "CONROD", "PROD", "CTUBE",
+                 "RBAR", "RBE1", "RBE2", "RBE3", "RROD", "MPC", "CELAS1", "CELAS2", "CELAS3",
+                 "CELAS4", "CMASS1", "CMASS3", "CMASS4", "CONM1", "CQUAD4", "CTRIA3", "CQUAD8",
+                 "CTRIA6", "CSHEAR", "CHEXA", "CPENTA", "CTETRA", "CBUSH", "CDAMP1", "CDAMP2",
+                 "CVISC", "SPOINT", "EPOINT", "GENEL", "SPCD", "SUPORT")
+
+NODE_DOF = 6
+
+
+@dataclass(frozen=True)
+class StickModel:
+    """A bar deck's structure (SI).
+
+    Attributes
+    ----------
+    node_ids : (n,) GRID ids; xyz : (n, 3) basic positions (m); cd_axes : (n, 3, 3) rows of
+        each grid's displacement-system axes in basic.
+    K, M : (6n, 6n) stiffness and mass, DOF 6 i + c - 1 = component c of grid i in its CD
+        system (N/m, N, N m; kg, kg m, kg m^2).
+    fixed : sorted constrained DOFs (SPC, SPC1, GRID PS); coupled : the consistent bar mass
+        (PARAM COUPMASS > 0) or lumped; notes : what was read and how; path, units.
+    """
+
+    node_ids: np.ndarray
+    xyz: np.ndarray
+    cd_axes: np.ndarray
+    K: np.ndarray
+    M: np.ndarray
+    fixed: tuple
+    coupled: bool
+    notes: tuple = ()
+    path: str = ""
+    units: str = "SI"
+
+    @property
+    def free(self) -> np.ndarray:
+        """The unconstrained DOFs."""
+        mask = np.ones(self.K.shape[0], bool)
+        mask[list(self.fixed)] = False
+        return np.flatnonzero(mask)
+
+    def dof(self, grid_id: int, component: int) -> int:
+        """Global DOF of GRID ``grid_id``, Nastran component 1-6."""
+        hit = np.flatnonzero(self.node_ids == int(grid_id))
+        if not hit.size or not 1 <= int(component) <= 6:
+            raise ValueError(f"grid_id {grid_id} / component {component}: not a GRID of the "
+                             f"deck or not in 1..6")
+        return NODE_DOF * int(hit[0]) + int(component) - 1
+
+
+@dataclass(frozen=True)
+class StickModes:
+    """Normal modes of a :class:`StickModel`: ``frequencies_hz`` (n_modes,), ``shapes``
+    (6 n_nodes, n_modes) in the grids' CD systems, mass-normalised (phi^T M phi = 1)."""
+
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray
+    notes: tuple = field(default=())
+
+
+def _card_ids(model, card: str) -> list:
+    return list(model._type_to_id_map.get(card, ()))
+
+
+def _refuse_cards(model, name: str) -> None:
+    bad = [(c, len(_card_ids(model, c)), _card_ids(model, c)[0])
+           for c in REFUSED_CARDS if _card_ids(model, c)]
+    if bad:
+        listed = ", ".join(f"{c} (x{n}, first id {i})" for c, n, i in bad)
+        raise BdfError(f"{name}: the stick-model import cannot represent {listed}; it reads "
+                       f"CBAR/PBAR/MAT1, CMASS2, CONM2, SPC/SPC1 and GRID PS")
+    if not _card_ids(model, "CBAR"):
+        raise BdfError(f"{name}: no CBAR element: not a stick model")
+
+
+def _rect_axes(model, cid: int, what: str) -> np.ndarray:
+    """Rows of a rectangular system's axes in basic; a curvilinear CD is refused."""
+    if not cid:
+        return np.eye(3)
+    c = model.coords[cid]
+    if c.type not in ("CORD2R", "CORD1R"):
+        raise BdfError(f"{what}: CD = {cid} is a {c.type}; only rectangular displacement "
+                       f"systems (CORD2R, CORD1R) are supported")
+    return np.asarray(c.beta(), float)
+
+
+def _grids(model, L: float):
+    ids = np.array(sorted(model.nodes), dtype=np.int64)
+    xyz = np.array([model.nodes[i].get_position() for i in ids], float) * L
+    axes = np.array([_rect_axes(model, model.nodes[i].cd, f"GRID {i}") for i in ids])
+    return ids, xyz, axes
+
+
+def _bar_vector(model, e, axes_of, xyz_of) -> np.ndarray:
+    """Orientation vector of a CBAR in basic (X1-X3 in GA's CD system, or toward G0)."""
+    if e.g0:
+        return xyz_of(e.g0) - xyz_of(e.ga)
+    return axes_of(e.ga).T @ np.asarray(e.x, float)
+
+
+def _check_bar(e) -> None:
+    if e.offt not in ("GGG", 1, "1", None, ""):
+        raise BdfError(f"CBAR {e.eid}: OFFT = {e.offt!r} is not supported (blank or GGG: the "
+                       f"orientation vector in GA's displacement system)")
+    if e.pa or e.pb:
+        raise BdfError(f"CBAR {e.eid}: pin flags PA = {e.pa}, PB = {e.pb} are not supported "
+                       f"(blank or 0)")
+    if np.any(np.asarray(e.wa, float)) or np.any(np.asarray(e.wb, float)):
+        raise BdfError(f"CBAR {e.eid}: offsets WA/WB are not supported (blank or 0)")
+
+
+def _bar_section(model, pid: int, eid: int, deck_units) -> BarSection:
+    """PBAR + MAT1 of a CBAR as SI section properties."""
+    L, Mu, T, wt = deck_units
+    p = model.properties[pid]
+    if p.type != "PBAR":
+        raise BdfError(f"CBAR {eid}: PID {pid} is a {p.type}; only PBAR is supported")
+    if p.i12:
+        raise BdfError(f"PBAR {pid}: I12 = {p.i12:g} is not supported (0: principal axes)")
+    if not p.A > 0:
+        raise BdfError(f"PBAR {pid}: A = {p.A!r} must be > 0")
+    mat = model.materials[p.mid]
+    if mat.type != "MAT1":
+        raise BdfError(f"PBAR {pid}: MID {p.mid} is a {mat.type}; only MAT1 is supported")
+    E, G, rho = mat.e, mat.g, mat.rho or 0.0
+    if not (E and E > 0 and G is not None and G >= 0):
+        raise BdfError(f"MAT1 {p.mid}: E must be > 0 and G >= 0, got E = {E!r}, G = {G!r}")
+    stress = Mu / (L * T * T)                      # deck pressure in Pa
+    return BarSection(ea=E * p.A * stress * L ** 2, gj=G * p.j * stress * L ** 4,
+                      ei1=E * p.i1 * stress * L ** 4, ei2=E * p.i2 * stress * L ** 4,
+                      mass=(rho * p.A + (p.nsm or 0.0)) * wt * Mu / L)
+
+
+def _add_bars(model, K, M, index, xyz, axes, coupled, deck_units) -> None:
+    for eid in _card_ids(model, "CBAR"):
+        e = model.elements[eid]
+        _check_bar(e)
+        ia, ib = index[e.ga], index[e.gb]
+        v = _bar_vector(model, e, lambda g: axes[index[g]], lambda g: xyz[index[g]])
+        try:
+            Ke, Me = global_bar_matrices(xyz[ia], xyz[ib], v,
+                                         _bar_section(model, e.pid, eid, deck_units), coupled)
+        except ValueError as exc:
+            raise BdfError(f"CBAR {eid}: {exc}") from None
+        d = np.r_[NODE_DOF * ia:NODE_DOF * ia + 6, NODE_DOF * ib:NODE_DOF * ib + 6]
+        K[np.ix_(d, d)] += Ke
+        M[np.ix_(d, d)] += Me
+
+
+def _skew(x) -> np.ndarray:
+    return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
+
+
+def _add_conm2(model, M, index, deck_units) -> None:
+    """CONM2: rigid mass m at offset x from its grid, inertia I about its centre, both in basic
+    (CID 0): u_p = u + theta x x, so M_grid = G^T diag(m, m, m, I) G, G = [[1, -S(x)], [0, 1]]."""
+    L, Mu, T, wt = deck_units
+    for eid in _card_ids(model, "CONM2"):
+        m = model.masses[eid]
+        if m.cid not in (0, None):
+            raise BdfError(f"CONM2 {eid}: CID = {m.cid} is not supported (0: basic)")
+        i = index[m.nid]
+        x = np.asarray(m.X, float) * L
+        inertia = np.asarray(m.Inertia(), float) * wt * Mu * L * L
+        mass = m.mass * wt * Mu
+        G = np.eye(6)
+        G[:3, 3:] = -_skew(x)
+        Mb = G.T @ np.block([[mass * np.eye(3), np.zeros((3, 3))],
+                             [np.zeros((3, 3)), inertia]]) @ G
+        d = np.r_[NODE_DOF * i:NODE_DOF * i + 6]
+        M[np.ix_(d, d)] += Mb            # basic; the whole model is rotated to CD afterwards
+
+
+def _components(c) -> list[int]:
+    return [int(ch) for ch in str(c or "") if ch in "123456"]
+
+
+def _spc_sets(model, name: str) -> list[int]:
+    sets = sorted(set(model.spcs) | set(getattr(model, "spcadds", {})))
+    cc = getattr(model, "case_control_deck", None)
+    if cc is not None:
+        for sub in cc.subcases.values():
+            if "SPC" in sub:
+                return [int(sub["SPC"][0])]
+    if len(sets) > 1:
+        raise BdfError(f"{name}: several SPC sets {sets} and no SPC in the case control")
+    return sets
+
+
+def _fixed_dofs(model, index, name: str) -> set:
+    fixed = set()
+    for nid, n in model.nodes.items():
+        fixed |= {NODE_DOF * index[nid] + c - 1 for c in _components(n.ps)}
+    for sid in _spc_sets(model, name):
+        for s in model.spcs.get(sid, ()):
+            if s.type == "SPC1":
+                pairs = [(g, s.components) for g in s.node_ids]
+            elif s.type == "SPC":
+                if any(float(v or 0.0) for v in s.enforced):
+                    raise BdfError(f"SPC {sid}: enforced displacement D is not supported (0)")
+                pairs = list(zip(s.node_ids, s.components))
+            else:
+                raise BdfError(f"{s.type} {sid} is not supported (SPC, SPC1)")
+            for g, comps in pairs:
+                if g not in index:
+                    raise BdfError(f"{s.type} {sid}: G = {g} is not a GRID")
+                fixed |= {NODE_DOF * index[g] + c - 1 for c in _components(comps)}
+    return fixed
+
+
+def _param(model, key: str, default):
+    p = model.params.get(key)
+    return p.values[0] if p is not None else default
+
+
+def read_stick_deck(path, units: str = "SI") -> StickModel:
+    """Read a CBAR stick-model deck's structure (module docstring) into SI matrices.
+
+    Parameters
+    ----------
+    path : str or Path
+        The deck.
+    units : str
+        Its unit system, a key of :data:`asekit.io.bdf.UNITS`.
+
+    Returns
+    -------
+    StickModel
+        Raises :class:`asekit.io.bdf.BdfError` (one line: card, id, field) for what it cannot
+        represent.
+
+    Examples
+    --------
+    >>> from asekit.util.paths import DATA_DIR                      # doctest: +SKIP
+    >>> sm = read_stick_deck(DATA_DIR / "benchmarks/pt145/pt145.bdf",
+    ...                      units="in-lbf-s")                          # doctest: +SKIP
+    >>> sm.K.shape, sm.coupled                                      # doctest: +SKIP
+    ((66, 66), True)
+    """
+    if units not in UNITS:
+        raise ValueError(f"units must be one of {sorted(UNITS)}, got {units!r}")
+    BDF = _need_pynastran()
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"BDF not found: {path}")
+    model = BDF(debug=None)
+    try:
+        model.read_bdf(str(path), xref=True)
+    except Exception as exc:  # pyNastran's own error: card and field in its words
+        raise BdfError(f"{path.name}: {str(exc).strip().splitlines()[0]}") from None
+    _refuse_cards(model, path.name)
+    L, Mu, T = UNITS[units]
+    wt = float(_param(model, "WTMASS", 1.0))
+    coupled = int(_param(model, "COUPMASS", -1)) > 0
+    deck_units = (L, Mu, T, wt)
+    ids, xyz, axes = _grids(model, L)
+    index = {int(g): i for i, g in enumerate(ids)}
+    n = NODE_DOF * len(ids)
+    K, M = np.zeros((n, n)), np.zeros((n, n))
+    _add_bars(model, K, M, index, xyz, axes, coupled, deck_units)
+    _add_conm2(model, M, index, deck_units)
+    # basic -> each grid's CD system: u_basic = A u_cd, A = diag(R^T, R^T) per grid
+    A = sla.block_diag(*[np.kron(np.eye(2), a.T) for a in axes])
+    K, M = A.T @ K @ A, A.T @ M @ A
+    _add_cmass2_si(model, M, index, deck_units)
+    fixed = _fixed_dofs(model, index, path.name)
+    notes = (f"{len(_card_ids(model, 'CBAR'))} CBAR, {len(ids)} GRID; bar mass "
+             f"{'consistent (PARAM COUPMASS 1)' if coupled else 'lumped'}",)
+    return StickModel(node_ids=ids, xyz=xyz, cd_axes=axes, K=0.5 * (K + K.T),
+                      M=0.5 * (M + M.T), fixed=tuple(sorted(fixed)), coupled=coupled,
+                      notes=notes, path=str(path), units=units)
+
+
+def _add_cmass2_si(model, M, index, deck_units) -> None:
+    """CMASS2 in SI: a translation component's mass in kg, a rotation's in kg m^2 (the deck's
+    M L^2)."""
+    L, Mu, T, wt = deck_units
+    for eid in _card_ids(model, "CMASS2"):
+        c = model.masses[eid]
+        dofs = []
+        for g, comp in ((c.nodes[0], c.c1), (c.nodes[1], c.c2)):
+            if not g:
+                continue
+            if g not in index or not comp or not 1 <= int(comp) <= 6:
+                raise BdfError(f"CMASS2 {eid}: G/C = {g}/{comp}: a GRID and a component 1-6 "
+                               f"are required")
+            dofs.append((NODE_DOF * index[g] + int(comp) - 1, int(comp) > 3))
+        if len(dofs) == 2 and dofs[0][1] != dofs[1][1]:
+            raise BdfError(f"CMASS2 {eid}: C1 and C2 must both be translations or rotations")
+        mass = c.mass * wt * Mu * (L * L if dofs and dofs[0][1] else 1.0)
+        d = [a for a, _ in dofs]
+        M[np.ix_(d, d)] += mass * (np.array([[1.0, -1.0], [-1.0, 1.0]]) if len(d) == 2
+                                   else np.ones((1, 1)))
+
+
+def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
+    """Normal modes K phi = omega^2 M phi of the free DOFs, the null space of M (e.g. the
+    twist of a bar without torsional inertia, in any frame) condensed statically (Guyan,
+    exact for motion without inertia).
+
+    Parameters
+    ----------
+    model : :class:`StickModel`.
+    n_modes : how many, lowest first (>= 1).
+
+    Returns
+    -------
+    StickModes
+
+    Examples
+    --------
+    One clamped-free Hermite bar (E I = m = L = 1): omega_1 = sqrt(12.48) = 3.533 (the exact
+    beam: 1.875^2 = 3.516)
+
+    >>> from asekit.structure.frame import BarSection, global_bar_matrices
+    >>> K, M = global_bar_matrices([0, 0, 0], [1, 0, 0], [0, 0, 1],
+    ...                            BarSection(1e6, 1.0, 1.0, 1.0, 1.0))
+    >>> sm = StickModel(np.array([1, 2]), np.zeros((2, 3)), np.array([np.eye(3)] * 2), K, M,
+    ...                 tuple(range(6)), True)
+    >>> round(float(stick_modes(sm, 1).frequencies_hz[0] * 2 * np.pi), 3)
+    3.533
+    """
+    free = model.free
+    K = model.K[np.ix_(free, free)]
+    M = model.M[np.ix_(free, free)]
+    mu, Q = np.linalg.eigh(M)
+    heavy = mu > 1e-12 * max(float(mu.max()), 1e-300)
+    Q1, Q0 = Q[:, heavy], Q[:, ~heavy]             # the mass's range and its null space
+    K11 = Q1.T @ K @ Q1
+    G = np.zeros((Q0.shape[1], Q1.shape[1]))
+    if Q0.shape[1]:
+        K00, K01 = Q0.T @ K @ Q0, Q0.T @ K @ Q1
+        if np.linalg.cond(K00) > 1e12:
+            raise BdfError("the stick model has a massless mechanism (free DOFs with neither "
+                           "stiffness nor mass): constrain them with SPC or GRID PS")
+        G = -np.linalg.solve(K00, K01)
+        K11 = K11 + K01.T @ G
+    n = min(int(n_modes), Q1.shape[1])
+    if n < 1:
+        raise ValueError(f"n_modes must be >= 1, got {n_modes}")
+    w2, a = sla.eigh(0.5 * (K11 + K11.T), np.diag(mu[heavy]), subset_by_index=[0, n - 1])
+    full = np.zeros((model.K.shape[0], n))
+    full[free] = Q1 @ a + Q0 @ (G @ a)
+    return StickModes(frequencies_hz=np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi),
+                      shapes=full)

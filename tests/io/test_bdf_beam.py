@@ -1,0 +1,117 @@
+"""Stick-model decks (asekit.io.bdf_beam): CBAR/PBAR frame import against analytic beam
+frequencies, rotation invariance and MSC's PT145 deck against its f06.
+
+References
+----------
+- Cantilever Euler-Bernoulli beam: f_n = (beta_n L)^2 / (2 pi L^2) sqrt(E I / m),
+  beta_1 L = 1.875104, beta_2 L = 4.694091 (Blevins, *Formulas for Natural Frequency and Mode
+  Shape*, 1979, Table 8-1); axial: f_1 = sqrt(E / rho) / (4 L) (Blevins Table 8-16).
+- PT145 (data/benchmarks/pt145/README.md): MSC Nastran 2020 f06, REAL EIGENVALUES table,
+  CYCLES column of modes 1-6.
+"""
+
+import os
+
+import numpy as np
+import pytest
+
+if os.environ.get("ASEKIT_REQUIRE_PYNASTRAN"):
+    import pyNastran  # noqa: F401
+else:
+    pytest.importorskip("pyNastran")
+
+from asekit.io.bdf import BdfError  # noqa: E402
+from asekit.io.bdf_beam import read_stick_deck, stick_modes  # noqa: E402
+from asekit.util.paths import DATA_DIR  # noqa: E402
+
+PT145 = DATA_DIR / "benchmarks" / "pt145" / "pt145.bdf"
+
+# SI cantilever: steel bar, 1 m, 20 elements
+E, NU, RHO, LEN, NEL = 2.0e11, 0.3, 7800.0, 1.0, 20
+A, I1, I2, J = 1e-4, 2e-9, 8e-10, 1.5e-9
+
+
+def _field(v) -> str:
+    s = f"{v:.6g}" if isinstance(v, float) else str(v)
+    return s.ljust(8)[:8] if len(s) <= 8 else f"{v:.2e}".replace("e", "").ljust(8)[:8]
+
+
+def _card(*fields) -> str:
+    return "".join(_field(f) for f in fields).rstrip()
+
+
+def _cantilever(path, R=np.eye(3), extra=(), offt=""):
+    """A cantilever CBAR deck along R's first row, plane-1 vector R's third row."""
+    lines = ["SOL 103", "CEND", "SPC = 1", "BEGIN BULK"]
+    for i in range(NEL + 1):
+        x = R[0] * LEN * i / NEL
+        lines.append(f"GRID,{i + 1},,{x[0]!r},{x[1]!r},{x[2]!r}")
+    v = R[2]
+    for i in range(NEL):
+        lines.append(f"CBAR,{i + 1},1,{i + 1},{i + 2},{v[0]!r},{v[1]!r},{v[2]!r},{offt}")
+    lines += [f"PBAR,1,1,{A!r},{I1!r},{I2!r},{J!r}", f"MAT1,1,{E!r},,{NU!r},{RHO!r}",
+              "SPC1,1,123456,1", "PARAM,COUPMASS,1", *extra, "ENDDATA"]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _rotation(a, b, c):
+    ca, sa, cb, sb, cc, sc = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(c), np.sin(c)
+    Rz = np.array([[ca, -sa, 0], [sa, ca, 0], [0, 0, 1]])
+    Ry = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]])
+    Rx = np.array([[1, 0, 0], [0, cc, -sc], [0, sc, cc]])
+    return (Rz @ Ry @ Rx).T                # rows: the rotated axes
+
+
+def test_cantilever_cbar_matches_analytic_beam(tmp_path):
+    modes = stick_modes(read_stick_deck(_cantilever(tmp_path / "c.bdf")), 16)
+    m = RHO * A
+    f = np.sort(modes.frequencies_hz)
+    ref = sorted([1.875104 ** 2 / (2 * np.pi * LEN ** 2) * np.sqrt(E * I / m)
+                  for I in (I1, I2)] + [4.694091 ** 2 / (2 * np.pi * LEN ** 2)
+                                        * np.sqrt(E * I / m) for I in (I1, I2)])
+    # Hermite elements converge as h^4: 20 elements are within 1e-5 for these modes
+    np.testing.assert_allclose(f[:4], ref, rtol=1e-5)
+    axial = np.sqrt(E / RHO) / (4 * LEN)
+    assert np.min(np.abs(modes.frequencies_hz / axial - 1)) < 2e-3   # linear axial elements
+
+
+def test_rotated_cantilever_has_the_same_frequencies(tmp_path):
+    f0 = stick_modes(read_stick_deck(_cantilever(tmp_path / "a.bdf")), 8).frequencies_hz
+    R = _rotation(0.7, -0.4, 1.1)
+    f1 = stick_modes(read_stick_deck(_cantilever(tmp_path / "b.bdf", R)), 8).frequencies_hz
+    np.testing.assert_allclose(f1, f0, rtol=1e-7)   # round-off of the rotation
+    assert not np.allclose(R, np.eye(3))
+
+
+def test_conm2_tip_mass_lowers_the_first_frequency_as_rayleigh(tmp_path):
+    """A tip CONM2 of mass M_t: f = sqrt(3 EI / L^3 / (M_t + 0.2357 m L)) / (2 pi) (Blevins
+    Table 8-1 case 'cantilever with end mass', Rayleigh; exact within 0.5 % for M_t >= m L)."""
+    mt = 3 * RHO * A * LEN
+    deck = _cantilever(tmp_path / "m.bdf", extra=(f"CONM2,99,{NEL + 1},,{mt!r}",))
+    f = stick_modes(read_stick_deck(deck), 1).frequencies_hz[0]
+    ref = np.sqrt(3 * E * I2 / LEN ** 3 / (mt + 0.2357 * RHO * A * LEN)) / (2 * np.pi)
+    assert abs(f / ref - 1) < 5e-3
+
+
+def test_pt145_modes_match_its_f06():
+    """PT145 (PARAM COUPMASS 1: the consistent bar mass; the torsional inertia only from the
+    CMASS2 cards) against the f06's eigenvalue table: the model is the same discretisation,
+    so the tolerance is the f06's print precision (7 digits), taken as 1e-5."""
+    f06 = [3.996147e1, 2.364137e2, 2.504423e2, 7.014011e2, 7.034198e2, 1.153105e3]
+    modes = stick_modes(read_stick_deck(PT145, units="in-lbf-s"), 6)
+    np.testing.assert_allclose(modes.frequencies_hz, f06, rtol=1e-5)
+
+
+def test_refused_cards_and_fields_are_named(tmp_path):
+    deck = _cantilever(tmp_path / "r.bdf", extra=("RBE2,500,1,123456,2",))
+    with pytest.raises(BdfError, match=r"RBE2 \(x1, first id 500\)"):
+        read_stick_deck(deck)
+    deck = _cantilever(tmp_path / "o.bdf", offt="BGG")
+    with pytest.raises(BdfError, match="CBAR 1: OFFT"):
+        read_stick_deck(deck)
+    text = (tmp_path / "o.bdf").read_text().replace("CBAR,3,1,3,4,0.0,0.0,1.0,BGG",
+                                                     "CBAR,3,1,3,4,0.0,0.0,1.0\n,,,0.0,0.1,0.0")
+    (tmp_path / "w.bdf").write_text(text.replace("BGG", ""))
+    with pytest.raises(BdfError, match="CBAR 3: offsets WA/WB"):
+        read_stick_deck(tmp_path / "w.bdf")
