@@ -384,3 +384,217 @@ def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
     full[free] = Q1 @ a + Q0 @ (G @ a)
     return StickModes(frequencies_hz=np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi),
                       shapes=full)
+
+
+# ---------------------------------------------------------------------------------------------
+# SPLINE2 (beam spline) and the deck's flutter requests
+# ---------------------------------------------------------------------------------------------
+def _hermite_row(s_nodes: np.ndarray, s: float):
+    """Weights of (w_j, w'_j) for w(s) and w'(s) and of theta_j for theta(s), theta'(s) on the
+    axis stations ``s_nodes`` (ascending): cubic Hermite between stations (a beam loaded only
+    at its stations), straight beyond the ends (an unloaded beam's extension)."""
+    n = s_nodes.size
+    ww, wd, dw, dd, tt, td = (np.zeros(n) for _ in range(6))
+    if s <= s_nodes[0] or s >= s_nodes[-1]:
+        j = 0 if s <= s_nodes[0] else n - 1
+        ww[j], wd[j], dd[j], tt[j] = 1.0, s - s_nodes[j], 1.0, 1.0
+        return ww, wd, dw, dd, tt, td
+    j = int(np.searchsorted(s_nodes, s) - 1)
+    h = s_nodes[j + 1] - s_nodes[j]
+    t = (s - s_nodes[j]) / h
+    ww[[j, j + 1]] = 1 - 3 * t * t + 2 * t ** 3, 3 * t * t - 2 * t ** 3
+    wd[[j, j + 1]] = h * (t - 2 * t * t + t ** 3), h * (t ** 3 - t * t)
+    dw[[j, j + 1]] = (-6 * t + 6 * t * t) / h, (6 * t - 6 * t * t) / h
+    dd[[j, j + 1]] = 1 - 4 * t + 3 * t * t, 3 * t * t - 2 * t
+    tt[[j, j + 1]] = 1 - t, t
+    td[[j, j + 1]] = -1 / h, 1 / h
+    return ww, wd, dw, dd, tt, td
+
+
+def beam_axis_spline(s_nodes, points_s, points_x, ex_flow: float, ey_flow: float):
+    """Interpolation of a beam spline's axis motion to points off the axis (MSC Nastran
+    SPLINE2 with its grids attached in deflection, slope and twist: DZ = DTHX = DTHY = 0).
+
+    The spline is a beam along its y axis (MSC Nastran Aeroelastic Analysis User's Guide,
+    Sec. 2.3 "Beam splines"): deflection w(s) along its z axis and slope w' = theta_x
+    interpolated by the cubic Hermite functions of a beam loaded only at the stations (exact
+    for it), twist theta_y linearly, both straight beyond the end stations. A point at chordwise
+    distance x from the axis moves
+
+        h = w(s) - x theta_y(s),   dh/dX = (w'(s) - x theta_y'(s)) e_y,X - theta_y(s) e_x,X,
+
+    X the flow direction (the basic x axis) and e_x,X, e_y,X the spline axes' X components.
+
+    Parameters
+    ----------
+    s_nodes : (n,) stations along the axis (m), strictly ascending.
+    points_s, points_x : (p,) the points' axial and chordwise coordinates (m).
+    ex_flow, ey_flow : X components of the spline's x and y axes.
+
+    Returns
+    -------
+    (H, D) : (p, 3 n) matrices giving h and dh/dX from the station values
+        (w_1..w_n, theta_x,1..theta_x,n, theta_y,1..theta_y,n) (m and rad).
+
+    Examples
+    --------
+    A rigid pitch theta_y = 1 about the axis: h = -x, dh/dX = -e_x,X.
+
+    >>> H, D = beam_axis_spline([0.0, 1.0], [0.5], [0.2], 1.0, 0.0)
+    >>> (H @ [0, 0, 0, 0, 1, 1]).round(12).tolist(), (D @ [0, 0, 0, 0, 1, 1]).tolist()
+    ([-0.2], [-1.0])
+    """
+    s_nodes = np.asarray(s_nodes, float)
+    if s_nodes.ndim != 1 or s_nodes.size < 2 or np.any(np.diff(s_nodes) <= 0):
+        raise ValueError("s_nodes must hold >= 2 strictly ascending stations")
+    ps, px = np.asarray(points_s, float), np.asarray(points_x, float)
+    n = s_nodes.size
+    H, D = np.zeros((ps.size, 3 * n)), np.zeros((ps.size, 3 * n))
+    for i, (s, x) in enumerate(zip(ps, px)):
+        ww, wd, dw, dd, tt, td = _hermite_row(s_nodes, s)
+        H[i] = np.r_[ww, wd, -x * tt]
+        D[i] = np.r_[dw * ey_flow, dd * ey_flow, -x * td * ey_flow - tt * ex_flow]
+    return H, D
+
+
+def _check_spline2(s) -> None:
+    for name, v in (("DZ", s.dz), ("DTHX", s.dthx), ("DTHY", s.dthy)):
+        if v not in (0, 0.0):
+            raise BdfError(f"SPLINE2 {s.eid}: {name} = {v!r} is not supported (0.0: attached, "
+                           f"no smoothing)")
+    if str(s.usage or "BOTH").upper() != "BOTH":
+        raise BdfError(f"SPLINE2 {s.eid}: USAGE = {s.usage!r} is not supported (BOTH)")
+
+
+def _spline2_station_matrix(model, s, sm: StickModel, L: float):
+    """(3 n_g, 6 n_nodes) map from the model's DOFs to the spline stations' (w, theta_x,
+    theta_y), the stations (sorted, m), the spline frame (rows e_x, e_y, e_z) and its origin."""
+    c = model.coords[s.cid] if s.cid else None
+    axes = np.asarray(c.beta(), float) if c is not None else np.eye(3)
+    origin = (np.asarray(c.origin, float) if c is not None else np.zeros(3)) * L
+    if abs(axes[2, 2]) < 1 - 1e-6:
+        raise BdfError(f"SPLINE2 {s.eid}: CID = {s.cid}: the spline's z axis must be normal "
+                       f"to the boxes (basic z)")
+    grids = [int(g) for g in model.sets[s.setg].ids]
+    idx = [int(np.flatnonzero(sm.node_ids == g)[0]) for g in grids]
+    st = (sm.xyz[idx] - origin) @ axes[1]
+    order = np.argsort(st)
+    if np.any(np.diff(st[order]) <= 1e-9 * max(1.0, np.ptp(st))):
+        raise BdfError(f"SPLINE2 {s.eid}: SETG {s.setg}: two grids at the same station")
+    n, N = len(idx), sm.K.shape[0]
+    S = np.zeros((3 * n, N))
+    for r, k in enumerate(order):
+        i = idx[k]
+        Rt = sm.cd_axes[i].T                           # CD components -> basic
+        d = NODE_DOF * i
+        S[r, d:d + 3] = axes[2] @ Rt                    # w
+        S[n + r, d + 3:d + 6] = axes[0] @ Rt            # theta_x (the slope)
+        S[2 * n + r, d + 3:d + 6] = axes[1] @ Rt        # theta_y (the twist)
+    return S, st[order], axes, origin
+
+
+def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L: float):
+    """The modes on the boxes through the deck's SPLINE2 cards (each box on one spline):
+    :func:`beam_axis_spline` at the control points (h, dh/dx) and load points (h)."""
+    from asekit.aero.spline import BoxModes
+    n_b, n_m = len(box_ids), modes.shapes.shape[1]
+    h_cp, d_cp, h_lp = np.zeros((n_b, n_m)), np.zeros((n_b, n_m)), np.zeros((n_b, n_m))
+    done = np.zeros(n_b, bool)
+    pos = {int(b): i for i, b in enumerate(box_ids)}
+    for s in model.splines.values():
+        if s.type != "SPLINE2":
+            raise BdfError(f"{s.type} {s.eid}: a stick deck's splines must be SPLINE2")
+        _check_spline2(s)
+        rows = [pos[b] for b in range(int(s.box1), int(s.box2) + 1) if b in pos]
+        S, st, axes, o = _spline2_station_matrix(model, s, sm, L)
+        q = S @ modes.shapes
+        for pts, out, dout in ((mesh.control_point, h_cp, d_cp), (mesh.load_point, h_lp, None)):
+            rel = pts[rows] - o
+            H, D = beam_axis_spline(st, rel @ axes[1], rel @ axes[0], axes[0, 0], axes[1, 0])
+            out[rows] = H @ q
+            if dout is not None:
+                dout[rows] = D @ q
+        done[rows] = True
+    if not done.all():
+        raise BdfError(f"boxes {[int(b) for b in np.asarray(box_ids)[~done][:10]]} are on no "
+                       f"SPLINE2")
+    return BoxModes(h_cp, d_cp, h_lp)
+
+
+def _n_modes(model) -> int:
+    p = model.params.get("LMODES")
+    if p is not None and int(p.values[0]) > 0:
+        return int(p.values[0])
+    for m in model.methods.values():
+        if getattr(m, "nd", None):
+            return int(m.nd)
+    return 6
+
+
+@dataclass(frozen=True)
+class StickFlutter:
+    """The flutter of a stick deck: ``modes`` (:class:`StickModes` used), ``results``
+    [(FlutterRequest, density, Mach, NastranFlutterResult)] per FLUTTER card and flight
+    condition, ``b_ref`` (m)."""
+
+    modes: StickModes
+    results: tuple
+    b_ref: float
+
+
+def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
+    """Run every K / KE / PK FLUTTER card of a CBAR stick deck (Nastran's methods,
+    :mod:`asekit.aeroelastic.nastran`) with asekit's doublet lattice on the CAERO1 boxes and
+    the SPLINE2 beam spline; PARAM LMODES (else EIGR/EIGRL ND) modes.
+
+    Parameters
+    ----------
+    path : the deck; units : its unit system (:data:`asekit.io.bdf.UNITS`).
+    ks : reduced frequencies of the aerodynamic table (default the MKAERO1 list, which the
+        method interpolates as the FLUTTER card's IMETH says, as Nastran does).
+
+    Returns
+    -------
+    StickFlutter
+    """
+    from asekit.aero.gaf import TabulatedGaf, gaf_from_box_modes
+    from asekit.aeroelastic.nastran import k_method, pk_method
+    from asekit.aeroelastic.statespace import modal_arrays
+    from asekit.io import bdf as B
+
+    sm = read_stick_deck(path, units)
+    model = B._need_pynastran()(debug=None)
+    model.read_bdf(str(path), xref=True)
+    L, Mu, T = UNITS[units]
+    deck = B._Deck(model, Path(path).name, L, Mu, T)
+    if not model.caeros or not model.flutters:
+        raise BdfError(f"{deck.name}: no CAERO1 or no FLUTTER card: nothing to run")
+    for c in model.caeros.values():
+        B._check_caero1(deck, c)
+    mesh, box_ids = B._boxes(model, L, 0.0)
+    b_ref, rho_ref, symmetric = B._read_aero_card(deck)
+    machs, table_ks = B._read_mkaero1(model, deck)
+    requests = [B._flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
+    modes = stick_modes(sm, _n_modes(model))
+    bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L)
+    w = 2 * np.pi * modes.frequencies_hz
+    modal = modal_arrays(M=np.eye(w.size), K=np.diag(w ** 2))
+    ks = np.asarray(table_ks if ks is None else ks, float)
+    gafs = {m: TabulatedGaf(ks, gaf_from_box_modes(bm, mesh, m, ks, b_ref, symmetric), b_ref, m)
+            for m in machs}
+    out = []
+    for r in requests:
+        for rho, mach in r.points():
+            if mach not in gafs:
+                raise BdfError(f"FLUTTER {r.sid}: Mach {mach:g} is not on an MKAERO1 card")
+            if r.method in ("K", "KE"):
+                res = k_method(modal, gafs[mach], rho, r.reduced_frequencies,
+                               vectors=r.method == "K", interpolation=r.imeth, mach=mach)
+            elif r.method == "PK":
+                res = pk_method(modal, gafs[mach], rho, r.velocities, eps=r.eps,
+                                interpolation=r.imeth, mach=mach)
+            else:
+                raise BdfError(f"FLUTTER {r.sid}: METHOD {r.method} is not run for stick "
+                               f"decks yet (K, KE, PK)")
+            out.append((r, rho, mach, res))
+    return StickFlutter(modes=modes, results=tuple(out), b_ref=b_ref)
