@@ -533,37 +533,61 @@ def _n_modes(model) -> int:
 
 @dataclass(frozen=True)
 class StickFlutter:
-    """The flutter of a stick deck: ``modes`` (:class:`StickModes` used), ``results``
-    [(FlutterRequest, density, Mach, NastranFlutterResult)] per FLUTTER card and flight
-    condition, ``b_ref`` (m)."""
+    """The flutter of a stick deck: ``modes`` (:class:`StickModes` used), ``results`` one
+    :class:`asekit.io.bdf.DeckFlutter` per FLUTTER card (the case control's FMETHOD first),
+    ``b_ref`` (m)."""
 
     modes: StickModes
     results: tuple
     b_ref: float
 
 
+@dataclass(frozen=True)
+class _Table:
+    """The GAF tables by Mach, read as :func:`asekit.io.bdf.deck_flutter` reads a database."""
+
+    gafs: dict
+
+    def at(self, mach: float):
+        if mach not in self.gafs:
+            raise BdfError(f"Mach {mach:g} of a FLUTTER card is not on an MKAERO1 card")
+        return self.gafs[mach]
+
+
+def is_stick_deck(path) -> bool:
+    """True when the deck's structure is bars (CBAR) and no shell: :func:`stick_flutter`'s
+    deck, not :func:`asekit.io.bdf.read_bdf`'s."""
+    model = _need_pynastran()(debug=None)
+    try:
+        model.read_bdf(str(path), xref=False)
+    except Exception:           # read_bdf reports the deck's error in its own words
+        return False
+    cc = model.card_count
+    return "CBAR" in cc and not any(c in cc for c in ("CQUAD4", "CTRIA3"))
+
+
 def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
-    """Run every K / KE / PK FLUTTER card of a CBAR stick deck (Nastran's methods,
-    :mod:`asekit.aeroelastic.nastran`) with asekit's doublet lattice on the CAERO1 boxes and
-    the SPLINE2 beam spline; PARAM LMODES (else EIGR/EIGRL ND) modes.
+    """Run every FLUTTER card (K, KE, PK, PKNL as Nastran defines them,
+    :mod:`asekit.aeroelastic.nastran`) of a CBAR stick deck with asekit's doublet lattice on
+    the CAERO1 boxes and the SPLINE2 beam spline; PARAM LMODES (else EIGR/EIGRL ND) modes.
 
     Parameters
     ----------
     path : the deck; units : its unit system (:data:`asekit.io.bdf.UNITS`).
     ks : reduced frequencies of the aerodynamic table (default the MKAERO1 list, which the
-        method interpolates as the FLUTTER card's IMETH says, as Nastran does).
+        method interpolates as the FLUTTER card's IMETH says, as Nastran does; outside the
+        list asekit holds the end values, :meth:`asekit.aero.gaf.TabulatedGaf.parts`).
 
     Returns
     -------
     StickFlutter
     """
     from asekit.aero.gaf import TabulatedGaf, gaf_from_box_modes
-    from asekit.aeroelastic.nastran import k_method, pk_method
     from asekit.aeroelastic.statespace import modal_arrays
     from asekit.io import bdf as B
 
     sm = read_stick_deck(path, units)
-    model = B._need_pynastran()(debug=None)
+    model = _need_pynastran()(debug=None)
     model.read_bdf(str(path), xref=True)
     L, Mu, T = UNITS[units]
     deck = B._Deck(model, Path(path).name, L, Mu, T)
@@ -575,26 +599,14 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     b_ref, rho_ref, symmetric = B._read_aero_card(deck)
     machs, table_ks = B._read_mkaero1(model, deck)
     requests = [B._flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
+    fm = B._case_value(model, "FMETHOD")
+    requests.sort(key=lambda r: r.sid != fm)
     modes = stick_modes(sm, _n_modes(model))
     bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L)
     w = 2 * np.pi * modes.frequencies_hz
     modal = modal_arrays(M=np.eye(w.size), K=np.diag(w ** 2))
     ks = np.asarray(table_ks if ks is None else ks, float)
-    gafs = {m: TabulatedGaf(ks, gaf_from_box_modes(bm, mesh, m, ks, b_ref, symmetric), b_ref, m)
-            for m in machs}
-    out = []
-    for r in requests:
-        for rho, mach in r.points():
-            if mach not in gafs:
-                raise BdfError(f"FLUTTER {r.sid}: Mach {mach:g} is not on an MKAERO1 card")
-            if r.method in ("K", "KE"):
-                res = k_method(modal, gafs[mach], rho, r.reduced_frequencies,
-                               vectors=r.method == "K", interpolation=r.imeth, mach=mach)
-            elif r.method == "PK":
-                res = pk_method(modal, gafs[mach], rho, r.velocities, eps=r.eps,
-                                interpolation=r.imeth, mach=mach)
-            else:
-                raise BdfError(f"FLUTTER {r.sid}: METHOD {r.method} is not run for stick "
-                               f"decks yet (K, KE, PK)")
-            out.append((r, rho, mach, res))
-    return StickFlutter(modes=modes, results=tuple(out), b_ref=b_ref)
+    db = _Table({m: TabulatedGaf(ks, gaf_from_box_modes(bm, mesh, m, ks, b_ref, symmetric),
+                                 b_ref, m) for m in machs})
+    return StickFlutter(modes=modes, b_ref=b_ref,
+                        results=tuple(B._solve_request(r, modal, db) for r in requests))

@@ -147,8 +147,10 @@ def test_pt145_ke_flutter_against_its_f06():
     other way, to 6174 in/s)."""
     from asekit.aeroelastic.nastran import crossings
     run = _pt145_flutter()
-    (req, rho, mach, res), = run.results
-    assert req.method == "KE" and mach == 0.45
+    (deck_flutter,) = run.results
+    (res,) = deck_flutter.results
+    req, rho = deck_flutter.request, res.density[0]
+    assert req.method == "KE" and res.mach[0] == 0.45
     assert abs(rho / (0.967 * 1.145e-7 * 4.4482216152605 / 0.0254 ** 4) - 1) < 1e-12
     ks = res.k[:, 0]
     V = res.velocity / 0.0254
@@ -164,6 +166,7 @@ def test_pt145_ke_flutter_against_its_f06():
             assert abs(res.damping_g[i, col] - g) < 0.002
             assert abs(res.frequency_hz[i, col] / f - 1) < 0.006
     found = [c for c in crossings(res) if not c.unstable_at_first_point]
+    assert [c.speed for c in deck_flutter.crossings] == [c.speed for c in found]
     assert [c.mode for c in found] == [1]
     t = 1.0861521e-2 / (1.0861521e-2 + 1.7230888e-2)
     v_f06 = 6112.9079 + t * (5831.7574 - 6112.9079)
@@ -179,3 +182,26 @@ def test_spline2_fields_are_checked(tmp_path):
     from asekit.io.bdf_beam import stick_flutter
     with pytest.raises(BdfError, match="SPLINE2 100: DZ"):
         stick_flutter(tmp_path / "p.bdf", units="in-lbf-s")
+
+
+def test_analyse_runs_the_pt145_deck(tmp_path, capsys):
+    """``asekit analyse pt145.bdf``: the FLUTTER card's KE crossing as a JSON row (the same
+    run as test_pt145_ke_flutter_against_its_f06; f06 6004.2 in/s, 140.1 Hz) and --report
+    refused in one line."""
+    import json
+
+    from asekit.cli.main import main
+    out = tmp_path / "pt145.json"
+    assert main(["analyse", str(PT145), "--units", "in-lbf-s", "--quiet", "--json",
+                 str(out)]) == 0
+    s = json.loads(out.read_text())
+    (row,) = s["flutter"]
+    assert (row["method"], row["sid"], row["mode"]) == ("KE", 30, 2)
+    assert abs(row["speed_ms"] / 0.0254 / 6004.2 - 1) < 0.03
+    assert abs(row["frequency_hz"] / 140.1 - 1) < 0.03
+    assert not row["unstable_at_first_point"]
+    np.testing.assert_allclose(s["modes_hz"], [39.96147, 236.4137, 250.4423], rtol=1e-5)
+    assert "FLUTTER SUMMARY" in capsys.readouterr().out
+    assert main(["analyse", str(PT145), "--units", "in-lbf-s", "--report",
+                 str(tmp_path / "r")]) == 2
+    assert "--report" in capsys.readouterr().err
