@@ -5,7 +5,9 @@ an actuator is given), print the summary table (a deck: every FLUTTER card with 
 method, K / KE / PK / PKNL as MSC Nastran defines them, its rows in the JSON's ``"flutter"``
 and Nastran's FLUTTER SUMMARY printed), and optionally write the JSON summary and an
 HTML report. A bad case file gets one line naming the key and exit status 2. Modes, damping
-and units follow docs/conventions.md (elastic modes from 1, "rigid pitch", g > 0 unstable)."""
+and units follow docs/conventions.md (elastic modes from 1, "rigid pitch", g > 0 unstable).
+A CBAR stick-model deck is run by :func:`asekit.io.bdf_beam.stick_flutter` instead (modes and
+the FLUTTER cards; no HTML report yet)."""
 
 from __future__ import annotations
 
