@@ -313,31 +313,33 @@ def read_stick_deck(path, units: str = "SI") -> StickModel:
 
 
 def _add_cmass2_si(model, M, index, deck_units) -> None:
-    """CMASS2 in SI: a translation component's mass in kg, a rotation's in kg m^2 (the deck's
-    M L^2)."""
+    """CMASS2 in SI: the scalar element's matrix m [[1, -1], [-1, 1]] (one grid: m) with each
+    entry scaled by the SI factor of its two DOFs, Mu s_i s_j (s = 1 for a translation, L for
+    a rotation: a mass in kg, a rotary inertia in kg m^2, a coupling in kg m)."""
     L, Mu, T, wt = deck_units
     for eid in _card_ids(model, "CMASS2"):
         c = model.masses[eid]
-        dofs = []
+        dofs, scale = [], []
         for g, comp in ((c.nodes[0], c.c1), (c.nodes[1], c.c2)):
             if not g:
                 continue
             if g not in index or not comp or not 1 <= int(comp) <= 6:
                 raise BdfError(f"CMASS2 {eid}: G/C = {g}/{comp}: a GRID and a component 1-6 "
                                f"are required")
-            dofs.append((NODE_DOF * index[g] + int(comp) - 1, int(comp) > 3))
-        if len(dofs) == 2 and dofs[0][1] != dofs[1][1]:
-            raise BdfError(f"CMASS2 {eid}: C1 and C2 must both be translations or rotations")
-        mass = c.mass * wt * Mu * (L * L if dofs and dofs[0][1] else 1.0)
-        d = [a for a, _ in dofs]
-        M[np.ix_(d, d)] += mass * (np.array([[1.0, -1.0], [-1.0, 1.0]]) if len(d) == 2
-                                   else np.ones((1, 1)))
+            dofs.append(NODE_DOF * index[g] + int(comp) - 1)
+            scale.append(1.0 if int(comp) <= 3 else L)
+        if not dofs:
+            continue
+        pattern = np.array([[1.0, -1.0], [-1.0, 1.0]]) if len(dofs) == 2 else np.ones((1, 1))
+        sc = np.asarray(scale)
+        M[np.ix_(dofs, dofs)] += c.mass * wt * Mu * pattern * np.outer(sc, sc)
 
 
 def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
-    """Normal modes K phi = omega^2 M phi of the free DOFs, the null space of M (e.g. the
-    twist of a bar without torsional inertia, in any frame) condensed statically (Guyan,
-    exact for motion without inertia).
+    """Normal modes K phi = omega^2 M phi of the free DOFs, solved as M phi = lambda K phi,
+    lambda = 1 / omega^2, for the largest lambda: exact with DOFs that carry no mass (e.g. the
+    twist of a bar without torsional inertia, in any frame: lambda = 0 there) and accurate for
+    the lowest modes of stiff bars (no stiffness-times-mass-basis mixing).
 
     Parameters
     ----------
@@ -364,24 +366,23 @@ def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
     free = model.free
     K = model.K[np.ix_(free, free)]
     M = model.M[np.ix_(free, free)]
-    mu, Q = np.linalg.eigh(M)
-    heavy = mu > 1e-12 * max(float(mu.max()), 1e-300)
-    Q1, Q0 = Q[:, heavy], Q[:, ~heavy]             # the mass's range and its null space
-    K11 = Q1.T @ K @ Q1
-    G = np.zeros((Q0.shape[1], Q1.shape[1]))
-    if Q0.shape[1]:
-        K00, K01 = Q0.T @ K @ Q0, Q0.T @ K @ Q1
-        if np.linalg.cond(K00) > 1e12:
-            raise BdfError("the stick model has a massless mechanism (free DOFs with neither "
-                           "stiffness nor mass): constrain them with SPC or GRID PS")
-        G = -np.linalg.solve(K00, K01)
-        K11 = K11 + K01.T @ G
-    n = min(int(n_modes), Q1.shape[1])
+    n = min(int(n_modes), free.size)
     if n < 1:
         raise ValueError(f"n_modes must be >= 1, got {n_modes}")
-    w2, a = sla.eigh(0.5 * (K11 + K11.T), np.diag(mu[heavy]), subset_by_index=[0, n - 1])
+    try:
+        lam, phi = sla.eigh(M, K, subset_by_index=[free.size - n, free.size - 1])
+    except np.linalg.LinAlgError:
+        raise BdfError("the stick model's stiffness is singular on its free DOFs (a "
+                       "mechanism or a rigid-body mode): constrain them with SPC or GRID "
+                       "PS") from None
+    lam, phi = lam[::-1], phi[:, ::-1]
+    if lam[-1] <= 1e-14 * lam[0]:
+        raise BdfError(f"fewer than {n} modes carry mass (the DOFs without mass have no "
+                       f"frequency): ask for fewer modes")
+    phi = phi / np.sqrt(np.einsum("ij,ik,kj->j", phi, M, phi))
     full = np.zeros((model.K.shape[0], n))
-    full[free] = Q1 @ a + Q0 @ (G @ a)
+    full[free] = phi
+    w2 = 1.0 / lam
     return StickModes(frequencies_hz=np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi),
                       shapes=full)
 
@@ -610,3 +611,97 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
                                  b_ref, m) for m in machs})
     return StickFlutter(modes=modes, b_ref=b_ref,
                         results=tuple(B._solve_request(r, modal, db) for r in requests))
+
+
+# ---------------------------------------------------------------------------------------------
+# export of a [[beam]] (a StraightBeam) as a CBAR deck
+# ---------------------------------------------------------------------------------------------
+def _bar_mass(beam) -> np.ndarray:
+    """The mass the deck's CBARs carry (PBAR NSM = m, PARAM COUPMASS 1), global frame."""
+    n = NODE_DOF * beam.n_nodes
+    M = np.zeros((n, n))
+    x = beam.nodes
+    for e, sec in enumerate(beam.sections):
+        bar = BarSection(sec.ea, sec.gj, sec.ei_flap, sec.ei_chord, sec.mass)
+        _, Me = global_bar_matrices(x[e], x[e + 1], beam.frame[2], bar, True)
+        d = np.r_[NODE_DOF * e:NODE_DOF * e + 12]
+        M[np.ix_(d, d)] += Me
+    return M
+
+
+def scalar_mass_pairs(R: np.ndarray, tol: float = 0.0) -> list[tuple[int, int, float]]:
+    """A symmetric matrix as scalar masses (CMASS2): R = sum_{i<j} m_ij (e_i - e_j)(e_i -
+    e_j)^T + sum_i m_i e_i e_i^T with m_ij = -R_ij and m_i = sum_j R_ij (the row sum).
+
+    Returns
+    -------
+    list of (i, j, m): j = -1 for a grounded (one-DOF) mass; entries with |m| <= tol left out.
+
+    Examples
+    --------
+    >>> R = np.array([[2.0, 1.0], [1.0, 2.0]])
+    >>> scalar_mass_pairs(R)
+    [(0, 1, -1.0), (0, -1, 3.0), (1, -1, 3.0)]
+    """
+    R = np.asarray(R, float)
+    n = R.shape[0]
+    out = [(i, j, -float(R[i, j])) for i in range(n) for j in range(i + 1, n)
+           if abs(R[i, j]) > tol]
+    out += [(i, -1, float(R[i].sum())) for i in range(n) if abs(R[i].sum()) > tol]
+    return out
+
+
+def write_beam_bdf(beam, path) -> Path:
+    """Write a clamped :class:`~asekit.structure.beam.StraightBeam` (a case's ``[[beam]]``,
+    :func:`asekit.case.pipeline.case_beam`) as an SI SOL 103 deck that
+    :func:`read_stick_deck` reads back to the same matrices.
+
+    GRID per node, CBAR per element (orientation vector the surface normal e3: plane 1 is the
+    flap plane), PBAR with MAT1 E = G = 1 Pa (A = EA, I1 = EI_flap, I2 = EI_chord, J = GJ,
+    NSM = m), PARAM COUPMASS 1 (the consistent bar mass), SPC1 123456 at the root. What a PBAR
+    cannot hold -- the polar inertia, the mass offset's bending-torsion coupling and the point
+    masses -- is the difference between the beam's consistent mass matrix
+    (:func:`asekit.structure.beam.assemble`) and the bars' one, written exactly as CMASS2 scalar
+    masses (:func:`scalar_mass_pairs`; some negative, as a consistent matrix's lumped form
+    needs).
+
+    Parameters
+    ----------
+    beam : StraightBeam.
+    path : the deck to write (overwritten).
+
+    Returns
+    -------
+    Path
+    """
+    from asekit.structure.beam import assemble
+
+    path = Path(path)
+    _, Mb = assemble(beam)
+    R = Mb - _bar_mass(beam)
+    free = slice(NODE_DOF, None)                  # the root node is clamped
+    Rf = np.zeros_like(R)
+    Rf[free, free] = R[free, free]
+    lines = ["SOL 103", "CEND", "SPC = 1", "METHOD = 1", "BEGIN BULK",
+             "$ written by asekit.io.bdf_beam.write_beam_bdf (SI)"]
+    for i, x in enumerate(beam.nodes):
+        lines.append(f"GRID,{i + 1},,{x[0]!r},{x[1]!r},{x[2]!r}")
+    v = beam.frame[2]
+    for e, sec in enumerate(beam.sections):
+        lines.append(f"CBAR,{e + 1},{e + 1},{e + 1},{e + 2},{v[0]!r},{v[1]!r},{v[2]!r}")
+        lines.append(f"PBAR,{e + 1},1,{sec.ea!r},{sec.ei_flap!r},{sec.ei_chord!r},"
+                     f"{sec.gj!r},{sec.mass!r}")
+    lines += ["MAT1,1,1.0,1.0", "SPC1,1,123456,1", "PARAM,COUPMASS,1",
+              f"EIGRL,1,,,{min(6, NODE_DOF * (beam.n_nodes - 1))}"]
+    tol = 1e-14 * float(np.abs(Mb).max())
+    eid = 100000
+    for i, j, m in scalar_mass_pairs(Rf, tol):
+        g1, c1 = divmod(i, NODE_DOF)
+        g2 = f"{j // NODE_DOF + 1},{j % NODE_DOF + 1}" if j >= 0 else ","
+        eid += 1
+        lines.append(f"CMASS2,{eid},{m!r},{g1 + 1},{c1 + 1},{g2}")
+    lines.append("ENDDATA")
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text("\n".join(lines) + "\n")
+    tmp.replace(path)
+    return path
