@@ -230,3 +230,13 @@ def test_beam_case_round_trip_through_a_cbar_deck(tmp_path):
         assert np.abs(sm.M[free, free] - M[free, free]).max() <= 1e-12 * np.abs(M).max()
         np.testing.assert_allclose(stick_modes(sm, 6).frequencies_hz,
                                    beam_modes(beam, 6).frequencies_hz, rtol=1e-9)
+
+
+def test_unconstrained_zero_stiffness_is_refused(tmp_path):
+    """PT145 without its GRID PS: the in-plane DOFs have no stiffness (PBAR I2 = 0) and the
+    modes are refused in one line instead of returning spurious zeros."""
+    text = PT145.read_text().replace("1       126\n", "\n")
+    (tmp_path / "free.bdf").write_text(text)
+    sm = read_stick_deck(tmp_path / "free.bdf", units="in-lbf-s")
+    with pytest.raises(BdfError, match="singular on its free DOFs"):
+        stick_modes(sm, 3)
