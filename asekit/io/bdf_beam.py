@@ -10,7 +10,12 @@
 - CMASS2 (scalar mass on a grid component, or between two), CONM2 (mass and inertia with
   offset, CID 0 or blank),
 - SPC1 / SPC (zero enforced value) of the case control's SPC set, PARAM COUPMASS (> 0: the
-  consistent bar mass, else lumped), PARAM WTMASS.
+  consistent bar mass, else lumped), PARAM WTMASS,
+- RBE2 (GN independent, CM components of the GMi dependent) and RBAR (GA independent in all
+  six components, CMB of GB dependent), eliminated by the rigid-link transformation
+  u_d = u_i + theta_i x (x_d - x_i), theta_d = theta_i (Przemieniecki Sec. 11.7; in the grids'
+  CD systems), K_r = T^T K T, M_r = T^T M T; chains (a dependent DOF independent elsewhere)
+  and SPC on a dependent DOF refused.
 
 The element is :mod:`asekit.structure.frame` (Przemieniecki 1968 Eqs. 5.116 and 11.41, rotated
 by the direction cosines, Eq. 6.26). Every grid carries six DOFs (T1, T2, T3, R1, R2, R3) in its
@@ -18,7 +23,7 @@ displacement system CD, as Nastran's g-set: with R_cd the rows of CD's axes in b
 basic-frame matrices become K_cd = T^T K_basic T, T = diag(R_cd^T, R_cd^T) per grid.
 Massless DOFs are condensed statically (exact for them: no inertia) before the eigen-solution.
 
-Other structural cards (CBEAM, CROD, RBE2, RBE3, shells, ...) are refused with the card and its
+Other structural cards (CBEAM, CROD, RBE3, shells, ...) are refused with the card and its
 first id; an unsupported field is refused with card, id and field. Aerodynamic and solution
 cards are read elsewhere (:mod:`asekit.io.bdf`); here they are ignored.
 """
@@ -36,11 +41,11 @@ from asekit.structure.frame import BarSection, global_bar_matrices
 
 #: structural cards a stick deck may hold (others are refused).
 STICK_CARDS = ("GRID", "CORD2R", "CORD1R", "CORD2C", "CORD2S", "CBAR", "PBAR", "MAT1",
-               "CMASS2", "CONM2", "SPC", "SPC1")
+               "CMASS2", "CONM2", "SPC", "SPC1", "RBE2", "RBAR")
 
 #: structural cards refused in a stick deck (asekit cannot represent them here).
 REFUSED_CARDS = ("CBEAM", "PBEAM", "PBARL", "PBEAML", "CROD", "CONROD", "PROD", "CTUBE",
-                 "RBAR", "RBE1", "RBE2", "RBE3", "RROD", "MPC", "CELAS1", "CELAS2", "CELAS3",
+                 "RBE1", "RBE3", "RROD", "MPC", "CELAS1", "CELAS2", "CELAS3",
                  "CELAS4", "CMASS1", "CMASS3", "CMASS4", "CONM1", "CQUAD4", "CTRIA3", "CQUAD8",
                  "CTRIA6", "CSHEAR", "CHEXA", "CPENTA", "CTETRA", "CBUSH", "CDAMP1", "CDAMP2",
                  "CVISC", "SPOINT", "EPOINT", "GENEL", "SPCD", "SUPORT")
@@ -60,6 +65,8 @@ class StickModel:
         system (N/m, N, N m; kg, kg m, kg m^2).
     fixed : sorted constrained DOFs (SPC, SPC1, GRID PS); coupled : the consistent bar mass
         (PARAM COUPMASS > 0) or lumped; notes : what was read and how; path, units.
+    rigid : (dependent DOF, ((independent DOF, coefficient), ...)) per DOF an RBE2 / RBAR
+        makes dependent.
     """
 
     node_ids: np.ndarray
@@ -72,13 +79,28 @@ class StickModel:
     notes: tuple = ()
     path: str = ""
     units: str = "SI"
+    rigid: tuple = ()
 
     @property
     def free(self) -> np.ndarray:
-        """The unconstrained DOFs."""
+        """The DOFs neither constrained nor dependent (the solution's unknowns)."""
         mask = np.ones(self.K.shape[0], bool)
         mask[list(self.fixed)] = False
+        mask[[d for d, _ in self.rigid]] = False
         return np.flatnonzero(mask)
+
+    def reduction(self) -> np.ndarray:
+        """T (n_dof, n_free): all DOFs from the free ones (constrained rows 0, dependent rows
+        the rigid links' coefficients; a coefficient on a constrained DOF drops out)."""
+        free = self.free
+        col = {int(d): j for j, d in enumerate(free)}
+        T = np.zeros((self.K.shape[0], free.size))
+        T[free, np.arange(free.size)] = 1.0
+        for d, row in self.rigid:
+            for i, c in row:
+                if i in col:
+                    T[d, col[i]] += c
+        return T
 
     def dof(self, grid_id: int, component: int) -> int:
         """Global DOF of GRID ``grid_id``, Nastran component 1-6."""
@@ -249,6 +271,51 @@ def _fixed_dofs(model, index, name: str) -> set:
     return fixed
 
 
+def _link(dep: dict, what: str, i: int, d: int, comps, xyz, axes) -> None:
+    """The rows of grid d's ``comps`` (CD components) from grid i's six DOFs (CD): rigid
+    kinematics u_d = u_i - S(x_d - x_i) theta_i, theta_d = theta_i in basic."""
+    G = np.eye(6)
+    G[:3, 3:] = -_skew(xyz[d] - xyz[i])
+    Gc = np.kron(np.eye(2), axes[d]) @ G @ np.kron(np.eye(2), axes[i].T)
+    for c in comps:
+        row = NODE_DOF * d + c - 1
+        if row in dep:
+            raise BdfError(f"{what}: component {c} of its dependent grid is already dependent "
+                           f"on another rigid element")
+        dep[row] = tuple((NODE_DOF * i + k, float(Gc[c - 1, k])) for k in range(6)
+                         if abs(Gc[c - 1, k]) > 1e-15)
+
+
+def _rigid_links(model, index, xyz, axes, fixed: set) -> tuple:
+    """RBE2 / RBAR as dependent DOF rows (module docstring)."""
+    dep = {}
+    for eid in sorted(model.rigid_elements):
+        r = model.rigid_elements[eid]
+        if r.type == "RBE2":
+            for g in r.Gmi:
+                _link(dep, f"RBE2 {eid} (GM {g})", index[r.gn], index[g], _components(r.cm),
+                      xyz, axes)
+        elif r.type == "RBAR":
+            if str(r.cna) != "123456" or str(r.cnb or "").strip() or str(r.cma or "").strip():
+                raise BdfError(f"RBAR {eid}: CNA = {r.cna!r}, CNB = {r.cnb!r}, CMA = {r.cma!r}: "
+                               f"only GA independent in all six components is supported "
+                               f"(CNA 123456, CNB and CMA blank)")
+            _link(dep, f"RBAR {eid}", index[r.ga], index[r.gb], _components(r.cmb or "123456"),
+                  xyz, axes)
+        else:
+            raise BdfError(f"{r.type} {eid} is not supported (RBE2, RBAR)")
+    chained = [d for d, row in dep.items() if any(i in dep for i, _ in row)]
+    if chained:
+        raise BdfError(f"rigid elements chained: DOF {chained[0] % NODE_DOF + 1} of GRID "
+                       f"index {chained[0] // NODE_DOF} is dependent and independent (not "
+                       f"supported)")
+    if fixed & set(dep):
+        d = min(fixed & set(dep))
+        raise BdfError(f"an SPC / GRID PS constrains component {d % NODE_DOF + 1} of a grid "
+                       f"an RBE2 / RBAR makes dependent (Nastran refuses it too)")
+    return tuple(sorted(dep.items()))
+
+
 def _param(model, key: str, default):
     p = model.params.get(key)
     return p.values[0] if p is not None else default
@@ -305,11 +372,12 @@ def read_stick_deck(path, units: str = "SI") -> StickModel:
     K, M = A.T @ K @ A, A.T @ M @ A
     _add_cmass2_si(model, M, index, deck_units)
     fixed = _fixed_dofs(model, index, path.name)
+    rigid = _rigid_links(model, index, xyz, axes, fixed)
     notes = (f"{len(_card_ids(model, 'CBAR'))} CBAR, {len(ids)} GRID; bar mass "
              f"{'consistent (PARAM COUPMASS 1)' if coupled else 'lumped'}",)
     return StickModel(node_ids=ids, xyz=xyz, cd_axes=axes, K=0.5 * (K + K.T),
                       M=0.5 * (M + M.T), fixed=tuple(sorted(fixed)), coupled=coupled,
-                      notes=notes, path=str(path), units=units)
+                      notes=notes, path=str(path), units=units, rigid=rigid)
 
 
 def _add_cmass2_si(model, M, index, deck_units) -> None:
@@ -364,8 +432,9 @@ def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
     3.533
     """
     free = model.free
-    K = model.K[np.ix_(free, free)]
-    M = model.M[np.ix_(free, free)]
+    Tr = model.reduction()
+    K = Tr.T @ model.K @ Tr
+    M = Tr.T @ model.M @ Tr
     n = min(int(n_modes), free.size)
     if n < 1:
         raise ValueError(f"n_modes must be >= 1, got {n_modes}")
@@ -380,8 +449,7 @@ def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
         raise BdfError(f"fewer than {n} modes carry mass (the DOFs without mass have no "
                        f"frequency): ask for fewer modes")
     phi = phi / np.sqrt(np.einsum("ij,ik,kj->j", phi, M, phi))
-    full = np.zeros((model.K.shape[0], n))
-    full[free] = phi
+    full = Tr @ phi
     w2 = 1.0 / lam
     return StickModes(frequencies_hz=np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi),
                       shapes=full)

@@ -104,11 +104,14 @@ def test_pt145_modes_match_its_f06():
 
 
 def test_refused_cards_and_fields_are_named(tmp_path):
-    deck = _cantilever(tmp_path / "r.bdf", extra=("RBE2,500,1,123456,2",))
-    with pytest.raises(BdfError, match=r"RBE2 \(x1, first id 500\)"):
+    deck = _cantilever(tmp_path / "r.bdf", extra=("RBE3,500,,1,123456,1.0,123,2,3",))
+    with pytest.raises(BdfError, match=r"RBE3 \(x1, first id 500\)"):
         read_stick_deck(deck)
     deck = _cantilever(tmp_path / "o.bdf", offt="BGG")
     with pytest.raises(BdfError, match="CBAR 1: OFFT"):
+        read_stick_deck(deck)
+    deck = _cantilever(tmp_path / "rb.bdf", extra=("RBAR,501,1,2,123456,123456",))
+    with pytest.raises(BdfError, match="RBAR 501: CNA"):
         read_stick_deck(deck)
     text = (tmp_path / "o.bdf").read_text().replace("CBAR,3,1,3,4,0.0,0.0,1.0,BGG",
                                                      "CBAR,3,1,3,4,0.0,0.0,1.0\n,,,0.0,0.1,0.0")
@@ -240,3 +243,23 @@ def test_unconstrained_zero_stiffness_is_refused(tmp_path):
     sm = read_stick_deck(tmp_path / "free.bdf", units="in-lbf-s")
     with pytest.raises(BdfError, match="singular on its free DOFs"):
         stick_modes(sm, 3)
+
+
+@pytest.mark.parametrize("link", ["RBE2,500,{tip},123456,{dep}", "RBAR,500,{tip},{dep},123456"])
+def test_rigid_link_equals_the_offset_mass(tmp_path, link):
+    """A CONM2 on a grid tied to the tip by an RBE2 / RBAR (the dependent grid's displacements
+    in a rotated CD system) has the same modes as the CONM2 on the tip with the same offset
+    (both are the rigid-link kinematics; Przemieniecki 1968 Sec. 11.7)."""
+    tip, dep, off = NEL + 1, NEL + 2, (0.03, 0.2, 0.05)
+    mt = 2 * RHO * A * LEN
+    direct = _cantilever(tmp_path / "d.bdf", extra=(f"CONM2,99,{tip},,{mt!r},{off[0]!r},"
+                                                    f"{off[1]!r},{off[2]!r}",))
+    cd = "CORD2R,5,,0.0,0.0,0.0,0.3,0.4,0.8\n,0.9,-0.1,0.2"
+    x = (LEN + off[0], off[1], off[2])
+    linked = _cantilever(tmp_path / "l.bdf", extra=(
+        cd, f"GRID,{dep},,{x[0]!r},{x[1]!r},{x[2]!r},5", f"CONM2,99,{dep},,{mt!r}",
+        link.format(tip=tip, dep=dep)))
+    f0 = stick_modes(read_stick_deck(direct), 8).frequencies_hz
+    sm = read_stick_deck(linked)
+    assert len(sm.rigid) == 6
+    np.testing.assert_allclose(stick_modes(sm, 8).frequencies_hz, f0, rtol=1e-9)
