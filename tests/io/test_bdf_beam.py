@@ -263,3 +263,35 @@ def test_rigid_link_equals_the_offset_mass(tmp_path, link):
     sm = read_stick_deck(linked)
     assert len(sm.rigid) == 6
     np.testing.assert_allclose(stick_modes(sm, 8).frequencies_hz, f0, rtol=1e-9)
+
+
+def test_orientation_vector_is_read_in_the_grids_cd_system(tmp_path):
+    """The rotated cantilever again, its grids' displacements in a CORD2R along the rotated
+    axes (CD) and the CBAR vector given there as (0, 0, 1) (MSC QRG CBAR: X1-X3 in GA's
+    displacement system): the frequencies of the unrotated beam; given in basic components
+    instead, plane 1 turns and they change."""
+    R = _rotation(0.7, -0.4, 1.1)
+    f0 = stick_modes(read_stick_deck(_cantilever(tmp_path / "a.bdf")), 6).frequencies_hz
+    text = _cantilever(tmp_path / "r.bdf", R).read_text()
+    a, c = R[2], R[0]                  # a point on the z axis and one in the x-z plane
+    cord = f"CORD2R,7,,0.0,0.0,0.0,{a[0]!r},{a[1]!r},{a[2]!r}\n,{c[0]!r},{c[1]!r},{c[2]!r}"
+    lines = []
+    for line in text.splitlines():
+        if line.startswith("GRID,"):
+            line += ",7"
+        elif line.startswith("CBAR,"):
+            f = line.split(",")
+            line = ",".join(f[:5] + ["0.0", "0.0", "1.0"] + f[8:])
+        lines.append(line)
+    lines.insert(lines.index("BEGIN BULK") + 1, cord)
+    (tmp_path / "cd.bdf").write_text("\n".join(lines) + "\n")
+    sm = read_stick_deck(tmp_path / "cd.bdf")
+    np.testing.assert_allclose(sm.cd_axes[0], R, atol=1e-12)
+    np.testing.assert_allclose(stick_modes(sm, 6).frequencies_hz, f0, rtol=1e-7)
+    # mode 1 bends in plane 2 (I2 < I1): along e_z = e_x x v = R[0] x R[2] = -R[1], the CD y
+    u = stick_modes(sm, 1).shapes[6 * NEL:6 * NEL + 3, 0]
+    assert abs(u[1]) > 1e6 * max(abs(u[0]), abs(u[2]))
+    (tmp_path / "basic.bdf").write_text("\n".join(lines).replace(",7\n", "\n") + "\n")
+    u = stick_modes(read_stick_deck(tmp_path / "basic.bdf"), 1).shapes[6 * NEL:6 * NEL + 3, 0]
+    # v = basic z: plane 2 is horizontal, mode 1 moves in the basic x-y plane (R[1] does not)
+    assert abs(u[2]) < 1e-9 * np.linalg.norm(u) and abs(R[1, 2]) > 0.1
