@@ -125,13 +125,21 @@ def _card_ids(model, card: str) -> list:
     return list(model._type_to_id_map.get(card, ()))
 
 
+#: the structural cards of each pyNastran container a stick deck may hold.
+_ALLOWED = {"elements": ("CBAR",), "masses": ("CMASS2", "CONM2"),
+            "rigid_elements": ("RBE2", "RBAR"), "properties": ("PBAR",)}
+
+
 def _refuse_cards(model, name: str) -> None:
-    bad = [(c, len(_card_ids(model, c)), _card_ids(model, c)[0])
-           for c in REFUSED_CARDS if _card_ids(model, c)]
+    found = {c for c in REFUSED_CARDS if _card_ids(model, c)}
+    for attr, ok in _ALLOWED.items():
+        found |= {v.type for v in getattr(model, attr).values() if v.type not in ok}
+    bad = [(c, len(_card_ids(model, c)), (_card_ids(model, c) or ["?"])[0])
+           for c in sorted(found)]
     if bad:
         listed = ", ".join(f"{c} (x{n}, first id {i})" for c, n, i in bad)
         raise BdfError(f"{name}: the stick-model import cannot represent {listed}; it reads "
-                       f"CBAR/PBAR/MAT1, CMASS2, CONM2, SPC/SPC1 and GRID PS")
+                       f"CBAR/PBAR/MAT1, CMASS2, CONM2, RBE2, RBAR, SPC/SPC1 and GRID PS")
     if not _card_ids(model, "CBAR"):
         raise BdfError(f"{name}: no CBAR element: not a stick model")
 

@@ -110,6 +110,10 @@ def test_refused_cards_and_fields_are_named(tmp_path):
     deck = _cantilever(tmp_path / "o.bdf", offt="BGG")
     with pytest.raises(BdfError, match="CBAR 1: OFFT"):
         read_stick_deck(deck)
+    deck = _cantilever(tmp_path / "cb.bdf", extra=("CBUSH,600,7,1,2,,,,0",
+                                                    "PBUSH,7,K,1.0,1.0,1.0,1.0,1.0,1.0"))
+    with pytest.raises(BdfError, match=r"CBUSH \(x1, first id 600\), PBUSH"):
+        read_stick_deck(deck)
     deck = _cantilever(tmp_path / "rb.bdf", extra=("RBAR,501,1,2,123456,123456",))
     with pytest.raises(BdfError, match="RBAR 501: CNA"):
         read_stick_deck(deck)
