@@ -5,7 +5,9 @@ an actuator is given), print the summary table (a deck: every FLUTTER card with 
 method, K / KE / PK / PKNL as MSC Nastran defines them, its rows in the JSON's ``"flutter"``
 and Nastran's FLUTTER SUMMARY printed), and optionally write the JSON summary and an
 HTML report. A bad case file gets one line naming the key and exit status 2. Modes, damping
-and units follow docs/conventions.md (elastic modes from 1, "rigid pitch", g > 0 unstable)."""
+and units follow docs/conventions.md (elastic modes from 1, "rigid pitch", g > 0 unstable).
+A CBAR stick-model deck is run by :func:`asekit.io.bdf_beam.stick_flutter` instead (modes and
+the FLUTTER cards; no HTML report yet)."""
 
 from __future__ import annotations
 
@@ -54,6 +56,42 @@ def _read_case(args, load_case):
     return load_case(path)
 
 
+def _stick_deck(args):
+    """The path of ``args.case`` when it is a CBAR stick-model deck
+    (:func:`asekit.io.bdf_beam.is_stick_deck`), else None (a case file or a plate deck)."""
+    path = resolve_case(args.case)
+    if path.suffix.lower() not in DECK_SUFFIXES or not path.is_file():
+        return None
+    try:
+        from asekit.io.bdf_beam import is_stick_deck
+        return path if is_stick_deck(path) else None
+    except ImportError:                 # no pyNastran: _read_case says so
+        return None
+
+
+def _run_stick(args, path) -> int:
+    """A stick-model deck: its modes and every FLUTTER card with its own method
+    (:func:`asekit.io.bdf_beam.stick_flutter`), the FLUTTER SUMMARY text and the JSON
+    ``{"deck", "modes_hz", "flutter": [rows of asekit.io.bdf.flutter_rows]}``."""
+    reason = outputs.check_file("--json", args.json)
+    if reason or args.report:
+        return _error(reason or "--report: the HTML report of a stick-model (CBAR) deck is "
+                                "not supported yet; use --json")
+    from asekit.case.report import write_text_atomic
+    from asekit.io import bdf
+    from asekit.io.bdf_beam import stick_flutter
+    try:
+        run = stick_flutter(path, units=getattr(args, "units", "SI"))
+    except ValueError as exc:
+        return _error(_named(path.name, exc))
+    f = [float(x) for x in run.modes.frequencies_hz]
+    s = {"deck": str(path), "modes_hz": f, "flutter": bdf.flutter_rows(list(run.results))}
+    text = (f"{path.name}: stick model, modes (Hz) " + ", ".join(f"{x:.4g}" for x in f)
+            + "\n\n" + bdf.format_flutter_summary(list(run.results)))
+    _write_outputs(args, s, text, write_text_atomic)
+    return 0
+
+
 def _error(msg: str) -> int:
     return outputs.print_error(f"error: {msg}", 2, _log)
 
@@ -93,7 +131,14 @@ def _write_outputs(args, s: dict, text: str, write_text_atomic) -> None:
 
 
 def run(args) -> int:
-    """The command: output paths first, then the case (the loader's checks), then the
+    """The command: a CBAR stick-model deck by :func:`_run_stick`, anything else by
+    :func:`_run_case`."""
+    stick = _stick_deck(args)
+    return _run_stick(args, stick) if stick is not None else _run_case(args)
+
+
+def _run_case(args) -> int:
+    """The command for a case file or a plate deck: output paths first, then the case (the loader's checks), then the
     pipeline; an input error or a numerical failure of the case is one line and exit 2 (other
     exceptions reach :func:`asekit.cli.main.main`: one line, exit 1)."""
     for reason in (outputs.check_file("--json", args.json),

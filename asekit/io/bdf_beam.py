@@ -1,0 +1,783 @@
+"""Nastran stick-model decks (CBAR beams) in: the structure of a bar deck as 3-D frame matrices.
+
+:func:`read_stick_deck` reads, through pyNastran, a deck whose structure is made of bars:
+
+- GRID (basic position through any CORD2R/CORD1R/CORD2C/CORD2S of CP; displacement system CD
+  rectangular; permanent constraints PS),
+- CBAR (orientation vector X1-X3 in GA's displacement system, or G0; OFFT blank, GGG, or the
+  old integer flag 1 "X1-X3 is a vector"; pin flags PA/PB and offsets WA/WB refused),
+- PBAR (A, I1, I2, J, NSM; I12 refused) with MAT1 (E, G, RHO),
+- CMASS2 (scalar mass on a grid component, or between two), CONM2 (mass and inertia with
+  offset, CID 0 or blank),
+- SPC1 / SPC (zero enforced value) of the case control's SPC set, PARAM COUPMASS (> 0: the
+  consistent bar mass, else lumped), PARAM WTMASS,
+- RBE2 (GN independent, CM components of the GMi dependent) and RBAR (GA independent in all
+  six components, CMB of GB dependent), eliminated by the rigid-link transformation
+  u_d = u_i + theta_i x (x_d - x_i), theta_d = theta_i (Przemieniecki Sec. 11.7; in the grids'
+  CD systems), K_r = T^T K T, M_r = T^T M T; chains (a dependent DOF independent elsewhere)
+  and SPC on a dependent DOF refused.
+
+The element is :mod:`asekit.structure.frame` (Przemieniecki 1968 Eqs. 5.116 and 11.41, rotated
+by the direction cosines, Eq. 6.26). Every grid carries six DOFs (T1, T2, T3, R1, R2, R3) in its
+displacement system CD, as Nastran's g-set: with R_cd the rows of CD's axes in basic, the
+basic-frame matrices become K_cd = T^T K_basic T, T = diag(R_cd^T, R_cd^T) per grid.
+Massless DOFs are condensed statically (exact for them: no inertia) before the eigen-solution.
+
+Other structural cards (CBEAM, CROD, RBE3, shells, ...) are refused with the card and its
+first id; an unsupported field is refused with card, id and field. Aerodynamic and solution
+cards are read elsewhere (:mod:`asekit.io.bdf`); here they are ignored.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import scipy.linalg as sla
+
+from asekit.io.bdf import UNITS, BdfError, _need_pynastran
+from asekit.structure.frame import BarSection, global_bar_matrices
+
+#: structural cards a stick deck may hold (others are refused).
+STICK_CARDS = ("GRID", "CORD2R", "CORD1R", "CORD2C", "CORD2S", "CBAR", "PBAR", "MAT1",
+               "CMASS2", "CONM2", "SPC", "SPC1", "RBE2", "RBAR")
+
+#: structural cards refused in a stick deck (asekit cannot represent them here).
+REFUSED_CARDS = ("CBEAM", "PBEAM", "PBARL", "PBEAML", "CROD", "CONROD", "PROD", "CTUBE",
+                 "RBE1", "RBE3", "RROD", "MPC", "CELAS1", "CELAS2", "CELAS3",
+                 "CELAS4", "CMASS1", "CMASS3", "CMASS4", "CONM1", "CQUAD4", "CTRIA3", "CQUAD8",
+                 "CTRIA6", "CSHEAR", "CHEXA", "CPENTA", "CTETRA", "CBUSH", "CDAMP1", "CDAMP2",
+                 "CVISC", "SPOINT", "EPOINT", "GENEL", "SPCD", "SUPORT")
+
+NODE_DOF = 6
+
+
+@dataclass(frozen=True)
+class StickModel:
+    """A bar deck's structure (SI).
+
+    Attributes
+    ----------
+    node_ids : (n,) GRID ids; xyz : (n, 3) basic positions (m); cd_axes : (n, 3, 3) rows of
+        each grid's displacement-system axes in basic.
+    K, M : (6n, 6n) stiffness and mass, DOF 6 i + c - 1 = component c of grid i in its CD
+        system (N/m, N, N m; kg, kg m, kg m^2).
+    fixed : sorted constrained DOFs (SPC, SPC1, GRID PS); coupled : the consistent bar mass
+        (PARAM COUPMASS > 0) or lumped; notes : what was read and how; path, units.
+    rigid : (dependent DOF, ((independent DOF, coefficient), ...)) per DOF an RBE2 / RBAR
+        makes dependent.
+    """
+
+    node_ids: np.ndarray
+    xyz: np.ndarray
+    cd_axes: np.ndarray
+    K: np.ndarray
+    M: np.ndarray
+    fixed: tuple
+    coupled: bool
+    notes: tuple = ()
+    path: str = ""
+    units: str = "SI"
+    rigid: tuple = ()
+
+    @property
+    def free(self) -> np.ndarray:
+        """The DOFs neither constrained nor dependent (the solution's unknowns)."""
+        mask = np.ones(self.K.shape[0], bool)
+        mask[list(self.fixed)] = False
+        mask[[d for d, _ in self.rigid]] = False
+        return np.flatnonzero(mask)
+
+    def reduction(self) -> np.ndarray:
+        """T (n_dof, n_free): all DOFs from the free ones (constrained rows 0, dependent rows
+        the rigid links' coefficients; a coefficient on a constrained DOF drops out)."""
+        free = self.free
+        col = {int(d): j for j, d in enumerate(free)}
+        T = np.zeros((self.K.shape[0], free.size))
+        T[free, np.arange(free.size)] = 1.0
+        for d, row in self.rigid:
+            for i, c in row:
+                if i in col:
+                    T[d, col[i]] += c
+        return T
+
+    def dof(self, grid_id: int, component: int) -> int:
+        """Global DOF of GRID ``grid_id``, Nastran component 1-6."""
+        hit = np.flatnonzero(self.node_ids == int(grid_id))
+        if not hit.size or not 1 <= int(component) <= 6:
+            raise ValueError(f"grid_id {grid_id} / component {component}: not a GRID of the "
+                             f"deck or not in 1..6")
+        return NODE_DOF * int(hit[0]) + int(component) - 1
+
+
+@dataclass(frozen=True)
+class StickModes:
+    """Normal modes of a :class:`StickModel`: ``frequencies_hz`` (n_modes,), ``shapes``
+    (6 n_nodes, n_modes) in the grids' CD systems, mass-normalised (phi^T M phi = 1)."""
+
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray
+    notes: tuple = field(default=())
+
+
+def _card_ids(model, card: str) -> list:
+    return list(model._type_to_id_map.get(card, ()))
+
+
+#: the structural cards of each pyNastran container a stick deck may hold.
+_ALLOWED = {"elements": ("CBAR",), "masses": ("CMASS2", "CONM2"),
+            "rigid_elements": ("RBE2", "RBAR"), "properties": ("PBAR",)}
+
+
+def _refuse_cards(model, name: str) -> None:
+    found = {c for c in REFUSED_CARDS if _card_ids(model, c)}
+    for attr, ok in _ALLOWED.items():
+        found |= {v.type for v in getattr(model, attr).values() if v.type not in ok}
+    bad = [(c, len(_card_ids(model, c)), (_card_ids(model, c) or ["?"])[0])
+           for c in sorted(found)]
+    if bad:
+        listed = ", ".join(f"{c} (x{n}, first id {i})" for c, n, i in bad)
+        raise BdfError(f"{name}: the stick-model import cannot represent {listed}; it reads "
+                       f"CBAR/PBAR/MAT1, CMASS2, CONM2, RBE2, RBAR, SPC/SPC1 and GRID PS")
+    if not _card_ids(model, "CBAR"):
+        raise BdfError(f"{name}: no CBAR element: not a stick model")
+
+
+def _rect_axes(model, cid: int, what: str) -> np.ndarray:
+    """Rows of a rectangular system's axes in basic; a curvilinear CD is refused."""
+    if not cid:
+        return np.eye(3)
+    c = model.coords[cid]
+    if c.type not in ("CORD2R", "CORD1R"):
+        raise BdfError(f"{what}: CD = {cid} is a {c.type}; only rectangular displacement "
+                       f"systems (CORD2R, CORD1R) are supported")
+    return np.asarray(c.beta(), float)
+
+
+def _grids(model, L: float):
+    ids = np.array(sorted(model.nodes), dtype=np.int64)
+    xyz = np.array([model.nodes[i].get_position() for i in ids], float) * L
+    axes = np.array([_rect_axes(model, model.nodes[i].cd, f"GRID {i}") for i in ids])
+    return ids, xyz, axes
+
+
+def _bar_vector(model, e, axes_of, xyz_of) -> np.ndarray:
+    """Orientation vector of a CBAR in basic (X1-X3 in GA's CD system, or toward G0)."""
+    if e.g0:
+        return xyz_of(e.g0) - xyz_of(e.ga)
+    return axes_of(e.ga).T @ np.asarray(e.x, float)
+
+
+def _check_bar(e) -> None:
+    if e.offt not in ("GGG", 1, "1", None, ""):
+        raise BdfError(f"CBAR {e.eid}: OFFT = {e.offt!r} is not supported (blank or GGG: the "
+                       f"orientation vector in GA's displacement system)")
+    if e.pa or e.pb:
+        raise BdfError(f"CBAR {e.eid}: pin flags PA = {e.pa}, PB = {e.pb} are not supported "
+                       f"(blank or 0)")
+    if np.any(np.asarray(e.wa, float)) or np.any(np.asarray(e.wb, float)):
+        raise BdfError(f"CBAR {e.eid}: offsets WA/WB are not supported (blank or 0)")
+
+
+def _bar_section(model, pid: int, eid: int, deck_units) -> BarSection:
+    """PBAR + MAT1 of a CBAR as SI section properties."""
+    L, Mu, T, wt = deck_units
+    p = model.properties[pid]
+    if p.type != "PBAR":
+        raise BdfError(f"CBAR {eid}: PID {pid} is a {p.type}; only PBAR is supported")
+    if p.i12:
+        raise BdfError(f"PBAR {pid}: I12 = {p.i12:g} is not supported (0: principal axes)")
+    if not p.A > 0:
+        raise BdfError(f"PBAR {pid}: A = {p.A!r} must be > 0")
+    mat = model.materials[p.mid]
+    if mat.type != "MAT1":
+        raise BdfError(f"PBAR {pid}: MID {p.mid} is a {mat.type}; only MAT1 is supported")
+    E, G, rho = mat.e, mat.g, mat.rho or 0.0
+    if not (E and E > 0 and G is not None and G >= 0):
+        raise BdfError(f"MAT1 {p.mid}: E must be > 0 and G >= 0, got E = {E!r}, G = {G!r}")
+    stress = Mu / (L * T * T)                      # deck pressure in Pa
+    return BarSection(ea=E * p.A * stress * L ** 2, gj=G * p.j * stress * L ** 4,
+                      ei1=E * p.i1 * stress * L ** 4, ei2=E * p.i2 * stress * L ** 4,
+                      mass=(rho * p.A + (p.nsm or 0.0)) * wt * Mu / L)
+
+
+def _add_bars(model, K, M, index, xyz, axes, coupled, deck_units) -> None:
+    for eid in _card_ids(model, "CBAR"):
+        e = model.elements[eid]
+        _check_bar(e)
+        ia, ib = index[e.ga], index[e.gb]
+        v = _bar_vector(model, e, lambda g: axes[index[g]], lambda g: xyz[index[g]])
+        try:
+            Ke, Me = global_bar_matrices(xyz[ia], xyz[ib], v,
+                                         _bar_section(model, e.pid, eid, deck_units), coupled)
+        except ValueError as exc:
+            raise BdfError(f"CBAR {eid}: {exc}") from None
+        d = np.r_[NODE_DOF * ia:NODE_DOF * ia + 6, NODE_DOF * ib:NODE_DOF * ib + 6]
+        K[np.ix_(d, d)] += Ke
+        M[np.ix_(d, d)] += Me
+
+
+def _skew(x) -> np.ndarray:
+    return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
+
+
+def _add_conm2(model, M, index, deck_units) -> None:
+    """CONM2: rigid mass m at offset x from its grid, inertia I about its centre, both in basic
+    (CID 0): u_p = u + theta x x, so M_grid = G^T diag(m, m, m, I) G, G = [[1, -S(x)], [0, 1]]."""
+    L, Mu, T, wt = deck_units
+    for eid in _card_ids(model, "CONM2"):
+        m = model.masses[eid]
+        if m.cid not in (0, None):
+            raise BdfError(f"CONM2 {eid}: CID = {m.cid} is not supported (0: basic)")
+        i = index[m.nid]
+        x = np.asarray(m.X, float) * L
+        inertia = np.asarray(m.Inertia(), float) * wt * Mu * L * L
+        mass = m.mass * wt * Mu
+        G = np.eye(6)
+        G[:3, 3:] = -_skew(x)
+        Mb = G.T @ np.block([[mass * np.eye(3), np.zeros((3, 3))],
+                             [np.zeros((3, 3)), inertia]]) @ G
+        d = np.r_[NODE_DOF * i:NODE_DOF * i + 6]
+        M[np.ix_(d, d)] += Mb            # basic; the whole model is rotated to CD afterwards
+
+
+def _components(c) -> list[int]:
+    return [int(ch) for ch in str(c or "") if ch in "123456"]
+
+
+def _spc_sets(model, name: str) -> list[int]:
+    sets = sorted(set(model.spcs) | set(getattr(model, "spcadds", {})))
+    cc = getattr(model, "case_control_deck", None)
+    if cc is not None:
+        for sub in cc.subcases.values():
+            if "SPC" in sub:
+                return [int(sub["SPC"][0])]
+    if len(sets) > 1:
+        raise BdfError(f"{name}: several SPC sets {sets} and no SPC in the case control")
+    return sets
+
+
+def _fixed_dofs(model, index, name: str) -> set:
+    fixed = set()
+    for nid, n in model.nodes.items():
+        fixed |= {NODE_DOF * index[nid] + c - 1 for c in _components(n.ps)}
+    for sid in _spc_sets(model, name):
+        for s in model.spcs.get(sid, ()):
+            if s.type == "SPC1":
+                pairs = [(g, s.components) for g in s.node_ids]
+            elif s.type == "SPC":
+                if any(float(v or 0.0) for v in s.enforced):
+                    raise BdfError(f"SPC {sid}: enforced displacement D is not supported (0)")
+                pairs = list(zip(s.node_ids, s.components))
+            else:
+                raise BdfError(f"{s.type} {sid} is not supported (SPC, SPC1)")
+            for g, comps in pairs:
+                if g not in index:
+                    raise BdfError(f"{s.type} {sid}: G = {g} is not a GRID")
+                fixed |= {NODE_DOF * index[g] + c - 1 for c in _components(comps)}
+    return fixed
+
+
+def _link(dep: dict, what: str, i: int, d: int, comps, xyz, axes) -> None:
+    """The rows of grid d's ``comps`` (CD components) from grid i's six DOFs (CD): rigid
+    kinematics u_d = u_i - S(x_d - x_i) theta_i, theta_d = theta_i in basic."""
+    G = np.eye(6)
+    G[:3, 3:] = -_skew(xyz[d] - xyz[i])
+    Gc = np.kron(np.eye(2), axes[d]) @ G @ np.kron(np.eye(2), axes[i].T)
+    for c in comps:
+        row = NODE_DOF * d + c - 1
+        if row in dep:
+            raise BdfError(f"{what}: component {c} of its dependent grid is already dependent "
+                           f"on another rigid element")
+        dep[row] = tuple((NODE_DOF * i + k, float(Gc[c - 1, k])) for k in range(6)
+                         if abs(Gc[c - 1, k]) > 1e-15)
+
+
+def _rigid_links(model, index, xyz, axes, fixed: set) -> tuple:
+    """RBE2 / RBAR as dependent DOF rows (module docstring)."""
+    dep = {}
+    for eid in sorted(model.rigid_elements):
+        r = model.rigid_elements[eid]
+        if r.type == "RBE2":
+            for g in r.Gmi:
+                _link(dep, f"RBE2 {eid} (GM {g})", index[r.gn], index[g], _components(r.cm),
+                      xyz, axes)
+        elif r.type == "RBAR":
+            if str(r.cna) != "123456" or str(r.cnb or "").strip() or str(r.cma or "").strip():
+                raise BdfError(f"RBAR {eid}: CNA = {r.cna!r}, CNB = {r.cnb!r}, CMA = {r.cma!r}: "
+                               f"only GA independent in all six components is supported "
+                               f"(CNA 123456, CNB and CMA blank)")
+            _link(dep, f"RBAR {eid}", index[r.ga], index[r.gb], _components(r.cmb or "123456"),
+                  xyz, axes)
+        else:
+            raise BdfError(f"{r.type} {eid} is not supported (RBE2, RBAR)")
+    chained = [d for d, row in dep.items() if any(i in dep for i, _ in row)]
+    if chained:
+        raise BdfError(f"rigid elements chained: DOF {chained[0] % NODE_DOF + 1} of GRID "
+                       f"index {chained[0] // NODE_DOF} is dependent and independent (not "
+                       f"supported)")
+    if fixed & set(dep):
+        d = min(fixed & set(dep))
+        raise BdfError(f"an SPC / GRID PS constrains component {d % NODE_DOF + 1} of a grid "
+                       f"an RBE2 / RBAR makes dependent (Nastran refuses it too)")
+    return tuple(sorted(dep.items()))
+
+
+def _param(model, key: str, default):
+    p = model.params.get(key)
+    return p.values[0] if p is not None else default
+
+
+def read_stick_deck(path, units: str = "SI") -> StickModel:
+    """Read a CBAR stick-model deck's structure (module docstring) into SI matrices.
+
+    Parameters
+    ----------
+    path : str or Path
+        The deck.
+    units : str
+        Its unit system, a key of :data:`asekit.io.bdf.UNITS`.
+
+    Returns
+    -------
+    StickModel
+        Raises :class:`asekit.io.bdf.BdfError` (one line: card, id, field) for what it cannot
+        represent.
+
+    Examples
+    --------
+    >>> from asekit.util.paths import DATA_DIR                      # doctest: +SKIP
+    >>> sm = read_stick_deck(DATA_DIR / "benchmarks/pt145/pt145.bdf",
+    ...                      units="in-lbf-s")                          # doctest: +SKIP
+    >>> sm.K.shape, sm.coupled                                      # doctest: +SKIP
+    ((66, 66), True)
+    """
+    if units not in UNITS:
+        raise ValueError(f"units must be one of {sorted(UNITS)}, got {units!r}")
+    BDF = _need_pynastran()
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"BDF not found: {path}")
+    model = BDF(debug=None)
+    try:
+        model.read_bdf(str(path), xref=True)
+    except Exception as exc:  # pyNastran's own error: card and field in its words
+        raise BdfError(f"{path.name}: {str(exc).strip().splitlines()[0]}") from None
+    _refuse_cards(model, path.name)
+    L, Mu, T = UNITS[units]
+    wt = float(_param(model, "WTMASS", 1.0))
+    coupled = int(_param(model, "COUPMASS", -1)) > 0
+    deck_units = (L, Mu, T, wt)
+    ids, xyz, axes = _grids(model, L)
+    index = {int(g): i for i, g in enumerate(ids)}
+    n = NODE_DOF * len(ids)
+    K, M = np.zeros((n, n)), np.zeros((n, n))
+    _add_bars(model, K, M, index, xyz, axes, coupled, deck_units)
+    _add_conm2(model, M, index, deck_units)
+    # basic -> each grid's CD system: u_basic = A u_cd, A = diag(R^T, R^T) per grid
+    A = sla.block_diag(*[np.kron(np.eye(2), a.T) for a in axes])
+    K, M = A.T @ K @ A, A.T @ M @ A
+    _add_cmass2_si(model, M, index, deck_units)
+    fixed = _fixed_dofs(model, index, path.name)
+    rigid = _rigid_links(model, index, xyz, axes, fixed)
+    notes = (f"{len(_card_ids(model, 'CBAR'))} CBAR, {len(ids)} GRID; bar mass "
+             f"{'consistent (PARAM COUPMASS 1)' if coupled else 'lumped'}",)
+    return StickModel(node_ids=ids, xyz=xyz, cd_axes=axes, K=0.5 * (K + K.T),
+                      M=0.5 * (M + M.T), fixed=tuple(sorted(fixed)), coupled=coupled,
+                      notes=notes, path=str(path), units=units, rigid=rigid)
+
+
+def _add_cmass2_si(model, M, index, deck_units) -> None:
+    """CMASS2 in SI: the scalar element's matrix m [[1, -1], [-1, 1]] (one grid: m) with each
+    entry scaled by the SI factor of its two DOFs, Mu s_i s_j (s = 1 for a translation, L for
+    a rotation: a mass in kg, a rotary inertia in kg m^2, a coupling in kg m)."""
+    L, Mu, T, wt = deck_units
+    for eid in _card_ids(model, "CMASS2"):
+        c = model.masses[eid]
+        dofs, scale = [], []
+        for g, comp in ((c.nodes[0], c.c1), (c.nodes[1], c.c2)):
+            if not g:
+                continue
+            if g not in index or not comp or not 1 <= int(comp) <= 6:
+                raise BdfError(f"CMASS2 {eid}: G/C = {g}/{comp}: a GRID and a component 1-6 "
+                               f"are required")
+            dofs.append(NODE_DOF * index[g] + int(comp) - 1)
+            scale.append(1.0 if int(comp) <= 3 else L)
+        if not dofs:
+            continue
+        pattern = np.array([[1.0, -1.0], [-1.0, 1.0]]) if len(dofs) == 2 else np.ones((1, 1))
+        sc = np.asarray(scale)
+        M[np.ix_(dofs, dofs)] += c.mass * wt * Mu * pattern * np.outer(sc, sc)
+
+
+def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
+    """Normal modes K phi = omega^2 M phi of the free DOFs, solved as M phi = lambda K phi,
+    lambda = 1 / omega^2, for the largest lambda: exact with DOFs that carry no mass (e.g. the
+    twist of a bar without torsional inertia, in any frame: lambda = 0 there) and accurate for
+    the lowest modes of stiff bars (no stiffness-times-mass-basis mixing).
+
+    Parameters
+    ----------
+    model : :class:`StickModel`.
+    n_modes : how many, lowest first (>= 1).
+
+    Returns
+    -------
+    StickModes
+
+    Examples
+    --------
+    One clamped-free Hermite bar (E I = m = L = 1): omega_1 = sqrt(12.48) = 3.533 (the exact
+    beam: 1.875^2 = 3.516)
+
+    >>> from asekit.structure.frame import BarSection, global_bar_matrices
+    >>> K, M = global_bar_matrices([0, 0, 0], [1, 0, 0], [0, 0, 1],
+    ...                            BarSection(1e6, 1.0, 1.0, 1.0, 1.0))
+    >>> sm = StickModel(np.array([1, 2]), np.zeros((2, 3)), np.array([np.eye(3)] * 2), K, M,
+    ...                 tuple(range(6)), True)
+    >>> round(float(stick_modes(sm, 1).frequencies_hz[0] * 2 * np.pi), 3)
+    3.533
+    """
+    free = model.free
+    Tr = model.reduction()
+    K = Tr.T @ model.K @ Tr
+    M = Tr.T @ model.M @ Tr
+    n = min(int(n_modes), free.size)
+    if n < 1:
+        raise ValueError(f"n_modes must be >= 1, got {n_modes}")
+    try:
+        lam, phi = sla.eigh(M, K, subset_by_index=[free.size - n, free.size - 1])
+    except np.linalg.LinAlgError:
+        raise BdfError("the stick model's stiffness is singular on its free DOFs (a "
+                       "mechanism or a rigid-body mode): constrain them with SPC or GRID "
+                       "PS") from None
+    lam, phi = lam[::-1], phi[:, ::-1]
+    if lam[-1] <= 1e-14 * lam[0]:
+        raise BdfError(f"fewer than {n} modes carry mass (the DOFs without mass have no "
+                       f"frequency): ask for fewer modes")
+    phi = phi / np.sqrt(np.einsum("ij,ik,kj->j", phi, M, phi))
+    full = Tr @ phi
+    w2 = 1.0 / lam
+    return StickModes(frequencies_hz=np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi),
+                      shapes=full)
+
+
+# ---------------------------------------------------------------------------------------------
+# SPLINE2 (beam spline) and the deck's flutter requests
+# ---------------------------------------------------------------------------------------------
+def _hermite_row(s_nodes: np.ndarray, s: float):
+    """Weights of (w_j, w'_j) for w(s) and w'(s) and of theta_j for theta(s), theta'(s) on the
+    axis stations ``s_nodes`` (ascending): cubic Hermite between stations (a beam loaded only
+    at its stations), straight beyond the ends (an unloaded beam's extension)."""
+    n = s_nodes.size
+    ww, wd, dw, dd, tt, td = (np.zeros(n) for _ in range(6))
+    if s <= s_nodes[0] or s >= s_nodes[-1]:
+        j = 0 if s <= s_nodes[0] else n - 1
+        ww[j], wd[j], dd[j], tt[j] = 1.0, s - s_nodes[j], 1.0, 1.0
+        return ww, wd, dw, dd, tt, td
+    j = int(np.searchsorted(s_nodes, s) - 1)
+    h = s_nodes[j + 1] - s_nodes[j]
+    t = (s - s_nodes[j]) / h
+    ww[[j, j + 1]] = 1 - 3 * t * t + 2 * t ** 3, 3 * t * t - 2 * t ** 3
+    wd[[j, j + 1]] = h * (t - 2 * t * t + t ** 3), h * (t ** 3 - t * t)
+    dw[[j, j + 1]] = (-6 * t + 6 * t * t) / h, (6 * t - 6 * t * t) / h
+    dd[[j, j + 1]] = 1 - 4 * t + 3 * t * t, 3 * t * t - 2 * t
+    tt[[j, j + 1]] = 1 - t, t
+    td[[j, j + 1]] = -1 / h, 1 / h
+    return ww, wd, dw, dd, tt, td
+
+
+def beam_axis_spline(s_nodes, points_s, points_x, ex_flow: float, ey_flow: float):
+    """Interpolation of a beam spline's axis motion to points off the axis (MSC Nastran
+    SPLINE2 with its grids attached in deflection, slope and twist: DZ = DTHX = DTHY = 0).
+
+    The spline is a beam along its y axis (MSC Nastran Aeroelastic Analysis User's Guide,
+    Sec. 2.3 "Beam splines"): deflection w(s) along its z axis and slope w' = theta_x
+    interpolated by the cubic Hermite functions of a beam loaded only at the stations (exact
+    for it), twist theta_y linearly, both straight beyond the end stations. A point at chordwise
+    distance x from the axis moves
+
+        h = w(s) - x theta_y(s),   dh/dX = (w'(s) - x theta_y'(s)) e_y,X - theta_y(s) e_x,X,
+
+    X the flow direction (the basic x axis) and e_x,X, e_y,X the spline axes' X components.
+
+    Parameters
+    ----------
+    s_nodes : (n,) stations along the axis (m), strictly ascending.
+    points_s, points_x : (p,) the points' axial and chordwise coordinates (m).
+    ex_flow, ey_flow : X components of the spline's x and y axes.
+
+    Returns
+    -------
+    (H, D) : (p, 3 n) matrices giving h and dh/dX from the station values
+        (w_1..w_n, theta_x,1..theta_x,n, theta_y,1..theta_y,n) (m and rad).
+
+    Examples
+    --------
+    A rigid pitch theta_y = 1 about the axis: h = -x, dh/dX = -e_x,X.
+
+    >>> H, D = beam_axis_spline([0.0, 1.0], [0.5], [0.2], 1.0, 0.0)
+    >>> (H @ [0, 0, 0, 0, 1, 1]).round(12).tolist(), (D @ [0, 0, 0, 0, 1, 1]).tolist()
+    ([-0.2], [-1.0])
+    """
+    s_nodes = np.asarray(s_nodes, float)
+    if s_nodes.ndim != 1 or s_nodes.size < 2 or np.any(np.diff(s_nodes) <= 0):
+        raise ValueError("s_nodes must hold >= 2 strictly ascending stations")
+    ps, px = np.asarray(points_s, float), np.asarray(points_x, float)
+    n = s_nodes.size
+    H, D = np.zeros((ps.size, 3 * n)), np.zeros((ps.size, 3 * n))
+    for i, (s, x) in enumerate(zip(ps, px)):
+        ww, wd, dw, dd, tt, td = _hermite_row(s_nodes, s)
+        H[i] = np.r_[ww, wd, -x * tt]
+        D[i] = np.r_[dw * ey_flow, dd * ey_flow, -x * td * ey_flow - tt * ex_flow]
+    return H, D
+
+
+def _check_spline2(s) -> None:
+    for name, v in (("DZ", s.dz), ("DTHX", s.dthx), ("DTHY", s.dthy)):
+        if v not in (0, 0.0):
+            raise BdfError(f"SPLINE2 {s.eid}: {name} = {v!r} is not supported (0.0: attached, "
+                           f"no smoothing)")
+    if str(s.usage or "BOTH").upper() != "BOTH":
+        raise BdfError(f"SPLINE2 {s.eid}: USAGE = {s.usage!r} is not supported (BOTH)")
+
+
+def _spline2_station_matrix(model, s, sm: StickModel, L: float):
+    """(3 n_g, 6 n_nodes) map from the model's DOFs to the spline stations' (w, theta_x,
+    theta_y), the stations (sorted, m), the spline frame (rows e_x, e_y, e_z) and its origin."""
+    c = model.coords[s.cid] if s.cid else None
+    axes = np.asarray(c.beta(), float) if c is not None else np.eye(3)
+    origin = (np.asarray(c.origin, float) if c is not None else np.zeros(3)) * L
+    if abs(axes[2, 2]) < 1 - 1e-6:
+        raise BdfError(f"SPLINE2 {s.eid}: CID = {s.cid}: the spline's z axis must be normal "
+                       f"to the boxes (basic z)")
+    grids = [int(g) for g in model.sets[s.setg].ids]
+    idx = [int(np.flatnonzero(sm.node_ids == g)[0]) for g in grids]
+    st = (sm.xyz[idx] - origin) @ axes[1]
+    order = np.argsort(st)
+    if np.any(np.diff(st[order]) <= 1e-9 * max(1.0, np.ptp(st))):
+        raise BdfError(f"SPLINE2 {s.eid}: SETG {s.setg}: two grids at the same station")
+    n, N = len(idx), sm.K.shape[0]
+    S = np.zeros((3 * n, N))
+    for r, k in enumerate(order):
+        i = idx[k]
+        Rt = sm.cd_axes[i].T                           # CD components -> basic
+        d = NODE_DOF * i
+        S[r, d:d + 3] = axes[2] @ Rt                    # w
+        S[n + r, d + 3:d + 6] = axes[0] @ Rt            # theta_x (the slope)
+        S[2 * n + r, d + 3:d + 6] = axes[1] @ Rt        # theta_y (the twist)
+    return S, st[order], axes, origin
+
+
+def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L: float):
+    """The modes on the boxes through the deck's SPLINE2 cards (each box on one spline):
+    :func:`beam_axis_spline` at the control points (h, dh/dx) and load points (h)."""
+    from asekit.aero.spline import BoxModes
+    n_b, n_m = len(box_ids), modes.shapes.shape[1]
+    h_cp, d_cp, h_lp = np.zeros((n_b, n_m)), np.zeros((n_b, n_m)), np.zeros((n_b, n_m))
+    done = np.zeros(n_b, bool)
+    pos = {int(b): i for i, b in enumerate(box_ids)}
+    for s in model.splines.values():
+        if s.type != "SPLINE2":
+            raise BdfError(f"{s.type} {s.eid}: a stick deck's splines must be SPLINE2")
+        _check_spline2(s)
+        rows = [pos[b] for b in range(int(s.box1), int(s.box2) + 1) if b in pos]
+        S, st, axes, o = _spline2_station_matrix(model, s, sm, L)
+        q = S @ modes.shapes
+        for pts, out, dout in ((mesh.control_point, h_cp, d_cp), (mesh.load_point, h_lp, None)):
+            rel = pts[rows] - o
+            H, D = beam_axis_spline(st, rel @ axes[1], rel @ axes[0], axes[0, 0], axes[1, 0])
+            out[rows] = H @ q
+            if dout is not None:
+                dout[rows] = D @ q
+        done[rows] = True
+    if not done.all():
+        raise BdfError(f"boxes {[int(b) for b in np.asarray(box_ids)[~done][:10]]} are on no "
+                       f"SPLINE2")
+    return BoxModes(h_cp, d_cp, h_lp)
+
+
+def _n_modes(model) -> int:
+    p = model.params.get("LMODES")
+    if p is not None and int(p.values[0]) > 0:
+        return int(p.values[0])
+    for m in model.methods.values():
+        if getattr(m, "nd", None):
+            return int(m.nd)
+    return 6
+
+
+@dataclass(frozen=True)
+class StickFlutter:
+    """The flutter of a stick deck: ``modes`` (:class:`StickModes` used), ``results`` one
+    :class:`asekit.io.bdf.DeckFlutter` per FLUTTER card (the case control's FMETHOD first),
+    ``b_ref`` (m)."""
+
+    modes: StickModes
+    results: tuple
+    b_ref: float
+
+
+@dataclass(frozen=True)
+class _Table:
+    """The GAF tables by Mach, read as :func:`asekit.io.bdf.deck_flutter` reads a database."""
+
+    gafs: dict
+
+    def at(self, mach: float):
+        if mach not in self.gafs:
+            raise BdfError(f"Mach {mach:g} of a FLUTTER card is not on an MKAERO1 card")
+        return self.gafs[mach]
+
+
+def is_stick_deck(path) -> bool:
+    """True when the deck's structure is bars (CBAR) and no shell: :func:`stick_flutter`'s
+    deck, not :func:`asekit.io.bdf.read_bdf`'s."""
+    model = _need_pynastran()(debug=None)
+    try:
+        model.read_bdf(str(path), xref=False)
+    except Exception:           # read_bdf reports the deck's error in its own words
+        return False
+    cc = model.card_count
+    return "CBAR" in cc and not any(c in cc for c in ("CQUAD4", "CTRIA3"))
+
+
+def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
+    """Run every FLUTTER card (K, KE, PK, PKNL as Nastran defines them,
+    :mod:`asekit.aeroelastic.nastran`) of a CBAR stick deck with asekit's doublet lattice on
+    the CAERO1 boxes and the SPLINE2 beam spline; PARAM LMODES (else EIGR/EIGRL ND) modes.
+
+    Parameters
+    ----------
+    path : the deck; units : its unit system (:data:`asekit.io.bdf.UNITS`).
+    ks : reduced frequencies of the aerodynamic table (default the MKAERO1 list, which the
+        method interpolates as the FLUTTER card's IMETH says, as Nastran does; outside the
+        list asekit holds the end values, :meth:`asekit.aero.gaf.TabulatedGaf.parts`).
+
+    Returns
+    -------
+    StickFlutter
+    """
+    from asekit.aero.gaf import TabulatedGaf, gaf_from_box_modes
+    from asekit.aeroelastic.statespace import modal_arrays
+    from asekit.io import bdf as B
+
+    sm = read_stick_deck(path, units)
+    model = _need_pynastran()(debug=None)
+    model.read_bdf(str(path), xref=True)
+    L, Mu, T = UNITS[units]
+    deck = B._Deck(model, Path(path).name, L, Mu, T)
+    if not model.caeros or not model.flutters:
+        raise BdfError(f"{deck.name}: no CAERO1 or no FLUTTER card: nothing to run")
+    for c in model.caeros.values():
+        B._check_caero1(deck, c)
+    mesh, box_ids = B._boxes(model, L, 0.0)
+    b_ref, rho_ref, symmetric = B._read_aero_card(deck)
+    machs, table_ks = B._read_mkaero1(model, deck)
+    requests = [B._flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
+    fm = B._case_value(model, "FMETHOD")
+    requests.sort(key=lambda r: r.sid != fm)
+    modes = stick_modes(sm, _n_modes(model))
+    bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L)
+    w = 2 * np.pi * modes.frequencies_hz
+    modal = modal_arrays(M=np.eye(w.size), K=np.diag(w ** 2))
+    ks = np.asarray(table_ks if ks is None else ks, float)
+    db = _Table({m: TabulatedGaf(ks, gaf_from_box_modes(bm, mesh, m, ks, b_ref, symmetric),
+                                 b_ref, m) for m in machs})
+    return StickFlutter(modes=modes, b_ref=b_ref,
+                        results=tuple(B._solve_request(r, modal, db) for r in requests))
+
+
+# ---------------------------------------------------------------------------------------------
+# export of a [[beam]] (a StraightBeam) as a CBAR deck
+# ---------------------------------------------------------------------------------------------
+def _bar_mass(beam) -> np.ndarray:
+    """The mass the deck's CBARs carry (PBAR NSM = m, PARAM COUPMASS 1), global frame."""
+    n = NODE_DOF * beam.n_nodes
+    M = np.zeros((n, n))
+    x = beam.nodes
+    for e, sec in enumerate(beam.sections):
+        bar = BarSection(sec.ea, sec.gj, sec.ei_flap, sec.ei_chord, sec.mass)
+        _, Me = global_bar_matrices(x[e], x[e + 1], beam.frame[2], bar, True)
+        d = np.r_[NODE_DOF * e:NODE_DOF * e + 12]
+        M[np.ix_(d, d)] += Me
+    return M
+
+
+def scalar_mass_pairs(R: np.ndarray, tol: float = 0.0) -> list[tuple[int, int, float]]:
+    """A symmetric matrix as scalar masses (CMASS2): R = sum_{i<j} m_ij (e_i - e_j)(e_i -
+    e_j)^T + sum_i m_i e_i e_i^T with m_ij = -R_ij and m_i = sum_j R_ij (the row sum).
+
+    Returns
+    -------
+    list of (i, j, m): j = -1 for a grounded (one-DOF) mass; entries with |m| <= tol left out.
+
+    Examples
+    --------
+    >>> R = np.array([[2.0, 1.0], [1.0, 2.0]])
+    >>> scalar_mass_pairs(R)
+    [(0, 1, -1.0), (0, -1, 3.0), (1, -1, 3.0)]
+    """
+    R = np.asarray(R, float)
+    n = R.shape[0]
+    out = [(i, j, -float(R[i, j])) for i in range(n) for j in range(i + 1, n)
+           if abs(R[i, j]) > tol]
+    out += [(i, -1, float(R[i].sum())) for i in range(n) if abs(R[i].sum()) > tol]
+    return out
+
+
+def write_beam_bdf(beam, path) -> Path:
+    """Write a clamped :class:`~asekit.structure.beam.StraightBeam` (a case's ``[[beam]]``,
+    :func:`asekit.case.pipeline.case_beam`) as an SI SOL 103 deck that
+    :func:`read_stick_deck` reads back to the same matrices.
+
+    GRID per node, CBAR per element (orientation vector the surface normal e3: plane 1 is the
+    flap plane), PBAR with MAT1 E = G = 1 Pa (A = EA, I1 = EI_flap, I2 = EI_chord, J = GJ,
+    NSM = m), PARAM COUPMASS 1 (the consistent bar mass), SPC1 123456 at the root. What a PBAR
+    cannot hold -- the polar inertia, the mass offset's bending-torsion coupling and the point
+    masses -- is the difference between the beam's consistent mass matrix
+    (:func:`asekit.structure.beam.assemble`) and the bars' one, written exactly as CMASS2 scalar
+    masses (:func:`scalar_mass_pairs`; some negative, as a consistent matrix's lumped form
+    needs).
+
+    Parameters
+    ----------
+    beam : StraightBeam.
+    path : the deck to write (overwritten).
+
+    Returns
+    -------
+    Path
+    """
+    from asekit.structure.beam import assemble
+
+    path = Path(path)
+    _, Mb = assemble(beam)
+    R = Mb - _bar_mass(beam)
+    free = slice(NODE_DOF, None)                  # the root node is clamped
+    Rf = np.zeros_like(R)
+    Rf[free, free] = R[free, free]
+    lines = ["SOL 103", "CEND", "SPC = 1", "METHOD = 1", "BEGIN BULK",
+             "$ written by asekit.io.bdf_beam.write_beam_bdf (SI)"]
+    for i, x in enumerate(beam.nodes):
+        lines.append(f"GRID,{i + 1},,{x[0]!r},{x[1]!r},{x[2]!r}")
+    v = beam.frame[2]
+    for e, sec in enumerate(beam.sections):
+        lines.append(f"CBAR,{e + 1},{e + 1},{e + 1},{e + 2},{v[0]!r},{v[1]!r},{v[2]!r}")
+        lines.append(f"PBAR,{e + 1},1,{sec.ea!r},{sec.ei_flap!r},{sec.ei_chord!r},"
+                     f"{sec.gj!r},{sec.mass!r}")
+    lines += ["MAT1,1,1.0,1.0", "SPC1,1,123456,1", "PARAM,COUPMASS,1",
+              f"EIGRL,1,,,{min(6, NODE_DOF * (beam.n_nodes - 1))}"]
+    tol = 1e-14 * float(np.abs(Mb).max())
+    eid = 100000
+    for i, j, m in scalar_mass_pairs(Rf, tol):
+        g1, c1 = divmod(i, NODE_DOF)
+        g2 = f"{j // NODE_DOF + 1},{j % NODE_DOF + 1}" if j >= 0 else ","
+        eid += 1
+        lines.append(f"CMASS2,{eid},{m!r},{g1 + 1},{c1 + 1},{g2}")
+    lines.append("ENDDATA")
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text("\n".join(lines) + "\n")
+    tmp.replace(path)
+    return path

@@ -1,0 +1,188 @@
+"""A 3-D frame element in any orientation: the bar of a stick model (Nastran's CBAR idea).
+
+The element joins two nodes with six degrees of freedom each, (u_x, u_y, u_z, r_x, r_y, r_z)
+per node. Its own frame follows Nastran's CBAR convention (MSC Nastran Quick Reference Guide,
+CBAR): e_x from node A to node B; the orientation vector v fixes plane 1, the plane of e_x and
+v: e_y is the part of v normal to e_x, e_z = e_x x e_y. Bending in plane 1 (deflection along
+e_y, slope r_z = dv/dx) has stiffness E I1; bending in plane 2 (deflection along e_z,
+r_y = -dw/dx) has E I2; axial E A, St Venant torsion G J.
+
+Local stiffness: Przemieniecki, *Theory of Matrix Structural Analysis* (McGraw-Hill 1968),
+Eq. 5.116 (cubic Hermite deflections, linear axial and twist). Mass: the consistent ("coupled")
+matrix of the same shape functions, Przemieniecki Eq. 11.41 for axial and transverse motion, or
+the lumped one, m L / 2 on each node's three translations (Nastran's default for the CBAR,
+PARAM COUPMASS < 1). Neither carries a polar (torsional) mass moment: a bar's mass is m = rho A
++ NSM per length on its axis, as Nastran's CBAR has it (its PBAR has no polar-inertia field;
+torsional inertia is given by point masses).
+
+Global matrices: with the direction-cosine matrix R (rows e_x, e_y, e_z in the global frame)
+and T = diag(R, R, R, R) (12 x 12), u_local = T u_global and
+
+    K_global = T^T K_local T,  M_global = T^T M_local T          (Przemieniecki Eq. 6.26),
+
+so the element's frequencies do not depend on how the structure is placed in space. SI units.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from asekit.util.validate import finite_array, in_range, positive
+
+#: degrees of freedom per node: u_x, u_y, u_z, r_x, r_y, r_z.
+NODE_DOF = 6
+
+
+@dataclass(frozen=True)
+class BarSection:
+    """Stiffness and mass of a bar's cross-section (SI), uniform along the element.
+
+    Parameters
+    ----------
+    ea : axial stiffness E A (N), > 0.
+    gj : torsional stiffness G J (N m^2), >= 0.
+    ei1 : bending stiffness in plane 1, E I1 (deflection along e_y) (N m^2), >= 0.
+    ei2 : bending stiffness in plane 2, E I2 (deflection along e_z) (N m^2), >= 0.
+    mass : mass per length m = rho A + NSM (kg/m), >= 0.
+
+    Examples
+    --------
+    >>> BarSection(ea=1e6, gj=10.0, ei1=5.0, ei2=0.0, mass=2.0).ei2
+    0.0
+    """
+
+    ea: float
+    gj: float
+    ei1: float
+    ei2: float
+    mass: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "ea", positive("ea", self.ea))
+        for name in ("gj", "ei1", "ei2", "mass"):
+            object.__setattr__(self, name, in_range(name, getattr(self, name), 0.0, True))
+
+
+def bar_frame(xa, xb, v) -> tuple[float, np.ndarray]:
+    """Length and direction cosines of a bar from node A to node B with orientation vector v.
+
+    Parameters
+    ----------
+    xa, xb : (3,) node positions (m), distinct.
+    v : (3,) orientation vector (any length), not parallel to B - A.
+
+    Returns
+    -------
+    (L, R) : the length (m) and the (3, 3) matrix whose rows are e_x, e_y, e_z (Nastran's
+        CBAR element frame: e_x = (B - A)/L, e_y = the part of v normal to e_x, normalised,
+        e_z = e_x x e_y).
+
+    Examples
+    --------
+    >>> L, R = bar_frame([0, 0, 0], [0, 2, 0], [0, 0, 1])
+    >>> float(L), R[0].tolist(), R[2].tolist()
+    (2.0, [0.0, 1.0, 0.0], [1.0, 0.0, 0.0])
+    """
+    xa, xb, v = (finite_array(n, a).reshape(3) for n, a in (("xa", xa), ("xb", xb), ("v", v)))
+    d = xb - xa
+    L = float(np.linalg.norm(d))
+    if L <= 1e-12 * max(1.0, float(np.linalg.norm(xa))):
+        raise ValueError("xb must differ from xa (a bar of zero length)")
+    ex = d / L
+    vy = v - (v @ ex) * ex
+    nv = float(np.linalg.norm(vy))
+    if nv <= 1e-9 * max(float(np.linalg.norm(v)), 1e-300):
+        raise ValueError("v must not be parallel to the bar's axis xb - xa (or zero)")
+    ey = vy / nv
+    return L, np.vstack([ex, ey, np.cross(ex, ey)])
+
+
+def _bending(ei: float, m: float, L: float, slope_sign: float, coupled: bool):
+    """(4, 4) stiffness and mass of one bending plane, DOFs (w1, r1, w2, r2), r = slope_sign w'
+    (Przemieniecki Eqs. 5.116 and 11.41)."""
+    k = ei / L ** 3 * np.array([[12, 6 * L, -12, 6 * L], [6 * L, 4 * L * L, -6 * L, 2 * L * L],
+                                [-12, -6 * L, 12, -6 * L], [6 * L, 2 * L * L, -6 * L, 4 * L * L]])
+    if coupled:
+        mm = m * L / 420 * np.array([[156, 22 * L, 54, -13 * L],
+                                     [22 * L, 4 * L * L, 13 * L, -3 * L * L],
+                                     [54, 13 * L, 156, -22 * L],
+                                     [-13 * L, -3 * L * L, -22 * L, 4 * L * L]])
+    else:
+        mm = np.diag([m * L / 2, 0.0, m * L / 2, 0.0])
+    s = np.diag([1.0, slope_sign, 1.0, slope_sign])
+    return s @ k @ s, s @ mm @ s
+
+
+def bar_matrices(section: BarSection, length: float, coupled: bool = True):
+    """Local stiffness and mass (12 x 12) of a bar, DOFs (u1, u2, u3, r1, r2, r3) of node A,
+    then of node B, in the element frame of :func:`bar_frame`.
+
+    Parameters
+    ----------
+    section : :class:`BarSection`.
+    length : L (m), > 0.
+    coupled : the consistent mass (True, Nastran's PARAM COUPMASS 1) or the lumped one.
+
+    Returns
+    -------
+    (K, M) : (12, 12) symmetric arrays (SI). Blocks: axial E A / L [[1, -1], [-1, 1]] with
+        mass m L / 6 [[2, 1], [1, 2]] (coupled); torsion G J / L, no mass; plane 1 (u2, r3 =
+        u2') with E I1 and plane 2 (u3, r2 = -u3') with E I2 by Hermite cubics.
+
+    Examples
+    --------
+    >>> K, M = bar_matrices(BarSection(1.0, 1.0, 1.0, 1.0, 3.0), 2.0)
+    >>> round(float(M[np.ix_([2, 8], [2, 8])].sum()), 12)     # transverse mass m L
+    6.0
+    """
+    L = positive("length", length)
+    s = section
+    K = np.zeros((12, 12))
+    M = np.zeros((12, 12))
+    ax, tw = np.array([0, 6]), np.array([3, 9])
+    K[np.ix_(ax, ax)] = s.ea / L * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    M[np.ix_(ax, ax)] = (s.mass * L / 6 * np.array([[2.0, 1.0], [1.0, 2.0]]) if coupled
+                         else np.diag([s.mass * L / 2] * 2))
+    K[np.ix_(tw, tw)] = s.gj / L * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    for dofs, ei, sign in (([1, 5, 7, 11], s.ei1, 1.0), ([2, 4, 8, 10], s.ei2, -1.0)):
+        k, m = _bending(ei, s.mass, L, sign, coupled)
+        K[np.ix_(dofs, dofs)] = k
+        M[np.ix_(dofs, dofs)] = m
+    return K, M
+
+
+def rotate(A: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """A 12 x 12 element matrix from the element frame to the global one: T^T A T with
+    T = diag(R, R, R, R) (Przemieniecki Eq. 6.26).
+
+    Examples
+    --------
+    >>> R = np.array([[0.0, 1, 0], [-1, 0, 0], [0, 0, 1]])
+    >>> A = np.eye(12)
+    >>> bool(np.allclose(rotate(A, R), A))
+    True
+    """
+    T = np.kron(np.eye(4), np.asarray(R, float))
+    return T.T @ np.asarray(A, float) @ T
+
+
+def global_bar_matrices(xa, xb, v, section: BarSection, coupled: bool = True):
+    """Stiffness and mass (12 x 12) of a bar in the global frame: :func:`bar_frame`, then
+    :func:`bar_matrices`, then :func:`rotate`.
+
+    Returns
+    -------
+    (K, M) : (12, 12) arrays, DOFs (u_x, u_y, u_z, r_x, r_y, r_z) of A then B (SI).
+
+    Examples
+    --------
+    >>> K, M = global_bar_matrices([0, 0, 0], [1, 1, 0], [0, 0, 1],
+    ...                            BarSection(1.0, 1.0, 1.0, 1.0, 1.0))
+    >>> bool(np.allclose(K, K.T)) and round(float(M[np.ix_([2, 8], [2, 8])].sum()), 12)
+    1.414213562373
+    """
+    L, R = bar_frame(xa, xb, v)
+    K, M = bar_matrices(section, L, coupled)
+    return rotate(K, R), rotate(M, R)
