@@ -150,7 +150,8 @@ class ControlSurfaceSpec:
     (0-based): its hinge line at chord fractions ``hinge_chord_fraction`` = (inboard, outboard)
     of the panel's local chord, between the span fractions ``span_fraction`` = (start, end) of
     the panel; ``kind`` "rigid" (a rigid surface rotating about its hinge, as Nastran's
-    AESURF); ``hinge_stiffness`` N m/rad and ``hinge_damping`` N m s/rad of the hinge;
+    AESURF) or "elastic" (the plate region released along its hinge,
+    :mod:`asekit.structure.hinge`); ``hinge_stiffness`` N m/rad and ``hinge_damping`` N m s/rad of the hinge;
     ``mass_balance``: ((x, y) m, mass kg) pairs fixed to the surface
     (:mod:`asekit.aeroelastic.control_surface`); ``freeplay_deg`` the half-width (deg) of a
     freeplay gap in the hinge spring (0: none; :mod:`asekit.aeroelastic.hinge_freeplay`)."""
