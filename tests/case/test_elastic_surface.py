@@ -170,3 +170,30 @@ def test_elastic_and_rigid_flutter_on_the_aileron_wing(elastic_case):
     for e, r, e8 in zip(el, rg, el8):
         assert e.speed_ms < r.speed_ms < 0.7 * 24.6
         assert e.speed_ms == pytest.approx(e8.speed_ms, rel=0.05)
+
+
+def test_spring_hinge_moment_equals_the_pressure_integral(models, elastic_case):
+    """The hinge moment two ways: with the wing held in its first mode (zeta_1 = 1) at
+    q = 200 Pa and the aileron floating on its spring, the spring's moment k_h delta (the
+    structure's output) equals the pressure integral -q sum dp_i d_i A_i over the aileron's
+    boxes (the vortex lattice's pressures of the deformed wing, d the load points' distance
+    aft of the hinge, asekit.aero.control_surface.HingedMesh.distance_aft)."""
+    from asekit.aero.vlm import vlm_normalwash_matrix
+    from asekit.aeroelastic.control_surface import steady_generalised_forces
+
+    el, _ = models
+    hm = P.control_surface_mesh(elastic_case)
+    q, n = 200.0, el.n_wing
+    q0, _, _ = steady_generalised_forces(el, hm, 0.0)
+    k_h = el.modal.K[n, n]
+    delta = q * q0[n, 0] / (k_h - q * q0[n, n])             # equilibrium of the hinge row
+    x = np.zeros(n + 1)
+    x[0], x[n] = 1.0, delta
+    mesh = hm.mesh
+    cp = np.linalg.solve(vlm_normalwash_matrix(mesh, 0.0, False),
+                         el.box_modes.normalwash(0.0, 1.0).real @ x)
+    on = hm.on_surface[0]
+    d = hm.distance_aft(0, mesh.load_point[on])
+    h_pressure = -q * float(np.sum(cp[on] * mesh.area[on] * d))
+    assert abs(delta) > 1e-3
+    assert k_h * delta == pytest.approx(h_pressure, rel=1e-6)
