@@ -259,7 +259,8 @@ def surface_elements(mesh, hm: HingedMesh, index: int) -> np.ndarray:
 
 
 def elastic_flap_modal_model(released, M_split, hm: HingedMesh, n_modes: int,
-                             modal_damping_ratio=None, structural_g=None) -> FlapModel:
+                             modal_damping_ratio=None, structural_g=None,
+                             dense_limit: int = 3000) -> FlapModel:
     """The modal model of a wing with one elastic control surface (``kind = "elastic"``): the
     plate released along the hinge (:func:`asekit.structure.hinge.release_hinge`, a
     ``"single"`` release) reduced by Craig & Bampton's method ("Coupling of substructures for
@@ -284,6 +285,8 @@ def elastic_flap_modal_model(released, M_split, hm: HingedMesh, n_modes: int,
     n_modes : fixed-interface modes kept (>= 1).
     modal_damping_ratio, structural_g : the wing modes' damping
         (:func:`asekit.structure.modes.with_damping`).
+    dense_limit : the fixed-hinge modes by a dense eigen-solution up to this many reduced
+        DOFs, beyond it by shift-invert Lanczos about 0 (the supported wing has no rigid mode).
 
     Returns
     -------
@@ -321,16 +324,23 @@ def elastic_flap_modal_model(released, M_split, hm: HingedMesh, n_modes: int,
         raise ValueError("elastic_flap_modal_model needs one surface with a 'single' release")
     r = int(released.hinge_index[0])
     o = np.setdiff1d(np.arange(released.K.shape[0]), [r])
-    K_r, M_r = released.K.toarray(), released.M.toarray()
-    lam, phi_o = linalg.eigh(K_r[np.ix_(o, o)], M_r[np.ix_(o, o)],
-                             subset_by_index=[0, n_modes - 1])
+    K_oo, M_oo = released.K[o][:, o], released.M[o][:, o]
+    if o.size <= dense_limit:
+        lam, phi_o = linalg.eigh(K_oo.toarray(), M_oo.toarray(), subset_by_index=[0, n_modes - 1])
+    else:
+        from scipy.sparse.linalg import eigsh
+
+        lam, phi_o = eigsh(K_oo.tocsc(), k=n_modes, M=M_oo.tocsc(), sigma=0.0, which="LM")
+        order = np.argsort(lam)
+        lam, phi_o = lam[order], phi_o[:, order]
+        phi_o = phi_o / np.sqrt(np.einsum("im,im->m", phi_o, M_oo @ phi_o))
     psi = hinge_constraint_mode(released)
-    basis = np.zeros((K_r.shape[0], n_modes + 1))
+    basis = np.zeros((released.K.shape[0], n_modes + 1))
     basis[o, :n_modes] = phi_o
     basis[:, n_modes] = psi
-    m_aug = basis.T @ M_r @ basis
-    k_aug = basis.T @ K_r @ basis
-    c_aug = basis.T @ released.C.toarray() @ basis
+    m_aug = basis.T @ (released.M @ basis)
+    k_aug = basis.T @ (released.K @ basis)
+    c_aug = basis.T @ (released.C @ basis)
     split = released.split.mesh
     shapes = (released.T @ basis).reshape(split.n_nodes, 3, n_modes + 1)
     f_hz = np.sqrt(np.maximum(lam, 0.0)) / (2.0 * math.pi)
