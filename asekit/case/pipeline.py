@@ -1642,7 +1642,8 @@ def _elastic_surface_model(case: Case, hm):
         raise CaseError(f"{path}.hinge_chord_fraction / span_fraction: {exc} (choose "
                         f"panel.n_chord, n_span or their spacing so that node lines fall "
                         f"there)") from None
-    support = supported_system(case).T
+    system = supported_system(case)
+    support = system.T
     own = np.setdiff1d(np.unique(split.mesh.elements[flap]), np.arange(split.n_original,
                                                                         split.mesh.n_nodes))
     if np.any(np.asarray(abs(support[3 * own]).sum(axis=1)).ravel() == 0):
@@ -1653,8 +1654,11 @@ def _elastic_surface_model(case: Case, hm):
     if case.point_masses:
         M = (M + point_mass_matrix(split.mesh, [(p.position, p.mass, p.inertia)
                                                 for p in case.point_masses])).tocsr()
+    K0, M0 = mass_and_stiffness(case)          # the support's own springs and masses
     released = release_hinge(split, K, M, c.hinge_stiffness, c.hinge_damping, "single",
-                             support=support)
+                             support=support,
+                             support_stiffness=system.K - support.T @ K0 @ support,
+                             support_mass=system.M - support.T @ M0 @ support)
     model = modal_model(case)
     d = case.damping
     try:

@@ -165,7 +165,8 @@ class ReleasedHinge:
 
 
 def release_hinge(split: HingeSplit, K, M, hinge_stiffness: float, hinge_damping: float = 0.0,
-                  release: str = "single", support=None) -> ReleasedHinge:
+                  release: str = "single", support=None, support_stiffness=None,
+                  support_mass=None) -> ReleasedHinge:
     """Tie the hinge copies to the wing with the rotation about the hinge released (module
     docstring): u = T q with q = [q_s, free side-edge copies' DOFs, r].
 
@@ -179,6 +180,9 @@ def release_hinge(split: HingeSplit, K, M, hinge_stiffness: float, hinge_damping
     support : optional (3 n_original, n_s) map of the supports on the original nodes (the
         ``T`` of :func:`asekit.structure.assembly.clamped_edge` on the unsplit mesh); default
         the identity (free-free).
+    support_stiffness, support_mass : optional (n_s, n_s) stiffness and mass the support adds
+        on its own coordinates beyond T^T K T (a shaft's spring, grounded springs: the
+        supported system's K_s - T^T K_0 T), added to the q_s block.
 
     Returns
     -------
@@ -236,6 +240,16 @@ def release_hinge(split: HingeSplit, K, M, hinge_stiffness: float, hinge_damping
     damper = sp.csr_matrix((c_n, (idx, idx)), shape=(n_q, n_q))
     Kr = (T.T @ K @ T).tocsr() + spring
     Mr = (T.T @ M @ T).tocsr()
+    pad = sp.eye(n_q, n_s, format="csr")                     # q_s block of q
+    for name, extra in (("support_stiffness", support_stiffness), ("support_mass", support_mass)):
+        if extra is None:
+            continue
+        if extra.shape != (n_s, n_s):
+            raise ValueError(f"{name} must be ({n_s}, {n_s}), got {extra.shape}")
+        if name == "support_stiffness":
+            Kr = Kr + pad @ sp.csr_matrix(extra) @ pad.T
+        else:
+            Mr = Mr + pad @ sp.csr_matrix(extra) @ pad.T
     return ReleasedHinge(K=(0.5 * (Kr + Kr.T)).tocsr(), M=(0.5 * (Mr + Mr.T)).tocsr(),
                          C=damper, T=T, hinge_index=idx, hinge_stiffness=k_n, weight=weight,
                          split=split)
