@@ -82,8 +82,8 @@ def test_inertia_and_unbalance_are_the_plate_strip_integrals(models):
 def test_hinge_coordinate_is_the_rigid_deflection(models, elastic_case):
     """The hinge coordinate's box mode (splined from the computed constraint mode) is the
     rigid deflection of the hinged boxes, so its generalised force is the pressure integral's
-    hinge moment -int dp d dA, the same as the rigid kind's; the Craig-Bampton stiffness has
-    no wing-hinge coupling and K_dd = k_h, so the spring's hinge moment is k_h delta."""
+    hinge moment -int dp d dA, the same as the rigid kind's; K_dd = k_h, so the spring's hinge
+    moment is k_h delta."""
     from asekit.aero.control_surface import deflection_modes
     from asekit.aeroelastic.control_surface import steady_generalised_forces
 
@@ -97,9 +97,9 @@ def test_hinge_coordinate_is_the_rigid_deflection(models, elastic_case):
     q_el, _, _ = steady_generalised_forces(el, hm, 0.0)
     q_rg, _, _ = steady_generalised_forces(rg, hm, 0.0)
     assert q_el[n, n] == pytest.approx(q_rg[rg.n_wing, rg.n_wing], rel=1e-7)
-    k = el.modal.K
-    assert np.max(np.abs(k[:n, n])) < 1e-9 * k[n - 1, n - 1]
-    assert k[n, n] == pytest.approx(0.5, rel=1e-6)          # hinge_stiffness = 0.5 N m/rad
+    # the constraint mode strains only the spring: psi^T K psi = k_h (the K-orthogonality to
+    # the fixed-hinge modes is checked inside elastic_flap_modal_model, 1e-6 of K's diagonal)
+    assert el.modal.K[n, n] == pytest.approx(0.5, rel=1e-6)     # hinge_stiffness 0.5 N m/rad
 
 
 def test_stiff_plate_rigid_and_elastic_hinge_frequencies_agree():
@@ -252,3 +252,18 @@ def test_the_support_keeps_its_own_spring():
     f_el = np.sqrt(np.diag(fm.modal.K)[:n] / np.diag(fm.modal.M)[:n]) / (2 * math.pi)
     f_plain = P.modal_model(case).frequencies_hz
     np.testing.assert_allclose(f_el[:2], f_plain[:2], rtol=0.02)
+
+
+def test_hinge_freeplay_runs_for_the_elastic_kind():
+    """The hinge row is a hinge coordinate for asekit.aeroelastic.hinge_freeplay: with a
+    0.5 deg freeplay the state-space flutter speed with the full spring is the p-k one of
+    control_surface_flutter to the RFA's accuracy (measured 11.90 against 11.52 m/s at M 0;
+    the rigid kind 12.99 against 12.75)."""
+    case = case_from_dict(_elastic(freeplay_deg=0.5))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rows = P.control_surface_freeplay(case)
+        pk = P.control_surface_flutter(case)
+    for r, f in zip(rows, pk):
+        assert r.linear_flutter_speed_ms == pytest.approx(f.speed_ms, rel=0.05)
+        assert r.lco_at_first_point       # unbalanced: LCOs from the first speed (2 m/s) on
