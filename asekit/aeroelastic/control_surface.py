@@ -41,6 +41,14 @@ full-span 25 % flap with the symmetric image (aspect ratio 8) gains lift up to d
 strip theory says, while the same wing alone or loaded antisymmetrically (rolling) reverses
 just below divergence (q_R = 477-488 Pa against q_D = 515-540 Pa).
 
+Elastic surfaces (``kind = "elastic"``, :func:`elastic_flap_modal_model`): the plate region
+released along its hinge (:mod:`asekit.structure.hinge`) reduced by Craig & Bampton's method,
+the hinge rotation the interface coordinate. The rigid kind above is that reduction with the
+locked plate's modes for the fixed-interface modes and a prescribed rigid rotation (lumped at
+the hinge line) for the constraint mode; the elastic kind computes both from the released
+plate, so the surface's inertia and unbalance are its elements' exactly and its side edges are
+free.
+
 The strip-theory closed forms are :func:`strip_theory_effectiveness` and
 :func:`strip_theory_reversal_q`; on a uniform torsion beam with its elastic axis 5 % of the chord
 behind the quarter chord, the vortex lattice's q_R tends to them as the aspect ratio grows

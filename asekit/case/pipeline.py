@@ -1466,7 +1466,9 @@ def control_surface_mesh(case: Case):
 def control_surface_model(case: Case):
     """The wing's modal model (:func:`modal_model`, surfaces locked) with one hinge coordinate
     per control surface, its hinge spring, damper and balance masses
-    (:func:`asekit.aeroelastic.control_surface.flap_modal_model`). Memoised on the case."""
+    (:func:`asekit.aeroelastic.control_surface.flap_modal_model`); for ``kind = "elastic"``
+    the plate released along the hinge, reduced to fixed-hinge modes plus the hinge rotation
+    (:func:`_elastic_surface_model`). Memoised on the case."""
     from asekit.aeroelastic.control_surface import BalanceMass, flap_modal_model
 
     hm = control_surface_mesh(case)
