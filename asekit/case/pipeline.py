@@ -1299,12 +1299,16 @@ def control_surface_mesh(case: Case):
 def control_surface_model(case: Case):
     """The wing's modal model (:func:`modal_model`, surfaces locked) with one hinge coordinate
     per control surface, its hinge spring, damper and balance masses
-    (:func:`asekit.aeroelastic.control_surface.flap_modal_model`). Memoised on the case."""
+    (:func:`asekit.aeroelastic.control_surface.flap_modal_model`); for ``kind = "elastic"``
+    the plate released along the hinge, reduced to fixed-hinge modes plus the hinge rotation
+    (:func:`_elastic_surface_model`). Memoised on the case."""
     from asekit.aeroelastic.control_surface import BalanceMass, flap_modal_model
 
     hm = control_surface_mesh(case)
-    _, m_fe = mass_and_stiffness(case)
     cs = case.control_surfaces
+    if any(c.kind == "elastic" for c in cs):
+        return _elastic_surface_model(case, hm)
+    _, m_fe = mass_and_stiffness(case)
     balance = tuple(BalanceMass(i, x, y, m) for i, c in enumerate(cs)
                     for (x, y), m in c.mass_balance)
     return flap_modal_model(modal_model(case), m_fe, hm, [c.hinge_stiffness for c in cs],
@@ -1449,6 +1453,54 @@ def control_surface_flutter(case: Case) -> tuple[ControlSurfaceFlutterRow, ...]:
                 float(m), c.altitude, c.density, None if f is None else float(f.speed),
                 None if f is None else float(f.frequency_hz), mode, bool(start)))
     return tuple(rows)
+
+
+def _elastic_surface_model(case: Case, hm):
+    """``kind = "elastic"``: the plate released along the surface's hinge
+    (:func:`asekit.structure.hinge.release_hinge`, one hinge rotation on the hinge spring and
+    damper, the case's supports on the wing) reduced to the wing's ``modes`` count of
+    fixed-hinge modes plus the hinge rotation
+    (:func:`asekit.aeroelastic.control_surface.elastic_flap_modal_model`)."""
+    from asekit.aeroelastic.control_surface import elastic_flap_modal_model, surface_elements
+    from asekit.structure.hinge import release_hinge, split_at_hinge
+
+    c = case.control_surfaces[0]
+    path = "control_surface[0]"
+    if case.structure is not None or modal_model(case).n_rigid:
+        raise CaseError(f"{path}.kind = \"elastic\" needs a plate case file whose support has "
+                        f"no rigid mode (clamped, or modes.keep_rigid = false)")
+    mesh = structural_mesh(case)
+    try:
+        flap = surface_elements(mesh, hm, 0)
+        split = split_at_hinge(mesh, flap, hm.hinge_point[0, :2], hm.hinge_axis[0, :2])
+    except ValueError as exc:
+        raise CaseError(f"{path}.hinge_chord_fraction / span_fraction: {exc} (choose "
+                        f"panel.n_chord, n_span or their spacing so that node lines fall "
+                        f"there)") from None
+    system = supported_system(case)
+    support = system.T
+    own = np.setdiff1d(np.unique(split.mesh.elements[flap]), np.arange(split.n_original,
+                                                                        split.mesh.n_nodes))
+    if np.any(np.asarray(abs(support[3 * own]).sum(axis=1)).ravel() == 0):
+        raise CaseError(f"{path}.span_fraction {list(c.span_fraction)}: the elastic surface "
+                        f"reaches the support (support.kind = \"{case.support.kind}\"), which "
+                        f"would hold it: end it short of the supported edge")
+    K, M = assemble(split.mesh, case.material)
+    if case.point_masses:
+        M = (M + point_mass_matrix(split.mesh, [(p.position, p.mass, p.inertia)
+                                                for p in case.point_masses])).tocsr()
+    K0, M0 = mass_and_stiffness(case)          # the support's own springs and masses
+    released = release_hinge(split, K, M, c.hinge_stiffness, c.hinge_damping, "single",
+                             support=support,
+                             support_stiffness=system.K - support.T @ K0 @ support,
+                             support_mass=system.M - support.T @ M0 @ support)
+    model = modal_model(case)
+    d = case.damping
+    try:
+        return elastic_flap_modal_model(released, M, hm, len(model.frequencies_hz),
+                                        d.modal_damping_ratio, d.structural_g)
+    except ValueError as exc:
+        raise CaseError(f"{path}: {exc}") from None
 
 
 # ---------------------------------------------------------------------------------------------

@@ -150,7 +150,8 @@ class ControlSurfaceSpec:
     (0-based): its hinge line at chord fractions ``hinge_chord_fraction`` = (inboard, outboard)
     of the panel's local chord, between the span fractions ``span_fraction`` = (start, end) of
     the panel; ``kind`` "rigid" (a rigid surface rotating about its hinge, as Nastran's
-    AESURF); ``hinge_stiffness`` N m/rad and ``hinge_damping`` N m s/rad of the hinge;
+    AESURF) or "elastic" (the plate region released along its hinge,
+    :mod:`asekit.structure.hinge`); ``hinge_stiffness`` N m/rad and ``hinge_damping`` N m s/rad of the hinge;
     ``mass_balance``: ((x, y) m, mass kg) pairs fixed to the surface
     (:mod:`asekit.aeroelastic.control_surface`); ``freeplay_deg`` the half-width (deg) of a
     freeplay gap in the hinge spring (0: none; :mod:`asekit.aeroelastic.hinge_freeplay`)."""
@@ -924,9 +925,10 @@ def _point_masses(raw, panels=()) -> tuple[PointMass, ...]:
     return tuple(out)
 
 
-#: the kinds of control surface (``control_surface[i].kind``); "elastic" (a plate region
-#: released along the hinge) is not implemented yet
-CONTROL_SURFACE_KINDS = ("rigid",)
+#: the kinds of control surface (``control_surface[i].kind``): "rigid" (a rigid rotation about
+#: the hinge added to the locked wing's modes) or "elastic" (the plate region released along
+#: the hinge, :mod:`asekit.structure.hinge`)
+CONTROL_SURFACE_KINDS = ("rigid", "elastic")
 
 
 def _mass_balance(t: _Table, path: str, panels) -> tuple:
@@ -972,6 +974,9 @@ def _one_control_surface(t: _Table, i: int, panels) -> ControlSurfaceSpec:
         raise CaseError(f"{path}.freeplay_deg = {freeplay:g} needs {path}.hinge_stiffness > 0 "
                         "(the freeplay is in the hinge spring)")
     t.done()
+    if kind == "elastic" and balance:
+        raise CaseError(f"{path}.mass_balance is not available with {path}.kind = \"elastic\" "
+                        f"(use kind = \"rigid\", or a [[point_mass]] on the surface)")
     return ControlSurfaceSpec(name, panel, hinge, span, kind, k_h, c_h, balance, actuator,
                               freeplay)
 
@@ -1002,6 +1007,11 @@ def _control_surfaces(raw, panels) -> tuple[ControlSurfaceSpec, ...]:
     names = [c.name for c in out]
     if len(set(names)) != len(names):
         raise CaseError(f"control_surface[].name must be unique, got {names}")
+    elastic = [i for i, c in enumerate(out) if c.kind == "elastic"]
+    if elastic and len(out) > 1:
+        raise CaseError(f"control_surface[{elastic[0]}].kind = \"elastic\" needs it to be the "
+                        f"case's only control surface (this case has {len(out)}); use kind = "
+                        f"\"rigid\" for several surfaces")
     for i, a in enumerate(out):
         for j, b in enumerate(out[:i]):
             if a.panel == b.panel and min(a.span_fraction[1], b.span_fraction[1]) > \

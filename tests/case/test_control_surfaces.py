@@ -34,7 +34,7 @@ def test_shipped_aileron_case_reads():
     ({"span_fraction": [0.6, 0.5]}, r"control_surface\[0\]\.span_fraction must be \[start, end\]"),
     ({"span_fraction": [0.5, 1.2]}, r"control_surface\[0\]\.span_fraction\[1\]"),
     ({"panel": 1}, r"control_surface\[0\]\.panel must be an integer in \[0, 0\]"),
-    ({"kind": "elastic"}, r"control_surface\[0\]\.kind must be one of 'rigid'"),
+    ({"kind": "flexible"}, r"control_surface\[0\]\.kind must be one of 'rigid'"),
     ({"hinge_stiffness": -1.0}, r"control_surface\[0\]\.hinge_stiffness"),
     ({"hinge_damping": "x"}, r"control_surface\[0\]\.hinge_damping"),
     ({"name": ""}, r"control_surface\[0\]\.name is missing"),

@@ -1,0 +1,333 @@
+"""A plate region released along a hinge line: the structure of an elastic control surface.
+
+The surface is a set of elements of the plate mesh (``flap_elements``) lying aft of a hinge
+line that runs along element edges. :func:`split_at_hinge` gives the surface its own copies of
+the nodes it shares with the wing: the copies on the hinge line stay joined to the wing, the
+copies on the surface's side edges are free (the gap between a flap and the wing beside it).
+
+:func:`release_hinge` joins the hinge copies to their wing nodes by linear multi-point
+constraints, eliminated by a master-slave transformation u = T q (Cook, Malkus, Plesha & Witt,
+*Concepts and Applications of Finite Element Analysis*, 4th ed., 2002, Sec. 9.2, Eqs. 9.2-3 to
+9.2-5: K_r = T^T K T, M_r = T^T M T). With the unit hinge axis s = (s_x, s_y) (outboard) in the
+plate plane and the rotation vector (theta_x, theta_y) of the plate's convention
+(theta_x = dw/dy, theta_y = -dw/dx, :mod:`asekit.structure.plate`), a hinge copy c of wing node
+m is the slave
+
+    w_c = w_m,      (theta_x, theta_y)_c = (theta_x, theta_y)_m + r s,
+
+so the translation and the rotation about the in-plane normal to the hinge are tied, the
+rotation about the hinge axis is released, and r is the relative rotation of the surface about
+its hinge (rad, trailing edge down positive, as :mod:`asekit.aero.control_surface`).
+``release = "single"``: one r for the whole hinge (a torque tube driven by one actuator);
+``"distributed"``: one r_n per hinge node (a piano hinge), each on its share of the spring.
+The hinge spring k_h (N m/rad) and damper c_h (N m s/rad) act on r: k_h on the single r, or
+k_h w_n on r_n with w_n the node's share of the hinge length (trapezoidal, sum w_n = 1), so a
+uniform relative rotation r meets the moment k_h r either way. The hinge rotation (the
+length-weighted mean of the r_n) and the spring's hinge moment H = sum k_h w_n r_n (N m) are
+outputs (:meth:`ReleasedHinge.hinge_rotation`, :meth:`ReleasedHinge.hinge_moment`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+import scipy.sparse as sp
+
+from asekit.structure.mesh import PlateMesh
+from asekit.structure.plate import DOF_PER_NODE
+from asekit.util.validate import in_range
+
+#: the hinge releases of :func:`release_hinge`
+RELEASES = ("single", "distributed")
+
+
+@dataclass(frozen=True)
+class HingeSplit:
+    """A mesh whose surface elements have their own copies of the nodes shared with the wing.
+
+    ``mesh`` the split mesh (the original nodes first, then the copies; the surface's elements
+    renumbered to the copies); ``n_original`` the original node count; ``copy_of`` (n_c,) the
+    original node of each copy; ``on_hinge`` (n_c,) True for a copy on the hinge line (tied by
+    :func:`release_hinge`), False for one on a side edge (free); ``weight`` (n_c,) each hinge
+    copy's share of the hinge length (0 on the side edges, sum 1); ``flap_elements`` (n_elem,)
+    bool; ``hinge_axis`` (2,) the unit hinge direction.
+    """
+
+    mesh: PlateMesh
+    n_original: int
+    copy_of: np.ndarray
+    on_hinge: np.ndarray
+    weight: np.ndarray
+    flap_elements: np.ndarray
+    hinge_axis: np.ndarray
+
+
+def split_at_hinge(mesh: PlateMesh, flap_elements, hinge_point, hinge_axis) -> HingeSplit:
+    """Copy the nodes that the surface's elements share with the wing (module docstring).
+
+    Parameters
+    ----------
+    mesh : the plate mesh (:mod:`asekit.structure.mesh`).
+    flap_elements : (n_elem,) bool, the elements of the surface (all aft of the hinge).
+    hinge_point : (x, y) m, a point of the hinge line.
+    hinge_axis : (s_x, s_y), its direction (normalised here; pointing outboard, s_y > 0).
+
+    Returns
+    -------
+    HingeSplit
+
+    Raises
+    ------
+    ValueError
+        No surface element; an element of the surface ahead of the hinge; fewer than two
+        shared nodes on the hinge line (the mesh has no element edge on the hinge).
+
+    Examples
+    --------
+    A 2 x 2 mesh of a 1 m square, the aft column of elements a surface hinged at x = 0.5:
+
+    >>> from asekit.geometry import Planform, Thickness
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> pm = panels_mesh([Planform((0, 0), 1.0, (0, 1.0), 1.0)], Thickness(0.01, 0.01), 2, [2])
+    >>> flap = pm.element_centroids()[:, 0] > 0.5
+    >>> hs = split_at_hinge(pm, flap, (0.5, 0.0), (0.0, 1.0))
+    >>> hs.copy_of.tolist(), hs.on_hinge.tolist(), hs.weight.tolist()
+    ([1, 4, 7], [True, True, True], [0.25, 0.5, 0.25])
+    """
+    flap = np.asarray(flap_elements, bool).reshape(-1)
+    if flap.shape != (mesh.n_elements,) or not flap.any():
+        raise ValueError(f"flap_elements must be {mesh.n_elements} booleans with at least one "
+                         f"True, got {flap.size} with {int(flap.sum())} True")
+    s = np.asarray(hinge_axis, float).reshape(2)
+    s = s / np.hypot(*s)
+    p0 = np.asarray(hinge_point, float).reshape(2)
+    aft = np.array([s[1], -s[0]])
+    d = (mesh.nodes - p0) @ aft                               # distance aft of the hinge (m)
+    tol = 1e-9 * max(float(np.ptp(mesh.nodes[:, 0])), float(np.ptp(mesh.nodes[:, 1])), 1e-300)
+    fn = np.unique(mesh.elements[flap])
+    if np.any(d[fn] < -tol):
+        raise ValueError("flap_elements must lie aft of the hinge line: an element of the "
+                         "surface has a node ahead of it")
+    shared = np.intersect1d(fn, np.unique(mesh.elements[~flap]))
+    on_hinge = np.abs(d[shared]) <= tol
+    if on_hinge.sum() < 2:
+        raise ValueError("the mesh has no element edge on the hinge line (fewer than two shared "
+                         "nodes on it): place a row of nodes on the hinge")
+    n0 = mesh.n_nodes
+    new = np.full(n0, -1)
+    new[shared] = n0 + np.arange(shared.size)
+    elements = mesh.elements.copy()
+    sub = elements[flap]
+    elements[flap] = np.where(new[sub] >= 0, new[sub], sub)
+    along = mesh.nodes[shared] @ s
+    weight = np.zeros(shared.size)
+    h = np.flatnonzero(on_hinge)
+    order = h[np.argsort(along[h])]
+    a = along[order]
+    gaps = np.diff(a)
+    w = np.zeros(a.size)
+    w[:-1] += 0.5 * gaps
+    w[1:] += 0.5 * gaps
+    weight[order] = w / w.sum()
+    split = replace(mesh, nodes=np.vstack([mesh.nodes, mesh.nodes[shared]]), elements=elements)
+    return HingeSplit(split, n0, shared, on_hinge, weight, flap, s)
+
+
+@dataclass(frozen=True)
+class ReleasedHinge:
+    """The split structure with its hinge constraints eliminated (:func:`release_hinge`).
+
+    ``K``, ``M``, ``C`` (n_q, n_q) sparse reduced stiffness, mass and (hinge) damping;
+    ``T`` (3 n_split_nodes, n_q) sparse, u = T q on the split mesh's DOFs; ``hinge_index``
+    (n_r,) the positions in q of the relative rotations r; ``hinge_stiffness`` (n_r,) the
+    spring on each (N m/rad); ``weight`` (n_r,) their shares of the hinge length; ``split``.
+    """
+
+    K: sp.csr_matrix
+    M: sp.csr_matrix
+    C: sp.csr_matrix
+    T: sp.csr_matrix
+    hinge_index: np.ndarray
+    hinge_stiffness: np.ndarray
+    weight: np.ndarray
+    split: HingeSplit
+
+    def hinge_rotation(self, q) -> np.ndarray:
+        """The hinge rotation (rad): the length-weighted mean relative rotation sum w_n r_n of
+        the reduced vector(s) ``q`` (n_q, ...)."""
+        return self.weight @ np.asarray(q)[self.hinge_index]
+
+    def hinge_moment(self, q) -> np.ndarray:
+        """The hinge spring's moment H = sum k_n r_n (N m; the moment that holds the surface,
+        positive when the surface is rotated trailing edge down) of ``q`` (n_q, ...)."""
+        return self.hinge_stiffness @ np.asarray(q)[self.hinge_index]
+
+
+def release_hinge(split: HingeSplit, K, M, hinge_stiffness: float, hinge_damping: float = 0.0,
+                  release: str = "single", support=None, support_stiffness=None,
+                  support_mass=None) -> ReleasedHinge:
+    """Tie the hinge copies to the wing with the rotation about the hinge released (module
+    docstring): u = T q with q = [q_s, free side-edge copies' DOFs, r].
+
+    Parameters
+    ----------
+    split : :func:`split_at_hinge`.
+    K, M : (3 n, 3 n) stiffness and mass of ``split.mesh`` (:func:`asekit.structure.assembly.
+        assemble`), unsupported.
+    hinge_stiffness : k_h (N m/rad), >= 0. hinge_damping : c_h (N m s/rad), >= 0.
+    release : "single" or "distributed" (:data:`RELEASES`).
+    support : optional (3 n_original, n_s) map of the supports on the original nodes (the
+        ``T`` of :func:`asekit.structure.assembly.clamped_edge` on the unsplit mesh); default
+        the identity (free-free).
+    support_stiffness, support_mass : optional (n_s, n_s) stiffness and mass the support adds
+        on its own coordinates beyond T^T K T (a shaft's spring, grounded springs: the
+        supported system's K_s - T^T K_0 T), added to the q_s block.
+
+    Returns
+    -------
+    ReleasedHinge
+
+    Examples
+    --------
+    The split of :func:`split_at_hinge`'s example released about one hinge rotation: the
+    hinge copies' 9 DOFs are replaced by 1.
+
+    >>> from asekit.geometry import Material, Planform, Thickness
+    >>> from asekit.structure.assembly import assemble
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> pm = panels_mesh([Planform((0, 0), 1.0, (0, 1.0), 1.0)], Thickness(0.01, 0.01), 2, [2])
+    >>> hs = split_at_hinge(pm, pm.element_centroids()[:, 0] > 0.5, (0.5, 0.0), (0.0, 1.0))
+    >>> K, M = assemble(hs.mesh, Material(70e9, 0.3, 2700.0))
+    >>> rh = release_hinge(hs, K, M, 10.0)
+    >>> rh.T.shape, rh.hinge_index.tolist()
+    ((36, 28), [27])
+    """
+    if release not in RELEASES:
+        raise ValueError(f"release must be one of {RELEASES}, got {release!r}")
+    k_h = in_range("hinge_stiffness", hinge_stiffness, 0.0, inclusive=True)
+    c_h = in_range("hinge_damping", hinge_damping, 0.0, inclusive=True)
+    n0, dof = split.n_original, DOF_PER_NODE
+    S = sp.identity(dof * n0, format="csr") if support is None else sp.csr_matrix(support)
+    if S.shape[0] != dof * n0:
+        raise ValueError(f"support must have {dof * n0} rows (the original nodes' DOFs), got "
+                         f"{S.shape[0]}")
+    free = np.flatnonzero(~split.on_hinge)
+    hinge = np.flatnonzero(split.on_hinge)
+    n_s, n_f = S.shape[1], dof * free.size
+    n_r = 1 if release == "single" else hinge.size
+    n_q = n_s + n_f + n_r
+    n_split = split.mesh.n_nodes
+    blocks = sp.lil_matrix((dof * n_split, n_q))
+    blocks[: dof * n0, :n_s] = S
+    for j, c in enumerate(free):
+        for k in range(dof):
+            blocks[dof * (n0 + c) + k, n_s + dof * j + k] = 1.0
+    S = S.tolil()
+    s = split.hinge_axis
+    for j, c in enumerate(hinge):
+        m = split.copy_of[c]
+        r = n_s + n_f + (0 if n_r == 1 else j)
+        for k in range(dof):
+            blocks[dof * (n0 + c) + k, :n_s] = S[dof * m + k, :]
+        blocks[dof * (n0 + c) + 1, r] = s[0]
+        blocks[dof * (n0 + c) + 2, r] = s[1]
+    T = blocks.tocsr()
+    weight = np.ones(1) if n_r == 1 else split.weight[hinge]
+    k_n, c_n = k_h * weight, c_h * weight
+    idx = n_s + n_f + np.arange(n_r)
+    spring = sp.csr_matrix((k_n, (idx, idx)), shape=(n_q, n_q))
+    damper = sp.csr_matrix((c_n, (idx, idx)), shape=(n_q, n_q))
+    Kr = (T.T @ K @ T).tocsr() + spring
+    Mr = (T.T @ M @ T).tocsr()
+    pad = sp.eye(n_q, n_s, format="csr")                     # q_s block of q
+    for name, extra in (("support_stiffness", support_stiffness), ("support_mass", support_mass)):
+        if extra is None:
+            continue
+        if extra.shape != (n_s, n_s):
+            raise ValueError(f"{name} must be ({n_s}, {n_s}), got {extra.shape}")
+        if name == "support_stiffness":
+            Kr = Kr + pad @ sp.csr_matrix(extra) @ pad.T
+        else:
+            Mr = Mr + pad @ sp.csr_matrix(extra) @ pad.T
+    return ReleasedHinge(K=(0.5 * (Kr + Kr.T)).tocsr(), M=(0.5 * (Mr + Mr.T)).tocsr(),
+                         C=damper, T=T, hinge_index=idx, hinge_stiffness=k_n, weight=weight,
+                         split=split)
+
+
+def released_modes(released: ReleasedHinge, n_modes: int, shift: float = -1.0):
+    """The lowest ``n_modes`` modes of the released structure, K v = omega^2 M v.
+
+    Dense symmetric eigen-solution (:func:`scipy.linalg.eigh`, the reduced models are a few
+    thousand DOFs at most) when n_q <= 3000, else shift-invert Lanczos about ``shift``
+    (rad^2/s^2, below zero so rigid modes are found).
+
+    Returns
+    -------
+    (f_hz (n_modes,), q (n_q, n_modes)) natural frequencies (Hz, sqrt of max(lambda, 0) / 2 pi)
+    and mass-normalised vectors in the reduced coordinates.
+
+    Examples
+    --------
+    The free-free 2 x 2 plate of :func:`release_hinge` with a zero hinge spring: four
+    rigid-body modes (plunge, two rotations, the surface's rotation about the hinge).
+
+    >>> from asekit.geometry import Material, Planform, Thickness
+    >>> from asekit.structure.assembly import assemble
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> pm = panels_mesh([Planform((0, 0), 1.0, (0, 1.0), 1.0)], Thickness(0.01, 0.01), 2, [2])
+    >>> hs = split_at_hinge(pm, pm.element_centroids()[:, 0] > 0.5, (0.5, 0.0), (0.0, 1.0))
+    >>> K, M = assemble(hs.mesh, Material(70e9, 0.3, 2700.0))
+    >>> f, _ = released_modes(release_hinge(hs, K, M, 0.0), 5)
+    >>> int((f < 1e-3 * f[-1]).sum())
+    4
+    """
+    import scipy.linalg as sla
+    import scipy.sparse.linalg as spla
+
+    if released.K.shape[0] <= 3000:
+        lam, v = sla.eigh(released.K.toarray(), released.M.toarray(),
+                          subset_by_index=[0, n_modes - 1])
+    else:
+        lam, v = spla.eigsh(released.K, k=n_modes, M=released.M, sigma=shift, which="LM")
+        order = np.argsort(lam)
+        lam, v = lam[order], v[:, order]
+    return np.sqrt(np.maximum(lam, 0.0)) / (2.0 * np.pi), v
+
+
+def hinge_constraint_mode(released: ReleasedHinge) -> np.ndarray:
+    """The static shape of a unit hinge rotation (rad) of a ``"single"`` release, the other
+    coordinates unloaded: q_o = -K_oo^-1 K_or (the constraint mode of Craig & Bampton, "Coupling
+    of substructures for dynamic analyses", AIAA J. 6(7), 1968, Eq. 5). On a supported wing it
+    is the surface's rigid rotation about the hinge (no strain), computed, not assumed.
+
+    Returns
+    -------
+    (n_q,) reduced vector with q[hinge_index] = 1.
+
+    Examples
+    --------
+    >>> from asekit.geometry import Material, Planform, Thickness
+    >>> from asekit.structure.assembly import assemble, clamped_edge
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> pm = panels_mesh([Planform((0, 0), 1.0, (0, 1.0), 1.0)], Thickness(0.01, 0.01), 2, [2])
+    >>> c = pm.element_centroids()                       # the outboard aft element's surface
+    >>> hs = split_at_hinge(pm, (c[:, 0] > 0.5) & (c[:, 1] > 0.5), (0.5, 0.5), (0.0, 1.0))
+    >>> K, M = assemble(hs.mesh, Material(70e9, 0.3, 2700.0))
+    >>> K0, M0 = assemble(pm, Material(70e9, 0.3, 2700.0))
+    >>> rh = release_hinge(hs, K, M, 1.0, support=clamped_edge(pm, K0, M0).T)
+    >>> u = rh.T @ hinge_constraint_mode(rh)
+    >>> round(float(u[3 * 8]), 9)                      # w of the trailing-edge tip node: -0.5 m
+    -0.5
+    """
+    import scipy.sparse.linalg as spla
+
+    if released.hinge_index.size != 1:
+        raise ValueError("hinge_constraint_mode needs a 'single' release (one hinge rotation)")
+    r = int(released.hinge_index[0])
+    other = np.setdiff1d(np.arange(released.K.shape[0]), [r])
+    K = released.K.tocsc()
+    q = np.zeros(K.shape[0])
+    q[r] = 1.0
+    q[other] = -spla.spsolve(K[other][:, other], K[other][:, [r]].toarray().ravel())
+    return q
