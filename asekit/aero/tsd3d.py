@@ -132,13 +132,34 @@ class Tsd3dGrid:
         return self.x.size, self.y.size, self.z.size
 
 
+def _chord_nodes(n: int, spacing: str, edges: str) -> np.ndarray:
+    """Nodes on [0, 1]: the faces f (cosine or uniform) themselves (``edges`` "nodes") or
+    their midpoints plus one node half a cell outside each end (``edges`` "faces": the ends
+    lie midway between two nodes)."""
+    if spacing == "cosine":
+        f = 0.5 * (1.0 - np.cos(np.linspace(0.0, np.pi, n + 1)))
+    elif spacing == "uniform":
+        f = np.linspace(0.0, 1.0, n + 1)
+    else:
+        raise ValueError(f"spacing must be 'cosine' or 'uniform', got {spacing!r}")
+    if edges == "nodes":
+        return f
+    if edges != "faces":
+        raise ValueError(f"edges must be 'nodes' or 'faces', got {edges!r}")
+    h0, h1 = f[1] - f[0], f[-1] - f[-2]
+    return np.concatenate([[-0.5 * h0], 0.5 * (f[1:] + f[:-1]), [1.0 + 0.5 * h1]])
+
+
 def tsd3d_grid(planform: TsdPlanform, n_chord: int = 24, n_span: int = 12, far: float = 8.0,
-               ratio: float = 1.25, spacing: str = "cosine") -> Tsd3dGrid:
-    """The grid of :func:`steady_tsd3d`: ``n_chord`` cells from the most forward leading edge
-    to the most aft trailing edge ("cosine" or "uniform" spacing, as
+               ratio: float = 1.25, spacing: str = "cosine", edges: str = "nodes") -> Tsd3dGrid:
+    """The grid of :func:`steady_tsd3d` and :func:`harmonic_tsd3d`: ``n_chord`` cells from the
+    most forward leading edge to the most aft trailing edge ("cosine" or "uniform" spacing, as
     :func:`asekit.aero.tsd.tsd_grid`), ``n_span`` uniform cells on the span, and geometric
     stretching by ``ratio`` up- and downstream, outboard and above to ``far`` root chords;
-    the first cell above the plane as fine as the chord's end cells.
+    the first cell above the plane as fine as the chord's end cells. ``edges`` "nodes" puts
+    grid nodes on the leading and trailing edges and the tip; "faces" puts those edges midway
+    between nodes (the wing's cells then lie inside the planform: the usual choice of
+    lifting TSD codes, e.g. Bailey & Ballhaus 1972, and of :func:`harmonic_tsd3d`).
 
     >>> g = tsd3d_grid(TsdPlanform.rectangular(1.0, 3.0), n_chord=8, n_span=6, far=5.0)
     >>> float(g.x[0]) <= -5.0, float(g.y[6]), float(g.z[0])
@@ -154,19 +175,18 @@ def tsd3d_grid(planform: TsdPlanform, n_chord: int = 24, n_span: int = 12, far: 
         raise ValueError(f"far must be > 1 root chord, got {far!r}")
     x0 = float(np.min(planform.x_le))
     x1 = float(np.max(planform.x_le + planform.chord))
-    if spacing == "cosine":
-        xs = 0.5 * (1.0 - np.cos(np.linspace(0.0, np.pi, int(n_chord) + 1)))
-    elif spacing == "uniform":
-        xs = np.linspace(0.0, 1.0, int(n_chord) + 1)
-    else:
-        raise ValueError(f"spacing must be 'cosine' or 'uniform', got {spacing!r}")
-    xs = x0 + (x1 - x0) * xs
+    xs = x0 + (x1 - x0) * _chord_nodes(int(n_chord), spacing, edges)
     h = float(xs[1] - xs[0])
     side = _stretched(h * ratio, far * c0, ratio)
-    x = np.concatenate([x0 - side[::-1], xs, x1 + side])
-    ys = np.linspace(0.0, planform.semispan, int(n_span) + 1)
-    hy = float(ys[1] - ys[0])
-    y = np.concatenate([ys, planform.semispan + _stretched(hy * ratio, far * c0, ratio)])
+    x = np.concatenate([xs[0] - side[::-1], xs, xs[-1] + side])
+    semi = planform.semispan
+    if edges == "faces":            # nodes 0, hy, ..., the tip at (n_span - 1/2) hy
+        hy = semi / (int(n_span) - 0.5)
+        ys = hy * np.arange(int(n_span) + 1)
+    else:
+        ys = np.linspace(0.0, semi, int(n_span) + 1)
+        hy = float(ys[1] - ys[0])
+    y = np.concatenate([ys, ys[-1] + _stretched(hy * ratio, far * c0, ratio)])
     z = np.concatenate([[0.0], _stretched(h, far * c0, ratio)])
     return Tsd3dGrid(x, y, z)
 
@@ -440,3 +460,241 @@ def _continuation(op: _Operator, phi: np.ndarray, src: np.ndarray, tol: float, m
         r = op.residual(phi, mu, src)
         res = float(np.max(np.abs(r)))
     return phi, max_iter
+
+
+# ---------------------------------------------------------------------------------------------
+# time-linearised lifting problem about the steady background
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class HarmonicTsd3dSolution:
+    """The lifting potential of harmonic motions about a steady 3-D TSD background.
+
+    Attributes
+    ----------
+    grid : the background's grid.
+    phi : (n_modes, n_x, n_y) complex upper-surface potential per U (length unit) on z = 0+
+        per unit modal amplitude (antisymmetric: the lower surface carries -phi).
+    wing : (n_x, n_y) bool, the nodes on the planform (the flux condition).
+    kappa : omega / U (1 / length unit); asekit's k is kappa b_ref.
+    """
+
+    grid: Tsd3dGrid
+    phi: np.ndarray
+    wing: np.ndarray
+    kappa: float
+
+    def delta_cp(self) -> np.ndarray:
+        """(n_modes, n_x - 1, n_y) pressure jump Cp_lower - Cp_upper = 4 (phi_x + i kappa phi)
+        at the x midpoints (positive: lift up)."""
+        dx = np.diff(self.grid.x)[None, :, None]
+        mid = 0.5 * (self.phi[:, 1:] + self.phi[:, :-1])
+        return 4.0 * (np.diff(self.phi, axis=1) / dx + 1j * self.kappa * mid)
+
+
+def _surface_sets(planform: TsdPlanform, grid: Tsd3dGrid):
+    """Node sets on z = 0: the wing (the flux condition), the wake behind it (the convected
+    jump) and the rest (phi = 0 by antisymmetry)."""
+    xl, c = planform.edges(grid.y)
+    x = grid.x[:, None]
+    inside = (c > 0.0)[None, :]
+    wing = inside & (x > xl[None, :]) & (x < (xl + c)[None, :])
+    wake = inside & (x >= (xl + c)[None, :])
+    return wing, wake
+
+
+def _lifting_matrix(background: Tsd3dSolution, kappa: float, wing, wake):
+    """The time-linearised operator (Eq. 3 of :mod:`asekit.aero.tsd` in 3-D) with its
+    boundary rows, over all nodes (i, j, k) -> (i n_y + j) n_z + k."""
+    grid, mach = background.grid, background.mach
+    op = _Operator(grid, mach, background.gamma)
+    nx, ny, nz = grid.shape
+    n = nx * ny * nz
+    u0 = np.diff(background.phi, axis=0) / op.dx[:, None, None]
+    a = (op.a0 - op.b * u0) / op.dx[:, None, None]
+    node = op.node
+    i = np.arange(1, nx - 1)
+    vol = op.vol[i]
+    span = (grid.x[i + 1] - grid.x[i - 1])[:, None, None]
+    t = 2j * kappa * mach ** 2 * vol / span
+    rows = np.concatenate([node[i].ravel()] * 3)
+    cols = np.concatenate([node[i].ravel(), node[i + 1].ravel(), node[i - 1].ravel()])
+    vals = np.concatenate([(vol * mach ** 2 * kappa ** 2).ravel(), -t.ravel(), t.ravel()])
+    # radiation through the outboard and upper faces, phi_n + i K phi = 0 with the acoustic
+    # wavenumber K = kappa M / beta of Eq. (3) (after phi = psi exp(i kappa M^2 x / beta^2) it
+    # is beta^2 psi_xx + psi_yy + psi_zz + K^2 psi = 0; first-order Sommerfeld condition:
+    # walls there would make a closed, resonant wind tunnel at kappa > 0)
+    k_ac = kappa * mach / np.sqrt(max(1.0 - mach ** 2, 1e-6))
+    top = op.node[i, :, -1]
+    side = op.node[i, -1, :]
+    rows = np.concatenate([rows, top.ravel(), side.ravel()])
+    cols = np.concatenate([cols, top.ravel(), side.ravel()])
+    vals = np.concatenate([vals,
+                           np.broadcast_to(-1j * k_ac * op.hx[i, None] * op.hy[None, :],
+                                           top.shape).ravel(),
+                           np.broadcast_to(-1j * k_ac * op.hx[i, None] * op.hz[None, :],
+                                           side.shape).ravel()])
+    K = (op.x_jacobian(a, op.switches(background.phi), complex) + op.lap
+         + sparse.coo_matrix((vals, (rows, cols)), shape=(n, n)).tocsr())
+    # replaced rows: upstream phi_x = 0, downstream phi_x + i kappa phi = 0, z = 0 off the
+    # wing: phi = 0 (antisymmetry) or, on the wake, phi_i = phi_{i-1} exp(-i kappa dx)
+    bi, bj, bv = [], [], []
+
+    def put(r, c, v):
+        r, c = np.broadcast_arrays(r, c)
+        bi.append(r.ravel())
+        bj.append(c.ravel())
+        bv.append(np.broadcast_to(np.asarray(v, complex), r.shape).ravel())
+
+    put(node[0], node[0], 1.0)
+    put(node[0], node[1], -1.0)
+    d = grid.x[-1] - grid.x[-2]
+    put(node[-1], node[-1], 1.0 / d + 0.5j * kappa)
+    put(node[-1], node[-2], -1.0 / d + 0.5j * kappa)
+    surf = np.zeros((nx, ny), bool)
+    surf[1:-1] = True
+    off = surf & ~wing & ~wake
+    put(node[:, :, 0][off], node[:, :, 0][off], 1.0)
+    iw, jw = np.nonzero(wake & surf)
+    put(node[iw, jw, 0], node[iw, jw, 0], 1.0)
+    put(node[iw, jw, 0], node[iw - 1, jw, 0],
+        -np.exp(-1j * kappa * (grid.x[iw] - grid.x[iw - 1])))
+    replaced = np.zeros(n, bool)
+    replaced[np.concatenate(bi)] = True
+    B = sparse.coo_matrix((np.concatenate(bv), (np.concatenate(bi), np.concatenate(bj))),
+                          shape=(n, n)).tocsr()
+    return (sparse.diags((~replaced).astype(float)) @ K + B).tocsc(), op
+
+
+def harmonic_tsd3d(background: Tsd3dSolution, modes, kappa: float) -> HarmonicTsd3dSolution:
+    """Time-linearised TSD about a steady 3-D solution: the antisymmetric (lifting) potential
+    phi1 e^{i omega t} of harmonic modal motions at kappa = omega / U.
+
+    The unsteady TSD equation (e.g. Batina 1989, J. Aircraft 26(6) 531-538, Eq. 1, without
+    the cross-flow terms; time per length / U), linearised about the steady phi0, is for the
+    harmonic amplitude phi1 (per U, a length)
+
+        [A0 phi1_x]_x + phi1_yy + phi1_zz + M^2 kappa^2 phi1 - 2 i kappa M^2 phi1_x = 0,
+        A0 = 1 - M^2 - (gamma + 1) M^2 phi0_x,                                         (3)
+
+    differenced as the steady operator (the background's Murman-Cole switches for the x term,
+    central phi1_x). On z = 0+: phi1_z = w/U = dh/dx + i kappa h on the wing (h the upward
+    displacement of the mode), phi1 = 0 off the wing and wake (antisymmetry), and on the wake
+    a continuous pressure phi1_x + i kappa phi1 = 0, solved exactly along the wake
+    (phi1 = phi1_TE exp(-i kappa (x - x_TE)): the jump is convected and the trailing edge
+    carries the Kutta condition); phi1_y = 0 on the root plane (symmetric motions of a
+    mirrored half wing), phi1_x = 0 upstream, phi1_x + i kappa phi1 = 0 downstream and the
+    first-order radiation condition phi1_n + i K phi1 = 0, K = kappa M / beta, on the
+    outboard and upper boundaries (zero flux there at kappa = 0). One sparse LU per kappa solves all
+    modes. Use a grid with ``edges="faces"`` (:func:`tsd3d_grid`).
+
+    Parameters
+    ----------
+    background : :class:`Tsd3dSolution` (zero thickness gives the linear lifting problem).
+    modes : list of callables f(x, y) -> (h, dh/dx) (as :func:`asekit.aero.spline.analytic_modes`).
+    kappa : omega / U >= 0 (1 / length unit).
+
+    Examples
+    --------
+    >>> wing = TsdPlanform.rectangular(1.0, 1.0)
+    >>> g = tsd3d_grid(wing, 8, 4, far=4.0, ratio=1.5, edges="faces")
+    >>> bg = steady_tsd3d(wing, biconvex_thickness(0.0), 0.5, g)
+    >>> sol = harmonic_tsd3d(bg, [lambda x, y: (0 * x, -1 + 0 * x)], 0.0)   # unit incidence
+    >>> bool(np.all(sol.delta_cp()[0][sol.wing[1:] & sol.wing[:-1]].real > 0))
+    True
+    """
+    kappa = float(kappa)
+    if not (np.isfinite(kappa) and kappa >= 0.0):
+        raise ValueError(f"kappa must be finite and >= 0, got {kappa!r}")
+    grid = background.grid
+    wing, wake = _surface_sets(background.planform, grid)
+    K, op = _lifting_matrix(background, kappa, wing, wake)
+    nx, ny, nz = grid.shape
+    X, Y = np.meshgrid(grid.x, grid.y, indexing="ij")
+    area = op.hx[:, None] * op.hy[None, :]
+    rhs = np.zeros((nx * ny * nz, len(modes)), complex)
+    surface = op.node[:, :, 0][wing]
+    for m, f in enumerate(modes):
+        h, dh = (np.broadcast_to(np.asarray(v, float), X.shape) for v in f(X, Y))
+        rhs[surface, m] = (area * (dh + 1j * kappa * h))[wing]
+    phi = _solve(K, rhs).reshape(nx, ny, nz, len(modes))
+    return HarmonicTsd3dSolution(grid, np.moveaxis(phi[:, :, 0, :], -1, 0), wing, kappa)
+
+
+def _solve(K, rhs: np.ndarray) -> np.ndarray:
+    """K x = rhs by sparse LU: real when K is (kappa = 0), else in the interleaved real form
+    [[Re, -Im], [Im, Re]] per node (SuperLU's complex factorisation was measured 10-200 times
+    slower than the real one of twice the size on these grids)."""
+    K = K.tocoo()
+    if not np.any(K.data.imag):
+        real = sparse.csc_matrix((K.data.real, (K.row, K.col)), shape=K.shape)
+        lu = splu(real)
+        return lu.solve(np.ascontiguousarray(rhs.real)) + 1j * lu.solve(
+            np.ascontiguousarray(rhs.imag))
+    r, c, v = K.row, K.col, K.data
+    n = K.shape[0]
+    R = sparse.csc_matrix((np.concatenate([v.real, -v.imag, v.imag, v.real]),
+                           (np.concatenate([2 * r, 2 * r, 2 * r + 1, 2 * r + 1]),
+                            np.concatenate([2 * c, 2 * c + 1, 2 * c, 2 * c + 1]))),
+                          shape=(2 * n, 2 * n))
+    b = np.empty((2 * n, rhs.shape[1]))
+    b[0::2], b[1::2] = rhs.real, rhs.imag
+    x = splu(R).solve(b)
+    return x[0::2] + 1j * x[1::2]
+
+
+def box_pressures(solution: HarmonicTsd3dSolution, mesh) -> np.ndarray:
+    """(n_boxes, n_modes) box-average pressure jumps of a :class:`~asekit.aero.boxes.BoxMesh`
+    in z = 0: the integral of Delta Cp = 4 (phi_x + i kappa phi) over each box, exact in x for
+    the piecewise-linear potential of each grid row (4 [phi]_{x_a}^{x_b} + 4 i kappa int phi
+    dx), rows weighted by their cells' overlap with the box, divided by the box area."""
+    grid, kap = solution.grid, solution.kappa
+    x = grid.x
+    dx = np.diff(x)
+    phi = solution.phi                                         # (m, nx, ny)
+    cum = np.concatenate([np.zeros_like(phi[:, :1]),
+                          np.cumsum(0.5 * (phi[:, 1:] + phi[:, :-1]) * dx[None, :, None],
+                                    axis=1)], axis=1)
+    ya, yb = _faces(grid.y)
+    c = mesh.corners
+    y_in = np.minimum(c[:, 0, 1], c[:, 3, 1])
+    y_out = np.maximum(c[:, 0, 1], c[:, 3, 1])
+    force = np.zeros((mesh.n, phi.shape[0]), complex)
+
+    def values(xq, j):
+        i = np.clip(np.searchsorted(x, xq) - 1, 0, x.size - 2)
+        t = xq - x[i]
+        p0, p1 = phi[:, i, j], phi[:, i + 1, j]
+        slope = (p1 - p0) / dx[i]
+        return p0 + slope * t, cum[:, i, j] + p0 * t + 0.5 * slope * t ** 2
+
+    for j in range(grid.y.size):
+        lo, hi = np.maximum(ya[j], y_in), np.minimum(yb[j], y_out)
+        w = np.clip(hi - lo, 0.0, None)
+        if not np.any(w > 0):
+            continue
+        eta = (0.5 * (lo + hi) - c[:, 0, 1]) / (c[:, 3, 1] - c[:, 0, 1])
+        xa = c[:, 0, 0] + eta * (c[:, 3, 0] - c[:, 0, 0])
+        xb = c[:, 1, 0] + eta * (c[:, 2, 0] - c[:, 1, 0])
+        pa, ca = values(xa, j)
+        pb, cb = values(xb, j)
+        force += (w * 4.0 * ((pb - pa) + 1j * kap * (cb - ca))).T
+    return force / mesh.area[:, None]
+
+
+def tsd_gaf(background: Tsd3dSolution, mesh, modes, k, b_ref: float) -> np.ndarray:
+    """Q(M, k) (n_k, n_modes, n_modes) per unit dynamic pressure of analytic ``modes``
+    (callables f(x, y) -> (h, dh/dx), the surface's length unit) about a steady background:
+    one :func:`harmonic_tsd3d` per k (kappa = k / b_ref), :func:`box_pressures` on ``mesh``
+    and Q = H_lp^T diag(A) Delta Cp, H_lp the modes at the boxes' load points (quarter chord,
+    as the DLM; the box-average pressure's own centroid would move the pitch moment of the
+    test wing by about 15 % on 12 boxes: the projection, not the solver, then dominates) (:func:`asekit.aero.spline.modal_forces`, thesis
+    Eqs. 2.10-2.11, as the DLM's GAFs)."""
+    from asekit.aero.spline import analytic_modes, modal_forces
+
+    if not (np.isfinite(b_ref) and b_ref > 0.0):
+        raise ValueError(f"b_ref must be a finite semi-chord > 0, got {b_ref!r}")
+    ks = np.atleast_1d(np.asarray(k, float))
+    bm = analytic_modes(mesh, modes)
+    return np.stack([modal_forces(bm, box_pressures(harmonic_tsd3d(background, modes,
+                                                                   kk / b_ref), mesh),
+                                  mesh.area) for kk in ks])

@@ -3,14 +3,18 @@
 import numpy as np
 import pytest
 
-from asekit.aero.boxes import TrapezoidSurface
+from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
+from asekit.aero.gaf import gaf_from_box_modes
+from asekit.aero.spline import analytic_modes
 from asekit.aero.tsd import biconvex, biconvex_linear_cp, steady_tsd, tsd_grid
 from asekit.aero.tsd3d import (
     TsdPlanform,
     biconvex_thickness,
+    harmonic_tsd3d,
     steady_tsd3d,
     thickness_flux,
     tsd3d_grid,
+    tsd_gaf,
 )
 
 
@@ -115,3 +119,65 @@ def test_planform_from_trapezoid_surfaces_and_bad_input():
         tsd3d_grid(p, n_span=1)
     with pytest.raises(ValueError, match="mach must be in"):
         steady_tsd3d(p, biconvex_thickness(0.04), 1.4, tsd3d_grid(p, 4, 2, far=3.0))
+
+
+# --- the time-linearised lifting problem (zero thickness: the linear limit) -----------------
+_MACH, _SEMI, _B = 0.8, 1.5, 0.5
+_MODES = [lambda x, y: (1.0 + 0 * x, 0 * x),                 # heave
+          lambda x, y: (-(x - 0.5), -1.0 + 0 * x)]           # nose-up pitch about mid-chord
+
+
+def _dlm(n, ks):
+    mesh = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, _SEMI, 0), 1.0, n, n)])
+    return mesh, gaf_from_box_modes(analytic_modes(mesh, _MODES), mesh, _MACH, ks, _B,
+                                    symmetric=True)
+
+
+def _tsd(n_chord, mesh, ks):
+    wing = TsdPlanform.rectangular(1.0, _SEMI)
+    g = tsd3d_grid(wing, n_chord, n_chord // 2, far=6.0, ratio=1.3, edges="faces")
+    bg = steady_tsd3d(wing, biconvex_thickness(0.0), _MACH, g)
+    return tsd_gaf(bg, mesh, _MODES, ks, _B)
+
+
+def test_steady_lift_of_a_rectangular_wing_matches_the_dlm_in_the_linear_limit():
+    """Zero thickness, k = 0, M 0.8, rectangular wing of aspect ratio 3 (semi-span 1.5 chords,
+    symmetric about the root). Both methods converge at first order in the cell / box size,
+    so both are Richardson-extrapolated (Q(h) = Q0 + C h) from two meshes. Lift per unit pitch,
+    Q_heave,pitch (m^2), measured: TSD 5.5653, 5.6376, 5.6745, 5.6949 on 8 x 4, 12 x 6, 16 x 8,
+    24 x 12 cells (far 6 chords; 0.3, 1.3, 3.4, 17 s), extrapolated 5.782 (8/12); DLM 6.0598,
+    5.9620, 5.8828 on 8 x 8, 12 x 12, 20 x 20 boxes, extrapolated 5.766 (8/12) and 5.764
+    (12/20): 0.3 % apart. (The far boundary at 6 chords adds about 1.3 % to the TSD lift:
+    5.638, 5.597, 5.568 at far 6, 15, 30 on 12 x 6 cells.)"""
+    mesh8, d8 = _dlm(8, [0.0])
+    mesh12, d12 = _dlm(12, [0.0])
+    t8, t12 = _tsd(8, mesh12, [0.0]), _tsd(12, mesh12, [0.0])
+    dlm = (12 * d12[0, 0, 1] - 8 * d8[0, 0, 1]) / 4
+    tsd = (12 * t12[0, 0, 1] - 8 * t8[0, 0, 1]) / 4
+    assert abs(tsd.real / dlm.real - 1) < 0.015
+    assert abs(tsd.imag) < 1e-12 and abs(t12[0, 0, 0]) < 1e-12      # heave: no steady load
+    assert abs(t12[0, 0, 1] / d12[0, 0, 1] - 1) < 0.07                # one grid: first order
+
+
+def test_harmonic_gafs_of_a_rectangular_wing_approach_the_dlm():
+    """k = 0.3 (b = c/2), M 0.8, heave and pitch, zero thickness. Measured max |Q/Q_DLM - 1|
+    over the four entries against the DLM on 12 x 12 boxes: 12.9 %, 9.7 %, 8.7 % on 8 x 4,
+    12 x 6, 16 x 8 cells (1.4, 5, 14 s on the shared machine); Q_heave,pitch is 5.8135 +
+    1.4199i on 16 x 8 cells against 6.1209 + 1.1191i. The issue's 1 % needs much finer grids
+    (first-order edges) than a unit test affords; this test checks the coarse grid's level
+    and the sign of every real and imaginary part (damping and stiffness)."""
+    mesh, d = _dlm(12, [0.3])
+    t = _tsd(8, mesh, [0.3])
+    assert np.max(np.abs(t / d - 1)) < 0.15
+    assert np.all(np.sign(t.real) == np.sign(d.real))
+    assert np.all(np.sign(t.imag) == np.sign(d.imag))
+
+
+def test_harmonic_refuses_a_bad_frequency():
+    wing = TsdPlanform.rectangular(1.0, 1.0)
+    bg = steady_tsd3d(wing, biconvex_thickness(0.0), 0.5,
+                      tsd3d_grid(wing, 4, 2, far=3.0, edges="faces"))
+    with pytest.raises(ValueError, match="kappa"):
+        harmonic_tsd3d(bg, _MODES, -0.1)
+    with pytest.raises(ValueError, match="b_ref"):
+        tsd_gaf(bg, None, _MODES, [0.1], 0.0)
