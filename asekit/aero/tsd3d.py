@@ -29,8 +29,14 @@ plane z = 0 (:meth:`TsdPlanform.from_surfaces` takes the panels of
 
 Validity and state: the steady background of a symmetric wing at zero incidence (no steady
 lift), with a reflection plane at the root; the far field phi = 0 on a box ``far`` root chords
-away. The sparse LU costs grow as about n^1.5-2 in 3-D: about 1e4 nodes solve in a second,
-5e4 in tens of seconds.
+away. The lifting problem (:func:`harmonic_tsd3d`, :func:`tsd_gaf`) is first order in the cell
+size at the edges (Richardson extrapolation of two grids recovers the DLM's steady lift of an
+aspect-ratio-3 wing at M 0.8 to 0.3 %; at k = 0.3 the 16 x 8-cell GAFs are within 6.4 % of the
+DLM's and converging), and its far field reflects part of the short upstream-running acoustic
+waves at high subsonic Mach. Not yet: camber / incidence backgrounds (steady lift and wake),
+the cross-flow terms of swept wings, supersonic free streams, ``method = "tsd"`` in the
+registry. The sparse LU costs grow as about n^1.5-2 in 3-D: about 1e4 nodes solve in a second
+(real) or a few seconds (the complex harmonic system), 4e4 nodes in tens of seconds.
 
 Examples
 --------
@@ -545,8 +551,10 @@ def _lifting_matrix(background: Tsd3dSolution, kappa: float, wing, wake):
         bj.append(c.ravel())
         bv.append(np.broadcast_to(np.asarray(v, complex), r.shape).ravel())
 
-    put(node[0], node[0], 1.0)
-    put(node[0], node[1], -1.0)
+    d0 = grid.x[1] - grid.x[0]
+    k_up = kappa * mach / (1.0 - mach) if mach < 1.0 else 0.0
+    put(node[0], node[0], -1.0 / d0 - 0.5j * k_up)
+    put(node[0], node[1], 1.0 / d0 - 0.5j * k_up)
     d = grid.x[-1] - grid.x[-2]
     put(node[-1], node[-1], 1.0 / d + 0.5j * kappa)
     put(node[-1], node[-2], -1.0 / d + 0.5j * kappa)
@@ -582,10 +590,16 @@ def harmonic_tsd3d(background: Tsd3dSolution, modes, kappa: float) -> HarmonicTs
     a continuous pressure phi1_x + i kappa phi1 = 0, solved exactly along the wake
     (phi1 = phi1_TE exp(-i kappa (x - x_TE)): the jump is convected and the trailing edge
     carries the Kutta condition); phi1_y = 0 on the root plane (symmetric motions of a
-    mirrored half wing), phi1_x = 0 upstream, phi1_x + i kappa phi1 = 0 downstream and the
-    first-order radiation condition phi1_n + i K phi1 = 0, K = kappa M / beta, on the
-    outboard and upper boundaries (zero flux there at kappa = 0). One sparse LU per kappa solves all
-    modes. Use a grid with ``edges="faces"`` (:func:`tsd3d_grid`).
+    mirrored half wing), phi1_x + i kappa phi1 = 0 downstream, and first-order radiation
+    conditions of the acoustic waves of Eq. (3) elsewhere: phi1_n + i K phi1 = 0,
+    K = kappa M / beta, on the outboard and upper boundaries, and phi1_x - i kappa M / (1 - M)
+    phi1 = 0 upstream (the upstream-running wave; zero flux / phi1_x = 0 at kappa = 0).
+    At high subsonic Mach the upstream wave is short (wavelength 2 pi (1 - M) / (kappa M)),
+    so the stretched far field resolves it poorly: at M 0.8, k = 0.3 the GAFs still move by
+    several per cent with the far-field extent (a limitation of this first version; a
+    non-reflecting far field is the next step). One sparse LU per kappa solves all
+    modes. Use a grid with ``edges="faces"`` (:func:`tsd3d_grid`). The complex system is
+    solved in its real form (see ``_solve``).
 
     Parameters
     ----------
