@@ -619,18 +619,26 @@ def harmonic_tsd3d(background: Tsd3dSolution, modes, kappa: float) -> HarmonicTs
     kappa = float(kappa)
     if not (np.isfinite(kappa) and kappa >= 0.0):
         raise ValueError(f"kappa must be finite and >= 0, got {kappa!r}")
+    X, Y = np.meshgrid(background.grid.x, background.grid.y, indexing="ij")
+    wash = []
+    for f in modes:
+        h, dh = (np.broadcast_to(np.asarray(v, float), X.shape) for v in f(X, Y))
+        wash.append(dh + 1j * kappa * h)
+    return _harmonic_solve(background, np.array(wash), kappa)
+
+
+def _harmonic_solve(background: Tsd3dSolution, wash: np.ndarray, kappa: float
+                    ) -> HarmonicTsd3dSolution:
+    """Eq. (3) for normalwash columns ``wash`` (n_cols, n_x, n_y) on the z = 0 nodes (used on
+    the wing nodes only)."""
     grid = background.grid
     wing, wake = _surface_sets(background.planform, grid)
     K, op = _lifting_matrix(background, kappa, wing, wake)
     nx, ny, nz = grid.shape
-    X, Y = np.meshgrid(grid.x, grid.y, indexing="ij")
     area = op.hx[:, None] * op.hy[None, :]
-    rhs = np.zeros((nx * ny * nz, len(modes)), complex)
-    surface = op.node[:, :, 0][wing]
-    for m, f in enumerate(modes):
-        h, dh = (np.broadcast_to(np.asarray(v, float), X.shape) for v in f(X, Y))
-        rhs[surface, m] = (area * (dh + 1j * kappa * h))[wing]
-    phi = _solve(K, rhs).reshape(nx, ny, nz, len(modes))
+    rhs = np.zeros((nx * ny * nz, wash.shape[0]), complex)
+    rhs[op.node[:, :, 0][wing]] = (area[None] * wash)[:, wing].T
+    phi = _solve(K, rhs).reshape(nx, ny, nz, wash.shape[0])
     return HarmonicTsd3dSolution(grid, np.moveaxis(phi[:, :, 0, :], -1, 0), wing, kappa)
 
 
@@ -712,3 +720,80 @@ def tsd_gaf(background: Tsd3dSolution, mesh, modes, k, b_ref: float) -> np.ndarr
     return np.stack([modal_forces(bm, box_pressures(harmonic_tsd3d(background, modes,
                                                                    kk / b_ref), mesh),
                                   mesh.area) for kk in ks])
+
+
+def planform_of_boxes(mesh) -> TsdPlanform:
+    """The :class:`TsdPlanform` covered by the boxes of a planar (z = 0) box mesh whose strips
+    tile a half wing from y = 0: per distinct strip edge y, the most forward leading edge and
+    the most aft trailing edge of the boxes there (straight-tapered between strip edges)."""
+    c = np.asarray(mesh.corners, float)
+    if np.any(np.abs(c[:, :, 2]) > 1e-9):
+        raise ValueError("the TSD planform needs boxes in the plane z = 0")
+    y = np.unique(np.round(np.concatenate([c[:, 0, 1], c[:, 3, 1]]), 12))
+    le, te = np.full(y.size, np.inf), np.full(y.size, -np.inf)
+    for a, b in ((0, 1), (3, 2)):                      # inboard and outboard edges
+        j = np.searchsorted(y, np.round(c[:, a, 1], 12))
+        np.minimum.at(le, j, c[:, a, 0])
+        np.maximum.at(te, j, c[:, b, 0])
+    if abs(y[0]) > 1e-9:
+        raise ValueError(f"the boxes must start at the root y = 0 (the symmetry plane), "
+                         f"got y = {y[0]!r}")
+    return TsdPlanform(y, le, te - le)
+
+
+def _box_of_nodes(mesh, grid: Tsd3dGrid, wing: np.ndarray) -> np.ndarray:
+    """(n_x, n_y) index of the box holding each wing node (-1 off the boxes)."""
+    c = mesh.corners
+    X, Y = np.meshgrid(grid.x, grid.y, indexing="ij")
+    out = np.full(X.shape, -1)
+    for b in range(mesh.n):
+        y0, y1 = c[b, 0, 1], c[b, 3, 1]
+        eta = (Y - y0) / (y1 - y0)
+        xa = c[b, 0, 0] + eta * (c[b, 3, 0] - c[b, 0, 0])
+        xb = c[b, 1, 0] + eta * (c[b, 2, 0] - c[b, 1, 0])
+        out[wing & (eta >= 0) & (eta < 1) & (X >= xa) & (X < xb)] = b
+    return out
+
+
+def tsd_pressure_matrices(mesh, mach: float, k, b_ref: float, thickness=None,
+                          grid_options: dict | None = None, gamma: float = GAMMA_AIR,
+                          background: Tsd3dSolution | None = None) -> np.ndarray:
+    """Pressure-per-normalwash matrices A (n_k, n, n), DeltaCp = A (w/U), of the boxes of a
+    planar half-wing mesh (root y = 0 a symmetry plane) by the time-linearised TSD: each box's
+    unit normalwash is applied on the grid nodes inside it, :func:`harmonic_tsd3d`'s operator
+    solved for all boxes at once per k (kappa = k / b_ref), and :func:`box_pressures` taken.
+    ``thickness`` (callable xi -> z_t / c, default none) gives the steady background
+    (:func:`steady_tsd3d`, computed once unless ``background`` is given); ``grid_options``
+    go to :func:`tsd3d_grid` (``edges="faces"`` always).
+
+    Examples
+    --------
+    >>> from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
+    >>> mesh = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, 1.0, 0), 1.0, 2, 2)])
+    >>> a = tsd_pressure_matrices(mesh, 0.5, [0.0], 0.5,
+    ...                           grid_options=dict(n_chord=8, n_span=4, far=3.0, ratio=1.5))
+    >>> a.shape, bool(np.all((a[0] @ -np.ones(4)).real > 0))     # a unit incidence lifts
+    ((1, 4, 4), True)
+    """
+    if not (np.isfinite(b_ref) and b_ref > 0.0):
+        raise ValueError(f"b_ref must be a finite semi-chord > 0, got {b_ref!r}")
+    ks = np.atleast_1d(np.asarray(k, float))
+    if background is None:
+        planform = planform_of_boxes(mesh)
+        opts = dict(grid_options or {})
+        opts["edges"] = "faces"
+        grid = tsd3d_grid(planform, **opts)
+        background = steady_tsd3d(planform, thickness or (lambda xi: 0.0 * xi), mach, grid,
+                                  gamma=gamma)
+        if not background.converged:
+            raise ValueError(f"the steady TSD background did not converge at M {mach:g} "
+                             f"(residual {background.residual:.2g}); refine or change the grid")
+    wing, _ = _surface_sets(background.planform, background.grid)
+    owner = _box_of_nodes(mesh, background.grid, wing)
+    out = np.empty((ks.size, mesh.n, mesh.n), complex)
+    for ik, kk in enumerate(ks):
+        wash = np.zeros((mesh.n,) + owner.shape, complex)
+        i, j = np.nonzero(owner >= 0)
+        wash[owner[i, j], i, j] = 1.0
+        out[ik] = box_pressures(_harmonic_solve(background, wash, kk / b_ref), mesh)
+    return out

@@ -5,16 +5,18 @@ import pytest
 
 from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
 from asekit.aero.gaf import gaf_from_box_modes
-from asekit.aero.spline import analytic_modes
+from asekit.aero.spline import analytic_modes, modal_forces
 from asekit.aero.tsd import biconvex, biconvex_linear_cp, steady_tsd, tsd_grid
 from asekit.aero.tsd3d import (
     TsdPlanform,
     biconvex_thickness,
     harmonic_tsd3d,
+    planform_of_boxes,
     steady_tsd3d,
     thickness_flux,
     tsd3d_grid,
     tsd_gaf,
+    tsd_pressure_matrices,
 )
 
 
@@ -202,3 +204,24 @@ def test_thickness_raises_the_lift_more_as_the_mach_number_rises():
         rise.append(q[1] / q[0] - 1)
     assert 0.01 < rise[0] < 0.06, rise
     assert rise[1] > 2 * rise[0], rise
+
+
+def test_pressure_matrices_reproduce_the_modal_gafs():
+    """tsd_pressure_matrices (each box's unit normalwash on the grid nodes inside it) applied
+    to the modes' box normalwash and projected with modal_forces gives the GAFs of tsd_gaf
+    (the modes' pointwise normalwash) up to the box-constant normalwash: at k = 0 the modes'
+    normalwash is constant per box and the two agree to round-off; at k = 0.3 (the pitch
+    mode's i k h / b varies across a box) measured 1.2 % and 3.0 % on the pitch column, on
+    8 x 4 cells, 6 x 6 boxes, M 0.8."""
+    mesh = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, _SEMI, 0), 1.0, 6, 6)])
+    assert np.allclose(planform_of_boxes(mesh).chord, 1.0)
+    ks = [0.0, 0.3]
+    a = tsd_pressure_matrices(mesh, _MACH, ks, _B,
+                              grid_options=dict(n_chord=8, n_span=4, far=6.0, ratio=1.3))
+    bm = analytic_modes(mesh, _MODES)
+    q = np.stack([modal_forces(bm, a[i] @ bm.normalwash(k, _B), mesh.area)
+                  for i, k in enumerate(ks)])
+    ref = _tsd(8, mesh, ks)
+    assert np.max(np.abs(q[0] - ref[0])) < 1e-10 * np.max(np.abs(ref[0]))
+    big = np.abs(ref) > 0.1
+    assert np.max(np.abs(q[big] / ref[big] - 1)) < 0.04
