@@ -237,9 +237,9 @@ def test_pressure_matrices_reproduce_the_modal_gafs():
     to the modes' box normalwash and projected with modal_forces gives the GAFs of tsd_gaf
     (the modes' pointwise normalwash) up to the box-constant normalwash: at k = 0 the modes'
     normalwash is constant per box and the two agree to round-off; at k = 0.3 (the pitch
-    mode's i k h / b varies across a box) measured 1.2 % and 3.0 % on the pitch column, on
-    8 x 4 cells, 6 x 6 boxes, M 0.8."""
-    mesh = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, _SEMI, 0), 1.0, 6, 6)])
+    mode's i k h / b varies across a box) measured 2.3 % and 4.2 % on the pitch column with
+    4 x 4 boxes, 1.2 % and 3.0 % with 6 x 6 (8 x 4 cells, M 0.8)."""
+    mesh = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, _SEMI, 0), 1.0, 4, 4)])
     assert np.allclose(planform_of_boxes(mesh).chord, 1.0)
     ks = [0.0, 0.3]
     a = tsd_pressure_matrices(mesh, _MACH, ks, _B,
@@ -250,7 +250,7 @@ def test_pressure_matrices_reproduce_the_modal_gafs():
     ref = _tsd(8, mesh, ks)
     assert np.max(np.abs(q[0] - ref[0])) < 1e-10 * np.max(np.abs(ref[0]))
     big = np.abs(ref) > 0.1
-    assert np.max(np.abs(q[big] / ref[big] - 1)) < 0.04
+    assert np.max(np.abs(q[big] / ref[big] - 1)) < 0.06
 
 
 @pytest.mark.slow
