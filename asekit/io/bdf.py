@@ -34,14 +34,17 @@ card with its own method), EIGR / EIGRL (number of modes or the frequency range)
 degenerated MITC4 (its third node repeated: a collapsed quadrilateral, Bathe, *Finite Element
 Procedures*, 1996, Ch. 5), stiffer than the quadrilateral on coarse meshes but convergent
 (tests/io/test_bdf.py: NAFEMS FV16). Solids, beams, bars, rods and other shells are refused with
-the list of what is missing. Every other card (e.g. ASET1, PARAM COUPMASS, plot cards) is
+the list of what is missing. Every other card (e.g. ASET1, PARAM POST, plot cards) is
 listed in one :class:`UnsupportedCardWarning` (name, count, first id) and otherwise ignored.
+PARAM COUPMASS is read as Nastran reads it: > 0 the consistent plate mass, else (and by
+default) the lumped mass, translational only (:func:`lumped_translational_mass`); the export
+writes PARAM COUPMASS 1 for asekit's own (consistent) plate.
 
 What asekit models: the out-of-plane bending of a flat plate in the plane z = z0 (degrees of
 freedom T3, R1, R2 of each GRID = asekit's w, theta_x, theta_y; the in-plane DOFs 1, 2, 6 are
 uncoupled from bending for a flat plate and are dropped). Differences from Nastran a user should
 expect: asekit's plate is Reissner-Mindlin with consistent translational *and* rotary inertia
-(Nastran's CQUAD4 mass has no rotary inertia; PSHELL MID3 blank makes Nastran's plate
+under PARAM COUPMASS 1 (Nastran's CQUAD4 mass has no rotary inertia; PSHELL MID3 blank makes Nastran's plate
 Kirchhoff); ASET1 (Guyan reduction) is ignored, so asekit solves the full model; asekit
 interpolates the modes onto the boxes with its finite-element shape functions, not with the
 deck's SPLINE1/SPLINE4 surface spline.
@@ -104,7 +107,7 @@ REFUSED_CARDS = ("CTRIA6", "CTRIAR", "CQUAD8", "CQUADR", "CQUAD", "CSHEAR", "CTE
                  "RBAR", "RBAR1", "RROD", "MPC", "CAERO2", "CAERO3", "CAERO4", "CAERO5",
                  "PCOMP", "PCOMPG")
 #: PARAMs asekit applies.
-_USED_PARAMS = ("WTMASS",)
+_USED_PARAMS = ("WTMASS", "COUPMASS")
 
 
 class UnsupportedCardWarning(UserWarning):
@@ -184,6 +187,8 @@ class BdfModel:
         file read; units : its unit system (a key of :data:`UNITS`).
     control_surfaces : the AESURF cards (:class:`DeckControlSurface`); aelinks : the AELINK
         cards as (dependent label, ((independent label, coefficient), ...)), kept, not applied.
+    coupled_mass : PARAM COUPMASS > 0 (the consistent plate mass); False: Nastran's default
+        lumped mass (:func:`lumped_translational_mass`).
     """
 
     mesh: PlateMesh
@@ -216,6 +221,7 @@ class BdfModel:
     notes: tuple[str, ...] = ()
     path: str = ""
     units: str = "SI"
+    coupled_mass: bool = True
 
     def node_index(self, grid_id: int) -> int:
         """Mesh node index of GRID ``grid_id``."""
@@ -912,11 +918,65 @@ def _nsm_mass(sub: PlateMesh, nsm: float) -> np.ndarray:
     return me * (nsm / h)[:, None, None]
 
 
+def _read_param_coupmass(model) -> bool:
+    """PARAM COUPMASS: True (coupled, i.e. consistent, mass) if its value is > 0; Nastran's
+    default (absent, or <= 0) is the lumped mass (MSC Nastran Quick Reference Guide, PARAM
+    COUPMASS: "-1 (default) ... lumped mass").
+
+    +-------+----------+--------+
+    |   1   |    2     |   3    |
+    +=======+==========+========+
+    | PARAM | COUPMASS | value  |
+    +-------+----------+--------+
+    """
+    cm = model.params.get("COUPMASS")
+    if cm is None:
+        return False
+    v = _number(cm.values[0] if cm.values else None)
+    if v is None or not math.isfinite(v):
+        raise BdfError(f"PARAM COUPMASS = {cm.values[0] if cm.values else None} must be an "
+                       f"integer (> 0 coupled mass, <= 0 lumped mass)")
+    return v > 0
+
+
+def lumped_translational_mass(me: np.ndarray) -> np.ndarray:
+    """Nastran's lumped plate mass from consistent element mass matrices: each corner's
+    translational mass is the row sum of the consistent w-w block (int N_i rho h dA, the
+    quarter of the element's mass on a parallelogram), placed on the diagonal; no rotary
+    inertia (MSC Nastran's CQUAD4 lumped mass, PARAM COUPMASS -1, the default).
+
+    Parameters
+    ----------
+    me : ndarray (n_elem, 12, 12)
+        Consistent element mass matrices, DOFs (w, theta_x, theta_y) per corner (kg, kg m,
+        kg m^2).
+
+    Returns
+    -------
+    ndarray (n_elem, 12, 12)
+        Diagonal lumped mass matrices: the element's translational mass kept exactly.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> me = np.zeros((1, 12, 12)); me[0, 0::3, 0::3] = [[4, 2, 1, 2], [2, 4, 2, 1],
+    ...                                                  [1, 2, 4, 2], [2, 1, 2, 4]]
+    >>> np.diag(lumped_translational_mass(me)[0])[0::3].tolist()
+    [9.0, 9.0, 9.0, 9.0]
+    """
+    out = np.zeros_like(me)
+    idx = np.arange(0, me.shape[1], 3)
+    out[:, idx, idx] = me[:, idx[:, None], idx[None, :]].sum(axis=2)
+    return out
+
+
 def _plate_matrices(deck: _Deck, conn, th, pids, props, angles, thickness_rule):
     """Global K and M (SI) of the plate elements, grouped by property and material angle:
-    MITC4 stiffness and consistent mass (:mod:`asekit.structure.plate`) plus the PSHELL NSM.
+    MITC4 stiffness and consistent mass (:mod:`asekit.structure.plate`) plus the PSHELL NSM,
+    lumped (:func:`lumped_translational_mass`) unless PARAM COUPMASS > 0, as Nastran.
     Returns (K, M, materials {(pid, angle): material}, groups, mesh)."""
     nodes, n = deck.nodes, deck.n_dof
+    coupled = _read_param_coupmass(deck.model)
     K = sp.csr_matrix((n, n))
     M = sp.csr_matrix((n, n))
     span = max(float(np.ptp(nodes[:, 1])), 1e-12)
@@ -930,10 +990,11 @@ def _plate_matrices(deck: _Deck, conn, th, pids, props, angles, thickness_rule):
         sub = PlateMesh(nodes=nodes, elements=conn[idx], thickness_root=1.0, thickness_tip=1.0,
                         y_root=float(nodes[:, 1].min()), span=span, corner_thickness=th[idx])
         K = K + _scatter(sub, mitc4_stiffness(sub, material, thickness_rule), n)
-        M = M + _scatter(sub, consistent_mass(sub, material, thickness_rule), n)
+        me = consistent_mass(sub, material, thickness_rule)
         nsm = float(p.nsm or 0.0) * deck.wtmass * deck.Mu / deck.L**2
         if nsm:
-            M = M + _scatter(sub, _nsm_mass(sub, nsm), n)
+            me = me + _nsm_mass(sub, nsm)
+        M = M + _scatter(sub, me if coupled else lumped_translational_mass(me), n)
     mesh = PlateMesh(nodes=nodes, elements=conn, thickness_root=float(th.max()),
                      thickness_tip=float(th.max()), y_root=float(nodes[:, 1].min()), span=span,
                      corner_thickness=th)
@@ -2003,7 +2064,8 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
                     materials=materials, element_pids=pids.copy(),
                     element_angles=_angles(keys, len(quads)), springs=springs, masses=masses,
                     fixed=tuple(sorted(fixed)), rigid=rigid, ignored=tuple(ignored),
-                    notes=tuple(deck.notes), path=str(path), units=units)
+                    notes=tuple(deck.notes), path=str(path), units=units,
+                    coupled_mass=_read_param_coupmass(model))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -2656,6 +2718,8 @@ def case_bdf(case, sol: int | None = None, n_modes: int | None = None):
         ids, eid = _plate_cards(model, case)
     eid = _point_mass_cards(model, case, ids, eid)
     _support_cards(model, case, ids, eid)
+    if case.structure is None or _deck_of(case).coupled_mass:
+        model.add_param("COUPMASS", [1])      # asekit's plate mass is the consistent one
     nmod = n_modes if n_modes is not None else case.modes.count
     model.add_eigrl(10, v1=None if nmod else -1.0e-3,
                     v2=None if nmod else float(case.modes.f_max), nd=nmod)

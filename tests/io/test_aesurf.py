@@ -53,7 +53,8 @@ def _aileron_deck(tmp_path, cards=AILERON, name="aileron.bdf"):
     control-surface cards."""
     lines = ["SOL 145", "CEND", "SPC = 1", "METHOD = 10", "FMETHOD = 20", "BEGIN BULK",
              "MAT1,1,70.0E9,,0.3,2700.0", "PSHELL,1,1,0.002,1,,1",
-             "EIGRL,10,,,4"]
+             "EIGRL,10,,,4",
+             "PARAM,COUPMASS,1"]       # the consistent plate mass, as the case file's
     nid = lambda i, j: 1 + j * (NC + 1) + i                      # i chordwise, j spanwise
     for j in range(NS + 1):
         for i in range(NC + 1):

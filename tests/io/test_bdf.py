@@ -136,13 +136,13 @@ def test_shaft_region_bending_spring_point_mass_orthotropic_round_trip(tmp_path)
 def test_unsupported_cards_warned_once_with_count_and_id(fin, tmp_path):
     p = B.write_case_bdf(fin, tmp_path / "a.bdf", sol=103)
     text = p.read_text().replace("ENDDATA", "ASET1   3       1       THRU    8\n"
-                                             "PARAM   COUPMASS1\nENDDATA")
+                                             "PARAM   POST    -1\nENDDATA")
     p.write_text(text)
     with pytest.warns(B.UnsupportedCardWarning) as rec:
         B.read_bdf(p)
     msgs = [str(r.message) for r in rec if issubclass(r.category, B.UnsupportedCardWarning)]
     assert len(msgs) == 1
-    assert "ASET1 x1" in msgs[0] and "PARAM COUPMASS" in msgs[0]
+    assert "ASET1 x1" in msgs[0] and "PARAM POST" in msgs[0]
 
 
 @pytest.mark.parametrize("card", ["CBAR    900     7       1       2       0.0     0.0     1.0",
