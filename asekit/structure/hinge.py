@@ -173,8 +173,8 @@ def release_hinge(split: HingeSplit, K, M, hinge_stiffness: float, hinge_damping
     Parameters
     ----------
     split : :func:`split_at_hinge`.
-    K, M : (3 n, 3 n) stiffness and mass of ``split.mesh`` (:func:`asekit.structure.assembly.
-        assemble`), unsupported.
+    K, M : (3 n, 3 n) stiffness and mass of ``split.mesh``
+        (:func:`asekit.structure.assembly.assemble`), unsupported.
     hinge_stiffness : k_h (N m/rad), >= 0. hinge_damping : c_h (N m s/rad), >= 0.
     release : "single" or "distributed" (:data:`RELEASES`).
     support : optional (3 n_original, n_s) map of the supports on the original nodes (the
