@@ -1458,11 +1458,12 @@ def control_surface_flutter(case: Case) -> tuple[ControlSurfaceFlutterRow, ...]:
 def _elastic_surface_model(case: Case, hm):
     """``kind = "elastic"``: the plate released along the surface's hinge
     (:func:`asekit.structure.hinge.release_hinge`, one hinge rotation on the hinge spring and
-    damper, the case's supports on the wing) reduced to the wing's ``modes`` count of
+    damper, the case's supports on the wing; the ``mass_balance`` masses on rigid arms from the
+    surface's hinge line, :func:`asekit.structure.hinge.hinge_balance_mass`) reduced to the wing's ``modes`` count of
     fixed-hinge modes plus the hinge rotation
     (:func:`asekit.aeroelastic.control_surface.elastic_flap_modal_model`)."""
     from asekit.aeroelastic.control_surface import elastic_flap_modal_model, surface_elements
-    from asekit.structure.hinge import release_hinge, split_at_hinge
+    from asekit.structure.hinge import hinge_balance_mass, release_hinge, split_at_hinge
 
     c = case.control_surfaces[0]
     path = "control_surface[0]"
@@ -1489,6 +1490,9 @@ def _elastic_surface_model(case: Case, hm):
     if case.point_masses:
         M = (M + point_mass_matrix(split.mesh, [(p.position, p.mass, p.inertia)
                                                 for p in case.point_masses])).tocsr()
+    for (x, y), m_b in c.mass_balance:          # on rigid arms from the surface's hinge
+        d_b = float(hm.distance_aft(0, np.array([[x, y, 0.0]]))[0])
+        M = (M + hinge_balance_mass(split, (x, y), d_b, m_b)).tocsr()
     K0, M0 = mass_and_stiffness(case)          # the support's own springs and masses
     released = release_hinge(split, K, M, c.hinge_stiffness, c.hinge_damping, "single",
                              support=support,
