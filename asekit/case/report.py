@@ -484,14 +484,19 @@ def _control_lines(rows) -> list[str]:
     """The control-surface block of the summary: one line per surface and Mach."""
     if not rows:
         return []
-    out = ["", "control surfaces (rigid derivatives per rad; reversal of the rolling moment)",
-           f"{'surface':>10} {'Mach':>6} {'dCL/dd':>8} {'dCL/da':>8} {'Ch_d':>8} {'Ch_a':>8} "
-           f"{'U_rev m/s':>10}"]
+    out = ["", "control surfaces (rigid derivatives per rad; rolling-moment reversal; "
+               "I_h, S about the hinge)",
+           f"{'surface':>10} {'kind':>7} {'Mach':>6} {'dCL/dd':>8} {'dCL/da':>8} {'Ch_d':>8} "
+           f"{'Ch_a':>8} {'U_rev m/s':>10} {'I_h g m2':>9} {'S g m':>8}"]
     for r in rows:
         rev = r["reversal_speed_ms"]
-        out.append(f"{r['name'][:10]:>10} {r['mach']:>6.3g} {r['dCL_ddelta_per_rad']:>8.4f} "
-                   f"{r['dCL_dalpha_per_rad']:>8.4f} {r['Ch_delta']:>8.4f} {r['Ch_alpha']:>8.4f} "
-                   f"{'none' if rev is None else f'{rev:.1f}':>10}")
+        i_h, s_h = r.get("hinge_inertia_kgm2"), r.get("static_unbalance_kgm")
+        out.append(f"{r['name'][:10]:>10} {(r.get('kind') or '-')[:7]:>7} {r['mach']:>6.3g} "
+                   f"{r['dCL_ddelta_per_rad']:>8.4f} {r['dCL_dalpha_per_rad']:>8.4f} "
+                   f"{r['Ch_delta']:>8.4f} {r['Ch_alpha']:>8.4f} "
+                   f"{'none' if rev is None else f'{rev:.1f}':>10} "
+                   f"{'-' if i_h is None else f'{1e3 * i_h:.4g}':>9} "
+                   f"{'-' if s_h is None else f'{1e3 * s_h:.4g}':>8}")
     return out
 
 

@@ -88,6 +88,19 @@ def written(tmp_path_factory):
     return a, index.read_text(), json.loads((index.parent / "summary.json").read_text())
 
 
+def test_summary_table_names_the_kind_and_the_hinge_moments_of_mass(written):
+    _, page, s = written
+    lines = report._control_lines(s["control_surfaces"])
+    r = s["control_surfaces"][0]
+    assert lines[2].split()[:2] == ["surface", "kind"]
+    cells = lines[3].split()
+    assert cells[:2] == ["aileron", "rigid"]
+    assert cells[-2:] == [f"{1e3 * r['hinge_inertia_kgm2']:.4g}",
+                          f"{1e3 * r['static_unbalance_kgm']:.4g}"]
+    assert all(len(x) <= 100 for x in lines)               # format_summary's width
+    assert lines[3] in page                                 # the report's summary table
+
+
 def test_report_shows_the_actuator_on_flap_loop(written):
     a, page, _ = written
     figs = report.figures(a)
