@@ -742,18 +742,19 @@ def fig_control_ase_steps(a) -> ReportFigure:
     fig, ax = new_figure(f"{a.case.name}: actuator on {r0.name}, power-limited "
                          f"{r0.step_deg:g} deg step", figsize=(7.0, 4.4), layout="constrained")
     for r in rows:
-        ts = ("fed-back angle not settled" if r.settling_time_s is None
-              else f"fed-back angle settles in {1e3 * r.settling_time_s:.1f} ms")
+        ts = ("not settled" if r.settling_time_s is None
+              else f"settles in {1e3 * r.settling_time_s:.1f} ms")
         line, = ax.plot(r.time_s * 1e3, np.degrees(r.surface_angle_rad),
-                        label=f"{r.topology}: {ts}")
+                        label=f"{r.topology}: {r0.name} angle in the air"
+                        + ("" if r.topology == "AEM1" else f" (fed back, {ts})"))
         if r.topology == "AEM1":           # AEM1 feeds back the hinge angle, not the air's
             ax.plot(r.time_s * 1e3, np.degrees(r.fed_back_rad), ls="--", lw=1.0,
-                    color=line.get_color(), label="AEM1: hinge angle (fed back)")
+                    color=line.get_color(), label=f"AEM1: hinge angle (fed back, {ts})")
         if r.settling_time_s is not None:
             ax.axvline(1e3 * r.settling_time_s, ls=":", color=line.get_color())
     ax.axhline(r0.step_deg, color="k", lw=0.8, ls="--", label="command")
     ax.set_xlabel("time (ms)")
-    ax.set_ylabel(f"{r0.name} angle in the air (deg)")
+    ax.set_ylabel("angle (deg)")
     ax.set_ylim(-0.5 * r0.step_deg, 2.5 * r0.step_deg)
     ax.legend()
     alt = (f"The {r0.name}'s angle after a {r0.step_deg:g} deg power-limited step command at "
