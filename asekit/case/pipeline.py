@@ -1458,11 +1458,12 @@ def control_surface_flutter(case: Case) -> tuple[ControlSurfaceFlutterRow, ...]:
 def _elastic_surface_model(case: Case, hm):
     """``kind = "elastic"``: the plate released along the surface's hinge
     (:func:`asekit.structure.hinge.release_hinge`, one hinge rotation on the hinge spring and
-    damper, the case's supports on the wing) reduced to the wing's ``modes`` count of
+    damper, the case's supports on the wing; the ``mass_balance`` masses on rigid arms from the
+    surface's hinge line, :func:`asekit.structure.hinge.hinge_balance_mass`) reduced to the wing's ``modes`` count of
     fixed-hinge modes plus the hinge rotation
     (:func:`asekit.aeroelastic.control_surface.elastic_flap_modal_model`)."""
     from asekit.aeroelastic.control_surface import elastic_flap_modal_model, surface_elements
-    from asekit.structure.hinge import release_hinge, split_at_hinge
+    from asekit.structure.hinge import hinge_balance_mass, release_hinge, split_at_hinge
 
     c = case.control_surfaces[0]
     path = "control_surface[0]"
@@ -1489,6 +1490,9 @@ def _elastic_surface_model(case: Case, hm):
     if case.point_masses:
         M = (M + point_mass_matrix(split.mesh, [(p.position, p.mass, p.inertia)
                                                 for p in case.point_masses])).tocsr()
+    for (x, y), m_b in c.mass_balance:          # on rigid arms from the surface's hinge
+        d_b = float(hm.distance_aft(0, np.array([[x, y, 0.0]]))[0])
+        M = (M + hinge_balance_mass(split, (x, y), d_b, m_b)).tocsr()
     K0, M0 = mass_and_stiffness(case)          # the support's own springs and masses
     released = release_hinge(split, K, M, c.hinge_stiffness, c.hinge_damping, "single",
                              support=support,
@@ -1615,6 +1619,15 @@ class ControlSurfaceAseRow:
     settling_time_s: float | None
     overshoot: float
     steady_error: float
+    # for the report's loop figures (asekit.case.report_figures.fig_control_ase_*): the step
+    # response (time s, the surface's angle in the air and the fed-back angle, rad), the open
+    # loop (forward path) on a frequency grid (Hz, complex) and its crossovers
+    time_s: np.ndarray | None = None
+    surface_angle_rad: np.ndarray | None = None
+    fed_back_rad: np.ndarray | None = None
+    frequency_hz: np.ndarray | None = None
+    open_loop: np.ndarray | None = None
+    crossovers: object = None
 
 
 _CONTROL_ASE = ("check [control_surface.actuator] (speed, mach, altitude) and the "
@@ -1670,12 +1683,14 @@ def control_surface_ase(case: Case) -> tuple[ControlSurfaceAseRow, ...]:
         return ()
     _, spec, m = control_surface_ase_condition(case)
     a = spec.actuator
+    f_plot = np.logspace(0, 3.5, 800)       # the report's Bode grid (Hz)
     step = math.radians(a.step_deg)
     rows = []
     for topo, which in (("AEM1", 2), ("AEM2", 3)):
         loop = ase_mod.closed_loop(m, SYSTEM_3, topo)
         maxre = float(np.linalg.eigvals(np.asarray(loop.A)).real.max())
-        cr = ase_mod.crossovers(ase_mod.forward_path(m, SYSTEM_3, which))
+        fw = ase_mod.forward_path(m, SYSTEM_3, which)
+        cr = ase_mod.crossovers(fw)
         sim = ase_mod.simulate_closed_loop(m, SYSTEM_3, step, topo, limits=THESIS_LIMITS,
                                            t_final=0.2)
         y = sim.fin_root
@@ -1687,7 +1702,9 @@ def control_surface_ase(case: Case) -> tuple[ControlSurfaceAseRow, ...]:
             cr.phase_margin_deg, cr.gain_margin_db,
             float(cr.gain_crossovers_hz[-1]) if cr.gain_crossovers_hz.size else None,
             float(a.step_deg), ts if math.isfinite(ts) else None,
-            float(metrics.overshoot(y, step)), float(abs(y[-1] - step) / step)))
+            float(metrics.overshoot(y, step)), float(abs(y[-1] - step) / step),
+            np.asarray(sim.t, float), np.asarray(y, float), np.asarray(fed_back, float),
+            f_plot, ase_mod.frequency_response(fw, f_plot), cr))
     return tuple(rows)
 
 

@@ -103,8 +103,12 @@ UNITS = {
     "Ch_delta": "1/rad (hinge moment / (q S_f c_f), > 0 trailing edge down)",
     "Ch_alpha": "1/rad (hinge moment / (q S_f c_f), > 0 trailing edge down)",
     "reversal_speed_ms": "m/s", "divergence_speed_ms": "m/s",
-    "hinge_inertia": "kg m^2 (about the hinge)",
-    "static_unbalance": "kg m (> 0: centre of mass aft of the hinge)",
+    "kind": "'rigid' (a rigid surface rotating about its hinge) or 'elastic' (the plate "
+            "region released along the hinge)",
+    "hinge_inertia_kgm2": "kg m^2 (the surface's mass moment of inertia about its hinge line, "
+                          "from the finite-element mass of its hinge mode)",
+    "static_unbalance_kgm": "kg m (the surface's first mass moment about its hinge line; > 0: "
+                            "centre of mass aft of the hinge)",
 }
 # the actuator loop on a control surface (issue 25, control_surface_ase rows)
 UNITS.update({
@@ -117,6 +121,8 @@ UNITS.update({
     "crossover_hz": "Hz (highest gain crossover of the forward path)",
     "step_deg": "deg (the power-limited step command)",
     "overshoot_pct": "% (of the surface's angle over the step)",
+    "settling_ms": "ms (2 % settling time of the fed-back angle after the step; null: not "
+                   "settled in 200 ms)",
 })
 # freeplay in a control surface's hinge (issue 25, control_surfaces rows with freeplay_deg > 0)
 UNITS.update({
@@ -279,14 +285,8 @@ def summary(a: Analysis) -> dict:
         if a.gust.turbulence is not None:
             out["turbulence"] = turbulence_json(a.gust)
     if getattr(c, "control_surfaces", ()):   # (surfaces at supersonic Machs only: no rows)
-        out["control_surfaces"] = [
-            {"name": r.name, "mach": r.mach, "dCL_ddelta_per_rad": r.dCL_ddelta_per_rad,
-             "dCL_dalpha_per_rad": r.dCL_dalpha_per_rad, "Ch_delta": r.Ch_delta,
-             "Ch_alpha": r.Ch_alpha, "reversal_speed_ms": _f(r.reversal_speed_ms),
-             "divergence_speed_ms": _f(r.divergence_speed_ms), "density": r.density,
-             "hinge_inertia": r.inertia, "static_unbalance": r.static_unbalance,
-             **freeplay_json(getattr(a, "control_freeplay", ()), r.name, r.mach)}
-            for r in a.control]
+        out["control_surfaces"] = control_surfaces_json(
+            c, a.control, getattr(a, "control_freeplay", ()))
         out["control_surface_flutter"] = [
             {"mach": r.mach, "altitude_m": r.altitude, "density": r.density,
              "speed_ms": _f(r.speed_ms), "frequency_hz": _f(r.frequency_hz), "mode": r.mode,
@@ -484,14 +484,19 @@ def _control_lines(rows) -> list[str]:
     """The control-surface block of the summary: one line per surface and Mach."""
     if not rows:
         return []
-    out = ["", "control surfaces (rigid derivatives per rad; reversal of the rolling moment)",
-           f"{'surface':>10} {'Mach':>6} {'dCL/dd':>8} {'dCL/da':>8} {'Ch_d':>8} {'Ch_a':>8} "
-           f"{'U_rev m/s':>10}"]
+    out = ["", "control surfaces (rigid derivatives per rad; rolling-moment reversal; "
+               "I_h, S about the hinge)",
+           f"{'surface':>10} {'kind':>7} {'Mach':>6} {'dCL/dd':>8} {'dCL/da':>8} {'Ch_d':>8} "
+           f"{'Ch_a':>8} {'U_rev m/s':>10} {'I_h g m2':>9} {'S g m':>8}"]
     for r in rows:
         rev = r["reversal_speed_ms"]
-        out.append(f"{r['name'][:10]:>10} {r['mach']:>6.3g} {r['dCL_ddelta_per_rad']:>8.4f} "
-                   f"{r['dCL_dalpha_per_rad']:>8.4f} {r['Ch_delta']:>8.4f} {r['Ch_alpha']:>8.4f} "
-                   f"{'none' if rev is None else f'{rev:.1f}':>10}")
+        i_h, s_h = r.get("hinge_inertia_kgm2"), r.get("static_unbalance_kgm")
+        out.append(f"{r['name'][:10]:>10} {(r.get('kind') or '-')[:7]:>7} {r['mach']:>6.3g} "
+                   f"{r['dCL_ddelta_per_rad']:>8.4f} {r['dCL_dalpha_per_rad']:>8.4f} "
+                   f"{r['Ch_delta']:>8.4f} {r['Ch_alpha']:>8.4f} "
+                   f"{'none' if rev is None else f'{rev:.1f}':>10} "
+                   f"{'-' if i_h is None else f'{1e3 * i_h:.4g}':>9} "
+                   f"{'-' if s_h is None else f'{1e3 * s_h:.4g}':>8}")
     return out
 
 
@@ -510,6 +515,23 @@ def _control_flutter_lines(rows) -> list[str]:
         out.append(f"{r['mach']:>6.3g} {r['density']:>10.4g} {sp:>9} "
                    f"{_cell(r['frequency_hz'], '{:.2f}'):>8}  {mode}")
     return out
+
+
+def control_surfaces_json(case, rows, freeplay=()) -> list[dict]:
+    """The ``control_surfaces`` rows of the analysis JSON (issue 25): per surface and Mach of
+    :func:`asekit.case.pipeline.control_surfaces` ``rows``, its ``kind`` (the case's
+    ``[[control_surface]]``), derivatives, reversal and divergence speeds, the hinge inertia and
+    static unbalance about the hinge (kg m^2, kg m; computed from the finite-element mass of
+    the surface's hinge mode) and, with freeplay, the ``freeplay`` rows' keys
+    (:func:`freeplay_json`)."""
+    kinds = {cs.name: cs.kind for cs in case.control_surfaces}
+    return [{"name": r.name, "kind": kinds.get(r.name), "mach": r.mach,
+             "dCL_ddelta_per_rad": r.dCL_ddelta_per_rad,
+             "dCL_dalpha_per_rad": r.dCL_dalpha_per_rad, "Ch_delta": r.Ch_delta,
+             "Ch_alpha": r.Ch_alpha, "reversal_speed_ms": _f(r.reversal_speed_ms),
+             "divergence_speed_ms": _f(r.divergence_speed_ms), "density": r.density,
+             "hinge_inertia_kgm2": r.inertia, "static_unbalance_kgm": r.static_unbalance,
+             **freeplay_json(freeplay, r.name, r.mach)} for r in rows]
 
 
 def freeplay_json(rows, name: str, mach: float) -> dict:
@@ -561,7 +583,9 @@ def control_ase_json(rows) -> dict:
          "effective_inertia_kgm2": r.effective_inertia,
          "phase_margin_deg": _f(r.phase_margin_deg), "gain_margin_db": _f(r.gain_margin_db),
          "crossover_hz": _f(r.crossover_hz), "step_deg": r.step_deg,
-         "settling_s": _f(r.settling_time_s), "overshoot_pct": 100.0 * r.overshoot,
+         "settling_s": _f(r.settling_time_s),
+         "settling_ms": None if r.settling_time_s is None else 1e3 * r.settling_time_s,
+         "overshoot_pct": 100.0 * r.overshoot,
          "steady_error_pct": 100.0 * r.steady_error} for r in rows]}
 
 

@@ -9,7 +9,9 @@ text that says what it shows.
   (one colour per condition), the flutter points starred;
 - the planform (thin grey FE mesh over coloured aerodynamic box outlines) and every kept mode
   shape with one colour bar and the node lines (w = 0);
-- with an actuator, the forward paths FWTF 1-3 and the power-limited step responses.
+- with an actuator, the forward paths FWTF 1-3 and the power-limited step responses;
+- with ``[control_surface.actuator]``, the actuator-on-flap loop (AEM1, AEM2): the surface's
+  power-limited step response and the open-loop Bode plot with its margins marked.
 
 Conventions (docs/conventions.md): SI inside, Hz and deg only on the axes; elastic modes named
 from 1 and the rigid mode "rigid pitch" (:func:`asekit.util.conventions.mode_label`); V-g damping
@@ -681,6 +683,89 @@ def fig_control_hinge_moments(a) -> ReportFigure:
     return ReportFigure(fig, alt, SECTIONS[5])
 
 
+# ---------------------------------------------------------------------------------------------
+# the actuator loop on a control surface (issue 25, asekit.ase.flap)
+# ---------------------------------------------------------------------------------------------
+def _margin_text(r) -> str:
+    """"PM 78.4 deg at 25.1 Hz, GM 12.0 dB" of a control_surface_ase row (its forward path)."""
+    pm = ("no gain crossover" if r.crossover_hz is None or not math.isfinite(r.phase_margin_deg)
+          else f"PM {r.phase_margin_deg:.1f} deg at {r.crossover_hz:.1f} Hz")
+    gm = ("no phase crossover" if not math.isfinite(r.gain_margin_db)
+          else f"GM {r.gain_margin_db:.1f} dB")
+    return f"{pm}, {gm}"
+
+
+def fig_control_ase_bode(a) -> ReportFigure:
+    """Gain (dB) and phase (deg) of the open loop (forward path) of the actuator on the control
+    surface, AEM1 (FWTF 2) and AEM2 (FWTF 3), each topology's gain crossovers (phase margins)
+    and phase crossovers (gain margins) marked."""
+    rows = [r for r in a.control_ase if r.open_loop is not None]
+    r0 = rows[0]
+    fig, (ax1, ax2) = new_figure(
+        f"{a.case.name}: actuator on {r0.name}, open loop at {r0.speed_ms:g} m/s, "
+        f"M {r0.mach:g}", nrows=2, figsize=(7.0, 6.4), sharex=True, layout="constrained")
+    for r in rows:
+        f, h = r.frequency_hz, r.open_loop
+        which = "FWTF 2" if r.topology == "AEM1" else "FWTF 3"
+        line, = ax1.semilogx(f, 20 * np.log10(np.abs(h)), label=f"{r.topology} ({which}): "
+                             f"{_margin_text(r)}")
+        ph = np.degrees(np.unwrap(np.angle(h)))
+        ax2.semilogx(f, ph, color=line.get_color())
+        cr = r.crossovers
+        for fc, pm in zip(cr.gain_crossovers_hz, cr.phase_margins_deg):
+            ax1.plot(fc, 0.0, "o", mfc="none", color=line.get_color())
+            p = np.interp(np.log(fc), np.log(f), ph)
+            ax2.annotate("", xy=(fc, p), xytext=(fc, p - pm),
+                         arrowprops=dict(arrowstyle="<->", color=line.get_color()))
+        for fc, gm in zip(cr.phase_crossovers_hz, cr.gain_margins_db):
+            ax1.annotate("", xy=(fc, 0.0), xytext=(fc, -gm),
+                         arrowprops=dict(arrowstyle="<->", color=line.get_color()))
+    ax1.axhline(0.0, color="k", lw=0.8)
+    ax2.axhline(-180.0, color="k", lw=0.8)
+    ax1.set_ylabel("open-loop gain (dB)")
+    ax2.set_ylabel("open-loop phase (deg)")
+    ax2.set_xlabel("frequency (Hz)")
+    ax1.legend(loc="lower left")
+    alt = (f"Bode plot of the open loop of the actuator on {r0.name} at {r0.speed_ms:g} m/s, "
+           f"Mach {r0.mach:g}, {r0.altitude:g} m, margins marked (circles: gain crossovers, "
+           f"arrows: the phase and gain margins): "
+           + "; ".join(f"{r.topology} {_margin_text(r)}" for r in rows))
+    return ReportFigure(fig, alt, SECTIONS[5])
+
+
+def fig_control_ase_steps(a) -> ReportFigure:
+    """The surface's angle in the air (deg) after the power-limited step command against time
+    (ms), AEM1 and AEM2 (AEM1's fed-back hinge angle dashed), each topology's 2 % settling time
+    of its fed-back angle marked."""
+    rows = [r for r in a.control_ase if r.time_s is not None]
+    r0 = rows[0]
+    fig, ax = new_figure(f"{a.case.name}: actuator on {r0.name}, power-limited "
+                         f"{r0.step_deg:g} deg step", figsize=(7.0, 4.4), layout="constrained")
+    for r in rows:
+        ts = ("not settled" if r.settling_time_s is None
+              else f"settles in {1e3 * r.settling_time_s:.1f} ms")
+        line, = ax.plot(r.time_s * 1e3, np.degrees(r.surface_angle_rad),
+                        label=f"{r.topology}: {r0.name} angle in the air"
+                        + ("" if r.topology == "AEM1" else f" (fed back, {ts})"))
+        if r.topology == "AEM1":           # AEM1 feeds back the hinge angle, not the air's
+            ax.plot(r.time_s * 1e3, np.degrees(r.fed_back_rad), ls="--", lw=1.0,
+                    color=line.get_color(), label=f"AEM1: hinge angle (fed back, {ts})")
+        if r.settling_time_s is not None:
+            ax.axvline(1e3 * r.settling_time_s, ls=":", color=line.get_color())
+    ax.axhline(r0.step_deg, color="k", lw=0.8, ls="--", label="command")
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("angle (deg)")
+    ax.set_ylim(-0.5 * r0.step_deg, 2.5 * r0.step_deg)
+    ax.legend()
+    alt = (f"The {r0.name}'s angle after a {r0.step_deg:g} deg power-limited step command at "
+           f"{r0.speed_ms:g} m/s: " + "; ".join(
+               f"{r.topology} {'stable' if r.stable else 'unstable'}, overshoot "
+               f"{100 * r.overshoot:.1f} %, settling " + (
+                   "none in 200 ms" if r.settling_time_s is None
+                   else f"{1e3 * r.settling_time_s:.1f} ms") for r in rows))
+    return ReportFigure(fig, alt, SECTIONS[5])
+
+
 def figures(a) -> dict:
     """{file name: :class:`ReportFigure`} of the report, in page order: the Mach figure, V-g /
     V-f and root locus at every analysed Mach, the planform and mode shapes, and with an
@@ -703,6 +788,9 @@ def figures(a) -> dict:
         out["control_effectiveness"] = fig_control_effectiveness(a)
     if getattr(a, "control_hinge", ()):
         out["control_hinge_moments"] = fig_control_hinge_moments(a)
+    if any(r.time_s is not None for r in getattr(a, "control_ase", ())):
+        out["control_ase_steps"] = fig_control_ase_steps(a)
+        out["control_ase_bode"] = fig_control_ase_bode(a)
     return out
 
 

@@ -974,9 +974,6 @@ def _one_control_surface(t: _Table, i: int, panels) -> ControlSurfaceSpec:
         raise CaseError(f"{path}.freeplay_deg = {freeplay:g} needs {path}.hinge_stiffness > 0 "
                         "(the freeplay is in the hinge spring)")
     t.done()
-    if kind == "elastic" and balance:
-        raise CaseError(f"{path}.mass_balance is not available with {path}.kind = \"elastic\" "
-                        f"(use kind = \"rigid\", or a [[point_mass]] on the surface)")
     return ControlSurfaceSpec(name, panel, hinge, span, kind, k_h, c_h, balance, actuator,
                               freeplay)
 

@@ -331,3 +331,62 @@ def hinge_constraint_mode(released: ReleasedHinge) -> np.ndarray:
     q[r] = 1.0
     q[other] = -spla.spsolve(K[other][:, other], K[other][:, [r]].toarray().ravel())
     return q
+
+
+def hinge_balance_mass(split: HingeSplit, position, distance_aft: float, mass: float):
+    """Mass matrix (3 n, 3 n) of a balance mass carried by the surface on a rigid arm from its
+    hinge line, on the split mesh's degrees of freedom (w, theta_x, theta_y per node).
+
+    The mass m sits at ``distance_aft`` d (m; < 0 ahead of the hinge, the usual mass balance)
+    from the hinge line and is attached to the surface's hinge copy c nearest to it along the
+    hinge. A rigid arm moves it by w_b = w_c - d (s_x theta_x,c + s_y theta_y,c), the surface's
+    rotation about the hinge axis s at c times the lever -d (a rigid link, Cook, Malkus,
+    Plesha & Witt 2002, Sec. 9.2), so its mass matrix is m g g^T with g = (1, -d s_x, -d s_y)
+    on c's degrees of freedom. Under a rigid hinge rotation r it adds m d to the surface's
+    static unbalance and m d^2 to its inertia about the hinge, as a balance mass of the rigid
+    kind (:func:`asekit.aeroelastic.control_surface.flap_modal_model`). The mass is placed at
+    c's station along the hinge (its own is snapped to the nearest hinge node).
+
+    Parameters
+    ----------
+    split : :class:`HingeSplit` of the surface.
+    position : (x, y) m, the balance mass's position in the plate plane.
+    distance_aft : d (m), its distance aft of the hinge line (negative ahead of it).
+    mass : m (kg), >= 0.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix (3 n_nodes, 3 n_nodes) of ``split.mesh``.
+
+    Examples
+    --------
+    The 2 x 2 mesh of :func:`split_at_hinge`: 0.1 kg, 0.2 m ahead of the hinge at y = 0.4 sits
+    on the middle hinge copy (node 10, y = 0.5); a unit hinge rotation of that copy moves it
+    by -d = 0.2 m (up, the trailing edge going down), so w^T M_b u = 0.02: a static unbalance
+    m d = -0.02 kg m (ahead of the hinge), and m d^2 = 0.004 kg m^2 of inertia.
+
+    >>> from asekit.geometry import Planform, Thickness
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> pm = panels_mesh([Planform((0, 0), 1.0, (0, 1.0), 1.0)], Thickness(0.01, 0.01), 2, [2])
+    >>> hs = split_at_hinge(pm, pm.element_centroids()[:, 0] > 0.5, (0.5, 0.0), (0.0, 1.0))
+    >>> Mb = hinge_balance_mass(hs, (0.3, 0.4), -0.2, 0.1)
+    >>> u = np.zeros(Mb.shape[0]); u[3 * 10 + 2] = 1.0          # theta about the hinge axis
+    >>> w = np.zeros(Mb.shape[0]); w[0::3] = 1.0
+    >>> round(float(w @ (Mb @ u)), 6), round(float(u @ (Mb @ u)), 6)
+    (0.02, 0.004)
+    """
+    in_range("mass", mass, 0.0, inclusive=True)
+    d = float(distance_aft)
+    if not np.isfinite(d):
+        raise ValueError(f"distance_aft must be finite, got {distance_aft!r}")
+    p = np.asarray(position, float).reshape(2)
+    s = np.asarray(split.hinge_axis, float)
+    copies = np.flatnonzero(split.on_hinge)
+    nodes = split.mesh.nodes[split.n_original + copies]
+    c = split.n_original + copies[int(np.argmin(np.abs((nodes - p) @ s)))]
+    dofs = DOF_PER_NODE * c + np.arange(3)
+    g = np.array([1.0, -d * s[0], -d * s[1]])
+    n = DOF_PER_NODE * split.mesh.n_nodes
+    rows, cols = np.meshgrid(dofs, dofs, indexing="ij")
+    return sp.csr_matrix((mass * np.outer(g, g).ravel(), (rows.ravel(), cols.ravel())),
+                         shape=(n, n))
