@@ -196,23 +196,28 @@ def _real_entries(blocks):
     return np.array(out, dtype=int)
 
 
-def _dg_eig(M, d, gh, groups, ir):
-    """lambda_max(N^* N + j (Gh N - N^* Gh)), N = diag(d) M diag(d)^-1, Gh = diag(gh) on the
-    entries ``ir``, and its gradient in (log d per group, gh) from the top eigenvector v:
-    d lambda = v^* dPhi v (simple eigenvalue), with dN/dx_k = E_k N - N E_k."""
+def _dg_eig(M, d, gh, groups, ir, t):
+    """lambda_max(Phi), Phi = N^* N + j (Gh N - N^* Gh), N = diag(d) M diag(d)^-1, Gh =
+    diag(gh) on the entries ``ir``; its smooth majorant lambda_max + t log sum_i
+    exp((lambda_i - lambda_max) / t) (t > 0, within t log n of lambda_max) and that
+    majorant's gradient in (log d per group, gh): the softmax-weighted d lambda_i =
+    v_i^* dPhi v_i, with dN/dx_k = E_k N - N E_k and dPhi/dgh_k = j (E_k N - N^* E_k)."""
     n = M.shape[0]
     N = d[:, None] * M / d[None, :]
     g = np.zeros(n)
     g[ir] = gh
     Phi = N.conj().T @ N + 1j * (g[:, None] * N - N.conj().T * g[None, :])
     lam, V = np.linalg.eigh(0.5 * (Phi + Phi.conj().T))
-    v = V[:, -1]
-    a = N @ v
-    b = g * v
-    c, e = N.conj().T @ a, N.conj().T @ b
-    gx = 2 * np.real(np.abs(a) ** 2 - c.conj() * v) - 2 * np.imag(b.conj() * a - e.conj() * v)
-    gg = -2 * np.imag(v.conj() * a)
-    return float(lam[-1]), np.array([gx[gi].sum() for gi in groups]), gg[ir]
+    e = np.exp((lam - lam[-1]) / t)
+    w = e / e.sum()
+    smooth = lam[-1] + t * math.log(e.sum())
+    A = N @ V
+    Bv = g[:, None] * V
+    C, E = N.conj().T @ A, N.conj().T @ Bv
+    GX = 2 * np.real(np.abs(A) ** 2 - C.conj() * V) - 2 * np.imag(Bv.conj() * A - E.conj() * V)
+    gx = GX @ w
+    gg = (-2 * np.imag(V.conj() * A)) @ w
+    return float(lam[-1]), smooth, np.array([gx[gi].sum() for gi in groups]), gg[ir]
 
 
 class _Done(Exception):
@@ -258,26 +263,27 @@ def mixed_upper_bound(M, blocks, x0=None, g0=None):
     scale = max(float(np.linalg.norm(M, 2)) ** 2, 1e-300)
     m = len(groups) - 1
 
-    def f(z):
+    seen = {}                                   # the best point evaluated: any is valid
+
+    def f(z, t):
         d = np.exp(_expand(np.concatenate([[0.0], z[:m]]), groups, n))
-        lam, gx, gg = _dg_eig(M, d, z[m:], groups, ir)
+        lam, smooth, gx, gg = _dg_eig(M, d, z[m:], groups, ir, t * scale)
+        if lam < seen.get("lam", math.inf):
+            seen["lam"], seen["z"] = lam, np.array(z)
         if lam <= 0:                            # certificate of mu = 0 found: stop here
             raise _Done(z)
-        return lam / scale, np.concatenate([gx[1:], gg]) / scale
+        return smooth / scale, np.concatenate([gx[1:], gg]) / scale
 
-    z0 = np.concatenate([x0[1:], g0])
-    best_z = z0
+    z = np.concatenate([x0[1:], g0])
     try:
-        best = f(z0)[0]
-        for _ in range(2 if len(ir) else 0):    # a restart: lambda_max is not smooth where
-            res = minimize(f, best_z, jac=True, method="BFGS",      # eigenvalues coalesce
-                           options={"gtol": 1e-8, "maxiter": 100})
-            val = f(res.x)[0]
-            if val < best:
-                best_z, best, gain = res.x, val, best - val
-                if gain > 1e-6 * best:
-                    continue
-            break
+        f(z, 1.0)
+        if len(ir):                             # smoothing continuation: lambda_max is not
+            for t, it in ((1e-3, 30), (1e-12, 100), (1e-12, 100)):  # smooth where
+                rel = max(seen["lam"] / scale, 1e-9)             # eigenvalues coalesce; the
+                z = minimize(f, seen["z"], args=(t * rel,), jac=True,   # last: lambda_max
+                             method="BFGS", options={"gtol": 1e-9, "maxiter": it}).x
+                f(z, 1.0)
+        best_z, best = seen["z"], seen["lam"] / scale
     except _Done as done:
         best_z, best = done.z, 0.0
     bound = math.sqrt(max(best, 0.0) * scale)
