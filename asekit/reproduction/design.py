@@ -798,6 +798,28 @@ def hinf_mu(controller, data=None, f_hz=None, condition=None) -> dict:
     return r
 
 
+def parameter_mu_grid(controller, data=None, machs=MACHS, altitudes=ALTITUDES, f_hz=None):
+    """The shaft and elastic-frequency uncertainty alone (three real blocks, mixed D-G bound)
+    about each flight condition of the grid, the Mach-altitude cover left out: a per-condition
+    certificate (the loop at that condition is stable for 1 / mu times the stated parameter
+    uncertainty), which says nothing between the grid points. ``controller``: a
+    DigitalController or a scheduled factory (:func:`controller_at`). Returns {(mach,
+    altitude): (mu_peak, f_peak_hz)}; a few minutes (one mu sweep per condition)."""
+    from asekit.ase import robust
+
+    data = load() if data is None else data
+    out = {}
+    for M in machs:
+        for h in altitudes:
+            A, B, C, unc = hinf_uncertainty(data, f_hz, (M, h))
+            K = robust.digital_gain(controller_at(controller, M, h))
+            n = len(unc.parameters)
+            Ms, blocks = robust.loop_matrix(A, B, C, K, unc, unc.cover_hz, HINF_DELAY)
+            r = robust.mu_subsets(Ms, blocks, unc.cover_hz, {"p": range(n)})["p"]
+            out[(M, h)] = (r["mu_peak"], r["f_peak_hz"])
+    return out
+
+
 def lqg_scheduled_mu(data=None, f_hz=None) -> dict:
     """:func:`hinf_mu` of the scheduled LQG (:func:`design_b_scheduled`) at its design point
     :data:`HINF_CONDITION`. The scheduled controller knows its Mach and altitude, so of this

@@ -64,6 +64,10 @@ def test_mu_bound_agrees_with_the_sampled_conditions(data, hinf):
     at_design = [dz.check(ctl, dz.fin_model(M0, h0, case=k, data=data), "AEM2")
                  for k in dz.ROBUSTNESS]
     assert all(c.stable for c in at_design)
+    # soundness where the sampled loop is unstable: the parameter bound there must reach 1
+    for c in unstable:
+        grid = dz.parameter_mu_grid(ctl, data, machs=[c.mach], altitudes=[c.altitude])
+        assert grid[(c.mach, c.altitude)][0] >= 1.0
 
 
 def test_design_is_cached_bit_identically(data, hinf, tmp_path, monkeypatch):
