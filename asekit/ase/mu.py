@@ -296,8 +296,8 @@ def mixed_upper_bound(M, blocks, x0=None, g0=None):
 
 
 def rank_one_mu(u, v, blocks) -> float:
-    """Exact mu of the rank-one M = u v^H for scalar blocks (sizes 1; Young 1994, Sec. 3;
-    Chen, Fan & Nett, IEEE TAC 39(5), 1994): with z_i = conj(v_i) u_i, det(I - M Delta) =
+    """Exact mu of the rank-one M = u v^H for scalar blocks (sizes 1; the rank-one mixed mu
+    of Young, Automatica 30(12), 1994, derived here): with z_i = conj(v_i) u_i, det(I - M Delta) =
     1 - sum delta_i z_i, so mu is the largest real value of sum delta_i z_i over the unit
     box, by LP duality
 

@@ -13,9 +13,9 @@ Sources of the known values:
   while the complex upper bound is |M| (conservative) and the D-G bound is 0.
 * mixed real/complex, rank one M = u v^H (scalar blocks): mu = inf_x sum_real |Re z_i +
   x Im z_i| + sqrt(1 + x^2) sum_complex |z_i|, z_i = conj(v_i) u_i (Young, Automatica 30(12),
-  1994; Chen, Fan & Nett, IEEE TAC 39(5), 1994), and the D-G bound (Fan, Tits & Doyle, IEEE
-  TAC 36(1), 1991; Young, Newlin & Doyle, IJRNC 5, 1995, Eq. 5) is exact for rank one (Young
-  1994). Diagonal and triangular M with real scalar blocks: det(I - M Delta) = prod (1 -
+  1994; LP duality over the unit box, derived in rank_one_mu), and the D-G bound (Fan, Tits &
+  Doyle, IEEE TAC 36(1), 1991; Young, Newlin & Doyle, IJRNC 5, 1995, Eq. 5) is exact for rank
+  one (Young 1994). Diagonal and triangular M with real scalar blocks: det(I - M Delta) = prod (1 -
   m_ii delta_i), so mu_R = max |m_ii| over the real m_ii only.
 """
 
