@@ -32,10 +32,11 @@ blocks, S repeated scalar, F full (Packard & Doyle 1993, Theorem 9.1; Sec. 9 of 
 
 Mixed real/complex structures (:func:`mixed_upper_bound`, used by :func:`mu_bounds` whenever a
 block is real): the D-G scaled bound of Fan, Tits & Doyle, "Robustness in the presence of mixed
-parametric uncertainty and unmodeled dynamics", IEEE TAC 36(1), 1991, Theorem 4.1, in the LMI
-form of Young, Newlin & Doyle, "Computing bounds for the mixed mu problem", IJRNC 5, 1995,
-Eq. (5): mu(M) <= beta if there are D > 0 and G = G^* in the commutants (G zero on the complex
-blocks) with
+parametric uncertainty and unmodeled dynamics", IEEE TAC 36(1), 1991 (their upper bound, a
+largest generalised eigenvalue), shown by Young, Newlin & Doyle, "Computing bounds for the mixed
+mu problem", IJRNC 5, 1995, to equal their (I + G^2)^-1/4 singular-value form (equation numbers
+not checked against the papers here): mu(M) <= beta if there are D > 0 and G = G^* in the
+commutants (G zero on the complex blocks) with
 
     M^* D M + j (G M - M^* G) - beta^2 D <= 0.
 
@@ -229,8 +230,8 @@ class _Done(Exception):
 
 
 def mixed_upper_bound(M, blocks, x0=None, g0=None):
-    """The D-G scaled upper bound of mixed real/complex mu (Fan, Tits & Doyle 1991, Theorem
-    4.1; Young, Newlin & Doyle 1995, Eq. 5; module docstring):
+    """The D-G scaled upper bound of mixed real/complex mu (Fan, Tits & Doyle 1991; Young,
+    Newlin & Doyle 1995; module docstring):
 
         mu(M) <= sqrt(max(0, inf_{d, Gh} lambda_max(N^* N + j (Gh N - N^* Gh)))),
 

@@ -14,7 +14,7 @@ Sources of the known values:
 * mixed real/complex, rank one M = u v^H (scalar blocks): mu = inf_x sum_real |Re z_i +
   x Im z_i| + sqrt(1 + x^2) sum_complex |z_i|, z_i = conj(v_i) u_i (Young, Automatica 30(12),
   1994; LP duality over the unit box, derived in rank_one_mu), and the D-G bound (Fan, Tits &
-  Doyle, IEEE TAC 36(1), 1991; Young, Newlin & Doyle, IJRNC 5, 1995, Eq. 5) is exact for rank
+  Doyle, IEEE TAC 36(1), 1991; Young, Newlin & Doyle, IJRNC 5, 1995) is exact for rank
   one (Young 1994). Diagonal and triangular M with real scalar blocks: det(I - M Delta) = prod (1 -
   m_ii delta_i), so mu_R = max |m_ii| over the real m_ii only.
 """
@@ -207,7 +207,7 @@ def test_mixed_bound_valid_and_below_complex(seed):
     up, d, g = mixed_upper_bound(M, blocks)
     assert up <= up_c + 1e-12
     assert np.all(g[3:] == 0)                                 # no G on the complex block
-    # the certificate itself: M^* D M + j (G M - M^* G) - beta^2 D <= 0 (FTD91 Th. 4.1)
+    # the certificate itself: M^* D M + j (G M - M^* G) - beta^2 D <= 0 (FTD91)
     D, G = np.diag(d ** 2), np.diag(d * g * d)
     beta = up * (1 + 1e-9)
     L = M.conj().T @ D @ M + 1j * (G @ M - M.conj().T @ G) - beta ** 2 * D
