@@ -27,10 +27,27 @@ Bounds (Packard & Doyle 1993, Eqs 6.1-6.2 and Sec. 8-9):
   global infimum; its gradient is sigma (|u_k|^2 - |v_k|^2) summed over the block's entries,
   with u, v the top singular vectors.
 
-For real blocks the upper bound is the complex one (a real block is a complex block restricted
-to real values, so mu_complex >= mu_real): conservative, stated, no D-G scaling. The bound is
-exact (gap 0 up to the optimiser's tolerance) for 2 S + F <= 3 complex blocks, S repeated
-scalar, F full (Packard & Doyle 1993, Theorem 9.1; Sec. 9 of the paper).
+For complex blocks the bound is exact (gap 0 up to the optimiser's tolerance) for 2 S + F <= 3
+blocks, S repeated scalar, F full (Packard & Doyle 1993, Theorem 9.1; Sec. 9 of the paper).
+
+Mixed real/complex structures (:func:`mixed_upper_bound`, used by :func:`mu_bounds` whenever a
+block is real): the D-G scaled bound of Fan, Tits & Doyle, "Robustness in the presence of mixed
+parametric uncertainty and unmodeled dynamics", IEEE TAC 36(1), 1991 (their upper bound, a
+largest generalised eigenvalue), shown by Young, Newlin & Doyle, "Computing bounds for the mixed
+mu problem", IJRNC 5, 1995, to equal their (I + G^2)^-1/4 singular-value form (equation numbers
+not checked against the papers here): mu(M) <= beta if there are D > 0 and G = G^* in the
+commutants (G zero on the complex blocks) with
+
+    M^* D M + j (G M - M^* G) - beta^2 D <= 0.
+
+With N = D^1/2 M D^-1/2 and Gh = D^-1/2 G D^-1/2 (diagonal D and G commute) this reads
+lambda_max(N^* N + j (Gh N - N^* Gh)) <= beta^2, so the bound is the square root of the
+infimum of that largest eigenvalue over log d and Gh, started from the complex D (Gh = 0,
+where it equals the complex bound, so the mixed bound never exceeds it). Any (d, Gh) gives a
+valid bound; the optimiser only tightens it. A real scalar whose loop gain is not real gets
+bound 0 (the G term drives the eigenvalue negative), which the complex bound cannot see. The
+bound is exact for rank-one M (Young, "The rank one mixed mu problem and 'Kharitonov-type'
+analysis", Automatica 30(12), 1994), whose mu has the closed form of :func:`rank_one_mu`.
 
 Plain numpy/scipy; no toolbox needed.
 """
@@ -63,12 +80,14 @@ class Block:
 class MuBounds:
     """Bounds of mu at one matrix: ``lower`` <= mu <= ``upper``; ``scaling`` the D diagonal
     (n,) of the upper bound; ``delta`` the (n, n) perturbation of the lower bound
-    (sigma_max(delta) <= 1, rho(M delta) = lower)."""
+    (sigma_max(delta) <= 1, rho(M delta) = lower); ``g_scaling`` the G of the mixed bound."""
 
     lower: float
     upper: float
     scaling: np.ndarray
     delta: np.ndarray
+    #: the (n,) real diagonal Gh of the mixed bound (zeros without real blocks)
+    g_scaling: np.ndarray | None = None
 
     @property
     def gap(self) -> float:
@@ -166,6 +185,151 @@ def upper_bound(M, blocks, x0=None):
     z = res.x if res.fun <= f(z0)[0] else z0
     best = min(float(np.exp(f(z)[0])), float(np.linalg.norm(M, 2)))
     return best, np.exp(_expand(np.concatenate([[0.0], z]), groups, n))
+
+
+def _real_entries(blocks):
+    """Indices of the entries of the real blocks (the free diagonal of G)."""
+    out, k = [], 0
+    for b in blocks:
+        if b.kind == "real":
+            out.extend(range(k, k + b.size))
+        k += b.size
+    return np.array(out, dtype=int)
+
+
+def _dg_eig(M, d, gh, groups, ir, t):
+    """lambda_max(Phi), Phi = N^* N + j (Gh N - N^* Gh), N = diag(d) M diag(d)^-1, Gh =
+    diag(gh) on the entries ``ir``; its smooth majorant lambda_max + t log sum_i
+    exp((lambda_i - lambda_max) / t) (t > 0, within t log n of lambda_max) and that
+    majorant's gradient in (log d per group, gh): the softmax-weighted d lambda_i =
+    v_i^* dPhi v_i, with dN/dx_k = E_k N - N E_k and dPhi/dgh_k = j (E_k N - N^* E_k)."""
+    n = M.shape[0]
+    N = d[:, None] * M / d[None, :]
+    g = np.zeros(n)
+    g[ir] = gh
+    Phi = N.conj().T @ N + 1j * (g[:, None] * N - N.conj().T * g[None, :])
+    lam, V = np.linalg.eigh(0.5 * (Phi + Phi.conj().T))
+    e = np.exp((lam - lam[-1]) / t)
+    w = e / e.sum()
+    smooth = lam[-1] + t * math.log(e.sum())
+    A = N @ V
+    Bv = g[:, None] * V
+    C, E = N.conj().T @ A, N.conj().T @ Bv
+    GX = 2 * np.real(np.abs(A) ** 2 - C.conj() * V) - 2 * np.imag(Bv.conj() * A - E.conj() * V)
+    gx = GX @ w
+    gg = (-2 * np.imag(V.conj() * A)) @ w
+    return float(lam[-1]), smooth, np.array([gx[gi].sum() for gi in groups]), gg[ir]
+
+
+class _Done(Exception):
+    """Raised inside the optimiser when the D-G matrix is negative definite (mu = 0)."""
+
+    def __init__(self, z):
+        super().__init__("mu = 0")
+        self.z = np.array(z)
+
+
+def mixed_upper_bound(M, blocks, x0=None, g0=None):
+    """The D-G scaled upper bound of mixed real/complex mu (Fan, Tits & Doyle 1991; Young,
+    Newlin & Doyle 1995; module docstring):
+
+        mu(M) <= sqrt(max(0, inf_{d, Gh} lambda_max(N^* N + j (Gh N - N^* Gh)))),
+
+    N = diag(d) M diag(d)^-1, Gh real diagonal on the real blocks' entries. Returns (bound, d,
+    g) with d (n,) and g (n,) (zero off the real blocks) at the optimum found. ``x0``, ``g0``:
+    warm starts (log d per scaling group, Gh per real entry); by default the complex D of
+    :func:`upper_bound` and Gh = 0, so the result never exceeds the complex bound.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> round(mixed_upper_bound(np.array([[0.7j]]), [Block(1, "real")])[0], 6)  # no real root
+    0.0
+    >>> round(mixed_upper_bound(np.array([[-0.7]]), [Block(1, "real")])[0], 6)
+    0.7
+    """
+    from scipy.optimize import minimize
+
+    M, blocks = _check(M, blocks)
+    n = M.shape[0]
+    groups = _groups(blocks)
+    ir = _real_entries(blocks)
+    if x0 is None:
+        up, d = upper_bound(M, blocks)
+        x0 = np.array([np.log(d[gi[0]]) for gi in groups])
+    else:
+        up = None
+    x0 = np.asarray(x0, float) - x0[0]
+    g0 = np.zeros(len(ir)) if g0 is None else np.asarray(g0, float)
+    scale = max(float(np.linalg.norm(M, 2)) ** 2, 1e-300)
+    m = len(groups) - 1
+
+    seen = {}                                   # the best point evaluated: any is valid
+
+    def f(z, t):
+        d = np.exp(_expand(np.concatenate([[0.0], z[:m]]), groups, n))
+        lam, smooth, gx, gg = _dg_eig(M, d, z[m:], groups, ir, t * scale)
+        if lam < seen.get("lam", math.inf):
+            seen["lam"], seen["z"] = lam, np.array(z)
+        if lam <= 0:                            # certificate of mu = 0 found: stop here
+            raise _Done(z)
+        return smooth / scale, np.concatenate([gx[1:], gg]) / scale
+
+    z = np.concatenate([x0[1:], g0])
+    try:
+        f(z, 1.0)
+        if len(ir):                             # smoothing continuation: lambda_max is not
+            for t, it in ((1e-3, 30), (1e-12, 100), (1e-12, 100)):  # smooth where
+                rel = max(seen["lam"] / scale, 1e-9)             # eigenvalues coalesce; the
+                z = minimize(f, seen["z"], args=(t * rel,), jac=True,   # last: lambda_max
+                             method="BFGS", options={"gtol": 1e-9, "maxiter": it}).x
+                f(z, 1.0)
+        best_z, best = seen["z"], seen["lam"] / scale
+    except _Done as done:
+        best_z, best = done.z, 0.0
+    bound = math.sqrt(max(best, 0.0) * scale)
+    if up is not None:
+        bound = min(bound, up)
+    d = np.exp(_expand(np.concatenate([[0.0], best_z[:m]]), groups, n))
+    g = np.zeros(n)
+    g[ir] = best_z[m:]
+    return bound, d, g
+
+
+def rank_one_mu(u, v, blocks) -> float:
+    """Exact mu of the rank-one M = u v^H for scalar blocks (sizes 1; the rank-one mixed mu
+    of Young, Automatica 30(12), 1994, derived here): with z_i = conj(v_i) u_i, det(I - M Delta) =
+    1 - sum delta_i z_i, so mu is the largest real value of sum delta_i z_i over the unit
+    box, by LP duality
+
+        mu = inf_x  sum_real |Re z_i + x Im z_i| + sqrt(1 + x^2) sum_complex |z_i|,
+
+    a convex function of x, minimised here on its kinks and by a bounded scalar search.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rank_one_mu(np.array([1.0, 1.0]), np.array([1.0, 1j]), [Block(1, "real")] * 2)
+    1.0
+    """
+    from scipy.optimize import minimize_scalar
+
+    blocks = tuple(blocks)
+    if any(b.size != 1 for b in blocks) or len(blocks) != len(u) or len(u) != len(v):
+        raise ValueError("rank_one_mu needs scalar blocks (size 1), one per entry of u and v")
+    z = np.conj(np.asarray(v, complex)) * np.asarray(u, complex)
+    real = np.array([b.kind == "real" for b in blocks])
+    zr, cc = z[real], float(np.sum(np.abs(z[~real])))
+
+    def h(x):
+        return float(np.sum(np.abs(zr.real + x * zr.imag)) + math.sqrt(1 + x * x) * cc)
+    kinks = [-zi.real / zi.imag for zi in zr if zi.imag != 0]
+    cands = [h(0.0)] + [h(x) for x in kinks]       # piecewise linear when no complex block
+    if cc > 0:                                     # h(x) >= |x| cc: the minimum has |x| <= R
+        R = h(0.0) / cc + 1.0
+        cands.append(minimize_scalar(h, bounds=(-R, R), method="bounded",
+                                     options={"xatol": 1e-12}).fun)
+    return float(min(cands))
 
 
 def _slices(blocks):
@@ -271,14 +435,17 @@ def _align(x, y, blocks, slices=None):
     return out
 
 
-def mu_bounds(M, blocks, x0=None, iterations: int = 200, starts: int = 4) -> MuBounds:
-    """Both bounds of mu(M) for ``blocks`` (module docstring).
+def mu_bounds(M, blocks, x0=None, iterations: int = 200, starts: int = 4,
+              g0=None) -> MuBounds:
+    """Both bounds of mu(M) for ``blocks`` (module docstring): the upper bound is the D-G
+    mixed bound (:func:`mixed_upper_bound`) when a block is real, else the complex D bound.
 
     Parameters
     ----------
     M : (n, n) complex matrix, the loop seen by the perturbation (Delta's output to its input).
     blocks : sequence of :class:`Block` whose sizes add up to n.
     x0 : optional warm start of the upper bound's log scalings.
+    g0 : optional warm start of the mixed bound's G (one per real entry).
     iterations, starts : of the lower bound's power iteration (:func:`lower_bound`).
 
     Returns
@@ -295,8 +462,20 @@ def mu_bounds(M, blocks, x0=None, iterations: int = 200, starts: int = 4) -> MuB
     """
     M, blocks = _check(M, blocks)
     up, d = upper_bound(M, blocks, x0)
+    g = np.zeros(M.shape[0])
+    if any(b.kind == "real" for b in blocks):
+        groups = _groups(blocks)
+        xs = np.array([np.log(d[gi[0]]) for gi in groups])
+        g0 = None if g0 is None else np.asarray(g0, float)
+        up_m, d_m, g_m = mixed_upper_bound(M, blocks, xs, g0)
+        if g0 is not None:                   # the warm start may sit in a worse basin
+            cold = mixed_upper_bound(M, blocks, xs)
+            if cold[0] < up_m:
+                up_m, d_m, g_m = cold
+        if up_m < up:
+            up, d, g = up_m, d_m, g_m
     lo, D = lower_bound(M, blocks, iterations, starts)
-    return MuBounds(lower=float(min(lo, up)), upper=float(up), scaling=d, delta=D)
+    return MuBounds(lower=float(min(lo, up)), upper=float(up), scaling=d, delta=D, g_scaling=g)
 
 
 def mu_frequency(Ms, blocks, iterations: int = 100, starts: int = 2) -> dict:
@@ -317,10 +496,12 @@ def mu_frequency(Ms, blocks, iterations: int = 100, starts: int = 2) -> dict:
         raise ValueError(f"Ms must be (n_f, n, n), got shape {Ms.shape}")
     groups = _groups(_check(Ms[0], blocks)[1])
     lo, up = np.zeros(len(Ms)), np.zeros(len(Ms))
+    ir = _real_entries(blocks)
     x = None
     for i, M in enumerate(Ms):
         b = mu_bounds(M, blocks, x, iterations, starts)
         lo[i], up[i] = b.lower, b.upper
-        x = np.array([np.log(b.scaling[g[0]]) for g in groups])
+        if not ir.size:
+            x = np.array([np.log(b.scaling[g[0]]) for g in groups])
     i = int(np.argmax(up))
     return {"lower": lo, "upper": up, "peak_upper": float(up[i]), "i_peak": i}

@@ -338,8 +338,9 @@ def digital_gain(controller: DigitalController):
 
 def robust_stability(A, B, C, K_y, uncertainty: Uncertainty, f_hz, delay: float = 1.5e-3):
     """Upper and lower bounds of mu over ``f_hz`` for :func:`loop_matrix` (the nominal loop's
-    stability is the caller's to check). Returns ``{"f_hz", "upper", "lower", "mu_peak",
-    "f_peak_hz", "margin"}``, margin = 1 / mu_peak: the loop is stable for that multiple of the
+    stability is the caller's to check; real parameters get the mixed D-G bound of
+    :func:`asekit.ase.mu.mixed_upper_bound`). Returns ``{"f_hz", "upper", "lower", "mu_peak",
+    "f_peak_hz", "margin", "blocks", "M"}`` (M the loop matrices), margin = 1 / mu_peak: the loop is stable for that multiple of the
     stated uncertainty.
 
     Examples
@@ -358,4 +359,36 @@ def robust_stability(A, B, C, K_y, uncertainty: Uncertainty, f_hz, delay: float 
     return {"f_hz": f, "upper": r["upper"], "lower": r["lower"], "mu_peak": peak,
             "mu_peak_lower": float(np.max(r["lower"])),
             "f_peak_hz": float(f[r["i_peak"]]),
-            "margin": math.inf if peak == 0 else 1.0 / peak, "blocks": blocks}
+            "margin": math.inf if peak == 0 else 1.0 / peak, "blocks": blocks, "M": Ms}
+
+
+def mu_subsets(Ms, blocks, f_hz, subsets: dict) -> dict:
+    """Which uncertainty drives mu: the bounds of mu over frequency with only some blocks kept
+    (the others set to zero, i.e. the rows and columns of M that belong to them dropped: the
+    loop seen by the remaining blocks). ``Ms`` (n_f, n, n) and ``blocks`` as returned by
+    :func:`loop_matrix`; ``subsets``: {name: indices of the blocks kept}. Returns {name:
+    {"mu_peak", "mu_peak_lower", "f_peak_hz", "upper"}}; 1 / mu_peak is the multiple of that
+    part of the uncertainty the loop tolerates alone.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from asekit.ase.mu import Block
+    >>> Ms = np.array([[[0.5, 3.0], [0.0, 2.0j]]])          # real block 0.5, complex 2j
+    >>> r = mu_subsets(Ms, (Block(1, "real"), Block(1)), [10.0], {"real": [0], "cx": [1]})
+    >>> round(r["real"]["mu_peak"], 6), round(r["cx"]["mu_peak"], 6)
+    (0.5, 2.0)
+    """
+    Ms = np.asarray(Ms, complex)
+    f = np.atleast_1d(np.asarray(f_hz, float))
+    starts = np.cumsum([0] + [b.size for b in blocks])
+    out = {}
+    for name, keep in subsets.items():
+        keep = sorted(int(k) for k in keep)
+        if not keep or keep[0] < 0 or keep[-1] >= len(blocks):
+            raise ValueError(f"subsets[{name!r}] must list block indices in 0..{len(blocks) - 1}")
+        idx = np.concatenate([np.arange(starts[k], starts[k + 1]) for k in keep])
+        r = mu_frequency(Ms[:, idx][:, :, idx], [blocks[k] for k in keep])
+        out[name] = {"mu_peak": r["peak_upper"], "mu_peak_lower": float(np.max(r["lower"])),
+                     "f_peak_hz": float(f[r["i_peak"]]), "upper": r["upper"]}
+    return out

@@ -724,7 +724,7 @@ def _plant_A(model):
     return np.array(ol.A), np.array(ol.B), np.array(ol.C)
 
 
-def hinf_uncertainty(data=None, f_hz=None):
+def hinf_uncertainty(data=None, f_hz=None, condition=None):
     """The stated uncertainty about the design condition as structured blocks
     (:class:`asekit.ase.robust.Uncertainty`):
 
@@ -739,12 +739,15 @@ def hinf_uncertainty(data=None, f_hz=None):
       moves with the dynamic pressure, which a stable multiplicative perturbation only
       approximates; the 45 exact checks of :func:`hinf_conditions` complement it).
 
+    ``condition``: (Mach, altitude m) of the nominal plant and of the parameter blocks
+    (default :data:`HINF_CONDITION`); the cover is always relative to that plant.
+
     Returns (A, B, C, Uncertainty) of the nominal plant."""
     from asekit.ase import robust
 
     data = load() if data is None else data
     db, modal = data
-    M0, h0 = HINF_CONDITION
+    M0, h0 = HINF_CONDITION if condition is None else condition
     A, B, C = _plant_A(fin_model(M0, h0, data=data))
 
     def model_with(mod):
@@ -772,15 +775,57 @@ def hinf_uncertainty(data=None, f_hz=None):
     return A, B, C, unc
 
 
-def hinf_mu(controller, data=None, f_hz=None) -> dict:
-    """Robust stability of the H-infinity loop for :func:`hinf_uncertainty`: bounds of mu
-    over frequency (:func:`asekit.ase.robust.robust_stability`, the sampled controller's
-    frequency response with the ZOH and 1.5 samples of delay)."""
+def hinf_mu(controller, data=None, f_hz=None, condition=None) -> dict:
+    """Robust stability of a loop at :data:`HINF_CONDITION` for :func:`hinf_uncertainty`:
+    bounds of mu over frequency (:func:`asekit.ase.robust.robust_stability`, the sampled
+    controller's frequency response with the ZOH and 1.5 samples of delay; the three real
+    parameters with the mixed D-G bound), and which uncertainty drives it
+    (:func:`asekit.ase.robust.mu_subsets`): ``mu_peak_parameters`` / ``f_peak_parameters_hz``
+    with the shaft and elastic-frequency blocks alone, ``mu_peak_flight`` /
+    ``f_peak_flight_hz`` with the Mach-altitude cover alone (one complex scalar: exact).
+    ``condition``: the nominal (Mach, altitude m) of :func:`hinf_uncertainty`."""
     from asekit.ase import robust
 
-    A, B, C, unc = hinf_uncertainty(data, f_hz)
-    return robust.robust_stability(A, B, C, robust.digital_gain(controller), unc,
-                                   unc.cover_hz, HINF_DELAY)
+    A, B, C, unc = hinf_uncertainty(data, f_hz, condition)
+    r = robust.robust_stability(A, B, C, robust.digital_gain(controller), unc,
+                                unc.cover_hz, HINF_DELAY)
+    n = len(unc.parameters)
+    sub = robust.mu_subsets(r["M"], r["blocks"], r["f_hz"],
+                            {"parameters": range(n), "flight": [n]})
+    for k, v in sub.items():
+        r[f"mu_peak_{k}"], r[f"f_peak_{k}_hz"] = v["mu_peak"], v["f_peak_hz"]
+        r[f"upper_{k}"] = v["upper"]
+    return r
+
+
+def parameter_mu_grid(controller, data=None, machs=MACHS, altitudes=ALTITUDES, f_hz=None):
+    """The shaft and elastic-frequency uncertainty alone (three real blocks, mixed D-G bound)
+    about each flight condition of the grid, the Mach-altitude cover left out: a per-condition
+    certificate (the loop at that condition is stable for 1 / mu times the stated parameter
+    uncertainty), which says nothing between the grid points. ``controller``: a
+    DigitalController or a scheduled factory (:func:`controller_at`). Returns {(mach,
+    altitude): (mu_peak, f_peak_hz)}; a few minutes (one mu sweep per condition)."""
+    from asekit.ase import robust
+
+    data = load() if data is None else data
+    out = {}
+    for M in machs:
+        for h in altitudes:
+            A, B, C, unc = hinf_uncertainty(data, f_hz, (M, h))
+            K = robust.digital_gain(controller_at(controller, M, h))
+            n = len(unc.parameters)
+            Ms, blocks = robust.loop_matrix(A, B, C, K, unc, unc.cover_hz, HINF_DELAY)
+            r = robust.mu_subsets(Ms, blocks, unc.cover_hz, {"p": range(n)})["p"]
+            out[(M, h)] = (r["mu_peak"], r["f_peak_hz"])
+    return out
+
+
+def lqg_scheduled_mu(data=None, f_hz=None) -> dict:
+    """:func:`hinf_mu` of the scheduled LQG (:func:`design_b_scheduled`) at its design point
+    :data:`HINF_CONDITION`. The scheduled controller knows its Mach and altitude, so of this
+    description only ``mu_peak_parameters`` (shaft and elastic frequencies) applies to it; the
+    full ``mu_peak`` is that of the same controller frozen over the whole envelope."""
+    return hinf_mu(controller_at(design_b_scheduled(data), *HINF_CONDITION), data, f_hz)
 
 
 def hinf_conditions(controller, data=None) -> list[Check]:
@@ -815,10 +860,12 @@ def hinf_quantities(data) -> list[Quantity]:
         q += [Quantity("ase.design.hinf.conditions_passed", n, "-",
                        "of 45: M 0.4-0.6 x 0-5000 m x nominal, shaft +-20 %, f1,f2 +-10 %"),
               Quantity("ase.design.hinf.mu_peak", mu["mu_peak"], "-",
-                       f"upper bound at {mu['f_peak_hz']:.0f} Hz (lower "
+                       f"mixed D-G upper bound at {mu['f_peak_hz']:.0f} Hz (lower "
                        f"{mu['mu_peak_lower']:.3g}); stable for {mu['margin']:.2g} x the "
-                       "stated uncertainty (complex bound of the real blocks, Mach-altitude "
-                       "as a multiplicative cover: conservative near the elastic modes)")]
+                       "stated uncertainty; shaft and elastic frequencies alone "
+                       f"{mu['mu_peak_parameters']:.3g} at {mu['f_peak_parameters_hz']:.0f} Hz, "
+                       f"Mach-altitude multiplicative cover alone {mu['mu_peak_flight']:.3g} "
+                       f"at {mu['f_peak_flight_hz']:.0f} Hz (drives the bound)")]
     else:
         why = "not computed: python -m asekit reproduce --robust (about a minute)"
         q += [Quantity("ase.design.hinf.conditions_passed", None, "-", why, computed=False),

@@ -106,3 +106,27 @@ def test_without_slycot_the_error_names_the_pip_line(monkeypatch):
     monkeypatch.setitem(sys.modules, "slycot", None)          # import slycot -> ImportError
     with pytest.raises(MissingExtra, match=r"pip install 'asekit-aero\[robust\]'"):
         robust.hinf_2dof(P, w, delay=0.0)
+
+
+def test_real_parameters_of_a_resonance_mixed_bound_is_exact():
+    """x'' + 2 z w0 (1 + rho d2) x' + w0^2 (1 + kappa d1) x = 0 is stable while both
+    coefficients stay positive (Routh, second order): |d1| < 1/kappa and |d2| < 1/rho
+    independently, so real mu = max(kappa, rho) (reached by the damping near w0). The complex
+    bound sees the stiffness block as j kappa / (2 z) at resonance (a complex perturbation is
+    negative damping) and is 1/(2 z) times too large; the loop matrix is rank one, where the
+    D-G bound is exact (Young 1994)."""
+    w0, z, kappa, rho = 2 * math.pi * 10.0, 0.02, 0.5, 0.8
+    A = np.array([[0.0, 1.0], [-w0 ** 2, -2 * z * w0]])
+    unc = Uncertainty(parameters=(("stiffness", np.array([[0.0, 0.0], [-kappa * w0 ** 2, 0.0]])),
+                                  ("damping", np.array([[0.0, 0.0], [0.0, -rho * 2 * z * w0]]))))
+    f = np.array([0.0, 3.0, 9.0, 10.0, 10.5, 13.0, 20.0])
+    B, C = np.array([[0.0], [1.0]]), np.array([[1.0, 0.0]])
+    r = robust.robust_stability(A, B, C, lambda w: 0.0, unc, f, delay=0.0)
+    # at s = j w a root needs w0^2 (1 + kappa d1) = w^2 and (for w > 0) zero damping, d2 =
+    # -1/rho: mu(w) = 1 / max(1/rho, |(w/w0)^2 - 1| / kappa) (kappa at w = 0: no damping term)
+    exact = 1 / np.maximum(1 / rho, np.abs((f / 10.0) ** 2 - 1) / kappa)
+    assert np.allclose(r["upper"], exact, rtol=1e-3)
+    assert r["mu_peak"] == pytest.approx(max(kappa, rho), rel=1e-3)
+    from asekit.ase.mu import upper_bound
+    complex_peak = max(upper_bound(M, r["blocks"])[0] for M in r["M"])
+    assert complex_peak > 0.9 * kappa / (2 * z)
