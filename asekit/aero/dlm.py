@@ -1234,3 +1234,91 @@ def pressure_jump(mesh: BoxMesh, mach: float, k: float, b_ref: float, normalwash
     if w.ndim not in (1, 2) or w.shape[0] != mesh.n or not np.all(np.isfinite(w)):
         raise ValueError(f"normalwash must be finite with first dimension {mesh.n}, got {w.shape}")
     return factor_aic(mesh, mach, k, b_ref, method, symmetric).pressures(w)
+
+
+# ---------------------------------------------------------------------------------------------
+# sub-blocks of D (for the compressed solve of asekit.aero.hmatrix)
+# ---------------------------------------------------------------------------------------------
+def _index_array(name: str, idx, n: int) -> np.ndarray:
+    """``idx`` as a 1-D int array of distinct box indices in [0, n) (ValueError naming it)."""
+    a = np.asarray(idx)
+    if a.ndim != 1 or a.size == 0 or a.dtype.kind not in "iu":
+        raise ValueError(f"{name} must be a non-empty 1-D integer array of box indices, got "
+                         f"shape {a.shape} dtype {a.dtype}")
+    if a.min() < 0 or a.max() >= n or np.unique(a).size != a.size:
+        raise ValueError(f"{name} must hold distinct box indices in [0, {n - 1}]")
+    return a.astype(np.intp, copy=False)
+
+
+def _vlm_block(mesh: BoxMesh, mach: float, rows: np.ndarray, cols: np.ndarray,
+               symmetric: bool) -> np.ndarray:
+    """D0[rows][:, cols] of :func:`asekit.aero.vlm.vlm_normalwash_matrix` (same horseshoe
+    sums, numpy loop; the masking scale is the whole mesh's longest bound vortex, as there)."""
+    from asekit.aero.vlm import _distinct_vertices, _horseshoe_normalwash, _senders
+    beta = math.sqrt(1.0 - mach * mach)
+    sx = np.array([1.0 / beta, 1.0, 1.0])
+    p = mesh.control_point[rows] * sx
+    n_r = mesh.normal[rows]
+    d = np.zeros((rows.size, cols.size))
+    for img in _senders(mesh, symmetric):
+        scale = float(np.max(np.linalg.norm((img.doublet_p3 - img.doublet_p1) * sx, axis=1)))
+        v, ia, ib = _distinct_vertices(img.doublet_p1[cols] * sx, img.doublet_p3[cols] * sx)
+        d += _horseshoe_normalwash(p, n_r, v, ia, ib, scale) * (0.5 * img.chord[cols])[None, :]
+    return d
+
+
+def normalwash_block(mesh: BoxMesh, mach: float, k, b_ref: float, rows, cols,
+                     method: str = "quartic", symmetric: bool = False,
+                     kernel: str | None = None) -> np.ndarray:
+    """The sub-block D(M, k)[rows][:, cols] of the DLM normalwash matrix, computed from the
+    kernel for those receivers and senders only (cost proportional to len(rows) len(cols)).
+
+    Same equations as :func:`normalwash_matrices` ([R71] Eqs. 22, 27, 36; [R98] Eqs. 1-5):
+    the steady part D0 by the horseshoe lattice, the increments D1 (+ D2 for nonplanar pairs)
+    by the all-planar path when every pair of the block is planar, else pairwise; with
+    ``symmetric`` each sending box and its image in y = 0 are summed into one column. The
+    result equals the corresponding entries of the full matrix to rounding
+    (tests/aero/test_hmatrix.py). This is the entry point that
+    :mod:`asekit.aero.hmatrix` uses to generate single rows and columns of admissible blocks.
+
+    Parameters
+    ----------
+    mesh, mach, k, b_ref, method, symmetric, kernel : as :func:`normalwash_matrices`
+        (k scalar or 1-D, b_ref in m).
+    rows, cols : 1-D integer arrays of distinct receiver and sender box indices.
+
+    Returns
+    -------
+    (n_k, len(rows), len(cols)) complex.
+
+    Examples
+    --------
+    >>> from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
+    >>> m = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, 1, 0), 1.0, 4, 3)])
+    >>> full = normalwash_matrices(m, 0.5, [0.3], 0.5)[0]
+    >>> blk = normalwash_block(m, 0.5, [0.3], 0.5, [1, 5], [0, 2, 7])[0]
+    >>> bool(np.allclose(blk, full[np.ix_([1, 5], [0, 2, 7])], rtol=0, atol=1e-13))
+    True
+    """
+    mach, ks, b = _check_request(mesh, mach, k, b_ref, method)
+    rows = _index_array("rows", rows, mesh.n)
+    cols = _index_array("cols", cols, mesh.n)
+    kernel = check_kernel(kernel)
+    snd_all = _Senders(mesh, symmetric)
+    s_idx = np.concatenate([cols + i * mesh.n for i in range(snd_all.n_images)])
+    rec, snd = _Receivers(mesh, rows), snd_all.subset(s_idx)
+    out = np.empty((ks.size, rows.size, cols.size), complex)
+    out[:] = _vlm_block(mesh, mach, rows, cols, symmetric)[None]
+    ik_nz = np.flatnonzero(ks > 0.0)
+    if ik_nz.size:
+        def add(ik, sl, d1):
+            out[ik, sl] += _fold(d1, cols.size, snd_all.n_images)
+
+        if _all_planar(rec, snd):
+            _planar_rows(rec, snd, mach, method, ks / b, ik_nz, add, None, kernel)
+        else:
+            _pairwise_rows(rec, snd, mach, method, ks / b, ik_nz, add, None)
+    if not np.isfinite(out).all():
+        raise ValueError("mesh: the DLM normalwash block is not finite (a control point on the "
+                         "spanwise line of a box side edge; see normalwash_matrices)")
+    return out
