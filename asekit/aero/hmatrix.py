@@ -46,6 +46,7 @@ import scipy.sparse.linalg as spla
 
 from asekit.aero.boxes import BoxMesh
 from asekit.aero.dlm import NormalwashBlocks
+from asekit.util.blas import one_blas_thread
 
 #: Default ACA stopping tolerance (relative Frobenius error of each admissible block).
 DEFAULT_EPS = 1e-7
@@ -55,6 +56,13 @@ DEFAULT_RTOL = 1e-9
 DEFAULT_ETA = 1.0
 #: Default largest cluster that is not bisected further.
 DEFAULT_LEAF = 48
+#: The DLM solvers of the GAF path (``aero.solver``): dense LU, this module, or by size.
+SOLVERS = ("dense", "hmatrix", "auto")
+#: "auto" takes the compressed solve from this many boxes: where one dense complex D alone
+#: (16 n^2 bytes) passes 2 GiB, the large-model memory budget of issue 23 (floor(sqrt(2^31 /
+#: 16)) = 11585). Below it dense LU is faster on every size measured
+#: (tests/benchmarks/bench_hmatrix.py, 1000-4000 boxes).
+AUTO_MIN_BOXES = 11585
 
 
 # ---------------------------------------------------------------------------------------------
@@ -299,7 +307,8 @@ class HMatrix:
     ----------
     tree : :class:`ClusterTree`.
     near : (n, n) scipy CSR matrix, the dense near-field blocks (tree order).
-    far : tuple of (r0, r1, c0, c1, U, V): the block [r0:r1, c0:c1] (tree order) ~ U V.
+    far : tuple of (r0, r1, cols, U, V): the rows r0:r1 (tree order) of a row cluster against
+        the columns ``cols`` (tree order) of all its admissible partners, ~ U V.
     diag : tuple of (start, stop, lu, piv): LU factors of the leaves' diagonal blocks (the
         preconditioner of :func:`solve`).
     eps, eta : the ACA tolerance and admissibility parameter it was built with.
@@ -340,8 +349,8 @@ class HMatrix:
 
     def _matvec_tree(self, xp: np.ndarray) -> np.ndarray:
         y = np.asarray(self.near @ xp, dtype=complex)
-        for r0, r1, c0, c1, u, v in self.far:
-            y[r0:r1] += u @ (v @ xp[c0:c1])
+        for r0, r1, cs, u, v in self.far:
+            y[r0:r1] += u @ (v @ xp[cs])
         return y
 
     def to_dense(self) -> np.ndarray:
@@ -379,13 +388,20 @@ def _near_field(mesh, tree, near, evaluate) -> tuple[sp.csr_matrix, dict]:
 
 
 def _far_field(tree, far, evaluate, eps: float) -> tuple:
-    """The admissible blocks by :func:`aca`; a block whose rank would not save memory is
-    stored as a dense low-rank pair (U = the block, V = I) instead."""
+    """The admissible blocks, those of one row cluster s together: the block row
+    [D_st1 ... D_stq] over its admissible partners t is approximated by one :func:`aca` (the
+    kernel is smooth for receivers in s and senders in any t, all far from s, so the block row
+    has low rank too, and one call per row or column then serves all q blocks). A block row
+    whose rank would not save memory is stored exactly (U = the block row, V = I, or U = I)."""
+    by_row: dict = {}
+    for s, t in far:
+        by_row.setdefault(s, []).append(t)
     out = []
     perm = tree.perm
-    for s, t in far:
-        r0, r1, c0, c1 = tree.start[s], tree.stop[s], tree.start[t], tree.stop[t]
-        rows, cols = perm[r0:r1], perm[c0:c1]
+    for s, ts in by_row.items():
+        r0, r1 = int(tree.start[s]), int(tree.stop[s])
+        cs = np.concatenate([np.arange(tree.start[t], tree.stop[t]) for t in ts])
+        rows, cols = perm[r0:r1], perm[cs]
         m, n = rows.size, cols.size
         max_rank = max(1, (m * n) // (m + n))
         u, v, ok = aca(lambda i: evaluate(rows[i:i + 1], cols)[0],
@@ -397,7 +413,7 @@ def _far_field(tree, far, evaluate, eps: float) -> tuple:
             u, v = evaluate(rows, cols), np.eye(n, dtype=complex)
             if m < n:
                 u, v = np.eye(m, dtype=complex), u
-        out.append((int(r0), int(r1), int(c0), int(c1), u, v))
+        out.append((r0, r1, cs, u, v))
     return tuple(out)
 
 
@@ -444,8 +460,9 @@ def build_hmatrix(mesh: BoxMesh, mach: float, k: float, b_ref: float, method: st
     def evaluate(rows, cols):
         return blocks(rows, cols)[0]
 
-    near_m, diag = _near_field(mesh, tree, near, evaluate)
-    far_t = _far_field(tree, far, evaluate, float(eps))
+    with one_blas_thread():         # many small products and QR / SVD
+        near_m, diag = _near_field(mesh, tree, near, evaluate)
+        far_t = _far_field(tree, far, evaluate, float(eps))
     factors = []
     for c in tree.leaves():
         lu, piv = sla.lu_factor(diag[c], check_finite=False)
@@ -502,6 +519,16 @@ def solve(h: HMatrix, w, rtol: float = DEFAULT_RTOL, maxiter: int = 500,
     op = spla.LinearOperator((h.n, h.n), matvec=lambda x: h._matvec_tree(x.reshape(-1)),
                              dtype=complex)
     pre = _preconditioner(h)
+    with one_blas_thread():         # small products: threads only contend
+        xs, its, worst = _gmres_columns(h, op, pre, cols, rtol, maxiter, restart)
+    xp = np.column_stack(xs)
+    x = np.empty_like(xp)
+    x[perm] = xp
+    return x.reshape(w.shape), SolveInfo(tuple(its), float(worst))
+
+
+def _gmres_columns(h, op, pre, cols, rtol, maxiter, restart):
+    perm = h.tree.perm
     xs, its, worst = [], [], 0.0
     for j in range(cols.shape[1]):
         b = cols[perm, j].astype(complex)
@@ -521,10 +548,7 @@ def solve(h: HMatrix, w, rtol: float = DEFAULT_RTOL, maxiter: int = 500,
         xs.append(x)
         its.append(count[0])
         worst = max(worst, res)
-    xp = np.column_stack(xs)
-    x = np.empty_like(xp)
-    x[perm] = xp
-    return x.reshape(w.shape), SolveInfo(tuple(its), float(worst))
+    return xs, its, worst
 
 
 @dataclass(frozen=True, eq=False)
@@ -543,3 +567,36 @@ class HmatrixFactor:
     def pressures(self, normalwash) -> np.ndarray:
         """DeltaCp for the normalwash ``normalwash`` (n,) or (n, m), complex, same shape."""
         return solve(self.h, normalwash, self.rtol)[0]
+
+
+def resolve_solver(solver: str, n_boxes: int) -> str:
+    """"dense" or "hmatrix" for ``solver`` (one of :data:`SOLVERS`) on ``n_boxes`` boxes:
+    "auto" is "hmatrix" from :data:`AUTO_MIN_BOXES` boxes, else "dense".
+
+    >>> resolve_solver("auto", 1200), resolve_solver("auto", 20000), resolve_solver("hmatrix", 10)
+    ('dense', 'hmatrix', 'hmatrix')
+    """
+    if solver not in SOLVERS:
+        raise ValueError(f"solver must be one of {list(SOLVERS)}, got {solver!r}")
+    if solver == "auto":
+        return "hmatrix" if n_boxes >= AUTO_MIN_BOXES else "dense"
+    return solver
+
+
+def compressed_pressures(mesh: BoxMesh, mach: float, ks, b_ref: float, normalwash,
+                         method: str = "quartic", symmetric: bool = False,
+                         eps: float = DEFAULT_EPS, rtol: float = DEFAULT_RTOL, on_k=None,
+                         kernel: str | None = None) -> list:
+    """DeltaCp per k for the normalwash columns ``normalwash(k)`` (n, m): one
+    :func:`build_hmatrix` and one :func:`solve` per reduced frequency (the compressed
+    counterpart of the streamed dense LU of :func:`asekit.aero.gaf.gaf_from_box_modes`).
+    ``on_k(ik, cp)`` is called as each k is done; returns the list of (n, m) arrays."""
+    out = []
+    for ik, kk in enumerate(np.atleast_1d(np.asarray(ks, float))):
+        h = build_hmatrix(mesh, mach, float(kk), b_ref, method, symmetric, eps, kernel=kernel)
+        cp = solve(h, normalwash(float(kk)), rtol)[0]
+        del h
+        if on_k is not None:
+            on_k(ik, cp)
+        out.append(cp)
+    return out

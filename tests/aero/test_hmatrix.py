@@ -97,9 +97,9 @@ def test_admissible_blocks_within_eps(wing400, mach, k, eps):
     d = normalwash_matrix(wing400, mach, k, B_REF)
     h = H.build_hmatrix(wing400, mach, k, B_REF, eps=eps, leaf_size=32)
     p = h.tree.perm
-    assert len(h.far) > 10
-    for r0, r1, c0, c1, u, v in h.far:
-        blk = d[np.ix_(p[r0:r1], p[c0:c1])]
+    assert len(h.far) > 5
+    for r0, r1, cs, u, v in h.far:
+        blk = d[np.ix_(p[r0:r1], p[cs])]
         assert np.linalg.norm(u @ v - blk) <= eps * np.linalg.norm(blk)
     # the near field is exact
     dense = h.to_dense()
