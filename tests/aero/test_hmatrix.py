@@ -146,3 +146,22 @@ def test_compression_below_one():
     x = np.random.default_rng(1).standard_normal(mesh.n)
     d = normalwash_matrix(mesh, 0.5, 0.0, B_REF)
     assert np.linalg.norm(h.matvec(x) - d @ x) <= 1e-6 * np.linalg.norm(d @ x)
+
+
+def test_gaf_switch(wing400):
+    """gaf_from_box_modes(solver=...): "hmatrix" equals "dense" to 1e-6 relative; "auto" is
+    the dense path itself below AUTO_MIN_BOXES (bit for bit); a bad name is refused."""
+    from asekit.aero.gaf import gaf_from_box_modes
+    from asekit.aero.spline import analytic_modes
+    modes = analytic_modes(wing400, [lambda x, y: (1.0 + 0 * x, 0 * x),
+                                     lambda x, y: (x - 0.4, 1.0 + 0 * x),
+                                     lambda x, y: (y * y / 16.0, 0 * x)])
+    ks = [0.0, 0.7]
+    dense = gaf_from_box_modes(modes, wing400, 0.7, ks, B_REF)
+    comp = gaf_from_box_modes(modes, wing400, 0.7, ks, B_REF, solver="hmatrix")
+    auto = gaf_from_box_modes(modes, wing400, 0.7, ks, B_REF, solver="auto")
+    for ik in range(len(ks)):
+        assert np.abs(comp[ik] - dense[ik]).max() <= 1e-6 * np.abs(dense[ik]).max()
+    assert np.array_equal(auto, dense)
+    with pytest.raises(ValueError, match="solver"):
+        gaf_from_box_modes(modes, wing400, 0.7, ks, B_REF, solver="lu")
