@@ -135,6 +135,10 @@ def test_gaf_equals_dense(wing400, mach, k):
     q = h_load.T @ (wing400.area[:, None] * cp)
     assert np.abs(q - q_dense).max() <= 1e-6 * np.abs(q_dense).max()
     assert np.allclose(H.HmatrixFactor(hm).pressures(w), cp, rtol=0, atol=1e-12)
+    cp_block, info_block = H.solve(hm, w, preconditioner="block")
+    q_block = h_load.T @ (wing400.area[:, None] * cp_block)
+    assert np.abs(q_block - q_dense).max() <= 1e-6 * np.abs(q_dense).max()
+    assert max(info.iterations) < max(info_block.iterations)
 
 
 def test_compression_below_one():
