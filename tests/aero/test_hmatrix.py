@@ -128,7 +128,7 @@ def test_gaf_equals_dense(wing400, mach, k):
     h_load, w = _modes(wing400, k)
     d = normalwash_matrix(wing400, mach, k, B_REF)
     cp_dense = factor_normalwash_matrix(d).pressures(w)
-    hm = H.build_hmatrix(wing400, mach, k, B_REF)
+    hm = H.build_hmatrix(wing400, mach, k, B_REF, leaf_size=32)
     cp, info = H.solve(hm, w)
     assert info.residual <= H.DEFAULT_RTOL
     q_dense = h_load.T @ (wing400.area[:, None] * cp_dense)
@@ -145,7 +145,7 @@ def test_compression_below_one():
     """800 boxes (8 x 100), steady part: the compressed matrix is smaller than the dense one
     (measured 0.91 with 48-box leaves)."""
     mesh = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0.6, 4, 0), 0.4, 8, 100)])
-    h = H.build_hmatrix(mesh, 0.5, 0.0, B_REF)
+    h = H.build_hmatrix(mesh, 0.5, 0.0, B_REF, leaf_size=48)
     assert h.compression < 0.95
     x = np.random.default_rng(1).standard_normal(mesh.n)
     d = normalwash_matrix(mesh, 0.5, 0.0, B_REF)
