@@ -63,8 +63,10 @@ DEFAULT_LEAF = 160
 SOLVERS = ("dense", "hmatrix", "auto")
 #: "auto" takes the compressed solve from this many boxes: where one dense complex D alone
 #: (16 n^2 bytes) passes 2 GiB, the large-model memory budget of issue 23 (floor(sqrt(2^31 /
-#: 16)) = 11585). Below it dense LU is faster on every size measured
-#: (tests/benchmarks/bench_hmatrix.py, 1000-4000 boxes).
+#: 16)) = 11585). Dense LU was faster at every size measured (tests/benchmarks/bench_hmatrix.py,
+#: 1000-8000 boxes, one k: 50.6 s against 83.5 s CPU at 8008 boxes); the time curves (growth
+#: exponents 2.47 and 1.76 between 4000 and 8000 boxes) cross near 16000 boxes by
+#: extrapolation.
 AUTO_MIN_BOXES = 11585
 
 
