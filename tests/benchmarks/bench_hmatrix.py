@@ -12,8 +12,28 @@ subprocess with one BLAS thread: dense = D(M, k) (:func:`asekit.aero.dlm.normalw
 :func:`asekit.aero.hmatrix.solve`. It prints CPU seconds, peak traced memory (tracemalloc sees
 numpy's allocations) and, where the dense solve ran, the GAF error of the compressed solve
 (max |dQ| / max |Q|), then the growth exponents between successive sizes and the crossover.
-A 15-k sweep costs about 15 times one k for both (the dense path shares the k-independent
-geometry across k, about 20 % of D).
+A 15-k sweep costs about 15 times one k for the compressed solve (each k is built afresh);
+the dense path shares the k-independent geometry across the k of a batch.
+
+Measured on the 2-core project machine (shared, load 2-9: CPU seconds are noisy by ~2x),
+M 0.8, k 0.5, 6 modes, one BLAS thread, leaf size 160, eta 1, eps 1e-7, rtol 1e-9 (dense from
+a run with the same dense code; the compressed column from a second run with
+``--dense-max 0``; peak MB by tracemalloc, which does not see SuperLU's own allocations):
+
+    boxes  dense s  dense MB    H s  (build)   H MB  compr  iters  rank  GAF err
+     1000     0.45        36   2.88     2.51     49  0.774      5    35  1.1e-10 (*)
+     2002     1.74        93   5.78     4.47    187  0.705      5    37  4.6e-09 (*)
+     4000     9.11       368  24.66    21.12    447  0.485      6    51  3.4e-08 (*)
+     8008    50.61      1471  83.52    64.01   1414  0.382      9    72  3.9e-08 (*)
+    16000        -         -  264.3    206.9   3155  0.248     12    97  -
+
+    (*) the GAF errors of the first run (leaf size 48, same eps and rtol)
+
+Growth exponents, time: dense 1.95, 2.39, 2.47; compressed 1.01, 2.10, 1.76, 1.66 (memory
+1.16 from 8000 to 16000). Dense at 16000 boxes is refused (one D is 4 GiB,
+asekit.aero.boxes.MAX_MATRIX_BYTES); extrapolated at exponent 2.47 it would take ~280 s: the
+crossover in time is near 16000 boxes; in memory the compressed solve is below dense from
+8000 boxes. The build is bound by the fixed cost of each row / column evaluation (~1 ms).
 """
 
 from __future__ import annotations
