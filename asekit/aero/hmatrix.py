@@ -30,8 +30,10 @@ Frobenius error of every admissible block below eps (the stopping rule is a heur
 estimate; measured in tests/aero/test_hmatrix.py); GMRES stops at ||D_H x - w|| <= rtol ||w||. The error of the
 pressures against the dense solve is then of order cond(D) (eps + rtol); the defaults
 (:data:`DEFAULT_EPS`, :data:`DEFAULT_RTOL`) keep the generalised aerodynamic forces within
-1e-6 relative of the dense LU solve (measured on wings of 400-1000 boxes, M 0.5-0.8,
-k 0-1: tests/aero/test_hmatrix.py).
+1e-6 relative of the dense LU solve (tests/aero/test_hmatrix.py: a 400-box wing at M 0.5 and
+0.8, k 0 and 1; tests/benchmarks/bench_hmatrix.py: 1e-10 to 4e-8 at 1000-8000 boxes, M 0.8,
+k 0.5). The admissible blocks of one row cluster are approximated together, as one block row
+(:func:`_far_field`), so that each row or column evaluation serves all of them.
 """
 
 from __future__ import annotations
