@@ -1075,16 +1075,20 @@ def _compiled_planar(rec, pts: "_StationPoints", rows: slice, mach: float, t1w: 
 
 
 def _planar_rows(rec, snd: _Senders, mach: float, method: str, kds, ik_nz, add, progress,
-                 kernel: str = "numpy", direct=None):
+                 kernel: str = "numpy", direct=None, pts=None, weights=None):
     """D1 of receivers ``rec`` against senders ``snd``, all pairs planar (module docstring):
     kernel per distinct station point in row chunks of about PLANAR_POINTS_PER_CHUNK
     (receiver, point) pairs, weights per block of chunks; ``add(ik, rows, d1)``. ``kernel``
     "compiled": the k loop by :func:`asekit.aero._dlm_compiled.planar_increment`, which adds
-    into ``direct(ik, rows)`` (a C-contiguous view of D) instead of calling ``add`` if given."""
+    into ``direct(ik, rows)`` (a C-contiguous view of D) instead of calling ``add`` if given.
+    ``pts``, ``weights``: the station points and weights of (rec, snd) if already known
+    (:class:`NormalwashBlocks`)."""
     stations, p_n, a_n = _METHODS[method]
     n, ns = rec.n, snd.mid.shape[0]
-    pts = _StationPoints(rec, snd, stations)
-    weights = _PlanarWeights(rec, snd, stations, PLANAR_WEIGHT_TABLE_BYTES)
+    if pts is None:
+        pts = _StationPoints(rec, snd, stations)
+    if weights is None:
+        weights = _PlanarWeights(rec, snd, stations, PLANAR_WEIGHT_TABLE_BYTES)
     nq = pts.xyz.shape[0]
     # the chunk holds ~12 real arrays per (row, point) and ~stations + 4 per (row, sender)
     if kernel == "compiled":
@@ -1234,3 +1238,199 @@ def pressure_jump(mesh: BoxMesh, mach: float, k: float, b_ref: float, normalwash
     if w.ndim not in (1, 2) or w.shape[0] != mesh.n or not np.all(np.isfinite(w)):
         raise ValueError(f"normalwash must be finite with first dimension {mesh.n}, got {w.shape}")
     return factor_aic(mesh, mach, k, b_ref, method, symmetric).pressures(w)
+
+
+# ---------------------------------------------------------------------------------------------
+# sub-blocks of D (for the compressed solve of asekit.aero.hmatrix)
+# ---------------------------------------------------------------------------------------------
+def _index_array(name: str, idx, n: int) -> np.ndarray:
+    """``idx`` as a 1-D int array of distinct box indices in [0, n) (ValueError naming it)."""
+    a = np.asarray(idx)
+    if a.ndim != 1 or a.size == 0 or a.dtype.kind not in "iu":
+        raise ValueError(f"{name} must be a non-empty 1-D integer array of box indices, got "
+                         f"shape {a.shape} dtype {a.dtype}")
+    if a.min() < 0 or a.max() >= n or np.unique(a).size != a.size:
+        raise ValueError(f"{name} must hold distinct box indices in [0, {n - 1}]")
+    return a.astype(np.intp, copy=False)
+
+
+def _vlm_block(mesh: BoxMesh, mach: float, rows: np.ndarray, cols: np.ndarray,
+               symmetric: bool) -> np.ndarray:
+    """D0[rows][:, cols] of :func:`asekit.aero.vlm.vlm_normalwash_matrix` (same horseshoe
+    sums, numpy loop; the masking scale is the whole mesh's longest bound vortex, as there)."""
+    from asekit.aero.vlm import _distinct_vertices, _horseshoe_normalwash, _senders
+    beta = math.sqrt(1.0 - mach * mach)
+    sx = np.array([1.0 / beta, 1.0, 1.0])
+    p = mesh.control_point[rows] * sx
+    n_r = mesh.normal[rows]
+    d = np.zeros((rows.size, cols.size))
+    for img in _senders(mesh, symmetric):
+        scale = float(np.max(np.linalg.norm((img.doublet_p3 - img.doublet_p1) * sx, axis=1)))
+        v, ia, ib = _distinct_vertices(img.doublet_p1[cols] * sx, img.doublet_p3[cols] * sx)
+        d += _horseshoe_normalwash(p, n_r, v, ia, ib, scale) * (0.5 * img.chord[cols])[None, :]
+    return d
+
+
+def normalwash_block(mesh: BoxMesh, mach: float, k, b_ref: float, rows, cols,
+                     method: str = "quartic", symmetric: bool = False,
+                     kernel: str | None = None) -> np.ndarray:
+    """The sub-block D(M, k)[rows][:, cols] of the DLM normalwash matrix, computed from the
+    kernel for those receivers and senders only (cost proportional to len(rows) len(cols)).
+
+    Same equations as :func:`normalwash_matrices` ([R71] Eqs. 22, 27, 36; [R98] Eqs. 1-5):
+    the steady part D0 by the horseshoe lattice, the increments D1 (+ D2 for nonplanar pairs)
+    by the all-planar path when every pair of the block is planar, else pairwise; with
+    ``symmetric`` each sending box and its image in y = 0 are summed into one column. The
+    result equals the corresponding entries of the full matrix to rounding
+    (tests/aero/test_hmatrix.py). This is the entry point that
+    :mod:`asekit.aero.hmatrix` uses to generate single rows and columns of admissible blocks.
+
+    Parameters
+    ----------
+    mesh, mach, k, b_ref, method, symmetric, kernel : as :func:`normalwash_matrices`
+        (k scalar or 1-D, b_ref in m).
+    rows, cols : 1-D integer arrays of distinct receiver and sender box indices.
+
+    Returns
+    -------
+    (n_k, len(rows), len(cols)) complex.
+
+    Examples
+    --------
+    >>> from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
+    >>> m = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, 1, 0), 1.0, 4, 3)])
+    >>> full = normalwash_matrices(m, 0.5, [0.3], 0.5)[0]
+    >>> blk = normalwash_block(m, 0.5, [0.3], 0.5, [1, 5], [0, 2, 7])[0]
+    >>> bool(np.allclose(blk, full[np.ix_([1, 5], [0, 2, 7])], rtol=0, atol=1e-13))
+    True
+    """
+    mach, ks, b = _check_request(mesh, mach, k, b_ref, method)
+    rows = _index_array("rows", rows, mesh.n)
+    cols = _index_array("cols", cols, mesh.n)
+    kernel = check_kernel(kernel)
+    snd_all = _Senders(mesh, symmetric)
+    s_idx = np.concatenate([cols + i * mesh.n for i in range(snd_all.n_images)])
+    rec, snd = _Receivers(mesh, rows), snd_all.subset(s_idx)
+    out = np.empty((ks.size, rows.size, cols.size), complex)
+    out[:] = _vlm_block(mesh, mach, rows, cols, symmetric)[None]
+    ik_nz = np.flatnonzero(ks > 0.0)
+    if ik_nz.size:
+        def add(ik, sl, d1):
+            out[ik, sl] += _fold(d1, cols.size, snd_all.n_images)
+
+        if _all_planar(rec, snd):
+            _planar_rows(rec, snd, mach, method, ks / b, ik_nz, add, None, kernel)
+        else:
+            _pairwise_rows(rec, snd, mach, method, ks / b, ik_nz, add, None)
+    if not np.isfinite(out).all():
+        raise ValueError("mesh: the DLM normalwash block is not finite (a control point on the "
+                         "spanwise line of a box side edge; see normalwash_matrices)")
+    return out
+
+
+class NormalwashBlocks:
+    """Evaluator of sub-blocks D(M, k)[rows][:, cols] of one mesh at one Mach number and a set
+    of reduced frequencies, for many small requests (the rows and columns that adaptive cross
+    approximation asks for, :mod:`asekit.aero.hmatrix`).
+
+    The k-independent data of all senders -- the distinct kernel station points, the planar
+    weight table and the horseshoe corners -- are computed once here, and each call takes the
+    subset it needs; the equations and so the entries are those of :func:`normalwash_block`
+    and :func:`normalwash_matrices` (agreement to rounding, tests/aero/test_hmatrix.py).
+    Meshes with nonplanar pairs are evaluated by :func:`normalwash_block` per call.
+
+    Parameters
+    ----------
+    mesh, mach, k, b_ref, method, symmetric, kernel : as :func:`normalwash_matrices`.
+
+    Examples
+    --------
+    >>> from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
+    >>> m = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0, 1, 0), 1.0, 4, 3)])
+    >>> ev = NormalwashBlocks(m, 0.5, [0.3], 0.5, symmetric=True)
+    >>> blk = normalwash_block(m, 0.5, [0.3], 0.5, [1, 5], [0, 2, 7], symmetric=True)
+    >>> bool(np.allclose(ev([1, 5], [0, 2, 7]), blk, rtol=0, atol=1e-13))
+    True
+    """
+
+    def __init__(self, mesh: BoxMesh, mach: float, k, b_ref: float, method: str = "quartic",
+                 symmetric: bool = False, kernel: str | None = None):
+        self.mach, self.ks, self.b = _check_request(mesh, mach, k, b_ref, method)
+        self.mesh, self.method, self.symmetric = mesh, method, bool(symmetric)
+        self.kernel = check_kernel(kernel)
+        self.snd = _Senders(mesh, symmetric)
+        self.planar = _all_planar(mesh, self.snd)
+        stations = _METHODS[method][0]
+        if self.planar:
+            self.pts = _StationPoints(mesh, self.snd, stations)
+            self.weights = _PlanarWeights(mesh, self.snd, stations, PLANAR_WEIGHT_TABLE_BYTES)
+        from asekit.aero.vlm import _distinct_vertices, _senders
+        beta = math.sqrt(1.0 - self.mach ** 2)
+        self.sx = np.array([1.0 / beta, 1.0, 1.0])
+        self.lattice = []
+        for img in _senders(mesh, symmetric):
+            a, b = img.doublet_p1 * self.sx, img.doublet_p3 * self.sx
+            scale = float(np.max(np.linalg.norm(b - a, axis=1)))
+            self.lattice.append((_distinct_vertices(a, b), scale, 0.5 * img.chord))
+
+    def _steady(self, rows, cols) -> np.ndarray:
+        from asekit.aero.vlm import _horseshoe_normalwash
+        p = self.mesh.control_point[rows] * self.sx
+        n_r = self.mesh.normal[rows]
+        d = np.zeros((rows.size, cols.size))
+        for (v, ia, ib), scale, half_chord in self.lattice:
+            used, inv = np.unique(np.concatenate([ia[cols], ib[cols]]), return_inverse=True)
+            inv = inv.reshape(-1)
+            if self.kernel == "compiled":       # the loop form of the same sums
+                from asekit.aero import _dlm_compiled
+                _dlm_compiled.horseshoe_normalwash(
+                    np.ascontiguousarray(p), np.ascontiguousarray(n_r), v[used],
+                    inv[:cols.size], inv[cols.size:], scale, half_chord[cols], d)
+                continue
+            d += (_horseshoe_normalwash(p, n_r, v[used], inv[:cols.size], inv[cols.size:],
+                                        scale) * half_chord[cols][None, :])
+        return d
+
+    def _sub_points(self, rows, s_idx):
+        """The station points and weights of receivers ``rows`` and senders ``s_idx``."""
+        pts = self.pts
+        used, inv = np.unique(pts.index[s_idx], return_inverse=True)
+        sub = object.__new__(_StationPoints)
+        sub.xyz, sub.e = pts.xyz[used], pts.e[used]
+        sub.index = inv.reshape(s_idx.size, -1)
+        sub.yz, sub.yz_class = pts.yz, pts.yz_class[used]
+        sub.r_yz, sub.r_class = pts.r_yz, pts.r_class[rows]
+        wt = self.weights
+        sw = object.__new__(_PlanarWeights)
+        sw.mesh, sw.snd, sw.stations = _Receivers(self.mesh, rows), self.snd.subset(s_idx), \
+            wt.stations
+        sw.r_group, sw.s_group, sw.table = wt.r_group[rows], wt.s_group[s_idx], wt.table
+        return sub, sw
+
+    def __call__(self, rows, cols) -> np.ndarray:
+        """D[rows][:, cols] for every k, (n_k, len(rows), len(cols)) complex (``rows``,
+        ``cols``: 1-D arrays of distinct box indices)."""
+        mesh = self.mesh
+        if not self.planar:
+            return normalwash_block(mesh, self.mach, self.ks, self.b, rows, cols, self.method,
+                                    self.symmetric, self.kernel)
+        rows = _index_array("rows", rows, mesh.n)
+        cols = _index_array("cols", cols, mesh.n)
+        n_img = self.snd.n_images
+        s_idx = np.concatenate([cols + i * mesh.n for i in range(n_img)])
+        out = np.empty((self.ks.size, rows.size, cols.size), complex)
+        out[:] = self._steady(rows, cols)[None]
+        ik_nz = np.flatnonzero(self.ks > 0.0)
+        if ik_nz.size:
+            def add(ik, sl, d1):
+                out[ik, sl] += _fold(d1, cols.size, n_img)
+
+            pts, weights = self._sub_points(rows, s_idx)
+            _planar_rows(_Receivers(mesh, rows), self.snd.subset(s_idx), self.mach,
+                         self.method, self.ks / self.b, ik_nz, add, None, self.kernel,
+                         pts=pts, weights=weights)
+        if not np.isfinite(out).all():
+            raise ValueError("mesh: the DLM normalwash block is not finite (a control point "
+                             "on the spanwise line of a box side edge; see "
+                             "normalwash_matrices)")
+        return out

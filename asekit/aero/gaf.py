@@ -28,6 +28,7 @@ import numpy as np
 
 from asekit.aero.boxes import BoxMesh
 from asekit.aero.dlm import factor_normalwash_matrix, map_normalwash_matrices
+from asekit.aero.hmatrix import compressed_pressures, resolve_solver
 from asekit.aero.methods import DLM_KERNELS, check_mach, pressures, resolve_method
 from asekit.aero.spline import BoxModes, fe_spline, modal_forces
 from asekit.aero.validity import check_k, mach_number
@@ -185,7 +186,8 @@ class GafDatabase:
 def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref: float,
                        symmetric: bool = False, method: str = "quartic",
                        progress=None, aero_options: dict | None = None,
-                       max_bytes: int | None = None, on_k=None) -> np.ndarray:
+                       max_bytes: int | None = None, on_k=None,
+                       solver: str = "dense") -> np.ndarray:
     """Q(M, k) (n_k, n_modes, n_modes) for mode shapes already interpolated to the boxes.
 
     The k sweep is streamed (:func:`asekit.aero.dlm.map_normalwash_matrices`): one LU
@@ -197,9 +199,15 @@ def gaf_from_box_modes(box_modes: BoxModes, mesh: BoxMesh, mach: float, k, b_ref
     (:mod:`asekit.aero.methods`; ``aero_options`` go to its pressure matrices); "quartic" and
     "parabolic" are the DLM kernels. ``on_k(ik, Q_k)``, when given, is called with each k's
     (n_modes, n_modes) result as soon as it is computed (the per-entry cache of
-    :func:`build_gaf_database`).
+    :func:`build_gaf_database`). ``solver`` (DLM only): "dense" (LU, default), "hmatrix" (the
+    compressed matrix and GMRES of :mod:`asekit.aero.hmatrix`, GAFs within 1e-6 relative of
+    the dense ones) or "auto" (:func:`asekit.aero.hmatrix.resolve_solver`: by box count).
     """
     ks = check_k(k)
+    if resolve_solver(solver, mesh.n) == "hmatrix" and (
+            method in DLM_KERNELS or resolve_method(method, mach) == "dlm"):
+        return _gaf_compressed(box_modes, mesh, mach, ks, b_ref, symmetric,
+                               method if method in DLM_KERNELS else "quartic", progress, on_k)
     if method not in DLM_KERNELS:
         if resolve_method(method, mach) != "dlm" or aero_options:
             cp = pressures(mesh, mach, ks, b_ref, lambda kk: box_modes.normalwash(kk, b_ref),
@@ -338,15 +346,32 @@ class _FreshEntries(GafEntryCache):
         return None
 
 
+def _gaf_compressed(box_modes, mesh, mach, ks, b_ref, symmetric, kernel, progress, on_k):
+    """Q per k by :func:`asekit.aero.hmatrix.compressed_pressures` (one compressed matrix and
+    GMRES solve per k)."""
+    out = np.empty((ks.size, box_modes.h_cp.shape[1], box_modes.h_cp.shape[1]), complex)
+
+    def project(ik, cp):
+        out[ik] = modal_forces(box_modes, cp, mesh.area)
+        if on_k is not None:
+            on_k(ik, out[ik])
+        if progress is not None:
+            progress(1)
+
+    compressed_pressures(mesh, mach, ks, b_ref, lambda kk: box_modes.normalwash(kk, b_ref),
+                         kernel, symmetric, on_k=project)
+    return out
+
+
 def _mach_entries(box_modes, mesh, mach, ks, b_ref, symmetric, method, bar, aero_options,
-                  entries: GafEntryCache | None) -> np.ndarray:
+                  entries: GafEntryCache | None, solver: str = "dense") -> np.ndarray:
     """Q (n_k, n, n) at one Mach: the cached entries loaded, the others computed (and cached
     as each is done). Computed k by k where needed, so a resumed Mach gives the numbers of an
     uninterrupted one bit for bit (the Mach-box grid always resolves the list's largest k)."""
     update = None if bar is None else bar.update
     if entries is None:
         return gaf_from_box_modes(box_modes, mesh, mach, ks, b_ref, symmetric, method,
-                                  progress=update, aero_options=aero_options)
+                                  progress=update, aero_options=aero_options, solver=solver)
     n = box_modes.h_cp.shape[1]
     q = np.empty((ks.size, n, n), complex)
     missing = []
@@ -378,16 +403,18 @@ def _mach_entries(box_modes, mesh, mach, ks, b_ref, symmetric, method, bar, aero
                   symmetric, **dict(aero_options or {}, k_grid=float(ks.max()), on_k=project))
     else:
         gaf_from_box_modes(box_modes, mesh, mach, todo, b_ref, symmetric, method,
-                           progress=update, aero_options=aero_options, on_k=keep)
+                           progress=update, aero_options=aero_options, on_k=keep,
+                           solver=solver)
     return q
 
 
 def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: float, n_rigid: int,
                        symmetric: bool = False, method: str = "quartic", progress: bool = True,
                        metadata: dict | None = None, aero_options: dict | None = None,
-                       entries: GafEntryCache | None = None) -> GafDatabase:
-    """Compute Q over ``machs`` x ``ks`` (tqdm bar over Mach x k when ``progress``); ``method``
-    and ``aero_options`` as in :func:`gaf_from_box_modes` (e.g. "auto" over subsonic and
+                       entries: GafEntryCache | None = None,
+                       solver: str = "dense") -> GafDatabase:
+    """Compute Q over ``machs`` x ``ks`` (tqdm bar over Mach x k when ``progress``); ``method``,
+    ``aero_options`` and ``solver`` as in :func:`gaf_from_box_modes` (e.g. "auto" over subsonic and
     supersonic Mach numbers, refusing the transonic gap). With ``entries``
     (:class:`GafEntryCache`) each (Mach, k) entry is read from it when cached and written to
     it as soon as it is computed: an interrupted build resumes where it stopped and gives the
@@ -412,7 +439,7 @@ def build_gaf_database(box_modes: BoxModes, mesh: BoxMesh, machs, ks, b_ref: flo
         with _blas_threads_for(mesh.n):
             for im, mach in enumerate(machs):
                 q[im] = _mach_entries(box_modes, mesh, mach, ks, b_ref, symmetric, method, bar,
-                                      aero_options, entries)
+                                      aero_options, entries, solver)
     finally:
         if bar is not None:
             bar.close()
@@ -469,7 +496,8 @@ def _load_matching(path: Path, fp: str, settings: dict, n_modes: int):
 def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetric: bool = False,
                         method: str = "quartic", progress: bool = True, rebuild: bool = False,
                         cache_dir=None, path=None, metadata: dict | None = None,
-                        entries: GafEntryCache | None = None, spline=None) -> GafDatabase:
+                        entries: GafEntryCache | None = None, spline=None,
+                        solver: str = "dense") -> GafDatabase:
     """The GAF database of a ``ModalModel`` on ``boxes`` over ``machs`` x ``ks``, from a cache
     when one matches, else computed (tqdm bar) and written atomically.
 
@@ -487,10 +515,18 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
     ``spline`` : a named pair ``(name, fn)`` with ``fn(model, boxes) -> BoxModes`` in place of
     :func:`asekit.aero.spline.fe_spline` (e.g. a stick model's beam-to-box spline,
     :func:`asekit.aero.beam_spline.beam_box_modes`); its name enters the fingerprint.
+
+    ``solver`` : the DLM solve (:func:`gaf_from_box_modes`); when it resolves to "hmatrix"
+    (:func:`asekit.aero.hmatrix.resolve_solver`) it enters the fingerprint with its tolerances
+    (the dense default leaves the fingerprint as it was).
     """
     settings = database_settings(machs, ks, b_ref, boxes, symmetric, method)
     if spline is not None:
         settings = {**settings, "spline": spline[0]}
+    if resolve_solver(solver, boxes.n) == "hmatrix":
+        from asekit.aero import hmatrix
+        settings = {**settings, "solver": "hmatrix", "hmatrix_eps": hmatrix.DEFAULT_EPS,
+                    "hmatrix_rtol": hmatrix.DEFAULT_RTOL}
     fp = mode_set_fingerprint(model, settings)
     n = len(model.frequencies_hz)
     if path is not None:
@@ -523,7 +559,7 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
     t0 = time.perf_counter()
     box_modes = fe_spline(model, boxes) if spline is None else spline[1](model, boxes)
     db = build_gaf_database(box_modes, boxes, machs, ks, b_ref, model.n_rigid,
-                            symmetric, method, progress, meta, entries=entries)
+                            symmetric, method, progress, meta, entries=entries, solver=solver)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
         save_npz(target, {"machs": db.machs, "k": db.k, "Q": db.Q}, meta)

@@ -674,7 +674,8 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True,
                                reduced_frequencies(case), a.reference_semichord,
                                symmetric=a.symmetry == "wall", method=method,
                                progress=progress, rebuild=not cache, path=path,
-                               metadata={"case": case.name}, spline=_structure_spline(case))
+                               metadata={"case": case.name}, spline=_structure_spline(case),
+                               solver=a.solver)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from asekit.aero.hmatrix import SOLVERS
 from asekit.aero.methods import METHODS, resolve_method
 from asekit.aeroelastic.methods import FLUTTER_METHODS
 from asekit.atmosphere import MAX_ALTITUDE, MIN_ALTITUDE
@@ -226,6 +227,9 @@ class AeroSpec:
     kernel: str = "quartic"
     symmetry: str = "none"
     method: str = "dlm"
+    #: the DLM solve of the GAFs (:data:`asekit.aero.hmatrix.SOLVERS`): "dense" LU (default),
+    #: "hmatrix" (compressed matrix + GMRES, GAFs within 1e-6 relative) or "auto" (by size)
+    solver: str = "dense"
 
 
 @dataclass(frozen=True)
@@ -526,6 +530,8 @@ class Case:
                 cs.pop("actuator", None)
         if self.beam is None:               # (likewise: plate cases)
             d.pop("beam")
+        if d.get("aero") is not None and d["aero"].get("solver") == "dense":
+            d["aero"].pop("solver")         # (likewise: the default dense DLM solve)
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
 
 
@@ -1065,6 +1071,7 @@ def _aero(t: _Table, panels) -> AeroSpec:
     kernel = t.string("kernel", ("quartic", "parabolic"), default="quartic")
     symmetry = t.string("symmetry", ("none", "wall"), default="none")
     boxes = t.raw("boxes", "auto")
+    solver = t.string("solver", SOLVERS, default="dense")   # (asekit.aero.hmatrix)
     t.done()
     if boxes == "auto":
         boxes = None
@@ -1082,7 +1089,7 @@ def _aero(t: _Table, panels) -> AeroSpec:
     if symmetry == "wall" and abs(panels[0].planform.root_le[1]) > 1e-12:
         raise CaseError(f"aero.symmetry = \"wall\" puts the reflection plane at y = 0, but the "
                         f"root is at y = {panels[0].planform.root_le[1]:g} m")
-    return AeroSpec(machs, b, ks, f_max, u_min, boxes, kernel, symmetry, method)
+    return AeroSpec(machs, b, ks, f_max, u_min, boxes, kernel, symmetry, method, solver)
 
 
 def check_resources(panels, aero: AeroSpec) -> None:
