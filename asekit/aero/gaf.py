@@ -469,7 +469,8 @@ def _load_matching(path: Path, fp: str, settings: dict, n_modes: int):
 def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetric: bool = False,
                         method: str = "quartic", progress: bool = True, rebuild: bool = False,
                         cache_dir=None, path=None, metadata: dict | None = None,
-                        entries: GafEntryCache | None = None, spline=None) -> GafDatabase:
+                        entries: GafEntryCache | None = None, spline=None,
+                        aero_options: dict | None = None) -> GafDatabase:
     """The GAF database of a ``ModalModel`` on ``boxes`` over ``machs`` x ``ks``, from a cache
     when one matches, else computed (tqdm bar) and written atomically.
 
@@ -487,10 +488,16 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
     ``spline`` : a named pair ``(name, fn)`` with ``fn(model, boxes) -> BoxModes`` in place of
     :func:`asekit.aero.spline.fe_spline` (e.g. a stick model's beam-to-box spline,
     :func:`asekit.aero.beam_spline.beam_box_modes`); its name enters the fingerprint.
+
+    ``aero_options`` : the method's options (:func:`build_gaf_database`, e.g. the TSD's
+    ``section``); they enter the fingerprint when given.
     """
     settings = database_settings(machs, ks, b_ref, boxes, symmetric, method)
     if spline is not None:
         settings = {**settings, "spline": spline[0]}
+    if aero_options:
+        settings = {**settings, "aero_options": {key: aero_options[key]
+                                                 for key in sorted(aero_options)}}
     fp = mode_set_fingerprint(model, settings)
     n = len(model.frequencies_hz)
     if path is not None:
@@ -523,7 +530,8 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
     t0 = time.perf_counter()
     box_modes = fe_spline(model, boxes) if spline is None else spline[1](model, boxes)
     db = build_gaf_database(box_modes, boxes, machs, ks, b_ref, model.n_rigid,
-                            symmetric, method, progress, meta, entries=entries)
+                            symmetric, method, progress, meta, entries=entries,
+                            aero_options=aero_options)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
         save_npz(target, {"machs": db.machs, "k": db.k, "Q": db.Q}, meta)

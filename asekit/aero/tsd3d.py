@@ -755,6 +755,40 @@ def _box_of_nodes(mesh, grid: Tsd3dGrid, wing: np.ndarray) -> np.ndarray:
     return out
 
 
+#: Cells of the grid a box mesh gets (:func:`tsd_grid_options`): per chordwise box, per strip.
+CELLS_PER_BOX = (2, 1)
+#: The far boundary (root chords) and stretching ratio of that grid (the tests' values).
+GRID_FAR, GRID_RATIO = 6.0, 1.3
+#: Largest grid (nodes) a case may ask for: the complex harmonic system is solved in its real
+#: form of twice the size by sparse LU, about n^1.5-2: 4e4 nodes take tens of seconds per k.
+MAX_NODES = 40_000
+
+
+def tsd_grid_options(n_chord_boxes: int, n_strips: int) -> dict:
+    """The :func:`tsd3d_grid` options of a box mesh with ``n_chord_boxes`` boxes per strip and
+    ``n_strips`` strips (asekit's rule): n_chord = max(8, 2 n_chord_boxes) chordwise cells
+    (the harmonic GAFs are first order in the cell size: 12 %, 8 %, 6 % from the DLM's on
+    8, 12, 16 chordwise cells at M 0.8, k = 0.3, tests/aero/test_tsd3d.py), n_span =
+    max(4, n_strips) spanwise cells, the far boundary :data:`GRID_FAR` root chords away,
+    stretching :data:`GRID_RATIO`, edges between nodes.
+
+    >>> tsd_grid_options(4, 4)["n_chord"], tsd_grid_options(4, 4)["n_span"]
+    (8, 4)
+    """
+    return dict(n_chord=max(8, 2 * int(n_chord_boxes)), n_span=max(4, int(n_strips)),
+                far=GRID_FAR, ratio=GRID_RATIO, edges="faces")
+
+
+def grid_nodes(planform: TsdPlanform, options: dict) -> int:
+    """Nodes of :func:`tsd3d_grid` ``(planform, **options)`` (cheap: no solve).
+
+    >>> grid_nodes(TsdPlanform.rectangular(1.0, 1.5), tsd_grid_options(4, 4))
+    6688
+    """
+    nx, ny, nz = tsd3d_grid(planform, **options).shape
+    return nx * ny * nz
+
+
 def tsd_pressure_matrices(mesh, mach: float, k, b_ref: float, thickness=None,
                           grid_options: dict | None = None, gamma: float = GAMMA_AIR,
                           background: Tsd3dSolution | None = None) -> np.ndarray:

@@ -674,7 +674,14 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True,
                                reduced_frequencies(case), a.reference_semichord,
                                symmetric=a.symmetry == "wall", method=method,
                                progress=progress, rebuild=not cache, path=path,
-                               metadata={"case": case.name}, spline=_structure_spline(case))
+                               metadata={"case": case.name}, spline=_structure_spline(case),
+                               aero_options=_aero_options(a))
+
+
+def _aero_options(aero) -> dict | None:
+    """The aerodynamic method's options from the case (issue 29: the TSD's ``aero.section``)."""
+    section = getattr(aero, "section", None)
+    return None if section is None else {"section": tuple(section)}
 
 
 # ---------------------------------------------------------------------------------------------

@@ -214,7 +214,9 @@ class AeroSpec:
     the mesh rules; kernel "quartic" | "parabolic"; symmetry "none" | "wall" (a reflection plane
     at the root); method: a key of :data:`asekit.aero.methods.AERO_METHODS` ("dlm" doublet
     lattice M < 1, "supersonic" Mach boxes M > 1, "piston" M > 1, "auto" by Mach), each Mach of
-    ``machs`` inside its range.
+    ``machs`` inside its range; "tsd" the time-linearised transonic small disturbance,
+    0 < M < 1 with the gap, which needs ``section`` = (shape, thickness_ratio) (``aero.section``,
+    "biconvex" only) and ``symmetry = "wall"``.
     """
 
     machs: tuple[float, ...]
@@ -226,6 +228,8 @@ class AeroSpec:
     kernel: str = "quartic"
     symmetry: str = "none"
     method: str = "dlm"
+    # issue 29 (tsdcase): the aerofoil section of method "tsd", (shape, thickness_ratio)
+    section: tuple[str, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -1068,6 +1072,7 @@ def _aero(t: _Table, panels) -> AeroSpec:
     kernel = t.string("kernel", ("quartic", "parabolic"), default="quartic")
     symmetry = t.string("symmetry", ("none", "wall"), default="none")
     boxes = t.raw("boxes", "auto")
+    section = _tsd_section(t, method, symmetry)
     t.done()
     if boxes == "auto":
         boxes = None
@@ -1085,7 +1090,34 @@ def _aero(t: _Table, panels) -> AeroSpec:
     if symmetry == "wall" and abs(panels[0].planform.root_le[1]) > 1e-12:
         raise CaseError(f"aero.symmetry = \"wall\" puts the reflection plane at y = 0, but the "
                         f"root is at y = {panels[0].planform.root_le[1]:g} m")
-    return AeroSpec(machs, b, ks, f_max, u_min, boxes, kernel, symmetry, method)
+    return AeroSpec(machs, b, ks, f_max, u_min, boxes, kernel, symmetry, method, section)
+
+
+# --- issue 29 (tsdcase): the TSD's aerofoil section -------------------------------------------
+def _tsd_section(t: _Table, method: str, symmetry: str) -> tuple[str, float] | None:
+    """``aero.section = { shape = "biconvex", thickness_ratio = tau }``, 0 <= tau < 0.3
+    (:func:`asekit.aero.tsd3d.biconvex_thickness`): required by ``aero.method = "tsd"`` (with
+    ``aero.symmetry = "wall"``: the TSD half wing is mirrored at its root), refused otherwise
+    (no other method reads it)."""
+    from asekit.aero.methods import TSD_SECTIONS
+
+    st = t.table("section")
+    if method != "tsd":
+        if st is not None:
+            raise CaseError(f"aero.section is read by aero.method = \"tsd\" only, got "
+                            f"aero.method = {method!r}; remove aero.section")
+        return None
+    if st is None:
+        raise CaseError("aero.section is missing: aero.method = \"tsd\" needs the aerofoil "
+                        "section, e.g. { shape = \"biconvex\", thickness_ratio = 0.04 }")
+    if symmetry != "wall":
+        raise CaseError(f"aero.symmetry must be \"wall\" with aero.method = \"tsd\" (its half "
+                        f"wing is mirrored at the root y = 0), got {symmetry!r}")
+    shape = st.string("shape", TSD_SECTIONS, required=True)
+    tau = st.number("thickness_ratio", required=True, low=0.0, high=0.3, low_open=False,
+                    high_open=True)
+    st.done()
+    return shape, float(tau)
 
 
 def check_resources(panels, aero: AeroSpec) -> None:
