@@ -49,6 +49,7 @@ Examples
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable
 
@@ -831,3 +832,69 @@ def tsd_pressure_matrices(mesh, mach: float, k, b_ref: float, thickness=None,
         wash[owner[i, j], i, j] = 1.0
         out[ik] = box_pressures(_harmonic_solve(background, wash, kk / b_ref), mesh)
     return out
+
+
+# --- the validity of a TSD result (issue 29) ------------------------------------------------
+@dataclass(frozen=True)
+class TsdValidity:
+    """What a steady TSD background says about the trust in its time-linearised loads.
+
+    Attributes
+    ----------
+    mach, thickness_ratio : free stream and section thickness ratio tau.
+    similarity : von Karman's transonic similarity parameter K = (1 - M^2) / (M^2 tau)^(2/3)
+        (von Karman 1947, J. Math. Phys. 26, 182-190; inf for tau = 0, the linear limit):
+        flows of equal K are similar; K of order 1 or less is transonic.
+    supersonic_points : grid nodes where the steady flow is supersonic (A < 0, Murman-Cole
+        upwind); > 0 means a supersonic pocket, closed by a (captured) shock.
+    cp_min, cp_critical : the lowest surface Cp of the background and the sonic Cp*.
+    converged : the steady solve met its tolerance.
+    """
+
+    mach: float
+    thickness_ratio: float
+    similarity: float
+    supersonic_points: int
+    cp_min: float
+    cp_critical: float
+    converged: bool
+
+    @property
+    def shock(self) -> bool:
+        """The background has a supersonic pocket (hence a shock)."""
+        return self.supersonic_points > 0
+
+    def text(self) -> str:
+        """One line for the results and the report."""
+        k = "inf (linear)" if math.isinf(self.similarity) else f"{self.similarity:.3g}"
+        flow = (f"supersonic pocket ({self.supersonic_points} nodes) closed by a captured "
+                f"shock: the loads assume small harmonic shock motion"
+                if self.shock else "subcritical (no shock): the loads are those of the "
+                "background-corrected linear equation")
+        conv = "" if self.converged else "; NOT CONVERGED: do not use"
+        return (f"TSD at M {self.mach:g}, tau {self.thickness_ratio:g}: similarity K = {k}, "
+                f"Cp_min {self.cp_min:.3g} vs Cp* {self.cp_critical:.3g}, {flow}{conv}")
+
+
+def tsd_validity(background: Tsd3dSolution, thickness_ratio: float) -> TsdValidity:
+    """The :class:`TsdValidity` of a steady background of a section of thickness ratio
+    ``thickness_ratio``: K = (1 - M^2) / (M^2 tau)^(2/3), the supersonic nodes, Cp_min over
+    the planform and Cp* = -2 (1 - M^2) / ((gamma + 1) M^2).
+
+    >>> wing = TsdPlanform.rectangular(1.0, 2.0)
+    >>> g = tsd3d_grid(wing, 8, 4, far=4.0, ratio=1.4, edges="faces")
+    >>> v = tsd_validity(steady_tsd3d(wing, biconvex_thickness(0.04), 0.5, g), 0.04)
+    >>> round(v.similarity, 3), v.shock
+    (16.158, False)
+    """
+    tau = float(thickness_ratio)
+    if not 0.0 <= tau < 0.3:
+        raise ValueError(f"thickness_ratio must be in [0, 0.3), got {tau!r}")
+    m = background.mach
+    k = math.inf if tau == 0.0 or m == 0.0 else (1.0 - m * m) / (m * m * tau) ** (2.0 / 3.0)
+    xl, c = background.planform.edges(background.grid.y)
+    xi = (background.x_mid[:, None] - xl[None, :]) / np.where(c > 0.0, c, 1.0)[None, :]
+    on = (xi > 0.0) & (xi < 1.0) & (c > 0.0)[None, :]
+    cp_min = float(np.min(background.cp[on])) if np.any(on) else 0.0
+    return TsdValidity(m, tau, float(k), int(background.supersonic_points), cp_min,
+                       float(background.cp_critical), bool(background.converged))
