@@ -97,9 +97,9 @@ def _tsd_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic",
     """The time-linearised TSD's matrices (:func:`asekit.aero.tsd3d.tsd_pressure_matrices`)
     about the steady flow over ``section`` = (shape, thickness_ratio) (biconvex:
     :func:`asekit.aero.tsd3d.biconvex_thickness`), on the grid of
-    :func:`asekit.aero.tsd3d.tsd_grid_options` unless ``grid_options`` are given. The TSD
+    :func:`asekit.aero.tsd3d.mesh_grid_options` unless ``grid_options`` are given. The TSD
     half wing is mirrored at its root: ``symmetric`` must be True (aero.symmetry = "wall")."""
-    from asekit.aero.tsd3d import biconvex_thickness, tsd_grid_options, tsd_pressure_matrices
+    from asekit.aero.tsd3d import biconvex_thickness, mesh_grid_options, tsd_pressure_matrices
 
     if options:
         raise ValueError(f"method='tsd' takes the options section and grid_options, got "
@@ -114,8 +114,7 @@ def _tsd_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic",
     if shape not in TSD_SECTIONS:
         raise ValueError(f"section shape must be one of {list(TSD_SECTIONS)}, got {shape!r}")
     if grid_options is None:
-        per_strip = np.unique(mesh.strip, return_counts=True)[1]   # boxes per strip
-        grid_options = tsd_grid_options(int(per_strip.max()), per_strip.size)
+        grid_options = mesh_grid_options(mesh)
     return tsd_pressure_matrices(mesh, mach, ks, b_ref, biconvex_thickness(tau),
                                  grid_options)
 

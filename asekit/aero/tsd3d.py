@@ -780,6 +780,12 @@ def tsd_grid_options(n_chord_boxes: int, n_strips: int) -> dict:
                 far=GRID_FAR, ratio=GRID_RATIO, edges="faces")
 
 
+def mesh_grid_options(mesh) -> dict:
+    """:func:`tsd_grid_options` of a box mesh: its most boxes per strip and its strips."""
+    per_strip = np.unique(mesh.strip, return_counts=True)[1]
+    return tsd_grid_options(int(per_strip.max()), per_strip.size)
+
+
 def grid_nodes(planform: TsdPlanform, options: dict) -> int:
     """Nodes of :func:`tsd3d_grid` ``(planform, **options)`` (cheap: no solve).
 

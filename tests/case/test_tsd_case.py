@@ -115,3 +115,29 @@ def test_a_tsd_grid_over_the_limit_is_refused_before_any_work():
     assert 0 < tsd_nodes(small.panels, small.aero) <= MAX_NODES
     with pytest.raises(CaseError, match=r"aero\.boxes: the TSD grid .* nodes \(at most"):
         case_from_dict(_tsd(boxes=[{"n_chord": 40, "n_span": 40}]))
+
+
+def test_the_results_carry_the_tsd_validity_line():
+    """The JSON summary and its text carry, per Mach, von Karman's similarity parameter and
+    the shock presence of the steady background (asekit.aero.tsd3d.tsd_validity) on the grid
+    of the GAFs: 4 % biconvex at M 0.8 is subcritical, K = 0.36 / (0.64 x 0.04)^(2/3) = 4.14
+    (hand value); the GAF and flutter parts of the analysis are not recomputed here."""
+    from types import SimpleNamespace
+
+    from asekit.case.report import format_summary, summary
+
+    case = case_from_dict(_tsd(section={"shape": "biconvex", "thickness_ratio": 0.04}))
+    (v,) = P.tsd_validity(case)
+    assert v.similarity == pytest.approx(0.36 / (0.64 * 0.04) ** (2 / 3), rel=1e-12)
+    assert v.converged and not v.shock and v.cp_min > v.cp_critical
+    a = SimpleNamespace(case=case, modal=P.modal_model(case),
+                        database=SimpleNamespace(metadata={"boxes": 16}),
+                        flutter=SimpleNamespace(results=(), divergence=(), match_points=(),
+                                                margins=(), notes=()),
+                        ase=None, gust=None, seconds={}, tsd_validity=(v,))
+    s = summary(a)
+    (row,) = s["tsd_validity"]
+    assert row["mach"] == 0.8 and row["shock"] is False
+    assert row["similarity_parameter"] == pytest.approx(v.similarity)
+    assert "validity: TSD at M 0.8, tau 0.04: similarity K = 4.14" in format_summary(s, 200)
+    assert P.tsd_validity(case_from_dict(_dict())) == ()
