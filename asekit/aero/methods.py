@@ -115,8 +115,15 @@ def _tsd_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic",
         raise ValueError(f"section shape must be one of {list(TSD_SECTIONS)}, got {shape!r}")
     if grid_options is None:
         grid_options = mesh_grid_options(mesh)
-    return tsd_pressure_matrices(mesh, mach, ks, b_ref, biconvex_thickness(tau),
-                                 grid_options)
+    try:
+        return tsd_pressure_matrices(mesh, mach, ks, b_ref, biconvex_thickness(tau),
+                                     grid_options)
+    except ValueError as exc:
+        if "did not converge" not in str(exc):
+            raise
+        raise ValueError(f"{exc} (a strong shock on a coarse grid can stall the type-dependent "
+                         f"switches; in a case: aero.section.thickness_ratio, aero.machs or "
+                         f"aero.boxes, which set the TSD grid)") from None
 
 
 @dataclass(frozen=True)
