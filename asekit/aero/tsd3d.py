@@ -34,8 +34,12 @@ size at the edges (Richardson extrapolation of two grids recovers the DLM's stea
 aspect-ratio-3 wing at M 0.8 to 0.3 %; at k = 0.3 the 16 x 8-cell GAFs are within 6.4 % of the
 DLM's and converging), and its far field reflects part of the short upstream-running acoustic
 waves at high subsonic Mach. Not yet: camber / incidence backgrounds (steady lift and wake),
-the cross-flow terms of swept wings, supersonic free streams, ``method = "tsd"`` in the
-registry. The sparse LU costs grow as about n^1.5-2 in 3-D: about 1e4 nodes solve in a second
+the cross-flow terms of swept wings, supersonic free streams. ``method = "tsd"`` of the
+registry (:mod:`asekit.aero.methods`) wraps :func:`tsd_pressure_matrices` on the grid of
+:func:`mesh_grid_options` (limit :data:`MAX_NODES`); :func:`tsd_validity` states the
+similarity parameter and shock presence of a background. On the coarse grids of unit tests
+the continuation can stall at a strong shock (4 % biconvex at M 0.95 on 8 x 4 cells:
+residual 8e-3 after 60, 150 and 300 steps). The sparse LU costs grow as about n^1.5-2 in 3-D: about 1e4 nodes solve in a second
 (real) or a few seconds (the complex harmonic system), 4e4 nodes in tens of seconds.
 
 Examples
