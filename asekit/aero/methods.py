@@ -97,9 +97,10 @@ def _tsd_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic",
     """The time-linearised TSD's matrices (:func:`asekit.aero.tsd3d.tsd_pressure_matrices`)
     about the steady flow over ``section`` = (shape, thickness_ratio) (biconvex:
     :func:`asekit.aero.tsd3d.biconvex_thickness`), on the grid of
-    :func:`asekit.aero.tsd3d.mesh_grid_options` unless ``grid_options`` are given. The TSD
+    :func:`asekit.aero.tsd3d.mesh_grid_options` unless ``grid_options`` are given, the steady
+    background cached (:func:`asekit.aero.tsd3d.tsd_background`). The TSD
     half wing is mirrored at its root: ``symmetric`` must be True (aero.symmetry = "wall")."""
-    from asekit.aero.tsd3d import biconvex_thickness, mesh_grid_options, tsd_pressure_matrices
+    from asekit.aero.tsd3d import tsd_background, tsd_pressure_matrices
 
     if options:
         raise ValueError(f"method='tsd' takes the options section and grid_options, got "
@@ -113,17 +114,13 @@ def _tsd_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic",
     shape, tau = section
     if shape not in TSD_SECTIONS:
         raise ValueError(f"section shape must be one of {list(TSD_SECTIONS)}, got {shape!r}")
-    if grid_options is None:
-        grid_options = mesh_grid_options(mesh)
-    try:
-        return tsd_pressure_matrices(mesh, mach, ks, b_ref, biconvex_thickness(tau),
-                                     grid_options)
-    except ValueError as exc:
-        if "did not converge" not in str(exc):
-            raise
-        raise ValueError(f"{exc} (a strong shock on a coarse grid can stall the type-dependent "
-                         f"switches; in a case: aero.section.thickness_ratio, aero.machs or "
-                         f"aero.boxes, which set the TSD grid)") from None
+    background = tsd_background(mesh, mach, tau, grid_options)
+    if not background.converged:
+        raise ValueError(f"the steady TSD background did not converge at M {mach:g} (residual "
+                         f"{background.residual:.2g}; a strong shock on a coarse grid can stall "
+                         f"the type-dependent switches); in a case: aero.section.thickness_ratio,"
+                         f" aero.machs or aero.boxes, which set the TSD grid")
+    return tsd_pressure_matrices(mesh, mach, ks, b_ref, background=background)
 
 
 @dataclass(frozen=True)

@@ -55,6 +55,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -908,3 +909,73 @@ def tsd_validity(background: Tsd3dSolution, thickness_ratio: float) -> TsdValidi
     cp_min = float(np.min(background.cp[on])) if np.any(on) else 0.0
     return TsdValidity(m, tau, float(k), int(background.supersonic_points), cp_min,
                        float(background.cp_critical), bool(background.converged))
+
+
+# --- the steady background, cached (issue 29) ------------------------------------------------
+#: Version of the cached steady backgrounds (part of their key).
+STEADY_FORMAT = 1
+
+
+def steady_key(planform: TsdPlanform, grid: Tsd3dGrid, thickness_ratio: float, mach: float,
+               gamma: float = GAMMA_AIR) -> str:
+    """SHA-256 of what a biconvex background depends on: the planform, the grid, tau, M,
+    gamma and :data:`STEADY_FORMAT` (arrays rounded to 12 decimals)."""
+    import hashlib
+
+    h = hashlib.sha256(f"tsd-steady-{STEADY_FORMAT}|{float(thickness_ratio)!r}|"
+                       f"{float(mach)!r}|{float(gamma)!r}".encode())
+    for a in (planform.y, planform.x_le, planform.chord, grid.x, grid.y, grid.z):
+        h.update(np.round(np.asarray(a, float), 12).tobytes())
+    return h.hexdigest()
+
+
+def cached_steady_tsd3d(planform: TsdPlanform, grid: Tsd3dGrid, thickness_ratio: float,
+                        mach: float, gamma: float = GAMMA_AIR, cache_dir=None) -> Tsd3dSolution:
+    """:func:`steady_tsd3d` of a biconvex section (:func:`biconvex_thickness`), read from
+    ``cache_dir`` (default :func:`asekit.util.paths.user_cache_dir`) when a file
+    ``tsd_steady_<key>.npz`` exists whose digest passes (:func:`asekit.util.cache.load_npz`)
+    and whose key (:func:`steady_key`) and potential shape match; else solved and written
+    atomically (:func:`asekit.util.cache.save_npz`; a folder that cannot be written only warns).
+    The solve's ``seconds`` of a cached background are those of the original solve."""
+    import warnings
+
+    from asekit.util.cache import CacheError, load_npz, save_npz
+    from asekit.util.paths import user_cache_dir
+
+    key = steady_key(planform, grid, thickness_ratio, mach, gamma)
+    path = Path(user_cache_dir() if cache_dir is None else cache_dir) / f"tsd_steady_{key[:32]}.npz"
+    try:
+        arrays, meta = load_npz(path, expect_metadata={"key": key},
+                                expect_shapes={"phi": grid.shape})
+        if np.all(np.isfinite(arrays["phi"])) and np.all(np.isfinite(arrays["cp"])):
+            return Tsd3dSolution(planform, grid, arrays["phi"], arrays["x_mid"], arrays["cp"],
+                                 float(mach), float(gamma), bool(meta["converged"]),
+                                 int(meta["iterations"]), float(meta["residual"]),
+                                 int(meta["supersonic_points"]), float(meta["seconds"]))
+    except (CacheError, FileNotFoundError, OSError, KeyError, ValueError, TypeError):
+        pass
+    sol = steady_tsd3d(planform, biconvex_thickness(thickness_ratio), mach, grid, gamma=gamma)
+    meta = {"key": key, "converged": bool(sol.converged), "iterations": int(sol.iterations),
+            "residual": float(sol.residual), "supersonic_points": int(sol.supersonic_points),
+            "seconds": float(sol.seconds), "mach": float(mach),
+            "thickness_ratio": float(thickness_ratio)}
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        save_npz(path, {"phi": sol.phi, "x_mid": sol.x_mid, "cp": sol.cp}, meta)
+    except OSError as exc:
+        warnings.warn(f"TSD background computed but not cached ({path}: {exc})", RuntimeWarning,
+                      stacklevel=2)
+    return sol
+
+
+def tsd_background(mesh, mach: float, thickness_ratio: float, grid_options: dict | None = None,
+                   cache_dir=None) -> Tsd3dSolution:
+    """The steady biconvex background of a box mesh's planform (:func:`planform_of_boxes`) on
+    the grid of :func:`mesh_grid_options` (or ``grid_options``, ``edges="faces"`` always),
+    cached (:func:`cached_steady_tsd3d`): what ``method = "tsd"`` linearises about and what its
+    validity line (:func:`tsd_validity`) reads."""
+    planform = planform_of_boxes(mesh)
+    opts = dict(mesh_grid_options(mesh) if grid_options is None else grid_options)
+    opts["edges"] = "faces"
+    return cached_steady_tsd3d(planform, tsd3d_grid(planform, **opts), thickness_ratio, mach,
+                               cache_dir=cache_dir)

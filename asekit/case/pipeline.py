@@ -687,26 +687,17 @@ def _aero_options(aero) -> dict | None:
 def tsd_validity(case: Case) -> tuple:
     """Issue 29: the :class:`asekit.aero.tsd3d.TsdValidity` of each of ``aero.machs`` for a
     case with ``aero.method = "tsd"`` (empty otherwise): the steady background over the
-    case's section on the grid the GAFs used (:func:`asekit.aero.tsd3d.mesh_grid_options` of
-    :func:`box_mesh`), its similarity parameter, supersonic nodes and Cp_min against Cp*."""
+    case's section on the grid the GAFs used (:func:`asekit.aero.tsd3d.tsd_background` of
+    :func:`box_mesh`, cached: the GAFs' own), its similarity parameter, supersonic nodes and Cp_min against Cp*."""
     a = case.aero
     if a is None or a.method != "tsd":
         return ()
-    from asekit.aero.tsd3d import (
-        biconvex_thickness,
-        mesh_grid_options,
-        planform_of_boxes,
-        steady_tsd3d,
-        tsd3d_grid,
-    )
+    from asekit.aero.tsd3d import tsd_background
     from asekit.aero.tsd3d import tsd_validity as validity
 
     mesh = box_mesh(case)
-    planform = planform_of_boxes(mesh)
-    grid = tsd3d_grid(planform, **mesh_grid_options(mesh))
     tau = a.section[1]
-    return tuple(validity(steady_tsd3d(planform, biconvex_thickness(tau), m, grid), tau)
-                 for m in a.machs)
+    return tuple(validity(tsd_background(mesh, m, tau), tau) for m in a.machs)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from asekit.aero.tsd3d import (
@@ -50,3 +51,32 @@ def test_bad_thickness_is_refused():
     bg = steady_tsd3d(_WING, biconvex_thickness(0.0), 0.5, _GRID)
     with pytest.raises(ValueError, match="thickness_ratio must be in"):
         tsd_validity(bg, 0.3)
+
+
+def test_steady_background_is_cached_verified_and_recomputed_when_corrupt(tmp_path,
+                                                                          monkeypatch):
+    """cached_steady_tsd3d writes the background once; a second call reads it bit for bit
+    without solving; a corrupted file fails its digest and is solved again; another
+    thickness is another key."""
+    from asekit.aero import tsd3d as T
+
+    first = T.cached_steady_tsd3d(_WING, _GRID, 0.04, 0.7, cache_dir=tmp_path)
+    (path,) = tmp_path.glob("tsd_steady_*.npz")
+    real = T.steady_tsd3d
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("solved again")
+
+    monkeypatch.setattr(T, "steady_tsd3d", refuse)
+    again = T.cached_steady_tsd3d(_WING, _GRID, 0.04, 0.7, cache_dir=tmp_path)
+    assert np.array_equal(again.phi, first.phi) and np.array_equal(again.cp, first.cp)
+    assert again.converged == first.converged and again.supersonic_points == first.supersonic_points
+    data = bytearray(path.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    path.write_bytes(bytes(data))
+    with pytest.raises(AssertionError, match="solved again"):
+        T.cached_steady_tsd3d(_WING, _GRID, 0.04, 0.7, cache_dir=tmp_path)
+    monkeypatch.setattr(T, "steady_tsd3d", real)
+    fresh = T.cached_steady_tsd3d(_WING, _GRID, 0.04, 0.7, cache_dir=tmp_path)
+    assert np.allclose(fresh.phi, first.phi, rtol=0, atol=1e-14)
+    assert T.steady_key(_WING, _GRID, 0.04, 0.7) != T.steady_key(_WING, _GRID, 0.05, 0.7)
