@@ -497,7 +497,7 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
                         method: str = "quartic", progress: bool = True, rebuild: bool = False,
                         cache_dir=None, path=None, metadata: dict | None = None,
                         entries: GafEntryCache | None = None, spline=None,
-                        solver: str = "dense") -> GafDatabase:
+                        solver: str = "dense", aero_options: dict | None = None) -> GafDatabase:
     """The GAF database of a ``ModalModel`` on ``boxes`` over ``machs`` x ``ks``, from a cache
     when one matches, else computed (tqdm bar) and written atomically.
 
@@ -519,6 +519,8 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
     ``solver`` : the DLM solve (:func:`gaf_from_box_modes`); when it resolves to "hmatrix"
     (:func:`asekit.aero.hmatrix.resolve_solver`) it enters the fingerprint with its tolerances
     (the dense default leaves the fingerprint as it was).
+    ``aero_options`` : the method's options (:func:`build_gaf_database`, e.g. the TSD's
+    ``section``); they enter the fingerprint when given.
     """
     settings = database_settings(machs, ks, b_ref, boxes, symmetric, method)
     if spline is not None:
@@ -527,6 +529,9 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
         from asekit.aero import hmatrix
         settings = {**settings, "solver": "hmatrix", "hmatrix_eps": hmatrix.DEFAULT_EPS,
                     "hmatrix_rtol": hmatrix.DEFAULT_RTOL}
+    if aero_options:
+        settings = {**settings, "aero_options": {key: aero_options[key]
+                                                 for key in sorted(aero_options)}}
     fp = mode_set_fingerprint(model, settings)
     n = len(model.frequencies_hz)
     if path is not None:
@@ -559,7 +564,8 @@ def cached_gaf_database(model, boxes: BoxMesh, machs, ks, b_ref: float, symmetri
     t0 = time.perf_counter()
     box_modes = fe_spline(model, boxes) if spline is None else spline[1](model, boxes)
     db = build_gaf_database(box_modes, boxes, machs, ks, b_ref, model.n_rigid,
-                            symmetric, method, progress, meta, entries=entries, solver=solver)
+                            symmetric, method, progress, meta, entries=entries, solver=solver,
+                            aero_options=aero_options)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
         save_npz(target, {"machs": db.machs, "k": db.k, "Q": db.Q}, meta)

@@ -7,6 +7,10 @@ pressure-per-normalwash matrices of every method.
   ``"parabolic"`` name its two kernel approximations and are accepted too);
 - ``"supersonic"``: the Mach-box lifting-surface method (:mod:`asekit.aero.supersonic`, M > 1);
 - ``"piston"``: piston theory (:mod:`asekit.aero.piston`, M > 1, warns outside its bound);
+- ``"tsd"``: the time-linearised transonic small-disturbance method
+  (:mod:`asekit.aero.tsd3d`, 0 < M < 1, the transonic gap 0.9 < M < 1 included without the
+  gap's warning: it models the nonlinear steady background; options ``section`` (a
+  (shape, thickness_ratio) pair, "biconvex" only) and ``grid_options``);
 - ``"auto"``: the DLM for M <= DLM_MACH_MAX (0.9), the supersonic method for
   M >= SUPERSONIC_MACH_MIN (1.15), and a :class:`TransonicGapError` in between.
 
@@ -47,7 +51,7 @@ from asekit.aero.validity import check_mach as _check_mach_range
 __all__ = ["AERO_METHODS", "AeroMethod", "DLM_KERNELS", "DLM_MACH_MAX", "METHODS",
            "SUPERSONIC_MACH_MIN", "TransonicGapError", "TransonicWarning", "check_k",
            "check_mach", "check_method", "max_box_chord", "method_spec", "pressure_matrices", "pressures",
-           "PressureMatrix", "resolve_method"]
+           "PressureMatrix", "resolve_method", "TSD_MACHS", "TSD_SECTIONS"]
 
 #: auto: highest Mach number given to the DLM, lowest given to the supersonic method.
 DLM_MACH_MAX = 0.9
@@ -79,6 +83,44 @@ def _piston_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic", *
     """Piston theory (:func:`asekit.aero.piston.piston_pressure_matrices`; a local law: the
     wall image has no effect, ``symmetric`` is ignored)."""
     return piston_pressure_matrices(mesh, mach, ks, b_ref, **options)
+
+
+#: The TSD method's Mach range: subsonic free streams, 0 < M < 1 (tsd3d has no supersonic
+#: free stream yet), the transonic gap's subsonic part included.
+TSD_MACHS = MachRange(0.0, 1.0, False, False, "subsonic and transonic")
+#: The aerofoil sections the TSD accepts (``aero.section.shape``).
+TSD_SECTIONS = ("biconvex",)
+
+
+def _tsd_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic",
+                  section=None, grid_options=None, **options):
+    """The time-linearised TSD's matrices (:func:`asekit.aero.tsd3d.tsd_pressure_matrices`)
+    about the steady flow over ``section`` = (shape, thickness_ratio) (biconvex:
+    :func:`asekit.aero.tsd3d.biconvex_thickness`), on the grid of
+    :func:`asekit.aero.tsd3d.mesh_grid_options` unless ``grid_options`` are given, the steady
+    background cached (:func:`asekit.aero.tsd3d.tsd_background`). The TSD
+    half wing is mirrored at its root: ``symmetric`` must be True (aero.symmetry = "wall")."""
+    from asekit.aero.tsd3d import tsd_background, tsd_pressure_matrices
+
+    if options:
+        raise ValueError(f"method='tsd' takes the options section and grid_options, got "
+                         f"{sorted(options)}")
+    if not symmetric:
+        raise ValueError("method='tsd' models a half wing mirrored at its root: it needs "
+                         "symmetric=True (aero.symmetry = \"wall\")")
+    if section is None:
+        raise ValueError("method='tsd' needs the option section = (shape, thickness_ratio), "
+                         "e.g. ('biconvex', 0.04) (case key aero.section)")
+    shape, tau = section
+    if shape not in TSD_SECTIONS:
+        raise ValueError(f"section shape must be one of {list(TSD_SECTIONS)}, got {shape!r}")
+    background = tsd_background(mesh, mach, tau, grid_options)
+    if not background.converged:
+        raise ValueError(f"the steady TSD background did not converge at M {mach:g} (residual "
+                         f"{background.residual:.2g}; a strong shock on a coarse grid can stall "
+                         f"the type-dependent switches); in a case: aero.section.thickness_ratio,"
+                         f" aero.machs or aero.boxes, which set the TSD grid")
+    return tsd_pressure_matrices(mesh, mach, ks, b_ref, background=background)
 
 
 @dataclass(frozen=True)
@@ -152,6 +194,9 @@ class AeroMethod:
         (:func:`asekit.aero.supersonic.max_box_chord`); piston theory, a local law with no
         kernel wavelength: the DLM's rule, which resolves the convected wavelength U / f of the
         normalwash i k h / b (asekit's choice).
+    transonic : bool
+        It models the transonic flow (the TSD): allowed in the gap DLM_MACH_MAX < M <
+        SUPERSONIC_MACH_MIN within its range without :class:`TransonicWarning`.
     """
 
     name: str
@@ -164,6 +209,7 @@ class AeroMethod:
     operators: Callable | None
     reuse_break_even: float = 0.0
     box_chord: Callable | None = None
+    transonic: bool = False
 
 
 def _dlm_box_chord(mach, k_max, b_ref, u_min, f_max):
@@ -192,6 +238,10 @@ AERO_METHODS: dict[str, AeroMethod] = {
                          SUPERSONIC, "method='piston'", "; use method='dlm' below M 1", True,
                          _piston_matrices, _matrix_operators(_piston_matrices), 0.0,
                          _dlm_box_chord),
+    "tsd": AeroMethod("tsd", "time-linearised transonic small disturbance (Batina 1989), "
+                      "0 < M < 1 including the transonic gap", TSD_MACHS, "method='tsd'",
+                      "; use method='supersonic' or 'piston' above M 1", False, _tsd_matrices,
+                      _matrix_operators(_tsd_matrices), 0.0, _dlm_box_chord, True),
 }
 #: The method names (the registry's keys).
 METHODS = tuple(AERO_METHODS)
@@ -237,7 +287,7 @@ def resolve_method(method: str, mach: float, name: str = "mach") -> str:
             "elsewhere")
     spec = AERO_METHODS["dlm" if method in DLM_KERNELS else method]
     _check_mach_range(mach, spec.mach_range, spec.who, name, spec.hint)
-    if DLM_MACH_MAX < m < SUPERSONIC_MACH_MIN:
+    if DLM_MACH_MAX < m < SUPERSONIC_MACH_MIN and not spec.transonic:
         warnings.warn(f"method={spec.name!r} at mach={m:g}, inside the transonic gap "
                       f"({DLM_MACH_MAX:g}, {SUPERSONIC_MACH_MIN:g}) where linear theory is not "
                       "trusted: shocks and their motion, not modelled, carry the unsteady loads "

@@ -34,8 +34,12 @@ size at the edges (Richardson extrapolation of two grids recovers the DLM's stea
 aspect-ratio-3 wing at M 0.8 to 0.3 %; at k = 0.3 the 16 x 8-cell GAFs are within 6.4 % of the
 DLM's and converging), and its far field reflects part of the short upstream-running acoustic
 waves at high subsonic Mach. Not yet: camber / incidence backgrounds (steady lift and wake),
-the cross-flow terms of swept wings, supersonic free streams, ``method = "tsd"`` in the
-registry. The sparse LU costs grow as about n^1.5-2 in 3-D: about 1e4 nodes solve in a second
+the cross-flow terms of swept wings, supersonic free streams. ``method = "tsd"`` of the
+registry (:mod:`asekit.aero.methods`) wraps :func:`tsd_pressure_matrices` on the grid of
+:func:`mesh_grid_options` (limit :data:`MAX_NODES`); :func:`tsd_validity` states the
+similarity parameter and shock presence of a background. On the coarse grids of unit tests
+the continuation can stall at a strong shock (4 % biconvex at M 0.95 on 8 x 4 cells:
+residual 8e-3 after 60, 150 and 300 steps). The sparse LU costs grow as about n^1.5-2 in 3-D: about 1e4 nodes solve in a second
 (real) or a few seconds (the complex harmonic system), 4e4 nodes in tens of seconds.
 
 Examples
@@ -49,7 +53,9 @@ Examples
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -755,6 +761,46 @@ def _box_of_nodes(mesh, grid: Tsd3dGrid, wing: np.ndarray) -> np.ndarray:
     return out
 
 
+#: Cells of the grid a box mesh gets (:func:`tsd_grid_options`): per chordwise box, per strip.
+CELLS_PER_BOX = (2, 1)
+#: The far boundary (root chords) and stretching ratio of that grid (the tests' values).
+GRID_FAR, GRID_RATIO = 6.0, 1.3
+#: Largest grid (nodes) a case may ask for: the complex harmonic system is solved in its real
+#: form of twice the size by sparse LU, about n^1.5-2: 4e4 nodes take tens of seconds per k.
+MAX_NODES = 40_000
+
+
+def tsd_grid_options(n_chord_boxes: int, n_strips: int) -> dict:
+    """The :func:`tsd3d_grid` options of a box mesh with ``n_chord_boxes`` boxes per strip and
+    ``n_strips`` strips (asekit's rule): n_chord = max(8, 2 n_chord_boxes) chordwise cells
+    (the harmonic GAFs are first order in the cell size: 12 %, 8 %, 6 % from the DLM's on
+    8, 12, 16 chordwise cells at M 0.8, k = 0.3, tests/aero/test_tsd3d.py), n_span =
+    max(4, n_strips) spanwise cells, the far boundary :data:`GRID_FAR` root chords away,
+    stretching :data:`GRID_RATIO`, edges between nodes.
+
+    >>> tsd_grid_options(4, 4)["n_chord"], tsd_grid_options(4, 4)["n_span"]
+    (8, 4)
+    """
+    return dict(n_chord=max(8, 2 * int(n_chord_boxes)), n_span=max(4, int(n_strips)),
+                far=GRID_FAR, ratio=GRID_RATIO, edges="faces")
+
+
+def mesh_grid_options(mesh) -> dict:
+    """:func:`tsd_grid_options` of a box mesh: its most boxes per strip and its strips."""
+    per_strip = np.unique(mesh.strip, return_counts=True)[1]
+    return tsd_grid_options(int(per_strip.max()), per_strip.size)
+
+
+def grid_nodes(planform: TsdPlanform, options: dict) -> int:
+    """Nodes of :func:`tsd3d_grid` ``(planform, **options)`` (cheap: no solve).
+
+    >>> grid_nodes(TsdPlanform.rectangular(1.0, 1.5), tsd_grid_options(4, 4))
+    6688
+    """
+    nx, ny, nz = tsd3d_grid(planform, **options).shape
+    return nx * ny * nz
+
+
 def tsd_pressure_matrices(mesh, mach: float, k, b_ref: float, thickness=None,
                           grid_options: dict | None = None, gamma: float = GAMMA_AIR,
                           background: Tsd3dSolution | None = None) -> np.ndarray:
@@ -797,3 +843,139 @@ def tsd_pressure_matrices(mesh, mach: float, k, b_ref: float, thickness=None,
         wash[owner[i, j], i, j] = 1.0
         out[ik] = box_pressures(_harmonic_solve(background, wash, kk / b_ref), mesh)
     return out
+
+
+# --- the validity of a TSD result (issue 29) ------------------------------------------------
+@dataclass(frozen=True)
+class TsdValidity:
+    """What a steady TSD background says about the trust in its time-linearised loads.
+
+    Attributes
+    ----------
+    mach, thickness_ratio : free stream and section thickness ratio tau.
+    similarity : von Karman's transonic similarity parameter K = (1 - M^2) / (M^2 tau)^(2/3)
+        (von Karman 1947, J. Math. Phys. 26, 182-190; inf for tau = 0, the linear limit):
+        flows of equal K are similar; K of order 1 or less is transonic.
+    supersonic_points : grid nodes where the steady flow is supersonic (A < 0, Murman-Cole
+        upwind); > 0 means a supersonic pocket, closed by a (captured) shock.
+    cp_min, cp_critical : the lowest surface Cp of the background and the sonic Cp*.
+    converged : the steady solve met its tolerance.
+    """
+
+    mach: float
+    thickness_ratio: float
+    similarity: float
+    supersonic_points: int
+    cp_min: float
+    cp_critical: float
+    converged: bool
+
+    @property
+    def shock(self) -> bool:
+        """The background has a supersonic pocket (hence a shock)."""
+        return self.supersonic_points > 0
+
+    def text(self) -> str:
+        """One line for the results and the report."""
+        k = "inf (linear)" if math.isinf(self.similarity) else f"{self.similarity:.3g}"
+        flow = (f"supersonic pocket ({self.supersonic_points} nodes) closed by a captured "
+                f"shock: the loads assume small harmonic shock motion"
+                if self.shock else "subcritical (no shock): the loads are those of the "
+                "background-corrected linear equation")
+        conv = "" if self.converged else "; NOT CONVERGED: do not use"
+        return (f"TSD at M {self.mach:g}, tau {self.thickness_ratio:g}: similarity K = {k}, "
+                f"Cp_min {self.cp_min:.3g} vs Cp* {self.cp_critical:.3g}, {flow}{conv}")
+
+
+def tsd_validity(background: Tsd3dSolution, thickness_ratio: float) -> TsdValidity:
+    """The :class:`TsdValidity` of a steady background of a section of thickness ratio
+    ``thickness_ratio``: K = (1 - M^2) / (M^2 tau)^(2/3), the supersonic nodes, Cp_min over
+    the planform and Cp* = -2 (1 - M^2) / ((gamma + 1) M^2).
+
+    >>> wing = TsdPlanform.rectangular(1.0, 2.0)
+    >>> g = tsd3d_grid(wing, 8, 4, far=4.0, ratio=1.4, edges="faces")
+    >>> v = tsd_validity(steady_tsd3d(wing, biconvex_thickness(0.04), 0.5, g), 0.04)
+    >>> round(v.similarity, 3), v.shock
+    (16.158, False)
+    """
+    tau = float(thickness_ratio)
+    if not 0.0 <= tau < 0.3:
+        raise ValueError(f"thickness_ratio must be in [0, 0.3), got {tau!r}")
+    m = background.mach
+    k = math.inf if tau == 0.0 or m == 0.0 else (1.0 - m * m) / (m * m * tau) ** (2.0 / 3.0)
+    xl, c = background.planform.edges(background.grid.y)
+    xi = (background.x_mid[:, None] - xl[None, :]) / np.where(c > 0.0, c, 1.0)[None, :]
+    on = (xi > 0.0) & (xi < 1.0) & (c > 0.0)[None, :]
+    cp_min = float(np.min(background.cp[on])) if np.any(on) else 0.0
+    return TsdValidity(m, tau, float(k), int(background.supersonic_points), cp_min,
+                       float(background.cp_critical), bool(background.converged))
+
+
+# --- the steady background, cached (issue 29) ------------------------------------------------
+#: Version of the cached steady backgrounds (part of their key).
+STEADY_FORMAT = 1
+
+
+def steady_key(planform: TsdPlanform, grid: Tsd3dGrid, thickness_ratio: float, mach: float,
+               gamma: float = GAMMA_AIR) -> str:
+    """SHA-256 of what a biconvex background depends on: the planform, the grid, tau, M,
+    gamma and :data:`STEADY_FORMAT` (arrays rounded to 12 decimals)."""
+    import hashlib
+
+    h = hashlib.sha256(f"tsd-steady-{STEADY_FORMAT}|{float(thickness_ratio)!r}|"
+                       f"{float(mach)!r}|{float(gamma)!r}".encode())
+    for a in (planform.y, planform.x_le, planform.chord, grid.x, grid.y, grid.z):
+        h.update(np.round(np.asarray(a, float), 12).tobytes())
+    return h.hexdigest()
+
+
+def cached_steady_tsd3d(planform: TsdPlanform, grid: Tsd3dGrid, thickness_ratio: float,
+                        mach: float, gamma: float = GAMMA_AIR, cache_dir=None) -> Tsd3dSolution:
+    """:func:`steady_tsd3d` of a biconvex section (:func:`biconvex_thickness`), read from
+    ``cache_dir`` (default :func:`asekit.util.paths.user_cache_dir`) when a file
+    ``tsd_steady_<key>.npz`` exists whose digest passes (:func:`asekit.util.cache.load_npz`)
+    and whose key (:func:`steady_key`) and potential shape match; else solved and written
+    atomically (:func:`asekit.util.cache.save_npz`; a folder that cannot be written only warns).
+    The solve's ``seconds`` of a cached background are those of the original solve."""
+    import warnings
+
+    from asekit.util.cache import CacheError, load_npz, save_npz
+    from asekit.util.paths import user_cache_dir
+
+    key = steady_key(planform, grid, thickness_ratio, mach, gamma)
+    path = Path(user_cache_dir() if cache_dir is None else cache_dir) / f"tsd_steady_{key[:32]}.npz"
+    try:
+        arrays, meta = load_npz(path, expect_metadata={"key": key},
+                                expect_shapes={"phi": grid.shape})
+        if np.all(np.isfinite(arrays["phi"])) and np.all(np.isfinite(arrays["cp"])):
+            return Tsd3dSolution(planform, grid, arrays["phi"], arrays["x_mid"], arrays["cp"],
+                                 float(mach), float(gamma), bool(meta["converged"]),
+                                 int(meta["iterations"]), float(meta["residual"]),
+                                 int(meta["supersonic_points"]), float(meta["seconds"]))
+    except (CacheError, FileNotFoundError, OSError, KeyError, ValueError, TypeError):
+        pass
+    sol = steady_tsd3d(planform, biconvex_thickness(thickness_ratio), mach, grid, gamma=gamma)
+    meta = {"key": key, "converged": bool(sol.converged), "iterations": int(sol.iterations),
+            "residual": float(sol.residual), "supersonic_points": int(sol.supersonic_points),
+            "seconds": float(sol.seconds), "mach": float(mach),
+            "thickness_ratio": float(thickness_ratio)}
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        save_npz(path, {"phi": sol.phi, "x_mid": sol.x_mid, "cp": sol.cp}, meta)
+    except OSError as exc:
+        warnings.warn(f"TSD background computed but not cached ({path}: {exc})", RuntimeWarning,
+                      stacklevel=2)
+    return sol
+
+
+def tsd_background(mesh, mach: float, thickness_ratio: float, grid_options: dict | None = None,
+                   cache_dir=None) -> Tsd3dSolution:
+    """The steady biconvex background of a box mesh's planform (:func:`planform_of_boxes`) on
+    the grid of :func:`mesh_grid_options` (or ``grid_options``, ``edges="faces"`` always),
+    cached (:func:`cached_steady_tsd3d`): what ``method = "tsd"`` linearises about and what its
+    validity line (:func:`tsd_validity`) reads."""
+    planform = planform_of_boxes(mesh)
+    opts = dict(mesh_grid_options(mesh) if grid_options is None else grid_options)
+    opts["edges"] = "faces"
+    return cached_steady_tsd3d(planform, tsd3d_grid(planform, **opts), thickness_ratio, mach,
+                               cache_dir=cache_dir)

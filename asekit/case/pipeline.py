@@ -675,7 +675,29 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True,
                                symmetric=a.symmetry == "wall", method=method,
                                progress=progress, rebuild=not cache, path=path,
                                metadata={"case": case.name}, spline=_structure_spline(case),
-                               solver=a.solver)
+                               solver=a.solver, aero_options=_aero_options(a))
+
+
+def _aero_options(aero) -> dict | None:
+    """The aerodynamic method's options from the case (issue 29: the TSD's ``aero.section``)."""
+    section = getattr(aero, "section", None)
+    return None if section is None else {"section": tuple(section)}
+
+
+def tsd_validity(case: Case) -> tuple:
+    """Issue 29: the :class:`asekit.aero.tsd3d.TsdValidity` of each of ``aero.machs`` for a
+    case with ``aero.method = "tsd"`` (empty otherwise): the steady background over the
+    case's section on the grid the GAFs used (:func:`asekit.aero.tsd3d.tsd_background` of
+    :func:`box_mesh`, cached: the GAFs' own), its similarity parameter, supersonic nodes and Cp_min against Cp*."""
+    a = case.aero
+    if a is None or a.method != "tsd":
+        return ()
+    from asekit.aero.tsd3d import tsd_background
+    from asekit.aero.tsd3d import tsd_validity as validity
+
+    mesh = box_mesh(case)
+    tau = a.section[1]
+    return tuple(validity(tsd_background(mesh, m, tau), tau) for m in a.machs)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -152,6 +152,7 @@ class Analysis:
     control_hinge: tuple = ()
     control_ase: tuple = ()
     control_freeplay: tuple = ()
+    tsd_validity: tuple = ()     # issue 29: asekit.aero.tsd3d.TsdValidity per Mach ("tsd")
 
 
 @contextlib.contextmanager
@@ -225,7 +226,8 @@ def run_analysis(case: Case, progress: bool = False) -> Analysis:
         sec["control_surface_ase"] = time.perf_counter() - t
     return Analysis(case, modal, db, fa, ase, sec, gust=gust, control=control,
                     control_flutter=control_flutter, control_hinge=control_hinge,
-                    control_ase=control_ase, control_freeplay=control_freeplay)
+                    control_ase=control_ase, control_freeplay=control_freeplay,
+                    tsd_validity=P.tsd_validity(case))
 
 
 def _f(v):
@@ -294,8 +296,18 @@ def summary(a: Analysis) -> dict:
             for r in a.control_flutter]
         out.update(hinge_load_json(getattr(a, "control_hinge", ())))
         out.update(control_ase_json(getattr(a, "control_ase", ())))
+    if getattr(a, "tsd_validity", ()):         # issue 29: the TSD's validity per Mach
+        out["tsd_validity"] = [tsd_validity_json(v) for v in a.tsd_validity]
     out["critical"] = critical_condition(out)
     return out
+
+
+def tsd_validity_json(v) -> dict:
+    """One Mach's :class:`asekit.aero.tsd3d.TsdValidity` as JSON (issue 29)."""
+    return {"mach": v.mach, "thickness_ratio": v.thickness_ratio,
+            "similarity_parameter": _f(v.similarity),
+            "supersonic_points": v.supersonic_points, "shock": v.shock, "cp_min": v.cp_min,
+            "cp_critical": v.cp_critical, "converged": v.converged, "text": v.text()}
 
 
 def _where(alt, rho=None) -> str:
@@ -689,6 +701,8 @@ def format_summary(s: dict, width: int = 100) -> str:
     lines += _control_flutter_lines(s.get("control_surface_flutter", ()))
     lines += _hinge_load_lines(s.get("control_surface_servo_sizing", ()))
     lines += _control_ase_lines(s.get("control_surface_ase", ()))
+    for v in s.get("tsd_validity", ()):           # issue 29
+        lines += textwrap.wrap("validity: " + v["text"], width, subsequent_indent="  ")
     for n in s["notes"]:
         lines += textwrap.wrap("note: " + n, width, subsequent_indent="  ")
     lines.append("")

@@ -282,7 +282,7 @@ def resource_problem(panels, aero) -> str | None:
                 + _fix_text(fixes(panels, aero)))
     grid = _grid_excess(panels, aero)
     if grid is None:
-        return None
+        return tsd_problem(panels, aero)
     i, m, k_max, g = grid
     where = ("on and around the surface" if g.n_relevant is not None
              else "in the grid's rectangle")
@@ -291,6 +291,35 @@ def resource_problem(panels, aero) -> str | None:
             f"k up to {k_max:.4g} (at most {limit} fit; the cells follow the shortest kernel "
             f"wavelength 2 pi b (M - 1) / (k M) and the box chords), set by {_keys(aero)}; "
             + _fix_text(fixes(panels, aero)))
+
+
+# --- issue 29 (tsdcase): the TSD grid ----------------------------------------------------------
+def tsd_nodes(panels, aero) -> int:
+    """Nodes of the TSD grid of a case with ``aero.method = "tsd"`` (0 otherwise): the grid
+    rule of :func:`asekit.aero.tsd3d.tsd_grid_options` on the case's boxes (the most boxes
+    per strip of any panel, the strips of all panels) over the panels' planform."""
+    if aero.method != "tsd":
+        return 0
+    from asekit.aero.tsd3d import TsdPlanform, grid_nodes, tsd_grid_options
+
+    counts = box_counts(panels, aero)
+    planform = TsdPlanform.from_surfaces(panel_surfaces(panels, counts))
+    return grid_nodes(planform, tsd_grid_options(max(nc for nc, _ in counts),
+                                                 sum(ns for _, ns in counts)))
+
+
+def tsd_problem(panels, aero) -> str | None:
+    """One line when the TSD grid (:func:`tsd_nodes`) exceeds
+    :data:`asekit.aero.tsd3d.MAX_NODES`, naming the keys that set it; else None."""
+    from asekit.aero.tsd3d import MAX_NODES
+
+    n = tsd_nodes(panels, aero)
+    if n <= MAX_NODES:
+        return None
+    return (f"aero.boxes: the TSD grid of aero.method = \"tsd\" would have {n} nodes (at most "
+            f"{MAX_NODES}, asekit.aero.tsd3d.MAX_NODES: 2 cells per chordwise box, 1 per strip, "
+            f"at least 8 x 4, stretched to 6 root chords); set by {_keys(aero)}: give fewer "
+            f"aero.boxes (e.g. {{ n_chord = 6, n_span = 6 }}) or lower aero.f_max")
 
 
 #: Largest p-k work of a case: Mach numbers x flight conditions x speeds of the sweep. About
@@ -329,4 +358,4 @@ def pk_problem(n_machs: int, n_conditions: int, velocities) -> str | None:
 
 
 __all__ = ["MAX_CELLS", "MAX_PK_POINTS", "pk_problem", "aero_reduced_frequencies", "auto_boxes", "box_counts", "fixes",
-           "panel_surfaces", "resource_problem"]
+           "panel_surfaces", "resource_problem", "tsd_nodes", "tsd_problem"]

@@ -215,7 +215,9 @@ class AeroSpec:
     the mesh rules; kernel "quartic" | "parabolic"; symmetry "none" | "wall" (a reflection plane
     at the root); method: a key of :data:`asekit.aero.methods.AERO_METHODS` ("dlm" doublet
     lattice M < 1, "supersonic" Mach boxes M > 1, "piston" M > 1, "auto" by Mach), each Mach of
-    ``machs`` inside its range.
+    ``machs`` inside its range; "tsd" the time-linearised transonic small disturbance,
+    0 < M < 1 with the gap, which needs ``section`` = (shape, thickness_ratio) (``aero.section``,
+    "biconvex" only) and ``symmetry = "wall"``.
     """
 
     machs: tuple[float, ...]
@@ -230,6 +232,8 @@ class AeroSpec:
     #: the DLM solve of the GAFs (:data:`asekit.aero.hmatrix.SOLVERS`): "dense" LU (default),
     #: "hmatrix" (compressed matrix + GMRES, GAFs within 1e-6 relative) or "auto" (by size)
     solver: str = "dense"
+    # issue 29 (tsdcase): the aerofoil section of method "tsd", (shape, thickness_ratio)
+    section: tuple[str, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -532,6 +536,8 @@ class Case:
             d.pop("beam")
         if d.get("aero") is not None and d["aero"].get("solver") == "dense":
             d["aero"].pop("solver")         # (likewise: the default dense DLM solve)
+        if d.get("aero") is not None and d["aero"].get("section") is None:
+            d["aero"].pop("section", None)  # (likewise: methods without a section, all but tsd)
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()
 
 
@@ -1072,6 +1078,7 @@ def _aero(t: _Table, panels) -> AeroSpec:
     symmetry = t.string("symmetry", ("none", "wall"), default="none")
     boxes = t.raw("boxes", "auto")
     solver = t.string("solver", SOLVERS, default="dense")   # (asekit.aero.hmatrix)
+    section = _tsd_section(t, method, symmetry)
     t.done()
     if boxes == "auto":
         boxes = None
@@ -1089,7 +1096,35 @@ def _aero(t: _Table, panels) -> AeroSpec:
     if symmetry == "wall" and abs(panels[0].planform.root_le[1]) > 1e-12:
         raise CaseError(f"aero.symmetry = \"wall\" puts the reflection plane at y = 0, but the "
                         f"root is at y = {panels[0].planform.root_le[1]:g} m")
-    return AeroSpec(machs, b, ks, f_max, u_min, boxes, kernel, symmetry, method, solver)
+    return AeroSpec(machs, b, ks, f_max, u_min, boxes, kernel, symmetry, method, solver,
+                    section)
+
+
+# --- issue 29 (tsdcase): the TSD's aerofoil section -------------------------------------------
+def _tsd_section(t: _Table, method: str, symmetry: str) -> tuple[str, float] | None:
+    """``aero.section = { shape = "biconvex", thickness_ratio = tau }``, 0 <= tau < 0.3
+    (:func:`asekit.aero.tsd3d.biconvex_thickness`): required by ``aero.method = "tsd"`` (with
+    ``aero.symmetry = "wall"``: the TSD half wing is mirrored at its root), refused otherwise
+    (no other method reads it)."""
+    from asekit.aero.methods import TSD_SECTIONS
+
+    st = t.table("section")
+    if method != "tsd":
+        if st is not None:
+            raise CaseError(f"aero.section is read by aero.method = \"tsd\" only, got "
+                            f"aero.method = {method!r}; remove aero.section")
+        return None
+    if st is None:
+        raise CaseError("aero.section is missing: aero.method = \"tsd\" needs the aerofoil "
+                        "section, e.g. { shape = \"biconvex\", thickness_ratio = 0.04 }")
+    if symmetry != "wall":
+        raise CaseError(f"aero.symmetry must be \"wall\" with aero.method = \"tsd\" (its half "
+                        f"wing is mirrored at the root y = 0), got {symmetry!r}")
+    shape = st.string("shape", TSD_SECTIONS, required=True)
+    tau = st.number("thickness_ratio", required=True, low=0.0, high=0.3, low_open=False,
+                    high_open=True)
+    st.done()
+    return shape, float(tau)
 
 
 def check_resources(panels, aero: AeroSpec) -> None:

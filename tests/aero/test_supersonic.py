@@ -617,11 +617,13 @@ def test_aero_method_registry_is_the_one_mach_check():
     from asekit.aero.dlm import check_k as dlm_check_k
     from asekit.aero.piston import check_supersonic_mach
     from asekit.aero.vlm import check_mach as vlm_check_mach
-    assert set(M.AERO_METHODS) == {"auto", "dlm", "supersonic", "piston"} == set(M.METHODS)
+    assert set(M.AERO_METHODS) == {"auto", "dlm", "supersonic", "piston", "tsd"} \
+        == set(M.METHODS)
     assert M.AERO_METHODS["dlm"].mach_range is V.SUBSONIC
     assert M.AERO_METHODS["supersonic"].mach_range is M.AERO_METHODS["piston"].mach_range \
         is V.SUPERSONIC
-    assert all(s.structure_independent for s in M.AERO_METHODS.values())
+    # the TSD's operator needs its section (a case option): not shared by the sweep
+    assert all(s.structure_independent for n, s in M.AERO_METHODS.items() if n != "tsd")
     assert V.SUBSONIC.contains(0.0) and not V.SUBSONIC.contains(1.0)
     assert V.SUPERSONIC.contains(1.0 + 1e-12) and not V.SUPERSONIC.contains(1.0)
     assert not V.SUPERSONIC.contains(math.nan)
@@ -637,7 +639,7 @@ def test_aero_method_registry_is_the_one_mach_check():
     with pytest.raises(ValueError, match=r"aero.machs\[2\] must be > 1 for method='supersonic'"):
         M.check_mach(0.5, "supersonic", "aero.machs[2]")
     with pytest.raises(ValueError, match=r"method must be one of \['auto', 'dlm', 'supersonic', "
-                                         r"'piston', 'quartic', 'parabolic'\], got 'mach_box'"):
+                                         r"'piston', 'tsd', 'quartic', 'parabolic'\], got 'mach_box'"):
         M.check_mach(2.0, "mach_box")
     assert M.check_mach(1.1, "supersonic") == 1.1           # in the gap: no warning at the door
     assert M.method_spec("auto", 0.5).name == "dlm" and M.method_spec("quartic").name == "dlm"

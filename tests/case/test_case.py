@@ -394,7 +394,7 @@ def test_aero_method_and_mach_range():
                                         r"must be < 1 for the DLM \(subsonic: 0 <= M < 1\)"):
         case_from_dict(_plate_dict(clamped, machs=(2.0,)))
     with pytest.raises(CaseError, match=r"aero\.method must be one of 'auto', 'dlm', "
-                                        r"'supersonic', 'piston', got 'zona51'"):
+                                        r"'supersonic', 'piston', 'tsd', got 'zona51'"):
         case_from_dict(_plate_dict(clamped, method="zona51"))
     with pytest.raises(CaseError, match=r"aero\.machs\[1\] = 1 with aero\.method = 'auto'"):
         case_from_dict(_plate_dict(clamped, machs=(0.5, 1.0), method="auto"))
