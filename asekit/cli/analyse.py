@@ -59,7 +59,10 @@ def _read_case(args, load_case):
 def _stick_deck(args):
     """The path of ``args.case`` when it is a CBAR stick-model deck
     (:func:`asekit.io.bdf_beam.is_stick_deck`), else None (a case file or a plate deck)."""
-    path = resolve_case(args.case)
+    try:
+        path = resolve_case(args.case)
+    except (FileNotFoundError, OSError):    # _run_case reports a missing or unreadable file
+        return None
     if path.suffix.lower() not in DECK_SUFFIXES or not path.is_file():
         return None
     try:
