@@ -270,6 +270,22 @@ class _System:
         return J[self.idx][:, self.idx].tocsc()
 
 
+def tsd_mach(mach) -> float:
+    """``mach`` as a float, checked against the range of the small-disturbance equation,
+    0 <= M < 1.3 (a ValueError naming ``mach`` otherwise); shared by the 2-D and 3-D solvers.
+
+    Examples
+    --------
+    >>> tsd_mach(0.8)
+    0.8
+    """
+    mach = float(mach)
+    if not 0.0 <= mach < 1.3:
+        raise ValueError(f"mach must be in [0, 1.3) for the transonic small-disturbance "
+                         f"equation, got {mach!r}")
+    return mach
+
+
 def steady_tsd(slope, mach: float, grid: TsdGrid | None = None, gamma: float = GAMMA_AIR,
                tol: float = 1e-10, max_iter: int = 60) -> TsdSolution:
     """Steady TSD flow about a thin symmetric airfoil (Eq. 1-2 of the module docstring).
@@ -289,10 +305,7 @@ def steady_tsd(slope, mach: float, grid: TsdGrid | None = None, gamma: float = G
     -------
     :class:`TsdSolution` (check ``converged``).
     """
-    mach = float(mach)
-    if not 0.0 <= mach < 1.3:
-        raise ValueError(f"mach must be in [0, 1.3) for the transonic small-disturbance "
-                         f"equation, got {mach!r}")
+    mach = tsd_mach(mach)
     grid = tsd_grid() if grid is None else grid
     sys_ = _System(grid, slope, mach, float(gamma))
     phi = np.zeros(grid.shape)

@@ -62,7 +62,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import splu
 
-from asekit.aero.tsd import GAMMA_AIR, _stretched
+from asekit.aero.tsd import GAMMA_AIR, _stretched, tsd_mach
 
 _EPS = 1e-12
 
@@ -429,10 +429,7 @@ def steady_tsd3d(planform: TsdPlanform, thickness, mach: float, grid: Tsd3dGrid 
     """
     import time
 
-    mach = float(mach)
-    if not 0.0 <= mach < 1.3:
-        raise ValueError(f"mach must be in [0, 1.3) for the transonic small-disturbance "
-                         f"equation, got {mach!r}")
+    mach = tsd_mach(mach)
     grid = tsd3d_grid(planform) if grid is None else grid
     t0 = time.perf_counter()
     op = _Operator(grid, mach, float(gamma))

@@ -7,6 +7,7 @@ import tomllib
 
 import numpy as np
 import pytest
+from small_cases import small_fin_raw
 
 from asekit.case import case_from_dict
 from asekit.case import pipeline as P
@@ -96,14 +97,7 @@ def _small_table_raw() -> dict:
     """The small fin of tests/case/test_design.py (4 x 4 elements, 3 elastic modes, 6 x 6 DLM
     boxes, M 0.4 / 0.6, 0 and 2500 m) with an uneven 3 x 3 thickness table (no symmetric,
     repeated values: the chain is differentiated at a generic design)."""
-    raw = copy.deepcopy(RAW)
-    raw["panel"][0].update(n_chord=4, n_span=4)
-    raw["modes"] = {"count": 3, "keep_rigid": True}
-    raw["aero"].update(machs=[0.4, 0.6], boxes=[{"n_chord": 6, "n_span": 6}],
-                       reduced_frequencies=[0.001, 0.1, 0.2, 0.3, 0.45, 0.6, 0.8])
-    raw["flight"].update(altitudes=[0.0, 2500.0],
-                         velocities={"min": 120.0, "max": 420.0, "step": 20.0})
-    raw.pop("actuator")
+    raw = small_fin_raw(point_mass=False)
     raw["thickness"] = {"kind": "table", "x_over_c": [0, 0.5, 1], "eta": [0, 0.4, 1],
                         "values_m": [[0.004, 0.0042, 0.0039], [0.0033, 0.0034, 0.0031],
                                      [0.002, 0.0021, 0.0019]]}
