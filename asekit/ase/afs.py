@@ -56,6 +56,7 @@ from asekit.ase.loop import (
     build_model,
     with_fin_root_rate,
 )
+from asekit.ase.sensors import Sensors, sensed_loop
 from asekit.util.blas import small_dense
 from asekit.util.validate import finite, positive
 
@@ -821,14 +822,17 @@ def simulate_release_sampled(model: AeroservoelasticModel, controller: ct.StateS
                              root_twist: float = math.radians(1.0), t_final: float = 0.2,
                              substeps: int = 10, supply_voltage: float = 24.0,
                              current_limit: float = 10.0,
-                             quantisers: Quantisers | None = None) -> AfsSimulation:
+                             quantisers: Quantisers | None = None,
+                             sensors: Sensors | None = None) -> AfsSimulation:
     """:func:`simulate_release` with the controller run by a processor: sampled every
     ``sample_time`` T (a discrete controller with dt = T, or a continuous one discretised by
     Tustin's rule), its voltage clipped to +-min(V_supply, I_lim R) and applied
     ``delay_samples`` samples later, held over each sample (ZOH); the plant propagated exactly
     over T / ``substeps`` (histories on that grid). With ``quantisers`` the samples pass the
     encoder and the ADC and the demand the DAC (:class:`Quantisers`): the loop is then
-    nonlinear and may settle in a quantisation limit cycle instead of at rest.
+    nonlinear and may settle in a quantisation limit cycle instead of at rest. With ``sensors``
+    the measurements pass first-order sensors and carry seeded white noise
+    (:mod:`asekit.ase.sensors`); None or ideal sensors give the sensor-free loop bit for bit.
 
     Returns
     -------
@@ -881,9 +885,12 @@ def simulate_release_sampled(model: AeroservoelasticModel, controller: ct.StateS
     v_dem = np.empty(n_s * m_sub)
     meas = list(kd.input_labels) if controller.isdtime(strict=True) else list(
         controller.input_labels)
+    Ad, Bd, Cy, Cp, x, direct, lagged = sensed_loop(A, B, Cy, Cp, Ad, Bd, x, sensors, ts,
+                                                    m_sub, n_s)
+    X = np.empty((n_s * m_sub, x.size))
     prev_th = 0.0
     for k in range(n_s):
-        y = Cy @ x
+        y = Cy @ x + direct[k]
         if quantisers is not None:
             y, th = _measure(y, meas, quantisers, ts, prev_th)
             prev_th = prev_th if th is None else th
@@ -899,7 +906,7 @@ def simulate_release_sampled(model: AeroservoelasticModel, controller: ct.StateS
         va = float(np.clip(d, -vmax, vmax))
         for j in range(m_sub):
             X[k * m_sub + j] = x
-            x = Ad @ x + Bd * va
+            x = Ad @ x + Bd * va + lagged[k]
         v_app[k * m_sub:(k + 1) * m_sub] = va
         v_dem[k * m_sub:(k + 1) * m_sub] = d
     Y = X @ Cp.T
