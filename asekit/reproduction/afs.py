@@ -31,7 +31,11 @@ open-loop flutter speed (just above it). Definitions of the reported numbers:
   boundary, gain margins from the eigenvalues with its gain scaled, phase margin on the unit
   circle and the sampled release at the check speed; ``.quantised_*``: the quantisation-induced
   limit cycle of the same loop with the word lengths :data:`QUANTISERS`; ``ase.afs.*.peak_voltage_v`` /
-  ``peak_current_a``: peaks of the release at the check speed.
+  ``peak_current_a``: peaks of the release at the check speed;
+* ``ase.afs.dlqg_1khz.sensed_*``: the same sampled release with the sensors :data:`SENSORS`
+  (first-order bandwidth, seeded white measurement noise, :mod:`asekit.ase.sensors`): peak
+  voltage and current, and the residual oscillation (RMS fin-root pitch and voltage over the
+  last 0.1 s of a 0.5 s release; the ideal loop decays to rest).
 """
 
 from __future__ import annotations
@@ -47,6 +51,7 @@ from asekit.aeroelastic.statespace import fin_outputs
 from asekit.ase import afs
 from asekit.ase.margins import nyquist_margins
 from asekit.ase.metrics import limit_cycle
+from asekit.ase.sensors import Sensors
 from asekit.case import pipeline
 from asekit.reproduction.driver import Quantity
 from asekit.reproduction.fin import fin_case
@@ -78,6 +83,10 @@ TOL = 0.01
 #: 12-bit ADC over +-pi rad for the fin-root potentiometer, a 12-bit DAC over +-24 V.
 QUANTISERS = afs.Quantisers(encoder_resolution=2 * math.pi / (2000 * 66), adc_bits=12,
                             dac_bits=12)
+#: Sensors of the processor loop (assumed, not the thesis's): 300 Hz first-order bandwidth and
+#: 1e-4 rad RMS white noise on each measured angle (about 0.07 of a 12-bit ADC step over
+#: +-pi rad), seed 26.
+SENSORS = Sensors(bandwidth=300.0, noise_rms=1e-4, seed=26)
 #: The processor: sample times (s) checked with one sample of computational delay.
 FAST_SAMPLE, THESIS_SAMPLE = 2e-4, 1e-3
 
@@ -121,6 +130,7 @@ class DigitalDesign:
     phase_margin_deg: float | None
     release: afs.AfsSimulation
     quantised: afs.AfsSimulation | None = None
+    sensed: afs.AfsSimulation | None = None
 
     @property
     def gain_margin_db(self) -> float:
@@ -213,7 +223,9 @@ def _digital(fam, design_speed, check_speed) -> DigitalDesign:
     sim = afs.simulate_release_sampled(m, K, ts, 1, root_twist=RELEASE_TWIST, t_final=0.1)
     quant = afs.simulate_release_sampled(m, K, ts, 1, root_twist=RELEASE_TWIST, t_final=0.5,
                                          quantisers=QUANTISERS)
-    return DigitalDesign(K, b, gm, pm, sim, quant)
+    sensed = afs.simulate_release_sampled(m, K, ts, 1, root_twist=RELEASE_TWIST, t_final=0.5,
+                                          sensors=SENSORS)
+    return DigitalDesign(K, b, gm, pm, sim, quant, sensed)
 
 
 def _gain(study: AfsStudy, d: AfsDesign):
@@ -280,7 +292,25 @@ def _digital_rows(study: AfsStudy) -> list[Quantity]:
             Quantity("ase.afs.dlqg_1khz.peak_voltage_v", float(np.max(np.abs(r.voltage))), "V",
                      rel + ("; demand clipped" if r.saturated else "")),
             Quantity("ase.afs.dlqg_1khz.peak_current_a", float(np.max(np.abs(r.current))), "A",
-                     rel)] + _quantised_rows(study)
+                     rel)] + _quantised_rows(study) + _sensed_rows(study)
+
+
+def _sensed_rows(study: AfsStudy) -> list[Quantity]:
+    r = study.digital.sensed
+    last = r.t >= r.t[-1] - 0.1
+    what = (f"{SENSORS.bandwidth:g} Hz first-order sensors, {SENSORS.noise_rms:g} rad RMS "
+            f"white noise (seed {SENSORS.seed}); 0.5 s release at {study.check_speed:.1f} m/s, "
+            "1 kHz, one sample of delay, 24 V / 10 A clip")
+    res = "last 0.1 s (the ideal loop decays to rest); " + what
+    return [Quantity("ase.afs.dlqg_1khz.sensed_peak_voltage_v", float(np.max(np.abs(r.voltage))),
+                     "V", what + ("; demand clipped" if r.saturated else "")),
+            Quantity("ase.afs.dlqg_1khz.sensed_peak_current_a", float(np.max(np.abs(r.current))),
+                     "A", what),
+            Quantity("ase.afs.dlqg_1khz.sensed_residual_rms_deg",
+                     math.degrees(float(np.sqrt(np.mean(r.fin_root[last] ** 2)))), "deg",
+                     "RMS fin-root pitch, " + res),
+            Quantity("ase.afs.dlqg_1khz.sensed_residual_voltage_rms_v",
+                     float(np.sqrt(np.mean(r.voltage[last] ** 2))), "V", "RMS voltage, " + res)]
 
 
 def _quantised_rows(study: AfsStudy) -> list[Quantity]:

@@ -17,6 +17,11 @@ and its quantisation-induced oscillation) were added on 2026-12-03 from
 ``python -m asekit reproduce --only ase --json`` (three runs, bit-identical); no other value
 changed.
 
+The four ``ase.afs.dlqg_1khz.sensed_*`` rows (issue 26: the 1 kHz discrete LQG's release with
+300 Hz sensors and seeded 1e-4 rad RMS noise) were added on 2026-12-03 from
+``python -m asekit reproduce --only ase --json``; no other value changed (the ``ase.fwtf*`` rows
+differ from the baseline by <= 1e-12 relative on this machine, inside RTOL).
+
 Eight p-k rows moved by 1.8e-9 to 5.3e-7 relative on 2026-12-03 with issue 23's batched,
 secant-accelerated k-iteration (its tolerance is 1e-7 relative in frequency, so the converged
 roots may move by that much): ``flutter.damping.pk``, ``flutter.structural_g.pk``,
