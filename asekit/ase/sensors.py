@@ -24,6 +24,10 @@ Systems*, 3rd ed., Sec. 10.4, Eq. 10.17 for x(k+1) = Phi x(k) + v(k)):
 
 (:func:`lagged_noise_variance`).
 
+The Table-2 step loop's single feedback angle has its own measurement chain
+(:class:`asekit.ase.loop.SensorModel`: first-order filter and quantisation, no noise); this
+module is the multi-channel one of the flutter-suppression loop.
+
 SI units inside; the bandwidth in Hz at the edge.
 """
 
@@ -36,7 +40,8 @@ import numpy as np
 
 from asekit.util.validate import finite, positive
 
-__all__ = ["Sensors", "measurement_noise", "sensed_discretisation", "lagged_noise_variance"]
+__all__ = ["Sensors", "measurement_noise", "sensed_discretisation", "lagged_noise_variance",
+           "sensed_loop"]
 
 
 @dataclass(frozen=True)

@@ -104,3 +104,17 @@ def test_sensor_refusals():
         Sensors(noise_rms=-1.0)
     with pytest.raises(ValueError, match="seed"):
         Sensors(seed=-2)
+
+
+def test_noise_driven_residual_scales_with_the_noise(setup):
+    # below the clip the loop is linear: with the same seed the residual (history minus the
+    # noise-free history) is proportional to the noise RMS
+    m, K = setup
+    kw = dict(root_twist=math.radians(0.1), t_final=0.2)
+    clean = afs.simulate_release_sampled(m, K, 1e-3, 1, sensors=Sensors(bandwidth=300.0), **kw)
+    r = [afs.simulate_release_sampled(m, K, 1e-3, 1, sensors=Sensors(300.0, s, 4), **kw)
+         for s in (1e-5, 1e-4)]
+    assert not any(x.saturated for x in r)
+    d1, d2 = (x.fin_root - clean.fin_root for x in r)
+    assert np.max(np.abs(d1)) > 0
+    np.testing.assert_allclose(d2, 10 * d1, rtol=0, atol=1e-9 * np.max(np.abs(d2)))
