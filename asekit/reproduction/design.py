@@ -478,6 +478,29 @@ def flutter_weighting_study(data=None, mach: float = 0.75, bands=(2.0, 3.0, 4.0)
 # ---------------------------------------------------------------------------------------------
 # reproduce chapter: the designs at Mach 0.5, sea level (cheap); the envelope in the notebook
 # ---------------------------------------------------------------------------------------------
+#: First-order sensor bandwidth (Hz) of the fin-root potentiometer checked on the PID design
+#: (issue 26, sensors; assumed, not the thesis's: its Table 2 gives no sensor bandwidth).
+SENSOR_BANDWIDTH_HZ = 300.0
+
+
+def sensor_bandwidth_quantities(data, model) -> list:
+    """``ase.design.pid_notch.sensor_300hz.*``: Table 2 of the PID design at Mach 0.5, sea level
+    with its measured angle through a first-order filter of :data:`SENSOR_BANDWIDTH_HZ`
+    (:class:`asekit.ase.loop.SensorModel`), the ideal sensor's rows beside it."""
+    ctl, topo = designs(data)["pid_notch"]
+    sensor = ase.SensorModel(cutoff_hz=SENSOR_BANDWIDTH_HZ)
+    c = check(controller_at(ctl, 0.5, 0.0), model, topo, sensor=sensor)
+    key = f"ase.design.pid_notch.sensor_{SENSOR_BANDWIDTH_HZ:g}hz"
+    note = (f"{topo}, M 0.5 sea level, measured angle through a {SENSOR_BANDWIDTH_HZ:g} Hz "
+            f"first-order sensor; overshoot {c.overshoot_pct:.2f} % (Table 2 limits as "
+            "ase.design.pid_notch.*)")
+    return [Quantity(f"{key}.table2_pass", c.table2_pass, "-", note),
+            Quantity(f"{key}.settling_ms", c.settling_ms if c.stable else None, "ms",
+                     "fin root, 2 % band, worst of 1 and 15 deg; " + note),
+            Quantity(f"{key}.steady_error_pct", c.steady_error_pct if c.stable else None, "%",
+                     "fin root, exact DC gain of the sampled loop; " + note)]
+
+
 def run(figures: bool = False) -> ChapterResult:
     data = load()
     q = []
@@ -493,6 +516,7 @@ def run(figures: bool = False) -> ChapterResult:
         q.append(Quantity(f"ase.design.{key}.steady_error_pct",
                           c.steady_error_pct if c.stable else None, "%",
                           "fin root, exact DC gain of the sampled loop" + unstable))
+    q += sensor_bandwidth_quantities(data, model)
     q += hinf_quantities(data)
     fc = flutter_comparison(data, 0.75, roger_lags=(), ms_states=(6,))
     rl_ms = [r for r in fc["rows"] if r[0].startswith("min-state, W")][0][3]

@@ -22,6 +22,12 @@ The four ``ase.afs.dlqg_1khz.sensed_*`` rows (issue 26: the 1 kHz discrete LQG's
 ``python -m asekit reproduce --only ase --json``; no other value changed (the ``ase.fwtf*`` rows
 differ from the baseline by <= 1e-12 relative on this machine, inside RTOL).
 
+The three ``ase.design.pid_notch.sensor_300hz.*`` rows (issue 26: design (a)'s Table-2 check with
+a 300 Hz first-order sensor) were added on 2026-12-03 from
+``python -m asekit reproduce --only design --json``; no other value changed beyond roundoff
+(``*.steady_error_pct`` at 1e-14 %, covered by ROUNDOFF_ZERO; the M 0.75 root-locus speed
+7e-12 relative).
+
 Eight p-k rows moved by 1.8e-9 to 5.3e-7 relative on 2026-12-03 with issue 23's batched,
 secant-accelerated k-iteration (its tolerance is 1e-7 relative in frequency, so the converged
 roots may move by that much): ``flutter.damping.pk``, ``flutter.structural_g.pk``,
