@@ -15,7 +15,7 @@
   six components, CMB of GB dependent), eliminated by the rigid-link transformation
   u_d = u_i + theta_i x (x_d - x_i), theta_d = theta_i (Przemieniecki Sec. 11.7; in the grids'
   CD systems), K_r = T^T K T, M_r = T^T M T; chains (a dependent DOF independent elsewhere)
-  and SPC on a dependent DOF refused.
+  resolved by substitution in dependency order, cycles and SPC on a dependent DOF refused.
 
 The element is :mod:`asekit.structure.frame` (Przemieniecki 1968 Eqs. 5.116 and 11.41, rotated
 by the direction cosines, Eq. 6.26). Every grid carries six DOFs (T1, T2, T3, R1, R2, R3) in its
@@ -279,9 +279,10 @@ def _fixed_dofs(model, index, name: str) -> set:
     return fixed
 
 
-def _link(dep: dict, what: str, i: int, d: int, comps, xyz, axes) -> None:
+def _link(dep: dict, what: str, i: int, d: int, comps, xyz, axes, who=None) -> None:
     """The rows of grid d's ``comps`` (CD components) from grid i's six DOFs (CD): rigid
-    kinematics u_d = u_i - S(x_d - x_i) theta_i, theta_d = theta_i in basic."""
+    kinematics u_d = u_i - S(x_d - x_i) theta_i, theta_d = theta_i in basic (``who``: the
+    card naming each row, for the chain resolution's messages)."""
     G = np.eye(6)
     G[:3, 3:] = -_skew(xyz[d] - xyz[i])
     Gc = np.kron(np.eye(2), axes[d]) @ G @ np.kron(np.eye(2), axes[i].T)
@@ -292,31 +293,68 @@ def _link(dep: dict, what: str, i: int, d: int, comps, xyz, axes) -> None:
                            f"on another rigid element")
         dep[row] = tuple((NODE_DOF * i + k, float(Gc[c - 1, k])) for k in range(6)
                          if abs(Gc[c - 1, k]) > 1e-15)
+        if who is not None:
+            who[row] = what
 
 
-def _rigid_links(model, index, xyz, axes, fixed: set) -> tuple:
+def _dof_name(d: int, ids) -> str:
+    return f"component {d % NODE_DOF + 1} of GRID {int(ids[d // NODE_DOF])}"
+
+
+def _resolve_chains(dep: dict, who: dict, ids) -> dict:
+    """Chained rigid elements (a dependent DOF of one independent in another) by substitution
+    in dependency order: u_d = sum_j c_dj u_j with every u_j that is itself dependent replaced
+    by its own (already resolved) row, until only true independents remain; exact, since each
+    link is linear (Przemieniecki Sec. 11.7 applied link by link). A cycle (a DOF dependent,
+    through the chain, on itself) is refused naming the cards."""
+    done, state = {}, {}
+    for root in sorted(dep):
+        stack = [root]
+        while stack:
+            d = stack[-1]
+            if d in done:
+                stack.pop()
+                continue
+            state[d] = 1
+            todo = [i for i, _ in dep[d] if i in dep and i not in done]
+            cyc = [i for i in todo if state.get(i) == 1]
+            if cyc:
+                loop = stack[stack.index(cyc[0]):]
+                raise BdfError("rigid elements form a cycle: " + " -> ".join(
+                    f"{who.get(x, '?')} ({_dof_name(x, ids)})" for x in loop)
+                    + " depends on itself (Nastran refuses it too)")
+            if todo:
+                stack.extend(todo[:1])
+                continue
+            acc = {}
+            for i, c in dep[d]:
+                for j, cj in (done[i] if i in dep else ((i, 1.0),)):
+                    acc[j] = acc.get(j, 0.0) + c * cj
+            done[d] = tuple((j, v) for j, v in sorted(acc.items()) if abs(v) > 1e-15)
+            state[d] = 2
+            stack.pop()
+    return done
+
+
+def _rigid_links(model, index, xyz, axes, fixed: set, ids) -> tuple:
     """RBE2 / RBAR as dependent DOF rows (module docstring)."""
-    dep = {}
+    dep, who = {}, {}
     for eid in sorted(model.rigid_elements):
         r = model.rigid_elements[eid]
         if r.type == "RBE2":
             for g in r.Gmi:
                 _link(dep, f"RBE2 {eid} (GM {g})", index[r.gn], index[g], _components(r.cm),
-                      xyz, axes)
+                      xyz, axes, who)
         elif r.type == "RBAR":
             if str(r.cna) != "123456" or str(r.cnb or "").strip() or str(r.cma or "").strip():
                 raise BdfError(f"RBAR {eid}: CNA = {r.cna!r}, CNB = {r.cnb!r}, CMA = {r.cma!r}: "
                                f"only GA independent in all six components is supported "
                                f"(CNA 123456, CNB and CMA blank)")
             _link(dep, f"RBAR {eid}", index[r.ga], index[r.gb], _components(r.cmb or "123456"),
-                  xyz, axes)
+                  xyz, axes, who)
         else:
             raise BdfError(f"{r.type} {eid} is not supported (RBE2, RBAR)")
-    chained = [d for d, row in dep.items() if any(i in dep for i, _ in row)]
-    if chained:
-        raise BdfError(f"rigid elements chained: DOF {chained[0] % NODE_DOF + 1} of GRID "
-                       f"index {chained[0] // NODE_DOF} is dependent and independent (not "
-                       f"supported)")
+    dep = _resolve_chains(dep, who, ids)
     if fixed & set(dep):
         d = min(fixed & set(dep))
         raise BdfError(f"an SPC / GRID PS constrains component {d % NODE_DOF + 1} of a grid "
@@ -380,7 +418,7 @@ def read_stick_deck(path, units: str = "SI") -> StickModel:
     K, M = A.T @ K @ A, A.T @ M @ A
     _add_cmass2_si(model, M, index, deck_units)
     fixed = _fixed_dofs(model, index, path.name)
-    rigid = _rigid_links(model, index, xyz, axes, fixed)
+    rigid = _rigid_links(model, index, xyz, axes, fixed, ids)
     notes = (f"{len(_card_ids(model, 'CBAR'))} CBAR, {len(ids)} GRID; bar mass "
              f"{'consistent (PARAM COUPMASS 1)' if coupled else 'lumped'}",)
     return StickModel(node_ids=ids, xyz=xyz, cd_axes=axes, K=0.5 * (K + K.T),
