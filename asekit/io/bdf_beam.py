@@ -449,9 +449,37 @@ def _add_cmass2_si(model, M, index, deck_units) -> None:
         M[np.ix_(dofs, dofs)] += c.mass * wt * Mu * pattern * np.outer(sc, sc)
 
 
+def _shifted_eigh(K: np.ndarray, M: np.ndarray, n: int):
+    """The n largest lambda of M phi = lambda (K + s M) phi, lambda = 1 / (omega^2 + s): s = 0
+    when K is positive definite, else (free-free: rigid-body modes, omega = 0) the shift
+    s = 1e-6 max diag K / max diag M, which makes K + s M positive definite whenever every
+    mode of zero stiffness carries mass; a massless mechanism, or more zero-stiffness modes
+    than a free body's six rigid-body modes (a mechanism), is refused. Returns
+    (lambda ascending, phi, s)."""
+    idx = [K.shape[0] - n, K.shape[0] - 1]
+    try:
+        return (*sla.eigh(M, K, subset_by_index=idx), 0.0)
+    except np.linalg.LinAlgError:
+        pass
+    s = 1e-6 * np.abs(np.diag(K)).max() / max(np.abs(np.diag(M)).max(), 1e-300)
+    try:
+        lam_all, phi_all = sla.eigh(M, K + s * M)
+    except np.linalg.LinAlgError:
+        lam_all = None
+    n_zero = 0 if lam_all is None else int(np.sum(1.0 / np.maximum(lam_all, 1e-300) - s
+                                                   < 1e-6 * s))
+    if lam_all is None or n_zero > 6:
+        raise BdfError(f"the stick model's stiffness is singular on its free DOFs (a "
+                       f"mechanism: {'massless' if lam_all is None else n_zero} zero-stiffness "
+                       f"modes, a free body has at most 6 rigid-body modes): constrain them "
+                       f"with SPC or GRID PS")
+    return lam_all[idx[0]:], phi_all[:, idx[0]:], s
+
+
 def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
     """Normal modes K phi = omega^2 M phi of the free DOFs, solved as M phi = lambda K phi,
-    lambda = 1 / omega^2, for the largest lambda: exact with DOFs that carry no mass (e.g. the
+    lambda = 1 / omega^2 (shifted, K + s M, when free-free: :func:`_shifted_eigh`), for the
+    largest lambda: exact with DOFs that carry no mass (e.g. the
     twist of a bar without torsional inertia, in any frame: lambda = 0 there) and accurate for
     the lowest modes of stiff bars (no stiffness-times-mass-basis mixing).
 
@@ -484,19 +512,14 @@ def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
     n = min(int(n_modes), free.size)
     if n < 1:
         raise ValueError(f"n_modes must be >= 1, got {n_modes}")
-    try:
-        lam, phi = sla.eigh(M, K, subset_by_index=[free.size - n, free.size - 1])
-    except np.linalg.LinAlgError:
-        raise BdfError("the stick model's stiffness is singular on its free DOFs (a "
-                       "mechanism or a rigid-body mode): constrain them with SPC or GRID "
-                       "PS") from None
+    lam, phi, shift = _shifted_eigh(K, M, n)
     lam, phi = lam[::-1], phi[:, ::-1]
     if lam[-1] <= 1e-14 * lam[0]:
         raise BdfError(f"fewer than {n} modes carry mass (the DOFs without mass have no "
                        f"frequency): ask for fewer modes")
     phi = phi / np.sqrt(np.einsum("ij,ik,kj->j", phi, M, phi))
     full = Tr @ phi
-    w2 = 1.0 / lam
+    w2 = 1.0 / lam - shift
     return StickModes(frequencies_hz=np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi),
                       shapes=full)
 

@@ -8,6 +8,8 @@ References
   Shape*, 1979, Table 8-1); axial: f_1 = sqrt(E / rho) / (4 L) (Blevins Table 8-16).
 - PT145 (data/benchmarks/pt145/README.md): MSC Nastran 2020 f06, REAL EIGENVALUES table,
   CYCLES column of modes 1-6.
+- BAH plane (data/benchmarks/bah_plane/README.md): MSC Nastran f06, REAL EIGENVALUES table,
+  CYCLES column of modes 3-8.
 """
 
 import os
@@ -25,6 +27,7 @@ from asekit.io.bdf_beam import read_stick_deck, stick_modes  # noqa: E402
 from asekit.util.paths import DATA_DIR  # noqa: E402
 
 PT145 = DATA_DIR / "benchmarks" / "pt145" / "pt145.bdf"
+BAH = DATA_DIR / "benchmarks" / "bah_plane" / "bah_plane_qhh.bdf"
 
 # SI cantilever: steel bar, 1 m, 20 elements
 E, NU, RHO, LEN, NEL = 2.0e11, 0.3, 7800.0, 1.0, 20
@@ -306,6 +309,20 @@ def test_rigid_link_cycle_is_refused(tmp_path):
     with pytest.raises(BdfError, match=r"cycle.*RBE2 50[01].*RBE2 50[01]") as err:
         read_stick_deck(deck)
     assert "\n" not in str(err.value)
+
+
+def test_free_free_bah_plane_modes_match_its_f06():
+    """pyNastran's BAH plane deck (data/benchmarks/bah_plane/README.md): a free-free 2-DOF
+    fuselage (plunge, pitch) with a CBAR wing, RBE2 mass arms and a chain of four RBAR to the
+    tail (chained rigid elements). Its f06 (MSC Nastran, REAL EIGENVALUES, CYCLES): two
+    rigid-body modes (< 3e-7 Hz, Nastran's round-off) and the elastic modes 3-8 below; same
+    discretisation, so the tolerance is the print precision (7 digits), taken as 1e-5."""
+    f06 = [2.454016, 3.753996, 8.702604, 9.002153, 14.50673, 22.15914]
+    sm = read_stick_deck(BAH)
+    assert len(sm.rigid) == 6 * (10 + 4)    # 5 RBE2 x 2 grids + 4 RBAR, 6 DOFs each
+    f = stick_modes(sm, 8).frequencies_hz
+    assert np.all(f[:2] < 1e-3)
+    np.testing.assert_allclose(f[2:], f06, rtol=1e-5)
 
 
 def test_orientation_vector_is_read_in_the_grids_cd_system(tmp_path):
