@@ -731,10 +731,10 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     deck = B._Deck(model, Path(path).name, L, Mu, T)
     if not model.caeros or not model.flutters:
         raise BdfError(f"{deck.name}: no CAERO1 or no FLUTTER card: nothing to run")
+    b_ref, rho_ref, symmetric = B._read_aero_card(deck)      # ACSID first: the flow axis
     for c in model.caeros.values():
         B._check_caero1(deck, c)
     mesh, box_ids = B._boxes(model, L, 0.0)
-    b_ref, rho_ref, symmetric = B._read_aero_card(deck)
     machs, table_ks = B._read_mkaero1(model, deck)
     requests = [B._flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
     fm = B._case_value(model, "FMETHOD")

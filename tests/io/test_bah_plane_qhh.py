@@ -117,3 +117,13 @@ def test_bah_plane_gaf_matches_nastran_qhh(tmp_path):
         # (measured <= 2.6 %)
         np.testing.assert_allclose(np.diag(a)[el].imag, np.diag(n)[el].imag, rtol=0.05)
         np.testing.assert_allclose(np.diag(a)[el].real, np.diag(n)[el].real, rtol=0.03)
+
+
+def test_flow_along_minus_x_is_refused():
+    """The deck as shipped (AERO ACSID 2: flow along basic -X) is refused in one line naming
+    the card and field, instead of read with the flow along +X (wing and tail reversed)."""
+    from asekit.io.bdf_beam import stick_flutter
+    with pytest.raises(B.BdfError, match=r"AERO ACSID = 2: its x axis \(the flow\) is "
+                                         r"\(-1\.0, 0\.0, 0\.0\)") as err:
+        stick_flutter(BAH / "bah_plane_qhh.bdf")
+    assert "\n" not in str(err.value)
