@@ -1295,6 +1295,21 @@ def _read_tabdmp1(model, deck: _Deck):
     return tuple((float(f) / deck.T, float(v)) for f, v in zip(tab.x, g))
 
 
+def _check_acsid(model, card: str, aero) -> None:
+    """AERO / AEROS ACSID: the aerodynamic system's x axis is the flow direction (MSC QRG,
+    AERO); asekit's CAERO1 boxes take the flow along basic +X and the normal along basic Z, so
+    an ACSID whose axes are not basic's (e.g. flow along -X) is refused, not misread."""
+    acsid = int(getattr(aero, "acsid", 0) or 0)
+    if acsid == 0:
+        return
+    axes = np.asarray(model.coords[acsid].beta(), float)
+    if not np.allclose(axes, np.eye(3), atol=1e-9):
+        raise BdfError(f"{card} ACSID = {acsid}: its x axis (the flow) is "
+                       f"{tuple(np.round(axes[0], 6).tolist())} and z axis "
+                       f"{tuple(np.round(axes[2], 6).tolist())} in basic; asekit takes the flow "
+                       f"along basic +X and z up (ACSID 0 or a system with basic's axes)")
+
+
 def _read_aero_card(deck: _Deck):
     """AERO / AEROS: (reference semichord REFC / 2 m, RHOREF kg/m^3 or None, SYMXZ = 1);
     SYMXY (ground effect) refused.
@@ -1314,6 +1329,7 @@ def _read_aero_card(deck: _Deck):
     if int(getattr(aero, "sym_xy", 0) or 0) != 0:
         raise BdfError("SYMXY (ground effect) is not supported")
     card = "AERO" if model.aero is not None else "AEROS"
+    _check_acsid(model, card, aero)
     rho_ref = (_check_range(deck, "AERO RHOREF", model.aero.rho_ref, "fluid density")
                if model.aero is not None else None)
     refc = _check_range(deck, f"{card} REFC", aero.cref, "length")

@@ -15,7 +15,7 @@
   six components, CMB of GB dependent), eliminated by the rigid-link transformation
   u_d = u_i + theta_i x (x_d - x_i), theta_d = theta_i (Przemieniecki Sec. 11.7; in the grids'
   CD systems), K_r = T^T K T, M_r = T^T M T; chains (a dependent DOF independent elsewhere)
-  and SPC on a dependent DOF refused.
+  resolved by substitution in dependency order, cycles and SPC on a dependent DOF refused.
 
 The element is :mod:`asekit.structure.frame` (Przemieniecki 1968 Eqs. 5.116 and 11.41, rotated
 by the direction cosines, Eq. 6.26). Every grid carries six DOFs (T1, T2, T3, R1, R2, R3) in its
@@ -279,9 +279,10 @@ def _fixed_dofs(model, index, name: str) -> set:
     return fixed
 
 
-def _link(dep: dict, what: str, i: int, d: int, comps, xyz, axes) -> None:
+def _link(dep: dict, what: str, i: int, d: int, comps, xyz, axes, who=None) -> None:
     """The rows of grid d's ``comps`` (CD components) from grid i's six DOFs (CD): rigid
-    kinematics u_d = u_i - S(x_d - x_i) theta_i, theta_d = theta_i in basic."""
+    kinematics u_d = u_i - S(x_d - x_i) theta_i, theta_d = theta_i in basic (``who``: the
+    card naming each row, for the chain resolution's messages)."""
     G = np.eye(6)
     G[:3, 3:] = -_skew(xyz[d] - xyz[i])
     Gc = np.kron(np.eye(2), axes[d]) @ G @ np.kron(np.eye(2), axes[i].T)
@@ -292,31 +293,68 @@ def _link(dep: dict, what: str, i: int, d: int, comps, xyz, axes) -> None:
                            f"on another rigid element")
         dep[row] = tuple((NODE_DOF * i + k, float(Gc[c - 1, k])) for k in range(6)
                          if abs(Gc[c - 1, k]) > 1e-15)
+        if who is not None:
+            who[row] = what
 
 
-def _rigid_links(model, index, xyz, axes, fixed: set) -> tuple:
+def _dof_name(d: int, ids) -> str:
+    return f"component {d % NODE_DOF + 1} of GRID {int(ids[d // NODE_DOF])}"
+
+
+def _resolve_chains(dep: dict, who: dict, ids) -> dict:
+    """Chained rigid elements (a dependent DOF of one independent in another) by substitution
+    in dependency order: u_d = sum_j c_dj u_j with every u_j that is itself dependent replaced
+    by its own (already resolved) row, until only true independents remain; exact, since each
+    link is linear (Przemieniecki Sec. 11.7 applied link by link). A cycle (a DOF dependent,
+    through the chain, on itself) is refused naming the cards."""
+    done, state = {}, {}
+    for root in sorted(dep):
+        stack = [root]
+        while stack:
+            d = stack[-1]
+            if d in done:
+                stack.pop()
+                continue
+            state[d] = 1
+            todo = [i for i, _ in dep[d] if i in dep and i not in done]
+            cyc = [i for i in todo if state.get(i) == 1]
+            if cyc:
+                loop = stack[stack.index(cyc[0]):]
+                raise BdfError("rigid elements form a cycle: " + " -> ".join(
+                    f"{who.get(x, '?')} ({_dof_name(x, ids)})" for x in loop)
+                    + " depends on itself (Nastran refuses it too)")
+            if todo:
+                stack.extend(todo[:1])
+                continue
+            acc = {}
+            for i, c in dep[d]:
+                for j, cj in (done[i] if i in dep else ((i, 1.0),)):
+                    acc[j] = acc.get(j, 0.0) + c * cj
+            done[d] = tuple((j, v) for j, v in sorted(acc.items()) if abs(v) > 1e-15)
+            state[d] = 2
+            stack.pop()
+    return done
+
+
+def _rigid_links(model, index, xyz, axes, fixed: set, ids) -> tuple:
     """RBE2 / RBAR as dependent DOF rows (module docstring)."""
-    dep = {}
+    dep, who = {}, {}
     for eid in sorted(model.rigid_elements):
         r = model.rigid_elements[eid]
         if r.type == "RBE2":
             for g in r.Gmi:
                 _link(dep, f"RBE2 {eid} (GM {g})", index[r.gn], index[g], _components(r.cm),
-                      xyz, axes)
+                      xyz, axes, who)
         elif r.type == "RBAR":
             if str(r.cna) != "123456" or str(r.cnb or "").strip() or str(r.cma or "").strip():
                 raise BdfError(f"RBAR {eid}: CNA = {r.cna!r}, CNB = {r.cnb!r}, CMA = {r.cma!r}: "
                                f"only GA independent in all six components is supported "
                                f"(CNA 123456, CNB and CMA blank)")
             _link(dep, f"RBAR {eid}", index[r.ga], index[r.gb], _components(r.cmb or "123456"),
-                  xyz, axes)
+                  xyz, axes, who)
         else:
             raise BdfError(f"{r.type} {eid} is not supported (RBE2, RBAR)")
-    chained = [d for d, row in dep.items() if any(i in dep for i, _ in row)]
-    if chained:
-        raise BdfError(f"rigid elements chained: DOF {chained[0] % NODE_DOF + 1} of GRID "
-                       f"index {chained[0] // NODE_DOF} is dependent and independent (not "
-                       f"supported)")
+    dep = _resolve_chains(dep, who, ids)
     if fixed & set(dep):
         d = min(fixed & set(dep))
         raise BdfError(f"an SPC / GRID PS constrains component {d % NODE_DOF + 1} of a grid "
@@ -380,7 +418,7 @@ def read_stick_deck(path, units: str = "SI") -> StickModel:
     K, M = A.T @ K @ A, A.T @ M @ A
     _add_cmass2_si(model, M, index, deck_units)
     fixed = _fixed_dofs(model, index, path.name)
-    rigid = _rigid_links(model, index, xyz, axes, fixed)
+    rigid = _rigid_links(model, index, xyz, axes, fixed, ids)
     notes = (f"{len(_card_ids(model, 'CBAR'))} CBAR, {len(ids)} GRID; bar mass "
              f"{'consistent (PARAM COUPMASS 1)' if coupled else 'lumped'}",)
     return StickModel(node_ids=ids, xyz=xyz, cd_axes=axes, K=0.5 * (K + K.T),
@@ -411,9 +449,37 @@ def _add_cmass2_si(model, M, index, deck_units) -> None:
         M[np.ix_(dofs, dofs)] += c.mass * wt * Mu * pattern * np.outer(sc, sc)
 
 
+def _shifted_eigh(K: np.ndarray, M: np.ndarray, n: int):
+    """The n largest lambda of M phi = lambda (K + s M) phi, lambda = 1 / (omega^2 + s): s = 0
+    when K is positive definite, else (free-free: rigid-body modes, omega = 0) the shift
+    s = 1e-6 max diag K / max diag M, which makes K + s M positive definite whenever every
+    mode of zero stiffness carries mass; a massless mechanism, or more zero-stiffness modes
+    than a free body's six rigid-body modes (a mechanism), is refused. Returns
+    (lambda ascending, phi, s)."""
+    idx = [K.shape[0] - n, K.shape[0] - 1]
+    try:
+        return (*sla.eigh(M, K, subset_by_index=idx), 0.0)
+    except np.linalg.LinAlgError:
+        pass
+    s = 1e-6 * np.abs(np.diag(K)).max() / max(np.abs(np.diag(M)).max(), 1e-300)
+    try:
+        lam_all, phi_all = sla.eigh(M, K + s * M)
+    except np.linalg.LinAlgError:
+        lam_all = None
+    n_zero = 0 if lam_all is None else int(np.sum(1.0 / np.maximum(lam_all, 1e-300) - s
+                                                   < 1e-6 * s))
+    if lam_all is None or n_zero > 6:
+        raise BdfError(f"the stick model's stiffness is singular on its free DOFs (a "
+                       f"mechanism: {'massless' if lam_all is None else n_zero} zero-stiffness "
+                       f"modes, a free body has at most 6 rigid-body modes): constrain them "
+                       f"with SPC or GRID PS")
+    return lam_all[idx[0]:], phi_all[:, idx[0]:], s
+
+
 def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
     """Normal modes K phi = omega^2 M phi of the free DOFs, solved as M phi = lambda K phi,
-    lambda = 1 / omega^2, for the largest lambda: exact with DOFs that carry no mass (e.g. the
+    lambda = 1 / omega^2 (shifted, K + s M, when free-free: :func:`_shifted_eigh`), for the
+    largest lambda: exact with DOFs that carry no mass (e.g. the
     twist of a bar without torsional inertia, in any frame: lambda = 0 there) and accurate for
     the lowest modes of stiff bars (no stiffness-times-mass-basis mixing).
 
@@ -446,19 +512,14 @@ def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
     n = min(int(n_modes), free.size)
     if n < 1:
         raise ValueError(f"n_modes must be >= 1, got {n_modes}")
-    try:
-        lam, phi = sla.eigh(M, K, subset_by_index=[free.size - n, free.size - 1])
-    except np.linalg.LinAlgError:
-        raise BdfError("the stick model's stiffness is singular on its free DOFs (a "
-                       "mechanism or a rigid-body mode): constrain them with SPC or GRID "
-                       "PS") from None
+    lam, phi, shift = _shifted_eigh(K, M, n)
     lam, phi = lam[::-1], phi[:, ::-1]
     if lam[-1] <= 1e-14 * lam[0]:
         raise BdfError(f"fewer than {n} modes carry mass (the DOFs without mass have no "
                        f"frequency): ask for fewer modes")
     phi = phi / np.sqrt(np.einsum("ij,ik,kj->j", phi, M, phi))
     full = Tr @ phi
-    w2 = 1.0 / lam
+    w2 = 1.0 / lam - shift
     return StickModes(frequencies_hz=np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi),
                       shapes=full)
 
@@ -670,10 +731,10 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     deck = B._Deck(model, Path(path).name, L, Mu, T)
     if not model.caeros or not model.flutters:
         raise BdfError(f"{deck.name}: no CAERO1 or no FLUTTER card: nothing to run")
+    b_ref, rho_ref, symmetric = B._read_aero_card(deck)      # ACSID first: the flow axis
     for c in model.caeros.values():
         B._check_caero1(deck, c)
     mesh, box_ids = B._boxes(model, L, 0.0)
-    b_ref, rho_ref, symmetric = B._read_aero_card(deck)
     machs, table_ks = B._read_mkaero1(model, deck)
     requests = [B._flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
     fm = B._case_value(model, "FMETHOD")

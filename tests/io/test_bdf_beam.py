@@ -8,6 +8,8 @@ References
   Shape*, 1979, Table 8-1); axial: f_1 = sqrt(E / rho) / (4 L) (Blevins Table 8-16).
 - PT145 (data/benchmarks/pt145/README.md): MSC Nastran 2020 f06, REAL EIGENVALUES table,
   CYCLES column of modes 1-6.
+- BAH plane (data/benchmarks/bah_plane/README.md): MSC Nastran f06, REAL EIGENVALUES table,
+  CYCLES column of modes 3-8.
 """
 
 import os
@@ -25,6 +27,7 @@ from asekit.io.bdf_beam import read_stick_deck, stick_modes  # noqa: E402
 from asekit.util.paths import DATA_DIR  # noqa: E402
 
 PT145 = DATA_DIR / "benchmarks" / "pt145" / "pt145.bdf"
+BAH = DATA_DIR / "benchmarks" / "bah_plane" / "bah_plane_qhh.bdf"
 
 # SI cantilever: steel bar, 1 m, 20 elements
 E, NU, RHO, LEN, NEL = 2.0e11, 0.3, 7800.0, 1.0, 20
@@ -267,6 +270,59 @@ def test_rigid_link_equals_the_offset_mass(tmp_path, link):
     sm = read_stick_deck(linked)
     assert len(sm.rigid) == 6
     np.testing.assert_allclose(stick_modes(sm, 8).frequencies_hz, f0, rtol=1e-9)
+
+
+def test_chained_rigid_links_equal_the_combined_offset_mass(tmp_path):
+    """Two chained RBE2 (tip -> a grid in a rotated CD system -> the CONM2's grid, the middle
+    grid dependent in one and independent in the other) carry the CONM2 as one offset mass at
+    the tip with the summed offset: the reduced mass T^T M T equals the direct deck's to 1e-9
+    (rigid kinematics compose: Przemieniecki 1968 Sec. 11.7), and so do the modes."""
+    tip, mid, dep = NEL + 1, NEL + 2, NEL + 3
+    o1, o2 = np.array([0.02, 0.15, -0.04]), np.array([0.01, 0.05, 0.09])
+    off = o1 + o2
+    mt = 2 * RHO * A * LEN
+    direct = _cantilever(tmp_path / "d.bdf", extra=(f"CONM2,99,{tip},,{mt!r},{off[0]!r},"
+                                                    f"{off[1]!r},{off[2]!r}",))
+    cd = "CORD2R,5,,0.0,0.0,0.0,0.3,0.4,0.8\n,0.9,-0.1,0.2"
+    xm, xd = np.array([LEN, 0.0, 0.0]) + o1, np.array([LEN, 0.0, 0.0]) + off
+    linked = _cantilever(tmp_path / "l.bdf", extra=(
+        cd, f"GRID,{mid},,{xm[0]!r},{xm[1]!r},{xm[2]!r},5",
+        f"GRID,{dep},,{xd[0]!r},{xd[1]!r},{xd[2]!r}", f"CONM2,99,{dep},,{mt!r}",
+        f"RBE2,501,{mid},123456,{dep}", f"RBE2,500,{tip},123456,{mid}"))
+    sd, sl = read_stick_deck(direct), read_stick_deck(linked)
+    assert len(sl.rigid) == 12
+    assert all(i // 6 < NEL + 1 for _, row in sl.rigid for i, _ in row)  # only beam DOFs
+    Md = sd.reduction().T @ sd.M @ sd.reduction()
+    Ml = sl.reduction().T @ sl.M @ sl.reduction()
+    np.testing.assert_allclose(Ml, Md, rtol=0, atol=1e-9 * np.abs(Md).max())
+    np.testing.assert_allclose(stick_modes(sl, 8).frequencies_hz,
+                               stick_modes(sd, 8).frequencies_hz, rtol=1e-9)
+
+
+def test_rigid_link_cycle_is_refused(tmp_path):
+    """Two RBE2 making each other's grid dependent (a cycle) are refused in one line naming
+    both cards."""
+    a, b = NEL + 2, NEL + 3
+    deck = _cantilever(tmp_path / "c.bdf", extra=(
+        f"GRID,{a},,1.1,0.0,0.0", f"GRID,{b},,1.2,0.0,0.0", f"CONM2,99,{b},,1.0",
+        f"RBE2,500,{a},123456,{b}", f"RBE2,501,{b},123456,{a}"))
+    with pytest.raises(BdfError, match=r"cycle.*RBE2 50[01].*RBE2 50[01]") as err:
+        read_stick_deck(deck)
+    assert "\n" not in str(err.value)
+
+
+def test_free_free_bah_plane_modes_match_its_f06():
+    """pyNastran's BAH plane deck (data/benchmarks/bah_plane/README.md): a free-free 2-DOF
+    fuselage (plunge, pitch) with a CBAR wing, RBE2 mass arms and a chain of four RBAR to the
+    tail (chained rigid elements). Its f06 (MSC Nastran, REAL EIGENVALUES, CYCLES): two
+    rigid-body modes (< 3e-7 Hz, Nastran's round-off) and the elastic modes 3-8 below; same
+    discretisation, so the tolerance is the print precision (7 digits), taken as 1e-5."""
+    f06 = [2.454016, 3.753996, 8.702604, 9.002153, 14.50673, 22.15914]
+    sm = read_stick_deck(BAH)
+    assert len(sm.rigid) == 6 * (10 + 4)    # 5 RBE2 x 2 grids + 4 RBAR, 6 DOFs each
+    f = stick_modes(sm, 8).frequencies_hz
+    assert np.all(f[:2] < 1e-3)
+    np.testing.assert_allclose(f[2:], f06, rtol=1e-5)
 
 
 def test_orientation_vector_is_read_in_the_grids_cd_system(tmp_path):
