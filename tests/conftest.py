@@ -251,3 +251,28 @@ def session_gaf_cache(tmp_path_factory, monkeypatch):
     fin's database is shipped in data/ and only read). Use it per module with
     ``pytestmark = pytest.mark.usefixtures("session_gaf_cache")``."""
     monkeypatch.setenv("ASEKIT_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "gaf-cache"))
+
+
+# ---------------------------------------------------------------------------------------------
+# active flutter suppression on the fin (tests/ase/test_afs.py, tests/ase/test_sensors.py)
+# ---------------------------------------------------------------------------------------------
+@pytest.fixture(scope="session")
+def afs_family(fin_ase):
+    """The fin's :class:`asekit.ase.afs.SpeedFamily` at :func:`fin_ase`'s condition, with the
+    tip trailing-edge deflection (x 0.156 m, y 0.15 m) as its one output."""
+    from asekit.aeroelastic.statespace import fin_outputs
+    from asekit.ase import afs
+    rows = fin_outputs(fin_ase.modal, np.array([[0.156, 0.15]]), names=["tip_te"],
+                       shaft_point=fin_ase.case.support.axis_point)
+    return afs.SpeedFamily(fin_ase.modal, fin_ase.rfa, fin_ase.density, rows,
+                           fin_ase.model.actuator, fin_ase.mach)
+
+
+@pytest.fixture(scope="session")
+def afs_open_loop(afs_family):
+    """The open-loop (actuator-locked) stability boundary of :func:`afs_family` on
+    ``small_cases.AFS_GRID`` (tol 1e-3 m/s)."""
+    from small_cases import AFS_GRID
+
+    from asekit.ase import afs
+    return afs.stability_boundary(lambda u: afs.locked_matrix(afs_family, u), AFS_GRID, tol=1e-3)

@@ -3,7 +3,14 @@ the raw TOML dictionary, so each test can adjust or write it)."""
 
 import tomllib
 
+import numpy as np
+
 from asekit.util.paths import FIN_FILE
+
+#: The speed grid (m/s) on which the active-flutter-suppression tests bracket a boundary
+#: (tests/ase/test_afs.py, tests/ase/test_sensors.py and conftest's ``afs_open_loop``).
+AFS_GRID = np.array([150.0, 200.0, 250.0, 300.0, 350.0, 400.0])
+AFS_GRID.setflags(write=False)
 
 
 def small_fin_raw(point_mass: bool = True) -> dict:

@@ -11,29 +11,25 @@ import math
 import control as ct
 import numpy as np
 import pytest
+from small_cases import AFS_GRID as GRID
 
 from asekit.aeroelastic.flutter import first_of, pk_flutter, pk_instabilities
-from asekit.aeroelastic.statespace import fin_outputs
 from asekit.ase import afs
 from asekit.ase import loop as ase
 from asekit.ase.margins import nyquist_margins
 from asekit.servo.actuator import SYSTEM_3
 from asekit.util.blas import one_blas_thread
 
-GRID = np.array([150.0, 200.0, 250.0, 300.0, 350.0, 400.0])
+
+@pytest.fixture(scope="module")
+def family(afs_family):
+    """conftest's fin speed family (shared with test_sensors)."""
+    return afs_family
 
 
 @pytest.fixture(scope="module")
-def family(fin_ase):
-    rows = fin_outputs(fin_ase.modal, np.array([[0.156, 0.15]]), names=["tip_te"],
-                       shaft_point=fin_ase.case.support.axis_point)
-    return afs.SpeedFamily(fin_ase.modal, fin_ase.rfa, fin_ase.density, rows,
-                           fin_ase.model.actuator, fin_ase.mach)
-
-
-@pytest.fixture(scope="module")
-def open_loop(family):
-    return afs.stability_boundary(lambda u: afs.locked_matrix(family, u), GRID, tol=1e-3)
+def open_loop(afs_open_loop):
+    return afs_open_loop
 
 
 def _boundary(family, K, tol=0.05):

@@ -12,7 +12,6 @@ import math
 import numpy as np
 import pytest
 
-from asekit.aeroelastic.statespace import fin_outputs
 from asekit.ase import afs
 from asekit.ase.sensors import (
     Sensors,
@@ -21,22 +20,14 @@ from asekit.ase.sensors import (
     sensed_discretisation,
 )
 
-GRID = np.array([150.0, 200.0, 250.0, 300.0, 350.0, 400.0])
-
 
 @pytest.fixture(scope="module")
-def family(fin_ase):
-    rows = fin_outputs(fin_ase.modal, np.array([[0.156, 0.15]]), names=["tip_te"],
-                       shaft_point=fin_ase.case.support.axis_point)
-    return afs.SpeedFamily(fin_ase.modal, fin_ase.rfa, fin_ase.density, rows,
-                           fin_ase.model.actuator, fin_ase.mach)
-
-
-@pytest.fixture(scope="module")
-def setup(family):
-    open_loop = afs.stability_boundary(lambda u: afs.locked_matrix(family, u), GRID, tol=1e-3)
-    K = afs.discrete_lqg_controller(family.model(1.35 * open_loop.speed), 1e-3, 1e4, 1e4, 0.1)
-    return family.model(1.05 * open_loop.speed), K
+def setup(afs_family, afs_open_loop):
+    """conftest's fin speed family at 1.05 times its open-loop boundary, and the discrete LQG
+    designed at 1.35 times it (1 kHz)."""
+    u = afs_open_loop.speed
+    K = afs.discrete_lqg_controller(afs_family.model(1.35 * u), 1e-3, 1e4, 1e4, 0.1)
+    return afs_family.model(1.05 * u), K
 
 
 KW = dict(root_twist=math.radians(0.1), t_final=0.05)
