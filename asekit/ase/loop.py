@@ -802,19 +802,41 @@ def static_gains(sys, outputs: list[str]) -> dict:
 class SensorModel:
     """Measurement chain of the feedback angle: a first-order low-pass filter (the
     potentiometer's or the encoder interface's anti-aliasing filter) of corner
-    ``cutoff_hz`` (None: no filter) and a quantisation step ``resolution`` (rad; None: ideal),
-    applied when the processor samples. A motor encoder of ``c`` counts per motor revolution
-    seen at the fin through the transmission ratio N has resolution 2 pi / (c N); a 12-bit
-    potentiometer over 2 pi rad, 2 pi / 4096."""
+    ``cutoff_hz`` (None: no filter), white measurement noise of RMS ``noise_rms`` (rad, >= 0;
+    0: none) added to each sample, drawn from ``numpy.random.default_rng(seed)`` so that the
+    same seed gives the same response bit for bit, and a quantisation step ``resolution``
+    (rad; None: ideal) applied to the noisy sample when the processor samples. A motor encoder
+    of ``c`` counts per motor revolution seen at the fin through the transmission ratio N has
+    resolution 2 pi / (c N); a 12-bit potentiometer over 2 pi rad, 2 pi / 4096."""
 
     cutoff_hz: float | None = None
     resolution: float | None = None
+    noise_rms: float = 0.0
+    seed: int = 0
 
     def __post_init__(self):
         if self.cutoff_hz is not None:
             positive("cutoff_hz", self.cutoff_hz)
         if self.resolution is not None:
             positive("resolution", self.resolution)
+        if not (math.isfinite(self.noise_rms) and self.noise_rms >= 0):
+            raise ValueError(f"noise_rms must be finite and >= 0 rad, got {self.noise_rms!r}")
+        if not (isinstance(self.seed, int) and self.seed >= 0):
+            raise ValueError(f"seed must be an integer >= 0, got {self.seed!r}")
+
+    def noise(self, samples: int) -> np.ndarray:
+        """The measurement noise (rad) of ``samples`` successive samples: zeros without a draw
+        if ``noise_rms`` is 0, else ``noise_rms`` times standard normal draws of
+        ``default_rng(seed)``.
+
+        >>> SensorModel(noise_rms=1e-4, seed=1).noise(3).shape
+        (3,)
+        >>> SensorModel().noise(2).tolist()
+        [0.0, 0.0]
+        """
+        if self.noise_rms == 0:
+            return np.zeros(samples)
+        return self.noise_rms * np.random.default_rng(self.seed).standard_normal(samples)
 
 
 @dataclass(frozen=True)
@@ -999,7 +1021,8 @@ def simulate_sampled(plant: SampledPlant, controller, command: float,
     is linear in the voltage, so the response is computed exactly by the discretised plant.
     The controller's ``integrator_states`` are held while the demand is clipped
     (conditional-integration anti-windup) and the controller is told the applied voltage
-    (its third input). ``sensor.resolution`` quantises the sample of the measured angle.
+    (its third input). ``sensor.noise_rms`` adds seeded white noise to each sample of the
+    measured angle and ``sensor.resolution`` then quantises it (:class:`SensorModel`).
     """
     ss = _check_digital(controller, plant.sample_time)
     command = finite("command", command)
@@ -1040,8 +1063,9 @@ def simulate_sampled(plant: SampledPlant, controller, command: float,
     vds = np.empty(n_s * m)
     cm = plant.C[plant.i_meas]
     v_app = 0.0
+    noise = np.zeros(n_s) if sensor is None else sensor.noise(n_s)
     for k in range(n_s):
-        y = float(cm @ x)
+        y = float(cm @ x) + float(noise[k])
         if res is not None:
             y = res * round(y / res)
         if delay_samples == 0:

@@ -501,6 +501,40 @@ def sensor_bandwidth_quantities(data, model) -> list:
                      "fin root, exact DC gain of the sampled loop; " + note)]
 
 
+#: RMS (rad) of the white noise on the measured angle in :func:`sensor_noise_quantities`
+#: (assumed, as the AFS chapter's sensed rows; 1e-4 rad = 0.006 deg, a few counts of a 16-bit
+#: encoder over 2 pi), and the number of seeded noise realisations checked.
+SENSOR_NOISE_RMS = 1e-4
+SENSOR_NOISE_SEEDS = 20
+
+
+def sensor_noise_quantities(data, model) -> list:
+    """``ase.design.pid_notch.sensor_300hz.noise.*``: Table 2 of the PID design at Mach 0.5,
+    sea level with the :data:`SENSOR_BANDWIDTH_HZ` sensor and white measurement noise of
+    :data:`SENSOR_NOISE_RMS` rad on every sample (:class:`asekit.ase.loop.SensorModel`), over
+    :data:`SENSOR_NOISE_SEEDS` seeded realisations (seeds 0, 1, ...): how many pass, and the
+    worst settling time and overshoot. The noise-free rows are
+    :func:`sensor_bandwidth_quantities`'."""
+    ctl, topo = designs(data)["pid_notch"]
+    c = controller_at(ctl, 0.5, 0.0)
+    plant = ase.sampled_plant(model, topo, SAMPLE_TIME,
+                              sensor=ase.SensorModel(cutoff_hz=SENSOR_BANDWIDTH_HZ))
+    checks = [check(c, model, topo, plant=plant,
+                    sensor=ase.SensorModel(cutoff_hz=SENSOR_BANDWIDTH_HZ,
+                                           noise_rms=SENSOR_NOISE_RMS, seed=seed))
+              for seed in range(SENSOR_NOISE_SEEDS)]
+    key = f"ase.design.pid_notch.sensor_{SENSOR_BANDWIDTH_HZ:g}hz.noise"
+    note = (f"{topo}, M 0.5 sea level, {SENSOR_BANDWIDTH_HZ:g} Hz first-order sensor with "
+            f"{SENSOR_NOISE_RMS:g} rad RMS white noise per sample, seeds 0-"
+            f"{SENSOR_NOISE_SEEDS - 1}, 1 and 15 deg steps")
+    return [Quantity(f"{key}.table2_pass_seeds", sum(ch.table2_pass for ch in checks), "-",
+                     f"of {SENSOR_NOISE_SEEDS} realisations; " + note),
+            Quantity(f"{key}.settling_ms_worst", max(ch.settling_ms for ch in checks), "ms",
+                     "fin root, 2 % band (inf: not settled in 0.15 s); " + note),
+            Quantity(f"{key}.overshoot_pct_worst", max(ch.overshoot_pct for ch in checks), "%",
+                     "fin root; " + note)]
+
+
 def run(figures: bool = False) -> ChapterResult:
     data = load()
     q = []
@@ -517,6 +551,7 @@ def run(figures: bool = False) -> ChapterResult:
                           c.steady_error_pct if c.stable else None, "%",
                           "fin root, exact DC gain of the sampled loop" + unstable))
     q += sensor_bandwidth_quantities(data, model)
+    q += sensor_noise_quantities(data, model)
     q += hinf_quantities(data)
     fc = flutter_comparison(data, 0.75, roger_lags=(), ms_states=(6,))
     rl_ms = [r for r in fc["rows"] if r[0].startswith("min-state, W")][0][3]

@@ -34,3 +34,32 @@ def test_sensor_lag_slows_the_step_and_keeps_zero_steady_error(setup):
     assert abs(wide.settling_ms - ideal.settling_ms) < abs(st - ideal.settling_ms)
     assert wide.overshoot_pct < dz.check(ctl, model, topo, sensor=ase.SensorModel(
         cutoff_hz=dz.SENSOR_BANDWIDTH_HZ)).overshoot_pct
+
+
+def test_measurement_noise_enters_the_step_loop_linearly_and_reproducibly(setup):
+    """Issue 26 (sensors): white noise on the measured angle in the Table-2 step loop
+    (``SensorModel.noise_rms``). Below the voltage clip and without quantisation the sampled
+    loop is linear, so the response to command + noise is the noise-free step plus a response
+    proportional to the noise: doubling ``noise_rms`` (same seed) doubles the deviation, to
+    roundoff. The same seed gives the same response bit for bit; zero noise is the ideal loop."""
+    import math
+
+    import numpy as np
+    _, model, ctl, topo = setup
+    sens = [ase.SensorModel(cutoff_hz=dz.SENSOR_BANDWIDTH_HZ, noise_rms=s, seed=7)
+            for s in (0.0, 1e-5, 2e-5)]
+    plant = ase.sampled_plant(model, topo, dz.SAMPLE_TIME, sensor=sens[0])
+    cmd = math.radians(1.0)
+    r0, r1, r2 = (ase.simulate_sampled(plant, ctl, cmd, t_final=0.1, sensor=s) for s in sens)
+    assert np.max(np.abs(r0.voltage)) < 20.0                 # below the clip: the loop is linear
+    d1, d2 = r1.fin_root - r0.fin_root, r2.fin_root - r0.fin_root
+    assert np.max(np.abs(d1)) > 1e-7                         # the noise moves the fin
+    np.testing.assert_allclose(d2, 2 * d1, rtol=0, atol=1e-9 * np.max(np.abs(d1)) + 1e-15)
+    again = ase.simulate_sampled(plant, ctl, cmd, t_final=0.1, sensor=sens[1])
+    assert np.array_equal(again.fin_root, r1.fin_root)
+    bare = ase.simulate_sampled(plant, ctl, cmd, t_final=0.1,
+                                sensor=ase.SensorModel(cutoff_hz=dz.SENSOR_BANDWIDTH_HZ))
+    assert np.array_equal(bare.fin_root, r0.fin_root)
+    for bad in (dict(noise_rms=-1e-4), dict(noise_rms=math.nan), dict(seed=-1)):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            ase.SensorModel(**bad)

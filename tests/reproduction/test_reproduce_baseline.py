@@ -28,6 +28,11 @@ a 300 Hz first-order sensor) were added on 2026-12-03 from
 (``*.steady_error_pct`` at 1e-14 %, covered by ROUNDOFF_ZERO; the M 0.75 root-locus speed
 7e-12 relative).
 
+The three ``ase.design.pid_notch.sensor_300hz.noise.*`` rows (issue 26: design (a)'s Table-2
+check with the 300 Hz sensor and 1e-4 rad RMS seeded measurement noise, 20 realisations) were
+added on 2026-12-03 (session 38) from ``python -m asekit reproduce --only design --json``; no other
+value changed beyond roundoff.
+
 Eight p-k rows moved by 1.8e-9 to 5.3e-7 relative on 2026-12-03 with issue 23's batched,
 secant-accelerated k-iteration (its tolerance is 1e-7 relative in frequency, so the converged
 roots may move by that much): ``flutter.damping.pk``, ``flutter.structural_g.pk``,
