@@ -45,7 +45,7 @@ from asekit.aero.boxes import BoxMesh, TrapezoidSurface
 from asekit.aero.spline import BoxModes, modal_forces
 from asekit.util.validate import in_range, integer
 
-__all__ = ["ControlSurface", "HingedMesh", "hinged_mesh", "deflection_modes", "hinge_moments",
+__all__ = ["ControlSurface", "HingedMesh", "hinged_mesh", "nesting", "deflection_modes", "hinge_moments",
            "steady_control_derivatives", "ControlDerivatives", "glauert_flap_effectiveness",
            "oscillatory_control_coefficients", "thin_airfoil_flap_derivatives",
            "dimensional_hinge_moments"]
@@ -151,28 +151,92 @@ def _hinge_fraction_at(surfaces, eta: float, side: str) -> float | None:
     return None
 
 
-def _segment_hinges(surfaces, e0: float, e1: float, default: float):
-    """(index of the surface covering [e0, e1] or -1, hinge fraction at e0, at e1)."""
+def _hinge_at(s: ControlSurface, e0: float, e1: float) -> tuple[float, float]:
+    """The hinge chord fractions of ``s`` at span fractions e0 and e1 (inside its span)."""
+    t0 = (e0 - s.span_start) / (s.span_end - s.span_start)
+    t1 = (e1 - s.span_start) / (s.span_end - s.span_start)
+    h = (s.hinge_inboard, s.hinge_outboard)
+    return h[0] + t0 * (h[1] - h[0]), h[0] + t1 * (h[1] - h[0])
+
+
+def _covers(s: ControlSurface, e0: float, e1: float) -> bool:
+    return s.span_start <= e0 + 1e-12 and s.span_end >= e1 - 1e-12
+
+
+def _segment_hinges(surfaces, e0: float, e1: float, default: float, parents=None):
+    """(index of the top-level surface covering [e0, e1] or -1, hinge fraction at e0, at e1);
+    ``parents`` (:func:`nesting`) leaves the nested surfaces (tabs) out."""
+    parents = [-1] * len(surfaces) if parents is None else parents
     for i, s in enumerate(surfaces):
-        if s.span_start <= e0 + 1e-12 and s.span_end >= e1 - 1e-12:
-            t0 = (e0 - s.span_start) / (s.span_end - s.span_start)
-            t1 = (e1 - s.span_start) / (s.span_end - s.span_start)
-            h = (s.hinge_inboard, s.hinge_outboard)
-            return i, h[0] + t0 * (h[1] - h[0]), h[0] + t1 * (h[1] - h[0])
-    h0 = _hinge_fraction_at(surfaces, e0, "left")
-    h1 = _hinge_fraction_at(surfaces, e1, "right")
+        if parents[i] < 0 and _covers(s, e0, e1):
+            return (i, *_hinge_at(s, e0, e1))
+    top = [s for s, p in zip(surfaces, parents) if p < 0]
+    h0 = _hinge_fraction_at(top, e0, "left")
+    h1 = _hinge_fraction_at(top, e1, "right")
     h0 = h1 if h0 is None else h0
     h1 = h0 if h1 is None else h1
     return -1, (default if h0 is None else h0), (default if h1 is None else h1)
 
 
-def _check_overlap(surfaces) -> None:
-    order = sorted(surfaces, key=lambda s: s.span_start)
-    for a, b in zip(order, order[1:]):
-        if b.span_start < a.span_end - 1e-12:
-            raise ValueError(f"control surfaces '{a.name}' and '{b.name}' overlap in span "
-                             f"({a.span_start:g}-{a.span_end:g} and {b.span_start:g}-"
-                             f"{b.span_end:g}): give each its own span range")
+def _nested_in(child: ControlSurface, parent: ControlSurface) -> bool:
+    """Whether ``child`` is a tab on ``parent``: its span inside the parent's and its hinge
+    aft of the parent's hinge at both of its side edges."""
+    if not _covers(parent, child.span_start, child.span_end):
+        return False
+    p0, p1 = _hinge_at(parent, child.span_start, child.span_end)
+    return child.hinge_inboard > p0 + 1e-9 and child.hinge_outboard > p1 + 1e-9
+
+
+def nesting(surfaces) -> tuple:
+    """The parent of each control surface: the index of the surface it is a tab on (its span
+    inside the parent's and its hinge aft of the parent's hinge), -1 for a surface on the
+    wing. Surfaces whose spans overlap must be nested so, one level deep (a tab on a flap,
+    not a tab on a tab); a tab rotates about its own hinge relative to its parent and with the
+    parent about the parent's hinge. Raises ValueError naming the surfaces otherwise.
+
+    Examples
+    --------
+    >>> nesting([ControlSurface("flap", 0.7, 0.7, 0.2, 0.8),
+    ...          ControlSurface("tab", 0.9, 0.9, 0.4, 0.6)])
+    (-1, 0)
+    """
+    surfaces = tuple(surfaces)
+    parents = [-1] * len(surfaces)
+    for i, a in enumerate(surfaces):
+        for j, b in enumerate(surfaces[:i]):
+            if b.span_start >= a.span_end - 1e-12 or a.span_start >= b.span_end - 1e-12:
+                continue
+            if not (_nested_in(a, b) or _nested_in(b, a)):
+                raise ValueError(
+                    f"control surfaces '{b.name}' and '{a.name}' overlap in span "
+                    f"({b.span_start:g}-{b.span_end:g} and {a.span_start:g}-{a.span_end:g}): "
+                    f"give each its own span range, or nest one in the other (a tab: its "
+                    f"span inside the flap's and its hinge aft of the flap's)")
+    for i, a in enumerate(surfaces):          # the innermost surface a tab lies in
+        hosts = [j for j, b in enumerate(surfaces) if j != i and _nested_in(a, b)]
+        if hosts:
+            parents[i] = min(hosts, key=lambda j: surfaces[j].flap_chord_fraction)
+    for i, p in enumerate(parents):
+        if p >= 0 and parents[p] >= 0:
+            raise ValueError(f"control surface '{surfaces[i].name}' is a tab on "
+                             f"'{surfaces[p].name}', itself a tab on "
+                             f"'{surfaces[parents[p]].name}': one level of nesting only")
+    return tuple(parents)
+
+
+def _tab_boxes(surfaces, parents, n_aft: int) -> int:
+    """Boxes per chord aft of the tabs' hinges: n_aft times the mean share of the tabs in
+    their parents' chord aft of the hinge, at least 1 and leaving at least 1 between the
+    hinges (0 without tabs)."""
+    share = [s.flap_chord_fraction / surfaces[p].flap_chord_fraction
+             for s, p in zip(surfaces, parents) if p >= 0]
+    if not share:
+        return 0
+    if n_aft < 2:
+        raise ValueError(f"n_chord_aft = {n_aft}: a tab needs at least 2 boxes per chord aft of "
+                         f"its flap's hinge (one between the hinges, one on the tab); raise "
+                         f"panel.n_chord")
+    return min(n_aft - 1, max(1, round(n_aft * float(np.mean(share)))))
 
 
 def _point(panel: TrapezoidSurface, eta: float, xi: float) -> np.ndarray:
@@ -191,14 +255,19 @@ def hinged_mesh(panel: TrapezoidSurface, surfaces, n_chord_aft: int | None = Non
     panel : the trapezoid; its ``n_chord`` (boxes per chord) and ``n_span`` (boxes across the
         span) are kept, the span boxes shared among the spanwise segments in proportion to
         their width (at least one each).
-    surfaces : :class:`ControlSurface` (one or a sequence; spans must not overlap).
+    surfaces : :class:`ControlSurface` (one or a sequence); spans must not overlap unless one
+        surface is a tab on another (:func:`nesting`).
     n_chord_aft : boxes aft of the hinge (1 .. n_chord - 1); default the nearest integer to
-        n_chord times the mean chord fraction aft of the hinges.
+        n_chord times the mean chord fraction aft of the hinges of the surfaces on the wing.
+        Where a tab lies, these boxes are shared between the flap ahead of the tab's hinge
+        and the tab (:func:`_tab_boxes`, at least one each).
 
     Returns
     -------
     HingedMesh : the boxes (strips root to tip, leading-edge box first in each strip, as
-    :func:`asekit.aero.boxes.mesh_surfaces`) and each surface's boxes and hinge line.
+    :func:`asekit.aero.boxes.mesh_surfaces`) and each surface's boxes and hinge line; a
+    flap's boxes include those of its tabs (they rotate with it), so its deflection mode,
+    hinge moment, area and mean chord run to the trailing edge.
 
     Examples
     --------
@@ -214,37 +283,54 @@ def hinged_mesh(panel: TrapezoidSurface, surfaces, n_chord_aft: int | None = Non
         raise ValueError("surfaces must be one or more ControlSurface")
     if not isinstance(panel, TrapezoidSurface):
         raise ValueError(f"panel must be a TrapezoidSurface, got {type(panel).__name__}")
-    _check_overlap(surfaces)
+    parents = nesting(surfaces)
     if panel.n_chord < 2:
         raise ValueError(f"panel.n_chord must be >= 2 (boxes ahead of and aft of the hinge), "
                          f"got {panel.n_chord}")
-    mean_aft = float(np.mean([s.flap_chord_fraction for s in surfaces]))
+    top = [s for s, p in zip(surfaces, parents) if p < 0]
+    mean_aft = float(np.mean([s.flap_chord_fraction for s in top]))
     if n_chord_aft is None:
         n_chord_aft = min(panel.n_chord - 1, max(1, round(panel.n_chord * mean_aft)))
     n_aft = integer("n_chord_aft", n_chord_aft, low=1, high=panel.n_chord - 1)
     n_fwd = panel.n_chord - n_aft
+    n_tab = _tab_boxes(surfaces, parents, n_aft)
     cuts = _span_cuts(surfaces)
     widths = np.diff(cuts)
     n_seg = np.maximum(1, np.round(panel.n_span * widths).astype(int))
     corners, strip, owner = [], [], []
     strip0 = 0
     for e0, e1, ns in zip(cuts[:-1], cuts[1:], n_seg):
-        isurf, h0, h1 = _segment_hinges(surfaces, e0, e1, 1.0 - mean_aft)
-        le0, le1 = _point(panel, e0, 0.0), _point(panel, e1, 0.0)
-        hp0, hp1 = _point(panel, e0, h0), _point(panel, e1, h1)
-        te0, te1 = _point(panel, e0, 1.0), _point(panel, e1, 1.0)
-        fwd = TrapezoidSurface(le0, hp0[0] - le0[0], le1, hp1[0] - le1[0], n_fwd, int(ns))
-        aft = TrapezoidSurface(hp0, te0[0] - hp0[0], hp1, te1[0] - hp1[0], n_aft, int(ns))
-        cf = fwd.boxes().reshape(int(ns), n_fwd, 4, 3)
-        ca = aft.boxes().reshape(int(ns), n_aft, 4, 3)
-        corners.append(np.concatenate([cf, ca], axis=1).reshape(-1, 4, 3))
+        isurf, h0, h1 = _segment_hinges(surfaces, e0, e1, 1.0 - mean_aft, parents)
+        itab = next((i for i, (s, p) in enumerate(zip(surfaces, parents))
+                     if p >= 0 and p == isurf and _covers(s, e0, e1)), -1)
+        lines = [(0.0, 0.0), (h0, h1)]
+        counts, owners = [n_fwd], [-1]
+        if itab >= 0:
+            lines.append(_hinge_at(surfaces[itab], e0, e1))
+            counts += [n_aft - n_tab, n_tab]
+            owners += [isurf, itab]
+        else:
+            counts.append(n_aft)
+            owners.append(isurf)
+        lines.append((1.0, 1.0))
+        parts = []
+        for (a0, a1), (b0, b1), nc in zip(lines[:-1], lines[1:], counts):
+            p0, p1 = _point(panel, e0, a0), _point(panel, e1, a1)
+            q0, q1 = _point(panel, e0, b0), _point(panel, e1, b1)
+            part = TrapezoidSurface(p0, q0[0] - p0[0], p1, q1[0] - p1[0], nc, int(ns))
+            parts.append(part.boxes().reshape(int(ns), nc, 4, 3))
+        corners.append(np.concatenate(parts, axis=1).reshape(-1, 4, 3))
         strip.append(strip0 + np.repeat(np.arange(int(ns)), panel.n_chord))
-        owner.append(np.tile(np.r_[np.full(n_fwd, -1), np.full(n_aft, isurf)], int(ns)))
+        owner.append(np.tile(np.concatenate([np.full(nc, o) for nc, o in zip(counts, owners)]),
+                             int(ns)))
         strip0 += int(ns)
     corners = np.concatenate(corners)
     mesh = BoxMesh(corners, np.concatenate(strip), np.zeros(len(corners), int), (panel.name,))
     owner = np.concatenate(owner)
     on = np.array([owner == i for i in range(len(surfaces))])
+    for i, p in enumerate(parents):          # a tab's boxes rotate with its parent too
+        if p >= 0:
+            on[p] |= on[i]
     pts = np.array([_point(panel, s.span_start, s.hinge_inboard) for s in surfaces])
     ends = np.array([_point(panel, s.span_end, s.hinge_outboard) for s in surfaces])
     axis = (ends - pts) / np.linalg.norm(ends - pts, axis=1)[:, None]

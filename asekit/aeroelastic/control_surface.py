@@ -64,7 +64,7 @@ import numpy as np
 from scipy import linalg
 from scipy.optimize import brentq
 
-from asekit.aero.control_surface import HingedMesh, deflection_modes
+from asekit.aero.control_surface import HingedMesh, deflection_modes, nesting
 from asekit.aero.spline import BoxModes, fe_spline
 from asekit.aeroelastic.statespace import ModalArrays
 from asekit.structure.modes import mode_shapes_at
@@ -158,7 +158,12 @@ def flap_modal_model(model, M_fe, hm: HingedMesh, hinge_stiffness, hinge_damping
         plate's plane.
     hinge_stiffness : k_h per surface (N m/rad, >= 0; scalar or one per surface).
     hinge_damping : c_h per surface (N m s/rad, >= 0).
-    balance : :class:`BalanceMass` items.
+    balance : :class:`BalanceMass` items; one on a tab (a surface nested in a flap,
+        :func:`asekit.aero.control_surface.nesting`) moves with the flap's rotation too.
+
+    A tab's rotation vector is its own rotation about its hinge; the flap's includes the tab's
+    nodes (aft of the flap's hinge), so the hinge block of M couples the two through the tab's
+    mass, M_ft = sum m d_f d_t.
 
     Returns
     -------
@@ -191,6 +196,7 @@ def flap_modal_model(model, M_fe, hm: HingedMesh, hinge_stiffness, hinge_damping
     for nm, v in (("hinge_stiffness", k_h), ("hinge_damping", c_h)):
         for x in v:
             in_range(nm, x, 0.0, inclusive=True)
+    parents = nesting(hm.surfaces)
     nodes = np.asarray(model.nodes, float)
     phi = np.asarray(model.shapes, float).reshape(3 * len(nodes), -1)
     uf = np.column_stack([flap_rotation_vector(nodes, hm, i) for i in range(n_s)])
@@ -215,6 +221,12 @@ def flap_modal_model(model, M_fe, hm: HingedMesh, hinge_stiffness, hinge_damping
         v = np.zeros(n_w + n_s)
         v[:n_w] = h[0]
         v[n_w + bm.surface] = -d
+        if parents[bm.surface] >= 0:        # a tab's mass rides on its flap as well
+            p = parents[bm.surface]
+            d_p = float(hm.distance_aft(p, np.array([[bm.x, bm.y, 0.0]]))[0])
+            v[n_w + p] = -d_p
+            unbalance[p] += bm.mass * d_p
+            inertia[p] += bm.mass * d_p * d_p
         m_aug += bm.mass * np.outer(v, v)
         unbalance[bm.surface] += bm.mass * d
         inertia[bm.surface] += bm.mass * d * d

@@ -1021,14 +1021,36 @@ def _control_surfaces(raw, panels) -> tuple[ControlSurfaceSpec, ...]:
         raise CaseError(f"control_surface[{elastic[0]}].kind = \"elastic\" needs it to be the "
                         f"case's only control surface (this case has {len(out)}); use kind = "
                         f"\"rigid\" for several surfaces")
-    for i, a in enumerate(out):
-        for j, b in enumerate(out[:i]):
-            if a.panel == b.panel and min(a.span_fraction[1], b.span_fraction[1]) > \
-                    max(a.span_fraction[0], b.span_fraction[0]):
-                raise CaseError(f"control_surface[{i}].span_fraction {list(a.span_fraction)} "
-                                f"overlaps control_surface[{j}] ({b.name!r}) on panel "
-                                f"{a.panel}: give each surface its own span range")
+    _check_nesting(out)
     return out
+
+
+def _check_nesting(out) -> None:
+    """Surfaces on one panel whose spans overlap must be a tab on a flap
+    (:func:`asekit.aero.control_surface.nesting`), both of kind "rigid"."""
+    from asekit.aero.control_surface import ControlSurface, nesting
+
+    surf = [ControlSurface(c.name, *c.hinge_chord_fraction, *c.span_fraction) for c in out]
+    for panel in sorted({c.panel for c in out}):
+        idx = [i for i, c in enumerate(out) if c.panel == panel]
+        for n, i in enumerate(idx):              # name the first pair that cannot be nested
+            for j in idx[:n]:
+                try:
+                    nesting([surf[j], surf[i]])
+                except ValueError as exc:
+                    raise CaseError(f"control_surface[{i}].span_fraction "
+                                    f"{list(out[i].span_fraction)} overlaps control_surface[{j}] "
+                                    f"({out[j].name!r}) on panel {panel}: {exc}") from None
+        try:
+            parents = nesting([surf[i] for i in idx])
+        except ValueError as exc:
+            raise CaseError(f"control_surface on panel {panel}: {exc}") from None
+        for k, p in enumerate(parents):
+            i = idx[k]
+            if p >= 0 and "elastic" in (out[i].kind, out[idx[p]].kind):
+                raise CaseError(f"control_surface[{i}] ({out[i].name!r}) is a tab on "
+                                f"control_surface[{idx[p]}] ({out[idx[p]].name!r}): a tab and "
+                                f"its flap must both be kind = \"rigid\"")
 
 
 def _damping(t: _Table | None) -> DampingSpec:
