@@ -338,7 +338,7 @@ def theodorsen_garrick_section(kappa: float, a: float, c: float, x_alpha: float,
                           stiffness_beta=i_b * float(omega_beta) ** 2, density=rho)
 
 
-def vg_matrices(sec: TypicalSection, k: float):
+def vg_matrices(sec: TypicalSection, k: float, aero=None):
     """(K_s, M_s + A(k)) of the harmonic flutter equation in the k-method form
     [K_s (1 + i g) - omega^2 (M_s + A(k))] q = 0 (Theodorsen 1935, Eq. for the "flutter
     determinant"; Smilg & Wasserman, AAF TR 4798, 1942; Bisplinghoff, Ashley & Halfman 1955,
@@ -352,9 +352,18 @@ def vg_matrices(sec: TypicalSection, k: float):
 
     C(k) Theodorsen's exact function. The structural viscous damping D_s is left out (the
     method's g is the structural damping a mode needs to be neutrally stable).
+
+    ``aero``, when given, replaces A(k): a callable k -> (3, 3) complex matrix per unit span in
+    the same form and coordinates [h, alpha, beta] (e.g. a lifting-surface GAF, 1/2 rho (b/k)^2
+    Q(k) / span, :func:`lifting_surface_aero`).
     """
     k = positive("k", k)
     m = section_matrices(sec, 1.0)
+    if aero is not None:
+        A = np.asarray(aero(k), dtype=complex)
+        if A.shape != (3, 3) or not np.all(np.isfinite(A)):
+            raise ValueError(f"aero(k) must return a finite (3, 3) matrix, got shape {A.shape}")
+        return m.K_s, m.M_s + A
     r = sec.semichord / k
     Ck = complex(theodorsen_function(k))
     A = (m.M_nc - 1j * r * m.B_nc - r * r * m.K_nc
@@ -362,11 +371,11 @@ def vg_matrices(sec: TypicalSection, k: float):
     return m.K_s, m.M_s + A
 
 
-def _vg_roots(sec: TypicalSection, k: float) -> np.ndarray:
+def _vg_roots(sec: TypicalSection, k: float, aero=None) -> np.ndarray:
     """lambda = (1 + i g) / omega^2 of the k-method eigenproblem (M_s + A) q = lambda K_s q:
     the finite roots (a zero flap stiffness makes one infinite: dropped)."""
     from scipy.linalg import eigvals
-    K, Mt = vg_matrices(sec, k)
+    K, Mt = vg_matrices(sec, k, aero)
     lam = eigvals(Mt, K)
     return lam[np.isfinite(lam)]
 
@@ -394,12 +403,12 @@ class VgResult:
     flutter: tuple | None
 
 
-def _vg_branch_g(sec, k, lam_ref, branch):
-    lam = _match(lam_ref, _vg_roots(sec, k))[branch]
+def _vg_branch_g(sec, k, lam_ref, branch, aero=None):
+    lam = _match(lam_ref, _vg_roots(sec, k, aero))[branch]
     return lam.imag / lam.real, lam
 
 
-def flutter_vg(sec: TypicalSection, k_values) -> VgResult:
+def flutter_vg(sec: TypicalSection, k_values, aero=None) -> VgResult:
     """The classical V-g (k) method for the section with the exact Theodorsen aerodynamics.
 
     For each reduced frequency k the eigenvalues lambda = (1 + i g) / omega^2 of
@@ -418,6 +427,8 @@ def flutter_vg(sec: TypicalSection, k_values) -> VgResult:
         Reduced frequencies (> 0), at least 2, fine enough to follow the branches; sorted
         descending here. The highest must lie above the flutter k (refused otherwise: a
         branch with g > 0 there is flutter below the sweep).
+    aero : callable, optional
+        k -> A(k) (3, 3) per unit span replacing Theodorsen's (:func:`vg_matrices`).
 
     Returns
     -------
@@ -435,10 +446,10 @@ def flutter_vg(sec: TypicalSection, k_values) -> VgResult:
     ks = np.sort(np.asarray(k_values, dtype=float).ravel())[::-1]
     if ks.size < 2 or not np.all(np.isfinite(ks)) or ks[-1] <= 0:
         raise ValueError("k_values must hold at least 2 finite reduced frequencies > 0")
-    lams = [_vg_roots(sec, ks[0])]
+    lams = [_vg_roots(sec, ks[0], aero)]
     lams[0] = lams[0][np.argsort(lams[0].real)]
     for k in ks[1:]:
-        lams.append(_match(lams[-1], _vg_roots(sec, k)))
+        lams.append(_match(lams[-1], _vg_roots(sec, k, aero)))
     lam = np.array(lams)
     with np.errstate(invalid="ignore"):
         omega = 1.0 / np.sqrt(lam.real)              # NaN where Re lambda <= 0 (no real omega)
@@ -451,13 +462,92 @@ def flutter_vg(sec: TypicalSection, k_values) -> VgResult:
     for j in range(lam.shape[1]):
         ok = (lam[:-1, j].real > 0) & (lam[1:, j].real > 0)
         for i in np.nonzero(ok & (g[:-1, j] < 0) & (g[1:, j] >= 0))[0]:
-            kf = brentq(lambda kk: _vg_branch_g(sec, kk, lam[i], j)[0], ks[i + 1], ks[i],
-                        xtol=1e-12)
-            w = 1.0 / math.sqrt(_vg_branch_g(sec, kf, lam[i], j)[1].real)
+            kf = brentq(lambda kk: _vg_branch_g(sec, kk, lam[i], j, aero)[0], ks[i + 1],
+                        ks[i], xtol=1e-12)
+            w = 1.0 / math.sqrt(_vg_branch_g(sec, kf, lam[i], j, aero)[1].real)
             cand = (w * sec.semichord / kf, w / (2 * math.pi), float(kf), j)
             if best is None or cand[0] < best[0]:
                 best = cand
     return VgResult(ks, U, omega / (2 * math.pi), g, best)
+
+
+def lifting_surface_aero(sec: TypicalSection, aspect_ratio: float, n_span: int, n_chord: int,
+                         k_values, mach: float = 0.0):
+    """A(k) per unit span of a rectangular wing of the section's chord and the given aspect ratio
+    moving rigidly in the section's three coordinates (plunge, pitch about the elastic axis,
+    a full-span flap about the hinge), by the doublet lattice: the 3-D counterpart of
+    Theodorsen's A(k) in :func:`vg_matrices`, for the wing "approaching the typical section as
+    the aspect ratio grows" (Theodorsen & Garrick's strip assumption).
+
+    The half wing (span s = AR c / 2, the image across the root: a wing of span AR c) is cut
+    along the hinge (:func:`asekit.aero.control_surface.hinged_mesh`); the box modes are, in
+    the lattice's +z-up displacement, plunge h = -1, pitch h = -(x - x_ea), dh/dx = -1 and the
+    flap's :func:`asekit.aero.control_surface.deflection_modes` (flap rotation relative to the
+    wing, as Theodorsen's beta). The generalised forces Q(k) per dynamic pressure
+    (:func:`asekit.aero.gaf.gaf_from_box_modes`, reference semichord b) on ``k_values`` are
+    splined (cubic, in k) and returned as the callable
+
+        A(k) = 1/2 rho (b / k)^2 Q(k) / s,
+
+    so that [K_s (1 + i g) - omega^2 (M_s + A(k))] q = 0 is the wing's flutter equation per unit
+    span with the section's structure (the q Q(k) force of :mod:`asekit.aeroelastic.flutter`
+    written at U = omega b / k).
+
+    Parameters
+    ----------
+    sec : TypicalSection
+    aspect_ratio : float
+        Span over chord of the whole wing (> 0).
+    n_span, n_chord : int
+        Boxes along the half span and along the chord (the flap gets the nearest share).
+    k_values : array_like
+        At least 4 increasing reduced frequencies (> 0) of the GAF table; A(k) is refused
+        outside it.
+    mach : float
+        Mach number (below 1: the doublet lattice).
+
+    Returns
+    -------
+    callable
+        k -> (3, 3) complex A(k) for :func:`flutter_vg`'s ``aero``.
+
+    Examples
+    --------
+    >>> s = theodorsen_garrick_section(0.1, -0.4, 0.6, 0.2, 0.0, 0.25, 0.0012, 0.5, 1.0, 2.0)
+    >>> A = lifting_surface_aero(s, 6.0, 6, 5, [0.3, 0.4, 0.5, 0.6])
+    >>> A2 = vg_matrices(s, 0.45)[1] - section_matrices(s, 1.0).M_s
+    >>> bool(0.7 < abs(A(0.45)[0, 0] / A2[0, 0]) < 1.0)      # the finite wing lifts less
+    True
+    """
+    from scipy.interpolate import CubicSpline
+
+    from asekit.aero.boxes import TrapezoidSurface
+    from asekit.aero.control_surface import ControlSurface, deflection_modes, hinged_mesh
+    from asekit.aero.gaf import gaf_from_box_modes
+    from asekit.aero.spline import BoxModes
+
+    ar = positive("aspect_ratio", aspect_ratio)
+    ks = np.asarray(k_values, dtype=float).ravel()
+    if ks.size < 4 or not np.all(np.isfinite(ks)) or ks[0] <= 0 or np.any(np.diff(ks) <= 0):
+        raise ValueError("k_values must hold at least 4 increasing reduced frequencies > 0")
+    b, rho = sec.semichord, sec.density
+    half_span = 0.5 * ar * 2 * b
+    panel = TrapezoidSurface((0, 0), 2 * b, (0, half_span), 2 * b, n_chord, n_span)
+    hinge = 0.5 * (1 + sec.c)
+    hm = hinged_mesh(panel, ControlSurface("flap", hinge, hinge))
+    mesh, flap = hm.mesh, deflection_modes(hm)
+    x_ea = b * (1 + sec.a)
+    one = np.ones(mesh.n)
+    modes = BoxModes(np.column_stack([-one, -(mesh.control_point[:, 0] - x_ea), flap.h_cp[:, 0]]),
+                     np.column_stack([0 * one, -one, flap.dhdx_cp[:, 0]]),
+                     np.column_stack([-one, -(mesh.load_point[:, 0] - x_ea), flap.h_lp[:, 0]]))
+    spline = CubicSpline(ks, gaf_from_box_modes(modes, mesh, mach, ks, b, symmetric=True), axis=0)
+
+    def aero(k):
+        if not ks[0] <= k <= ks[-1]:
+            raise ValueError(f"k = {k:g} outside the GAF table [{ks[0]:g}, {ks[-1]:g}]")
+        return 0.5 * rho * (b / k) ** 2 * spline(k) / half_span
+    return aero
 
 
 # ---------------------------------------------------------------------------------------------
@@ -529,4 +619,4 @@ __all__ = ["TypicalSection", "theodorsen_t", "theodorsen_function", "jones_funct
            "section_matrices", "state_matrix", "frequency_domain_matrix", "connected_system",
            "flutter_speed", "flutter_speed_exact", "conner_1997", "CONNER_SPAN",
            "CONNER_FREEPLAY_HALF_WIDTH_DEG", "theodorsen_garrick_section", "vg_matrices",
-           "VgResult", "flutter_vg"]
+           "VgResult", "flutter_vg", "lifting_surface_aero"]
