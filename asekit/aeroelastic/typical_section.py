@@ -388,19 +388,33 @@ def _match(prev: np.ndarray, new: np.ndarray) -> np.ndarray:
     return new[list(best)]
 
 
+def _vg_mode(sec, k, aero, u, f_hz):
+    """The eigenvector of the k-method root nearest (1 + 0 i) / omega_F^2 at k, [h / b, alpha,
+    beta], largest component 1."""
+    from scipy.linalg import eig
+    K, Mt = vg_matrices(sec, k, aero)
+    lam, vec = eig(Mt, K)
+    lam = np.where(np.isfinite(lam), lam, np.inf)
+    v = vec[:, int(np.argmin(np.abs(lam - 1.0 / (2 * math.pi * f_hz) ** 2)))].copy()
+    v[0] /= sec.semichord
+    return v / v[int(np.argmax(np.abs(v)))]
+
+
 @dataclass(frozen=True)
 class VgResult:
     """A V-g (k-method) sweep: ``k`` (n_k,) the reduced frequencies in the order swept
     (descending, airspeed rising), and per branch (n_k, n_branches) the airspeed ``velocity``
     (m/s), ``frequency_hz`` and the required structural damping ``damping`` g; ``flutter``
     (U_F m/s, f_F Hz, k_F, branch) at the lowest airspeed where a branch's g rises through
-    zero, or None."""
+    zero, or None; ``flutter_mode`` (3,) complex, the flutter eigenvector in [h / b, alpha,
+    beta] scaled so that its largest component is 1 (None without flutter)."""
 
     k: np.ndarray
     velocity: np.ndarray
     frequency_hz: np.ndarray
     damping: np.ndarray
     flutter: tuple | None
+    flutter_mode: np.ndarray | None = None
 
 
 def _vg_branch_g(sec, k, lam_ref, branch, aero=None):
@@ -468,7 +482,8 @@ def flutter_vg(sec: TypicalSection, k_values, aero=None) -> VgResult:
             cand = (w * sec.semichord / kf, w / (2 * math.pi), float(kf), j)
             if best is None or cand[0] < best[0]:
                 best = cand
-    return VgResult(ks, U, omega / (2 * math.pi), g, best)
+    return VgResult(ks, U, omega / (2 * math.pi), g, best,
+                    None if best is None else _vg_mode(sec, best[2], aero, best[0], best[1]))
 
 
 def lifting_surface_aero(sec: TypicalSection, aspect_ratio: float, n_span: int, n_chord: int,

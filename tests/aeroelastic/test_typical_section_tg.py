@@ -29,6 +29,7 @@ from asekit.aeroelastic.typical_section import (
     flutter_vg,
     frequency_domain_matrix,
     theodorsen_garrick_section,
+    vg_matrices,
 )
 
 KS = np.geomspace(3.0, 0.03, 300)
@@ -58,8 +59,13 @@ def test_vg_is_the_determinant_neutral_point_and_jones_is_close(kappa, omega_h, 
     two-lag C(k) in the time-domain state space moves it by less than 2 % (measured 0.2-1.5 %
     on these four cases; the flap-free case omega_beta = 0 included)."""
     sec = _section(kappa, omega_h, omega_beta)
-    uf, ff, kf, _ = flutter_vg(sec, KS).flutter
+    res = flutter_vg(sec, KS)
+    uf, ff, kf, _ = res.flutter
     assert kf == pytest.approx(ff * 2 * math.pi * sec.semichord / uf, rel=1e-12)
+    q = res.flutter_mode * np.array([sec.semichord, 1.0, 1.0])       # the mode solves it
+    K, Mt = vg_matrices(sec, kf)
+    w = 2 * math.pi * ff
+    assert np.abs(K @ q - w * w * Mt @ q).max() < 1e-10 * np.abs(K @ q).max()
     ue, fe = flutter_speed_exact(sec, uf, ff)
     assert ue == pytest.approx(uf, rel=1e-8) and fe == pytest.approx(ff, rel=1e-8)
     uj, fj = flutter_speed(sec, 0.05 * uf, 3.0 * uf, 300)
@@ -75,9 +81,11 @@ def test_stiff_flap_limit_is_the_pitch_plunge_section(kappa, omega_h):
     errs = []
     for wb in (10.0, 20.0, 40.0):
         sec = _section(kappa, omega_h, wb)
-        uf, ff, _, _ = flutter_vg(sec, KS).flutter
+        res = flutter_vg(sec, KS)
+        uf, ff, _, _ = res.flutter
         u2, f2 = _two_dof(sec, uf, ff)
         errs.append(abs(uf / u2 - 1))
+    assert abs(res.flutter_mode[2]) < 0.01                 # the flap hardly moves
     assert errs[2] < 0.002
     assert errs[0] / errs[1] == pytest.approx(4.0, rel=0.25)
     assert errs[1] / errs[2] == pytest.approx(4.0, rel=0.25)
@@ -104,16 +112,20 @@ def test_mass_balance_removes_low_speed_aileron_flutter():
     of mass aft of the hinge (x_beta = +0.002) flutters at U / (b omega_alpha) = 0.105
     (k = 4.5, a flap-dominated mode); with x_beta = 0 at 0.663 and balanced ahead of the hinge
     (x_beta = -0.005) at 1.13: each step of balance raises the flutter speed (Theodorsen &
-    Garrick's mass-balance conclusion, NACA 685). Every point within 2 % of the state-space
-    model with Jones' C(k)."""
-    us = []
+    Garrick's mass-balance conclusion, NACA 685). The unbalanced aileron's flutter mode is flap
+    and plunge (|alpha| 0.04 of |beta|); the pitch share grows with the balance (|alpha| /
+    |beta| 0.43, 0.54). Every point within 2 % of the state-space model with Jones' C(k)."""
+    us, pitch = [], []
     for xb in (0.002, 0.0, -0.005):
         sec = _section(0.1, 0.5, 0.3, x_beta=xb)
-        uf, ff, kf, _ = flutter_vg(sec, np.geomspace(50.0, 0.03, 600)).flutter
+        res = flutter_vg(sec, np.geomspace(50.0, 0.03, 600))
+        uf, ff, kf, _ = res.flutter
         uj = flutter_speed(sec, 0.01, 3.0, 400)[0]
         assert uj == pytest.approx(uf, rel=0.02)
         us.append(uf)
+        pitch.append(abs(res.flutter_mode[1] / res.flutter_mode[2]))
     assert us[0] < 0.15 < 0.5 < us[1] < 0.8 < 1.0 < us[2]
+    assert pitch[0] < 0.1 < 0.3 < pitch[1] < pitch[2]
 
 
 def test_vg_input_is_checked():
