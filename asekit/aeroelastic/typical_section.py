@@ -34,6 +34,14 @@ the second kind). This is the model of Conner, Tang, Dowell & Virgin (J. Fluids 
 State x = [h, alpha, beta, h', alpha', beta', x1, x2] (8 states), x' = A x. The flap spring
 K_b is the connection of :mod:`asekit.aeroelastic.nonlinear`: :func:`connected_system` returns
 (A0 with K_b = 0, b, c) so the hinge spring can be freeplay.
+
+With the exact C(k) the section is solved in the frequency domain two ways: the neutral point of
+the flutter determinant by Newton iteration (:func:`flutter_speed_exact`) and the classical V-g
+(k) method of Theodorsen & Garrick (:func:`flutter_vg`, :func:`vg_matrices`), which sweeps k and
+needs no guess. :func:`theodorsen_garrick_section` builds the section from the nondimensional
+parameters of NACA Reports 496, 685 and 741 (kappa, x, r^2, frequency ratios), and
+:func:`lifting_surface_aero` replaces Theodorsen's strip by a doublet-lattice wing of finite
+aspect ratio moving in the same three coordinates.
 """
 
 from __future__ import annotations
