@@ -34,6 +34,14 @@ the second kind). This is the model of Conner, Tang, Dowell & Virgin (J. Fluids 
 State x = [h, alpha, beta, h', alpha', beta', x1, x2] (8 states), x' = A x. The flap spring
 K_b is the connection of :mod:`asekit.aeroelastic.nonlinear`: :func:`connected_system` returns
 (A0 with K_b = 0, b, c) so the hinge spring can be freeplay.
+
+With the exact C(k) the section is solved in the frequency domain two ways: the neutral point of
+the flutter determinant by Newton iteration (:func:`flutter_speed_exact`) and the classical V-g
+(k) method of Theodorsen & Garrick (:func:`flutter_vg`, :func:`vg_matrices`), which sweeps k and
+needs no guess. :func:`theodorsen_garrick_section` builds the section from the nondimensional
+parameters of NACA Reports 496, 685 and 741 (kappa, x, r^2, frequency ratios), and
+:func:`lifting_surface_aero` replaces Theodorsen's strip by a doublet-lattice wing of finite
+aspect ratio moving in the same three coordinates.
 """
 
 from __future__ import annotations
@@ -280,6 +288,292 @@ def flutter_speed_exact(sec: TypicalSection, u_guess: float, f_guess_hz: float,
 
 
 # ---------------------------------------------------------------------------------------------
+# Theodorsen and Garrick's nondimensional section and the classical V-g (k) method
+# ---------------------------------------------------------------------------------------------
+def theodorsen_garrick_section(kappa: float, a: float, c: float, x_alpha: float, x_beta: float,
+                               r_alpha_sq: float, r_beta_sq: float, omega_h: float,
+                               omega_alpha: float, omega_beta: float, semichord: float = 1.0,
+                               density: float = 1.225) -> TypicalSection:
+    """The section in Theodorsen's nondimensional parameters (NACA Report 496, 1935, p. 8-9;
+    Theodorsen & Garrick, NACA Report 685, 1940, and Report 741, 1942, the same symbols).
+
+    Parameters
+    ----------
+    kappa : float
+        Mass ratio kappa = pi rho b^2 / M (> 0; 1 / kappa is the mass ratio mu of later texts),
+        M the mass per unit span (moving in plunge, pitch and flap alike).
+    a, c : float
+        Elastic axis and hinge, semichords from mid-chord (-1 < a < c < 1).
+    x_alpha, x_beta : float
+        Static unbalances S_alpha / (M b) about the elastic axis and S_beta / (M b) about the
+        hinge (positive when the centre of mass is aft).
+    r_alpha_sq, r_beta_sq : float
+        Squared radii of gyration I_alpha / (M b^2) (about the elastic axis) and
+        I_beta / (M b^2) (about the hinge), > 0.
+    omega_h, omega_alpha, omega_beta : float
+        Uncoupled frequencies (rad/s): omega_h^2 = C_h / M, omega_alpha^2 = C_alpha / I_alpha,
+        omega_beta^2 = C_beta / I_beta (omega_beta = 0: a free flap).
+    semichord, density : float
+        b (m) and rho (kg/m^3) that make the section dimensional; results in U / (b omega_alpha)
+        and omega / omega_alpha depend only on the nondimensional set.
+
+    Returns
+    -------
+    TypicalSection
+        M = pi rho b^2 / kappa, S_alpha = M x_alpha b, S_beta = M x_beta b, I_alpha =
+        M r_alpha^2 b^2, I_beta = M r_beta^2 b^2, K_h = M omega_h^2, K_alpha = I_alpha
+        omega_alpha^2, K_beta = I_beta omega_beta^2; no viscous damping.
+
+    Examples
+    --------
+    >>> s = theodorsen_garrick_section(0.25, -0.4, 0.6, 0.2, 0.0, 0.25, 0.0012, 0.25, 1.0, 0.5)
+    >>> round(s.heave_mass * 0.25 / (math.pi * 1.225), 12), round(s.stiffness_alpha / s.inertia_alpha, 12)
+    (1.0, 1.0)
+    """
+    kappa, b, rho = (positive(n, v) for n, v in (("kappa", kappa), ("semichord", semichord),
+                                                  ("density", density)))
+    for n, v in (("r_alpha_sq", r_alpha_sq), ("r_beta_sq", r_beta_sq),
+                 ("omega_h", omega_h), ("omega_alpha", omega_alpha)):
+        positive(n, v)
+    in_range("omega_beta", omega_beta, 0.0, inclusive=True)
+    m = math.pi * rho * b * b / kappa
+    i_a, i_b = m * r_alpha_sq * b * b, m * r_beta_sq * b * b
+    return TypicalSection(semichord=b, a=float(a), c=float(c), heave_mass=m,
+                          static_moment_alpha=m * float(x_alpha) * b,
+                          static_moment_beta=m * float(x_beta) * b,
+                          inertia_alpha=i_a, inertia_beta=i_b,
+                          stiffness_h=m * omega_h ** 2, stiffness_alpha=i_a * omega_alpha ** 2,
+                          stiffness_beta=i_b * float(omega_beta) ** 2, density=rho)
+
+
+def vg_matrices(sec: TypicalSection, k: float, aero=None):
+    """(K_s, M_s + A(k)) of the harmonic flutter equation in the k-method form
+    [K_s (1 + i g) - omega^2 (M_s + A(k))] q = 0 (Theodorsen 1935, Eq. for the "flutter
+    determinant"; Smilg & Wasserman, AAF TR 4798, 1942; Bisplinghoff, Ashley & Halfman 1955,
+    Sec. 9-4), at reduced frequency k = omega b / U > 0.
+
+    With the hat quantities of :func:`section_matrices` per unit airspeed (B_nc = U B^,
+    K_nc = U^2 K^, f_c = U f^, w_q = U w^) and U = omega b / k, every aerodynamic term of
+    :func:`frequency_domain_matrix` is -omega^2 times
+
+        A(k) = M_nc - i (b/k) B^ - (b/k)^2 K^ + C(k) (b/k) f^ [(b/k) w^ + i w_qd]^T,
+
+    C(k) Theodorsen's exact function. The structural viscous damping D_s is left out (the
+    method's g is the structural damping a mode needs to be neutrally stable).
+
+    ``aero``, when given, replaces A(k): a callable k -> (3, 3) complex matrix per unit span in
+    the same form and coordinates [h, alpha, beta] (e.g. a lifting-surface GAF, 1/2 rho (b/k)^2
+    Q(k) / span, :func:`lifting_surface_aero`).
+    """
+    k = positive("k", k)
+    m = section_matrices(sec, 1.0)
+    if aero is not None:
+        A = np.asarray(aero(k), dtype=complex)
+        if A.shape != (3, 3) or not np.all(np.isfinite(A)):
+            raise ValueError(f"aero(k) must return a finite (3, 3) matrix, got shape {A.shape}")
+        return m.K_s, m.M_s + A
+    r = sec.semichord / k
+    Ck = complex(theodorsen_function(k))
+    A = (m.M_nc - 1j * r * m.B_nc - r * r * m.K_nc
+         + Ck * r * np.outer(m.f_c, r * m.w_q + 1j * m.w_qd))
+    return m.K_s, m.M_s + A
+
+
+def _vg_roots(sec: TypicalSection, k: float, aero=None) -> np.ndarray:
+    """lambda = (1 + i g) / omega^2 of the k-method eigenproblem (M_s + A) q = lambda K_s q:
+    the finite roots (a zero flap stiffness makes one infinite: dropped)."""
+    from scipy.linalg import eigvals
+    K, Mt = vg_matrices(sec, k, aero)
+    lam = eigvals(Mt, K)
+    return lam[np.isfinite(lam)]
+
+
+def _match(prev: np.ndarray, new: np.ndarray) -> np.ndarray:
+    """``new`` reordered to follow the branches of ``prev`` (least relative change)."""
+    from itertools import permutations
+    best = min(permutations(range(len(new))),
+               key=lambda p: float(np.sum(np.abs(new[list(p)] - prev) / np.abs(prev))))
+    return new[list(best)]
+
+
+def _vg_mode(sec, k, aero, u, f_hz):
+    """The eigenvector of the k-method root nearest (1 + 0 i) / omega_F^2 at k, [h / b, alpha,
+    beta], largest component 1."""
+    from scipy.linalg import eig
+    K, Mt = vg_matrices(sec, k, aero)
+    lam, vec = eig(Mt, K)
+    lam = np.where(np.isfinite(lam), lam, np.inf)
+    v = vec[:, int(np.argmin(np.abs(lam - 1.0 / (2 * math.pi * f_hz) ** 2)))].copy()
+    v[0] /= sec.semichord
+    return v / v[int(np.argmax(np.abs(v)))]
+
+
+@dataclass(frozen=True)
+class VgResult:
+    """A V-g (k-method) sweep: ``k`` (n_k,) the reduced frequencies in the order swept
+    (descending, airspeed rising), and per branch (n_k, n_branches) the airspeed ``velocity``
+    (m/s), ``frequency_hz`` and the required structural damping ``damping`` g; ``flutter``
+    (U_F m/s, f_F Hz, k_F, branch) at the lowest airspeed where a branch's g rises through
+    zero, or None; ``flutter_mode`` (3,) complex, the flutter eigenvector in [h / b, alpha,
+    beta] scaled so that its largest component is 1 (None without flutter)."""
+
+    k: np.ndarray
+    velocity: np.ndarray
+    frequency_hz: np.ndarray
+    damping: np.ndarray
+    flutter: tuple | None
+    flutter_mode: np.ndarray | None = None
+
+
+def _vg_branch_g(sec, k, lam_ref, branch, aero=None):
+    lam = _match(lam_ref, _vg_roots(sec, k, aero))[branch]
+    return lam.imag / lam.real, lam
+
+
+def flutter_vg(sec: TypicalSection, k_values, aero=None) -> VgResult:
+    """The classical V-g (k) method for the section with the exact Theodorsen aerodynamics.
+
+    For each reduced frequency k the eigenvalues lambda = (1 + i g) / omega^2 of
+    (M_s + A(k)) q = lambda K_s q (:func:`vg_matrices`) give per branch omega = 1 / sqrt(Re
+    lambda), g = Im lambda / Re lambda and U = omega b / k (Theodorsen & Garrick, NACA Report
+    685, 1940, solve the same determinant for the real and imaginary parts, their X = (omega_a /
+    omega)^2 (1 + i g)). Branches are followed from k to k by least change of lambda; the
+    flutter point, where a branch's g rises through zero with falling k, is refined by Brent's
+    method on that branch's g(k). An independent route to the neutral point of
+    :func:`flutter_speed_exact` (which solves det = 0 by Newton iteration from a guess).
+
+    Parameters
+    ----------
+    sec : TypicalSection
+    k_values : array_like
+        Reduced frequencies (> 0), at least 2, fine enough to follow the branches; sorted
+        descending here. The highest must lie above the flutter k (refused otherwise: a
+        branch with g > 0 there is flutter below the sweep).
+    aero : callable, optional
+        k -> A(k) (3, 3) per unit span replacing Theodorsen's (:func:`vg_matrices`).
+
+    Returns
+    -------
+    VgResult
+
+    Examples
+    --------
+    >>> s = theodorsen_garrick_section(0.1, -0.4, 0.6, 0.2, 0.0, 0.25, 0.0012, 0.5, 1.0, 2.0)
+    >>> r = flutter_vg(s, np.geomspace(2.0, 0.05, 200))
+    >>> uf, ff, kf, br = r.flutter
+    >>> abs(flutter_speed_exact(s, uf, ff)[0] / uf - 1) < 1e-6
+    True
+    """
+    from scipy.optimize import brentq
+    ks = np.sort(np.asarray(k_values, dtype=float).ravel())[::-1]
+    if ks.size < 2 or not np.all(np.isfinite(ks)) or ks[-1] <= 0:
+        raise ValueError("k_values must hold at least 2 finite reduced frequencies > 0")
+    lams = [_vg_roots(sec, ks[0], aero)]
+    lams[0] = lams[0][np.argsort(lams[0].real)]
+    for k in ks[1:]:
+        lams.append(_match(lams[-1], _vg_roots(sec, k, aero)))
+    lam = np.array(lams)
+    with np.errstate(invalid="ignore"):
+        omega = 1.0 / np.sqrt(lam.real)              # NaN where Re lambda <= 0 (no real omega)
+    g = lam.imag / lam.real
+    if np.any((lam[0].real > 0) & (g[0] > 0)):
+        raise ValueError(f"k_values: a branch already needs g > 0 at the highest k = {ks[0]:g} "
+                         "(flutter below the swept airspeeds); extend k_values upward")
+    U = omega * sec.semichord / ks[:, None]
+    best = None
+    for j in range(lam.shape[1]):
+        ok = (lam[:-1, j].real > 0) & (lam[1:, j].real > 0)
+        for i in np.nonzero(ok & (g[:-1, j] < 0) & (g[1:, j] >= 0))[0]:
+            kf = brentq(lambda kk: _vg_branch_g(sec, kk, lam[i], j, aero)[0], ks[i + 1],
+                        ks[i], xtol=1e-12)
+            w = 1.0 / math.sqrt(_vg_branch_g(sec, kf, lam[i], j, aero)[1].real)
+            cand = (w * sec.semichord / kf, w / (2 * math.pi), float(kf), j)
+            if best is None or cand[0] < best[0]:
+                best = cand
+    return VgResult(ks, U, omega / (2 * math.pi), g, best,
+                    None if best is None else _vg_mode(sec, best[2], aero, best[0], best[1]))
+
+
+def lifting_surface_aero(sec: TypicalSection, aspect_ratio: float, n_span: int, n_chord: int,
+                         k_values, mach: float = 0.0):
+    """A(k) per unit span of a rectangular wing of the section's chord and the given aspect ratio
+    moving rigidly in the section's three coordinates (plunge, pitch about the elastic axis,
+    a full-span flap about the hinge), by the doublet lattice: the 3-D counterpart of
+    Theodorsen's A(k) in :func:`vg_matrices`, for the wing "approaching the typical section as
+    the aspect ratio grows" (Theodorsen & Garrick's strip assumption).
+
+    The half wing (span s = AR c / 2, the image across the root: a wing of span AR c) is cut
+    along the hinge (:func:`asekit.aero.control_surface.hinged_mesh`); the box modes are, in
+    the lattice's +z-up displacement, plunge h = -1, pitch h = -(x - x_ea), dh/dx = -1 and the
+    flap's :func:`asekit.aero.control_surface.deflection_modes` (flap rotation relative to the
+    wing, as Theodorsen's beta). The generalised forces Q(k) per dynamic pressure
+    (:func:`asekit.aero.gaf.gaf_from_box_modes`, reference semichord b) on ``k_values`` are
+    splined (cubic, in k) and returned as the callable
+
+        A(k) = 1/2 rho (b / k)^2 Q(k) / s,
+
+    so that [K_s (1 + i g) - omega^2 (M_s + A(k))] q = 0 is the wing's flutter equation per unit
+    span with the section's structure (the q Q(k) force of :mod:`asekit.aeroelastic.flutter`
+    written at U = omega b / k).
+
+    Parameters
+    ----------
+    sec : TypicalSection
+    aspect_ratio : float
+        Span over chord of the whole wing (> 0).
+    n_span, n_chord : int
+        Boxes along the half span and along the chord (the flap gets the nearest share).
+    k_values : array_like
+        At least 4 increasing reduced frequencies (> 0) of the GAF table; A(k) is refused
+        outside it.
+    mach : float
+        Mach number (below 1: the doublet lattice).
+
+    Returns
+    -------
+    callable
+        k -> (3, 3) complex A(k) for :func:`flutter_vg`'s ``aero``.
+
+    Examples
+    --------
+    >>> s = theodorsen_garrick_section(0.1, -0.4, 0.6, 0.2, 0.0, 0.25, 0.0012, 0.5, 1.0, 2.0)
+    >>> A = lifting_surface_aero(s, 6.0, 6, 5, [0.3, 0.4, 0.5, 0.6])
+    >>> A2 = vg_matrices(s, 0.45)[1] - section_matrices(s, 1.0).M_s
+    >>> bool(0.7 < abs(A(0.45)[0, 0] / A2[0, 0]) < 1.0)      # the finite wing lifts less
+    True
+    """
+    from scipy.interpolate import CubicSpline
+
+    from asekit.aero.boxes import TrapezoidSurface
+    from asekit.aero.control_surface import ControlSurface, deflection_modes, hinged_mesh
+    from asekit.aero.gaf import gaf_from_box_modes
+    from asekit.aero.spline import BoxModes
+
+    ar = positive("aspect_ratio", aspect_ratio)
+    ks = np.asarray(k_values, dtype=float).ravel()
+    if ks.size < 4 or not np.all(np.isfinite(ks)) or ks[0] <= 0 or np.any(np.diff(ks) <= 0):
+        raise ValueError("k_values must hold at least 4 increasing reduced frequencies > 0")
+    b, rho = sec.semichord, sec.density
+    half_span = 0.5 * ar * 2 * b
+    panel = TrapezoidSurface((0, 0), 2 * b, (0, half_span), 2 * b, n_chord, n_span)
+    hinge = 0.5 * (1 + sec.c)
+    hm = hinged_mesh(panel, ControlSurface("flap", hinge, hinge))
+    mesh, flap = hm.mesh, deflection_modes(hm)
+    x_ea = b * (1 + sec.a)
+    one = np.ones(mesh.n)
+    modes = BoxModes(np.column_stack([-one, -(mesh.control_point[:, 0] - x_ea), flap.h_cp[:, 0]]),
+                     np.column_stack([0 * one, -one, flap.dhdx_cp[:, 0]]),
+                     np.column_stack([-one, -(mesh.load_point[:, 0] - x_ea), flap.h_lp[:, 0]]))
+    spline = CubicSpline(ks, gaf_from_box_modes(modes, mesh, mach, ks, b, symmetric=True), axis=0)
+
+    def aero(k):
+        if not ks[0] <= k <= ks[-1]:
+            raise ValueError(f"k = {k:g} outside the GAF table [{ks[0]:g}, {ks[-1]:g}]")
+        return 0.5 * rho * (b / k) ** 2 * spline(k) / half_span
+    return aero
+
+
+# ---------------------------------------------------------------------------------------------
 # the published case
 # ---------------------------------------------------------------------------------------------
 #: Span of the Duke wind-tunnel model (m; Conner et al. 1997, Table A.1). Informational only: the
@@ -347,4 +641,5 @@ def conner_1997(heave_mass: float = 3.39298, wing_mass: float = 1.5666) -> Typic
 __all__ = ["TypicalSection", "theodorsen_t", "theodorsen_function", "jones_function",
            "section_matrices", "state_matrix", "frequency_domain_matrix", "connected_system",
            "flutter_speed", "flutter_speed_exact", "conner_1997", "CONNER_SPAN",
-           "CONNER_FREEPLAY_HALF_WIDTH_DEG"]
+           "CONNER_FREEPLAY_HALF_WIDTH_DEG", "theodorsen_garrick_section", "vg_matrices",
+           "VgResult", "flutter_vg", "lifting_surface_aero"]
