@@ -37,6 +37,7 @@ usual NACA definition (Abbott & von Doenhoff, *Theory of Wing Sections*, 1959, S
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,7 +49,7 @@ from asekit.util.validate import in_range, integer
 __all__ = ["ControlSurface", "HingedMesh", "hinged_mesh", "nesting", "deflection_modes", "hinge_moments",
            "steady_control_derivatives", "ControlDerivatives", "glauert_flap_effectiveness",
            "oscillatory_control_coefficients", "thin_airfoil_flap_derivatives",
-           "dimensional_hinge_moments"]
+           "dimensional_hinge_moments", "mean_aerodynamic_chord"]
 
 
 @dataclass(frozen=True)
@@ -391,7 +392,10 @@ class ControlDerivatives:
     """Steady (rigid) derivatives of a panel with control surfaces at one Mach number, per
     radian: lift coefficients on the reference area, ``dCL_dalpha`` and ``dCL_ddelta``
     (n_surfaces,); hinge-moment coefficients C_h = H / (q S_f c_f), ``Ch_alpha`` and
-    ``Ch_delta`` (n_surfaces,); ``mach``; ``reference_area`` (m^2)."""
+    ``Ch_delta`` (n_surfaces,); ``mach``; ``reference_area`` (m^2); pitching-moment
+    coefficients ``dCm_dalpha`` and ``dCm_ddelta`` (n_surfaces,), Cm = M_y / (q S c_ref)
+    positive nose up, about the axis x = ``moment_reference[0]`` (m) parallel to y, with
+    c_ref = ``moment_reference[1]`` (m)."""
 
     mach: float
     reference_area: float
@@ -399,6 +403,9 @@ class ControlDerivatives:
     dCL_ddelta: np.ndarray
     Ch_alpha: np.ndarray
     Ch_delta: np.ndarray
+    dCm_dalpha: float = math.nan
+    dCm_ddelta: np.ndarray | None = None
+    moment_reference: tuple = (math.nan, math.nan)
 
     @property
     def effectiveness(self) -> np.ndarray:
@@ -406,15 +413,45 @@ class ControlDerivatives:
         return self.dCL_ddelta / self.dCL_dalpha
 
 
+def mean_aerodynamic_chord(mesh: BoxMesh) -> tuple[float, float]:
+    """(x_ref, c_ref) m: the quarter-chord point x of the mean aerodynamic chord and the mean
+    aerodynamic chord c_ref = int c^2 dy / int c dy of the boxes' strips (each strip's chord
+    its area over its width, its leading edge that of its foremost box at mid-strip), x_ref =
+    x_le,MAC + c_ref / 4 with x_le,MAC = int x_le c dy / int c dy (the standard reference of
+    pitching moments; Raymer, *Aircraft Design*, 1992, Sec. 7.5).
+
+    Examples
+    --------
+    >>> p = TrapezoidSurface((0, 0), 2.0, (1.0, 4.0), 1.0, 4, 40)
+    >>> from asekit.aero.boxes import mesh_surfaces
+    >>> x, c = mean_aerodynamic_chord(mesh_surfaces([p]))
+    >>> round(c, 3), round(x, 3)                    # 2/3 (cr + ct - cr ct / (cr + ct)) = 1.556
+    (1.556, 0.833)
+    """
+    strips = np.unique(mesh.strip)
+    c, w, x_le = (np.empty(strips.size) for _ in range(3))
+    for n, st in enumerate(strips):
+        m = mesh.strip == st
+        w[n] = 2.0 * float(mesh.half_width[m][0])
+        c[n] = float(np.sum(mesh.area[m])) / w[n]
+        le = 0.5 * (mesh.corners[m][:, 0, 0] + mesh.corners[m][:, 3, 0])
+        x_le[n] = float(np.min(le))
+    c_ref = float(np.sum(c * c * w) / np.sum(c * w))
+    return float(np.sum(x_le * c * w) / np.sum(c * w)) + 0.25 * c_ref, c_ref
+
+
 def steady_control_derivatives(hm: HingedMesh, mach: float, symmetric: bool = False,
-                               reference_area: float | None = None) -> ControlDerivatives:
-    """dCL/d alpha, dCL/d delta, C_h alpha and C_h delta of every surface from the vortex
-    lattice (:mod:`asekit.aero.vlm`) at Mach ``mach`` (0 <= M < 1).
+                               reference_area: float | None = None,
+                               moment_reference: tuple | None = None) -> ControlDerivatives:
+    """dCL/d alpha, dCL/d delta, dCm/d alpha, dCm/d delta, C_h alpha and C_h delta of every
+    surface from the vortex lattice (:mod:`asekit.aero.vlm`) at Mach ``mach`` (0 <= M < 1).
 
     The angle of attack is w/U = -1 on every box, a deflection the steady normalwash of
     :func:`deflection_modes`; CL = sum DeltaCp A n_z / S (S the panel's area, doubled with
-    its image when ``symmetric``, or ``reference_area``), C_h = H / (q S_f c_f) with H from
-    :func:`hinge_moments`.
+    its image when ``symmetric``, or ``reference_area``), Cm = -sum (x_lp - x_ref) DeltaCp A
+    n_z / (S c_ref) (nose up positive; each box's load at its load point x_lp; (x_ref, c_ref)
+    = ``moment_reference``, default :func:`mean_aerodynamic_chord`), C_h = H / (q S_f c_f)
+    with H from :func:`hinge_moments`.
 
     Examples
     --------
@@ -432,17 +469,23 @@ def steady_control_derivatives(hm: HingedMesh, mach: float, symmetric: bool = Fa
     wash = np.column_stack([-nz, modes.normalwash(0.0, 1.0).real])
     cp = steady_pressure(mesh, mach, wash, symmetric)
     lift = (mesh.area * nz) @ cp
+    x_ref, c_ref = (mean_aerodynamic_chord(mesh) if moment_reference is None else
+                    (float(moment_reference[0]), in_range("moment_reference[1]",
+                                                          moment_reference[1], 0.0)))
+    pitch = -((mesh.load_point[:, 0] - x_ref) * mesh.area * nz) @ cp
     s = float(np.sum(mesh.area))
     if symmetric:
-        lift = 2.0 * lift
+        lift, pitch = 2.0 * lift, 2.0 * pitch
         s *= 2.0
     if reference_area is not None:
         s = in_range("reference_area", reference_area, 0.0)
     h = hinge_moments(hm, cp)                       # (n_surfaces, 1 + n_surfaces)
     sc = np.array([hm.surface_area(i) * hm.mean_chord(i) for i in range(len(hm.surfaces))])
     n_s = len(hm.surfaces)
+    cm = pitch / (s * c_ref)
     return ControlDerivatives(float(mach), s, float(lift[0] / s), lift[1:] / s,
-                              h[:, 0] / sc, h[np.arange(n_s), 1 + np.arange(n_s)] / sc)
+                              h[:, 0] / sc, h[np.arange(n_s), 1 + np.arange(n_s)] / sc,
+                              float(cm[0]), cm[1:], (float(x_ref), float(c_ref)))
 
 
 def oscillatory_control_coefficients(hm: HingedMesh, mach: float, k, b_ref: float,
