@@ -236,8 +236,8 @@ def test_pitching_moment_of_the_flap_against_thin_airfoil_theory(ar20_flap):
     per rad, -0.6495 for a 25 %-chord flap. Lifting-line theory adds only flat-plate loading
     (the induced angle), whose moment about the quarter chord is zero, so the AR 20 wing keeps
     the 2-D value: within 3 % (measured -0.6356, -2.1 %), and |dCm/d alpha| below 1 % of dCL/d
-    alpha (measured 0.015 against 5.47 per rad)
-    about the mean aerodynamic chord's quarter point (which is the wing's quarter chord)."""
+    alpha (measured 0.015 against 5.47 per rad), both about the mean aerodynamic chord's
+    quarter point (the rectangular wing's quarter chord)."""
     th = math.acos(1.0 - 2.0 * 0.75)
     cm_2d = -math.sin(th) * (1.0 - math.cos(th)) / 2.0
     assert cm_2d == pytest.approx(-0.6495, abs=1e-4)
