@@ -398,13 +398,17 @@ class StaticEffectiveness:
     """Steady flexible-to-rigid effectiveness of each surface: ``dynamic_pressure`` (n_q,) Pa;
     ``ratio`` (n_s, n_q) flexible over rigid rolling moment (or lift) per unit deflection;
     ``reversal_q`` (n_s,) Pa (nan: none below the divergence or the search limit);
-    ``divergence_q`` Pa (nan: none found); ``what`` "rolling moment" or "lift"."""
+    ``divergence_q`` Pa (nan: none found); ``what`` "rolling moment" or "lift"; ``rigid``
+    (n_s,) the rigid value per unit dynamic pressure and per radian of each surface's
+    deflection (rolling moment about y = 0, m^3, positive for lift at y > 0; or lift, m^2),
+    of the half model when there is an image."""
 
     dynamic_pressure: np.ndarray
     ratio: np.ndarray
     reversal_q: np.ndarray
     divergence_q: float
     what: str
+    rigid: np.ndarray | None = None
 
     def reversal_speed(self, density: float) -> np.ndarray:
         """Reversal speeds sqrt(2 q_R / rho) (m/s) at air density ``density`` (kg/m^3)."""
@@ -512,7 +516,7 @@ def static_effectiveness(fm: FlapModel, hm: HingedMesh, mach: float, q_max: floa
         if sign.size:
             i = int(sign[0])
             q_r[j] = brentq(lambda q: ratio(q, j), qs[i], qs[i + 1], xtol=1e-10 * q_top)
-    return StaticEffectiveness(qs, rat, q_r, q_div, what)
+    return StaticEffectiveness(qs, rat, q_r, q_div, what, np.asarray(r[f], float))
 
 
 
