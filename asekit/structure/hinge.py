@@ -25,6 +25,12 @@ k_h w_n on r_n with w_n the node's share of the hinge length (trapezoidal, sum w
 uniform relative rotation r meets the moment k_h r either way. The hinge rotation (the
 length-weighted mean of the r_n) and the spring's hinge moment H = sum k_h w_n r_n (N m) are
 outputs (:meth:`ReleasedHinge.hinge_rotation`, :meth:`ReleasedHinge.hinge_moment`).
+
+Several surfaces side by side (inboard and outboard ailerons): :func:`split_at_hinges` splits
+the mesh at every surface's hinge line and side edges at once, :func:`release_hinges` releases
+each hinge to its own rotation r_k on its own spring and damper, and
+:func:`hinge_constraint_modes` gives the n constraint modes of Craig & Bampton (1968, Eq. 5),
+each surface's static rotation with the others held.
 """
 
 from __future__ import annotations
