@@ -91,6 +91,21 @@ def test_each_surface_has_its_strip_inertia_and_no_inertial_coupling(coarse):
     assert np.all(coupling > 1e-3 * np.sqrt(fm.inertia))
 
 
+def test_mass_balance_goes_to_its_own_surface():
+    """0.1 kg on a rigid arm 3 cm ahead of the outboard aileron's hinge (d = -0.03 m): the
+    outboard S and I_h gain exactly m d and m d^2, the inboard's stay the strip's, and the two
+    hinge coordinates stay mass-orthogonal."""
+    m_b, d_b = 0.1, -0.03
+    d = _coarse(tomllib.loads(TWO.read_text()))
+    d["control_surface"][1]["mass_balance"] = [{"position": [0.195, 1.05], "mass": m_b}]
+    fm = P.control_surface_model(case_from_dict(d))
+    i_strip, s_strip = MASS * (C_F ** 2 / 3 + H ** 2 / 12), MASS * C_F / 2
+    np.testing.assert_allclose(fm.inertia, [i_strip, i_strip + m_b * d_b ** 2], rtol=1e-7)
+    np.testing.assert_allclose(fm.static_unbalance, [s_strip, s_strip + m_b * d_b], rtol=0,
+                               atol=1e-7 * s_strip)     # the strip's 1e-7, not the sum's
+    assert abs(fm.hinge_mass_matrix[0, 1]) < 1e-7 * fm.inertia[0]
+
+
 def test_analyse_gives_rows_per_surface_and_names_the_flap_mode(coarse, summary):
     """``analyse``'s JSON: one row per surface (and Mach) with its kind, its inertia and a
     reversal speed; the two halves' rigid dCL/d delta add up to the one aileron's on the same
