@@ -1493,13 +1493,14 @@ def _elastic_splits(case: Case, hm):
             raise CaseError(f"control_surface[{i}].hinge_chord_fraction / span_fraction: {exc} "
                             f"(choose panel.n_chord, n_span or their spacing so that node "
                             f"lines fall there)") from None
-    try:
-        splits = split_at_hinges(mesh, flaps, hm.hinge_point[:, :2], hm.hinge_axis[:, :2])
-    except ValueError as exc:         # names "(surface k)" when there are several
-        path = "control_surface[0]" if len(flaps) == 1 else "control_surface"
-        raise CaseError(f"{path}.hinge_chord_fraction / span_fraction: {exc} (choose "
-                        f"panel.n_chord, n_span or their spacing so that node lines fall "
-                        f"there)") from None
+    for n in range(1, len(flaps) + 1):     # surface by surface, so the error names its key
+        try:
+            splits = split_at_hinges(mesh, flaps[:n], hm.hinge_point[:n, :2],
+                                     hm.hinge_axis[:n, :2])
+        except ValueError as exc:
+            raise CaseError(f"control_surface[{n - 1}].hinge_chord_fraction / span_fraction: "
+                            f"{exc} (choose panel.n_chord, n_span or their spacing so that "
+                            f"node lines fall there)") from None
     return flaps, splits
 
 
@@ -1552,7 +1553,8 @@ def _elastic_surface_model(case: Case, hm):
         return elastic_flap_modal_model(released, M, hm, len(model.frequencies_hz),
                                         d.modal_damping_ratio, d.structural_g)
     except ValueError as exc:
-        raise CaseError(f"control_surface: {exc}") from None
+        path = "control_surface[0]" if len(cs) == 1 else "control_surface"
+        raise CaseError(f"{path}: {exc}") from None
 
 
 # ---------------------------------------------------------------------------------------------

@@ -149,3 +149,8 @@ def test_mixed_kinds_and_a_surface_on_the_support_are_refused():
     with pytest.raises(CaseError, match=r"control_surface\[0\]\.span_fraction \[0\.0, 0\.5\]: "
                                         r"the elastic surface reaches the support"):
         P.control_surface_model(case_from_dict(d))
+    d = _coarse(tomllib.loads(TWO.read_text()))
+    d["control_surface"][1]["hinge_chord_fraction"] = [0.7, 0.7]     # between node lines
+    with pytest.raises(CaseError, match=r"control_surface\[1\]\.hinge_chord_fraction / "
+                                        r"span_fraction: .*'outboard'.*element lines"):
+        P.control_surface_model(case_from_dict(d))
