@@ -106,6 +106,13 @@ class FlapModel:
     n_wing: int
     names: tuple
 
+    @property
+    def hinge_mass_matrix(self) -> np.ndarray:
+        """(n_s, n_s) the hinge coordinates' block of the modal mass (kg m^2): the inertias on
+        its diagonal, the surfaces' inertial coupling off it (M_jk = Psi_j^T M Psi_k, nonzero
+        when two surfaces share nodes or a balance mass)."""
+        return np.array(self.modal.M, float)[self.n_wing:, self.n_wing:]
+
 
 def flap_rotation_vector(nodes: np.ndarray, hm: HingedMesh, index: int) -> np.ndarray:
     """Unit rigid rotation (1 rad, trailing edge down) of surface ``index`` on the
@@ -281,18 +288,21 @@ def surface_elements(mesh, hm: HingedMesh, index: int) -> np.ndarray:
 def elastic_flap_modal_model(released, M_split, hm: HingedMesh, n_modes: int,
                              modal_damping_ratio=None, structural_g=None,
                              dense_limit: int = 3000) -> FlapModel:
-    """The modal model of a wing with one elastic control surface (``kind = "elastic"``): the
-    plate released along the hinge (:func:`asekit.structure.hinge.release_hinge`, a
-    ``"single"`` release) reduced by Craig & Bampton's method ("Coupling of substructures for
-    dynamic analyses", AIAA J. 6(7), 1968, Eqs. 5-9) with the hinge rotation delta as the
-    interface coordinate:
+    """The modal model of a wing with one or several elastic control surfaces
+    (``kind = "elastic"``): the plate released along the hinges
+    (:func:`asekit.structure.hinge.release_hinge`, a ``"single"`` release, or
+    :func:`asekit.structure.hinge.release_hinges` for several side-by-side surfaces) reduced by
+    Craig & Bampton's method ("Coupling of substructures for dynamic analyses", AIAA J. 6(7),
+    1968, Eqs. 5-9) with the hinge rotations delta_k as the interface coordinates:
 
-        u = Phi zeta + psi delta,
+        u = Phi zeta + sum_k psi_k delta_k,
 
-    Phi the ``n_modes`` lowest modes with delta held (mass-normalised) and psi the constraint
-    mode (:func:`asekit.structure.hinge.hinge_constraint_mode`, the surface's static rotation
-    about the hinge). M = B^T M_r B, K = B^T K_r B (the Phi-psi stiffness coupling vanishes:
-    K_oo psi_o + K_or = 0), C the hinge damper plus the wing modes' damping. The coordinate
+    Phi the ``n_modes`` lowest modes with every delta held (mass-normalised) and psi_k the
+    constraint modes (:func:`asekit.structure.hinge.hinge_constraint_modes`, surface k's static
+    rotation about its hinge with the other surfaces held). M = B^T M_r B, K = B^T K_r B (the
+    Phi-Psi stiffness coupling vanishes: K_oo Psi_o + K_oR = 0), C the hinge dampers plus the
+    wing modes' damping; the surfaces' inertial coupling is M's hinge block off its diagonal
+    (:attr:`FlapModel.hinge_mass_matrix`). The coordinate
     delta is the hinge's relative rotation, so the hinge moment of the spring is k_h delta, as
     for the rigid kind (:func:`flap_modal_model`), whose model is this one with Phi the locked
     plate's modes and psi the prescribed rigid rotation.
@@ -301,7 +311,8 @@ def elastic_flap_modal_model(released, M_split, hm: HingedMesh, n_modes: int,
     ----------
     released : :class:`asekit.structure.hinge.ReleasedHinge` of the supported wing.
     M_split : the unreduced mass matrix of ``released.split.mesh`` (for the static unbalance).
-    hm : the boxes with the one surface (:func:`asekit.aero.control_surface.hinged_mesh`).
+    hm : the boxes with the surfaces (:func:`asekit.aero.control_surface.hinged_mesh`), in
+        the order of ``released.splits``.
     n_modes : fixed-interface modes kept (>= 1).
     modal_damping_ratio, structural_g : the wing modes' damping
         (:func:`asekit.structure.modes.with_damping`).
@@ -336,14 +347,17 @@ def elastic_flap_modal_model(released, M_split, hm: HingedMesh, n_modes: int,
     >>> round(1e3 * float(fm.static_unbalance[0]), 2), round(1e3 * float(fm.inertia[0]), 3)
     (9.11, 0.456)
     """
-    from asekit.structure.hinge import hinge_constraint_mode
+    from asekit.structure.hinge import hinge_constraint_modes
     from asekit.structure.modes import ModalModel, with_damping
 
     n_modes = integer("n_modes", n_modes, low=1)
-    if len(hm.surfaces) != 1 or released.hinge_index.size != 1:
-        raise ValueError("elastic_flap_modal_model needs one surface with a 'single' release")
-    r = int(released.hinge_index[0])
-    o = np.setdiff1d(np.arange(released.K.shape[0]), [r])
+    n_s = len(hm.surfaces)
+    if released.hinge_index.size != n_s or (n_s > 1 and len(released.splits) != n_s):
+        raise ValueError(f"elastic_flap_modal_model needs one 'single' hinge release per "
+                         f"surface ({n_s} surfaces, {released.hinge_index.size} hinge "
+                         f"rotations)")
+    R = np.asarray(released.hinge_index)
+    o = np.setdiff1d(np.arange(released.K.shape[0]), R)
     K_oo, M_oo = released.K[o][:, o], released.M[o][:, o]
     if o.size <= dense_limit:
         lam, phi_o = linalg.eigh(K_oo.toarray(), M_oo.toarray(), subset_by_index=[0, n_modes - 1])
@@ -354,43 +368,45 @@ def elastic_flap_modal_model(released, M_split, hm: HingedMesh, n_modes: int,
         order = np.argsort(lam)
         lam, phi_o = lam[order], phi_o[:, order]
         phi_o = phi_o / np.sqrt(np.einsum("im,im->m", phi_o, M_oo @ phi_o))
-    psi = hinge_constraint_mode(released)
-    basis = np.zeros((released.K.shape[0], n_modes + 1))
-    basis[o, :n_modes] = phi_o
-    basis[:, n_modes] = psi
+    psi = hinge_constraint_modes(released)
+    n = n_modes
+    basis = np.zeros((released.K.shape[0], n + n_s))
+    basis[o, :n] = phi_o
+    basis[:, n:] = psi
     m_aug = basis.T @ (released.M @ basis)
     k_aug = basis.T @ (released.K @ basis)
-    # Craig-Bampton: the fixed-interface modes and the constraint mode are K-orthogonal
-    # (K_oo psi_o + K_or = 0); what is left is the solver's round-off, removed here so that the
-    # hinge row couples to nothing but through the mass (as the rigid kind's)
-    coupling = float(np.max(np.abs(k_aug[:n_modes, n_modes])))
+    # Craig-Bampton: the fixed-interface modes and the constraint modes are K-orthogonal
+    # (K_oo Psi_o + K_oR = 0); what is left is the solver's round-off, removed here so that the
+    # hinge rows couple to nothing but through the mass (as the rigid kind's)
+    coupling = float(np.max(np.abs(k_aug[:n, n:])))
     if coupling > 1e-6 * float(np.max(np.abs(np.diag(k_aug)))):
         raise ValueError(f"the hinge constraint mode is not K-orthogonal to the fixed-hinge "
                          f"modes (coupling {coupling:.3g}): the released system is ill-posed")
-    k_aug[:n_modes, n_modes] = k_aug[n_modes, :n_modes] = 0.0
+    k_aug[:n, n:] = 0.0
+    k_aug[n:, :n] = 0.0
     c_aug = basis.T @ (released.C @ basis)
     split = released.split.mesh
-    shapes = (released.T @ basis).reshape(split.n_nodes, 3, n_modes + 1)
+    shapes = (released.T @ basis).reshape(split.n_nodes, 3, n + n_s)
     f_hz = np.sqrt(np.maximum(lam, 0.0)) / (2.0 * math.pi)
-    wing = ModalModel(f_hz, np.eye(n_modes), np.diag(lam), np.zeros((n_modes, n_modes)), 0,
-                      math.nan, split.nodes, shapes[:, :, :n_modes], split.elements,
+    wing = ModalModel(f_hz, np.eye(n), np.diag(lam), np.zeros((n, n)), 0,
+                      math.nan, split.nodes, shapes[:, :, :n], split.elements,
                       f"{split.n_elements}-element plate, hinge released")
     wing = with_damping(wing, modal_damping_ratio, structural_g)
-    c_aug[:n_modes, :n_modes] += wing.C
-    flap = replace(wing, frequencies_hz=np.zeros(1), M=np.ones((1, 1)), K=np.zeros((1, 1)),
-                   C=np.zeros((1, 1)), shapes=shapes[:, :, n_modes:])
+    c_aug[:n, :n] += wing.C
+    flap = replace(wing, frequencies_hz=np.zeros(n_s), M=np.eye(n_s), K=np.zeros((n_s, n_s)),
+                   C=np.zeros((n_s, n_s)), shapes=shapes[:, :, n:])
     bw, bf = fe_spline(wing, hm.mesh), fe_spline(flap, hm.mesh)
     box = BoxModes(np.hstack([bw.h_cp, bf.h_cp]), np.hstack([bw.dhdx_cp, bf.dhdx_cp]),
                    np.hstack([bw.h_lp, bf.h_lp]))
     u_psi = released.T @ psi
     w_unit = np.zeros(3 * split.n_nodes)
     w_unit[0::3] = 1.0
-    inertia = np.array([m_aug[n_modes, n_modes]])
-    unbalance = np.array([-(w_unit @ (M_split @ u_psi))])
-    k_h = float(released.hinge_stiffness[0])
+    inertia = np.diag(m_aug[n:, n:]).copy()
+    unbalance = -(w_unit @ (M_split @ u_psi))
+    k_h = np.asarray(released.hinge_stiffness, float)
     f_h = np.sqrt(k_h / inertia) / (2.0 * math.pi)
     return FlapModel(ModalArrays(m_aug, k_aug, c_aug, 0), box, inertia, unbalance, f_h,
-                     n_modes, tuple(s.name for s in hm.surfaces))
+                     n, tuple(s.name for s in hm.surfaces))
 
 
 @dataclass(frozen=True)

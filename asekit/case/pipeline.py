@@ -1478,55 +1478,82 @@ def control_surface_flutter(case: Case) -> tuple[ControlSurfaceFlutterRow, ...]:
     return tuple(rows)
 
 
-def _elastic_surface_model(case: Case, hm):
-    """``kind = "elastic"``: the plate released along the surface's hinge
-    (:func:`asekit.structure.hinge.release_hinge`, one hinge rotation on the hinge spring and
-    damper, the case's supports on the wing; the ``mass_balance`` masses on rigid arms from the
-    surface's hinge line, :func:`asekit.structure.hinge.hinge_balance_mass`) reduced to the wing's ``modes`` count of
-    fixed-hinge modes plus the hinge rotation
-    (:func:`asekit.aeroelastic.control_surface.elastic_flap_modal_model`)."""
-    from asekit.aeroelastic.control_surface import elastic_flap_modal_model, surface_elements
-    from asekit.structure.hinge import hinge_balance_mass, release_hinge, split_at_hinge
+def _elastic_splits(case: Case, hm):
+    """Each elastic surface's plate elements and the mesh split at all their hinges
+    (:func:`asekit.structure.hinge.split_at_hinges`), the case's errors naming the key."""
+    from asekit.aeroelastic.control_surface import surface_elements
+    from asekit.structure.hinge import split_at_hinges
 
-    c = case.control_surfaces[0]
-    path = "control_surface[0]"
-    if case.structure is not None or modal_model(case).n_rigid:
-        raise CaseError(f"{path}.kind = \"elastic\" needs a plate case file whose support has "
-                        f"no rigid mode (clamped, or modes.keep_rigid = false)")
     mesh = structural_mesh(case)
-    try:
-        flap = surface_elements(mesh, hm, 0)
-        split = split_at_hinge(mesh, flap, hm.hinge_point[0, :2], hm.hinge_axis[0, :2])
-    except ValueError as exc:
-        raise CaseError(f"{path}.hinge_chord_fraction / span_fraction: {exc} (choose "
-                        f"panel.n_chord, n_span or their spacing so that node lines fall "
-                        f"there)") from None
+    flaps = []
+    for i in range(len(case.control_surfaces)):
+        try:
+            flaps.append(surface_elements(mesh, hm, i))
+        except ValueError as exc:
+            raise CaseError(f"control_surface[{i}].hinge_chord_fraction / span_fraction: {exc} "
+                            f"(choose panel.n_chord, n_span or their spacing so that node "
+                            f"lines fall there)") from None
+    for n in range(1, len(flaps) + 1):     # surface by surface, so the error names its key
+        try:
+            splits = split_at_hinges(mesh, flaps[:n], hm.hinge_point[:n, :2],
+                                     hm.hinge_axis[:n, :2])
+        except ValueError as exc:
+            raise CaseError(f"control_surface[{n - 1}].hinge_chord_fraction / span_fraction: "
+                            f"{exc} (choose panel.n_chord, n_span or their spacing so that "
+                            f"node lines fall there)") from None
+    return flaps, splits
+
+
+def _elastic_surface_model(case: Case, hm):
+    """``kind = "elastic"``: the plate released along each surface's hinge
+    (:func:`asekit.structure.hinge.release_hinges`, one hinge rotation per surface on its own
+    hinge spring and damper, the case's supports on the wing; the ``mass_balance`` masses on
+    rigid arms from their surface's hinge line,
+    :func:`asekit.structure.hinge.hinge_balance_mass`) reduced to the wing's ``modes`` count of
+    fixed-hinge modes plus the hinge rotations
+    (:func:`asekit.aeroelastic.control_surface.elastic_flap_modal_model`). Several elastic
+    surfaces side by side are allowed; the schema refuses mixing them with rigid ones."""
+    from asekit.aeroelastic.control_surface import elastic_flap_modal_model
+    from asekit.structure.hinge import hinge_balance_mass, release_hinges
+
+    cs = case.control_surfaces
+    if case.structure is not None or modal_model(case).n_rigid:
+        raise CaseError("control_surface[0].kind = \"elastic\" needs a plate case file whose "
+                        "support has no rigid mode (clamped, or modes.keep_rigid = false)")
+    flaps, splits = _elastic_splits(case, hm)
     system = supported_system(case)
     support = system.T
-    own = np.setdiff1d(np.unique(split.mesh.elements[flap]), np.arange(split.n_original,
-                                                                        split.mesh.n_nodes))
-    if np.any(np.asarray(abs(support[3 * own]).sum(axis=1)).ravel() == 0):
-        raise CaseError(f"{path}.span_fraction {list(c.span_fraction)}: the elastic surface "
-                        f"reaches the support (support.kind = \"{case.support.kind}\"), which "
-                        f"would hold it: end it short of the supported edge")
-    K, M = assemble(split.mesh, case.material)
+    held = np.asarray(abs(support).sum(axis=1)).ravel()[0::3] == 0     # w held, per node
+    n0 = splits[0].n_original
+    for i, (c, flap, split) in enumerate(zip(cs, flaps, splits)):
+        own = np.unique(split.mesh.elements[flap])
+        own = own[own < n0]
+        if np.any(held[own]):
+            raise CaseError(f"control_surface[{i}].span_fraction {list(c.span_fraction)}: the "
+                            f"elastic surface reaches the support (support.kind = "
+                            f"\"{case.support.kind}\"), which would hold it: end it short of "
+                            f"the supported edge")
+    mesh = splits[0].mesh
+    K, M = assemble(mesh, case.material)
     if case.point_masses:
-        M = (M + point_mass_matrix(split.mesh, [(p.position, p.mass, p.inertia)
-                                                for p in case.point_masses])).tocsr()
-    for (x, y), m_b in c.mass_balance:          # on rigid arms from the surface's hinge
-        d_b = float(hm.distance_aft(0, np.array([[x, y, 0.0]]))[0])
-        M = (M + hinge_balance_mass(split, (x, y), d_b, m_b)).tocsr()
+        M = (M + point_mass_matrix(mesh, [(p.position, p.mass, p.inertia)
+                                          for p in case.point_masses])).tocsr()
+    for i, (c, split) in enumerate(zip(cs, splits)):
+        for (x, y), m_b in c.mass_balance:          # on rigid arms from the surface's hinge
+            d_b = float(hm.distance_aft(i, np.array([[x, y, 0.0]]))[0])
+            M = (M + hinge_balance_mass(split, (x, y), d_b, m_b)).tocsr()
     K0, M0 = mass_and_stiffness(case)          # the support's own springs and masses
-    released = release_hinge(split, K, M, c.hinge_stiffness, c.hinge_damping, "single",
-                             support=support,
-                             support_stiffness=system.K - support.T @ K0 @ support,
-                             support_mass=system.M - support.T @ M0 @ support)
+    released = release_hinges(splits, K, M, [c.hinge_stiffness for c in cs],
+                              [c.hinge_damping for c in cs], support=support,
+                              support_stiffness=system.K - support.T @ K0 @ support,
+                              support_mass=system.M - support.T @ M0 @ support)
     model = modal_model(case)
     d = case.damping
     try:
         return elastic_flap_modal_model(released, M, hm, len(model.frequencies_hz),
                                         d.modal_damping_ratio, d.structural_g)
     except ValueError as exc:
+        path = "control_surface[0]" if len(cs) == 1 else "control_surface"
         raise CaseError(f"{path}: {exc}") from None
 
 

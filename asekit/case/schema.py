@@ -1017,10 +1017,11 @@ def _control_surfaces(raw, panels) -> tuple[ControlSurfaceSpec, ...]:
     if len(set(names)) != len(names):
         raise CaseError(f"control_surface[].name must be unique, got {names}")
     elastic = [i for i, c in enumerate(out) if c.kind == "elastic"]
-    if elastic and len(out) > 1:
-        raise CaseError(f"control_surface[{elastic[0]}].kind = \"elastic\" needs it to be the "
-                        f"case's only control surface (this case has {len(out)}); use kind = "
-                        f"\"rigid\" for several surfaces")
+    if elastic and len(elastic) < len(out):      # several elastic side by side: issue 25
+        rigid = next(i for i, c in enumerate(out) if c.kind != "elastic")
+        raise CaseError(f"control_surface[{rigid}].kind = \"{out[rigid].kind}\" cannot be "
+                        f"mixed with the elastic control_surface[{elastic[0]}]: give every "
+                        f"surface of the case the same kind (\"rigid\" or \"elastic\")")
     _check_nesting(out)
     return out
 

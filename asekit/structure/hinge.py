@@ -25,6 +25,12 @@ k_h w_n on r_n with w_n the node's share of the hinge length (trapezoidal, sum w
 uniform relative rotation r meets the moment k_h r either way. The hinge rotation (the
 length-weighted mean of the r_n) and the spring's hinge moment H = sum k_h w_n r_n (N m) are
 outputs (:meth:`ReleasedHinge.hinge_rotation`, :meth:`ReleasedHinge.hinge_moment`).
+
+Several surfaces side by side (inboard and outboard ailerons): :func:`split_at_hinges` splits
+the mesh at every surface's hinge line and side edges at once, :func:`release_hinges` releases
+each hinge to its own rotation r_k on its own spring and damper, and
+:func:`hinge_constraint_modes` gives the n constraint modes of Craig & Bampton (1968, Eq. 5),
+each surface's static rotation with the others held.
 """
 
 from __future__ import annotations
@@ -51,7 +57,10 @@ class HingeSplit:
     original node of each copy; ``on_hinge`` (n_c,) True for a copy on the hinge line (tied by
     :func:`release_hinge`), False for one on a side edge (free); ``weight`` (n_c,) each hinge
     copy's share of the hinge length (0 on the side edges, sum 1); ``flap_elements`` (n_elem,)
-    bool; ``hinge_axis`` (2,) the unit hinge direction.
+    bool; ``hinge_axis`` (2,) the unit hinge direction; ``first_copy`` the position of this
+    surface's first copy among the mesh's copies (0 for one surface; with several surfaces,
+    :func:`split_at_hinges`, the copies are numbered surface after surface, so this surface's
+    copy j is node ``n_original + first_copy + j`` of ``mesh``).
     """
 
     mesh: PlateMesh
@@ -61,6 +70,12 @@ class HingeSplit:
     weight: np.ndarray
     flap_elements: np.ndarray
     hinge_axis: np.ndarray
+    first_copy: int = 0
+
+    @property
+    def copy_nodes(self) -> np.ndarray:
+        """(n_c,) the node numbers of this surface's copies in ``mesh``."""
+        return self.n_original + self.first_copy + np.arange(self.copy_of.size)
 
 
 def split_at_hinge(mesh: PlateMesh, flap_elements, hinge_point, hinge_axis) -> HingeSplit:
@@ -95,10 +110,12 @@ def split_at_hinge(mesh: PlateMesh, flap_elements, hinge_point, hinge_axis) -> H
     >>> hs.copy_of.tolist(), hs.on_hinge.tolist(), hs.weight.tolist()
     ([1, 4, 7], [True, True, True], [0.25, 0.5, 0.25])
     """
-    flap = np.asarray(flap_elements, bool).reshape(-1)
-    if flap.shape != (mesh.n_elements,) or not flap.any():
-        raise ValueError(f"flap_elements must be {mesh.n_elements} booleans with at least one "
-                         f"True, got {flap.size} with {int(flap.sum())} True")
+    return split_at_hinges(mesh, [flap_elements], [hinge_point], [hinge_axis])[0]
+
+
+def _surface_copies(mesh, flap, hinge_point, hinge_axis, wing_nodes, earlier_nodes, k):
+    """Surface ``k``'s shared nodes (sorted), which of them lie on its hinge line, their
+    shares of the hinge length and the unit hinge axis (:func:`split_at_hinges`)."""
     s = np.asarray(hinge_axis, float).reshape(2)
     s = s / np.hypot(*s)
     p0 = np.asarray(hinge_point, float).reshape(2)
@@ -106,20 +123,15 @@ def split_at_hinge(mesh: PlateMesh, flap_elements, hinge_point, hinge_axis) -> H
     d = (mesh.nodes - p0) @ aft                               # distance aft of the hinge (m)
     tol = 1e-9 * max(float(np.ptp(mesh.nodes[:, 0])), float(np.ptp(mesh.nodes[:, 1])), 1e-300)
     fn = np.unique(mesh.elements[flap])
+    where = "" if k is None else f" (surface {k})"
     if np.any(d[fn] < -tol):
-        raise ValueError("flap_elements must lie aft of the hinge line: an element of the "
-                         "surface has a node ahead of it")
-    shared = np.intersect1d(fn, np.unique(mesh.elements[~flap]))
-    on_hinge = np.abs(d[shared]) <= tol
+        raise ValueError(f"flap_elements must lie aft of the hinge line: an element of the "
+                         f"surface{where} has a node ahead of it")
+    shared = np.union1d(np.intersect1d(fn, wing_nodes), np.intersect1d(fn, earlier_nodes))
+    on_hinge = (np.abs(d[shared]) <= tol) & np.isin(shared, wing_nodes)
     if on_hinge.sum() < 2:
-        raise ValueError("the mesh has no element edge on the hinge line (fewer than two shared "
-                         "nodes on it): place a row of nodes on the hinge")
-    n0 = mesh.n_nodes
-    new = np.full(n0, -1)
-    new[shared] = n0 + np.arange(shared.size)
-    elements = mesh.elements.copy()
-    sub = elements[flap]
-    elements[flap] = np.where(new[sub] >= 0, new[sub], sub)
+        raise ValueError(f"the mesh has no element edge on the hinge line{where} (fewer than "
+                         f"two shared nodes on it): place a row of nodes on the hinge")
     along = mesh.nodes[shared] @ s
     weight = np.zeros(shared.size)
     h = np.flatnonzero(on_hinge)
@@ -130,18 +142,101 @@ def split_at_hinge(mesh: PlateMesh, flap_elements, hinge_point, hinge_axis) -> H
     w[:-1] += 0.5 * gaps
     w[1:] += 0.5 * gaps
     weight[order] = w / w.sum()
-    split = replace(mesh, nodes=np.vstack([mesh.nodes, mesh.nodes[shared]]), elements=elements)
-    return HingeSplit(split, n0, shared, on_hinge, weight, flap, s)
+    return shared, on_hinge, weight, s
+
+
+def split_at_hinges(mesh: PlateMesh, flap_elements, hinge_points, hinge_axes) -> tuple:
+    """Split the mesh for several side-by-side surfaces at once (:func:`split_at_hinge`'s rule
+    surface by surface).
+
+    Surface k copies the nodes its elements share with the wing (the elements of no surface)
+    and with the surfaces before it; a copy is tied at the hinge when it lies on surface k's
+    hinge line and on a wing element, else it is free (a side edge, also the gap between two
+    adjacent surfaces: the first of the two keeps the original node, the second gets a free
+    copy, so no node is left without an element). Surfaces may not share an element (a tab
+    nested in a flap is not a side-by-side surface).
+
+    Parameters
+    ----------
+    mesh : the plate mesh.
+    flap_elements : n_s arrays (n_elem,) of bool, one per surface, disjoint.
+    hinge_points : n_s points (x, y) m, one on each hinge line.
+    hinge_axes : n_s directions (s_x, s_y) (normalised here; outboard).
+
+    Returns
+    -------
+    tuple of n_s :class:`HingeSplit`, all on the same split ``mesh`` (the original nodes, then
+    surface 0's copies, then surface 1's, ...; ``first_copy`` tells where each begins).
+
+    Raises
+    ------
+    ValueError
+        As :func:`split_at_hinge`, naming the surface; two surfaces sharing an element.
+
+    Examples
+    --------
+    The 2 x 2 mesh of :func:`split_at_hinge`, the aft column split into an inboard and an
+    outboard surface: the node between them at the trailing edge (node 5) stays the inboard
+    surface's, the outboard one gets a free copy of it.
+
+    >>> from asekit.geometry import Planform, Thickness
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> pm = panels_mesh([Planform((0, 0), 1.0, (0, 1.0), 1.0)], Thickness(0.01, 0.01), 2, [2])
+    >>> c = pm.element_centroids()
+    >>> a, b = split_at_hinges(pm, [(c[:, 0] > 0.5) & (c[:, 1] < 0.5),
+    ...                             (c[:, 0] > 0.5) & (c[:, 1] > 0.5)],
+    ...                        [(0.5, 0.0)] * 2, [(0.0, 1.0)] * 2)
+    >>> a.copy_of.tolist(), a.on_hinge.tolist(), b.copy_of.tolist(), b.on_hinge.tolist()
+    ([1, 4], [True, True], [4, 5, 7], [True, False, True])
+    >>> a.mesh.n_nodes, b.first_copy
+    (14, 2)
+    """
+    flaps = [np.asarray(f, bool).reshape(-1) for f in flap_elements]
+    n_s = len(flaps)
+    if n_s == 0 or len(hinge_points) != n_s or len(hinge_axes) != n_s:
+        raise ValueError(f"flap_elements, hinge_points and hinge_axes must have one entry per "
+                         f"surface (at least one), got {n_s}, {len(hinge_points)} and "
+                         f"{len(hinge_axes)}")
+    for f in flaps:
+        if f.shape != (mesh.n_elements,) or not f.any():
+            raise ValueError(f"flap_elements must be {mesh.n_elements} booleans with at least "
+                             f"one True, got {f.size} with {int(f.sum())} True")
+    count = np.sum(flaps, axis=0)
+    if np.any(count > 1):
+        raise ValueError("flap_elements: two surfaces share an element (a surface nested in "
+                         "another is not supported)")
+    wing_nodes = np.unique(mesh.elements[count == 0])
+    n0 = mesh.n_nodes
+    elements = mesh.elements.copy()
+    parts, offset = [], 0
+    for k, (flap, p, a) in enumerate(zip(flaps, hinge_points, hinge_axes)):
+        earlier = (np.unique(mesh.elements[np.any(flaps[:k], axis=0)]) if k
+                   else np.zeros(0, int))
+        shared, on_hinge, weight, s = _surface_copies(mesh, flap, p, a, wing_nodes, earlier,
+                                                      None if n_s == 1 else k)
+        new = np.full(n0, -1)
+        new[shared] = n0 + offset + np.arange(shared.size)
+        sub = mesh.elements[flap]
+        elements[flap] = np.where(new[sub] >= 0, new[sub], sub)
+        parts.append((shared, on_hinge, weight, flap, s, offset))
+        offset += shared.size
+    copies = np.concatenate([q[0] for q in parts])
+    split = replace(mesh, nodes=np.vstack([mesh.nodes, mesh.nodes[copies]]), elements=elements)
+    return tuple(HingeSplit(split, n0, sh, oh, w, f, s, off) for sh, oh, w, f, s, off in parts)
 
 
 @dataclass(frozen=True)
 class ReleasedHinge:
-    """The split structure with its hinge constraints eliminated (:func:`release_hinge`).
+    """The split structure with its hinge constraints eliminated (:func:`release_hinge`,
+    :func:`release_hinges`).
 
     ``K``, ``M``, ``C`` (n_q, n_q) sparse reduced stiffness, mass and (hinge) damping;
     ``T`` (3 n_split_nodes, n_q) sparse, u = T q on the split mesh's DOFs; ``hinge_index``
     (n_r,) the positions in q of the relative rotations r; ``hinge_stiffness`` (n_r,) the
-    spring on each (N m/rad); ``weight`` (n_r,) their shares of the hinge length; ``split``.
+    spring on each (N m/rad); ``weight`` (n_r,) their shares of the hinge length; ``split``
+    the (first) surface's :class:`HingeSplit`; ``splits`` all of them (one per surface, empty
+    for :func:`release_hinge`'s one surface); ``surface`` (n_r,) the surface of each r (None:
+    all the one surface's).
     """
 
     K: sp.csr_matrix
@@ -152,16 +247,26 @@ class ReleasedHinge:
     hinge_stiffness: np.ndarray
     weight: np.ndarray
     split: HingeSplit
+    splits: tuple = ()
+    surface: np.ndarray | None = None
+
+    def _per_surface(self, coeff, q) -> np.ndarray:
+        v = np.asarray(q)[self.hinge_index]
+        if len(self.splits) <= 1:
+            return coeff @ v
+        return np.stack([coeff[self.surface == k] @ v[self.surface == k]
+                         for k in range(len(self.splits))])
 
     def hinge_rotation(self, q) -> np.ndarray:
         """The hinge rotation (rad): the length-weighted mean relative rotation sum w_n r_n of
-        the reduced vector(s) ``q`` (n_q, ...)."""
-        return self.weight @ np.asarray(q)[self.hinge_index]
+        the reduced vector(s) ``q`` (n_q, ...); (n_s, ...) one per surface for several."""
+        return self._per_surface(self.weight, q)
 
     def hinge_moment(self, q) -> np.ndarray:
         """The hinge spring's moment H = sum k_n r_n (N m; the moment that holds the surface,
-        positive when the surface is rotated trailing edge down) of ``q`` (n_q, ...)."""
-        return self.hinge_stiffness @ np.asarray(q)[self.hinge_index]
+        positive when the surface is rotated trailing edge down) of ``q`` (n_q, ...); (n_s, ...)
+        one per surface for several."""
+        return self._per_surface(self.hinge_stiffness, q)
 
 
 def release_hinge(split: HingeSplit, K, M, hinge_stiffness: float, hinge_damping: float = 0.0,
@@ -207,35 +312,106 @@ def release_hinge(split: HingeSplit, K, M, hinge_stiffness: float, hinge_damping
         raise ValueError(f"release must be one of {RELEASES}, got {release!r}")
     k_h = in_range("hinge_stiffness", hinge_stiffness, 0.0, inclusive=True)
     c_h = in_range("hinge_damping", hinge_damping, 0.0, inclusive=True)
-    n0, dof = split.n_original, DOF_PER_NODE
+    return _release((split,), K, M, [k_h], [c_h], release, support, support_stiffness,
+                    support_mass)
+
+
+def release_hinges(splits, K, M, hinge_stiffness, hinge_damping=0.0, support=None,
+                   support_stiffness=None, support_mass=None) -> ReleasedHinge:
+    """Release several side-by-side surfaces (:func:`split_at_hinges`), each about its own
+    hinge rotation r_k on its own spring k_h,k and damper c_h,k (a ``"single"`` release per
+    surface, :func:`release_hinge`'s constraints surface by surface):
+    q = [q_s, every surface's free copies' DOFs (surface by surface), r_0, ..., r_(n_s - 1)].
+
+    Parameters
+    ----------
+    splits : the tuple of :func:`split_at_hinges`.
+    K, M : (3 n, 3 n) stiffness and mass of the split mesh, unsupported.
+    hinge_stiffness, hinge_damping : one value per surface or one for all (N m/rad, N m s/rad,
+        >= 0).
+    support, support_stiffness, support_mass : as :func:`release_hinge`.
+
+    Returns
+    -------
+    ReleasedHinge (``hinge_index`` (n_s,), one rotation per surface, in the surfaces' order).
+
+    Examples
+    --------
+    The two surfaces of :func:`split_at_hinges`' example: the 4 + 2 hinge copies' DOFs are
+    replaced by two rotations, the outboard surface's free copy keeps its 3 DOFs.
+
+    >>> from asekit.geometry import Material, Planform, Thickness
+    >>> from asekit.structure.assembly import assemble
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> pm = panels_mesh([Planform((0, 0), 1.0, (0, 1.0), 1.0)], Thickness(0.01, 0.01), 2, [2])
+    >>> c = pm.element_centroids()
+    >>> parts = split_at_hinges(pm, [(c[:, 0] > 0.5) & (c[:, 1] < 0.5),
+    ...                              (c[:, 0] > 0.5) & (c[:, 1] > 0.5)],
+    ...                         [(0.5, 0.0)] * 2, [(0.0, 1.0)] * 2)
+    >>> K, M = assemble(parts[0].mesh, Material(70e9, 0.3, 2700.0))
+    >>> rh = release_hinges(parts, K, M, [10.0, 20.0])
+    >>> rh.T.shape, rh.hinge_index.tolist(), rh.hinge_stiffness.tolist()
+    ((42, 32), [30, 31], [10.0, 20.0])
+    """
+    splits = tuple(splits)
+    n = len(splits)
+    k_h = np.broadcast_to(np.asarray(hinge_stiffness, float), (n,))
+    c_h = np.broadcast_to(np.asarray(hinge_damping, float), (n,))
+    k_h = [in_range("hinge_stiffness", x, 0.0, inclusive=True) for x in k_h]
+    c_h = [in_range("hinge_damping", x, 0.0, inclusive=True) for x in c_h]
+    return _release(splits, K, M, k_h, c_h, "single", support, support_stiffness,
+                    support_mass)
+
+
+def _release_map(splits, S, release):
+    """T (u = T q) and the hinge rotations' positions in q (:func:`_release`)."""
+    first = splits[0]
+    n0, dof = first.n_original, DOF_PER_NODE
+    n_s = S.shape[1]
+    free = [sp_.copy_nodes[~sp_.on_hinge] for sp_ in splits]
+    n_f = dof * sum(f.size for f in free)
+    hinge = [np.flatnonzero(sp_.on_hinge) for sp_ in splits]
+    n_r = [1 if release == "single" else h.size for h in hinge]
+    n_q = n_s + n_f + sum(n_r)
+    blocks = sp.lil_matrix((dof * first.mesh.n_nodes, n_q))
+    blocks[: dof * n0, :n_s] = S
+    for j, node in enumerate(np.concatenate(free)):
+        for k in range(dof):
+            blocks[dof * node + k, n_s + dof * j + k] = 1.0
+    S = S.tolil()
+    r0 = n_s + n_f
+    for sp_, h, nr in zip(splits, hinge, n_r):
+        s = sp_.hinge_axis
+        for j, c in enumerate(h):
+            m = sp_.copy_of[c]
+            node = sp_.copy_nodes[c]
+            r = r0 + (0 if nr == 1 else j)
+            for k in range(dof):
+                blocks[dof * node + k, :n_s] = S[dof * m + k, :]
+            blocks[dof * node + 1, r] = s[0]
+            blocks[dof * node + 2, r] = s[1]
+        r0 += nr
+    return blocks.tocsr(), n_s + n_f + np.arange(sum(n_r)), n_r
+
+
+def _release(splits, K, M, k_h, c_h, release, support, support_stiffness, support_mass):
+    """The reduced system of :func:`release_hinge` / :func:`release_hinges` (K_r = T^T K T +
+    the springs, M_r = T^T M T, Cook et al. 2002, Eqs. 9.2-3 to 9.2-5)."""
+    n0, dof = splits[0].n_original, DOF_PER_NODE
     S = sp.identity(dof * n0, format="csr") if support is None else sp.csr_matrix(support)
     if S.shape[0] != dof * n0:
         raise ValueError(f"support must have {dof * n0} rows (the original nodes' DOFs), got "
                          f"{S.shape[0]}")
-    free = np.flatnonzero(~split.on_hinge)
-    hinge = np.flatnonzero(split.on_hinge)
-    n_s, n_f = S.shape[1], dof * free.size
-    n_r = 1 if release == "single" else hinge.size
-    n_q = n_s + n_f + n_r
-    n_split = split.mesh.n_nodes
-    blocks = sp.lil_matrix((dof * n_split, n_q))
-    blocks[: dof * n0, :n_s] = S
-    for j, c in enumerate(free):
-        for k in range(dof):
-            blocks[dof * (n0 + c) + k, n_s + dof * j + k] = 1.0
-    S = S.tolil()
-    s = split.hinge_axis
-    for j, c in enumerate(hinge):
-        m = split.copy_of[c]
-        r = n_s + n_f + (0 if n_r == 1 else j)
-        for k in range(dof):
-            blocks[dof * (n0 + c) + k, :n_s] = S[dof * m + k, :]
-        blocks[dof * (n0 + c) + 1, r] = s[0]
-        blocks[dof * (n0 + c) + 2, r] = s[1]
-    T = blocks.tocsr()
-    weight = np.ones(1) if n_r == 1 else split.weight[hinge]
-    k_n, c_n = k_h * weight, c_h * weight
-    idx = n_s + n_f + np.arange(n_r)
+    n_s = S.shape[1]
+    T, idx, n_r = _release_map(splits, S, release)
+    n_q = T.shape[1]
+    surface = np.repeat(np.arange(len(splits)), n_r)
+    if release == "single":
+        weight = np.ones(len(splits))
+    else:
+        weight = splits[0].weight[splits[0].on_hinge]
+    k_n = np.asarray(k_h, float)[surface] * weight
+    c_n = np.asarray(c_h, float)[surface] * weight
     spring = sp.csr_matrix((k_n, (idx, idx)), shape=(n_q, n_q))
     damper = sp.csr_matrix((c_n, (idx, idx)), shape=(n_q, n_q))
     Kr = (T.T @ K @ T).tocsr() + spring
@@ -250,9 +426,11 @@ def release_hinge(split: HingeSplit, K, M, hinge_stiffness: float, hinge_damping
             Kr = Kr + pad @ sp.csr_matrix(extra) @ pad.T
         else:
             Mr = Mr + pad @ sp.csr_matrix(extra) @ pad.T
+    several = len(splits) > 1
     return ReleasedHinge(K=(0.5 * (Kr + Kr.T)).tocsr(), M=(0.5 * (Mr + Mr.T)).tocsr(),
                          C=damper, T=T, hinge_index=idx, hinge_stiffness=k_n, weight=weight,
-                         split=split)
+                         split=splits[0], splits=splits if several else (),
+                         surface=surface if several else None)
 
 
 def released_modes(released: ReleasedHinge, n_modes: int, shift: float = -1.0):
@@ -320,17 +498,55 @@ def hinge_constraint_mode(released: ReleasedHinge) -> np.ndarray:
     >>> round(float(u[3 * 8]), 9)                      # w of the trailing-edge tip node: -0.5 m
     -0.5
     """
-    import scipy.sparse.linalg as spla
-
     if released.hinge_index.size != 1:
         raise ValueError("hinge_constraint_mode needs a 'single' release (one hinge rotation)")
-    r = int(released.hinge_index[0])
-    other = np.setdiff1d(np.arange(released.K.shape[0]), [r])
+    return hinge_constraint_modes(released)[:, 0]
+
+
+def hinge_constraint_modes(released: ReleasedHinge) -> np.ndarray:
+    """The constraint modes of all the hinge rotations r (Craig & Bampton 1968, Eq. 5, the
+    interface coordinates being the r): column k is the static shape of r_k = 1 with the other
+    rotations held at 0 and the rest of q unloaded, Psi_o = -K_oo^-1 K_oR (one sparse
+    factorisation of K_oo for all columns). With several surfaces
+    (:func:`release_hinges`) each column is one surface's rotation about its own hinge, the
+    others held.
+
+    Returns
+    -------
+    (n_q, n_r) reduced vectors, Psi[hinge_index] = identity.
+
+    Examples
+    --------
+    Two side-by-side surfaces on the two outboard aft elements of a clamped 2 x 3 plate
+    (1 m x 1.5 m): each mode moves the trailing edge of its own surface only (w = -0.5 m at
+    nodes 8, (1, 1), and 11, (1, 1.5)).
+
+    >>> from asekit.geometry import Material, Planform, Thickness
+    >>> from asekit.structure.assembly import assemble, clamped_edge
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> pm = panels_mesh([Planform((0, 0), 1.0, (0, 1.5), 1.0)], Thickness(0.01, 0.01), 2, [3])
+    >>> c = pm.element_centroids()
+    >>> parts = split_at_hinges(pm, [(c[:, 0] > 0.5) & (abs(c[:, 1] - 0.75) < 0.1),
+    ...                              (c[:, 0] > 0.5) & (c[:, 1] > 1.0)],
+    ...                         [(0.5, 0.0)] * 2, [(0.0, 1.0)] * 2)
+    >>> K, M = assemble(parts[0].mesh, Material(70e9, 0.3, 2700.0))
+    >>> K0, M0 = assemble(pm, Material(70e9, 0.3, 2700.0))
+    >>> rh = release_hinges(parts, K, M, 1.0, support=clamped_edge(pm, K0, M0).T)
+    >>> u = rh.T @ hinge_constraint_modes(rh)
+    >>> (np.round(u[3 * np.array([8, 11])], 9) + 0.0).tolist()
+    [[-0.5, 0.0], [0.0, -0.5]]
+    """
+    import scipy.sparse.linalg as spla
+
+    R = np.asarray(released.hinge_index)
+    other = np.setdiff1d(np.arange(released.K.shape[0]), R)
     K = released.K.tocsc()
-    q = np.zeros(K.shape[0])
-    q[r] = 1.0
-    q[other] = -spla.spsolve(K[other][:, other], K[other][:, [r]].toarray().ravel())
-    return q
+    psi = np.zeros((K.shape[0], R.size))
+    psi[R, np.arange(R.size)] = 1.0
+    rhs = K[other][:, R].toarray()
+    sol = spla.splu(K[other][:, other].tocsc()).solve(rhs)
+    psi[other] = -sol
+    return psi
 
 
 def hinge_balance_mass(split: HingeSplit, position, distance_aft: float, mass: float):
@@ -381,9 +597,9 @@ def hinge_balance_mass(split: HingeSplit, position, distance_aft: float, mass: f
         raise ValueError(f"distance_aft must be finite, got {distance_aft!r}")
     p = np.asarray(position, float).reshape(2)
     s = np.asarray(split.hinge_axis, float)
-    copies = np.flatnonzero(split.on_hinge)
-    nodes = split.mesh.nodes[split.n_original + copies]
-    c = split.n_original + copies[int(np.argmin(np.abs((nodes - p) @ s)))]
+    copies = split.copy_nodes[split.on_hinge]
+    nodes = split.mesh.nodes[copies]
+    c = copies[int(np.argmin(np.abs((nodes - p) @ s)))]
     dofs = DOF_PER_NODE * c + np.arange(3)
     g = np.array([1.0, -d * s[0], -d * s[1]])
     n = DOF_PER_NODE * split.mesh.n_nodes

@@ -50,9 +50,12 @@ def test_kind_is_read_and_checked():
     d = _elastic()
     d["control_surface"].append(dict(d["control_surface"][0], name="inboard", kind="rigid",
                                      span_fraction=[0.1, 0.4]))
-    with pytest.raises(CaseError, match=r"control_surface\[0\]\.kind = \"elastic\" needs it to "
-                                        r"be the case's only control surface"):
+    with pytest.raises(CaseError, match=r"control_surface\[1\]\.kind = \"rigid\" cannot be mixed "
+                                        r"with the elastic control_surface\[0\]"):
         case_from_dict(d)
+    d["control_surface"][1]["kind"] = "elastic"          # several elastic surfaces: allowed
+    d["control_surface"][1].pop("actuator")             # (one actuator per case)
+    assert [c.kind for c in case_from_dict(d).control_surfaces] == ["elastic", "elastic"]
 
 
 def test_mesh_and_support_are_checked():
