@@ -1343,7 +1343,11 @@ class ControlSurfaceRow:
     """Steady results of one control surface at one Mach number (rigid derivatives per rad,
     C_h = H / (q S_f c_f); the flexible rolling-moment effectiveness against speed at
     ``density`` (kg/m^3), the first flight condition, the surfaces held at their deflection;
-    reversal and divergence speeds in m/s, None when not found below ``speed_limit_ms``)."""
+    reversal and divergence speeds in m/s, None when not found below ``speed_limit_ms``;
+    pitching moment Cm = M_y / (q S c_ref) about the mean aerodynamic chord's quarter point,
+    nose up positive (:func:`asekit.aero.control_surface.steady_control_derivatives`); the rigid
+    rolling moment about y = 0 of the half model per unit dynamic pressure and per rad of the
+    deflection, m^3, positive for lift at y > 0, with the antisymmetric image at a wall)."""
 
     name: str
     mach: float
@@ -1359,6 +1363,9 @@ class ControlSurfaceRow:
     speed_limit_ms: float
     inertia: float
     static_unbalance: float
+    dCm_ddelta_per_rad: float = math.nan
+    dCm_dalpha_per_rad: float = math.nan
+    rolling_moment_per_rad_m3: float = math.nan
 
 
 @_memo_with_warnings
@@ -1410,7 +1417,8 @@ def control_surfaces(case: Case) -> tuple[ControlSurfaceRow, ...]:
                 np.sqrt(2.0 * se.dynamic_pressure / rho), se.ratio[i],
                 None if not math.isfinite(u_r[i]) else float(u_r[i]),
                 None if u_d is None or u_d > u_lim else u_d, u_lim,
-                float(fm.inertia[i]), float(fm.static_unbalance[i])))
+                float(fm.inertia[i]), float(fm.static_unbalance[i]),
+                float(d.dCm_ddelta[i]), float(d.dCm_dalpha), float(se.rigid[i])))
     return tuple(rows)
 
 

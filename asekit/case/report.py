@@ -100,6 +100,14 @@ UNITS = {
     "omega_max": "rad/s (upper end of the turbulence integrals: k_max U / b)",
     "dCL_ddelta_per_rad": "1/rad (lift coefficient on the panel area per rad of deflection)",
     "dCL_dalpha_per_rad": "1/rad",
+    "dCm_ddelta_per_rad": "1/rad (pitching moment / (q S c_ref) about the mean aerodynamic "
+                          "chord's quarter point, nose up > 0, per rad of deflection)",
+    "dCm_dalpha_per_rad": "1/rad (pitching moment / (q S c_ref) about the mean aerodynamic "
+                          "chord's quarter point, nose up > 0)",
+    "rolling_moment_per_rad_m3": "m^3 (rigid rolling moment about the root chord line of the "
+                                 "half model per unit dynamic pressure and per rad of "
+                                 "deflection, > 0 for lift outboard; the opposite aileron's "
+                                 "image at a wall)",
     "Ch_delta": "1/rad (hinge moment / (q S_f c_f), > 0 trailing edge down)",
     "Ch_alpha": "1/rad (hinge moment / (q S_f c_f), > 0 trailing edge down)",
     "reversal_speed_ms": "m/s", "divergence_speed_ms": "m/s",
@@ -540,7 +548,10 @@ def control_surfaces_json(case, rows, freeplay=()) -> list[dict]:
     return [{"name": r.name, "kind": kinds.get(r.name), "mach": r.mach,
              "dCL_ddelta_per_rad": r.dCL_ddelta_per_rad,
              "dCL_dalpha_per_rad": r.dCL_dalpha_per_rad, "Ch_delta": r.Ch_delta,
-             "Ch_alpha": r.Ch_alpha, "reversal_speed_ms": _f(r.reversal_speed_ms),
+             "Ch_alpha": r.Ch_alpha, "dCm_ddelta_per_rad": _f(r.dCm_ddelta_per_rad),
+             "dCm_dalpha_per_rad": _f(r.dCm_dalpha_per_rad),
+             "rolling_moment_per_rad_m3": _f(r.rolling_moment_per_rad_m3),
+             "reversal_speed_ms": _f(r.reversal_speed_ms),
              "divergence_speed_ms": _f(r.divergence_speed_ms), "density": r.density,
              "hinge_inertia_kgm2": r.inertia, "static_unbalance_kgm": r.static_unbalance,
              **freeplay_json(freeplay, r.name, r.mach)} for r in rows]

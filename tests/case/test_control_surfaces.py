@@ -101,6 +101,12 @@ def test_pipeline_rows_physics(rows):
         assert r.reversal_speed_ms is not None and r.divergence_speed_ms is not None
         assert 0 < r.reversal_speed_ms < r.divergence_speed_ms
         assert r.static_unbalance > 0 and r.inertia > 0
+        # the flap's lift acts aft of the quarter chord (nose down), the plate's at it; the
+        # outboard aileron's lift rolls the wing, its centre of pressure on the half span
+        # (0 < roll < the half wing's symmetric lift per rad x its span of 1.2 m)
+        assert r.dCm_ddelta_per_rad < 0 and abs(r.dCm_dalpha_per_rad) < 0.05 * r.dCL_dalpha_per_rad
+        s_half = 0.3 * 1.2
+        assert 0 < r.rolling_moment_per_rad_m3 < r.dCL_ddelta_per_rad * s_half * 1.2
     pg = rows[1].dCL_dalpha_per_rad / rows[0].dCL_dalpha_per_rad
     assert 1.0 < pg < 1.0 / math.sqrt(1 - 0.09) + 1e-9
     assert rows[1].reversal_speed_ms < rows[0].reversal_speed_ms
