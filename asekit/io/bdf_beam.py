@@ -36,7 +36,19 @@ from pathlib import Path
 import numpy as np
 import scipy.linalg as sla
 
-from asekit.io.bdf import UNITS, BdfError, _need_pynastran
+from asekit.io.bdf import (
+    UNITS,
+    BdfError,
+    Deck,
+    case_value,
+    check_caero1,
+    deck_boxes,
+    need_pynastran,
+    read_aero_card,
+    read_flutter,
+    read_mkaero1,
+    solve_request,
+)
 from asekit.structure.frame import BarSection, global_bar_matrices
 
 #: structural cards a stick deck may hold (others are refused).
@@ -393,7 +405,7 @@ def read_stick_deck(path, units: str = "SI") -> StickModel:
     """
     if units not in UNITS:
         raise ValueError(f"units must be one of {sorted(UNITS)}, got {units!r}")
-    BDF = _need_pynastran()
+    BDF = need_pynastran()
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"BDF not found: {path}")
@@ -695,7 +707,7 @@ class _Table:
 def is_stick_deck(path) -> bool:
     """True when the deck's structure is bars (CBAR) and no shell: :func:`stick_flutter`'s
     deck, not :func:`asekit.io.bdf.read_bdf`'s."""
-    model = _need_pynastran()(debug=None)
+    model = need_pynastran()(debug=None)
     try:
         model.read_bdf(str(path), xref=False)
     except Exception:           # read_bdf reports the deck's error in its own words
@@ -722,22 +734,21 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     """
     from asekit.aero.gaf import TabulatedGaf, gaf_from_box_modes
     from asekit.aeroelastic.statespace import modal_arrays
-    from asekit.io import bdf as B
 
     sm = read_stick_deck(path, units)
-    model = _need_pynastran()(debug=None)
+    model = need_pynastran()(debug=None)
     model.read_bdf(str(path), xref=True)
     L, Mu, T = UNITS[units]
-    deck = B._Deck(model, Path(path).name, L, Mu, T)
+    deck = Deck(model, Path(path).name, L, Mu, T)
     if not model.caeros or not model.flutters:
         raise BdfError(f"{deck.name}: no CAERO1 or no FLUTTER card: nothing to run")
-    b_ref, rho_ref, symmetric = B._read_aero_card(deck)      # ACSID first: the flow axis
+    b_ref, rho_ref, symmetric = read_aero_card(deck)      # ACSID first: the flow axis
     for c in model.caeros.values():
-        B._check_caero1(deck, c)
-    mesh, box_ids = B._boxes(model, L, 0.0)
-    machs, table_ks = B._read_mkaero1(model, deck)
-    requests = [B._flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
-    fm = B._case_value(model, "FMETHOD")
+        check_caero1(deck, c)
+    mesh, box_ids = deck_boxes(model, L, 0.0)
+    machs, table_ks = read_mkaero1(model, deck)
+    requests = [read_flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
+    fm = case_value(model, "FMETHOD")
     requests.sort(key=lambda r: r.sid != fm)
     modes = stick_modes(sm, _n_modes(model))
     bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L)
@@ -747,7 +758,7 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     db = _Table({m: TabulatedGaf(ks, gaf_from_box_modes(bm, mesh, m, ks, b_ref, symmetric),
                                  b_ref, m) for m in machs})
     return StickFlutter(modes=modes, b_ref=b_ref,
-                        results=tuple(B._solve_request(r, modal, db) for r in requests))
+                        results=tuple(solve_request(r, modal, db) for r in requests))
 
 
 # ---------------------------------------------------------------------------------------------
