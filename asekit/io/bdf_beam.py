@@ -142,7 +142,15 @@ class StickModes:
     notes: tuple = field(default=())
 
 
-def _card_ids(model, card: str) -> list:
+def card_ids(model, card: str) -> list:
+    """The ids of every ``card`` (e.g. ``"CBAR"``) of a pyNastran model, in its order.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> card_ids(NS(_type_to_id_map={"CBAR": [3, 1]}), "CBAR")
+    [3, 1]
+    """
     return list(model._type_to_id_map.get(card, ()))
 
 
@@ -155,17 +163,17 @@ BAR_CARDS = ("CBAR", "CBEAM")
 
 
 def _refuse_cards(model, name: str) -> None:
-    found = {c for c in REFUSED_CARDS if _card_ids(model, c)}
+    found = {c for c in REFUSED_CARDS if card_ids(model, c)}
     for attr, ok in _ALLOWED.items():
         found |= {v.type for v in getattr(model, attr).values() if v.type not in ok}
-    bad = [(c, len(_card_ids(model, c)), (_card_ids(model, c) or ["?"])[0])
+    bad = [(c, len(card_ids(model, c)), (card_ids(model, c) or ["?"])[0])
            for c in sorted(found)]
     if bad:
         listed = ", ".join(f"{c} (x{n}, first id {i})" for c, n, i in bad)
         raise BdfError(f"{name}: the stick-model import cannot represent {listed}; it reads "
                        f"CBAR/CBEAM with PBAR/PBEAM/PBARL and MAT1, CMASS2, CONM2, RBE2, RBAR, "
                        f"SPC/SPC1 and GRID PS")
-    if not any(_card_ids(model, c) for c in BAR_CARDS):
+    if not any(card_ids(model, c) for c in BAR_CARDS):
         raise BdfError(f"{name}: no CBAR or CBEAM element: not a stick model")
 
 
@@ -187,8 +195,19 @@ def _grids(model, L: float):
     return ids, xyz, axes
 
 
-def _bar_vector(model, e, axes_of, xyz_of) -> np.ndarray:
-    """Orientation vector of a CBAR in basic (X1-X3 in GA's CD system, or toward G0)."""
+def bar_orientation(model, e, axes_of, xyz_of) -> np.ndarray:
+    """Orientation vector of a CBAR / CBEAM in basic (m or deck units, as ``xyz_of``).
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF``; e : the CBAR / CBEAM card.
+    axes_of : GRID id -> (3, 3) rows of its CD system's axes in basic.
+    xyz_of : GRID id -> (3,) its basic position.
+
+    Returns
+    -------
+    (3,) X1-X3 rotated from GA's CD system to basic, or G0 - GA (MSC QRG CBAR, CBEAM).
+    """
     if e.g0:
         return xyz_of(e.g0) - xyz_of(e.ga)
     return axes_of(e.ga).T @ np.asarray(e.x, float)
@@ -369,8 +388,26 @@ _SECTION_VALUES = {"PBAR": _pbar_values, "PBEAM": _pbeam_values, "PBARL": _pbarl
 _ELEMENT_PROPERTIES = {"CBAR": ("PBAR", "PBARL"), "CBEAM": ("PBEAM", "PBARL")}
 
 
-def _bar_section(model, pid: int, eid: int, deck_units, card: str = "CBAR") -> BarSection:
-    """PBAR / PBEAM / PBARL + MAT1 of a CBAR / CBEAM as SI section properties."""
+def bar_section(model, pid: int, eid: int, deck_units, card: str = "CBAR") -> BarSection:
+    """PBAR / PBEAM / PBARL + MAT1 of a CBAR / CBEAM as SI section properties.
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF``, cross-referenced.
+    pid, eid : the element's PID and id; card : "CBAR" or "CBEAM" (which properties it takes).
+    deck_units : (L m, Mu kg, T s, PARAM WTMASS) of one deck unit.
+
+    Returns
+    -------
+    :class:`~asekit.structure.frame.BarSection`
+        EA = E A, GJ = G J, EI1 = E I1, EI2 = E I2 (N, N m^2), mass = (rho A + NSM) WTMASS
+        (kg/m).
+
+    Raises
+    ------
+    BdfError
+        Naming the card, its id and the field asekit cannot represent.
+    """
     L, Mu, T, wt = deck_units
     p = model.properties[pid]
     if p.type not in _ELEMENT_PROPERTIES[card]:
@@ -392,13 +429,13 @@ def _bar_section(model, pid: int, eid: int, deck_units, card: str = "CBAR") -> B
 
 
 def _add_bars(model, K, M, index, xyz, axes, coupled, deck_units) -> None:
-    for eid in [i for c in BAR_CARDS for i in _card_ids(model, c)]:
+    for eid in [i for c in BAR_CARDS for i in card_ids(model, c)]:
         e = model.elements[eid]
         _check_bar(e)
         ia, ib = index[e.ga], index[e.gb]
-        v = _bar_vector(model, e, lambda g: axes[index[g]], lambda g: xyz[index[g]])
+        v = bar_orientation(model, e, lambda g: axes[index[g]], lambda g: xyz[index[g]])
         try:
-            sec = _bar_section(model, e.pid, eid, deck_units, e.type)
+            sec = bar_section(model, e.pid, eid, deck_units, e.type)
             Ke, Me = global_bar_matrices(xyz[ia], xyz[ib], v, sec, coupled)
         except BdfError:
             raise
@@ -417,7 +454,7 @@ def _add_conm2(model, M, index, deck_units) -> None:
     """CONM2: rigid mass m at offset x from its grid, inertia I about its centre, both in basic
     (CID 0): u_p = u + theta x x, so M_grid = G^T diag(m, m, m, I) G, G = [[1, -S(x)], [0, 1]]."""
     L, Mu, T, wt = deck_units
-    for eid in _card_ids(model, "CONM2"):
+    for eid in card_ids(model, "CONM2"):
         m = model.masses[eid]
         if m.cid not in (0, None):
             raise BdfError(f"CONM2 {eid}: CID = {m.cid} is not supported (0: basic)")
@@ -553,7 +590,15 @@ def _rigid_links(model, index, xyz, axes, fixed: set, ids) -> tuple:
     return tuple(sorted(dep.items()))
 
 
-def _param(model, key: str, default):
+def deck_param(model, key: str, default):
+    """The first value of PARAM ``key`` (e.g. ``"WTMASS"``), or ``default`` without it.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> deck_param(NS(params={"WTMASS": NS(values=[0.00259])}), "WTMASS", 1.0)
+    0.00259
+    """
     p = model.params.get(key)
     return p.values[0] if p is not None else default
 
@@ -595,8 +640,8 @@ def read_stick_deck(path, units: str = "SI") -> StickModel:
         raise BdfError(f"{path.name}: {str(exc).strip().splitlines()[0]}") from None
     _refuse_cards(model, path.name)
     L, Mu, T = UNITS[units]
-    wt = float(_param(model, "WTMASS", 1.0))
-    coupled = int(_param(model, "COUPMASS", -1)) > 0
+    wt = float(deck_param(model, "WTMASS", 1.0))
+    coupled = int(deck_param(model, "COUPMASS", -1)) > 0
     deck_units = (L, Mu, T, wt)
     ids, xyz, axes = _grids(model, L)
     index = {int(g): i for i, g in enumerate(ids)}
@@ -610,7 +655,7 @@ def read_stick_deck(path, units: str = "SI") -> StickModel:
     _add_cmass2_si(model, M, index, deck_units)
     fixed = _fixed_dofs(model, index, path.name)
     rigid = _rigid_links(model, index, xyz, axes, fixed, ids)
-    notes = (f"{len(_card_ids(model, 'CBAR'))} CBAR, {len(_card_ids(model, 'CBEAM'))} CBEAM, "
+    notes = (f"{len(card_ids(model, 'CBAR'))} CBAR, {len(card_ids(model, 'CBEAM'))} CBEAM, "
              f"{len(ids)} GRID; bar mass "
              f"{'consistent (PARAM COUPMASS 1)' if coupled else 'lumped'}",)
     return StickModel(node_ids=ids, xyz=xyz, cd_axes=axes, K=0.5 * (K + K.T),
@@ -623,7 +668,7 @@ def _add_cmass2_si(model, M, index, deck_units) -> None:
     entry scaled by the SI factor of its two DOFs, Mu s_i s_j (s = 1 for a translation, L for
     a rotation: a mass in kg, a rotary inertia in kg m^2, a coupling in kg m)."""
     L, Mu, T, wt = deck_units
-    for eid in _card_ids(model, "CMASS2"):
+    for eid in card_ids(model, "CMASS2"):
         c = model.masses[eid]
         dofs, scale = [], []
         for g, comp in ((c.nodes[0], c.c1), (c.nodes[1], c.c2)):
@@ -851,7 +896,16 @@ def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L
     return BoxModes(h_cp, d_cp, h_lp)
 
 
-def _n_modes(model) -> int:
+def requested_mode_count(model) -> int:
+    """The number of modes a stick deck asks for: PARAM LMODES (> 0), else the ND of its
+    first EIGR / EIGRL, else 6.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> requested_mode_count(NS(params={}, methods={10: NS(nd=4)}))
+    4
+    """
     p = model.params.get("LMODES")
     if p is not None and int(p.values[0]) > 0:
         return int(p.values[0])
@@ -930,7 +984,7 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     requests = [read_flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
     fm = case_value(model, "FMETHOD")
     requests.sort(key=lambda r: r.sid != fm)
-    modes = stick_modes(sm, _n_modes(model))
+    modes = stick_modes(sm, requested_mode_count(model))
     bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L)
     w = 2 * np.pi * modes.frequencies_hz
     modal = modal_arrays(M=np.eye(w.size), K=np.diag(w ** 2))
@@ -998,8 +1052,8 @@ def write_beam_bdf(beam, path, element: str = "CBAR") -> Path:
     flap plane), PBAR with MAT1 E = G = 1 Pa (A = EA, I1 = EI_flap, I2 = EI_chord, J = GJ,
     NSM = m), PARAM COUPMASS 1 (the consistent bar mass), SPC1 123456 at the root. With
     ``element="CBEAM"`` the elements are CBEAM with a constant-section PBEAM holding the same
-    values (end B "YESA", K1 = K2 = 0.0: no shear flexibility), the same Euler-Bernoulli bar. What a PBAR
-    cannot hold -- the polar inertia, the mass offset's bending-torsion coupling and the point
+    values (end B "YESA", K1 = K2 = 0.0: no shear flexibility), the same Euler-Bernoulli bar.
+    What a PBAR cannot hold -- the polar inertia, the mass offset's bending-torsion coupling and the point
     masses -- is the difference between the beam's consistent mass matrix
     (:func:`asekit.structure.beam.assemble`) and the bars' one, written exactly as CMASS2 scalar
     masses (:func:`scalar_mass_pairs`; some negative, as a consistent matrix's lumped form
