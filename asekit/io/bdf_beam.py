@@ -237,6 +237,11 @@ def _pbar_values(p) -> tuple:
     """PBAR: (A, I1, I2, J, NSM) in deck units; I12 refused."""
     if p.i12:
         raise BdfError(f"PBAR {p.pid}: I12 = {p.i12:g} is not supported (0: principal axes)")
+    for name in ("k1", "k2"):           # blank (pyNastran: 1e8) or 0.0: no shear flexibility
+        k = getattr(p, name, None)
+        if k not in (None, 0.0, 1e8):
+            raise BdfError(f"PBAR {p.pid}: {name.upper()} = {k:g} (shear flexibility) is not "
+                           f"supported (blank or 0.0: the Euler-Bernoulli bar asekit builds)")
     return p.A, p.i1, p.i2, p.j, p.nsm or 0.0
 
 

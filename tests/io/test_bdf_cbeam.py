@@ -138,6 +138,8 @@ def test_goland_wing_as_a_cbeam_deck_reads_back_to_its_modes(tmp_path):
     (_elements("CBEAM"), [f"PBAR,1,1,{A!r},{I1!r},{I2!r},{J!r}"],
      r"CBEAM 1: PID 1 is a PBAR; a CBEAM takes PBEAM or PBARL"),
     (_elements("CBEAM", "\n,,,0.0,0.1,0.0"), _pbeam(), r"CBEAM 1: offsets WA/WB"),
+    (_elements("CBAR"), [f"PBAR,1,1,{A!r},{I1!r},{I2!r},{J!r}", ",,,,,,,,", ",0.85,0.85"],
+     r"PBAR 1: K1 = 0.85 \(shear flexibility\) is not supported"),
     (_elements("CBAR"), ["PBARL,1,1,,HAT", ",0.1,0.01,0.05,0.02"],
      r"PBARL 1: TYPE = 'HAT' is not supported"),
     (_elements("CBAR"), ["PBARL,1,1,,I", ",0.3,0.15,0.1,0.006,0.01,0.01"],
