@@ -17,6 +17,9 @@ card check of the stick reader applies) and writes what the case format can expr
 - the masses: a CONM2 (CID 0) as a ``point_masses`` entry (mass, offset and principal
   inertia along the beam's axes; products of inertia in those axes refused), a one-grid
   CMASS2 on a rotation about one of the beam's axes as that inertia;
+- the spline: every spline a SPLINE2 over all the GRIDs along the beam's axis (its CID's y
+  axis through the CID's origin), which is the case's beam spline extended straight beyond
+  the end grids (``spline_extension = true``);
 - the aerodynamics: each CAERO1 (uniform NSPAN x NCHORD, in the plane z = 0) as a ``[[panel]]``
   with its ``aero.boxes``, AERO REFC / 2 as ``reference_semichord``, SYMXZ = 1 as
   ``symmetry = "wall"``, the MKAERO1 Machs and reduced frequencies;
@@ -31,7 +34,9 @@ card check of the stick reader applies) and writes what the case format can expr
 Anything else is refused in one line naming the card, its id and the field: rigid elements
 (RBE2 / RBAR), a lumped bar mass, GRIDs off one straight line in z = 0, an axis pointing
 inboard, an oblique orientation vector, other constraints, a translational or two-grid
-CMASS2, CAERO1 with AEFACT divisions.
+CMASS2 (so a deck from :func:`asekit.io.bdf_beam.write_beam_bdf`, whose CMASS2 pairs carry a
+consistent polar inertia, is refused), SPLINE1 / SPLINE4 or a SPLINE2 off the axis or on a
+subset of the GRIDs, CAERO1 with AEFACT divisions.
 """
 
 from __future__ import annotations
@@ -245,9 +250,33 @@ def _structure(path, units: str, name: str):
     if masses:
         beam["point_masses"] = masses
     beam["spline_extension"] = True        # SPLINE2: straight beyond the end stations
+    _check_splines(model, sm, r, e1, L)
     n = requested_mode_count(model)
     f = stick_modes(sm, n).frequencies_hz
     return model, beam, (L, Mu, T), f
+
+
+def _check_splines(model, sm: StickModel, root: int, e1, L: float) -> None:
+    """Every spline a SPLINE2 on all the GRIDs whose axis (its CID's y axis through the CID's
+    origin) is the beam's: the case's beam spline is then the deck's (a different axis or a
+    subset of grids is a different interpolation, refused)."""
+    for sid in sorted(model.splines):
+        sp = model.splines[sid]
+        if sp.type != "SPLINE2":
+            raise BdfError(f"{sp.type} {sid}: a case's beam is splined as SPLINE2 (the beam "
+                           f"spline); only SPLINE2 is expressible")
+        c = model.coords[sp.cid] if sp.cid else None
+        axes = np.asarray(c.beta(), float) if c is not None else np.eye(3)
+        origin = (np.asarray(c.origin, float) if c is not None else np.zeros(3)) * L
+        d = origin - sm.xyz[root]
+        off = np.linalg.norm(d - (d @ e1) * e1)
+        if abs(abs(axes[1] @ e1) - 1) > 1e-9 or off > 1e-9 * max(1.0, float(np.ptp(sm.xyz))):
+            raise BdfError(f"SPLINE2 {sid}: CID = {sp.cid}: its y axis is not the beam's axis "
+                           f"(the case's beam spline runs along the beam)")
+        grids = {int(g) for g in model.sets[sp.setg].ids}
+        if grids != {int(g) for g in sm.node_ids}:
+            raise BdfError(f"SPLINE2 {sid}: SETG = {sp.setg} holds {len(grids)} of the "
+                           f"{len(sm.node_ids)} GRIDs; the case's beam spline uses them all")
 
 
 def _panels(model, L: float) -> tuple[list, list]:

@@ -84,6 +84,8 @@ def _edit(tmp_path, old, new, name="e.bdf"):
     ("GRID    5       1       .0      2.288   .0      1       126",
      "GRID    5       1       .0      2.288   .0      1       12",
      r"some GRIDs have their in-plane motion constrained and some not|GRID 5 constrains"),
+    ("SET1    100     1       THRU    11", "SET1    100     1       THRU    10",
+     r"SPLINE2 100: SETG = 100 holds 10 of the 11 GRIDs"),
     ("CAERO1  101     1       1       6       4                       1",
      "CAERO1  101     1       1               4       7               1",
      r"CAERO1 101: LSPAN / LCHORD"),
