@@ -39,6 +39,7 @@ cards are read elsewhere (:mod:`asekit.io.bdf`); here they are ignored.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -233,28 +234,37 @@ def _check_bar(e) -> None:
                            f"supported (blank or 0: no warping)")
 
 
+def _shear_factor(p, name: str) -> float:
+    """PBAR / PBEAM K1 or K2 (> 0: shear area factor, K G A the shear stiffness), or 0.0 for
+    no shear flexibility (PBAR blank, which pyNastran stores as 1e8; PBEAM 0.0)."""
+    k = getattr(p, name, None)
+    if k is None or k == 1e8 and p.type == "PBAR":
+        return 0.0
+    k = float(k)
+    if not (math.isfinite(k) and k >= 0):
+        raise BdfError(f"{p.type} {p.pid}: {name.upper()} = {k:g} must be >= 0")
+    return k
+
+
 def _pbar_values(p) -> tuple:
-    """PBAR: (A, I1, I2, J, NSM) in deck units; I12 refused."""
+    """PBAR: (A, I1, I2, J, NSM, K1, K2) in deck units; I12 refused."""
     if p.i12:
         raise BdfError(f"PBAR {p.pid}: I12 = {p.i12:g} is not supported (0: principal axes)")
-    for name in ("k1", "k2"):           # blank (pyNastran: 1e8) or 0.0: no shear flexibility
-        k = getattr(p, name, None)
-        if k not in (None, 0.0, 1e8):
-            raise BdfError(f"PBAR {p.pid}: {name.upper()} = {k:g} (shear flexibility) is not "
-                           f"supported (blank or 0.0: the Euler-Bernoulli bar asekit builds)")
-    return p.A, p.i1, p.i2, p.j, p.nsm or 0.0
+    return (p.A, p.i1, p.i2, p.j, p.nsm or 0.0, _shear_factor(p, "k1"),
+            _shear_factor(p, "k2"))
 
 
-#: PBEAM fields that must be zero for asekit's bar (constant section, no shear flexibility, no
-#: shear relief, no NSM inertia, no warping, no NSM or neutral-axis offsets).
-_PBEAM_ZERO = ("k1", "k2", "s1", "s2", "nsia", "nsib", "cwa", "cwb", "m1a", "m2a", "m1b",
-               "m2b", "n1a", "n2a", "n1b", "n2b")
+#: PBEAM fields that must be zero for asekit's bar (constant section, no shear relief, no NSM
+#: inertia, no warping, no NSM or neutral-axis offsets).
+_PBEAM_ZERO = ("s1", "s2", "nsia", "nsib", "cwa", "cwb", "m1a", "m2a", "m1b", "m2b", "n1a",
+               "n2a", "n1b", "n2b")
 
 
 def _pbeam_values(p) -> tuple:
-    """PBEAM of constant section: (A, I1, I2, J, NSM) of end A in deck units; every station
-    equal to end A, I12 = 0 and the :data:`_PBEAM_ZERO` fields 0, else refused naming the
-    field (MSC QRG PBEAM: K1 = K2 = 0.0 neglects the shear flexibility)."""
+    """PBEAM of constant section: (A, I1, I2, J, NSM, K1, K2) of end A in deck units; every
+    station equal to end A, I12 = 0 and the :data:`_PBEAM_ZERO` fields 0, else refused naming
+    the field (MSC QRG PBEAM: K1, K2 default 1.0, the shear stiffness K G A; 0.0 neglects
+    the shear flexibility)."""
     vals = {name: np.atleast_1d(np.asarray(getattr(p, key), float)) for name, key in
             (("A", "A"), ("I1", "i1"), ("I2", "i2"), ("J", "j"), ("NSM", "nsm"),
              ("I12", "i12"))}
@@ -269,10 +279,9 @@ def _pbeam_values(p) -> tuple:
     for key in _PBEAM_ZERO:
         x = float(getattr(p, key) or 0.0)
         if x != 0.0:
-            what = ("0.0: shear flexibility neglected, the Euler-Bernoulli bar asekit builds"
-                    if key in ("k1", "k2") else "0.0")
-            raise BdfError(f"PBEAM {p.pid}: {key.upper()} = {x:g} is not supported ({what})")
-    return tuple(float(vals[n][0]) for n in ("A", "I1", "I2", "J", "NSM"))
+            raise BdfError(f"PBEAM {p.pid}: {key.upper()} = {x:g} is not supported (0.0)")
+    return (*(float(vals[n][0]) for n in ("A", "I1", "I2", "J", "NSM")),
+            _shear_factor(p, "k1"), _shear_factor(p, "k2"))
 
 
 #: PBARL section types :func:`pbarl_section` evaluates, with their number of dimensions.
@@ -380,12 +389,13 @@ _PBARL_FORMS = {"BAR": _bar_form, "ROD": _tube_form, "TUBE": _tube_form, "BOX": 
 
 
 def _pbarl_values(p) -> tuple:
-    """PBARL: (A, I1, I2, J, NSM) in deck units (:func:`pbarl_section`); GROUP MSCBML0 only."""
+    """PBARL: (A, I1, I2, J, NSM, 0, 0) in deck units (:func:`pbarl_section`; no shear
+    flexibility: PBARL has no K1 / K2 field); GROUP MSCBML0 only."""
     group = str(getattr(p, "group", "MSCBML0") or "MSCBML0").strip().upper()
     if group != "MSCBML0":
         raise BdfError(f"PBARL {p.pid}: GROUP = {group!r} is not supported (MSCBML0, the "
                        f"standard beam library)")
-    return (*pbarl_section(p.beam_type, p.dim, f"PBARL {p.pid}"), float(p.nsm or 0.0))
+    return (*pbarl_section(p.beam_type, p.dim, f"PBARL {p.pid}"), float(p.nsm or 0.0), 0.0, 0.0)
 
 
 _SECTION_VALUES = {"PBAR": _pbar_values, "PBEAM": _pbeam_values, "PBARL": _pbarl_values}
@@ -418,7 +428,7 @@ def bar_section(model, pid: int, eid: int, deck_units, card: str = "CBAR") -> Ba
     if p.type not in _ELEMENT_PROPERTIES[card]:
         raise BdfError(f"{card} {eid}: PID {pid} is a {p.type}; a {card} takes "
                        f"{' or '.join(_ELEMENT_PROPERTIES[card])}")
-    A, i1, i2, j, nsm = _SECTION_VALUES[p.type](p)
+    A, i1, i2, j, nsm, k1, k2 = _SECTION_VALUES[p.type](p)
     if not A > 0:
         raise BdfError(f"{p.type} {pid}: A = {A!r} must be > 0")
     mat = model.materials[p.mid]
@@ -428,9 +438,12 @@ def bar_section(model, pid: int, eid: int, deck_units, card: str = "CBAR") -> Ba
     if not (E and E > 0 and G is not None and G >= 0):
         raise BdfError(f"MAT1 {p.mid}: E must be > 0 and G >= 0, got E = {E!r}, G = {G!r}")
     stress = Mu / (L * T * T)                      # deck pressure in Pa
+    if (k1 or k2) and not G > 0:
+        raise BdfError(f"{p.type} {pid}: K1 / K2 (shear flexibility) need MAT1 {p.mid} G > 0")
+    gas = [k * G * A * stress * L ** 2 if k else math.inf for k in (k1, k2)]
     return BarSection(ea=E * A * stress * L ** 2, gj=G * j * stress * L ** 4,
                       ei1=E * i1 * stress * L ** 4, ei2=E * i2 * stress * L ** 4,
-                      mass=(rho * A + (nsm or 0.0)) * wt * Mu / L)
+                      mass=(rho * A + (nsm or 0.0)) * wt * Mu / L, gas1=gas[0], gas2=gas[1])
 
 
 def _add_bars(model, K, M, index, xyz, axes, coupled, deck_units) -> None:

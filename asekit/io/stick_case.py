@@ -147,6 +147,10 @@ def _sections(model, sm: StickModel, index, order, e1, deck_units, name: str) ->
         p = v - (v @ e1) * e1
         p = p / np.linalg.norm(p)
         sec = bar_section(model, e.pid, eid, deck_units, e.type)
+        if math.isfinite(sec.gas1) or math.isfinite(sec.gas2):
+            raise BdfError(f"{model.properties[e.pid].type} {e.pid} (of {e.type} {eid}): K1 / "
+                           f"K2 give shear flexibility, which a case's Euler-Bernoulli [[beam]] "
+                           f"cannot express")
         if abs(abs(p[2]) - 1) < 1e-9:
             flap, chord = sec.ei1, sec.ei2
         elif abs(p[2]) < 1e-9:

@@ -62,6 +62,30 @@ def test_cbeam_cantilever_equals_the_cbar_one(tmp_path):
     assert "20 CBEAM" in beam.notes[0]
 
 
+@pytest.mark.parametrize("element,props", [
+    ("CBEAM", _pbeam(k="0.8,0.6")),
+    ("CBAR", [f"PBAR,1,1,{A!r},{I1!r},{I2!r},{J!r}", ",,,,,,,,", ",0.8,0.6"])])
+def test_shear_flexible_cantilever_tip_deflection(tmp_path, element, props):
+    """K1 / K2 > 0: the shear-flexible (Timoshenko) bar, exact for an end load: tip deflection
+    P L^3 / (3 E I) + P L / (K G A) in each plane (Przemieniecki 1968, Eq. 5.116 with Phi;
+    G = E / (2 (1 + nu)) from MAT1)."""
+    sm = read_stick_deck(_deck(tmp_path / "s.bdf", _elements(element), props))
+    free = sm.free
+    G = E / (2 * (1 + NU))
+    v = np.array([0.0, 0.3, 1.0])
+    e_y = v / np.linalg.norm(v)
+    e_z = np.cross([1.0, 0.0, 0.0], e_y)
+    tip = 6 * NEL
+    for e, I, K in ((e_y, I1, 0.8), (e_z, I2, 0.6)):
+        F = np.zeros(sm.K.shape[0])
+        F[tip:tip + 3] = e                       # 1 N at the tip along the plane's deflection
+        u = np.zeros_like(F)
+        u[free] = np.linalg.solve(sm.K[np.ix_(free, free)], F[free])
+        ref = LEN ** 3 / (3 * E * I) + LEN / (K * G * A)
+        assert u[tip:tip + 3] @ e == pytest.approx(ref, rel=1e-9)
+        assert LEN / (K * G * A) > 1e-5 * ref    # the shear part is resolved by the test
+
+
 def test_pbarl_closed_forms():
     b, h = 0.2, 0.1
     assert pbarl_section("BAR", [b, h])[:3] == pytest.approx((b * h, b * h ** 3 / 12,
@@ -133,13 +157,12 @@ def test_goland_wing_as_a_cbeam_deck_reads_back_to_its_modes(tmp_path):
 
 
 @pytest.mark.parametrize("elements,props,match", [
-    (_elements("CBEAM"), _pbeam(k="1.0,1.0"), r"PBEAM 1: K1 = 1 is not supported \(0.0: shear"),
+    (_elements("CBEAM"), _pbeam(k="0.0,0.0") + [",0.0,0.0,0.0,0.0,0.0,0.0,0.0,0.1"],
+     r"PBEAM 1: N2B = 0.1 is not supported"),
     (_elements("CBEAM"), _pbeam(a2=2 * A), r"PBEAM 1: A varies along the beam"),
     (_elements("CBEAM"), [f"PBAR,1,1,{A!r},{I1!r},{I2!r},{J!r}"],
      r"CBEAM 1: PID 1 is a PBAR; a CBEAM takes PBEAM or PBARL"),
     (_elements("CBEAM", "\n,,,0.0,0.1,0.0"), _pbeam(), r"CBEAM 1: offsets WA/WB"),
-    (_elements("CBAR"), [f"PBAR,1,1,{A!r},{I1!r},{I2!r},{J!r}", ",,,,,,,,", ",0.85,0.85"],
-     r"PBAR 1: K1 = 0.85 \(shear flexibility\) is not supported"),
     (_elements("CBAR"), ["PBARL,1,1,,HAT", ",0.1,0.01,0.05,0.02"],
      r"PBARL 1: TYPE = 'HAT' is not supported"),
     (_elements("CBAR"), ["PBARL,1,1,,I", ",0.3,0.15,0.1,0.006,0.01,0.01"],
