@@ -38,6 +38,9 @@ def run(args) -> int:
     reason = outputs.check_file("CASE.toml", args.out, dash=False)
     if reason:
         raise ValueError(reason)
-    path = write_stick_case(deck, args.out, units=args.units, name=args.name)
+    try:
+        path = write_stick_case(deck, args.out, units=args.units, name=args.name)
+    except ImportError as exc:          # no pyNastran: the user's to install (exit 2)
+        raise ValueError(str(exc)) from None
     print(f"wrote {path}", file=sys.stdout)
     return 0
