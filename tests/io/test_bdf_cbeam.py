@@ -173,3 +173,28 @@ def test_goland_wing_as_a_cbeam_deck_reads_back_to_its_modes(tmp_path):
 def test_unrepresentable_fields_are_named(tmp_path, elements, props, match):
     with pytest.raises(BdfError, match=match):
         read_stick_deck(_deck(tmp_path / "x.bdf", elements, props))
+
+
+def test_pt145_as_a_cbeam_deck_runs_as_the_cbar_one(tmp_path):
+    """PT145 with its CBAR / PBAR written as CBEAM / PBEAM (K1 = K2 = 0.0) gives the same
+    modes and the same KE flutter crossing (the same element; tests/io/test_bdf_beam.py holds
+    the CBAR deck against its f06). PBEAM needs I2 > 0 (QRG: I1 I2 - I12^2 > 0) where the PBAR
+    has it blank; the grids' PS 126 fixes the in-plane bending I2 acts on, so any value does."""
+    import re
+
+    from asekit.io.bdf_beam import stick_flutter
+    from asekit.util.paths import DATA_DIR
+
+    pt145 = DATA_DIR / "benchmarks" / "pt145" / "pt145.bdf"
+    text = re.sub(r"^CBAR    (\d+)\s+1\s+(\d+)\s+(\d+)\s+\.0\s+\.0\s+1\.0\s+1$",
+                  r"CBEAM,\1,1,\2,\3,0.0,0.0,1.0", pt145.read_text(), flags=re.M)
+    assert text.count("CBEAM,") == 10 and "\nCBAR" not in text
+    text = text.replace("PBAR    1       1       7.175-2 9.83-6          36.8-6",
+                        "\n".join(["PBEAM,1,1,7.175-2,9.83-6,1.0-6,0.0,36.8-6", *PBEAM_TAIL]))
+    deck = tmp_path / "pt145_cbeam.bdf"
+    deck.write_text(text)
+    bar, beam = (stick_flutter(p, units="in-lbf-s") for p in (pt145, deck))
+    np.testing.assert_allclose(beam.modes.frequencies_hz, bar.modes.frequencies_hz, rtol=1e-9)
+    (c_bar,) = [c for d in bar.results for c in d.crossings]
+    (c_beam,) = [c for d in beam.results for c in d.crossings]
+    assert c_beam.speed == pytest.approx(c_bar.speed, rel=1e-9)
