@@ -45,7 +45,8 @@ def _hermite(xi: np.ndarray, length: np.ndarray):
     return n, dn
 
 
-def beam_spline_matrices(beam: StraightBeam, points) -> tuple[np.ndarray, np.ndarray]:
+def beam_spline_matrices(beam: StraightBeam, points,
+                         extend: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Interpolation matrices (G, Gx), each (n_points, 6 n_nodes): h(points) = G u and
     dh/dx(points) = Gx u for a global beam displacement vector u (ux, uy, uz, rx, ry, rz per
     node, :func:`asekit.structure.beam.assemble`'s order).
@@ -54,7 +55,12 @@ def beam_spline_matrices(beam: StraightBeam, points) -> tuple[np.ndarray, np.nda
     ----------
     beam : :class:`~asekit.structure.beam.StraightBeam` (its axis in the (x, y) plane).
     points : (n_points, 2 or 3) x, y (m) of points on the surface; their projection on the
-        axis must lie between the root and the tip (ValueError naming the point otherwise).
+        axis must lie between the root and the tip (ValueError naming the point otherwise)
+        unless ``extend``.
+    extend : bool, points beyond the root or the tip move with the end section extended
+        straight, as MSC Nastran's SPLINE2 (Aeroelastic Analysis User's Guide, Sec. 2.3: the
+        spline beam is unloaded beyond its end stations): h = w_e + w'_e (s - s_e) - a theta_e,
+        dh/dx = w'_e e1_x - theta_e e1_y (default False).
 
     Returns
     -------
@@ -82,11 +88,13 @@ def beam_spline_matrices(beam: StraightBeam, points) -> tuple[np.ndarray, np.nda
     st = beam.stations
     tol = SPAN_TOLERANCE * st[-1]
     bad = np.flatnonzero((s < -tol) | (s > st[-1] + tol))
-    if bad.size:
+    if bad.size and not extend:
         i = int(bad[0])
         raise ValueError(f"points[{i}] = {p[i, :2].tolist()} lies at s = {s[i]:.6g} m along the "
                          f"beam axis, outside the beam [0, {st[-1]:.6g}] m "
                          f"({bad.size} points outside)")
+    beyond = (s - np.clip(s, 0.0, st[-1]) if extend      # (0 inside) straight extension
+              else np.zeros_like(s))
     s = np.clip(s, 0.0, st[-1])
     elem = np.clip(np.searchsorted(st, s, side="right") - 1, 0, st.size - 2)
     length = st[elem + 1] - st[elem]
@@ -105,7 +113,8 @@ def beam_spline_matrices(beam: StraightBeam, points) -> tuple[np.ndarray, np.nda
         nw, ns = n[:, 2 * side], n[:, 2 * side + 1]            # value and slope functions
         dnw, dns = dn[:, 2 * side], dn[:, 2 * side + 1]
         nt = 1 - xi if side == 0 else xi                         # linear twist
-        dnt = (-1.0 if side == 0 else 1.0) / length
+        dnt = np.where(beyond == 0.0, (-1.0 if side == 0 else 1.0) / length, 0.0)
+        nw, ns = nw + beyond * dnw, ns + beyond * dns             # w_e + w'_e (s - s_e)
         # h = w - a theta
         G[rows, base + 2] += nw
         Gx[rows, base + 2] += dnw * e1x

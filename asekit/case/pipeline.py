@@ -456,7 +456,22 @@ def case_beam(case: Case) -> StraightBeam:
         s0, s1 = b.stations[i] * b.length, b.stations[i + 1] * b.length
         stations.extend(np.linspace(s0, s1, b.n_elements + 1)[1:].tolist())
         sections.extend([BeamSection(*sec)] * b.n_elements)
-    return straight_beam(b.root, b.direction, stations, sections)
+    return straight_beam(b.root, b.direction, stations, sections,
+                         _beam_point_masses(b, np.asarray(stations)))
+
+
+def _beam_point_masses(b, stations: np.ndarray) -> tuple:
+    """The [[beam]] point_masses as :class:`~asekit.structure.beam.PointMass` es: offset and
+    inertia given along (axis e1, aft a = e1 x e3, up e3), rotated to the global axes
+    (offset = R^T o, inertia = R^T diag(I) R, R the rows e1, a, e3)."""
+    from asekit.structure.beam import PointMass
+
+    e1 = np.array([b.direction[0], b.direction[1], 0.0])
+    e3 = np.array([0.0, 0.0, 1.0])
+    R = np.array([e1, np.cross(e1, e3), e3])
+    return tuple(PointMass(int(np.argmin(np.abs(stations - s))), m, R.T @ np.asarray(o),
+                           R.T @ np.diag(inertia) @ R)
+                 for s, m, o, inertia in b.point_masses)
 
 
 def _beam_full_shapes(model: ModalModel) -> np.ndarray:
@@ -477,8 +492,9 @@ def _structure_spline(case: Case):
 
     def spline(model, boxes):
         try:
-            g_cp, gx_cp = beam_spline_matrices(beam, boxes.control_point)
-            g_lp, _ = beam_spline_matrices(beam, boxes.load_point)
+            ext = bool(getattr(case.beam, "spline_extension", False))
+            g_cp, gx_cp = beam_spline_matrices(beam, boxes.control_point, extend=ext)
+            g_lp, _ = beam_spline_matrices(beam, boxes.load_point, extend=ext)
         except ValueError as exc:
             raise CaseError(f"beam[0] / panel: {exc}") from None
         phi = _beam_full_shapes(model)
@@ -504,12 +520,14 @@ def beam_modal_model(case: Case) -> ModalModel:
     """
     beam = case_beam(case)
     md = case.modes
-    n_max = NODE_DOF * (beam.n_nodes - 1)
+    fixed = getattr(case.beam, "in_plane", "free") == "fixed"
+    per_node = 3 if fixed else NODE_DOF
+    n_max = per_node * (beam.n_nodes - 1)
     n = min(md.count, n_max) if md.count is not None else n_max
     if md.count is not None and md.count > n_max:
-        raise CaseError(f"modes.count must be <= {n_max} (6 x the {beam.n_nodes - 1} beam "
-                        f"elements), got {md.count}")
-    modes = beam_modes(beam, n)
+        raise CaseError(f"modes.count must be <= {n_max} ({per_node} x the {beam.n_nodes - 1} "
+                        f"beam elements), got {md.count}")
+    modes = beam_modes(beam, n, in_plane_fixed=fixed)
     keep = (modes.frequencies_hz <= md.f_max if md.count is None
             else np.ones(n, bool))
     if not keep.any():
@@ -521,7 +539,8 @@ def beam_modal_model(case: Case) -> ModalModel:
     model = ModalModel(f, np.eye(m), np.diag((2 * math.pi * f) ** 2), np.zeros((m, m)), 0, 0.0,
                        beam.nodes[:, :2].copy(), np.ascontiguousarray(shapes),
                        np.zeros((0, 4), int),
-                       f"beam, {beam.n_nodes - 1} elements, clamped root")
+                       f"beam, {beam.n_nodes - 1} elements, clamped root"
+                       + (", in-plane motion fixed" if fixed else ""))
     d = case.damping
     try:
         return _read_only(with_damping(model, d.modal_damping_ratio, d.structural_g))

@@ -534,6 +534,13 @@ class Case:
                 cs.pop("actuator", None)
         if self.beam is None:               # (likewise: plate cases)
             d.pop("beam")
+        else:                               # (likewise: beams without in_plane / point_masses)
+            if d["beam"].get("in_plane") == "free":
+                d["beam"].pop("in_plane")
+            if not d["beam"].get("point_masses"):
+                d["beam"].pop("point_masses")
+            if not d["beam"].get("spline_extension"):
+                d["beam"].pop("spline_extension")
         if d.get("aero") is not None and d["aero"].get("solver") == "dense":
             d["aero"].pop("solver")         # (likewise: the default dense DLM solve)
         if d.get("aero") is not None and d["aero"].get("section") is None:
@@ -1327,6 +1334,10 @@ def _gust(t: _Table | None, aero: AeroSpec, actuator: ActuatorSpec | None,
 BEAM_PROPERTIES = (("ea", 0.0, "N"), ("gj", 0.0, "N m^2"), ("ei_flap", 0.0, "N m^2"),
                    ("ei_chord", 0.0, "N m^2"), ("mass_per_length", 0.0, "kg/m"),
                    ("polar_inertia", 0.0, "kg m"))
+#: the [[beam]] properties that may be 0 (ea, ei_chord: with in_plane = "fixed" only)
+_BEAM_ZERO_OK = ("ea", "ei_chord", "polar_inertia")
+#: the values of [[beam]] in_plane
+BEAM_IN_PLANE = ("free", "fixed")
 #: the largest number of beam elements (a dense 6 (n + 1) eigenproblem)
 MAX_BEAM_ELEMENTS = 2000
 
@@ -1346,6 +1357,13 @@ class BeamSpec:
     sections : one (ea, gj, ei_flap, ei_chord, mass, polar_inertia, mass_offset) tuple per
         segment (SI: N, N m^2, N m^2, N m^2, kg/m, kg m, m; the mass axis ``mass_offset`` aft
         of the elastic axis), the arguments of :class:`asekit.structure.beam.BeamSection`.
+    in_plane : "free" (default) or "fixed": the in-plane motion (ux, uy, rz) of every node
+        fixed, the out-of-plane modes solved alone (Nastran PS 126 on a stick model).
+    point_masses : (s, mass, offset, inertia) per rigid mass on a node: s (m) along the axis
+        (a node's station), mass (kg), offset (3,) m along (axis, aft, up) and inertia (3,)
+        kg m^2 about its centre along the same axes.
+    spline_extension : bool, boxes beyond the root or tip move with the end section extended
+        straight (Nastran's SPLINE2); False: every panel corner must lie along the beam.
     """
 
     root: tuple[float, float]
@@ -1354,6 +1372,9 @@ class BeamSpec:
     stations: tuple[float, ...]
     n_elements: int
     sections: tuple[tuple[float, ...], ...]
+    in_plane: str = "free"
+    point_masses: tuple = ()
+    spline_extension: bool = False
 
 
 def _beam_axis(t: _Table):
@@ -1387,7 +1408,8 @@ def _beam_sections(t: _Table, n_seg: int):
             return t.numbers(k, length=n_seg, low=low, high=high, low_open=low_open, unit=unit)
         return (t.number(k, default, required=default is None, low=low, high=high,
                          low_open=low_open, unit=unit),) * n_seg
-    cols = [column(k, None, low, 1e15, True, unit) for k, low, unit in BEAM_PROPERTIES]
+    cols = [column(k, None, low, 1e15, k not in _BEAM_ZERO_OK, unit)
+            for k, low, unit in BEAM_PROPERTIES]
     cols.append(column("mass_offset", 0.0, -1e4, 1e4, False, "m"))
     for i in range(n_seg):
         m, ip, d = cols[4][i], cols[5][i], cols[6][i]
@@ -1418,17 +1440,71 @@ def _beam(raw, panels) -> BeamSpec | None:
         raise CaseError(f"{t.key('n_elements')} x segments = {n_el * (len(st) - 1)} must be "
                         f"<= {MAX_BEAM_ELEMENTS} elements")
     sections = _beam_sections(t, len(st) - 1)
+    in_plane = t.text("in_plane", "free")
+    if in_plane not in BEAM_IN_PLANE:
+        raise CaseError(f"{t.key('in_plane')} must be one of {list(BEAM_IN_PLANE)}, got "
+                        f"{in_plane!r}")
+    if in_plane == "free":
+        for k, j in (("ea", 0), ("ei_chord", 3)):
+            if any(sec[j] == 0 for sec in sections):
+                raise CaseError(f"{t.key(k)} must be > 0 unless in_plane = \"fixed\" (the "
+                                f"in-plane motion would have no stiffness)")
+    masses = _beam_point_masses(t, length, st, n_el)
+    extension = t.boolean("spline_extension", False)
     t.done()
     tol = 1e-9 * length
-    for i, p in enumerate(panels):
+    for i, p in enumerate(() if extension else panels):
         for c in p.planform.corners:
             s = (c[0] - root[0]) * e1[0] + (c[1] - root[1]) * e1[1]
             if s < -tol or s > length + tol:
                 raise CaseError(f"panel[{i}] corner {[float(c[0]), float(c[1])]} m lies at "
                                 f"{s:.6g} m along beam[0]'s axis, outside the beam [0, "
                                 f"{length:.6g}] m: the beam-to-box spline needs every box "
-                                f"between the beam's root and tip")
-    return BeamSpec(tuple(root), tuple(e1), length, tuple(st), n_el, sections)
+                                f"between the beam's root and tip (or set {t.key('spline_extension')}"
+                                f" = true)")
+    return BeamSpec(tuple(root), tuple(e1), length, tuple(st), n_el, sections, in_plane,
+                    masses, extension)
+
+
+def beam_node_stations(length: float, stations, n_elements: int) -> np.ndarray:
+    """The node distances (m) from the root of a [[beam]]: each segment between ``stations``
+    (fractions of ``length``) cut into ``n_elements`` equal elements.
+
+    Examples
+    --------
+    >>> beam_node_stations(2.0, [0.0, 0.5, 1.0], 2).tolist()
+    [0.0, 0.5, 1.0, 1.5, 2.0]
+    """
+    out = [0.0]
+    for a, b in zip(stations[:-1], stations[1:]):
+        out.extend(np.linspace(a * length, b * length, n_elements + 1)[1:].tolist())
+    return np.asarray(out)
+
+
+def _beam_point_masses(t: _Table, length: float, st, n_el: int) -> tuple:
+    """[[beam]] point_masses: inline tables {s, mass, offset, inertia}, each on a node."""
+    raw = t.raw("point_masses", [])
+    if not isinstance(raw, list):
+        raise CaseError(f"{t.key('point_masses')} must be an array of inline tables "
+                        f"{{ s, mass, offset, inertia }}")
+    nodes = beam_node_stations(length, st, n_el)
+    out = []
+    for i, d in enumerate(raw):
+        pm = _Table(d, f"{t.path}.point_masses[{i}]")
+        s = pm.number("s", required=True, low=0.0, high=length * (1 + 1e-12), low_open=False,
+                      unit="m")
+        if np.min(np.abs(nodes - s)) > 1e-9 * length:
+            raise CaseError(f"{pm.key('s')} = {s:g} m is not a node of the beam (nodes every "
+                            f"segment / n_elements; nearest {nodes[np.argmin(np.abs(nodes - s))]:g}"
+                            f" m)")
+        m = pm.number("mass", 0.0, low=0.0, high=1e9, low_open=False, unit="kg")
+        off = pm.numbers("offset", default=[0.0, 0.0, 0.0], length=3, low=-1e4, high=1e4,
+                         unit="m")
+        inertia = pm.numbers("inertia", default=[0.0, 0.0, 0.0], length=3, low=0.0,
+                             low_open=False, high=1e9, unit="kg m^2")
+        pm.done()
+        out.append((float(nodes[np.argmin(np.abs(nodes - s))]), m, tuple(off), tuple(inertia)))
+    return tuple(out)
 
 
 def _structure_kind(top: _Table) -> bool:

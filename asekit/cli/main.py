@@ -11,6 +11,8 @@ Commands (argparse subcommands; each sets ``func(args) -> exit code``, so more c
   the flutter margin (see :mod:`asekit.cli.optimise`);
 * ``trajectory CASE PROFILE.csv [--json PATH] [--plot PATH]``: margins, dynamic pressure and
   hinge moment along a flight trajectory (see :mod:`asekit.cli.trajectory`);
+* ``convert DECK.bdf CASE.toml [--units U] [--name NAME]``: a Nastran stick-model deck as a
+  ``[[beam]]`` case file (see :mod:`asekit.cli.convert`);
 * ``--version``.
 
 Options of every command (before or after its name): ``-v/--verbose`` (the package's info
@@ -43,6 +45,7 @@ import sys
 from asekit.cli import outputs
 from asekit.cli.analyse import add_parser as add_analyse
 from asekit.cli.cases import add_parser as add_cases
+from asekit.cli.convert import add_parser as add_convert
 from asekit.cli.optimise import add_parser as add_optimise
 from asekit.cli.sweep import add_parser as add_sweep
 from asekit.cli.trajectory import add_parser as add_trajectory
@@ -141,6 +144,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_cases(sub)
     add_optimise(sub)
     add_trajectory(sub)
+    add_convert(sub)
     _add_common(parser, top=True)
     seen = set()
     for p in sub.choices.values():              # also after the command (aliases: once)

@@ -19,6 +19,14 @@ a deck that pyNastran reads and Nastran runs (SOL 103 or SOL 145 case control), 
 written by kind (:data:`SUPPORT_CARDS`), its control surfaces as CAERO1 + CORD2R + AELIST +
 AESURF (:func:`_control_surface_cards`).
 
+Reader API (shared with :mod:`asekit.io.bdf_beam`)
+-------------------------------------------------
+The aerodynamic and solution readers are public so that the stick-model reader uses the same
+code: :func:`need_pynastran`, :class:`Deck` (one import's units and notes),
+:func:`read_aero_card` (AERO / AEROS), :func:`check_caero1` and :func:`deck_boxes` (CAERO1),
+:func:`read_mkaero1`, :func:`read_flutter` (FLUTTER + FLFACT), :func:`case_value` (case
+control) and :func:`solve_request` (one FLUTTER card with its own method).
+
 Supported cards and what asekit makes of them
 ---------------------------------------------
 GRID (basic or CORD2R/CORD1R... any coordinate system pyNastran resolves; ``PS`` permanent
@@ -118,7 +126,25 @@ class BdfError(ValueError):
     """A BDF that asekit cannot represent; the message lists what is missing."""
 
 
-def _need_pynastran():
+def need_pynastran():
+    """pyNastran's ``BDF`` class, the deck parser of every reader here (public reader API,
+    shared by :mod:`asekit.io.bdf` and :mod:`asekit.io.bdf_beam`).
+
+    Returns
+    -------
+    type
+        ``pyNastran.bdf.bdf.BDF``.
+
+    Raises
+    ------
+    ImportError
+        pyNastran is not installed (one line naming the package to install).
+
+    Examples
+    --------
+    >>> need_pynastran().__name__                               # doctest: +SKIP
+    'BDF'
+    """
     try:
         from pyNastran.bdf.bdf import BDF
     except ImportError as exc:                                    # pragma: no cover
@@ -285,11 +311,22 @@ def _scatter(mesh: PlateMesh, Ke: np.ndarray, n: int) -> sp.csr_matrix:
 # one reader per card (the field tables are those of the MSC Nastran Quick Reference Guide)
 # ---------------------------------------------------------------------------------------------
 @dataclass
-class _Deck:
-    """The working state of one import: the pyNastran model, the deck's units (one deck unit
-    of length L m, mass Mu kg, time T s), PARAM WTMASS, the GRIDs (ids, index, basic
-    coordinates in deck units, in-plane SI coordinates), the plate's plane z0 (deck units)
-    and the notes collected on the way."""
+class Deck:
+    """The working state of one import (public reader API: the card readers
+    :func:`read_aero_card`, :func:`check_caero1`, :func:`read_mkaero1`, :func:`read_flutter`
+    take it).
+
+    Attributes
+    ----------
+    model : pyNastran ``BDF``, cross-referenced.
+    name : str, the deck's file name (in messages).
+    L, Mu, T : float, one deck unit of length (m), mass (kg) and time (s) (:data:`UNITS`).
+    wtmass : float, PARAM WTMASS.
+    nids, index, xyz, nodes : the GRIDs (ids, id -> row, basic coordinates in deck units,
+        in-plane SI coordinates); None / empty until the plate reader sets them.
+    z0 : float, the plate's plane (deck units).
+    notes, missing : lists of what was read and how, and of what is missing.
+    """
 
     model: object
     name: str
@@ -654,7 +691,7 @@ def _shell_elements(model, name: str) -> list:
     return quads
 
 
-def _read_grids(deck: _Deck, quads, tol: float | None) -> None:
+def _read_grids(deck: Deck, quads, tol: float | None) -> None:
     """GRID: every grid in basic coordinates (pyNastran resolves CP through CORD2R / CORD1R /
     CORD2C / CORD2S); CD must be basic (0); the plate's grids must lie in one plane z = z0.
 
@@ -712,7 +749,7 @@ def _read_pshell(p, e) -> None:
         raise BdfError(f"{e.type} {e.eid}: ZOFFS = {e.zoffset} is not supported")
 
 
-def _check_shell_ranges(deck: _Deck, quads, th, props) -> None:
+def _check_shell_ranges(deck: Deck, quads, th, props) -> None:
     """PSHELL T (> 0) and NSM, and each element's corner thicknesses (deck units): all >= 0,
     the largest > 0 (an element of zero thickness has no stiffness), within :data:`RANGES`."""
     for p in props.values():
@@ -729,7 +766,7 @@ def _check_shell_ranges(deck: _Deck, quads, th, props) -> None:
                        f"{RANGES['thickness'][1] / deck.L:g} (10 m)")
 
 
-def _check_element_shapes(deck: _Deck, quads, conn) -> None:
+def _check_element_shapes(deck: Deck, quads, conn) -> None:
     """Every element's Jacobian positive inside it (after :func:`_orient`): det J of the
     bilinear map is affine in r and s, so it is > 0 everywhere inside iff it is >= 0 at the
     four corners and > 0 at the centre (a CTRIA3, G3 repeated, has det J = 0 at that corner).
@@ -791,7 +828,7 @@ def _element_angle(elem, xyz_of, g1, g2, model) -> float:
     return edge + math.radians(float(tm or 0.0))
 
 
-def _orient(deck: _Deck, conn, th, is_tri) -> None:
+def _orient(deck: Deck, conn, th, is_tri) -> None:
     """Renumber (in place) the elements numbered clockwise seen from +z: a quadrilateral
     reversed, a triangle G1 G3 G2 (G2 repeated)."""
     xy = deck.nodes[conn]
@@ -808,7 +845,7 @@ def _orient(deck: _Deck, conn, th, is_tri) -> None:
                           f"renumbered (same element)")
 
 
-def _read_shells(deck: _Deck, quads):
+def _read_shells(deck: Deck, quads):
     """CQUAD4 / CTRIA3 (fields in :func:`_shell_thickness`) with their PSHELL: connectivity
     (a CTRIA3 as a degenerated MITC4, G1 G2 G3 G3), corner thicknesses (m), material angles
     (rad) and property ids; returns (conn, th, angles, pids, props)."""
@@ -839,7 +876,7 @@ def _read_shells(deck: _Deck, quads):
     return conn, th * deck.L, angles, np.array([e.pid for e in quads]), props
 
 
-def _read_mat1(mat, deck: _Deck, pid: int) -> Material:
+def _read_mat1(mat, deck: Deck, pid: int) -> Material:
     """MAT1 in SI (stress F / L^2, density m / L^3, x WTMASS): two of E, G, NU (all three only
     if consistent).
 
@@ -863,7 +900,7 @@ def _read_mat1(mat, deck: _Deck, pid: int) -> Material:
                     name=f"MAT1 {mat.mid}")
 
 
-def _read_mat8(mat, deck: _Deck, angle: float) -> OrthotropicMaterial:
+def _read_mat8(mat, deck: Deck, angle: float) -> OrthotropicMaterial:
     """MAT8 in SI at the element's material angle (rad); G1Z / G2Z blank -> G12.
 
     +------+-----+-----+------+------+-----+-----+-----+-----+
@@ -887,7 +924,7 @@ def _read_mat8(mat, deck: _Deck, angle: float) -> OrthotropicMaterial:
                                mod["G1Z"], mod["G2Z"], angle, name=f"MAT8 {mat.mid}")
 
 
-def _material(deck: _Deck, mat, angle: float, pid: int):
+def _material(deck: Deck, mat, angle: float, pid: int):
     """asekit material of a MAT1 / MAT8 (SI)."""
     if mat.type == "MAT1":
         return _read_mat1(mat, deck, pid)
@@ -897,7 +934,7 @@ def _material(deck: _Deck, mat, angle: float, pid: int):
                    f"(MAT1 or MAT8)")
 
 
-def _material_groups(deck: _Deck, pids, props, angles) -> dict:
+def _material_groups(deck: Deck, pids, props, angles) -> dict:
     """{(pid, material angle rad, 0 for MAT1): element indices}."""
     keys = {}
     for j, pid in enumerate(pids):
@@ -970,7 +1007,7 @@ def lumped_translational_mass(me: np.ndarray) -> np.ndarray:
     return out
 
 
-def _plate_matrices(deck: _Deck, conn, th, pids, props, angles, thickness_rule):
+def _plate_matrices(deck: Deck, conn, th, pids, props, angles, thickness_rule):
     """Global K and M (SI) of the plate elements, grouped by property and material angle:
     MITC4 stiffness and consistent mass (:mod:`asekit.structure.plate`) plus the PSHELL NSM,
     lumped (:func:`lumped_translational_mass`) unless PARAM COUPMASS > 0, as Nastran.
@@ -1001,7 +1038,7 @@ def _plate_matrices(deck: _Deck, conn, th, pids, props, angles, thickness_rule):
     return K, M, materials, keys, mesh
 
 
-def _celas_dofs(deck: _Deck, e):
+def _celas_dofs(deck: Deck, e):
     """(dof a, dof b) of a CELAS1 / CELAS2 (None: ground or an in-plane component) and
     whether any end is on an in-plane component."""
     dofs, dropped = [], False
@@ -1015,7 +1052,7 @@ def _celas_dofs(deck: _Deck, e):
     return dofs, any(rot), dropped
 
 
-def _read_celas(deck: _Deck):
+def _read_celas(deck: Deck):
     """CELAS1 (with PELAS K) and CELAS2 springs to ground or between two grids, in SI (force
     per length, or moment per radian on R1 / R2); springs on in-plane components are dropped.
 
@@ -1062,7 +1099,7 @@ def _read_celas(deck: _Deck):
     return tuple(springs), Kx.tocsr()
 
 
-def _read_conm2(deck: _Deck):
+def _read_conm2(deck: Deck):
     """CONM2 point masses in SI (x WTMASS) with their offset X (rigid: w_m = w + theta_x dy -
     theta_y dx) and inertias I11, I21, I22 (about the offset point); CID basic only.
 
@@ -1097,7 +1134,7 @@ def _read_conm2(deck: _Deck):
     return tuple(masses), Mx.tocsr()
 
 
-def _conm2_values(deck: _Deck, m):
+def _conm2_values(deck: Deck, m):
     """(mass kg, offset (3,) m, (I11, I21, I22, ...) kg m^2) of a CONM2, checked: mass and
     offsets within :data:`RANGES`, I11, I22 >= 0 and I21^2 <= I11 I22."""
     what = f"CONM2 {m.eid}"
@@ -1114,17 +1151,17 @@ def _conm2_values(deck: _Deck, m):
     return mass, X * deck.L, I
 
 
-def _read_grid_ps(deck: _Deck) -> set:
+def _read_grid_ps(deck: Deck) -> set:
     """GRID PS (permanent single-point constraints, field 8 of GRID, :func:`_read_grids`):
     the constrained global DOFs (components 3, 4, 5; 1, 2, 6 are in-plane)."""
     return {deck.dof(nid, c) for nid, g in deck.model.nodes.items() for c in _components(g.ps)}
 
 
-def _spc_set_ids(deck: _Deck) -> list:
+def _spc_set_ids(deck: Deck) -> list:
     """The SPC sets applied: the case control's SPC = n, else all (with a note if several)."""
     model = deck.model
     ids = sorted(model.spcs)
-    cc = _case_value(model, "SPC")
+    cc = case_value(model, "SPC")
     if cc is not None and cc in model.spcs:
         return [cc]
     adds = (getattr(model, "spcadds", {}) or {}).get(cc) if cc is not None else None
@@ -1141,7 +1178,7 @@ def _spc_set_ids(deck: _Deck) -> list:
     return ids
 
 
-def _read_spc_card(deck: _Deck, sid: int, c) -> set:
+def _read_spc_card(deck: Deck, sid: int, c) -> set:
     """The DOFs an SPC1 or SPC card fixes (zero enforced displacement only).
 
     +------+-----+----+----+------+----+----+----+
@@ -1167,7 +1204,7 @@ def _read_spc_card(deck: _Deck, sid: int, c) -> set:
     return out
 
 
-def _read_spcs(deck: _Deck) -> set:
+def _read_spcs(deck: Deck) -> set:
     """Every DOF fixed by GRID PS and the applied SPC / SPC1 sets."""
     fixed = _read_grid_ps(deck)
     for sid in _spc_set_ids(deck):
@@ -1176,7 +1213,7 @@ def _read_spcs(deck: _Deck) -> set:
     return fixed
 
 
-def _read_rbe2(deck: _Deck, fixed: set):
+def _read_rbe2(deck: Deck, fixed: set):
     """RBE2 rigid links: the dependent grids' components CM (3, 4, 5) follow the independent
     grid GN rigidly (w_j = w_i + theta_x,i dy - theta_y,i dx). No chains, no dependent DOF
     that is also constrained.
@@ -1232,7 +1269,7 @@ def _reduction(n: int, fixed: set, dep: dict, K, M) -> sp.csr_matrix:
     return Tm[:, np.flatnonzero(~empty)].tocsr() if empty.any() else Tm
 
 
-def _read_eigen_method(model, deck: _Deck):
+def _read_eigen_method(model, deck: Deck):
     """EIGRL (or EIGR) of the case control's METHOD (else the first): (ND number of modes or
     None, V2 / F2 upper frequency Hz or None).
 
@@ -1247,7 +1284,7 @@ def _read_eigen_method(model, deck: _Deck):
     methods = model.methods
     if not methods:
         return None, None
-    meth = _case_value(model, "METHOD")
+    meth = case_value(model, "METHOD")
     mth = methods.get(meth) if meth in methods else methods[min(methods)]
     nd = getattr(mth, "nd", None)
     v2 = getattr(mth, "v2", None) if mth.type == "EIGRL" else getattr(mth, "f2", None)
@@ -1265,12 +1302,12 @@ def _eigen_card(model) -> str:
     methods = model.methods
     if not methods:
         return ""
-    meth = _case_value(model, "METHOD")
+    meth = case_value(model, "METHOD")
     mth = methods.get(meth) if meth in methods else methods[min(methods)]
     return f"{mth.type} {mth.sid}"
 
 
-def _read_tabdmp1(model, deck: _Deck):
+def _read_tabdmp1(model, deck: Deck):
     """TABDMP1 (the first): modal damping vs frequency as ((f Hz, g), ...); TYPE G as given,
     CRIT (fraction of critical) as g = 2 zeta.
 
@@ -1310,9 +1347,24 @@ def _check_acsid(model, card: str, aero) -> None:
                        f"along basic +X and z up (ACSID 0 or a system with basic's axes)")
 
 
-def _read_aero_card(deck: _Deck):
-    """AERO / AEROS: (reference semichord REFC / 2 m, RHOREF kg/m^3 or None, SYMXZ = 1);
-    SYMXY (ground effect) refused.
+def read_aero_card(deck: Deck):
+    """AERO / AEROS: the reference semichord, reference density and symmetry (public reader
+    API); SYMXY (ground effect) and an ACSID whose axes are not basic's refused.
+
+    Parameters
+    ----------
+    deck : :class:`Deck`
+
+    Returns
+    -------
+    b_ref : float, REFC / 2 (m).
+    rho_ref : float or None, AERO RHOREF (kg/m^3); None for AEROS.
+    symmetric : bool, SYMXZ = 1.
+
+    Raises
+    ------
+    BdfError
+        No AERO / AEROS, SYMXY != 0, a rotated ACSID, or a field out of :data:`RANGES`.
 
     +-------+-------+-------+--------+--------+-------+-------+
     |   1   |   2   |   3   |   4    |   5    |   6   |   7   |
@@ -1336,9 +1388,30 @@ def _read_aero_card(deck: _Deck):
     return 0.5 * refc, rho_ref, int(aero.sym_xz or 0) == 1
 
 
-def _read_mkaero1(model, deck=None):
+def read_mkaero1(model, deck=None):
     """MKAERO1: the Mach numbers and reduced frequencies of the GAF database (all pairs of
-    all cards; subsonic only, asekit's doublet lattice).
+    all cards; subsonic only, asekit's doublet lattice). Public reader API.
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF`` (its ``mkaeros``).
+    deck : :class:`Deck` or None, when given each k is checked against :data:`RANGES`.
+
+    Returns
+    -------
+    machs, ks : tuples of the sorted distinct Mach numbers and reduced frequencies (b_ref).
+
+    Raises
+    ------
+    BdfError
+        MKAERO2, a Mach outside the doublet lattice's range, or k out of range.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> mk = NS(type="MKAERO1", machs=[0.5, 0.0], reduced_freqs=[0.1, 0.01])
+    >>> read_mkaero1(NS(mkaeros=[mk]))
+    ((0.0, 0.5), (0.01, 0.1))
 
     +---------+----+----+----+----+----+----+----+----+
     |    1    | 2  | 3  | 4  | 5  | 6  | 7  | 8  | 9  |
@@ -1365,7 +1438,7 @@ def _read_mkaero1(model, deck=None):
     return machs, tuple(sorted({p[1] for p in pairs}))
 
 
-def _read_aero(deck: _Deck) -> dict:
+def _read_aero(deck: Deck) -> dict:
     """The aerodynamic part (CAERO1 boxes, splines checked, AERO, MKAERO1, FLUTTER): the
     keyword arguments of :class:`BdfModel` it sets (empty without CAERO1)."""
     model = deck.model
@@ -1374,22 +1447,40 @@ def _read_aero(deck: _Deck) -> dict:
             raise BdfError("FLUTTER without CAERO1 boxes")
         return {}
     for c in model.caeros.values():
-        _check_caero1(deck, c)
-    boxes, box_ids = _boxes(model, deck.L, deck.z0 * deck.L)
+        check_caero1(deck, c)
+    boxes, box_ids = deck_boxes(model, deck.L, deck.z0 * deck.L)
     _check_splines(model, box_ids, deck.notes)
-    b_ref, rho_ref, symmetric = _read_aero_card(deck)
-    machs, ks = _read_mkaero1(model, deck)
-    flut = [_flutter(model, f, rho_ref, deck)
+    b_ref, rho_ref, symmetric = read_aero_card(deck)
+    machs, ks = read_mkaero1(model, deck)
+    flut = [read_flutter(model, f, rho_ref, deck)
             for f in model.flutters.values()]
-    fm = _case_value(model, "FMETHOD")
+    fm = case_value(model, "FMETHOD")
     flut.sort(key=lambda r: r.sid != fm)          # the case control's FMETHOD first
     return {"boxes": boxes, "box_ids": box_ids, "b_ref": b_ref, "rho_ref": rho_ref,
             "symmetric": symmetric, "machs": machs, "reduced_frequencies": ks,
             "flutter": tuple(flut)}
 
 
-def _case_value(model, key: str):
-    """The integer value of ``key`` (e.g. SPC, METHOD) in the first subcase, or None."""
+def case_value(model, key: str):
+    """The integer value of a case-control entry in the first subcase (public reader API).
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF`` (its ``case_control_deck``).
+    key : str, e.g. ``"SPC"``, ``"METHOD"``, ``"FMETHOD"``.
+
+    Returns
+    -------
+    int or None
+        The value in subcase 1 (or the global subcase 0); None without a case control, without
+        the entry, or when its value is not an integer.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> case_value(NS(case_control_deck=None), "SPC") is None
+    True
+    """
     cc = getattr(model, "case_control_deck", None)
     if cc is None:
         return None
@@ -1456,9 +1547,21 @@ def _caero1_boxes(c, L):
 MAX_BOXES_PER_CAERO1 = 10000
 
 
-def _check_caero1(deck: _Deck, c) -> None:
-    """CAERO1 corners P1, P4 and chords X12, X43 within :data:`RANGES` (chords >= 0, one of
-    them > 0), NSPAN x NCHORD <= :data:`MAX_BOXES_PER_CAERO1`."""
+def check_caero1(deck: Deck, c) -> None:
+    """Check one CAERO1 card before any box is built (public reader API): corners P1, P4 and
+    chords X12, X43 within :data:`RANGES` (chords >= 0, one of them > 0), NSPAN x NCHORD <=
+    :data:`MAX_BOXES_PER_CAERO1`. Other CAERO types pass (:func:`deck_boxes` refuses them).
+
+    Parameters
+    ----------
+    deck : :class:`Deck`
+    c : a pyNastran CAERO card.
+
+    Raises
+    ------
+    BdfError
+        Naming the card, its id and the field.
+    """
     if c.type != "CAERO1":
         return
     for name, p in (("P1", c.p1), ("P4", c.p4)):
@@ -1477,9 +1580,26 @@ def _check_caero1(deck: _Deck, c) -> None:
                        f"matrix would need {16 * (ns * nc) ** 2 / 2**30:.3g} GiB per Mach and k)")
 
 
-def _boxes(model, L, z0):
-    """Every CAERO1 as one :class:`BoxMesh` (in the structure's plane, z = 0 in asekit) and
-    the Nastran box ids."""
+def deck_boxes(model, L, z0):
+    """Every CAERO1 of a deck as one :class:`BoxMesh` (public reader API).
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF``, cross-referenced (CAERO1 with PAERO1, AEFACT).
+    L : float, one deck length unit in m.
+    z0 : float, the structure's plane (m); every surface must lie in it (no dihedral).
+
+    Returns
+    -------
+    mesh : :class:`BoxMesh`, in the structure's plane (z = 0 in asekit), spanwise from the
+        root, one surface per CAERO1 in id order.
+    box_ids : (n_boxes,) int, the Nastran box ids (EID + chordwise-first index).
+
+    Raises
+    ------
+    BdfError
+        A CAERO type other than CAERO1, or a surface off the plane.
+    """
     corners, strip, surface, ids, names = [], [], [], [], []
     s0 = 0
     for i, cid in enumerate(sorted(model.caeros)):
@@ -1603,7 +1723,7 @@ def _aelist_region(a, c, ids: list[int]):
     return rows[0], rows[-1], j0, ns, nc
 
 
-def _hinge_axis(deck: _Deck, a, c, pts) -> tuple[np.ndarray, np.ndarray]:
+def _hinge_axis(deck: Deck, a, c, pts) -> tuple[np.ndarray, np.ndarray]:
     """The hinge system CID1's origin (deck units) and unit y axis (basic), checked to run
     along the boxes' front edge through ``pts`` (its two ends, deck units) root to tip."""
     model = deck.model
@@ -1633,7 +1753,7 @@ def _aesurfs_of(model, label: str):
     return None
 
 
-def _read_aesurf(deck: _Deck, a) -> DeckControlSurface:
+def _read_aesurf(deck: Deck, a) -> DeckControlSurface:
     """AESURF (with its AELIST of boxes and the CORD2R of its hinge) as a control surface of
     one CAERO1 (MSC Nastran Quick Reference Guide, AESURF: the hinge line is the y axis of
     CIDi, a positive deflection a right-handed rotation about it: trailing edge down for a y
@@ -1667,7 +1787,7 @@ def _read_aesurf(deck: _Deck, a) -> DeckControlSurface:
     e0, e1 = float(eta[i0]), float(eta[i1 + 1])
     pts = [p1 + e * (p4 - p1) + np.array([xi * (c.x12 + e * (c.x43 - c.x12)), 0.0, 0.0])
            for e in (e0, e1)]
-    if p4[1] < p1[1]:                       # spanwise from the root (least y), as _boxes
+    if p4[1] < p1[1]:                       # spanwise from the root (least y), as deck_boxes
         e0, e1, pts = 1.0 - e1, 1.0 - e0, pts[::-1]
     o, y = _hinge_axis(deck, a, c, pts)
     L = deck.L
@@ -1710,7 +1830,7 @@ def _read_aelinks(model, surfaces, notes) -> tuple:
     return tuple(out)
 
 
-def _read_control_surfaces(deck: _Deck) -> dict:
+def _read_control_surfaces(deck: Deck) -> dict:
     """Every AESURF (:func:`_read_aesurf`) and AELINK: the keyword arguments of
     :class:`BdfModel` they set."""
     model = deck.model
@@ -1763,9 +1883,25 @@ def _check_pknl(f, ids, lists) -> None:
                        f"(one flight point per index)")
 
 
-def _flutter(model, f, rho_ref, deck) -> FlutterRequest:
+def read_flutter(model, f, rho_ref, deck) -> FlutterRequest:
     """A FLUTTER request with its FLFACT lists in SI (densities x RHOREF, |velocities|), as
-    MSC Nastran reads it (Quick Reference Guide, FLUTTER and FLFACT).
+    MSC Nastran reads it (Quick Reference Guide, FLUTTER and FLFACT). Public reader API.
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF`` (its FLFACT cards).
+    f : the pyNastran FLUTTER card.
+    rho_ref : float or None, AERO RHOREF (kg/m^3) (:func:`read_aero_card`).
+    deck : :class:`Deck` (units and ranges).
+
+    Returns
+    -------
+    FlutterRequest
+
+    Raises
+    ------
+    BdfError
+        Naming FLUTTER SID and the field (METHOD, DENS, MACH, RFREQ, IMETH, NVALUE, EPS).
 
     +---------+-----+--------+------+------+-------+-------+-------+------+
     |    1    |  2  |   3    |  4   |  5   |   6   |   7   |   8   |  9   |
@@ -1833,7 +1969,7 @@ def _components_of(n: int, links) -> np.ndarray:
     return np.array([root(i) for i in range(n)])
 
 
-def _check_connectivity(deck: _Deck, conn, quads, springs, masses, rigid) -> np.ndarray:
+def _check_connectivity(deck: Deck, conn, quads, springs, masses, rigid) -> np.ndarray:
     """Warn (:class:`BdfWarning`) about GRIDs that no element, spring, mass or rigid link uses
     (ignored) and about plate elements in pieces that share no grid, rigid link or spring with
     the largest piece; returns the component label of each node (elements and RBE2 joined)."""
@@ -1868,7 +2004,7 @@ def _check_connectivity(deck: _Deck, conn, quads, springs, masses, rigid) -> np.
     return comp
 
 
-def _rigid_vectors(deck: _Deck, comp: np.ndarray):
+def _rigid_vectors(deck: Deck, comp: np.ndarray):
     """The rigid out-of-plane motions of each component with a label >= 0 (3 per component:
     w = 1; w = y - y_c, theta_x = 1; w = -(x - x_c), theta_y = 1, lengths in units of the
     model's size, so that every column has entries of order 1), as an (n_dof, 3 n_comp)
@@ -1904,7 +2040,7 @@ def _unrestrained(R, fixed: set, Ks, K) -> np.ndarray:
     return Vt[s <= 1e-6].T
 
 
-def _free_rigid_modes(deck: _Deck, comp, fixed: set, Ks, K, M):
+def _free_rigid_modes(deck: Deck, comp, fixed: set, Ks, K, M):
     """The rigid-body modes the supports leave: the unrestrained rigid motions
     (:func:`_unrestrained`) that carry mass, split as the mode selection of the pipeline
     does (:data:`asekit.structure.modes.MIN_OUT_OF_PLANE`): those with an out-of-plane (w)
@@ -1943,7 +2079,7 @@ def _suport_dofs(model) -> int:
     return sum(len(_components(c)) for s in cards for c in getattr(s, "Cs", []))
 
 
-def _holding_words(deck: _Deck, fixed: set, springs) -> str:
+def _holding_words(deck: Deck, fixed: set, springs) -> str:
     """What the deck holds the structure with (for the rigid-body error)."""
     parts = [f"SPC / SPC1 / GRID PS fix {len(fixed)} out-of-plane DOFs" if fixed else
              "no SPC / SPC1 set applies and no GRID PS holds a T3, R1 or R2 DOF"]
@@ -1953,7 +2089,7 @@ def _holding_words(deck: _Deck, fixed: set, springs) -> str:
     return "; ".join(parts)
 
 
-def _check_rigid_modes(deck: _Deck, comp, fixed, springs, Ks, K, M) -> None:
+def _check_rigid_modes(deck: Deck, comp, fixed, springs, Ks, K, M) -> None:
     """Refuse a structure with rigid-body modes (zero strain energy, some mass) the deck does
     not explain; with as many SUPORT DOFs as modes (a free-free model declared) warn."""
     n, dropped, where = _free_rigid_modes(deck, comp, fixed, Ks, K, M)
@@ -2035,7 +2171,7 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
     """
     if units not in UNITS:
         raise ValueError(f"units must be one of {sorted(UNITS)}, got {units!r}")
-    BDF = _need_pynastran()
+    BDF = need_pynastran()
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"BDF not found: {path}")
@@ -2043,7 +2179,7 @@ def read_deck(path, units: str = "SI", tol: float | None = None,
         raise BdfError(f"{path}: not a file (give the deck's .bdf file)")
     model, trace = _open_deck(path, BDF)
     ignored = _check_cards(model, path.name)
-    deck = _Deck(model, path.name, *UNITS[units], wtmass=_read_param_wtmass(model, path.name))
+    deck = Deck(model, path.name, *UNITS[units], wtmass=_read_param_wtmass(model, path.name))
     if trace.repeats:
         deck.notes.append(f"{trace.repeats} cards repeated exactly (same id, same fields): "
                           f"each read once")
@@ -2280,7 +2416,22 @@ def _signed(req: FlutterRequest) -> np.ndarray:
     return np.where(np.asarray(req.print_vectors, bool), -v, v) if req.print_vectors else v
 
 
-def _solve_request(req: FlutterRequest, modal, db) -> DeckFlutter:
+def solve_request(req: FlutterRequest, modal, db) -> DeckFlutter:
+    """Run one FLUTTER request with its own method (public reader API).
+
+    Parameters
+    ----------
+    req : :class:`FlutterRequest` (:func:`read_flutter`).
+    modal : the elastic modal model (:class:`~asekit.aeroelastic.statespace.ModalArrays`).
+    db : the GAF tables by Mach (``db.at(mach)`` a
+        :class:`~asekit.aero.gaf.TabulatedGaf`).
+
+    Returns
+    -------
+    DeckFlutter
+        The request, one :mod:`asekit.aeroelastic.nastran` result per (density, Mach) point
+        (one matched-point result for PKNL) and the crossings.
+    """
     from asekit.aeroelastic import nastran as N
 
     def gaf(mach):
@@ -2331,7 +2482,7 @@ def deck_flutter(case: Case, db=None) -> list[DeckFlutter]:
         machs = tuple(sorted({m for r in bdf.flutter for m in r.machs}))
         db = pl.gaf_database(replace(case, aero=replace(case.aero, machs=machs)),
                              progress=False)
-    return [_solve_request(req, modal, db) for req in bdf.flutter]
+    return [solve_request(req, modal, db) for req in bdf.flutter]
 
 
 def flutter_rows(solved: list[DeckFlutter]) -> list[dict]:
@@ -2725,7 +2876,7 @@ def case_bdf(case, sol: int | None = None, n_modes: int | None = None):
     145 when the case has aero and flight conditions, else 103.
     """
     from pyNastran.bdf.case_control_deck import CaseControlDeck
-    BDF = _need_pynastran()
+    BDF = need_pynastran()
     sol = _export_sol(case, sol)
     model = BDF(debug=None)
     if case.structure is not None:

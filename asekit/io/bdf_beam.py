@@ -1,4 +1,5 @@
-"""Nastran stick-model decks (CBAR beams) in: the structure of a bar deck as 3-D frame matrices.
+"""Nastran stick-model decks (CBAR / CBEAM beams) in: the structure of a bar deck as 3-D frame
+matrices.
 
 :func:`read_stick_deck` reads, through pyNastran, a deck whose structure is made of bars:
 
@@ -7,6 +8,14 @@
 - CBAR (orientation vector X1-X3 in GA's displacement system, or G0; OFFT blank, GGG, or the
   old integer flag 1 "X1-X3 is a vector"; pin flags PA/PB and offsets WA/WB refused),
 - PBAR (A, I1, I2, J, NSM; I12 refused) with MAT1 (E, G, RHO),
+- CBEAM as the same Euler-Bernoulli bar (orientation as CBAR; OFFT blank or GGG, BIT, pin
+  flags, offsets WA/WB and warping scalar points SA/SB refused) with PBEAM of constant section
+  (every station's A, I1, I2, J, NSM equal to end A's; I12, the shear factors K1/K2 (0.0: shear
+  flexibility neglected, as the Euler-Bernoulli element has none), shear relief S1/S2, NSI,
+  warping CW and the NSM / neutral-axis offsets M1-N2 must be 0),
+- PBARL of type BAR, ROD, TUBE, BOX or (doubly symmetric) I with GROUP MSCBML0, its A, I1, I2
+  and J from the closed forms of :func:`pbarl_section` (dimensions as the MSC Nastran Quick
+  Reference Guide's PBARL figures define them),
 - CMASS2 (scalar mass on a grid component, or between two), CONM2 (mass and inertia with
   offset, CID 0 or blank),
 - SPC1 / SPC (zero enforced value) of the case control's SPC set, PARAM COUPMASS (> 0: the
@@ -23,28 +32,41 @@ displacement system CD, as Nastran's g-set: with R_cd the rows of CD's axes in b
 basic-frame matrices become K_cd = T^T K_basic T, T = diag(R_cd^T, R_cd^T) per grid.
 Massless DOFs are condensed statically (exact for them: no inertia) before the eigen-solution.
 
-Other structural cards (CBEAM, CROD, RBE3, shells, ...) are refused with the card and its
+Other structural cards (CROD, RBE3, PBEAML, shells, ...) are refused with the card and its
 first id; an unsupported field is refused with card, id and field. Aerodynamic and solution
 cards are read elsewhere (:mod:`asekit.io.bdf`); here they are ignored.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import scipy.linalg as sla
 
-from asekit.io.bdf import UNITS, BdfError, _need_pynastran
+from asekit.io.bdf import (
+    UNITS,
+    BdfError,
+    Deck,
+    case_value,
+    check_caero1,
+    deck_boxes,
+    need_pynastran,
+    read_aero_card,
+    read_flutter,
+    read_mkaero1,
+    solve_request,
+)
 from asekit.structure.frame import BarSection, global_bar_matrices
 
 #: structural cards a stick deck may hold (others are refused).
 STICK_CARDS = ("GRID", "CORD2R", "CORD1R", "CORD2C", "CORD2S", "CBAR", "PBAR", "MAT1",
-               "CMASS2", "CONM2", "SPC", "SPC1", "RBE2", "RBAR")
+               "CMASS2", "CONM2", "SPC", "SPC1", "RBE2", "RBAR", "CBEAM", "PBEAM", "PBARL")
 
 #: structural cards refused in a stick deck (asekit cannot represent them here).
-REFUSED_CARDS = ("CBEAM", "PBEAM", "PBARL", "PBEAML", "CROD", "CONROD", "PROD", "CTUBE",
+REFUSED_CARDS = ("PBEAML", "CROD", "CONROD", "PROD", "CTUBE",
                  "RBE1", "RBE3", "RROD", "MPC", "CELAS1", "CELAS2", "CELAS3",
                  "CELAS4", "CMASS1", "CMASS3", "CMASS4", "CONM1", "CQUAD4", "CTRIA3", "CQUAD8",
                  "CTRIA6", "CSHEAR", "CHEXA", "CPENTA", "CTETRA", "CBUSH", "CDAMP1", "CDAMP2",
@@ -121,27 +143,39 @@ class StickModes:
     notes: tuple = field(default=())
 
 
-def _card_ids(model, card: str) -> list:
+def card_ids(model, card: str) -> list:
+    """The ids of every ``card`` (e.g. ``"CBAR"``) of a pyNastran model, in its order.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> card_ids(NS(_type_to_id_map={"CBAR": [3, 1]}), "CBAR")
+    [3, 1]
+    """
     return list(model._type_to_id_map.get(card, ()))
 
 
 #: the structural cards of each pyNastran container a stick deck may hold.
-_ALLOWED = {"elements": ("CBAR",), "masses": ("CMASS2", "CONM2"),
-            "rigid_elements": ("RBE2", "RBAR"), "properties": ("PBAR",)}
+_ALLOWED = {"elements": ("CBAR", "CBEAM"), "masses": ("CMASS2", "CONM2"),
+            "rigid_elements": ("RBE2", "RBAR"), "properties": ("PBAR", "PBEAM", "PBARL")}
+
+#: the line elements a stick deck's structure is made of.
+BAR_CARDS = ("CBAR", "CBEAM")
 
 
 def _refuse_cards(model, name: str) -> None:
-    found = {c for c in REFUSED_CARDS if _card_ids(model, c)}
+    found = {c for c in REFUSED_CARDS if card_ids(model, c)}
     for attr, ok in _ALLOWED.items():
         found |= {v.type for v in getattr(model, attr).values() if v.type not in ok}
-    bad = [(c, len(_card_ids(model, c)), (_card_ids(model, c) or ["?"])[0])
+    bad = [(c, len(card_ids(model, c)), (card_ids(model, c) or ["?"])[0])
            for c in sorted(found)]
     if bad:
         listed = ", ".join(f"{c} (x{n}, first id {i})" for c, n, i in bad)
         raise BdfError(f"{name}: the stick-model import cannot represent {listed}; it reads "
-                       f"CBAR/PBAR/MAT1, CMASS2, CONM2, RBE2, RBAR, SPC/SPC1 and GRID PS")
-    if not _card_ids(model, "CBAR"):
-        raise BdfError(f"{name}: no CBAR element: not a stick model")
+                       f"CBAR/CBEAM with PBAR/PBEAM/PBARL and MAT1, CMASS2, CONM2, RBE2, RBAR, "
+                       f"SPC/SPC1 and GRID PS")
+    if not any(card_ids(model, c) for c in BAR_CARDS):
+        raise BdfError(f"{name}: no CBAR or CBEAM element: not a stick model")
 
 
 def _rect_axes(model, cid: int, what: str) -> np.ndarray:
@@ -162,57 +196,269 @@ def _grids(model, L: float):
     return ids, xyz, axes
 
 
-def _bar_vector(model, e, axes_of, xyz_of) -> np.ndarray:
-    """Orientation vector of a CBAR in basic (X1-X3 in GA's CD system, or toward G0)."""
+def bar_orientation(model, e, axes_of, xyz_of) -> np.ndarray:
+    """Orientation vector of a CBAR / CBEAM in basic (m or deck units, as ``xyz_of``).
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF``; e : the CBAR / CBEAM card.
+    axes_of : GRID id -> (3, 3) rows of its CD system's axes in basic.
+    xyz_of : GRID id -> (3,) its basic position.
+
+    Returns
+    -------
+    (3,) X1-X3 rotated from GA's CD system to basic, or G0 - GA (MSC QRG CBAR, CBEAM).
+    """
     if e.g0:
         return xyz_of(e.g0) - xyz_of(e.ga)
     return axes_of(e.ga).T @ np.asarray(e.x, float)
 
 
 def _check_bar(e) -> None:
+    """The CBAR / CBEAM fields asekit's bar cannot represent, refused with card, id, field."""
+    card = f"{e.type} {e.eid}"
     if e.offt not in ("GGG", 1, "1", None, ""):
-        raise BdfError(f"CBAR {e.eid}: OFFT = {e.offt!r} is not supported (blank or GGG: the "
+        raise BdfError(f"{card}: OFFT = {e.offt!r} is not supported (blank or GGG: the "
                        f"orientation vector in GA's displacement system)")
     if e.pa or e.pb:
-        raise BdfError(f"CBAR {e.eid}: pin flags PA = {e.pa}, PB = {e.pb} are not supported "
+        raise BdfError(f"{card}: pin flags PA = {e.pa}, PB = {e.pb} are not supported "
                        f"(blank or 0)")
     if np.any(np.asarray(e.wa, float)) or np.any(np.asarray(e.wb, float)):
-        raise BdfError(f"CBAR {e.eid}: offsets WA/WB are not supported (blank or 0)")
+        raise BdfError(f"{card}: offsets WA/WB are not supported (blank or 0)")
+    if e.type == "CBEAM":
+        if getattr(e, "bit", None) is not None:
+            raise BdfError(f"{card}: BIT = {e.bit!r} (beam-in-tapered) is not supported "
+                           f"(blank, or OFFT blank / GGG)")
+        if e.sa or e.sb:
+            raise BdfError(f"{card}: warping scalar points SA = {e.sa}, SB = {e.sb} are not "
+                           f"supported (blank or 0: no warping)")
 
 
-def _bar_section(model, pid: int, eid: int, deck_units) -> BarSection:
-    """PBAR + MAT1 of a CBAR as SI section properties."""
+def _shear_factor(p, name: str) -> float:
+    """PBAR / PBEAM K1 or K2 (> 0: shear area factor, K G A the shear stiffness), or 0.0 for
+    no shear flexibility (PBAR blank, which pyNastran stores as 1e8; PBEAM 0.0)."""
+    k = getattr(p, name, None)
+    if k is None or k == 1e8 and p.type == "PBAR":
+        return 0.0
+    k = float(k)
+    if not (math.isfinite(k) and k >= 0):
+        raise BdfError(f"{p.type} {p.pid}: {name.upper()} = {k:g} must be >= 0")
+    return k
+
+
+def _pbar_values(p) -> tuple:
+    """PBAR: (A, I1, I2, J, NSM, K1, K2) in deck units; I12 refused."""
+    if p.i12:
+        raise BdfError(f"PBAR {p.pid}: I12 = {p.i12:g} is not supported (0: principal axes)")
+    return (p.A, p.i1, p.i2, p.j, p.nsm or 0.0, _shear_factor(p, "k1"),
+            _shear_factor(p, "k2"))
+
+
+#: PBEAM fields that must be zero for asekit's bar (constant section, no shear relief, no NSM
+#: inertia, no warping, no NSM or neutral-axis offsets).
+_PBEAM_ZERO = ("s1", "s2", "nsia", "nsib", "cwa", "cwb", "m1a", "m2a", "m1b", "m2b", "n1a",
+               "n2a", "n1b", "n2b")
+
+
+def _pbeam_values(p) -> tuple:
+    """PBEAM of constant section: (A, I1, I2, J, NSM, K1, K2) of end A in deck units; every
+    station equal to end A, I12 = 0 and the :data:`_PBEAM_ZERO` fields 0, else refused naming
+    the field (MSC QRG PBEAM: K1, K2 default 1.0, the shear stiffness K G A; 0.0 neglects
+    the shear flexibility)."""
+    vals = {name: np.atleast_1d(np.asarray(getattr(p, key), float)) for name, key in
+            (("A", "A"), ("I1", "i1"), ("I2", "i2"), ("J", "j"), ("NSM", "nsm"),
+             ("I12", "i12"))}
+    for name, v in vals.items():
+        if np.any(v != v[0]):
+            raise BdfError(f"PBEAM {p.pid}: {name} varies along the beam "
+                           f"({', '.join(f'{x:g}' for x in v)}); only a constant section "
+                           f"is supported")
+    if vals["I12"][0]:
+        raise BdfError(f"PBEAM {p.pid}: I12 = {vals['I12'][0]:g} is not supported (0: "
+                       f"principal axes)")
+    for key in _PBEAM_ZERO:
+        x = float(getattr(p, key) or 0.0)
+        if x != 0.0:
+            raise BdfError(f"PBEAM {p.pid}: {key.upper()} = {x:g} is not supported (0.0)")
+    return (*(float(vals[n][0]) for n in ("A", "I1", "I2", "J", "NSM")),
+            _shear_factor(p, "k1"), _shear_factor(p, "k2"))
+
+
+#: PBARL section types :func:`pbarl_section` evaluates, with their number of dimensions.
+PBARL_TYPES = {"BAR": 2, "ROD": 1, "TUBE": 2, "BOX": 4, "I": 6}
+
+
+def _pbarl_geometry(t: str, d) -> str:
+    """The reason a PBARL's dimensions do not make a section (empty when they do)."""
+    if t == "TUBE" and not d[1] < d[0]:
+        return "DIM2 (inner radius) must be < DIM1 (outer radius)"
+    if t == "BOX" and not (2 * d[3] < d[0] and 2 * d[2] < d[1]):
+        return "2 DIM4 < DIM1 and 2 DIM3 < DIM2 (the walls leave a hole)"
+    if t == "I" and not (d[4] + d[5] < d[0] and d[3] < min(d[1], d[2])):
+        return "DIM5 + DIM6 < DIM1 and DIM4 < DIM2, DIM3 (a web between the flanges)"
+    if t == "I" and (d[1] != d[2] or d[4] != d[5]):
+        return ("DIM2 = DIM3 and DIM5 = DIM6 (doubly symmetric; an unsymmetric I has its "
+                "centroid off the reference axis, an offset asekit's bar does not have)")
+    return ""
+
+
+def pbarl_section(section_type: str, dims, where: str = "PBARL") -> tuple:
+    """A, I1, I2, J of a PBARL cross-section from its DIMi (any consistent length unit).
+
+    The dimensions are those of the PBARL figures of the MSC Nastran Quick Reference Guide
+    (element y axis = plane 1, z axis = plane 2; I1 = int y^2 dA, I2 = int z^2 dA):
+
+    - BAR: DIM1 width along z, DIM2 height along y. A = b h, I1 = b h^3 / 12,
+      I2 = h b^3 / 12; J = a c^3 (1/3 - 0.21 (c/a)(1 - c^4 / (12 a^4))), a = max(b, h),
+      c = min(b, h) (Roark, *Formulas for Stress and Strain*, 7th ed., Table 10.7 case 4).
+    - ROD: DIM1 radius r. A = pi r^2, I1 = I2 = pi r^4 / 4, J = pi r^4 / 2.
+    - TUBE: DIM1 outer, DIM2 inner radius. A = pi (ro^2 - ri^2), I1 = I2 = pi (ro^4 - ri^4)/4,
+      J = pi (ro^4 - ri^4) / 2.
+    - BOX: DIM1 width b (z), DIM2 height h (y), DIM3 thickness t1 of the walls normal to y,
+      DIM4 thickness t2 of the walls normal to z. A = b h - bi hi (bi = b - 2 t2,
+      hi = h - 2 t1), I1 = (b h^3 - bi hi^3) / 12, I2 = (h b^3 - hi bi^3) / 12; J of the
+      closed thin-walled section on the wall mid-lines (Bredt-Batho, Roark Table 10.7 case 16):
+      J = 2 t1 t2 (b - t2)^2 (h - t1)^2 / (b t2 + h t1 - t2^2 - t1^2).
+    - I (doubly symmetric: DIM2 = DIM3, DIM5 = DIM6): DIM1 height h (y), DIM2 flange width b,
+      DIM4 web thickness tw, DIM5 flange thickness tf; web height hw = h - 2 tf.
+      A = 2 b tf + hw tw, I1 = (b h^3 - (b - tw) hw^3) / 12, I2 = (2 tf b^3 + hw tw^3) / 12,
+      J = (2 b tf^3 + hw tw^3) / 3 (open thin-walled section, sum of its rectangles).
+
+    Parameters
+    ----------
+    section_type : one of :data:`PBARL_TYPES`.
+    dims : its DIMi (> 0; DIM2 of TUBE >= 0).
+    where : the card named in an error (e.g. ``"PBARL 7"``).
+
+    Returns
+    -------
+    (A, I1, I2, J) : floats in the unit of ``dims`` squared and to the fourth power.
+
+    Raises
+    ------
+    BdfError
+        An unsupported type, the wrong number of dimensions, or dimensions that make no
+        section, naming ``where`` and the field.
+
+    Examples
+    --------
+    >>> A, I1, I2, J = pbarl_section("BAR", [0.2, 0.1])
+    >>> round(A, 6), round(I1 * 1e6, 4), round(I2 * 1e6, 4)
+    (0.02, 16.6667, 66.6667)
+    """
+    t = str(section_type).upper()
+    if t not in PBARL_TYPES:
+        raise BdfError(f"{where}: TYPE = {t!r} is not supported ({', '.join(PBARL_TYPES)})")
+    d = [float(x) for x in dims]
+    if len(d) != PBARL_TYPES[t]:
+        raise BdfError(f"{where}: TYPE {t} needs {PBARL_TYPES[t]} dimensions DIMi, got {len(d)}")
+    for i, x in enumerate(d):
+        if not (np.isfinite(x) and (x > 0 or (t == "TUBE" and i == 1 and x == 0))):
+            raise BdfError(f"{where}: DIM{i + 1} = {x:g} must be > 0")
+    why = _pbarl_geometry(t, d)
+    if why:
+        raise BdfError(f"{where}: TYPE {t} DIM = {d}: {why}")
+    return _PBARL_FORMS[t](*d)
+
+
+def _bar_form(b, h):
+    a, c = max(b, h), min(b, h)
+    return (b * h, b * h ** 3 / 12, h * b ** 3 / 12,
+            a * c ** 3 * (1 / 3 - 0.21 * (c / a) * (1 - c ** 4 / (12 * a ** 4))))
+
+
+def _tube_form(ro, ri=0.0):
+    i = np.pi * (ro ** 4 - ri ** 4) / 4
+    return np.pi * (ro ** 2 - ri ** 2), i, i, 2 * i
+
+
+def _box_form(b, h, t1, t2):
+    bi, hi = b - 2 * t2, h - 2 * t1
+    J = 2 * t1 * t2 * (b - t2) ** 2 * (h - t1) ** 2 / (b * t2 + h * t1 - t2 ** 2 - t1 ** 2)
+    return b * h - bi * hi, (b * h ** 3 - bi * hi ** 3) / 12, (h * b ** 3 - hi * bi ** 3) / 12, J
+
+
+def _i_form(h, b, _b2, tw, tf, _tf2):
+    hw = h - 2 * tf
+    return (2 * b * tf + hw * tw, (b * h ** 3 - (b - tw) * hw ** 3) / 12,
+            (2 * tf * b ** 3 + hw * tw ** 3) / 12, (2 * b * tf ** 3 + hw * tw ** 3) / 3)
+
+
+_PBARL_FORMS = {"BAR": _bar_form, "ROD": _tube_form, "TUBE": _tube_form, "BOX": _box_form,
+                "I": _i_form}
+
+
+def _pbarl_values(p) -> tuple:
+    """PBARL: (A, I1, I2, J, NSM, 0, 0) in deck units (:func:`pbarl_section`; no shear
+    flexibility: PBARL has no K1 / K2 field); GROUP MSCBML0 only."""
+    group = str(getattr(p, "group", "MSCBML0") or "MSCBML0").strip().upper()
+    if group != "MSCBML0":
+        raise BdfError(f"PBARL {p.pid}: GROUP = {group!r} is not supported (MSCBML0, the "
+                       f"standard beam library)")
+    return (*pbarl_section(p.beam_type, p.dim, f"PBARL {p.pid}"), float(p.nsm or 0.0), 0.0, 0.0)
+
+
+_SECTION_VALUES = {"PBAR": _pbar_values, "PBEAM": _pbeam_values, "PBARL": _pbarl_values}
+#: the properties each line element may reference (MSC QRG CBAR / CBEAM PID).
+_ELEMENT_PROPERTIES = {"CBAR": ("PBAR", "PBARL"), "CBEAM": ("PBEAM", "PBARL")}
+
+
+def bar_section(model, pid: int, eid: int, deck_units, card: str = "CBAR") -> BarSection:
+    """PBAR / PBEAM / PBARL + MAT1 of a CBAR / CBEAM as SI section properties.
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF``, cross-referenced.
+    pid, eid : the element's PID and id; card : "CBAR" or "CBEAM" (which properties it takes).
+    deck_units : (L m, Mu kg, T s, PARAM WTMASS) of one deck unit.
+
+    Returns
+    -------
+    :class:`~asekit.structure.frame.BarSection`
+        EA = E A, GJ = G J, EI1 = E I1, EI2 = E I2 (N, N m^2), mass = (rho A + NSM) WTMASS
+        (kg/m).
+
+    Raises
+    ------
+    BdfError
+        Naming the card, its id and the field asekit cannot represent.
+    """
     L, Mu, T, wt = deck_units
     p = model.properties[pid]
-    if p.type != "PBAR":
-        raise BdfError(f"CBAR {eid}: PID {pid} is a {p.type}; only PBAR is supported")
-    if p.i12:
-        raise BdfError(f"PBAR {pid}: I12 = {p.i12:g} is not supported (0: principal axes)")
-    if not p.A > 0:
-        raise BdfError(f"PBAR {pid}: A = {p.A!r} must be > 0")
+    if p.type not in _ELEMENT_PROPERTIES[card]:
+        raise BdfError(f"{card} {eid}: PID {pid} is a {p.type}; a {card} takes "
+                       f"{' or '.join(_ELEMENT_PROPERTIES[card])}")
+    A, i1, i2, j, nsm, k1, k2 = _SECTION_VALUES[p.type](p)
+    if not A > 0:
+        raise BdfError(f"{p.type} {pid}: A = {A!r} must be > 0")
     mat = model.materials[p.mid]
     if mat.type != "MAT1":
-        raise BdfError(f"PBAR {pid}: MID {p.mid} is a {mat.type}; only MAT1 is supported")
+        raise BdfError(f"{p.type} {pid}: MID {p.mid} is a {mat.type}; only MAT1 is supported")
     E, G, rho = mat.e, mat.g, mat.rho or 0.0
     if not (E and E > 0 and G is not None and G >= 0):
         raise BdfError(f"MAT1 {p.mid}: E must be > 0 and G >= 0, got E = {E!r}, G = {G!r}")
     stress = Mu / (L * T * T)                      # deck pressure in Pa
-    return BarSection(ea=E * p.A * stress * L ** 2, gj=G * p.j * stress * L ** 4,
-                      ei1=E * p.i1 * stress * L ** 4, ei2=E * p.i2 * stress * L ** 4,
-                      mass=(rho * p.A + (p.nsm or 0.0)) * wt * Mu / L)
+    if (k1 or k2) and not G > 0:
+        raise BdfError(f"{p.type} {pid}: K1 / K2 (shear flexibility) need MAT1 {p.mid} G > 0")
+    gas = [k * G * A * stress * L ** 2 if k else math.inf for k in (k1, k2)]
+    return BarSection(ea=E * A * stress * L ** 2, gj=G * j * stress * L ** 4,
+                      ei1=E * i1 * stress * L ** 4, ei2=E * i2 * stress * L ** 4,
+                      mass=(rho * A + (nsm or 0.0)) * wt * Mu / L, gas1=gas[0], gas2=gas[1])
 
 
 def _add_bars(model, K, M, index, xyz, axes, coupled, deck_units) -> None:
-    for eid in _card_ids(model, "CBAR"):
+    for eid in [i for c in BAR_CARDS for i in card_ids(model, c)]:
         e = model.elements[eid]
         _check_bar(e)
         ia, ib = index[e.ga], index[e.gb]
-        v = _bar_vector(model, e, lambda g: axes[index[g]], lambda g: xyz[index[g]])
+        v = bar_orientation(model, e, lambda g: axes[index[g]], lambda g: xyz[index[g]])
         try:
-            Ke, Me = global_bar_matrices(xyz[ia], xyz[ib], v,
-                                         _bar_section(model, e.pid, eid, deck_units), coupled)
+            sec = bar_section(model, e.pid, eid, deck_units, e.type)
+            Ke, Me = global_bar_matrices(xyz[ia], xyz[ib], v, sec, coupled)
+        except BdfError:
+            raise
         except ValueError as exc:
-            raise BdfError(f"CBAR {eid}: {exc}") from None
+            raise BdfError(f"{e.type} {eid}: {exc}") from None
         d = np.r_[NODE_DOF * ia:NODE_DOF * ia + 6, NODE_DOF * ib:NODE_DOF * ib + 6]
         K[np.ix_(d, d)] += Ke
         M[np.ix_(d, d)] += Me
@@ -226,7 +472,7 @@ def _add_conm2(model, M, index, deck_units) -> None:
     """CONM2: rigid mass m at offset x from its grid, inertia I about its centre, both in basic
     (CID 0): u_p = u + theta x x, so M_grid = G^T diag(m, m, m, I) G, G = [[1, -S(x)], [0, 1]]."""
     L, Mu, T, wt = deck_units
-    for eid in _card_ids(model, "CONM2"):
+    for eid in card_ids(model, "CONM2"):
         m = model.masses[eid]
         if m.cid not in (0, None):
             raise BdfError(f"CONM2 {eid}: CID = {m.cid} is not supported (0: basic)")
@@ -362,7 +608,15 @@ def _rigid_links(model, index, xyz, axes, fixed: set, ids) -> tuple:
     return tuple(sorted(dep.items()))
 
 
-def _param(model, key: str, default):
+def deck_param(model, key: str, default):
+    """The first value of PARAM ``key`` (e.g. ``"WTMASS"``), or ``default`` without it.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> deck_param(NS(params={"WTMASS": NS(values=[0.00259])}), "WTMASS", 1.0)
+    0.00259
+    """
     p = model.params.get(key)
     return p.values[0] if p is not None else default
 
@@ -393,7 +647,7 @@ def read_stick_deck(path, units: str = "SI") -> StickModel:
     """
     if units not in UNITS:
         raise ValueError(f"units must be one of {sorted(UNITS)}, got {units!r}")
-    BDF = _need_pynastran()
+    BDF = need_pynastran()
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"BDF not found: {path}")
@@ -404,8 +658,8 @@ def read_stick_deck(path, units: str = "SI") -> StickModel:
         raise BdfError(f"{path.name}: {str(exc).strip().splitlines()[0]}") from None
     _refuse_cards(model, path.name)
     L, Mu, T = UNITS[units]
-    wt = float(_param(model, "WTMASS", 1.0))
-    coupled = int(_param(model, "COUPMASS", -1)) > 0
+    wt = float(deck_param(model, "WTMASS", 1.0))
+    coupled = int(deck_param(model, "COUPMASS", -1)) > 0
     deck_units = (L, Mu, T, wt)
     ids, xyz, axes = _grids(model, L)
     index = {int(g): i for i, g in enumerate(ids)}
@@ -419,7 +673,8 @@ def read_stick_deck(path, units: str = "SI") -> StickModel:
     _add_cmass2_si(model, M, index, deck_units)
     fixed = _fixed_dofs(model, index, path.name)
     rigid = _rigid_links(model, index, xyz, axes, fixed, ids)
-    notes = (f"{len(_card_ids(model, 'CBAR'))} CBAR, {len(ids)} GRID; bar mass "
+    notes = (f"{len(card_ids(model, 'CBAR'))} CBAR, {len(card_ids(model, 'CBEAM'))} CBEAM, "
+             f"{len(ids)} GRID; bar mass "
              f"{'consistent (PARAM COUPMASS 1)' if coupled else 'lumped'}",)
     return StickModel(node_ids=ids, xyz=xyz, cd_axes=axes, K=0.5 * (K + K.T),
                       M=0.5 * (M + M.T), fixed=tuple(sorted(fixed)), coupled=coupled,
@@ -431,7 +686,7 @@ def _add_cmass2_si(model, M, index, deck_units) -> None:
     entry scaled by the SI factor of its two DOFs, Mu s_i s_j (s = 1 for a translation, L for
     a rotation: a mass in kg, a rotary inertia in kg m^2, a coupling in kg m)."""
     L, Mu, T, wt = deck_units
-    for eid in _card_ids(model, "CMASS2"):
+    for eid in card_ids(model, "CMASS2"):
         c = model.masses[eid]
         dofs, scale = [], []
         for g, comp in ((c.nodes[0], c.c1), (c.nodes[1], c.c2)):
@@ -659,7 +914,16 @@ def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L
     return BoxModes(h_cp, d_cp, h_lp)
 
 
-def _n_modes(model) -> int:
+def requested_mode_count(model) -> int:
+    """The number of modes a stick deck asks for: PARAM LMODES (> 0), else the ND of its
+    first EIGR / EIGRL, else 6.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> requested_mode_count(NS(params={}, methods={10: NS(nd=4)}))
+    4
+    """
     p = model.params.get("LMODES")
     if p is not None and int(p.values[0]) > 0:
         return int(p.values[0])
@@ -693,15 +957,15 @@ class _Table:
 
 
 def is_stick_deck(path) -> bool:
-    """True when the deck's structure is bars (CBAR) and no shell: :func:`stick_flutter`'s
+    """True when the deck's structure is bars (CBAR / CBEAM) and no shell: :func:`stick_flutter`'s
     deck, not :func:`asekit.io.bdf.read_bdf`'s."""
-    model = _need_pynastran()(debug=None)
+    model = need_pynastran()(debug=None)
     try:
         model.read_bdf(str(path), xref=False)
     except Exception:           # read_bdf reports the deck's error in its own words
         return False
     cc = model.card_count
-    return "CBAR" in cc and not any(c in cc for c in ("CQUAD4", "CTRIA3"))
+    return any(c in cc for c in BAR_CARDS) and not any(c in cc for c in ("CQUAD4", "CTRIA3"))
 
 
 def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
@@ -722,24 +986,23 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     """
     from asekit.aero.gaf import TabulatedGaf, gaf_from_box_modes
     from asekit.aeroelastic.statespace import modal_arrays
-    from asekit.io import bdf as B
 
     sm = read_stick_deck(path, units)
-    model = _need_pynastran()(debug=None)
+    model = need_pynastran()(debug=None)
     model.read_bdf(str(path), xref=True)
     L, Mu, T = UNITS[units]
-    deck = B._Deck(model, Path(path).name, L, Mu, T)
+    deck = Deck(model, Path(path).name, L, Mu, T)
     if not model.caeros or not model.flutters:
         raise BdfError(f"{deck.name}: no CAERO1 or no FLUTTER card: nothing to run")
-    b_ref, rho_ref, symmetric = B._read_aero_card(deck)      # ACSID first: the flow axis
+    b_ref, rho_ref, symmetric = read_aero_card(deck)      # ACSID first: the flow axis
     for c in model.caeros.values():
-        B._check_caero1(deck, c)
-    mesh, box_ids = B._boxes(model, L, 0.0)
-    machs, table_ks = B._read_mkaero1(model, deck)
-    requests = [B._flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
-    fm = B._case_value(model, "FMETHOD")
+        check_caero1(deck, c)
+    mesh, box_ids = deck_boxes(model, L, 0.0)
+    machs, table_ks = read_mkaero1(model, deck)
+    requests = [read_flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
+    fm = case_value(model, "FMETHOD")
     requests.sort(key=lambda r: r.sid != fm)
-    modes = stick_modes(sm, _n_modes(model))
+    modes = stick_modes(sm, requested_mode_count(model))
     bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L)
     w = 2 * np.pi * modes.frequencies_hz
     modal = modal_arrays(M=np.eye(w.size), K=np.diag(w ** 2))
@@ -747,7 +1010,7 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     db = _Table({m: TabulatedGaf(ks, gaf_from_box_modes(bm, mesh, m, ks, b_ref, symmetric),
                                  b_ref, m) for m in machs})
     return StickFlutter(modes=modes, b_ref=b_ref,
-                        results=tuple(B._solve_request(r, modal, db) for r in requests))
+                        results=tuple(solve_request(r, modal, db) for r in requests))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -788,15 +1051,27 @@ def scalar_mass_pairs(R: np.ndarray, tol: float = 0.0) -> list[tuple[int, int, f
     return out
 
 
-def write_beam_bdf(beam, path) -> Path:
+def _section_lines(element: str, pid: int, sec) -> list[str]:
+    """PBAR, or the constant-section PBEAM (end A; C-F stress points 0; end B YESA; K1 = K2 =
+    0.0), of a :class:`~asekit.structure.beam.BeamSection` with MAT1 E = G = 1."""
+    if element == "CBAR":
+        return [f"PBAR,{pid},1,{sec.ea!r},{sec.ei_flap!r},{sec.ei_chord!r},{sec.gj!r},"
+                f"{sec.mass!r}"]
+    return [f"PBEAM,{pid},1,{sec.ea!r},{sec.ei_flap!r},{sec.ei_chord!r},0.0,{sec.gj!r},"
+            f"{sec.mass!r}", "," + ",".join(["0.0"] * 8), ",YESA,1.0", ",0.0,0.0"]
+
+
+def write_beam_bdf(beam, path, element: str = "CBAR") -> Path:
     """Write a clamped :class:`~asekit.structure.beam.StraightBeam` (a case's ``[[beam]]``,
     :func:`asekit.case.pipeline.case_beam`) as an SI SOL 103 deck that
     :func:`read_stick_deck` reads back to the same matrices.
 
     GRID per node, CBAR per element (orientation vector the surface normal e3: plane 1 is the
     flap plane), PBAR with MAT1 E = G = 1 Pa (A = EA, I1 = EI_flap, I2 = EI_chord, J = GJ,
-    NSM = m), PARAM COUPMASS 1 (the consistent bar mass), SPC1 123456 at the root. What a PBAR
-    cannot hold -- the polar inertia, the mass offset's bending-torsion coupling and the point
+    NSM = m), PARAM COUPMASS 1 (the consistent bar mass), SPC1 123456 at the root. With
+    ``element="CBEAM"`` the elements are CBEAM with a constant-section PBEAM holding the same
+    values (end B "YESA", K1 = K2 = 0.0: no shear flexibility), the same Euler-Bernoulli bar.
+    What a PBAR cannot hold -- the polar inertia, the mass offset's bending-torsion coupling and the point
     masses -- is the difference between the beam's consistent mass matrix
     (:func:`asekit.structure.beam.assemble`) and the bars' one, written exactly as CMASS2 scalar
     masses (:func:`scalar_mass_pairs`; some negative, as a consistent matrix's lumped form
@@ -806,6 +1081,7 @@ def write_beam_bdf(beam, path) -> Path:
     ----------
     beam : StraightBeam.
     path : the deck to write (overwritten).
+    element : ``"CBAR"`` (PBAR) or ``"CBEAM"`` (PBEAM).
 
     Returns
     -------
@@ -813,6 +1089,8 @@ def write_beam_bdf(beam, path) -> Path:
     """
     from asekit.structure.beam import assemble
 
+    if element not in BAR_CARDS:
+        raise ValueError(f"element must be one of {BAR_CARDS}, got {element!r}")
     path = Path(path)
     _, Mb = assemble(beam)
     R = Mb - _bar_mass(beam)
@@ -825,9 +1103,8 @@ def write_beam_bdf(beam, path) -> Path:
         lines.append(f"GRID,{i + 1},,{x[0]!r},{x[1]!r},{x[2]!r}")
     v = beam.frame[2]
     for e, sec in enumerate(beam.sections):
-        lines.append(f"CBAR,{e + 1},{e + 1},{e + 1},{e + 2},{v[0]!r},{v[1]!r},{v[2]!r}")
-        lines.append(f"PBAR,{e + 1},1,{sec.ea!r},{sec.ei_flap!r},{sec.ei_chord!r},"
-                     f"{sec.gj!r},{sec.mass!r}")
+        lines.append(f"{element},{e + 1},{e + 1},{e + 1},{e + 2},{v[0]!r},{v[1]!r},{v[2]!r}")
+        lines += _section_lines(element, e + 1, sec)
     lines += ["MAT1,1,1.0,1.0", "SPC1,1,123456,1", "PARAM,COUPMASS,1",
               f"EIGRL,1,,,{min(6, NODE_DOF * (beam.n_nodes - 1))}"]
     tol = 1e-14 * float(np.abs(Mb).max())

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from asekit.util.validate import finite, finite_array, integer, positive
+from asekit.util.validate import finite, finite_array, in_range, integer, positive
 
 #: degrees of freedom per node: ux, uy, uz, rx, ry, rz (global frame).
 NODE_DOF = 6
@@ -53,13 +53,16 @@ class BeamSection:
 
     Parameters
     ----------
-    ea : axial stiffness E A (N), > 0.
+    ea : axial stiffness E A (N), >= 0 (0 only for a beam solved with its in-plane motion
+        fixed, :func:`beam_modes` ``in_plane_fixed``).
     gj : torsional stiffness G J (N m^2), > 0.
     ei_flap : bending stiffness out of the surface's plane, deflection along e3 (N m^2), > 0.
-    ei_chord : bending stiffness in the surface's plane, deflection along e2 (N m^2), > 0.
+    ei_chord : bending stiffness in the surface's plane, deflection along e2 (N m^2), >= 0
+        (0 as ``ea``).
     mass : mass per unit length m (kg/m), > 0.
     polar_inertia : polar mass moment of inertia per unit length about the elastic axis
-        I_p (kg m^2/m = kg m), > 0.
+        I_p (kg m^2/m = kg m), >= 0 (0: the torsional inertia only from point masses, as a
+        Nastran CBAR's).
     mass_offset : distance of the mass axis aft of the elastic axis d (m), any sign
         (I_p >= m d^2 is required: the inertia about the mass axis is not negative).
 
@@ -79,8 +82,10 @@ class BeamSection:
     mass_offset: float = 0.0
 
     def __post_init__(self):
-        for name in ("ea", "gj", "ei_flap", "ei_chord", "mass", "polar_inertia"):
+        for name in ("gj", "ei_flap", "mass"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
+        for name in ("ea", "ei_chord", "polar_inertia"):
+            object.__setattr__(self, name, in_range(name, getattr(self, name), 0.0, True))
         d = finite("mass_offset", self.mass_offset)
         object.__setattr__(self, "mass_offset", d)
         if self.polar_inertia < self.mass * d * d * (1 - 1e-12):
@@ -374,9 +379,29 @@ class BeamModes:
         return np.eye(n), np.diag(self.omega ** 2), np.zeros((n, n))
 
 
-def beam_modes(beam: StraightBeam, n_modes: int = 6) -> BeamModes:
+def out_of_plane_dofs(n_nodes: int) -> np.ndarray:
+    """The out-of-plane DOFs (uz, rx, ry: 2, 3, 4 of each node's six) of nodes 1..n-1.
+
+    For a beam in the (x, y) plane whose mass offsets lie in that plane these are decoupled
+    from the in-plane ones (ux, uy, rz): K and M have no entry between the two sets (the
+    element matrices are rotated about z only, Eq. 6.26 of Przemieniecki 1968), so fixing the
+    in-plane motion (Nastran: PS 126 on a grid whose CD z is the plane's normal) leaves the
+    out-of-plane modes unchanged.
+
+    Examples
+    --------
+    >>> out_of_plane_dofs(3).tolist()
+    [8, 9, 10, 14, 15, 16]
+    """
+    nodes = np.arange(1, int(n_nodes))
+    return (NODE_DOF * nodes[:, None] + np.array([2, 3, 4])[None, :]).ravel()
+
+
+def beam_modes(beam: StraightBeam, n_modes: int = 6, in_plane_fixed: bool = False) -> BeamModes:
     """The lowest ``n_modes`` natural modes of ``beam`` clamped at its root node (all six
     degrees of freedom fixed), K phi = omega^2 M phi solved densely (``scipy.linalg.eigh``).
+    With ``in_plane_fixed`` only the out-of-plane DOFs (:func:`out_of_plane_dofs`) are free:
+    the in-plane motion of every node is fixed (``ea`` and ``ei_chord`` may then be 0).
 
     Each mode's sign is fixed (its largest-magnitude entry positive), so the shapes are
     reproducible.
@@ -384,7 +409,9 @@ def beam_modes(beam: StraightBeam, n_modes: int = 6) -> BeamModes:
     Parameters
     ----------
     beam : :class:`StraightBeam`.
-    n_modes : number of modes, 1 <= n_modes <= 6 (n_nodes - 1).
+    n_modes : number of modes, 1 <= n_modes <= 6 (n_nodes - 1) (3 (n_nodes - 1) with
+        ``in_plane_fixed``).
+    in_plane_fixed : bool, fix ux, uy, rz of every node (default False).
 
     Returns
     -------
@@ -397,15 +424,21 @@ def beam_modes(beam: StraightBeam, n_modes: int = 6) -> BeamModes:
     >>> round(float(f) * 2 * math.pi / (1.8751041 ** 2 * math.sqrt(1e4)), 6)   # Euler-Bernoulli
     1.0
     """
-    n_free = NODE_DOF * (beam.n_nodes - 1)
+    if in_plane_fixed:
+        free = out_of_plane_dofs(beam.n_nodes)
+    else:
+        free = np.arange(NODE_DOF, NODE_DOF * beam.n_nodes)
+        if any(s.ea == 0 or s.ei_chord == 0 for s in beam.sections):
+            raise ValueError("a section with ea = 0 or ei_chord = 0 leaves the in-plane motion "
+                             "without stiffness: solve with in_plane_fixed=True")
+    n_free = free.size
     n_modes = integer("n_modes", n_modes, low=1, high=n_free)
     K, M = assemble(beam)
-    free = slice(NODE_DOF, None)
+    K, M = K[np.ix_(free, free)], M[np.ix_(free, free)]
     # M phi = mu K phi, mu = 1 / omega^2: the lowest modes are the largest mu, accurate to
     # rounding relative to mu_max however stiff the axial and in-plane terms (EA, EI_chord)
     # make K; K phi = omega^2 M phi directly loses them to ||K|| ||M^-1|| on fine meshes.
-    mu, phi = sla.eigh(M[free, free], K[free, free],
-                       subset_by_index=[n_free - n_modes, n_free - 1])
+    mu, phi = sla.eigh(M, K, subset_by_index=[n_free - n_modes, n_free - 1])
     w2 = 1.0 / mu[::-1]
     phi = phi[:, ::-1] / np.sqrt(mu[::-1])[None, :]       # mass-normalised: phi^T M phi = I
     full = np.zeros((NODE_DOF * beam.n_nodes, n_modes))

@@ -8,7 +8,9 @@ e_y, slope r_z = dv/dx) has stiffness E I1; bending in plane 2 (deflection along
 r_y = -dw/dx) has E I2; axial E A, St Venant torsion G J.
 
 Local stiffness: Przemieniecki, *Theory of Matrix Structural Analysis* (McGraw-Hill 1968),
-Eq. 5.116 (cubic Hermite deflections, linear axial and twist). Mass: the consistent ("coupled")
+Eq. 5.116 (cubic Hermite deflections, linear axial and twist; with a finite shear stiffness
+K G A per plane its shear parameter Phi, Timoshenko's shear flexibility, as Nastran's PBEAM
+K1 / K2 and PBAR K1 / K2 ask). Mass: the consistent ("coupled")
 matrix of the same shape functions, Przemieniecki Eq. 11.41 for axial and transverse motion, or
 the lumped one, m L / 2 on each node's three translations (Nastran's default for the CBAR,
 PARAM COUPMASS < 1). Neither carries a polar (torsional) mass moment: a bar's mass is m = rho A
@@ -25,6 +27,7 @@ so the element's frequencies do not depend on how the structure is placed in spa
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -46,6 +49,8 @@ class BarSection:
     ei1 : bending stiffness in plane 1, E I1 (deflection along e_y) (N m^2), >= 0.
     ei2 : bending stiffness in plane 2, E I2 (deflection along e_z) (N m^2), >= 0.
     mass : mass per length m = rho A + NSM (kg/m), >= 0.
+    gas1, gas2 : transverse shear stiffness K G A of plane 1 and plane 2 (N), > 0; inf
+        (default) neglects the shear flexibility (Euler-Bernoulli).
 
     Examples
     --------
@@ -58,11 +63,18 @@ class BarSection:
     ei1: float
     ei2: float
     mass: float
+    gas1: float = math.inf
+    gas2: float = math.inf
 
     def __post_init__(self):
         object.__setattr__(self, "ea", positive("ea", self.ea))
         for name in ("gj", "ei1", "ei2", "mass"):
             object.__setattr__(self, name, in_range(name, getattr(self, name), 0.0, True))
+        for name in ("gas1", "gas2"):
+            v = float(getattr(self, name))
+            if not v > 0:
+                raise ValueError(f"{name} must be > 0 N (inf: no shear flexibility), got {v}")
+            object.__setattr__(self, name, v)
 
 
 def bar_frame(xa, xb, v) -> tuple[float, np.ndarray]:
@@ -99,11 +111,17 @@ def bar_frame(xa, xb, v) -> tuple[float, np.ndarray]:
     return L, np.vstack([ex, ey, np.cross(ex, ey)])
 
 
-def _bending(ei: float, m: float, L: float, slope_sign: float, coupled: bool):
+def _bending(ei: float, m: float, L: float, slope_sign: float, coupled: bool,
+             gas: float = math.inf):
     """(4, 4) stiffness and mass of one bending plane, DOFs (w1, r1, w2, r2), r = slope_sign w'
-    (Przemieniecki Eqs. 5.116 and 11.41)."""
-    k = ei / L ** 3 * np.array([[12, 6 * L, -12, 6 * L], [6 * L, 4 * L * L, -6 * L, 2 * L * L],
-                                [-12, -6 * L, 12, -6 * L], [6 * L, 2 * L * L, -6 * L, 4 * L * L]])
+    (Przemieniecki Eqs. 5.116 and 11.41). With a finite shear stiffness ``gas`` = K G A the
+    stiffness is Przemieniecki's Eq. 5.116 with the shear parameter Phi = 12 E I / (K G A L^2)
+    (exact for end loads: tip deflection P L^3 / (3 E I) + P L / (K G A)); the mass stays
+    Eq. 11.41's (no shear terms)."""
+    phi = 12 * ei / (gas * L * L) if math.isfinite(gas) else 0.0
+    a, b = (4 + phi) * L * L, (2 - phi) * L * L
+    k = ei / ((1 + phi) * L ** 3) * np.array([[12, 6 * L, -12, 6 * L], [6 * L, a, -6 * L, b],
+                                              [-12, -6 * L, 12, -6 * L], [6 * L, b, -6 * L, a]])
     if coupled:
         mm = m * L / 420 * np.array([[156, 22 * L, 54, -13 * L],
                                      [22 * L, 4 * L * L, 13 * L, -3 * L * L],
@@ -146,8 +164,9 @@ def bar_matrices(section: BarSection, length: float, coupled: bool = True):
     M[np.ix_(ax, ax)] = (s.mass * L / 6 * np.array([[2.0, 1.0], [1.0, 2.0]]) if coupled
                          else np.diag([s.mass * L / 2] * 2))
     K[np.ix_(tw, tw)] = s.gj / L * np.array([[1.0, -1.0], [-1.0, 1.0]])
-    for dofs, ei, sign in (([1, 5, 7, 11], s.ei1, 1.0), ([2, 4, 8, 10], s.ei2, -1.0)):
-        k, m = _bending(ei, s.mass, L, sign, coupled)
+    for dofs, ei, sign, gas in (([1, 5, 7, 11], s.ei1, 1.0, s.gas1),
+                                ([2, 4, 8, 10], s.ei2, -1.0, s.gas2)):
+        k, m = _bending(ei, s.mass, L, sign, coupled, gas)
         K[np.ix_(dofs, dofs)] = k
         M[np.ix_(dofs, dofs)] = m
     return K, M

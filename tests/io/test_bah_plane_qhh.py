@@ -32,7 +32,7 @@ from asekit.aero.boxes import BoxMesh  # noqa: E402
 from asekit.aero.gaf import gaf_from_box_modes  # noqa: E402
 from asekit.io import bdf as B  # noqa: E402
 from asekit.io.bdf_beam import (  # noqa: E402
-    _need_pynastran,
+    need_pynastran,
     read_stick_deck,
     spline2_box_modes,
     stick_modes,
@@ -82,7 +82,7 @@ def _nastran_qhh(tmp: Path) -> np.ndarray:
 
 
 def _asekit_qhh(path: Path) -> np.ndarray:
-    model = _need_pynastran()(debug=None)
+    model = need_pynastran()(debug=None)
     model.read_bdf(str(path), xref=True)
     corners, strip, surface, s0 = [], [], [], 0
     ids = []
