@@ -1080,6 +1080,25 @@ def simulate(system: ConnectedSystem, connection: Connection, x0, t_final: float
                                diverged=diverged)
 
 
+def _step_propagator(aug_r, phi_r, memo, r, rem, dt, h):
+    """expm(``aug_r`` ``rem``), the propagator of region ``r`` over the time ``rem`` (s) left of
+    the sample interval ``dt`` (s) of :func:`simulate_exact`: ``phi_r`` (= expm(aug_r h)) when
+    rem is the nominal step ``h`` to 1e-12 h; a whole interval (rem == dt) from ``memo``, keyed
+    by (r, dt): the intervals t_out[k+1] - t_out[k] of the uniform grid take only a handful of
+    distinct float values (k h rounded, most a few ulps off h), so each is exponentiated once,
+    bit for bit the expm a per-step call gives; the rest of an interval after a switch afresh."""
+    from scipy.linalg import expm
+
+    if abs(rem - h) <= 1e-12 * h:
+        return phi_r
+    if rem != dt:
+        return expm(aug_r * rem)
+    key = (r, dt)
+    if key not in memo:
+        memo[key] = expm(aug_r * dt)
+    return memo[key]
+
+
 @small_dense
 def simulate_exact(system: ConnectedSystem, connection: Connection, x0, t_final: float,
                    u=None, step: float = 5e-5, max_switches: int = 200000,
@@ -1175,12 +1194,13 @@ def simulate_exact(system: ConnectedSystem, connection: Connection, x0, t_final:
     switches, switch_d = [], []
     diverged = False
     last = n_steps
+    grid_phi = {}                            # memo of _step_propagator
     for k in range(n_steps):
         dt = t_out[k + 1] - t_out[k]
         rem = dt
         tk = t_out[k]
         while True:
-            y_new = phi[r] @ y if abs(rem - h) <= 1e-12 * h else expm(aug[r] * rem) @ y
+            y_new = _step_propagator(aug[r], phi[r], grid_phi, r, rem, dt, h) @ y
             edge = exits(r, ct @ y_new)
             if edge is None:
                 y = y_new
