@@ -775,7 +775,7 @@ def multi_harmonic_balance(system: ConnectedSystem, connection: Connection, ampl
 
     def resid(z, nh):
         D, w = unpack(z, nh)
-        d = np.real(np.exp(1j * np.outer(th, np.arange(nh + 1))) @ D)
+        d = np.real(basis[nh] @ D)
         F = np.fft.rfft(connection.moment(d)) / M
         F = F[:nh + 1].copy()
         F[1:] *= 2.0
@@ -800,6 +800,8 @@ def multi_harmonic_balance(system: ConnectedSystem, connection: Connection, ampl
                             np.column_stack([Dg[2:].real, Dg[2:].imag]).ravel() / dl, [1.0]])
         nh = N
         steps = [N]
+    # e^{i n theta_m} for each harmonic count resid meets: made once here, not per residual
+    basis = {n: np.exp(1j * np.outer(th, np.arange(n + 1))) for n in {nh, *steps}}
     sol = None
     for nh_new in steps:
         if nh_new > nh:                       # pad the new harmonics with zeros
@@ -1087,16 +1089,17 @@ def _step_propagator(aug_r, phi_r, memo, r, rem, dt, h):
     by (r, dt): the intervals t_out[k+1] - t_out[k] of the uniform grid take only a handful of
     distinct float values (k h rounded, most a few ulps off h), so each is exponentiated once,
     bit for bit the expm a per-step call gives; the rest of an interval after a switch afresh."""
-    from scipy.linalg import expm
-
     if abs(rem - h) <= 1e-12 * h:
         return phi_r
-    if rem != dt:
-        return expm(aug_r * rem)
-    key = (r, dt)
-    if key not in memo:
-        memo[key] = expm(aug_r * dt)
-    return memo[key]
+    whole = rem == dt
+    if whole and (r, dt) in memo:
+        return memo[(r, dt)]
+    from scipy.linalg import expm
+
+    e = expm(aug_r * rem)
+    if whole:
+        memo[(r, dt)] = e
+    return e
 
 
 @small_dense
