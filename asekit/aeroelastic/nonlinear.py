@@ -775,7 +775,7 @@ def multi_harmonic_balance(system: ConnectedSystem, connection: Connection, ampl
 
     def resid(z, nh):
         D, w = unpack(z, nh)
-        d = np.real(np.exp(1j * np.outer(th, np.arange(nh + 1))) @ D)
+        d = np.real(basis[nh] @ D)
         F = np.fft.rfft(connection.moment(d)) / M
         F = F[:nh + 1].copy()
         F[1:] *= 2.0
@@ -800,6 +800,8 @@ def multi_harmonic_balance(system: ConnectedSystem, connection: Connection, ampl
                             np.column_stack([Dg[2:].real, Dg[2:].imag]).ravel() / dl, [1.0]])
         nh = N
         steps = [N]
+    # e^{i n theta_m} for each harmonic count resid meets: made once here, not per residual
+    basis = {n: np.exp(1j * np.outer(th, np.arange(n + 1))) for n in {nh, *steps}}
     sol = None
     for nh_new in steps:
         if nh_new > nh:                       # pad the new harmonics with zeros
@@ -1080,6 +1082,26 @@ def simulate(system: ConnectedSystem, connection: Connection, x0, t_final: float
                                diverged=diverged)
 
 
+def _step_propagator(aug_r, phi_r, memo, r, rem, dt, h):
+    """expm(``aug_r`` ``rem``), the propagator of region ``r`` over the time ``rem`` (s) left of
+    the sample interval ``dt`` (s) of :func:`simulate_exact`: ``phi_r`` (= expm(aug_r h)) when
+    rem is the nominal step ``h`` to 1e-12 h; a whole interval (rem == dt) from ``memo``, keyed
+    by (r, dt): the intervals t_out[k+1] - t_out[k] of the uniform grid take only a handful of
+    distinct float values (k h rounded, most a few ulps off h), so each is exponentiated once,
+    bit for bit the expm a per-step call gives; the rest of an interval after a switch afresh."""
+    if abs(rem - h) <= 1e-12 * h:
+        return phi_r
+    whole = rem == dt
+    if whole and (r, dt) in memo:
+        return memo[(r, dt)]
+    from scipy.linalg import expm
+
+    e = expm(aug_r * rem)
+    if whole:
+        memo[(r, dt)] = e
+    return e
+
+
 @small_dense
 def simulate_exact(system: ConnectedSystem, connection: Connection, x0, t_final: float,
                    u=None, step: float = 5e-5, max_switches: int = 200000,
@@ -1175,13 +1197,16 @@ def simulate_exact(system: ConnectedSystem, connection: Connection, x0, t_final:
     switches, switch_d = [], []
     diverged = False
     last = n_steps
+    grid_phi = {}                            # memo of _step_propagator
     for k in range(n_steps):
         dt = t_out[k + 1] - t_out[k]
         rem = dt
         tk = t_out[k]
         while True:
-            y_new = phi[r] @ y if abs(rem - h) <= 1e-12 * h else expm(aug[r] * rem) @ y
-            edge = exits(r, ct @ y_new)
+            # ndarray.dot: the same BLAS product as @, without matmul's per-call overhead
+            # (a third of the time of a 9 x 9 step; results equal bit for bit)
+            y_new = _step_propagator(aug[r], phi[r], grid_phi, r, rem, dt, h).dot(y)
+            edge = exits(r, ct.dot(y_new))
             if edge is None:
                 y = y_new
                 break
@@ -1190,7 +1215,7 @@ def simulate_exact(system: ConnectedSystem, connection: Connection, x0, t_final:
             if r in modal:
                 lam, cv, vinv = modal[r]
                 alpha = cv * (vinv @ y)
-                d_of = (lambda s_: float(np.real(alpha @ np.exp(lam * s_))) - edge)
+                d_of = (lambda s_: float(np.real(alpha.dot(np.exp(lam * s_)))) - edge)
                 if np.sign(d_of(0.0)) == np.sign(d_of(rem)):   # ill-resolved: exact fallback
                     d_of = (lambda s_: ct @ (expm(A_r * s_) @ y) - edge)
             else:
@@ -1210,7 +1235,7 @@ def simulate_exact(system: ConnectedSystem, connection: Connection, x0, t_final:
             if rem <= 0:
                 break
         X[:, k + 1] = y[:n]
-        if abs(ct @ y) > lim:
+        if abs(ct.dot(y)) > lim:
             diverged = True
             last = k + 1
             break
