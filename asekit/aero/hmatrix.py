@@ -751,8 +751,17 @@ def _preconditioner(h: HMatrix, kind: str) -> spla.LinearOperator:
     return spla.LinearOperator((h.n, h.n), matvec=apply, dtype=complex)
 
 
+def near_preconditioner(h: HMatrix, kind: str = "near") -> spla.LinearOperator:
+    """The preconditioner M ~ D_H^-1 of :func:`solve` as a LinearOperator in tree order (kind
+    one of :data:`PRECONDITIONERS`), to be reused for the matrices of nearby reduced
+    frequencies on the same :class:`BlockStructure` (:func:`compressed_pressures`)."""
+    if kind not in PRECONDITIONERS:
+        raise ValueError(f"kind must be one of {list(PRECONDITIONERS)}, got {kind!r}")
+    return _preconditioner(h, kind)
+
+
 def solve(h: HMatrix, w, rtol: float = DEFAULT_RTOL, maxiter: int = 500,
-          restart: int = 60, preconditioner: str = "near") -> tuple[np.ndarray, SolveInfo]:
+          restart: int = 60, preconditioner="near") -> tuple[np.ndarray, SolveInfo]:
     """Solve D_H x = w for the columns of ``w`` (n,) or (n, m) by GMRES (Saad & Schultz 1986,
     :func:`scipy.sparse.linalg.gmres`) with the compressed matrix as a LinearOperator,
     preconditioned by the LU of its near field (:data:`PRECONDITIONERS`).
@@ -764,7 +773,10 @@ def solve(h: HMatrix, w, rtol: float = DEFAULT_RTOL, maxiter: int = 500,
     maxiter, restart : GMRES outer iterations and Krylov dimension.
     preconditioner : "near" (sparse LU of the whole near field, default) or "block" (LU of
         the leaves' diagonal near-field blocks, block Jacobi: cheaper to form, 6x more
-        iterations on the DLM).
+        iterations on the DLM), or a :class:`scipy.sparse.linalg.LinearOperator` in tree
+        order from :func:`near_preconditioner` (e.g. of another reduced frequency's matrix
+        on the same :class:`BlockStructure`: GMRES still stops at ``rtol`` of this matrix,
+        only the iteration count changes).
 
     Returns
     -------
@@ -781,10 +793,16 @@ def solve(h: HMatrix, w, rtol: float = DEFAULT_RTOL, maxiter: int = 500,
     perm = h.tree.perm
     op = spla.LinearOperator((h.n, h.n), matvec=lambda x: h._matvec_tree(x.reshape(-1)),
                              dtype=complex)
-    if preconditioner not in PRECONDITIONERS:
-        raise ValueError(f"preconditioner must be one of {list(PRECONDITIONERS)}, got "
-                         f"{preconditioner!r}")
-    pre = _preconditioner(h, preconditioner)
+    if isinstance(preconditioner, spla.LinearOperator):
+        if preconditioner.shape != (h.n, h.n):
+            raise ValueError(f"preconditioner must be a ({h.n}, {h.n}) LinearOperator, got "
+                             f"shape {preconditioner.shape}")
+        pre = preconditioner
+    elif preconditioner in PRECONDITIONERS:
+        pre = _preconditioner(h, preconditioner)
+    else:
+        raise ValueError(f"preconditioner must be one of {list(PRECONDITIONERS)} or a "
+                         f"LinearOperator, got {preconditioner!r}")
     with one_blas_thread():         # small products: threads only contend
         xs, its, worst = _gmres_columns(h, op, pre, cols, rtol, maxiter, restart)
     xp = np.column_stack(xs)
@@ -849,20 +867,82 @@ def resolve_solver(solver: str, n_boxes: int) -> str:
     return solver
 
 
+#: Default bytes of compressed matrices built at once by :func:`compressed_pressures` (the
+#: reduced frequencies of a batch share every kernel evaluation; the batch is sized from the
+#: near field and then from the measured size of the previous batch's matrices).
+SWEEP_BYTES = 1 << 30
+
+
+def _batch_size(per_k: float, n_left: int, max_bytes: int) -> int:
+    """How many k fit in ``max_bytes`` at ``per_k`` bytes each (at least 1, at most n_left)."""
+    return int(max(1, min(n_left, max_bytes // max(per_k, 1.0))))
+
+
+def _solve_reusing(h, w, rtol, pre):
+    """:func:`solve` with the preconditioner ``pre`` of a nearby k; if GMRES then fails to
+    converge, again with this matrix's own (the answer is held to ``rtol`` either way).
+    Returns (x, info, refactored)."""
+    try:
+        return (*solve(h, w, rtol, maxiter=2, preconditioner=pre), False)
+    except RuntimeError:
+        return (*solve(h, w, rtol), True)
+
+
 def compressed_pressures(mesh: BoxMesh, mach: float, ks, b_ref: float, normalwash,
                          method: str = "quartic", symmetric: bool = False,
                          eps: float = DEFAULT_EPS, rtol: float = DEFAULT_RTOL, on_k=None,
-                         kernel: str | None = None) -> list:
-    """DeltaCp per k for the normalwash columns ``normalwash(k)`` (n, m): one
-    :func:`build_hmatrix` and one :func:`solve` per reduced frequency (the compressed
-    counterpart of the streamed dense LU of :func:`asekit.aero.gaf.gaf_from_box_modes`).
-    ``on_k(ik, cp)`` is called as each k is done; returns the list of (n, m) arrays."""
-    out = []
-    for ik, kk in enumerate(np.atleast_1d(np.asarray(ks, float))):
-        h = build_hmatrix(mesh, mach, float(kk), b_ref, method, symmetric, eps, kernel=kernel)
-        cp = solve(h, normalwash(float(kk)), rtol)[0]
-        del h
-        if on_k is not None:
-            on_k(ik, cp)
-        out.append(cp)
+                         kernel: str | None = None, max_bytes: int = SWEEP_BYTES,
+                         reuse_preconditioner: bool = True, on_info=None,
+                         structure: BlockStructure | None = None) -> list:
+    """DeltaCp per k for the normalwash columns ``normalwash(k)`` (n, m), the compressed
+    counterpart of the streamed dense LU of :func:`asekit.aero.gaf.gaf_from_box_modes`.
+
+    What does not depend on k is made once per sweep: the cluster tree, the block partition
+    and the near-field pattern (:func:`block_structure`). The k are built in batches of at
+    most ``max_bytes`` of compressed matrices by :func:`build_hmatrices` (each row, column and
+    near-field block of D evaluated once for all k of the batch, the steady part D0 and the
+    geometry shared; admissible blocks by :func:`aca_multi` with each k's error held to
+    ``eps``). With ``reuse_preconditioner`` the near-field LU is factored once per batch, at
+    its middle k, and serves every k of the batch (GMRES still stops at ``rtol`` of each k's
+    own matrix; if it fails to converge, that k is solved again with its own LU).
+
+    Parameters
+    ----------
+    mesh, mach, b_ref, method, symmetric, kernel : as :func:`build_hmatrix`.
+    ks : reduced frequencies; normalwash : callable k -> (n, m) w/U.
+    eps, rtol : ACA and GMRES tolerances; max_bytes : > 0, the batch budget.
+    on_k : called ``on_k(ik, cp)`` as each k is done; on_info : called
+        ``on_info(ik, SolveInfo, refactored)``.
+    structure : the :class:`BlockStructure` of ``mesh`` (default :func:`block_structure`).
+
+    Returns
+    -------
+    list of (n, m) complex DeltaCp, one per k.
+    """
+    ks = np.atleast_1d(np.asarray(ks, float))
+    if not (isinstance(max_bytes, (int, np.integer)) and max_bytes > 0):
+        raise ValueError(f"max_bytes must be a positive integer, got {max_bytes!r}")
+    st = block_structure(mesh) if structure is None else structure
+    per_k = 3.0 * 16.0 * st.nnz            # near-field data (twice while built) + far guess
+    out, at = [], 0
+    while at < ks.size:
+        nb = _batch_size(per_k, ks.size - at, int(max_bytes))
+        hs = build_hmatrices(mesh, mach, ks[at:at + nb], b_ref, method, symmetric, eps, st,
+                             kernel)
+        per_k = max(h.nbytes for h in hs) + 16.0 * st.nnz
+        pre = near_preconditioner(hs[nb // 2]) if reuse_preconditioner else None
+        for j in range(nb):
+            w = normalwash(float(ks[at + j]))
+            if pre is None:
+                cp, info, again = (*solve(hs[j], w, rtol), False)
+            else:
+                cp, info, again = _solve_reusing(hs[j], w, rtol, pre)
+            hs[j] = None
+            if on_info is not None:
+                on_info(at + j, info, again)
+            if on_k is not None:
+                on_k(at + j, cp)
+            out.append(cp)
+        at += nb
+        del hs, pre
     return out
