@@ -20,8 +20,14 @@ low numerical rank. This module
    (:class:`asekit.aero.dlm.NormalwashBlocks`, :func:`aca`),
 4. applies the compressed matrix (:meth:`HMatrix.matvec`) in O(n log n) and solves
    D DeltaCp = w/U for the few modal normalwash columns by GMRES (Saad & Schultz 1986;
-   :func:`scipy.sparse.linalg.gmres`) preconditioned by the sparse LU of the near-field
-   blocks (or of their diagonal blocks only) (:func:`solve`, :class:`HmatrixFactor`).
+   all columns in lockstep, :func:`gmres_columns`) preconditioned by the sparse LU of the
+   near-field blocks (or of their diagonal blocks only) (:func:`solve`,
+   :class:`HmatrixFactor`).
+5. sweeps the reduced frequencies (:func:`compressed_pressures`) reusing what does not depend
+   on k: the tree, the partition and the near-field pattern (:class:`BlockStructure`), every
+   kernel evaluation shared by the k of a batch (:func:`build_hmatrices`, :func:`aca_multi`:
+   one row or column call for all k, the steady part D0 computed once per call) and the
+   near-field LU of the batch's middle k as every k's preconditioner.
 
 Error control. ACA stops at rank r when ||u_r|| ||v_r|| <= eps/10 ||S_r||_F (Bebendorf &
 Rjasanow 2003 Eq. (3.6), S_r the approximant so far) holds for two successive steps; the
@@ -740,15 +746,19 @@ def _preconditioner(h: HMatrix, kind: str) -> spla.LinearOperator:
     "block", LU fill 1.7x the near field's entries); "block", the leaves' diagonal blocks."""
     if kind == "near":
         lu = spla.splu(h.near.tocsc())
-        return spla.LinearOperator((h.n, h.n), dtype=complex,
-                                   matvec=lambda x: lu.solve(np.asarray(x, complex).reshape(-1)))
+
+        def solve_lu(x):
+            return lu.solve(np.asarray(x, complex))
+        return spla.LinearOperator((h.n, h.n), dtype=complex, matmat=solve_lu,
+                                   matvec=lambda x: solve_lu(np.reshape(x, -1)))
 
     def apply(x):
-        y = np.array(x, dtype=complex).reshape(-1)
+        y = np.array(x, dtype=complex)
         for a, b, lu, piv in h.diag:
             y[a:b] = sla.lu_solve((lu, piv), y[a:b], check_finite=False)
         return y
-    return spla.LinearOperator((h.n, h.n), matvec=apply, dtype=complex)
+    return spla.LinearOperator((h.n, h.n), matvec=lambda x: apply(np.reshape(x, -1)),
+                               matmat=apply, dtype=complex)
 
 
 def near_preconditioner(h: HMatrix, kind: str = "near") -> spla.LinearOperator:
@@ -762,15 +772,16 @@ def near_preconditioner(h: HMatrix, kind: str = "near") -> spla.LinearOperator:
 
 def solve(h: HMatrix, w, rtol: float = DEFAULT_RTOL, maxiter: int = 500,
           restart: int = 60, preconditioner="near") -> tuple[np.ndarray, SolveInfo]:
-    """Solve D_H x = w for the columns of ``w`` (n,) or (n, m) by GMRES (Saad & Schultz 1986,
-    :func:`scipy.sparse.linalg.gmres`) with the compressed matrix as a LinearOperator,
-    preconditioned by the LU of its near field (:data:`PRECONDITIONERS`).
+    """Solve D_H x = w for the columns of ``w`` (n,) or (n, m) by GMRES (Saad & Schultz 1986;
+    :func:`gmres_columns`, the columns in lockstep so that the products with D_H and the
+    preconditioner are matrix-matrix products), right-preconditioned by the LU of its near
+    field (:data:`PRECONDITIONERS`), started from x0 = M^-1 w.
 
     Parameters
     ----------
     h : :class:`HMatrix`; w : right-hand sides in the original order.
     rtol : relative residual ||D_H x - w|| <= rtol ||w|| per column (0 < rtol < 1).
-    maxiter, restart : GMRES outer iterations and Krylov dimension.
+    maxiter, restart : GMRES restart cycles and Krylov dimension.
     preconditioner : "near" (sparse LU of the whole near field, default) or "block" (LU of
         the leaves' diagonal near-field blocks, block Jacobi: cheaper to form, 6x more
         iterations on the DLM), or a :class:`scipy.sparse.linalg.LinearOperator` in tree
@@ -791,8 +802,6 @@ def solve(h: HMatrix, w, rtol: float = DEFAULT_RTOL, maxiter: int = 500,
                          f"shape {w.shape}")
     cols = w.reshape(h.n, -1)
     perm = h.tree.perm
-    op = spla.LinearOperator((h.n, h.n), matvec=lambda x: h._matvec_tree(x.reshape(-1)),
-                             dtype=complex)
     if isinstance(preconditioner, spla.LinearOperator):
         if preconditioner.shape != (h.n, h.n):
             raise ValueError(f"preconditioner must be a ({h.n}, {h.n}) LinearOperator, got "
@@ -804,35 +813,104 @@ def solve(h: HMatrix, w, rtol: float = DEFAULT_RTOL, maxiter: int = 500,
         raise ValueError(f"preconditioner must be one of {list(PRECONDITIONERS)} or a "
                          f"LinearOperator, got {preconditioner!r}")
     with one_blas_thread():         # small products: threads only contend
-        xs, its, worst = _gmres_columns(h, op, pre, cols, rtol, maxiter, restart)
-    xp = np.column_stack(xs)
+        xp, its, worst = _gmres_columns(h, pre, cols, rtol, maxiter, restart)
     x = np.empty_like(xp)
     x[perm] = xp
     return x.reshape(w.shape), SolveInfo(tuple(its), float(worst))
 
 
-def _gmres_columns(h, op, pre, cols, rtol, maxiter, restart):
-    perm = h.tree.perm
-    xs, its, worst = [], [], 0.0
-    for j in range(cols.shape[1]):
-        b = cols[perm, j].astype(complex)
-        nb = np.linalg.norm(b)
-        if nb == 0.0:
-            xs.append(np.zeros(h.n, complex))
-            its.append(0)
-            continue
-        count = [0]
-        x, info = spla.gmres(op, b, x0=pre.matvec(b), rtol=rtol, atol=0.0, restart=restart,
-                             maxiter=maxiter, M=pre, callback_type="pr_norm",
-                             callback=lambda _r, c=count: c.__setitem__(0, c[0] + 1))
-        res = np.linalg.norm(h._matvec_tree(x) - b) / nb
-        if info != 0:
-            raise RuntimeError(f"GMRES did not reach rtol = {rtol:g} for column {j} within "
-                               f"{maxiter} x {restart} iterations (residual {res:.3g})")
-        xs.append(x)
-        its.append(count[0])
-        worst = max(worst, res)
-    return xs, its, worst
+def _gmres_columns(h, pre, cols, rtol, maxiter, restart):
+    """:func:`gmres_columns` on the compressed matrix in tree order for the nonzero columns
+    of ``cols`` (original order); returns (x in tree order, iterations, worst residual)."""
+    b = cols[h.tree.perm].astype(complex)
+    nb = np.linalg.norm(b, axis=0)
+    nz = nb > 0.0
+    x = np.zeros_like(b)
+    its = np.zeros(b.shape[1], int)
+    if not nz.any():
+        return x, its, 0.0
+    x0 = pre.matmat(b[:, nz])
+    x[:, nz], its[nz], ok = gmres_columns(h._matvec_tree, pre.matmat, b[:, nz], x0, rtol,
+                                          restart, maxiter)
+    res = np.linalg.norm(h._matvec_tree(x[:, nz]) - b[:, nz], axis=0) / nb[nz]
+    if not ok:
+        raise RuntimeError(f"GMRES did not reach rtol = {rtol:g} for every column within "
+                           f"{maxiter} x {restart} iterations (residual {res.max():.3g})")
+    return x, its, float(res.max())
+
+def _lstsq_residuals(hess: np.ndarray, beta: np.ndarray):
+    """Per column c the minimiser y_c of ||beta_c e_1 - H_c y|| over the (j + 1, j) Hessenberg
+    matrices ``hess`` (m, j + 1, j) and the residual norms it leaves (the GMRES residual)."""
+    m, jp1, j = hess.shape
+    rhs = np.zeros((m, jp1), complex)
+    rhs[:, 0] = beta
+    q, r = np.linalg.qr(hess)                               # (m, j+1, j), (m, j, j)
+    qb = np.einsum("mij,mi->mj", q.conj(), rhs)
+    y = np.linalg.solve(r, qb[..., None])[..., 0]
+    res = np.linalg.norm(rhs - np.einsum("mij,mj->mi", hess, y), axis=1)
+    return y, res
+
+
+def gmres_columns(apply_a, apply_m, b: np.ndarray, x0: np.ndarray, rtol: float,
+                  restart: int = 60, maxiter: int = 10):
+    """Right-preconditioned GMRES (Saad & Schultz 1986, Algorithm 4 with right
+    preconditioning, Saad, "Iterative methods for sparse linear systems", 2003, Algorithm 9.5)
+    for all columns of ``b`` in lockstep: each column has its own Krylov space, but the
+    products with A and the preconditioner M are made for all columns at once (sparse and
+    dense matrix-matrix products instead of m matrix-vector products).
+
+    Parameters
+    ----------
+    apply_a, apply_m : callables (n, m) -> (n, m), A X and M^-1 X.
+    b, x0 : (n, m) right-hand sides and initial guesses.
+    rtol : stop a column at ||b - A x|| <= rtol ||b|| (the least-squares residual, checked
+        against the true residual at each restart); restart : Krylov dimension; maxiter :
+        restart cycles.
+
+    Returns
+    -------
+    (x (n, m), iterations (m,) int, converged bool).
+
+    Examples
+    --------
+    >>> a = np.diag(np.arange(1.0, 21.0)) + 0.1 * np.eye(20, k=1)
+    >>> b = np.ones((20, 2)) * [1.0, 2.0]
+    >>> x, its, ok = gmres_columns(lambda v: a @ v, lambda v: v, b, np.zeros((20, 2)), 1e-10)
+    >>> bool(ok and np.linalg.norm(a @ x - b) <= 1e-9 * np.linalg.norm(b))
+    True
+    """
+    n, m = b.shape
+    nb = np.linalg.norm(b, axis=0)
+    target = rtol * nb
+    x = np.array(x0, dtype=complex)
+    its = np.zeros(m, int)
+    for _ in range(maxiter):
+        r = b - apply_a(x)
+        beta = np.linalg.norm(r, axis=0)
+        todo = beta > target
+        if not todo.any():
+            return x, its, True
+        beta_t = beta[todo]
+        basis = [r[:, todo] / beta_t]
+        hess = np.zeros((int(todo.sum()), restart + 1, restart), complex)
+        y = None
+        for j in range(restart):
+            w = apply_a(apply_m(basis[j]))
+            for i in range(j + 1):                          # modified Gram-Schmidt
+                hij = np.einsum("nc,nc->c", basis[i].conj(), w)
+                hess[:, i, j] = hij
+                w -= basis[i] * hij
+            hn = np.linalg.norm(w, axis=0)
+            hess[:, j + 1, j] = hn
+            basis.append(w / np.where(hn > 0.0, hn, 1.0))
+            y, res = _lstsq_residuals(hess[:, :j + 2, :j + 1], beta_t)
+            its[todo] += 1
+            if (res <= target[todo]).all():
+                break
+        step = np.einsum("jnc,cj->nc", np.array(basis[:y.shape[1]]), y)
+        x[:, todo] += apply_m(step)
+    r = b - apply_a(x)
+    return x, its, bool((np.linalg.norm(r, axis=0) <= target).all())
 
 
 @dataclass(frozen=True, eq=False)
