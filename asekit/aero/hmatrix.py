@@ -69,13 +69,16 @@ DEFAULT_ETA = 1.0
 DEFAULT_LEAF = 160
 #: The DLM solvers of the GAF path (``aero.solver``): dense LU, this module, or by size.
 SOLVERS = ("dense", "hmatrix", "auto")
-#: "auto" takes the compressed solve from this many boxes: where one dense complex D alone
-#: (16 n^2 bytes) passes 2 GiB, the large-model memory budget of issue 23 (floor(sqrt(2^31 /
-#: 16)) = 11585). Dense LU was faster at every size measured (tests/benchmarks/bench_hmatrix.py,
-#: 1000-8000 boxes, one k: 50.6 s against 83.5 s CPU at 8008 boxes); the time curves (growth
-#: exponents 2.47 and 1.76 between 4000 and 8000 boxes) cross near 16000 boxes by
-#: extrapolation.
-AUTO_MIN_BOXES = 11585
+#: "auto" takes the compressed solve from this many boxes: the measured crossover of a sweep.
+#: The GAF path always solves a sweep of reduced frequencies, and :func:`compressed_pressures`
+#: shares the block structure, the kernel evaluations and the near-field LU across the k of a
+#: batch: for 15 k (0 to 1.4) at M 0.8, 6 modes, one BLAS thread, 4000 boxes, the compressed
+#: sweep took 118.5 s CPU against dense LU's 117.3 s (peak RSS 1.18 GB against 1.39 GB), and
+#: its time grows more slowly with the box count (tests/benchmarks/bench_hmatrix.py; dense
+#: grows like n^2.4). For a single k dense stays faster up to ~16000 boxes (one k at 8008
+#: boxes: 50.6 s dense against 83.5 s compressed, before the sweep reuse); the first round
+#: had this at 11585 boxes, where one dense D passes 2 GiB.
+AUTO_MIN_BOXES = 4000
 
 
 # ---------------------------------------------------------------------------------------------
@@ -816,7 +819,7 @@ def solve(h: HMatrix, w, rtol: float = DEFAULT_RTOL, maxiter: int = 500,
         xp, its, worst = _gmres_columns(h, pre, cols, rtol, maxiter, restart)
     x = np.empty_like(xp)
     x[perm] = xp
-    return x.reshape(w.shape), SolveInfo(tuple(its), float(worst))
+    return x.reshape(w.shape), SolveInfo(tuple(int(i) for i in its), float(worst))
 
 
 def _gmres_columns(h, pre, cols, rtol, maxiter, restart):

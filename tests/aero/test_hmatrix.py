@@ -209,6 +209,7 @@ def test_sweep_gaf_equals_dense(wing400, max_bytes, ks):
         q = h_load.T @ (wing400.area[:, None] * cps[ik])
         assert np.abs(q - q_dense).max() <= 1e-6 * np.abs(q_dense).max()
         assert infos[ik].residual <= H.DEFAULT_RTOL and max(infos[ik].iterations) > 0
+        assert all(type(i) is int for i in infos[ik].iterations)
 
 
 def test_sweep_arguments_checked(wing400):
