@@ -69,16 +69,17 @@ DEFAULT_ETA = 1.0
 DEFAULT_LEAF = 160
 #: The DLM solvers of the GAF path (``aero.solver``): dense LU, this module, or by size.
 SOLVERS = ("dense", "hmatrix", "auto")
-#: "auto" takes the compressed solve from this many boxes: the measured crossover of a sweep.
-#: The GAF path always solves a sweep of reduced frequencies, and :func:`compressed_pressures`
-#: shares the block structure, the kernel evaluations and the near-field LU across the k of a
-#: batch: for 15 k (0 to 1.4) at M 0.8, 6 modes, one BLAS thread, 4000 boxes, the compressed
-#: sweep took 118.5 s CPU against dense LU's 117.3 s (peak RSS 1.18 GB against 1.39 GB), and
-#: its time grows more slowly with the box count (tests/benchmarks/bench_hmatrix.py; dense
-#: grows like n^2.4). For a single k dense stays faster up to ~16000 boxes (one k at 8008
-#: boxes: 50.6 s dense against 83.5 s compressed, before the sweep reuse); the first round
-#: had this at 11585 boxes, where one dense D passes 2 GiB.
-AUTO_MIN_BOXES = 4000
+#: "auto" takes the compressed solve from this many boxes: where one dense complex D alone
+#: (16 n^2 bytes) passes 2 GiB, the large-model memory budget of issue 23 (floor(sqrt(2^31 /
+#: 16)) = 11585). Kept there after the sweep reuse of :func:`compressed_pressures`, because no
+#: crossover in time was measured: over 15 k (0 to 1.4) at M 0.8, 6 modes, one BLAS thread
+#: (tests/benchmarks/bench_hmatrix.py, CPU s, dense / compressed sweep): 4.9 / 10.4 at 1000,
+#: 21.5 / 31.3 at 2002, 107.0 / 141.9 at 4000 boxes (a second run at 4000: 117.3 / 118.5);
+#: growth exponents 2.13 / 1.59 and 2.31 / 2.18. The sweep made the compressed path 2-3x
+#: faster than one build per k (31.3 s per-k at 1000, 67.2 s at 2002), and its memory is
+#: below dense's from 4000 boxes (peak RSS 1.23 against 1.39 GB), but a time crossover lies
+#: beyond the measured sizes (8000+ boxes not measured in the slot).
+AUTO_MIN_BOXES = 11585
 
 
 # ---------------------------------------------------------------------------------------------
