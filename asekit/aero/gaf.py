@@ -347,8 +347,9 @@ class _FreshEntries(GafEntryCache):
 
 
 def _gaf_compressed(box_modes, mesh, mach, ks, b_ref, symmetric, kernel, progress, on_k):
-    """Q per k by :func:`asekit.aero.hmatrix.compressed_pressures` (one compressed matrix and
-    GMRES solve per k)."""
+    """Q per k by :func:`asekit.aero.hmatrix.compressed_pressures` (the k swept in batches
+    that share the block structure, every kernel evaluation and a near-field LU; one GMRES
+    solve of all modes per k)."""
     out = np.empty((ks.size, box_modes.h_cp.shape[1], box_modes.h_cp.shape[1]), complex)
 
     def project(ik, cp):

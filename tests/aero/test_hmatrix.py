@@ -169,3 +169,60 @@ def test_gaf_switch(wing400):
     assert np.array_equal(auto, dense)
     with pytest.raises(ValueError, match="solver"):
         gaf_from_box_modes(modes, wing400, 0.7, ks, B_REF, solver="lu")
+
+
+# --- the k sweep (issue 23, round 2): several k per build, shared pivots, reused LU ---------
+def test_multi_k_blocks_within_eps(wing400):
+    """build_hmatrices (one kernel call per row / column for all k, ACA with shared pivots):
+    every admissible block of every k within eps of the dense D(M, k), the near field exact."""
+    ks, eps = [0.0, 0.6, 2.0], 1e-6
+    st = H.block_structure(wing400, leaf_size=32)
+    hs = H.build_hmatrices(wing400, 0.8, ks, B_REF, eps=eps, structure=st)
+    p = st.tree.perm
+    rows, cols = hs[0].near.nonzero()
+    for kk, h in zip(ks, hs):
+        d = normalwash_matrix(wing400, 0.8, kk, B_REF)
+        assert len(h.far) > 5 and h.tree is st.tree
+        for r0, r1, cs, u, v in h.far:
+            blk = d[np.ix_(p[r0:r1], p[cs])]
+            assert np.linalg.norm(u @ v - blk) <= eps * np.linalg.norm(blk)
+        near = np.asarray(h.near[rows, cols]).ravel()
+        assert np.abs(near - d[p[rows], p[cols]]).max() <= 1e-14 * np.abs(d).max()
+
+
+@pytest.mark.parametrize("max_bytes,ks", [(1, [0.0, 1.2]), (1 << 30, [0.0, 0.4, 1.2])])
+def test_sweep_gaf_equals_dense(wing400, max_bytes, ks):
+    """compressed_pressures over k at M 0.8, in batches of one k (max_bytes 1: own LU per k)
+    or all k in one batch (the middle k's near-field LU preconditions the others): GAFs equal
+    the dense LU's to 1e-6 relative (the issue's default), every k's GMRES residual below
+    rtol, iterations reported."""
+    infos = {}
+    st = H.block_structure(wing400, leaf_size=32)
+    cps = H.compressed_pressures(wing400, 0.8, ks, B_REF, lambda kk: _modes(wing400, kk)[1],
+                                 max_bytes=max_bytes, structure=st,
+                                 on_info=lambda ik, info, again: infos.update({ik: info}))
+    assert sorted(infos) == list(range(len(ks)))
+    for ik, kk in enumerate(ks):
+        h_load, w = _modes(wing400, kk)
+        cp_dense = factor_normalwash_matrix(normalwash_matrix(wing400, 0.8, kk, B_REF)).pressures(w)
+        q_dense = h_load.T @ (wing400.area[:, None] * cp_dense)
+        q = h_load.T @ (wing400.area[:, None] * cps[ik])
+        assert np.abs(q - q_dense).max() <= 1e-6 * np.abs(q_dense).max()
+        assert infos[ik].residual <= H.DEFAULT_RTOL and max(infos[ik].iterations) > 0
+        assert all(type(i) is int for i in infos[ik].iterations)
+
+
+def test_sweep_arguments_checked(wing400):
+    with pytest.raises(ValueError, match="max_bytes"):
+        H.compressed_pressures(wing400, 0.5, [0.1], B_REF, lambda k: np.ones((400, 1)),
+                               max_bytes=0)
+    with pytest.raises(ValueError, match="ks"):
+        H.build_hmatrices(wing400, 0.5, [], B_REF)
+    small = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0.6, 4, 0), 0.4, 4, 10)])
+    with pytest.raises(ValueError, match="structure"):
+        H.build_hmatrices(wing400, 0.5, [0.1], B_REF, structure=H.block_structure(small))
+    h = H.build_hmatrix(small, 0.5, 0.1, B_REF)
+    other = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (0.6, 4, 0), 0.4, 4, 12)])
+    with pytest.raises(ValueError, match="preconditioner"):
+        H.solve(h, np.ones(40), preconditioner=H.near_preconditioner(
+            H.build_hmatrix(other, 0.5, 0.1, B_REF)))
