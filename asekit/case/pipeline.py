@@ -681,7 +681,9 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True,
 def _aero_options(aero) -> dict | None:
     """The aerodynamic method's options from the case (issue 29: the TSD's ``aero.section``)."""
     section = getattr(aero, "section", None)
-    return None if section is None else {"section": tuple(section)}
+    # issue 29 (tsdswept): the TSD's cross-flow terms of swept wings, always on in a case (they
+    # enter the GAF database's fingerprint: databases of the equation without them are stale)
+    return None if section is None else {"section": tuple(section), "cross_flow": True}
 
 
 def tsd_validity(case: Case) -> tuple:
