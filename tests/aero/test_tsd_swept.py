@@ -105,3 +105,46 @@ def test_cross_flow_terms_leave_the_linear_limit_and_an_unswept_mid_span_unchang
         assert sol.converged and sol.cross_flow == cf and sol.supersonic_points > 0
         cp.append(sol.section_cp(0.0)[1])
     assert np.max(np.abs(cp[1] - cp[0])) < 0.002 * np.max(np.abs(cp[0]))
+
+
+# --- the swept wing's linear limit against the DLM -------------------------------------------
+_CR = 0.5578                                  # m, AGARD 445.6 root chord (Yates 1987)
+_SEMI, _XT, _CT = 0.762 / _CR, 0.8094 / _CR, 0.3682 / _CR      # in root chords
+_SWEPT_MODES = [lambda x, y: (y * y + 0 * x, 0 * x),                   # bending-like
+                lambda x, y: (-(x - (0.25 + y)) * y, -y + 0 * x)]       # torsion-like
+
+
+def _swept_lift_error(n_chord: int, n_span: int, dlm) -> float:
+    from asekit.aero.tsd3d import tsd_gaf
+
+    wing = TsdPlanform(np.array([0.0, _SEMI]), np.array([0.0, _XT]), np.array([1.0, _CT]))
+    grid = tsd3d_grid(wing, n_chord, n_span, far=6.0, ratio=1.3, edges="faces")
+    bg = steady_tsd3d(wing, biconvex_thickness(0.0), 0.8, grid, cross_flow=True)
+    mesh, d = dlm
+    q = tsd_gaf(bg, mesh, _SWEPT_MODES, [0.0], 0.5)
+    return float(q[0, 0, 1].real / d[0, 0, 1].real - 1.0)
+
+
+def test_swept_wing_linear_limit_approaches_the_dlm_slowly():
+    """The AGARD 445.6 planform (45 deg quarter-chord sweep, taper 0.66, root chord 1), zero
+    thickness (the cross-flow terms are then inactive), M 0.8, k = 0, a bending-like and a
+    torsion-like mode: Q_bending,torsion against the DLM on 12 x 12 boxes (1.5192; 20 x 20:
+    1.4728). Measured TSD errors: -62.9 %, -34.3 %, -28.5 % on 8 x 4, 12 x 6, 16 x 8 cells
+    (k = 0.1: -62.9, -34.4, -28.3 %), -29.2 % on 16 x 4, -27.7 % on 24 x 6, but -38.5 % on
+    8 x 8 and -38.6 % on 12 x 12: the n_chord cells span the whole planform's x extent (2.1
+    root chords here), so the local chord gets about half of them and the oblique leading
+    and trailing edges cut the cells; refining only the span lowers the lift (as on the
+    rectangular wing, tests/aero/test_tsd3d.py). This is what bounds the AGARD 445.6 flutter
+    index of method "tsd" (docs/case-format.md): the swept linear limit is far from the
+    DLM's on the grids a case affords. The test holds the measured level and the decrease
+    along the diagonal refinement (about 1.5 s)."""
+    from asekit.aero.boxes import TrapezoidSurface, mesh_surfaces
+    from asekit.aero.gaf import gaf_from_box_modes
+    from asekit.aero.spline import analytic_modes
+
+    mesh = mesh_surfaces([TrapezoidSurface((0, 0, 0), 1.0, (_XT, _SEMI, 0), _CT, 12, 12)])
+    dlm = mesh, gaf_from_box_modes(analytic_modes(mesh, _SWEPT_MODES), mesh, 0.8, [0.0], 0.5,
+                                   symmetric=True)
+    assert dlm[1][0, 0, 1].real == pytest.approx(1.5192, abs=2e-4)
+    e = [_swept_lift_error(n, n // 2, dlm) for n in (8, 12)]
+    assert -0.66 < e[0] < e[1] < -0.30, e
