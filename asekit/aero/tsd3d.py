@@ -51,13 +51,15 @@ Validity and state: the steady background of a symmetric wing at zero incidence 
 lift), with a reflection plane at the root; the far field phi = 0 on a box ``far`` root chords
 away. The lifting problem (:func:`harmonic_tsd3d`, :func:`tsd_gaf`) is first order in the cell
 size at the edges (Richardson extrapolation of two grids recovers the DLM's steady lift of an
-aspect-ratio-3 wing at M 0.8 to 0.3 %; at k = 0.3 the 16 x 8-cell GAFs are within 6.4 % of the
-DLM's and converging), and its far field reflects part of the short upstream-running acoustic
+aspect-ratio-3 wing at M 0.8 to 0.1 %; at k = 0.3 the 16 x 8-cell GAFs are within 4.9 % of the
+DLM's and converging; before issue 29's tsdswept projection fix 0.3 % and 6.4 %), and its far field reflects part of the short upstream-running acoustic
 waves at high subsonic Mach. On swept wings the Cartesian grid resolves the local chord by
 fewer cells (the n_chord cells span the whole planform's x extent, the leading and trailing
 edges cut the cells obliquely): for the AGARD 445.6 planform (45 deg, taper 0.66) at M 0.8,
-k = 0.1 and zero thickness the lift GAFs are 63 %, 34 %, 28 % below the DLM's on 8 x 4,
-12 x 6, 16 x 8 cells (issue 29, tsdswept; tests/aero/test_tsd_swept.py). Not yet: camber /
+k = 0 and zero thickness the lift GAFs are +30 %, +7.1 %, +1.9 % from the DLM's on 8 x 4,
+12 x 6, 16 x 8 cells (issue 29, tsdswept; tests/aero/test_tsd_swept.py; the rectangular
+aspect-ratio-3 wing: +7.2 %, +3.7 %, +2.0 %, Richardson-extrapolated 12/16 within 0.1 % of
+the DLM's extrapolated lift). Not yet: camber /
 incidence backgrounds (steady lift and wake), supersonic free streams. ``method = "tsd"`` of the
 registry (:mod:`asekit.aero.methods`) wraps :func:`tsd_pressure_matrices` on the grid of
 :func:`mesh_grid_options` (limit :data:`MAX_NODES`); :func:`tsd_validity` states the
@@ -615,12 +617,15 @@ class HarmonicTsd3dSolution:
         per unit modal amplitude (antisymmetric: the lower surface carries -phi).
     wing : (n_x, n_y) bool, the nodes on the planform (the flux condition).
     kappa : omega / U (1 / length unit); asekit's k is kappa b_ref.
+    planform : the wing (:func:`box_pressures` samples each grid row at the boxes' chord
+        fractions on it; None: at the boxes' own abscissae).
     """
 
     grid: Tsd3dGrid
     phi: np.ndarray
     wing: np.ndarray
     kappa: float
+    planform: TsdPlanform | None = None
 
     def delta_cp(self) -> np.ndarray:
         """(n_modes, n_x - 1, n_y) pressure jump Cp_lower - Cp_upper = 4 (phi_x + i kappa phi)
@@ -775,7 +780,8 @@ def _harmonic_solve(background: Tsd3dSolution, wash: np.ndarray, kappa: float
     rhs = np.zeros((nx * ny * nz, wash.shape[0]), complex)
     rhs[op.node[:, :, 0][wing]] = (area[None] * wash)[:, wing].T
     phi = _solve(K, rhs).reshape(nx, ny, nz, wash.shape[0])
-    return HarmonicTsd3dSolution(grid, np.moveaxis(phi[:, :, 0, :], -1, 0), wing, kappa)
+    return HarmonicTsd3dSolution(grid, np.moveaxis(phi[:, :, 0, :], -1, 0), wing, kappa,
+                                 background.planform)
 
 
 def _solve(K, rhs: np.ndarray) -> np.ndarray:
@@ -800,11 +806,38 @@ def _solve(K, rhs: np.ndarray) -> np.ndarray:
     return x[0::2] + 1j * x[1::2]
 
 
+def _to_row(planform: TsdPlanform | None, y_box: np.ndarray, y_row: float, xa: np.ndarray,
+            xb: np.ndarray, x: np.ndarray, wing_row: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Box chordwise limits ``xa``, ``xb`` taken at span stations ``y_box`` moved to the grid
+    row ``y_row`` (nodes ``x``, wing nodes ``wing_row``) at equal local chord fraction, the
+    chord [0, 1] mapped onto the row's last node ahead of the wing and first wake node (issue
+    29, tsdswept). A row stands for the potential of its band of span: on a swept or tapered
+    wing the edges move across the band, and sampling the row at the boxes' own abscissae put
+    the first boxes' x_a behind the row's leading edge and the last boxes' x_b ahead of its
+    trailing edge on half the band (a 45-deg wing's lift 23 % low); and the edges lie between
+    nodes, so the interpolated potential at them dropped half an edge cell of the jump (the
+    rectangular wing's lift 9 % low on 12 x 6 cells). With the map, the boxes of a strip sum
+    to the row's whole jump, the solver's circulation 4 phi(first wake node). Unchanged
+    without a planform or on a row off the wing."""
+    if planform is None:
+        return xa, xb
+    on = np.flatnonzero(wing_row)
+    if on.size == 0 or on[0] == 0 or on[-1] + 1 >= x.size:
+        return xa, xb
+    x0, x1 = x[on[0] - 1], x[on[-1] + 1]
+    xl_b, c_b = planform.edges(y_box)
+    c_b = np.where(c_b > 0.0, c_b, 1.0)
+    return x0 + (xa - xl_b) / c_b * (x1 - x0), x0 + (xb - xl_b) / c_b * (x1 - x0)
+
+
 def box_pressures(solution: HarmonicTsd3dSolution, mesh) -> np.ndarray:
     """(n_boxes, n_modes) box-average pressure jumps of a :class:`~asekit.aero.boxes.BoxMesh`
     in z = 0: the integral of Delta Cp = 4 (phi_x + i kappa phi) over each box, exact in x for
     the piecewise-linear potential of each grid row (4 [phi]_{x_a}^{x_b} + 4 i kappa int phi
-    dx), rows weighted by their cells' overlap with the box, divided by the box area."""
+    dx), rows weighted by their cells' overlap with the box, divided by the box area. With
+    the solution's planform, each row is sampled at the boxes' chord fractions between its own
+    edge nodes (``_to_row``, issue 29 tsdswept)."""
     grid, kap = solution.grid, solution.kappa
     x = grid.x
     dx = np.diff(x)
@@ -830,9 +863,11 @@ def box_pressures(solution: HarmonicTsd3dSolution, mesh) -> np.ndarray:
         w = np.clip(hi - lo, 0.0, None)
         if not np.any(w > 0):
             continue
-        eta = (0.5 * (lo + hi) - c[:, 0, 1]) / (c[:, 3, 1] - c[:, 0, 1])
+        y_mid = 0.5 * (lo + hi)
+        eta = (y_mid - c[:, 0, 1]) / (c[:, 3, 1] - c[:, 0, 1])
         xa = c[:, 0, 0] + eta * (c[:, 3, 0] - c[:, 0, 0])
         xb = c[:, 1, 0] + eta * (c[:, 2, 0] - c[:, 1, 0])
+        xa, xb = _to_row(solution.planform, y_mid, grid.y[j], xa, xb, x, solution.wing[:, j])
         pa, ca = values(xa, j)
         pb, cb = values(xb, j)
         force += (w * 4.0 * ((pb - pa) + 1j * kap * (cb - ca))).T
@@ -903,8 +938,9 @@ MAX_NODES = 40_000
 def tsd_grid_options(n_chord_boxes: int, n_strips: int) -> dict:
     """The :func:`tsd3d_grid` options of a box mesh with ``n_chord_boxes`` boxes per strip and
     ``n_strips`` strips (asekit's rule): n_chord = max(8, 2 n_chord_boxes) chordwise cells
-    (the harmonic GAFs are first order in the cell size: 12 %, 8 %, 6 % from the DLM's on
-    8, 12, 16 chordwise cells at M 0.8, k = 0.3, tests/aero/test_tsd3d.py), n_span =
+    (the harmonic GAFs are first order in the cell size: 7.8 %, 5.9 %, 4.9 % from the DLM's
+    on 8, 12, 16 chordwise cells at M 0.8, k = 0.3, max entry, the rectangular wing of
+    tests/aero/test_tsd3d.py; 12 %, 8 %, 6 % before issue 29's tsdswept projection fix), n_span =
     max(4, n_strips) spanwise cells, the far boundary :data:`GRID_FAR` root chords away,
     stretching :data:`GRID_RATIO`, edges between nodes.
 
@@ -1042,6 +1078,10 @@ def tsd_validity(background: Tsd3dSolution, thickness_ratio: float) -> TsdValidi
 
 
 # --- the steady background, cached (issue 29) ------------------------------------------------
+#: Version of the TSD's GAFs (part of a case's GAF database fingerprint): 2 since issue 29's
+#: tsdswept step (the cross-flow terms; box_pressures sampling each grid row between its own
+#: edge nodes).
+TSD_GAF_FORMAT = 2
 #: Version of the cached steady backgrounds (part of their key).
 STEADY_FORMAT = 2        # 2: the cross-flow flag in the key (issue 29, tsdswept)
 
