@@ -93,17 +93,25 @@ TSD_SECTIONS = ("biconvex",)
 
 
 def _tsd_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic",
-                  section=None, grid_options=None, **options):
+                  section=None, grid_options=None, cross_flow=True, tsd_format=None,
+                  **options):
     """The time-linearised TSD's matrices (:func:`asekit.aero.tsd3d.tsd_pressure_matrices`)
     about the steady flow over ``section`` = (shape, thickness_ratio) (biconvex:
     :func:`asekit.aero.tsd3d.biconvex_thickness`), on the grid of
     :func:`asekit.aero.tsd3d.mesh_grid_options` unless ``grid_options`` are given, the steady
-    background cached (:func:`asekit.aero.tsd3d.tsd_background`). The TSD
+    background cached (:func:`asekit.aero.tsd3d.tsd_background`; ``cross_flow`` the
+    cross-flow terms of swept wings, on by default, issue 29 tsdswept; ``tsd_format`` the
+    version :data:`asekit.aero.tsd3d.TSD_GAF_FORMAT` a case's database fingerprint carries). The TSD
     half wing is mirrored at its root: ``symmetric`` must be True (aero.symmetry = "wall")."""
-    from asekit.aero.tsd3d import tsd_background, tsd_pressure_matrices
+    from asekit.aero.tsd3d import TSD_GAF_FORMAT, tsd_background, tsd_pressure_matrices
+
+    if tsd_format not in (None, TSD_GAF_FORMAT):
+        raise ValueError(f"tsd_format must be {TSD_GAF_FORMAT} (this asekit's TSD GAFs), got "
+                         f"{tsd_format!r}")
 
     if options:
-        raise ValueError(f"method='tsd' takes the options section and grid_options, got "
+        raise ValueError(f"method='tsd' takes the options section, grid_options, "
+                         f"cross_flow and tsd_format, got "
                          f"{sorted(options)}")
     if not symmetric:
         raise ValueError("method='tsd' models a half wing mirrored at its root: it needs "
@@ -114,7 +122,7 @@ def _tsd_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic",
     shape, tau = section
     if shape not in TSD_SECTIONS:
         raise ValueError(f"section shape must be one of {list(TSD_SECTIONS)}, got {shape!r}")
-    background = tsd_background(mesh, mach, tau, grid_options)
+    background = tsd_background(mesh, mach, tau, grid_options, cross_flow=bool(cross_flow))
     if not background.converged:
         raise ValueError(f"the steady TSD background did not converge at M {mach:g} (residual "
                          f"{background.residual:.2g}; a strong shock on a coarse grid can stall "

@@ -8,7 +8,27 @@ the perturbation potential phi per U (a length: x, y, z and phi in the planform'
 
     d/dx [ (1 - M^2) phi_x - (gamma + 1)/2 M^2 phi_x^2 ] + phi_yy + phi_zz = 0,         (1)
 
-with the thin-wing boundary condition on the mean plane phi_z(x, y, 0+) = dz_t/dx on the
+and, with ``cross_flow=True`` (issue 29, tsdswept: needed by swept wings), the modified TSD
+equation of Batina (1989, J. Aircraft 26(6) 531-538, Eq. 1; CAP-TSD) with the cross-flow
+terms in conservative form,
+
+    d/dx [ (1 - M^2) phi_x - (gamma + 1)/2 M^2 phi_x^2 + G phi_y^2 ]
+        + d/dy [ phi_y + H phi_x phi_y ] + phi_zz = 0,
+    G = (gamma - 3)/2 M^2,  H = -(gamma - 1) M^2,                                    (1b)
+
+whose expansion adds -(gamma - 1) M^2 phi_x phi_yy - 2 M^2 phi_y phi_xy, the cross-flow terms
+of the full-potential expansion (Ballhaus, Bailey & Frick 1977, NASA CP-2001): on an infinite
+yawed wing, phi = f(x - y tan Lambda), Eq. (1b) is exactly the TSD equation of the normal
+Mach number M cos Lambda (simple sweep theory), while Eq. (1) under-weights the nonlinear term
+by cos^2 Lambda (tests/aero/test_tsd_swept.py). The G phi_y^2 flux is differenced with the
+x-flux by the Murman-Cole operator (phi_y at an x-face the mean of the nodes' central
+phi_y), the H phi_x phi_y flux through the y-faces (phi_x there the mean of the nodes'
+central phi_x); the type switch stays that of Eq. (1), A = 1 - M^2 - (gamma+1) M^2 phi_x.
+The terms are quadratic in phi: the linear limit (thickness -> 0) is unchanged, but
+gamma = -1 no longer makes the equation linear with them. :func:`harmonic_tsd3d` linearises them about the
+background (their Jacobian, :class:`_CrossFlow`).
+
+With the thin-wing boundary condition on the mean plane phi_z(x, y, 0+) = dz_t/dx on the
 planform (upper surface z_t; the flow is symmetric in z, so only z >= 0 is solved, and no wake is
 needed), phi_z = 0 on z = 0 off the planform, phi_y = 0 on the root plane y = 0 (a half wing
 mirrored there, or a wall), phi = 0 on the far boundaries, and Cp = -2 phi_x.
@@ -31,10 +51,16 @@ Validity and state: the steady background of a symmetric wing at zero incidence 
 lift), with a reflection plane at the root; the far field phi = 0 on a box ``far`` root chords
 away. The lifting problem (:func:`harmonic_tsd3d`, :func:`tsd_gaf`) is first order in the cell
 size at the edges (Richardson extrapolation of two grids recovers the DLM's steady lift of an
-aspect-ratio-3 wing at M 0.8 to 0.3 %; at k = 0.3 the 16 x 8-cell GAFs are within 6.4 % of the
-DLM's and converging), and its far field reflects part of the short upstream-running acoustic
-waves at high subsonic Mach. Not yet: camber / incidence backgrounds (steady lift and wake),
-the cross-flow terms of swept wings, supersonic free streams. ``method = "tsd"`` of the
+aspect-ratio-3 wing at M 0.8 to 0.1 %; at k = 0.3 the 16 x 8-cell GAFs are within 4.9 % of the
+DLM's and converging; before issue 29's tsdswept projection fix 0.3 % and 6.4 %), and its far field reflects part of the short upstream-running acoustic
+waves at high subsonic Mach. On swept wings the Cartesian grid resolves the local chord by
+fewer cells (the n_chord cells span the whole planform's x extent, the leading and trailing
+edges cut the cells obliquely): for the AGARD 445.6 planform (45 deg, taper 0.66) at M 0.8,
+k = 0 and zero thickness the lift GAFs are +30 %, +7.1 %, +1.9 % from the DLM's on 8 x 4,
+12 x 6, 16 x 8 cells (issue 29, tsdswept; tests/aero/test_tsd_swept.py; the rectangular
+aspect-ratio-3 wing: +7.2 %, +3.7 %, +2.0 %, Richardson-extrapolated 12/16 within 0.1 % of
+the DLM's extrapolated lift). Not yet: camber /
+incidence backgrounds (steady lift and wake), supersonic free streams. ``method = "tsd"`` of the
 registry (:mod:`asekit.aero.methods`) wraps :func:`tsd_pressure_matrices` on the grid of
 :func:`mesh_grid_options` (limit :data:`MAX_NODES`); :func:`tsd_validity` states the
 similarity parameter and shock presence of a background. On the coarse grids of unit tests
@@ -263,7 +289,7 @@ class _Operator:
     x-operator's residual and Jacobian. Unknowns are the nodes off the Dirichlet boundaries
     (first and last x, last y, last z)."""
 
-    def __init__(self, grid: Tsd3dGrid, mach: float, gamma: float):
+    def __init__(self, grid: Tsd3dGrid, mach: float, gamma: float, cross_flow: bool = False):
         self.grid = grid
         nx, ny, nz = self.shape = grid.shape
         self.dx = np.diff(grid.x)
@@ -280,6 +306,7 @@ class _Operator:
         self.vol = (self.hx[:, None, None] * self.hy[None, :, None]
                     * self.hz[None, None, :])
         self.lap = self._laplacian()
+        self.cross = _CrossFlow(self, mach, gamma) if cross_flow else None
 
     def _laplacian(self):
         """phi_yy + phi_zz times the cell volume (flux differences times face areas)."""
@@ -335,6 +362,8 @@ class _Operator:
         r = np.zeros(self.shape)
         r[1:-1] = c * (f[i] - f[i - 1]) + up * (f[i - 1] - fm)
         r = r.ravel() + self.lap @ phi.ravel() - source.ravel()
+        if self.cross is not None:
+            r = r + self.cross.residual(phi, mu)
         return r[self.idx]
 
     def x_jacobian(self, a: np.ndarray, mu: np.ndarray, dtype=float):
@@ -356,7 +385,104 @@ class _Operator:
         u = np.diff(phi, axis=0) / self.dx[:, None, None]
         a = (self.a0 - self.b * u) / self.dx[:, None, None]
         J = self.x_jacobian(a, mu) + self.lap
+        if self.cross is not None:
+            J = J + self.cross.jacobian(phi, mu)
         return J[self.idx][:, self.idx].tocsc()
+
+
+# --- issue 29 (tsdswept): the cross-flow terms of swept wings --------------------------------
+def cross_flow_coefficients(mach: float, gamma: float = GAMMA_AIR) -> tuple[float, float]:
+    """(G, H) of the cross-flow terms of the modified TSD equation (Batina 1989, J. Aircraft
+    26(6) 531-538, Eq. 1: x-flux + G phi_y^2, y-flux + H phi_x phi_y), G = (gamma - 3) M^2 / 2,
+    H = -(gamma - 1) M^2: with these, expanded, the terms are -(gamma - 1) M^2 phi_x phi_yy -
+    2 M^2 phi_y phi_xy, the cross-flow terms of the full-potential expansion kept by Ballhaus,
+    Bailey & Frick (1977, "Improved computational treatment of transonic flow about swept
+    wings", NASA CP-2001, pp. 1311-1320) for swept wings.
+
+    >>> [round(c, 12) for c in cross_flow_coefficients(0.5, 1.4)]
+    [-0.2, -0.1]
+    """
+    m2 = float(mach) ** 2
+    return 0.5 * (float(gamma) - 3.0) * m2, -(float(gamma) - 1.0) * m2
+
+
+def _coo(rows, cols, vals, shape):
+    return sparse.coo_matrix((np.concatenate([np.ravel(v) for v in vals]),
+                              (np.concatenate([np.ravel(r) for r in rows]),
+                               np.concatenate([np.ravel(c) for c in cols]))),
+                             shape=shape).tocsr()
+
+
+class _CrossFlow:
+    """The cross-flow terms (:func:`cross_flow_coefficients`) of an :class:`_Operator`, finite
+    volume like the rest: the x-face flux G v^2 (v = phi_y at the x-faces, the mean of the
+    central phi_y of the two nodes; 0 on the root plane) differenced by the operator's
+    Murman-Cole x-operator, and the y-face flux H u v (u = phi_x at the y-faces, the mean of
+    the central phi_x of the two nodes; v the face's difference) through the y-faces."""
+
+    def __init__(self, op: "_Operator", mach: float, gamma: float):
+        self.op = op
+        self.g, self.h = cross_flow_coefficients(mach, gamma)
+        nx, ny, nz = op.shape
+        node, n = op.node, nx * ny * nz
+        x, y = op.grid.x, op.grid.y
+        # central phi_y at the nodes (0 on the root plane, one-sided at the far y boundary)
+        j = np.arange(1, ny - 1)
+        dyc = (y[j + 1] - y[j - 1])[None, :, None]
+        one = np.ones((nx, j.size, nz))
+        d_last = 1.0 / (y[-1] - y[-2]) * np.ones((nx, nz))
+        cy = _coo([node[:, j], node[:, j], node[:, -1], node[:, -1]],
+                  [node[:, j + 1], node[:, j - 1], node[:, -1], node[:, -2]],
+                  [one / dyc, -one / dyc, d_last, -d_last], (n, n))
+        # central phi_x at the nodes (one-sided at the ends)
+        i = np.arange(1, nx - 1)
+        dxc = (x[i + 1] - x[i - 1])[:, None, None]
+        onex = np.ones((i.size, ny, nz))
+        e0 = np.ones((ny, nz)) / (x[1] - x[0])
+        e1 = np.ones((ny, nz)) / (x[-1] - x[-2])
+        cx = _coo([node[i], node[i], node[0], node[0], node[-1], node[-1]],
+                  [node[i + 1], node[i - 1], node[1], node[0], node[-1], node[-2]],
+                  [onex / dxc, -onex / dxc, e0, -e0, e1, -e1], (n, n))
+        # x-face (i + 1/2) means and y-face (j + 1/2) means and differences
+        fx = np.arange((nx - 1) * ny * nz).reshape(nx - 1, ny, nz)
+        fy = np.arange(nx * (ny - 1) * nz).reshape(nx, ny - 1, nz)
+        half_x = 0.5 * np.ones(fx.shape)
+        half_y = 0.5 * np.ones(fy.shape)
+        self.vx = _coo([fx, fx], [node[:-1], node[1:]], [half_x, half_x],
+                       (fx.size, n)) @ cy
+        self.uy = _coo([fy, fy], [node[:, :-1], node[:, 1:]], [half_y, half_y],
+                       (fy.size, n)) @ cx
+        inv = np.broadcast_to((1.0 / np.diff(y))[None, :, None], fy.shape)
+        self.dy = _coo([fy, fy], [node[:, 1:], node[:, :-1]], [inv, -inv], (fy.size, n))
+        # the y-faces' fluxes into the nodes' cells (face areas hx hz, as the Laplacian)
+        area = np.broadcast_to(op.hx[:, None, None] * op.hz[None, None, :], fy.shape)
+        self.ydiv = _coo([node[:, :-1], node[:, 1:]], [fy, fy], [area, -area], (n, fy.size))
+        self.fx = fx
+
+    def sx(self, mu: np.ndarray):
+        """The Murman-Cole x-operator (n_nodes x n_x-faces) of :meth:`_Operator.residual`."""
+        op = self.op
+        i, c, up = op.x_parts(mu)
+        fx, node = self.fx, op.node
+        im2 = np.maximum(i - 2, 0)
+        n = int(np.prod(op.shape))
+        return _coo([node[i]] * 4, [fx[i], fx[i - 1], fx[i - 1], fx[im2]],
+                    [c, -c, up, -up], (n, fx.size))
+
+    def residual(self, phi: np.ndarray, mu: np.ndarray) -> np.ndarray:
+        p = phi.ravel()
+        v = self.vx @ p
+        return (self.sx(mu) @ (self.g * v * v)
+                + self.ydiv @ (self.h * (self.uy @ p) * (self.dy @ p)))
+
+    def jacobian(self, phi: np.ndarray, mu: np.ndarray):
+        """The terms' derivative at ``phi`` (also their time-linearisation about it)."""
+        p = phi.ravel()
+        v = self.vx @ p
+        u, d = self.uy @ p, self.dy @ p
+        return (self.sx(mu) @ sparse.diags(2.0 * self.g * v) @ self.vx
+                + self.ydiv @ (sparse.diags(self.h * u) @ self.dy
+                               + sparse.diags(self.h * d) @ self.uy))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -377,6 +503,7 @@ class Tsd3dSolution:
         phi = 0).
     supersonic_points : nodes with A < 0.
     seconds : wall time of the solve.
+    cross_flow : the cross-flow terms of swept wings were included (:func:`steady_tsd3d`).
     """
 
     planform: TsdPlanform
@@ -391,6 +518,7 @@ class Tsd3dSolution:
     residual: float
     supersonic_points: int
     seconds: float
+    cross_flow: bool = False
 
     @property
     def cp_critical(self) -> float:
@@ -408,8 +536,8 @@ class Tsd3dSolution:
 
 
 def steady_tsd3d(planform: TsdPlanform, thickness, mach: float, grid: Tsd3dGrid | None = None,
-                 gamma: float = GAMMA_AIR, tol: float = 1e-9, max_iter: int = 60
-                 ) -> Tsd3dSolution:
+                 gamma: float = GAMMA_AIR, tol: float = 1e-9, max_iter: int = 60,
+                 cross_flow: bool = False) -> Tsd3dSolution:
     """Steady TSD flow about a thin symmetric wing at zero incidence (Eq. 1 of the module).
 
     Parameters
@@ -422,6 +550,9 @@ def steady_tsd3d(planform: TsdPlanform, thickness, mach: float, grid: Tsd3dGrid 
     gamma : ratio of specific heats (1.4; -1 gives the linear equation).
     tol : tolerance on the max-norm residual relative to that of phi = 0.
     max_iter : pseudo-time steps at most.
+    cross_flow : add the cross-flow terms of swept wings (Eq. 1b of the module; issue 29,
+        tsdswept); the equation is then nonlinear even with gamma = -1 (only thickness -> 0
+        is the linear limit).
 
     Returns
     -------
@@ -432,7 +563,7 @@ def steady_tsd3d(planform: TsdPlanform, thickness, mach: float, grid: Tsd3dGrid 
     mach = tsd_mach(mach)
     grid = tsd3d_grid(planform) if grid is None else grid
     t0 = time.perf_counter()
-    op = _Operator(grid, mach, float(gamma))
+    op = _Operator(grid, mach, float(gamma), bool(cross_flow))
     src = np.zeros(grid.shape)
     src[:, :, 0] = thickness_flux(planform, thickness, grid)
     phi = np.zeros(grid.shape)
@@ -443,7 +574,7 @@ def steady_tsd3d(planform: TsdPlanform, thickness, mach: float, grid: Tsd3dGrid 
     u = np.diff(phi[:, :, 0], axis=0) / op.dx[:, None]
     return Tsd3dSolution(planform, grid, phi, 0.5 * (grid.x[1:] + grid.x[:-1]), -2.0 * u, mach,
                          float(gamma), res <= tol, steps, res, int(mu.sum()),
-                         time.perf_counter() - t0)
+                         time.perf_counter() - t0, bool(cross_flow))
 
 
 def _continuation(op: _Operator, phi: np.ndarray, src: np.ndarray, tol: float, max_iter: int,
@@ -459,7 +590,8 @@ def _continuation(op: _Operator, phi: np.ndarray, src: np.ndarray, tol: float, m
     for it in range(1, max_iter + 1):
         if res <= tol:
             return phi, it - 1
-        dtau = dtau0 * r_first / res if op.b != 0.0 else np.inf     # linear: one Newton step
+        linear = op.b == 0.0 and op.cross is None
+        dtau = np.inf if linear else dtau0 * r_first / res         # linear: one Newton step
         J = op.jacobian(phi, mu)
         step = splu((sparse.diags(vol / dtau) - J).tocsc()).solve(r)
         flat = phi.ravel().copy()
@@ -485,12 +617,15 @@ class HarmonicTsd3dSolution:
         per unit modal amplitude (antisymmetric: the lower surface carries -phi).
     wing : (n_x, n_y) bool, the nodes on the planform (the flux condition).
     kappa : omega / U (1 / length unit); asekit's k is kappa b_ref.
+    planform : the wing (:func:`box_pressures` samples each grid row at the boxes' chord
+        fractions on it; None: at the boxes' own abscissae).
     """
 
     grid: Tsd3dGrid
     phi: np.ndarray
     wing: np.ndarray
     kappa: float
+    planform: TsdPlanform | None = None
 
     def delta_cp(self) -> np.ndarray:
         """(n_modes, n_x - 1, n_y) pressure jump Cp_lower - Cp_upper = 4 (phi_x + i kappa phi)
@@ -515,7 +650,7 @@ def _lifting_matrix(background: Tsd3dSolution, kappa: float, wing, wake):
     """The time-linearised operator (Eq. 3 of :mod:`asekit.aero.tsd` in 3-D) with its
     boundary rows, over all nodes (i, j, k) -> (i n_y + j) n_z + k."""
     grid, mach = background.grid, background.mach
-    op = _Operator(grid, mach, background.gamma)
+    op = _Operator(grid, mach, background.gamma, background.cross_flow)
     nx, ny, nz = grid.shape
     n = nx * ny * nz
     u0 = np.diff(background.phi, axis=0) / op.dx[:, None, None]
@@ -542,8 +677,11 @@ def _lifting_matrix(background: Tsd3dSolution, kappa: float, wing, wake):
                                            top.shape).ravel(),
                            np.broadcast_to(-1j * k_ac * op.hx[i, None] * op.hz[None, :],
                                            side.shape).ravel()])
-    K = (op.x_jacobian(a, op.switches(background.phi), complex) + op.lap
+    mu0 = op.switches(background.phi)
+    K = (op.x_jacobian(a, mu0, complex) + op.lap
          + sparse.coo_matrix((vals, (rows, cols)), shape=(n, n)).tocsr())
+    if op.cross is not None:        # the cross-flow terms linearised about phi0 (tsdswept)
+        K = K + op.cross.jacobian(background.phi, mu0)
     # replaced rows: upstream phi_x = 0, downstream phi_x + i kappa phi = 0, z = 0 off the
     # wing: phi = 0 (antisymmetry) or, on the wake, phi_i = phi_{i-1} exp(-i kappa dx)
     bi, bj, bv = [], [], []
@@ -642,7 +780,8 @@ def _harmonic_solve(background: Tsd3dSolution, wash: np.ndarray, kappa: float
     rhs = np.zeros((nx * ny * nz, wash.shape[0]), complex)
     rhs[op.node[:, :, 0][wing]] = (area[None] * wash)[:, wing].T
     phi = _solve(K, rhs).reshape(nx, ny, nz, wash.shape[0])
-    return HarmonicTsd3dSolution(grid, np.moveaxis(phi[:, :, 0, :], -1, 0), wing, kappa)
+    return HarmonicTsd3dSolution(grid, np.moveaxis(phi[:, :, 0, :], -1, 0), wing, kappa,
+                                 background.planform)
 
 
 def _solve(K, rhs: np.ndarray) -> np.ndarray:
@@ -667,11 +806,38 @@ def _solve(K, rhs: np.ndarray) -> np.ndarray:
     return x[0::2] + 1j * x[1::2]
 
 
+def _to_row(planform: TsdPlanform | None, y_box: np.ndarray, y_row: float, xa: np.ndarray,
+            xb: np.ndarray, x: np.ndarray, wing_row: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Box chordwise limits ``xa``, ``xb`` taken at span stations ``y_box`` moved to the grid
+    row ``y_row`` (nodes ``x``, wing nodes ``wing_row``) at equal local chord fraction, the
+    chord [0, 1] mapped onto the row's last node ahead of the wing and first wake node (issue
+    29, tsdswept). A row stands for the potential of its band of span: on a swept or tapered
+    wing the edges move across the band, and sampling the row at the boxes' own abscissae put
+    the first boxes' x_a behind the row's leading edge and the last boxes' x_b ahead of its
+    trailing edge on half the band (a 45-deg wing's lift 23 % low); and the edges lie between
+    nodes, so the interpolated potential at them dropped half an edge cell of the jump (the
+    rectangular wing's lift 9 % low on 12 x 6 cells). With the map, the boxes of a strip sum
+    to the row's whole jump, the solver's circulation 4 phi(first wake node). Unchanged
+    without a planform or on a row off the wing."""
+    if planform is None:
+        return xa, xb
+    on = np.flatnonzero(wing_row)
+    if on.size == 0 or on[0] == 0 or on[-1] + 1 >= x.size:
+        return xa, xb
+    x0, x1 = x[on[0] - 1], x[on[-1] + 1]
+    xl_b, c_b = planform.edges(y_box)
+    c_b = np.where(c_b > 0.0, c_b, 1.0)
+    return x0 + (xa - xl_b) / c_b * (x1 - x0), x0 + (xb - xl_b) / c_b * (x1 - x0)
+
+
 def box_pressures(solution: HarmonicTsd3dSolution, mesh) -> np.ndarray:
     """(n_boxes, n_modes) box-average pressure jumps of a :class:`~asekit.aero.boxes.BoxMesh`
     in z = 0: the integral of Delta Cp = 4 (phi_x + i kappa phi) over each box, exact in x for
     the piecewise-linear potential of each grid row (4 [phi]_{x_a}^{x_b} + 4 i kappa int phi
-    dx), rows weighted by their cells' overlap with the box, divided by the box area."""
+    dx), rows weighted by their cells' overlap with the box, divided by the box area. With
+    the solution's planform, each row is sampled at the boxes' chord fractions between its own
+    edge nodes (``_to_row``, issue 29 tsdswept)."""
     grid, kap = solution.grid, solution.kappa
     x = grid.x
     dx = np.diff(x)
@@ -697,9 +863,11 @@ def box_pressures(solution: HarmonicTsd3dSolution, mesh) -> np.ndarray:
         w = np.clip(hi - lo, 0.0, None)
         if not np.any(w > 0):
             continue
-        eta = (0.5 * (lo + hi) - c[:, 0, 1]) / (c[:, 3, 1] - c[:, 0, 1])
+        y_mid = 0.5 * (lo + hi)
+        eta = (y_mid - c[:, 0, 1]) / (c[:, 3, 1] - c[:, 0, 1])
         xa = c[:, 0, 0] + eta * (c[:, 3, 0] - c[:, 0, 0])
         xb = c[:, 1, 0] + eta * (c[:, 2, 0] - c[:, 1, 0])
+        xa, xb = _to_row(solution.planform, y_mid, grid.y[j], xa, xb, x, solution.wing[:, j])
         pa, ca = values(xa, j)
         pb, cb = values(xb, j)
         force += (w * 4.0 * ((pb - pa) + 1j * kap * (cb - ca))).T
@@ -770,8 +938,9 @@ MAX_NODES = 40_000
 def tsd_grid_options(n_chord_boxes: int, n_strips: int) -> dict:
     """The :func:`tsd3d_grid` options of a box mesh with ``n_chord_boxes`` boxes per strip and
     ``n_strips`` strips (asekit's rule): n_chord = max(8, 2 n_chord_boxes) chordwise cells
-    (the harmonic GAFs are first order in the cell size: 12 %, 8 %, 6 % from the DLM's on
-    8, 12, 16 chordwise cells at M 0.8, k = 0.3, tests/aero/test_tsd3d.py), n_span =
+    (the harmonic GAFs are first order in the cell size: 7.8 %, 5.9 %, 4.9 % from the DLM's
+    on 8, 12, 16 chordwise cells at M 0.8, k = 0.3, max entry, the rectangular wing of
+    tests/aero/test_tsd3d.py; 12 %, 8 %, 6 % before issue 29's tsdswept projection fix), n_span =
     max(4, n_strips) spanwise cells, the far boundary :data:`GRID_FAR` root chords away,
     stretching :data:`GRID_RATIO`, edges between nodes.
 
@@ -909,25 +1078,30 @@ def tsd_validity(background: Tsd3dSolution, thickness_ratio: float) -> TsdValidi
 
 
 # --- the steady background, cached (issue 29) ------------------------------------------------
+#: Version of the TSD's GAFs (part of a case's GAF database fingerprint): 2 since issue 29's
+#: tsdswept step (the cross-flow terms; box_pressures sampling each grid row between its own
+#: edge nodes).
+TSD_GAF_FORMAT = 2
 #: Version of the cached steady backgrounds (part of their key).
-STEADY_FORMAT = 1
+STEADY_FORMAT = 2        # 2: the cross-flow flag in the key (issue 29, tsdswept)
 
 
 def steady_key(planform: TsdPlanform, grid: Tsd3dGrid, thickness_ratio: float, mach: float,
-               gamma: float = GAMMA_AIR) -> str:
+               gamma: float = GAMMA_AIR, cross_flow: bool = False) -> str:
     """SHA-256 of what a biconvex background depends on: the planform, the grid, tau, M,
-    gamma and :data:`STEADY_FORMAT` (arrays rounded to 12 decimals)."""
+    gamma, the cross-flow terms and :data:`STEADY_FORMAT` (arrays rounded to 12 decimals)."""
     import hashlib
 
     h = hashlib.sha256(f"tsd-steady-{STEADY_FORMAT}|{float(thickness_ratio)!r}|"
-                       f"{float(mach)!r}|{float(gamma)!r}".encode())
+                       f"{float(mach)!r}|{float(gamma)!r}|{bool(cross_flow)}".encode())
     for a in (planform.y, planform.x_le, planform.chord, grid.x, grid.y, grid.z):
         h.update(np.round(np.asarray(a, float), 12).tobytes())
     return h.hexdigest()
 
 
 def cached_steady_tsd3d(planform: TsdPlanform, grid: Tsd3dGrid, thickness_ratio: float,
-                        mach: float, gamma: float = GAMMA_AIR, cache_dir=None) -> Tsd3dSolution:
+                        mach: float, gamma: float = GAMMA_AIR, cache_dir=None,
+                        cross_flow: bool = False) -> Tsd3dSolution:
     """:func:`steady_tsd3d` of a biconvex section (:func:`biconvex_thickness`), read from
     ``cache_dir`` (default :func:`asekit.util.paths.user_cache_dir`) when a file
     ``tsd_steady_<key>.npz`` exists whose digest passes (:func:`asekit.util.cache.load_npz`)
@@ -939,7 +1113,7 @@ def cached_steady_tsd3d(planform: TsdPlanform, grid: Tsd3dGrid, thickness_ratio:
     from asekit.util.cache import CacheError, load_npz, save_npz
     from asekit.util.paths import user_cache_dir
 
-    key = steady_key(planform, grid, thickness_ratio, mach, gamma)
+    key = steady_key(planform, grid, thickness_ratio, mach, gamma, cross_flow)
     path = Path(user_cache_dir() if cache_dir is None else cache_dir) / f"tsd_steady_{key[:32]}.npz"
     try:
         arrays, meta = load_npz(path, expect_metadata={"key": key},
@@ -948,10 +1122,12 @@ def cached_steady_tsd3d(planform: TsdPlanform, grid: Tsd3dGrid, thickness_ratio:
             return Tsd3dSolution(planform, grid, arrays["phi"], arrays["x_mid"], arrays["cp"],
                                  float(mach), float(gamma), bool(meta["converged"]),
                                  int(meta["iterations"]), float(meta["residual"]),
-                                 int(meta["supersonic_points"]), float(meta["seconds"]))
+                                 int(meta["supersonic_points"]), float(meta["seconds"]),
+                                 bool(cross_flow))
     except (CacheError, FileNotFoundError, OSError, KeyError, ValueError, TypeError):
         pass
-    sol = steady_tsd3d(planform, biconvex_thickness(thickness_ratio), mach, grid, gamma=gamma)
+    sol = steady_tsd3d(planform, biconvex_thickness(thickness_ratio), mach, grid, gamma=gamma,
+                       cross_flow=cross_flow)
     meta = {"key": key, "converged": bool(sol.converged), "iterations": int(sol.iterations),
             "residual": float(sol.residual), "supersonic_points": int(sol.supersonic_points),
             "seconds": float(sol.seconds), "mach": float(mach),
@@ -966,13 +1142,16 @@ def cached_steady_tsd3d(planform: TsdPlanform, grid: Tsd3dGrid, thickness_ratio:
 
 
 def tsd_background(mesh, mach: float, thickness_ratio: float, grid_options: dict | None = None,
-                   cache_dir=None) -> Tsd3dSolution:
+                   cache_dir=None, cross_flow: bool = True) -> Tsd3dSolution:
     """The steady biconvex background of a box mesh's planform (:func:`planform_of_boxes`) on
     the grid of :func:`mesh_grid_options` (or ``grid_options``, ``edges="faces"`` always),
     cached (:func:`cached_steady_tsd3d`): what ``method = "tsd"`` linearises about and what its
-    validity line (:func:`tsd_validity`) reads."""
+    validity line (:func:`tsd_validity`) reads. ``cross_flow`` (default on: the method's
+    equation is the modified TSD equation, Eq. 1b of the module, since issue 29's tsdswept
+    step) adds the cross-flow terms of swept wings; :func:`harmonic_tsd3d` linearises
+    them too."""
     planform = planform_of_boxes(mesh)
     opts = dict(mesh_grid_options(mesh) if grid_options is None else grid_options)
     opts["edges"] = "faces"
     return cached_steady_tsd3d(planform, tsd3d_grid(planform, **opts), thickness_ratio, mach,
-                               cache_dir=cache_dir)
+                               cache_dir=cache_dir, cross_flow=cross_flow)

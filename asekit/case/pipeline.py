@@ -700,7 +700,13 @@ def gaf_database(case: Case, progress: bool = True, cache: bool = True,
 def _aero_options(aero) -> dict | None:
     """The aerodynamic method's options from the case (issue 29: the TSD's ``aero.section``)."""
     section = getattr(aero, "section", None)
-    return None if section is None else {"section": tuple(section)}
+    # issue 29 (tsdswept): the TSD's cross-flow terms of swept wings, always on in a case, and
+    # the version of its GAFs (they enter the GAF database's fingerprint: older databases are
+    # stale)
+    from asekit.aero.tsd3d import TSD_GAF_FORMAT
+
+    return None if section is None else {"section": tuple(section), "cross_flow": True,
+                                         "tsd_format": TSD_GAF_FORMAT}
 
 
 def tsd_validity(case: Case) -> tuple:
