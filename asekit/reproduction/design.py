@@ -852,29 +852,26 @@ def lqg_scheduled_mu(data=None, f_hz=None) -> dict:
     return hinf_mu(controller_at(design_b_scheduled(data), *HINF_CONDITION), data, f_hz)
 
 
-#: The flight parameters of the real-parameter description (:func:`flight_lft`) and the
-#: monomials of its fit: dynamic pressure q, rho U (the aerodynamic damping's factor), U (the
-#: lag roots' factor) and Mach (the GAFs), each normalised to [-1, 1] over the envelope, affine
-#: plus the products q M and rho U M (the Mach-dependent aerodynamic matrices times q and rho U;
-#: aeroelastic_matrices, Eq. 2.63). Measured: the purely affine fit in (q, rho U, U, M) misses
-#: the grid's responses by up to 31 %, with the two products by 7 %.
-FLIGHT_PARAMETERS = ("q", "rho U", "U", "Mach")
-FLIGHT_MONOMIALS = ((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1), (1, 0, 0, 1),
-                    (0, 1, 0, 1))
+#: The flight parameters of the real-parameter description (:func:`flight_lft`): Mach and
+#: altitude, each normalised to [-1, 1] over the envelope (so the LFT's box is the envelope
+#: itself), and the monomials of the fit: a full quadratic. Measured (issue 26): a box of
+#: four independent parameters (q, rho U, U, Mach; affine plus q M, rho U M) fits the grid's
+#: responses within 9 %, but its centre and corners are not flight conditions and the
+#: H-infinity loop is unstable there (largest closed-loop real part +183 1/s at the centre,
+#: +8800 1/s at a corner): no mu certificate can hold on that box.
+FLIGHT_PARAMETERS = ("Mach", "altitude")
+FLIGHT_MONOMIALS = ((1, 0), (0, 1), (1, 1), (2, 0), (0, 2))
 
 
 def flight_parameters(mach, altitude):
-    """(q Pa, rho U kg/(m^2 s), U m/s, Mach) at (``mach``, ``altitude`` m), 1976 atmosphere."""
-    s = standard_atmosphere(altitude)
-    U = mach * float(s.speed_of_sound)
-    rho = float(s.density)
-    return np.array([0.5 * rho * U * U, rho * U, U, float(mach)])
+    """(Mach, altitude m): the physical coordinates of the envelope."""
+    return np.array([float(mach), float(altitude)])
 
 
 @dataclass(frozen=True)
 class FlightLFT:
     """The Mach-altitude envelope as real parameters (:func:`flight_lft`): ``lft`` (A0 the fit
-    at the box's centre), the plant's ``B``, ``C``, the box ``lo``, ``hi`` (physical units of
+    at the box's centre, Mach 0.5, 2500 m), the plant's ``B``, ``C``, the box ``lo``, ``hi`` (units of
     :data:`FLIGHT_PARAMETERS`), and the fit-error cover ``cover`` over ``cover_hz`` (the largest
     relative response error |P(j w) / P_lft(j w) - 1| over ``checked`` (Mach, altitude) points)."""
 
@@ -904,10 +901,10 @@ def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8) -> Fli
     depend on the flight condition) fitted by least squares (:func:`asekit.ase.robust.
     fit_polynomial`) in :data:`FLIGHT_MONOMIALS` of the normalised :data:`FLIGHT_PARAMETERS` on
     an ``n_grid`` x ``n_grid`` grid of Mach x altitude, pulled out as a linear fractional
-    transformation (:func:`asekit.ase.robust.polynomial_lft`; the dynamic-pressure parameter of
-    Lind & Brenner, "Robust aeroservoelastic stability analysis", Springer 1999, Ch. 5, with
-    rho U, U and Mach beside it). The four parameters vary independently in the LFT's box,
-    which contains the envelope (conservative). The fit error is not hidden: ``cover`` is the
+    transformation (:func:`asekit.ase.robust.polynomial_lft`; the parametric flight-condition
+    uncertainty of Lind & Brenner, "Robust aeroservoelastic stability analysis", Springer
+    1999, Ch. 5, there on dynamic pressure alone). The box of the two parameters is the
+    envelope itself. The fit error is not hidden: ``cover`` is the
     largest relative response error of the LFT against the direct model over the grid and the
     (n_grid - 1)^2 cell centres (also off the fit's samples), to be covered by a complex
     output-multiplicative block."""
@@ -933,6 +930,50 @@ def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8) -> Fli
         cover = np.maximum(cover, np.abs(_response(plants[p][0], B, C, f)
                                          / _response(A_l, B, C, f) - 1.0))
     return replace(out, cover=cover)
+
+
+def hinf_mu_real(controller, data=None, f_hz=None, n_mixed: int = 3, n_grid: int = 5) -> dict:
+    """Robust stability with Mach and altitude as real parameters (issue 26, the description
+    that replaces :func:`hinf_mu`'s complex cover of the envelope): the shaft and
+    elastic-frequency blocks of :func:`hinf_uncertainty` (about the design condition), the four
+    real repeated-scalar blocks of :func:`flight_lft` and one complex output-multiplicative
+    block covering its measured fit error, about the LFT's centre plant A0. At every
+    frequency the complex D bound (:func:`asekit.ase.mu.upper_bound`, valid for real blocks
+    too); at the ``n_mixed`` frequencies where it is largest also the mixed D-G bound (seconds
+    to minutes each at this size), the smaller kept: an upper bound of mu at each grid
+    frequency. Returns ``{"f_hz", "upper", "mu_peak", "f_peak_hz", "blocks", "M", "sizes",
+    "fit_cover", "mixed_hz"}`` and, from :func:`asekit.ase.robust.mu_subsets` with the
+    complex D bound, ``mu_peak_<part>`` / ``f_peak_<part>_hz`` for the parts "parameters"
+    (shaft, frequencies), "flight" (the LFT) and "fit" (the fit-error cover)."""
+    from asekit.ase import robust
+    from asekit.ase.mu import mixed_upper_bound, upper_bound
+
+    data = load() if data is None else data
+    f = np.logspace(0, np.log10(490.0), 60) if f_hz is None else np.asarray(f_hz, float)
+    fl = flight_lft(data, n_grid=n_grid, f_hz=f)
+    _, _, _, unc0 = hinf_uncertainty(data, f)
+    unc = robust.Uncertainty(parameters=unc0.parameters, lft=fl.lft, cover_hz=f,
+                             cover=fl.cover, cover_name="flight LFT fit error")
+    Ms, blocks = robust.loop_matrix(fl.lft.A0, fl.B, fl.C, robust.digital_gain(controller),
+                                    unc, f, HINF_DELAY)
+    up = np.array([upper_bound(M, blocks)[0] for M in Ms])
+    mixed = np.argsort(up)[::-1][:max(0, int(n_mixed))]
+    for i in mixed:
+        up[i] = min(up[i], mixed_upper_bound(Ms[i], blocks)[0])
+    i = int(np.argmax(up))
+    n, k = len(unc.parameters), len(fl.lft.sizes)
+    out = {"f_hz": f, "upper": up, "mu_peak": float(up[i]), "f_peak_hz": float(f[i]),
+           "blocks": blocks, "M": Ms, "sizes": fl.lft.sizes, "fit_cover": float(fl.cover.max()),
+           "mixed_hz": f[mixed]}
+    parts = {"parameters": range(n), "flight": range(n, n + k), "fit": [n + k]}
+    for name, keep in parts.items():
+        idx = np.concatenate([np.arange(sum(b.size for b in blocks[:j]),
+                                        sum(b.size for b in blocks[:j + 1])) for j in keep])
+        sub = [blocks[j] for j in keep]
+        u = np.array([upper_bound(M[np.ix_(idx, idx)], sub)[0] for M in Ms])
+        out[f"mu_peak_{name}"], out[f"f_peak_{name}_hz"] = float(u.max()), float(f[u.argmax()])
+        out[f"upper_{name}"] = u
+    return out
 
 
 def hinf_conditions(controller, data=None) -> list[Check]:
