@@ -1013,9 +1013,22 @@ def hinf_quantities(data) -> list[Quantity]:
                        "stated uncertainty; shaft and elastic frequencies alone "
                        f"{mu['mu_peak_parameters']:.3g} at {mu['f_peak_parameters_hz']:.0f} Hz, "
                        f"Mach-altitude multiplicative cover alone {mu['mu_peak_flight']:.3g} "
-                       f"at {mu['f_peak_flight_hz']:.0f} Hz (drives the bound)")]
+                       f"at {mu['f_peak_flight_hz']:.0f} Hz (drives the bound)"),
+              _mu_real_quantity(hinf_mu_real(ctl, data))]
     else:
         why = "not computed: python -m asekit reproduce --robust (about a minute)"
         q += [Quantity("ase.design.hinf.conditions_passed", None, "-", why, computed=False),
-              Quantity("ase.design.hinf.mu_peak", None, "-", why, computed=False)]
+              Quantity("ase.design.hinf.mu_peak", None, "-", why, computed=False),
+              Quantity("ase.design.hinf.mu_peak_real", None, "-", why, computed=False)]
     return q
+
+
+def _mu_real_quantity(mu) -> Quantity:
+    """The ``ase.design.hinf.mu_peak_real`` row from :func:`hinf_mu_real`."""
+    return Quantity("ase.design.hinf.mu_peak_real", mu["mu_peak"], "-",
+                    f"upper bound with Mach and altitude as real parameters (quadratic LFT, "
+                    f"blocks {mu['sizes']}, fit error <= {mu['fit_cover']:.2f} as a complex "
+                    f"cover) at {mu['f_peak_hz']:.0f} Hz; alone: shaft and elastic frequencies "
+                    f"{mu['mu_peak_parameters']:.3g}, Mach-altitude LFT "
+                    f"{mu['mu_peak_flight']:.3g} at {mu['f_peak_flight_hz']:.0f} Hz, fit cover "
+                    f"{mu['mu_peak_fit']:.3g} (complex D bounds)")

@@ -35,6 +35,7 @@ def test_quantities_without_the_robust_flag(data, hinf, monkeypatch):
     assert q["ase.design.hinf.table2_pass"].asekit is True
     assert q["ase.design.hinf.order"].asekit == dz.HINF_ORDER
     assert not q["ase.design.hinf.mu_peak"].computed
+    assert not q["ase.design.hinf.mu_peak_real"].computed
     assert "--robust" in q["ase.design.hinf.conditions_passed"].note
 
 
