@@ -938,10 +938,11 @@ def hinf_mu_real(controller, data=None, f_hz=None, n_mixed: int = 3, n_grid: int
     elastic-frequency blocks of :func:`hinf_uncertainty` (about the design condition), the four
     real repeated-scalar blocks of :func:`flight_lft` and one complex output-multiplicative
     block covering its measured fit error, about the LFT's centre plant A0. At every
-    frequency the complex D bound (:func:`asekit.ase.mu.upper_bound`, valid for real blocks
-    too); at the ``n_mixed`` frequencies where it is largest also the mixed D-G bound (seconds
-    to minutes each at this size), the smaller kept: an upper bound of mu at each grid
-    frequency. Returns ``{"f_hz", "upper", "mu_peak", "f_peak_hz", "blocks", "M", "sizes",
+    frequency the complex D bound with one scale per block (:func:`asekit.ase.mu.upper_bound`
+    with ``per_block``, valid for real blocks too: the LFT's repeated blocks have about a
+    hundred entries each, and one scale per entry takes minutes per frequency); at the
+    ``n_mixed`` frequencies where it is largest also the mixed D-G bound, the smaller kept: an
+    upper bound of mu at each grid frequency. Returns ``{"f_hz", "upper", "mu_peak", "f_peak_hz", "blocks", "M", "sizes",
     "fit_cover", "mixed_hz"}`` and, from :func:`asekit.ase.robust.mu_subsets` with the
     complex D bound, ``mu_peak_<part>`` / ``f_peak_<part>_hz`` for the parts "parameters"
     (shaft, frequencies), "flight" (the LFT) and "fit" (the fit-error cover)."""
@@ -956,10 +957,10 @@ def hinf_mu_real(controller, data=None, f_hz=None, n_mixed: int = 3, n_grid: int
                              cover=fl.cover, cover_name="flight LFT fit error")
     Ms, blocks = robust.loop_matrix(fl.lft.A0, fl.B, fl.C, robust.digital_gain(controller),
                                     unc, f, HINF_DELAY)
-    up = np.array([upper_bound(M, blocks)[0] for M in Ms])
+    up = np.array([upper_bound(M, blocks, per_block=True)[0] for M in Ms])
     mixed = np.argsort(up)[::-1][:max(0, int(n_mixed))]
     for i in mixed:
-        up[i] = min(up[i], mixed_upper_bound(Ms[i], blocks)[0])
+        up[i] = min(up[i], mixed_upper_bound(Ms[i], blocks, per_block=True)[0])
     i = int(np.argmax(up))
     n, k = len(unc.parameters), len(fl.lft.sizes)
     out = {"f_hz": f, "upper": up, "mu_peak": float(up[i]), "f_peak_hz": float(f[i]),
@@ -970,7 +971,7 @@ def hinf_mu_real(controller, data=None, f_hz=None, n_mixed: int = 3, n_grid: int
         idx = np.concatenate([np.arange(sum(b.size for b in blocks[:j]),
                                         sum(b.size for b in blocks[:j + 1])) for j in keep])
         sub = [blocks[j] for j in keep]
-        u = np.array([upper_bound(M[np.ix_(idx, idx)], sub)[0] for M in Ms])
+        u = np.array([upper_bound(M[np.ix_(idx, idx)], sub, per_block=True)[0] for M in Ms])
         out[f"mu_peak_{name}"], out[f"f_peak_{name}_hz"] = float(u.max()), float(f[u.argmax()])
         out[f"upper_{name}"] = u
     return out
