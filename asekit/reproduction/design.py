@@ -932,7 +932,13 @@ def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8) -> Fli
     return replace(out, cover=cover)
 
 
-def hinf_mu_real(controller, data=None, f_hz=None, n_mixed: int = 3, n_grid: int = 5) -> dict:
+#: The frequencies (Hz) of :func:`hinf_mu_real` in ``reproduce --robust``: a coarse grid over
+#: the loop's band and the two elastic modes (about a minute per frequency at this size).
+MU_REAL_HZ = (1.0, 10.0, 50.0, 95.0, 130.0, 145.0, 155.0, 200.0, 300.0)
+
+
+def hinf_mu_real(controller, data=None, f_hz=MU_REAL_HZ, n_mixed: int = 0,
+                 n_grid: int = 5) -> dict:
     """Robust stability with Mach and altitude as real parameters (issue 26, the description
     that replaces :func:`hinf_mu`'s complex cover of the envelope): the shaft and
     elastic-frequency blocks of :func:`hinf_uncertainty` (about the design condition), the four
@@ -950,8 +956,10 @@ def hinf_mu_real(controller, data=None, f_hz=None, n_mixed: int = 3, n_grid: int
     from asekit.ase.mu import mixed_upper_bound, upper_bound
 
     data = load() if data is None else data
-    f = np.logspace(0, np.log10(490.0), 60) if f_hz is None else np.asarray(f_hz, float)
-    fl = flight_lft(data, n_grid=n_grid, f_hz=f)
+    f = np.asarray(f_hz, float)
+    fl = flight_lft(data, n_grid=n_grid, f_hz=np.logspace(0, np.log10(490.0), 300))
+    fit_cover = float(fl.cover.max())
+    fl = replace(fl, cover_hz=f, cover=np.interp(f, fl.cover_hz, fl.cover))
     _, _, _, unc0 = hinf_uncertainty(data, f)
     unc = robust.Uncertainty(parameters=unc0.parameters, lft=fl.lft, cover_hz=f,
                              cover=fl.cover, cover_name="flight LFT fit error")
@@ -964,7 +972,7 @@ def hinf_mu_real(controller, data=None, f_hz=None, n_mixed: int = 3, n_grid: int
     i = int(np.argmax(up))
     n, k = len(unc.parameters), len(fl.lft.sizes)
     out = {"f_hz": f, "upper": up, "mu_peak": float(up[i]), "f_peak_hz": float(f[i]),
-           "blocks": blocks, "M": Ms, "sizes": fl.lft.sizes, "fit_cover": float(fl.cover.max()),
+           "blocks": blocks, "M": Ms, "sizes": fl.lft.sizes, "fit_cover": fit_cover,
            "mixed_hz": f[mixed]}
     parts = {"parameters": range(n), "flight": range(n, n + k), "fit": [n + k]}
     for name, keep in parts.items():
