@@ -35,6 +35,13 @@ exp(-j w tau), is bounded by :func:`asekit.ase.mu.mu_frequency`: robust stabilit
 uncertainty if the nominal loop is stable and sup_w mu < 1; the loop tolerates 1 / sup mu times
 the stated uncertainty (Packard & Doyle 1993, Theorem 4.3 / small-mu theorem).
 
+Real parameters that enter A polynomially (flight condition: Mach, altitude) are pulled out as
+a linear fractional transformation (:func:`fit_polynomial` on sampled plants, then
+:func:`polynomial_lft`; Zhou, Doyle & Glover, "Robust and optimal control", 1996, Sec. 10.2;
+Lind & Brenner, "Robust aeroservoelastic stability analysis", 1999, Ch. 5): each monomial's
+coefficient matrix is rank-factorised and a degree-two monomial becomes a chain of two
+scalars, so every parameter is one repeated real scalar block (``Uncertainty.lft``).
+
 SI units (rad, V, s, rad/s).
 """
 
