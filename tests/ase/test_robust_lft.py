@@ -77,7 +77,9 @@ def test_mu_of_a_bilinear_parameter_loop():
     assert r["blocks"] == lft.blocks
     # the LFT's M(0) at the worst corner is singular: a verified destabilising perturbation
     assert r["mu_peak_lower"] <= 1 / alpha + 1e-9 <= r["mu_peak"] + 2e-9
-    assert r["mu_peak"] < 1.3 / alpha            # D-G bound with diagonal D: may be loose
+    # the D-G bound (diagonal D on the repeated d1) is not exact in general; here it meets the
+    # lower bound (measured: both 0.8 to 1e-13)
+    assert r["mu_peak"] == pytest.approx(1 / alpha, rel=1e-6)
     # the destabilising corner: det(I - M Delta) = 0 at Delta = alpha diag(1, 1, 1)
     M = r["M"][0]
     assert abs(np.linalg.det(np.eye(3) - M * alpha)) < 1e-9
