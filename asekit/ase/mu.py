@@ -111,12 +111,13 @@ def _check(M, blocks):
     return M, blocks
 
 
-def _groups(blocks):
+def _groups(blocks, per_block: bool = False):
     """Index arrays of the free scaling variables: one per full block, one per entry of a
-    repeated scalar block."""
+    repeated scalar block (``per_block``: one d I per block of any kind, a smaller subset of
+    the commutant: a valid, possibly looser bound with far fewer variables)."""
     out, k = [], 0
     for b in blocks:
-        if b.kind == "full":
+        if b.kind == "full" or per_block:
             out.append(np.arange(k, k + b.size))
         else:
             out.extend(np.array([k + i]) for i in range(b.size))
@@ -149,10 +150,11 @@ def _osborne(M, groups, sweeps: int = 20):
     return x - x[0]
 
 
-def upper_bound(M, blocks, x0=None):
+def upper_bound(M, blocks, x0=None, per_block: bool = False):
     """inf_D sigma_max(D M D^-1) (Packard & Doyle 1993, Eq. 6.2): returns (bound, d) with d
     the (n,) diagonal of the optimal D. ``x0``: a starting log-scaling per group (warm start
-    over frequency).
+    over frequency). ``per_block``: D = d_i I on each block (for large repeated blocks: one
+    variable per block instead of one per entry; still an upper bound).
 
     Examples
     --------
@@ -165,7 +167,7 @@ def upper_bound(M, blocks, x0=None):
 
     M, blocks = _check(M, blocks)
     n = M.shape[0]
-    groups = _groups(blocks)
+    groups = _groups(blocks, per_block)
     if len(groups) == 1:
         return float(np.linalg.norm(M, 2)), np.ones(n)
 
@@ -229,7 +231,7 @@ class _Done(Exception):
         self.z = np.array(z)
 
 
-def mixed_upper_bound(M, blocks, x0=None, g0=None):
+def mixed_upper_bound(M, blocks, x0=None, g0=None, per_block: bool = False):
     """The D-G scaled upper bound of mixed real/complex mu (Fan, Tits & Doyle 1991; Young,
     Newlin & Doyle 1995; module docstring):
 
@@ -239,6 +241,7 @@ def mixed_upper_bound(M, blocks, x0=None, g0=None):
     g) with d (n,) and g (n,) (zero off the real blocks) at the optimum found. ``x0``, ``g0``:
     warm starts (log d per scaling group, Gh per real entry); by default the complex D of
     :func:`upper_bound` and Gh = 0, so the result never exceeds the complex bound.
+    ``per_block``: D = d_i I per block (as :func:`upper_bound`); G stays diagonal per entry.
 
     Examples
     --------
@@ -252,10 +255,10 @@ def mixed_upper_bound(M, blocks, x0=None, g0=None):
 
     M, blocks = _check(M, blocks)
     n = M.shape[0]
-    groups = _groups(blocks)
+    groups = _groups(blocks, per_block)
     ir = _real_entries(blocks)
     if x0 is None:
-        up, d = upper_bound(M, blocks)
+        up, d = upper_bound(M, blocks, per_block=per_block)
         x0 = np.array([np.log(d[gi[0]]) for gi in groups])
     else:
         up = None

@@ -35,6 +35,13 @@ exp(-j w tau), is bounded by :func:`asekit.ase.mu.mu_frequency`: robust stabilit
 uncertainty if the nominal loop is stable and sup_w mu < 1; the loop tolerates 1 / sup mu times
 the stated uncertainty (Packard & Doyle 1993, Theorem 4.3 / small-mu theorem).
 
+Real parameters that enter A polynomially (flight condition: Mach, altitude) are pulled out as
+a linear fractional transformation (:func:`fit_polynomial` on sampled plants, then
+:func:`polynomial_lft`; Zhou, Doyle & Glover, "Robust and optimal control", 1996, Sec. 10.2;
+Lind & Brenner, "Robust aeroservoelastic stability analysis", 1999, Ch. 5): each monomial's
+coefficient matrix is rank-factorised and a degree-two monomial becomes a chain of two
+scalars, so every parameter is one repeated real scalar block (``Uncertainty.lft``).
+
 SI units (rad, V, s, rad/s).
 """
 
@@ -281,6 +288,9 @@ class Uncertainty:
     cover_hz: np.ndarray | None = None
     cover: np.ndarray | None = None
     cover_name: str = "flight condition"
+    #: real parameters entering A as a :class:`ParametricLFT` (about the same A; None: none);
+    #: its blocks follow those of ``parameters``, before the cover's
+    lft: ParametricLFT | None = None
 
 
 def loop_matrix(A, B, C, K_y, uncertainty: Uncertainty, f_hz, delay: float = 1.5e-3):
@@ -298,6 +308,16 @@ def loop_matrix(A, B, C, K_y, uncertainty: Uncertainty, f_hz, delay: float = 1.5
         blocks.append(Block(U.shape[1], "real"))
     U = np.hstack(Us) if Us else np.zeros((n, 0))
     V = np.hstack(Vs) if Vs else np.zeros((n, 0))
+    Dzz = np.zeros((U.shape[1], U.shape[1]))
+    lft = uncertainty.lft
+    if lft is not None:
+        if lft.A0.shape != A.shape:
+            raise ValueError(f"uncertainty.lft.A0 is {lft.A0.shape}, the plant's A {A.shape}")
+        m0 = U.shape[1]
+        U, V = np.hstack([U, lft.Bw]), np.hstack([V, lft.Cz.T])
+        Dzz = np.zeros((U.shape[1], U.shape[1]))
+        Dzz[m0:, m0:] = lft.Dzw
+        blocks.extend(lft.blocks)
     cover = uncertainty.cover is not None
     if cover:
         blocks.append(Block(1, "complex"))
@@ -311,7 +331,7 @@ def loop_matrix(A, B, C, K_y, uncertainty: Uncertainty, f_hz, delay: float = 1.5
         H = np.linalg.inv(np.eye(n) - L * GB @ C)
         x_w = H @ GU                                                   # x per parameter input
         x_f = H @ GB * L                                               # x per cover input
-        rows = [np.hstack([V.T @ x_w, V.T @ x_f] if cover else [V.T @ x_w])]
+        rows = [np.hstack([V.T @ x_w + Dzz, V.T @ x_f] if cover else [V.T @ x_w + Dzz])]
         if cover:
             rows.append(wf[i] * np.hstack([C @ x_w, C @ x_f]))
         out.append(np.vstack(rows))
@@ -392,3 +412,129 @@ def mu_subsets(Ms, blocks, f_hz, subsets: dict) -> dict:
         out[name] = {"mu_peak": r["peak_upper"], "mu_peak_lower": float(np.max(r["lower"])),
                      "f_peak_hz": float(f[r["i_peak"]]), "upper": r["upper"]}
     return out
+
+
+# ---------------------------------------------------------------------------------------------
+# real-parameter LFT of a parameter-dependent state matrix (issue 26)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ParametricLFT:
+    """A(delta) = A0 + Bw Delta (I - Dzw Delta)^-1 Cz, Delta = diag(delta_i I_{r_i}) (each real
+    parameter delta_i in [-1, 1] a repeated real scalar of size ``sizes[i]``, its channels
+    contiguous in the order of ``names``): the upper linear fractional transformation of a
+    polynomial matrix (Zhou, Doyle & Glover, "Robust and optimal control", 1996, Sec. 10.2;
+    Lind & Brenner, "Robust aeroservoelastic stability analysis", 1999, Ch. 5 for the flight
+    parameters). Built by :func:`polynomial_lft`."""
+
+    A0: np.ndarray
+    Bw: np.ndarray
+    Cz: np.ndarray
+    Dzw: np.ndarray
+    names: tuple
+    sizes: tuple
+
+    @property
+    def blocks(self) -> tuple:
+        """One real repeated-scalar :class:`asekit.ase.mu.Block` per parameter."""
+        return tuple(Block(int(s), "real") for s in self.sizes)
+
+
+def _monomial(powers, k):
+    p = tuple(int(x) for x in powers)
+    if len(p) != k or min(p) < 0 or not 1 <= sum(p) <= 2:
+        raise ValueError(f"monomial powers must be {k} non-negative integers of total degree 1 "
+                         f"or 2, got {powers!r}")
+    return [i for i in range(k) for _ in range(p[i])]        # parameter index per factor
+
+
+def polynomial_lft(A0, terms, names, rtol: float = 1e-8) -> ParametricLFT:
+    """The LFT of A(delta) = A0 + sum_k m_k(delta) dA_k, m_k a monomial of degree 1 or 2 in the
+    real parameters (Zhou, Doyle & Glover 1996, Sec. 10.2): each dA_k = U_k V_k^T
+    (:func:`rank_factors`, rank r_k) is pulled out as z = V_k^T x, w = delta_i z,
+    x' += U_k w for delta_i; for delta_i delta_j a chain z1 = V_k^T x, w1 = delta_j z1,
+    z2 = w1 (the Dzw entry), w2 = delta_i z2, x' += U_k w2. ``terms``: ((powers, dA), ...)
+    with powers one integer per parameter; ``names``: the parameters.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A0 = np.array([[-1.0, 0.0], [0.0, -2.0]])
+    >>> lft = polynomial_lft(A0, [((1, 0), np.diag([1.0, 0.0])),
+    ...                           ((1, 1), np.array([[0.0, 1.0], [0.0, 0.0]]))], ("a", "b"))
+    >>> lft.sizes
+    (2, 1)
+    >>> A = lft_state_matrix(lft, [0.5, -0.4])
+    >>> bool(np.allclose(A, [[-0.5, -0.2], [0.0, -2.0]]))
+    True
+    """
+    A0 = np.atleast_2d(np.asarray(A0, float))
+    n, k = A0.shape[0], len(names)
+    chans = []                     # (param, column of U or None, row of V or None, feeds chan)
+    for powers, dA in terms:
+        idx = _monomial(powers, k)
+        U, V = rank_factors(np.asarray(dA, float), rtol)
+        for c in range(U.shape[1]):
+            prev = None
+            for j, p in enumerate(reversed(idx)):       # the last factor acts on V^T x first
+                last = j == len(idx) - 1
+                chans.append((p, U[:, c] if last else None, V[:, c] if prev is None else None,
+                              prev))
+                prev = len(chans) - 1
+    order = sorted(range(len(chans)), key=lambda i: chans[i][0])      # stable: by parameter
+    pos = {old: new for new, old in enumerate(order)}
+    m = len(chans)
+    Bw, Cz, Dzw = np.zeros((n, m)), np.zeros((m, n)), np.zeros((m, m))
+    for old, (p, u, v, prev) in enumerate(chans):
+        i = pos[old]
+        if u is not None:
+            Bw[:, i] = u
+        if v is not None:
+            Cz[i] = v
+        if prev is not None:
+            Dzw[i, pos[prev]] = 1.0
+    sizes = tuple(sum(1 for c in chans if c[0] == p) for p in range(k))
+    if min(sizes) == 0:
+        raise ValueError("every parameter must appear in a term with a non-zero dA")
+    return ParametricLFT(A0=A0, Bw=Bw, Cz=Cz, Dzw=Dzw, names=tuple(names), sizes=sizes)
+
+
+def lft_state_matrix(lft: ParametricLFT, deltas) -> np.ndarray:
+    """A(delta) = A0 + Bw Delta (I - Dzw Delta)^-1 Cz for one value of the real parameters
+    (``deltas``, one per parameter; Zhou, Doyle & Glover 1996, Eq. 10.3)."""
+    d = np.asarray(deltas, float)
+    if d.shape != (len(lft.sizes),):
+        raise ValueError(f"deltas must have one value per parameter {lft.names}, got {d.shape}")
+    D = np.diag(np.repeat(d, lft.sizes))
+    return lft.A0 + lft.Bw @ D @ np.linalg.solve(np.eye(len(D)) - lft.Dzw @ D, lft.Cz)
+
+
+def fit_polynomial(deltas, As, monomials):
+    """Least-squares fit of sampled state matrices by a polynomial in the normalised
+    parameters: As[s] ~ A0 + sum_k m_k(deltas[s]) dA_k, entry by entry (ordinary least
+    squares on the monomial basis). ``deltas`` (n_s, k), ``As`` (n_s, n, n), ``monomials``:
+    powers per parameter (degree 1 or 2). Returns (A0, ((powers, dA_k), ...), residual
+    (n_s, n, n) = As - fit).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> d = np.array([[-1.0], [0.0], [1.0]])
+    >>> As = np.array([[[1.0 + 2 * x + 3 * x * x]] for x in d[:, 0]])
+    >>> A0, terms, res = fit_polynomial(d, As, [(1,), (2,)])
+    >>> round(float(A0[0, 0]), 9), [round(float(t[1][0, 0]), 9) for t in terms]
+    (1.0, [2.0, 3.0])
+    """
+    d = np.atleast_2d(np.asarray(deltas, float))
+    As = np.asarray(As, float)
+    if As.ndim != 3 or len(As) != len(d):
+        raise ValueError("As must be (n_samples, n, n) with one sample per row of deltas")
+    mons = [tuple(int(x) for x in p) for p in monomials]
+    for p in mons:
+        _monomial(p, d.shape[1])
+    Phi = np.column_stack([np.ones(len(d))] + [np.prod(d ** np.array(p), axis=1) for p in mons])
+    if np.linalg.matrix_rank(Phi) < Phi.shape[1]:
+        raise ValueError("the samples do not determine every monomial (rank-deficient basis)")
+    coef = np.linalg.lstsq(Phi, As.reshape(len(d), -1), rcond=None)[0]
+    coef = coef.reshape(-1, *As.shape[1:])
+    return coef[0], tuple(zip(mons, coef[1:])), As - (Phi @ coef.reshape(len(coef), -1)
+                                                      ).reshape(As.shape)

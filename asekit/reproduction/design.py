@@ -887,6 +887,139 @@ def lqg_scheduled_mu(data=None, f_hz=None) -> dict:
     return hinf_mu(controller_at(design_b_scheduled(data), *HINF_CONDITION), data, f_hz)
 
 
+#: The flight parameters of the real-parameter description (:func:`flight_lft`): Mach and
+#: altitude, each normalised to [-1, 1] over the envelope (so the LFT's box is the envelope
+#: itself), and the monomials of the fit: a full quadratic. Measured (issue 26): a box of
+#: four independent parameters (q, rho U, U, Mach; affine plus q M, rho U M) fits the grid's
+#: responses within 9 %, but its centre and corners are not flight conditions and the
+#: H-infinity loop is unstable there (largest closed-loop real part +183 1/s at the centre,
+#: +8800 1/s at a corner): no mu certificate can hold on that box.
+FLIGHT_PARAMETERS = ("Mach", "altitude")
+FLIGHT_MONOMIALS = ((1, 0), (0, 1), (1, 1), (2, 0), (0, 2))
+
+
+def flight_parameters(mach, altitude):
+    """(Mach, altitude m): the physical coordinates of the envelope."""
+    return np.array([float(mach), float(altitude)])
+
+
+@dataclass(frozen=True)
+class FlightLFT:
+    """The Mach-altitude envelope as real parameters (:func:`flight_lft`): ``lft`` (A0 the fit
+    at the box's centre, Mach 0.5, 2500 m), the plant's ``B``, ``C``, the box ``lo``, ``hi`` (units of
+    :data:`FLIGHT_PARAMETERS`), and the fit-error cover ``cover`` over ``cover_hz`` (the largest
+    relative response error |P(j w) / P_lft(j w) - 1| over ``checked`` (Mach, altitude) points)."""
+
+    lft: object
+    B: np.ndarray
+    C: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    cover_hz: np.ndarray
+    cover: np.ndarray
+    checked: tuple
+
+    def deltas(self, mach, altitude):
+        """The normalised parameters (each in [-1, 1] inside the envelope)."""
+        return (flight_parameters(mach, altitude) - (self.hi + self.lo) / 2) \
+            / ((self.hi - self.lo) / 2)
+
+
+def _response(A, B, C, f_hz):
+    n = A.shape[0]
+    return np.array([(C @ np.linalg.solve(2j * np.pi * f * np.eye(n) - A, B))[0, 0]
+                     for f in f_hz])
+
+
+def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8) -> FlightLFT:
+    """Mach 0.4-0.6 and 0-5000 m as real parameters: OPLOOP 3's state matrix A (B and C do not
+    depend on the flight condition) fitted by least squares (:func:`asekit.ase.robust.
+    fit_polynomial`) in :data:`FLIGHT_MONOMIALS` of the normalised :data:`FLIGHT_PARAMETERS` on
+    an ``n_grid`` x ``n_grid`` grid of Mach x altitude, pulled out as a linear fractional
+    transformation (:func:`asekit.ase.robust.polynomial_lft`; the parametric flight-condition
+    uncertainty of Lind & Brenner, "Robust aeroservoelastic stability analysis", Springer
+    1999, Ch. 5, there on dynamic pressure alone). The box of the two parameters is the
+    envelope itself. The fit error is not hidden: ``cover`` is the
+    largest relative response error of the LFT against the direct model over the grid and the
+    (n_grid - 1)^2 cell centres (also off the fit's samples), to be covered by a complex
+    output-multiplicative block."""
+    from asekit.ase import robust
+
+    data = load() if data is None else data
+    f = np.logspace(0, np.log10(490.0), 300) if f_hz is None else np.asarray(f_hz, float)
+    ms, hs = np.linspace(MACHS[0], MACHS[-1], n_grid), np.linspace(ALTITUDES[0], ALTITUDES[-1],
+                                                                   n_grid)
+    pts = [(M, h) for M in ms for h in hs]
+    mid = [(M, h) for M in (ms[1:] + ms[:-1]) / 2 for h in (hs[1:] + hs[:-1]) / 2]
+    plants = {p: _plant_A(fin_model(*p, data=data)) for p in pts + mid}
+    P = np.array([flight_parameters(*p) for p in pts])
+    lo, hi = P.min(axis=0), P.max(axis=0)
+    D = (P - (hi + lo) / 2) / ((hi - lo) / 2)
+    A0, terms, _ = robust.fit_polynomial(D, [plants[p][0] for p in pts], FLIGHT_MONOMIALS)
+    lft = robust.polynomial_lft(A0, terms, FLIGHT_PARAMETERS, rtol)
+    _, B, C = plants[pts[0]]
+    out = FlightLFT(lft, B, C, lo, hi, f, np.zeros(len(f)), tuple(pts + mid))
+    cover = np.zeros(len(f))
+    for p in pts + mid:
+        A_l = robust.lft_state_matrix(lft, out.deltas(*p))
+        cover = np.maximum(cover, np.abs(_response(plants[p][0], B, C, f)
+                                         / _response(A_l, B, C, f) - 1.0))
+    return replace(out, cover=cover)
+
+
+#: The frequencies (Hz) of :func:`hinf_mu_real` in ``reproduce --robust``: a coarse grid over
+#: the loop's band and the two elastic modes (about a minute per frequency at this size).
+MU_REAL_HZ = (1.0, 10.0, 50.0, 95.0, 130.0, 145.0, 155.0, 200.0, 300.0)
+
+
+def hinf_mu_real(controller, data=None, f_hz=MU_REAL_HZ, n_mixed: int = 0,
+                 n_grid: int = 5) -> dict:
+    """Robust stability with Mach and altitude as real parameters (issue 26, the description
+    that replaces :func:`hinf_mu`'s complex cover of the envelope): the shaft and
+    elastic-frequency blocks of :func:`hinf_uncertainty` (about the design condition), the four
+    real repeated-scalar blocks of :func:`flight_lft` and one complex output-multiplicative
+    block covering its measured fit error, about the LFT's centre plant A0. At every
+    frequency the complex D bound with one scale per block (:func:`asekit.ase.mu.upper_bound`
+    with ``per_block``, valid for real blocks too: the LFT's repeated blocks have about a
+    hundred entries each, and one scale per entry takes minutes per frequency); at the
+    ``n_mixed`` frequencies where it is largest also the mixed D-G bound, the smaller kept: an
+    upper bound of mu at each grid frequency. Returns ``{"f_hz", "upper", "mu_peak", "f_peak_hz", "blocks", "M", "sizes",
+    "fit_cover", "mixed_hz"}`` and, from :func:`asekit.ase.robust.mu_subsets` with the
+    complex D bound, ``mu_peak_<part>`` / ``f_peak_<part>_hz`` for the parts "parameters"
+    (shaft, frequencies), "flight" (the LFT) and "fit" (the fit-error cover)."""
+    from asekit.ase import robust
+    from asekit.ase.mu import mixed_upper_bound, upper_bound
+
+    data = load() if data is None else data
+    f = np.asarray(f_hz, float)
+    fl = flight_lft(data, n_grid=n_grid, f_hz=np.logspace(0, np.log10(490.0), 300))
+    fit_cover = float(fl.cover.max())
+    fl = replace(fl, cover_hz=f, cover=np.interp(f, fl.cover_hz, fl.cover))
+    _, _, _, unc0 = hinf_uncertainty(data, f)
+    unc = robust.Uncertainty(parameters=unc0.parameters, lft=fl.lft, cover_hz=f,
+                             cover=fl.cover, cover_name="flight LFT fit error")
+    Ms, blocks = robust.loop_matrix(fl.lft.A0, fl.B, fl.C, robust.digital_gain(controller),
+                                    unc, f, HINF_DELAY)
+    up = np.array([upper_bound(M, blocks, per_block=True)[0] for M in Ms])
+    mixed = np.argsort(up)[::-1][:max(0, int(n_mixed))]
+    for i in mixed:
+        up[i] = min(up[i], mixed_upper_bound(Ms[i], blocks, per_block=True)[0])
+    i = int(np.argmax(up))
+    n, k = len(unc.parameters), len(fl.lft.sizes)
+    out = {"f_hz": f, "upper": up, "mu_peak": float(up[i]), "f_peak_hz": float(f[i]),
+           "blocks": blocks, "M": Ms, "sizes": fl.lft.sizes, "fit_cover": fit_cover,
+           "mixed_hz": f[mixed]}
+    parts = {"parameters": range(n), "flight": range(n, n + k), "fit": [n + k]}
+    for name, keep in parts.items():
+        idx = np.concatenate([np.arange(sum(b.size for b in blocks[:j]),
+                                        sum(b.size for b in blocks[:j + 1])) for j in keep])
+        sub = [blocks[j] for j in keep]
+        u = np.array([upper_bound(M[np.ix_(idx, idx)], sub, per_block=True)[0] for M in Ms])
+        out[f"mu_peak_{name}"], out[f"f_peak_{name}_hz"] = float(u.max()), float(f[u.argmax()])
+        out[f"upper_{name}"] = u
+    return out
+
+
 def hinf_conditions(controller, data=None) -> list[Check]:
     """:func:`check` of ``controller`` at the 45 conditions (3 Mach x 3 altitudes x the five
     :data:`ROBUSTNESS` cases)."""
@@ -924,9 +1057,22 @@ def hinf_quantities(data) -> list[Quantity]:
                        "stated uncertainty; shaft and elastic frequencies alone "
                        f"{mu['mu_peak_parameters']:.3g} at {mu['f_peak_parameters_hz']:.0f} Hz, "
                        f"Mach-altitude multiplicative cover alone {mu['mu_peak_flight']:.3g} "
-                       f"at {mu['f_peak_flight_hz']:.0f} Hz (drives the bound)")]
+                       f"at {mu['f_peak_flight_hz']:.0f} Hz (drives the bound)"),
+              _mu_real_quantity(hinf_mu_real(ctl, data))]
     else:
         why = "not computed: python -m asekit reproduce --robust (about a minute)"
         q += [Quantity("ase.design.hinf.conditions_passed", None, "-", why, computed=False),
-              Quantity("ase.design.hinf.mu_peak", None, "-", why, computed=False)]
+              Quantity("ase.design.hinf.mu_peak", None, "-", why, computed=False),
+              Quantity("ase.design.hinf.mu_peak_real", None, "-", why, computed=False)]
     return q
+
+
+def _mu_real_quantity(mu) -> Quantity:
+    """The ``ase.design.hinf.mu_peak_real`` row from :func:`hinf_mu_real`."""
+    return Quantity("ase.design.hinf.mu_peak_real", mu["mu_peak"], "-",
+                    f"upper bound with Mach and altitude as real parameters (quadratic LFT, "
+                    f"blocks {mu['sizes']}, fit error <= {mu['fit_cover']:.2f} as a complex "
+                    f"cover) at {mu['f_peak_hz']:.0f} Hz; alone: shaft and elastic frequencies "
+                    f"{mu['mu_peak_parameters']:.3g}, Mach-altitude LFT "
+                    f"{mu['mu_peak_flight']:.3g} at {mu['f_peak_flight_hz']:.0f} Hz, fit cover "
+                    f"{mu['mu_peak_fit']:.3g} (complex D bounds)")

@@ -222,3 +222,24 @@ def test_mixed_bound_valid_and_below_complex(seed):
         lam = np.linalg.eigvals(M @ dl)
         lam = lam[np.abs(lam.imag) < 1e-12 * np.abs(lam).max()]
         assert np.all(np.abs(lam) <= up + 1e-9)
+
+
+def test_per_block_scaling_is_a_looser_valid_bound():
+    """One scale per block (upper_bound(per_block=True)) for large repeated blocks: still an
+    upper bound, never below the per-entry one. M = [[0, 4], [1, 0]] with a repeated complex
+    scalar delta I_2: mu = rho(M) = 2 (Packard & Doyle 1993, Sec. 3: a repeated complex scalar
+    gives the spectral radius); per-entry D reaches 2 (d1 / d2 = 1/2), while d I commutes with
+    M and leaves sigma_max = 4."""
+    M = np.array([[0.0, 4.0], [1.0, 0.0]])
+    b = [Block(2, "complex")]
+    assert upper_bound(M, b)[0] == pytest.approx(2.0, rel=1e-6)
+    assert upper_bound(M, b, per_block=True)[0] == pytest.approx(4.0, rel=1e-9)
+    rng = np.random.default_rng(3)
+    blocks = [Block(3, "real"), Block(2, "complex"), Block(1, "complex")]
+    for _ in range(2):
+        X = rng.standard_normal((6, 6)) + 1j * rng.standard_normal((6, 6))
+        lo = mu_bounds(X, blocks).lower
+        entry = upper_bound(X, blocks)[0]
+        block = upper_bound(X, blocks, per_block=True)[0]
+        assert lo <= entry * (1 + 1e-9) and entry <= block * (1 + 1e-6)
+        assert lo <= mixed_upper_bound(X, blocks, per_block=True)[0] * (1 + 1e-6)

@@ -11,6 +11,10 @@ The six ``ase.design.hinf.*`` rows (issue 26: the H-infinity design; ``condition
 ``mu_peak`` are computed with ``reproduce --robust`` only) were added on 2026-12-03 from
 ``python -m asekit reproduce --only design --json``; no other value changed.
 
+The ``ase.design.hinf.mu_peak_real`` row (issue 26: the mu bound with Mach and altitude as
+real parameters; computed with ``reproduce --robust`` only, so None here) was added on
+2026-12-03 by hand, a copy of the ``mu_peak`` row's not-computed entry.
+
 The twenty-four ``ase.afs.*`` rows (issue 26: active flutter suppression, the open- and
 closed-loop flutter boundaries, margins, release peaks, the sampled loops, the 1 kHz discrete LQG
 and its quantisation-induced oscillation) were added on 2026-12-03 from
