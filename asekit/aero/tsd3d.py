@@ -10,7 +10,7 @@ the perturbation potential phi per U (a length: x, y, z and phi in the planform'
 
 and, with ``cross_flow=True`` (issue 29, tsdswept: needed by swept wings), the modified TSD
 equation of Batina (1989, J. Aircraft 26(6) 531-538, Eq. 1; CAP-TSD) with the cross-flow
-terms in conservative form,
+terms in conservative form::
 
     d/dx [ (1 - M^2) phi_x - (gamma + 1)/2 M^2 phi_x^2 + G phi_y^2 ]
         + d/dy [ phi_y + H phi_x phi_y ] + phi_zz = 0,

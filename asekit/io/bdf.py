@@ -20,7 +20,7 @@ written by kind (:data:`SUPPORT_CARDS`), its control surfaces as CAERO1 + CORD2R
 AESURF (:func:`_control_surface_cards`).
 
 Reader API (shared with :mod:`asekit.io.bdf_beam`)
--------------------------------------------------
+--------------------------------------------------
 The aerodynamic and solution readers are public so that the stick-model reader uses the same
 code: :func:`need_pynastran`, :class:`Deck` (one import's units and notes),
 :func:`read_aero_card` (AERO / AEROS), :func:`check_caero1` and :func:`deck_boxes` (CAERO1),
@@ -1366,13 +1366,15 @@ def read_aero_card(deck: Deck):
     BdfError
         No AERO / AEROS, SYMXY != 0, a rotated ACSID, or a field out of :data:`RANGES`.
 
-    +-------+-------+-------+--------+--------+-------+-------+
-    |   1   |   2   |   3   |   4    |   5    |   6   |   7   |
-    +=======+=======+=======+========+========+=======+=======+
-    | AERO  | ACSID | VELO  |  REFC  | RHOREF | SYMXZ | SYMXY |
-    +-------+-------+-------+--------+--------+-------+-------+
-    | AEROS | ACSID | RCSID |  REFC  |  REFB  | REFS  | SYMXZ | SYMXY |
-    +-------+-------+-------+--------+--------+-------+-------+
+    Card fields (MSC Quick Reference Guide)::
+
+        +-------+-------+-------+--------+--------+-------+-------+
+        |   1   |   2   |   3   |   4    |   5    |   6   |   7   |
+        +=======+=======+=======+========+========+=======+=======+
+        | AERO  | ACSID | VELO  |  REFC  | RHOREF | SYMXZ | SYMXY |
+        +-------+-------+-------+--------+--------+-------+-------+
+        | AEROS | ACSID | RCSID |  REFC  |  REFB  | REFS  | SYMXZ | SYMXY |
+        +-------+-------+-------+--------+--------+-------+-------+
     """
     model = deck.model
     aero = model.aero or model.aeros
@@ -1903,13 +1905,15 @@ def read_flutter(model, f, rho_ref, deck) -> FlutterRequest:
     BdfError
         Naming FLUTTER SID and the field (METHOD, DENS, MACH, RFREQ, IMETH, NVALUE, EPS).
 
-    +---------+-----+--------+------+------+-------+-------+-------+------+
-    |    1    |  2  |   3    |  4   |  5   |   6   |   7   |   8   |  9   |
-    +=========+=====+========+======+======+=======+=======+=======+======+
-    | FLUTTER | SID | METHOD | DENS | MACH | RFREQ | IMETH | NVALUE| EPS  |
-    +---------+-----+--------+------+------+-------+-------+-------+------+
-    | FLFACT  | SID |   F1   |  F2  |  F3  |  F4   |  F5   |  F6   |  F7  |
-    +---------+-----+--------+------+------+-------+-------+-------+------+
+    Card fields (MSC Quick Reference Guide)::
+
+        +---------+-----+--------+------+------+-------+-------+-------+------+
+        |    1    |  2  |   3    |  4   |  5   |   6   |   7   |   8   |  9   |
+        +=========+=====+========+======+======+=======+=======+=======+======+
+        | FLUTTER | SID | METHOD | DENS | MACH | RFREQ | IMETH | NVALUE| EPS  |
+        +---------+-----+--------+------+------+-------+-------+-------+------+
+        | FLFACT  | SID |   F1   |  F2  |  F3  |  F4   |  F5   |  F6   |  F7  |
+        +---------+-----+--------+------+------+-------+-------+-------+------+
 
     METHOD K / KE: RFREQ lists reduced frequencies k > 0; PK / PKNL: velocities (negative:
     print the eigenvectors at |V|). PKNL: DENS, MACH and VEL lists of equal length, one flight
