@@ -52,7 +52,7 @@ from asekit.io.bdf import (
     Deck,
     case_value,
     check_caero1,
-    deck_boxes,
+    deck_boxes_aero,
     need_pynastran,
     read_aero_card,
     read_flutter,
@@ -850,24 +850,50 @@ def beam_axis_spline(s_nodes, points_s, points_x, ex_flow: float, ey_flow: float
     return H, D
 
 
-def _check_spline2(s) -> None:
+def _check_spline2(s) -> bool:
+    """SPLINE2 USAGE BOTH; True when DZ / DTHX / DTHY ask for smoothing (> 0: attachment
+    flexibility), which :func:`_check_rigid_stations` then accepts only where it changes
+    nothing."""
+    smooth = False
     for name, v in (("DZ", s.dz), ("DTHX", s.dthx), ("DTHY", s.dthy)):
         if v not in (0, 0.0):
-            raise BdfError(f"SPLINE2 {s.eid}: {name} = {v!r} is not supported (0.0: attached, "
-                           f"no smoothing)")
+            if v is None or v < 0:
+                raise BdfError(f"SPLINE2 {s.eid}: {name} = {v!r} is not supported (>= 0.0)")
+            smooth = True
     if str(s.usage or "BOTH").upper() != "BOTH":
         raise BdfError(f"SPLINE2 {s.eid}: USAGE = {s.usage!r} is not supported (BOTH)")
+    return smooth
 
 
-def _spline2_station_matrix(model, s, sm: StickModel, L: float):
+def _check_rigid_stations(s, st: np.ndarray, q: np.ndarray) -> None:
+    """A smoothing SPLINE2 (DZ, DTHX or DTHY > 0) is accepted where its grids move rigidly in
+    every mode (w linear in s, theta_x = dw/ds and theta_y constant, to 1e-8): a beam spline
+    fits such data with no strain energy and no attachment force, so smoothing and
+    interpolating splines coincide (MSC Aeroelastic Analysis User's Guide, Sec. 2.3)."""
+    n = st.size
+    w, tx, ty = q[:n], q[n:2 * n], q[2 * n:]
+    span = max(float(np.ptp(st)), 1e-12)
+    A = np.c_[np.ones(n), st - st.mean()]
+    coef = np.linalg.lstsq(A, w, rcond=None)[0]
+    scale = np.abs(w).max(0) / span + np.abs(tx).max(0) + np.abs(ty).max(0) + 1e-300
+    err = np.max(np.r_[np.abs(A @ coef - w) / span, np.abs(tx - coef[1]), np.abs(ty - ty[:1])]
+                 / scale, axis=0)
+    if n < 2 or np.max(err) > 1e-8:
+        raise BdfError(f"SPLINE2 {s.eid}: DZ/DTHX/DTHY = {s.dz!r}/{s.dthx!r}/{s.dthy!r} "
+                       f"(smoothing) is supported only where the SETG grids move rigidly; "
+                       f"0.0 (attached) otherwise")
+
+
+def _spline2_station_matrix(model, s, sm: StickModel, L: float, aero=None):
     """(3 n_g, 6 n_nodes) map from the model's DOFs to the spline stations' (w, theta_x,
-    theta_y), the stations (sorted, m), the spline frame (rows e_x, e_y, e_z) and its origin."""
+    theta_y), the stations (sorted, m), the spline frame (rows e_x, e_y, e_z) and its origin;
+    ``aero`` the ACSID axes (rows, basic), whose z the spline's z must be along."""
     c = model.coords[s.cid] if s.cid else None
     axes = np.asarray(c.beta(), float) if c is not None else np.eye(3)
     origin = (np.asarray(c.origin, float) if c is not None else np.zeros(3)) * L
-    if abs(axes[2, 2]) < 1 - 1e-6:
+    if abs(axes[2] @ (np.eye(3) if aero is None else aero)[2]) < 1 - 1e-6:
         raise BdfError(f"SPLINE2 {s.eid}: CID = {s.cid}: the spline's z axis must be normal "
-                       f"to the boxes (basic z)")
+                       f"to the boxes (the z axis of AERO ACSID)")
     grids = [int(g) for g in model.sets[s.setg].ids]
     idx = [int(np.flatnonzero(sm.node_ids == g)[0]) for g in grids]
     st = (sm.xyz[idx] - origin) @ axes[1]
@@ -886,10 +912,17 @@ def _spline2_station_matrix(model, s, sm: StickModel, L: float):
     return S, st[order], axes, origin
 
 
-def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L: float):
+def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L: float,
+                      aero=None):
     """The modes on the boxes through the deck's SPLINE2 cards (each box on one spline):
-    :func:`beam_axis_spline` at the control points (h, dh/dx) and load points (h)."""
+    :func:`beam_axis_spline` at the control points (h, dh/dx) and load points (h).
+
+    ``aero`` (rows: the ACSID's axes in basic, :func:`asekit.io.bdf.aero_axes`; default basic)
+    is the frame of ``mesh``: a box point p_a is at basic p_a R, the flow X is R's first row
+    (so the spline axes' X components are e_x . R_x, e_y . R_x) and h, dh/dX are along R's z:
+    the spline's w (along its own z) times sign(e_z . R_z)."""
     from asekit.aero.spline import BoxModes
+    R = np.eye(3) if aero is None else np.asarray(aero, float)
     n_b, n_m = len(box_ids), modes.shapes.shape[1]
     h_cp, d_cp, h_lp = np.zeros((n_b, n_m)), np.zeros((n_b, n_m)), np.zeros((n_b, n_m))
     done = np.zeros(n_b, bool)
@@ -897,16 +930,20 @@ def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L
     for s in model.splines.values():
         if s.type != "SPLINE2":
             raise BdfError(f"{s.type} {s.eid}: a stick deck's splines must be SPLINE2")
-        _check_spline2(s)
+        smooth = _check_spline2(s)
         rows = [pos[b] for b in range(int(s.box1), int(s.box2) + 1) if b in pos]
-        S, st, axes, o = _spline2_station_matrix(model, s, sm, L)
+        S, st, axes, o = _spline2_station_matrix(model, s, sm, L, R)
         q = S @ modes.shapes
+        if smooth:
+            _check_rigid_stations(s, st, q)
+        sz = float(np.sign(axes[2] @ R[2]))
         for pts, out, dout in ((mesh.control_point, h_cp, d_cp), (mesh.load_point, h_lp, None)):
-            rel = pts[rows] - o
-            H, D = beam_axis_spline(st, rel @ axes[1], rel @ axes[0], axes[0, 0], axes[1, 0])
-            out[rows] = H @ q
+            rel = pts[rows] @ R - o
+            H, D = beam_axis_spline(st, rel @ axes[1], rel @ axes[0], axes[0] @ R[0],
+                                    axes[1] @ R[0])
+            out[rows] = sz * (H @ q)
             if dout is not None:
-                dout[rows] = D @ q
+                dout[rows] = sz * (D @ q)
         done[rows] = True
     if not done.all():
         raise BdfError(f"boxes {[int(b) for b in np.asarray(box_ids)[~done][:10]]} are on no "
@@ -994,16 +1031,16 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     deck = Deck(model, Path(path).name, L, Mu, T)
     if not model.caeros or not model.flutters:
         raise BdfError(f"{deck.name}: no CAERO1 or no FLUTTER card: nothing to run")
-    b_ref, rho_ref, symmetric = read_aero_card(deck)      # ACSID first: the flow axis
+    b_ref, rho_ref, symmetric = read_aero_card(deck, rotated_acsid=True)  # the flow axis
     for c in model.caeros.values():
         check_caero1(deck, c)
-    mesh, box_ids = deck_boxes(model, L, 0.0)
+    mesh, box_ids, aero = deck_boxes_aero(model, L)        # in ACSID's axes, nonplanar
     machs, table_ks = read_mkaero1(model, deck)
     requests = [read_flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
     fm = case_value(model, "FMETHOD")
     requests.sort(key=lambda r: r.sid != fm)
     modes = stick_modes(sm, requested_mode_count(model))
-    bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L)
+    bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L, aero)
     w = 2 * np.pi * modes.frequencies_hz
     modal = modal_arrays(M=np.eye(w.size), K=np.diag(w ** 2))
     ks = np.asarray(table_ks if ks is None else ks, float)

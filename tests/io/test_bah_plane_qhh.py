@@ -5,7 +5,7 @@ The deck's AERO ACSID = 2 puts the flow along basic -X (asekit's CAERO1 reader t
 along basic +X), so the test rotates the whole deck by 180 degrees about Y (GRID x, z and the
 CBAR vector's z negated, the two CORD2R rebuilt): the same physics with the flow along +X. The
 tail's boxes lie 0.5 m above the wing's plane: the test keeps them there (asekit's doublet
-lattice is nonplanar, Rodden, Giesing and Kalman 1971), which the deck reader still refuses.
+lattice is nonplanar, Rodden, Giesing and Kalman 1971), as the stick-deck reader now does.
 The tail's SPLINE2 DZ = 1.0 (smoothing) is set to 0: its grids move rigidly (RBAR chain from
 grid 1), which any beam spline interpolates exactly.
 
@@ -119,11 +119,16 @@ def test_bah_plane_gaf_matches_nastran_qhh(tmp_path):
         np.testing.assert_allclose(np.diag(a)[el].real, np.diag(n)[el].real, rtol=0.03)
 
 
-def test_flow_along_minus_x_is_refused():
-    """The deck as shipped (AERO ACSID 2: flow along basic -X) is refused in one line naming
-    the card and field, instead of read with the flow along +X (wing and tail reversed)."""
-    from asekit.io.bdf_beam import stick_flutter
+def test_flow_along_minus_x_is_refused_by_the_plate_reader():
+    """The deck as shipped (AERO ACSID 2: flow along basic -X) is read by the stick-deck path
+    (boxes in the ACSID's axes: tests/io/test_bah_acsid.py) but the plate (CQUAD4) path, whose
+    surface spline works in basic x-y, still refuses it in one line naming the card and field
+    instead of reading it with the flow along +X (wing and tail reversed)."""
+    model = need_pynastran()(debug=None)
+    model.read_bdf(str(BAH / "bah_plane_qhh.bdf"), xref=True)
+    deck = B.Deck(model, "bah_plane_qhh.bdf", 1.0, 1.0, 1.0)
     with pytest.raises(B.BdfError, match=r"AERO ACSID = 2: its x axis \(the flow\) is "
                                          r"\(-1\.0, 0\.0, 0\.0\)") as err:
-        stick_flutter(BAH / "bah_plane_qhh.bdf")
+        B.read_aero_card(deck)
     assert "\n" not in str(err.value)
+    assert B.read_aero_card(deck, rotated_acsid=True) == (2.0, 1.225, True)
