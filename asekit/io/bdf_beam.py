@@ -40,7 +40,7 @@ cards are read elsewhere (:mod:`asekit.io.bdf`); here they are ignored.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -953,21 +953,47 @@ def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L
 
 def requested_mode_count(model) -> int:
     """The number of modes a stick deck asks for: PARAM LMODES (> 0), else the ND of its
-    first EIGR / EIGRL, else 6.
+    first EIGR / EIGRL, else 6; never more than that ND when both are given.
+
+    Nastran fills the LMODES modes beyond the ND eigenvectors with residual vectors (PARAM
+    RESVEC, on by default in SOL 145: pyNastran's bah_plane_qhh.f06, "REAL EIGENVALUES (AFTER
+    AUGMENTATION OF RESIDUAL VECTORS)", 8 eigenvectors + 2 of 4 residual vectors at 41.2 and
+    56.6 Hz for LMODES 10). asekit computes no residual vectors; taking further eigenvectors
+    instead (24.3 and 32.1 Hz there) would be neither Nastran's basis nor the deck's ND, so
+    the ND eigenvectors are used (:func:`residual_vector_note` says so).
 
     Examples
     --------
     >>> from types import SimpleNamespace as NS
     >>> requested_mode_count(NS(params={}, methods={10: NS(nd=4)}))
     4
+    >>> requested_mode_count(NS(params={"LMODES": NS(values=[10])}, methods={1: NS(nd=8)}))
+    8
     """
+    nd = next((int(m.nd) for m in model.methods.values() if getattr(m, "nd", None)), None)
     p = model.params.get("LMODES")
     if p is not None and int(p.values[0]) > 0:
-        return int(p.values[0])
-    for m in model.methods.values():
-        if getattr(m, "nd", None):
-            return int(m.nd)
-    return 6
+        return int(p.values[0]) if nd is None else min(int(p.values[0]), nd)
+    return 6 if nd is None else nd
+
+
+def residual_vector_note(model) -> str | None:
+    """The note for a deck whose PARAM LMODES exceeds its EIGR / EIGRL ND (Nastran's residual
+    vectors fill the difference; asekit uses the ND eigenvectors only), else None.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> residual_vector_note(NS(params={"LMODES": NS(values=[10])}, methods={1: NS(nd=8)}))[:31]
+    'PARAM LMODES 10 > EIGR/EIGRL ND'
+    """
+    p = model.params.get("LMODES")
+    n = requested_mode_count(model)
+    if p is None or int(p.values[0]) <= n:
+        return None
+    return (f"PARAM LMODES {int(p.values[0])} > EIGR/EIGRL ND {n}: Nastran adds "
+            f"{int(p.values[0]) - n} residual vectors (RESVEC); asekit computes none and uses "
+            f"the {n} eigenvectors")
 
 
 @dataclass(frozen=True)
@@ -1040,6 +1066,9 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     fm = case_value(model, "FMETHOD")
     requests.sort(key=lambda r: r.sid != fm)
     modes = stick_modes(sm, requested_mode_count(model))
+    note = residual_vector_note(model)
+    if note:
+        modes = replace(modes, notes=modes.notes + (note,))
     bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L, aero)
     w = 2 * np.pi * modes.frequencies_hz
     modal = modal_arrays(M=np.eye(w.size), K=np.diag(w ** 2))
