@@ -504,8 +504,15 @@ def _lerp(a, b, t):
     return float(a + t * (b - a))
 
 
+#: |g| at or below this is neutral, not unstable: a mode with no aerodynamic force (e.g. an
+#: in-plane mode of a wing: g = +-1e-16 at every velocity, in Nastran's f06 as in asekit)
+#: must not "cross" at every sign change of round-off.
+G_NEUTRAL = 1e-9
+
+
 def _column_crossings(res: NastranFlutterResult, j: int) -> list[NastranCrossing]:
     g, V, f = res.damping_g[:, j], res.velocity[:, j], res.frequency_hz[:, j]
+    g = np.where(np.abs(g) <= G_NEUTRAL, 0.0, g)
     ok = np.isfinite(g) & np.isfinite(V)
     idx = np.flatnonzero(ok)
     out = []
