@@ -145,3 +145,25 @@ def test_mach_0_real_roots_and_instability(run):
     assert t[(0.0, 4)][0, 3] > 0 and g[0, 3] > 0          # 2.3 Hz: unstable at 4774 m/s
     first = {c.mode for c in run.results[0].crossings if c.unstable_at_first_point}
     assert {0, 1, 2, 3} <= first
+
+
+def test_analyse_json_of_the_deck(run, tmp_path, monkeypatch, capsys):
+    """``asekit analyse bah_plane_qhh.bdf --json``: the residual-vector note, one flutter row
+    per crossing (Mach 0.2: the point-4 crossing near 395 m/s, no row for the in-plane point 5)
+    and the printed FLUTTER SUMMARY with Nastran's real-root damping. The module's run is
+    reused (the deck is solved once per test module)."""
+    import json
+
+    import asekit.io.bdf_beam as bb
+    from asekit.cli.main import main
+    monkeypatch.setattr(bb, "stick_flutter", lambda *a, **k: run)
+    out = tmp_path / "bah.json"
+    assert main(["analyse", str(BAH / "bah_plane_qhh.bdf"), "--quiet", "--json",
+                 str(out)]) == 0
+    s = json.loads(out.read_text())
+    assert any("residual vectors" in n for n in s["notes"])
+    rows = [r for r in s["flutter"] if r["sid"] == 502 and not r["unstable_at_first_point"]]
+    assert len(rows) == 1 and rows[0]["mode"] == 4
+    assert abs(rows[0]["speed_ms"] / 394.03 - 1) < 0.01
+    text = capsys.readouterr().out
+    assert "note: PARAM LMODES 10" in text and "FLUTTER SUMMARY" in text
