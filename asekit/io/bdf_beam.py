@@ -779,6 +779,93 @@ def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
                       shapes=full)
 
 
+def _rigid_body_vectors(model: StickModel) -> np.ndarray:
+    """(6 n, 6): unit rigid-body motions of every grid (translations along basic x, y, z and
+    rotations about basic x, y, z through the origin), in each grid's CD components."""
+    U = np.zeros((model.K.shape[0], 6))
+    for i, (r, R) in enumerate(zip(model.xyz, model.cd_axes)):
+        for d in range(6):
+            t, rot = np.zeros(3), np.zeros(3)
+            if d < 3:
+                t[d] = 1.0
+            else:
+                rot[d - 3] = 1.0
+                t = np.cross(rot, r)
+            U[NODE_DOF * i:NODE_DOF * i + 3, d] = R @ t
+            U[NODE_DOF * i + 3:NODE_DOF * i + 6, d] = R @ rot
+    return U
+
+
+def residual_vector_modes(model: StickModel, modes: StickModes, n_total: int) -> StickModes:
+    """The modal basis augmented to ``n_total`` modes by residual vectors for inertia-relief
+    loads (MSC Nastran case control RESVEC, INRLOD; the basis a SOL 145 deck gets when PARAM
+    LMODES exceeds the EIGR / EIGRL ND).
+
+    Loads: the inertia of the six rigid-body accelerations, f_d = M u_d (u_d a unit
+    translation or rotation of the whole model), with inertia relief against the free
+    rigid-body modes phi_r (f <- f - M phi_r phi_r^T f, so that K u = f is consistent). Static
+    responses u_d (solved with K + M phi_r phi_r^T M, nonsingular and equal to K on them) are
+    made M-orthogonal to the eigenvectors; the Rayleigh-Ritz eigenproblem on their span gives
+    the augmented modes, lowest first (MSC Nastran Dynamic Analysis User's Guide, residual
+    vectors). On pyNastran's bah_plane_qhh deck (8 eigenvectors, grid 1 free in plunge and
+    pitch) this gives the f06's "AFTER AUGMENTATION OF RESIDUAL VECTORS" 41.22899, 56.55734,
+    120.5794, 180.3152 Hz to 1e-6.
+
+    Parameters
+    ----------
+    model : :class:`StickModel`; modes : its eigenvectors (:func:`stick_modes`);
+    n_total : modes wanted (LMODES); at most len(modes) + the independent residual vectors.
+
+    Returns
+    -------
+    StickModes, the eigenvectors followed by the residual-vector modes (mass-normalised).
+
+    Examples
+    --------
+    A clamped two-bar cantilever (E I = m = L = 1), one eigenvector plus one residual vector:
+    the augmented frequency lies above the first and no higher than the exact second mode.
+
+    >>> from asekit.structure.frame import BarSection, global_bar_matrices
+    >>> sec = BarSection(1e6, 1.0, 1.0, 1.0, 1.0)
+    >>> K, M = np.zeros((18, 18)), np.zeros((18, 18))
+    >>> for a, b in ((0, 1), (1, 2)):
+    ...     k, m = global_bar_matrices([0.5 * a, 0, 0], [0.5 * b, 0, 0], [0, 0, 1], sec)
+    ...     ix = np.r_[6 * a:6 * a + 6, 6 * b:6 * b + 6]
+    ...     K[np.ix_(ix, ix)] += k
+    ...     M[np.ix_(ix, ix)] += m
+    >>> sm = StickModel(np.array([1, 2, 3]), np.array([[0, 0, 0], [.5, 0, 0], [1, 0, 0]]),
+    ...                 np.array([np.eye(3)] * 3), K, M, tuple(range(6)), True)
+    >>> m1, m2 = stick_modes(sm, 1), stick_modes(sm, 2)
+    >>> f = residual_vector_modes(sm, m1, 2).frequencies_hz
+    >>> bool(f[0] == m1.frequencies_hz[0] and f[1] >= m2.frequencies_hz[1] * (1 - 1e-9))
+    True
+    """
+    n_eig = modes.shapes.shape[1]
+    if n_total <= n_eig:
+        return modes
+    free, Tr = model.free, model.reduction()
+    K, M = Tr.T @ model.K @ Tr, Tr.T @ model.M @ Tr
+    phi = modes.shapes[free]
+    f_hz = modes.frequencies_hz
+    rigid = phi[:, f_hz <= 1e-5 * max(float(f_hz.max()), 1e-300)]
+    F = Tr.T @ (model.M @ _rigid_body_vectors(model))
+    F = F - M @ rigid @ (rigid.T @ F)
+    U = np.linalg.solve(K + M @ rigid @ rigid.T @ M, F)
+    U = U - phi @ (phi.T @ M @ U)
+    w, Q = np.linalg.eigh(U.T @ M @ U)
+    ok = w > 1e-10 * max(float(w.max()), 1e-300)
+    if not ok.any():
+        return modes
+    V = U @ (Q[:, ok] / np.sqrt(w[ok]))
+    lam, X = sla.eigh(V.T @ K @ V, V.T @ M @ V)
+    n_add = min(n_total - n_eig, lam.size)
+    R = V @ X[:, :n_add]
+    R = R / np.sqrt(np.einsum("ij,ik,kj->j", R, M, R))
+    return replace(modes, frequencies_hz=np.r_[f_hz, np.sqrt(np.clip(lam[:n_add], 0.0, None))
+                                                / (2 * np.pi)],
+                   shapes=np.c_[modes.shapes, Tr @ R])
+
+
 # ---------------------------------------------------------------------------------------------
 # SPLINE2 (beam spline) and the deck's flutter requests
 # ---------------------------------------------------------------------------------------------
@@ -952,15 +1039,15 @@ def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L
 
 
 def requested_mode_count(model) -> int:
-    """The number of modes a stick deck asks for: PARAM LMODES (> 0), else the ND of its
+    """The number of eigenvectors a stick deck asks for: PARAM LMODES (> 0), else the ND of its
     first EIGR / EIGRL, else 6; never more than that ND when both are given.
 
-    Nastran fills the LMODES modes beyond the ND eigenvectors with residual vectors (PARAM
-    RESVEC, on by default in SOL 145: pyNastran's bah_plane_qhh.f06, "REAL EIGENVALUES (AFTER
-    AUGMENTATION OF RESIDUAL VECTORS)", 8 eigenvectors + 2 of 4 residual vectors at 41.2 and
-    56.6 Hz for LMODES 10). asekit computes no residual vectors; taking further eigenvectors
-    instead (24.3 and 32.1 Hz there) would be neither Nastran's basis nor the deck's ND, so
-    the ND eigenvectors are used (:func:`residual_vector_note` says so).
+    Nastran fills the LMODES modes beyond the ND eigenvectors with residual vectors (case
+    control RESVEC, on by default in SOL 145: pyNastran's bah_plane_qhh.f06, "REAL EIGENVALUES
+    (AFTER AUGMENTATION OF RESIDUAL VECTORS)", 8 eigenvectors + 4 residual vectors, of which
+    LMODES 10 keeps 2, at 41.23 and 56.56 Hz); :func:`stick_flutter` adds them with
+    :func:`residual_vector_modes` (:func:`lmodes_beyond_nd`). Taking further eigenvectors
+    instead (24.3 and 32.1 Hz there) would be neither Nastran's basis nor the deck's ND.
 
     Examples
     --------
@@ -977,23 +1064,39 @@ def requested_mode_count(model) -> int:
     return 6 if nd is None else nd
 
 
-def residual_vector_note(model) -> str | None:
-    """The note for a deck whose PARAM LMODES exceeds its EIGR / EIGRL ND (Nastran's residual
-    vectors fill the difference; asekit uses the ND eigenvectors only), else None.
+def _resvec_off(model) -> bool:
+    """Case control RESVEC = NO (or NOINRL: no inertia-relief residual vectors)."""
+    cc = getattr(model, "case_control_deck", None)
+    for sc in ([] if cc is None else [cc.subcases.get(1), cc.subcases.get(0)]):
+        try:
+            value, options = sc.get_parameter("RESVEC")[:2]
+        except (AttributeError, KeyError):          # no subcase, or no RESVEC in it
+            continue
+        words = " ".join(str(x) for x in [value, *(options or [])]).upper()
+        return bool(set(words.replace(",", " ").replace("(", " ").replace(")", " ").split())
+                    & {"NO", "NOINRL"})
+    return False
+
+
+def lmodes_beyond_nd(model) -> tuple[int, str | None]:
+    """(LMODES, note) when a deck's PARAM LMODES exceeds its EIGR / EIGRL ND and residual
+    vectors are not switched off (RESVEC = NO / NOINRL), else (the eigenvector count, None).
 
     Examples
     --------
     >>> from types import SimpleNamespace as NS
-    >>> residual_vector_note(NS(params={"LMODES": NS(values=[10])}, methods={1: NS(nd=8)}))[:31]
-    'PARAM LMODES 10 > EIGR/EIGRL ND'
+    >>> n, note = lmodes_beyond_nd(NS(params={"LMODES": NS(values=[10])}, methods={1: NS(nd=8)},
+    ...                                case_control_deck=None))
+    >>> n, note[:31]
+    (10, 'PARAM LMODES 10 > EIGR/EIGRL ND')
     """
     p = model.params.get("LMODES")
     n = requested_mode_count(model)
-    if p is None or int(p.values[0]) <= n:
-        return None
-    return (f"PARAM LMODES {int(p.values[0])} > EIGR/EIGRL ND {n}: Nastran adds "
-            f"{int(p.values[0]) - n} residual vectors (RESVEC); asekit computes none and uses "
-            f"the {n} eigenvectors")
+    if p is None or int(p.values[0]) <= n or _resvec_off(model):
+        return n, None
+    lm = int(p.values[0])
+    return lm, (f"PARAM LMODES {lm} > EIGR/EIGRL ND {n}: modes {n + 1}-{lm} are residual vectors "
+                f"for inertia-relief loads (Nastran's RESVEC default, INRLOD)")
 
 
 @dataclass(frozen=True)
@@ -1066,8 +1169,9 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     fm = case_value(model, "FMETHOD")
     requests.sort(key=lambda r: r.sid != fm)
     modes = stick_modes(sm, requested_mode_count(model))
-    note = residual_vector_note(model)
+    n_lmodes, note = lmodes_beyond_nd(model)
     if note:
+        modes = residual_vector_modes(sm, modes, n_lmodes)
         modes = replace(modes, notes=modes.notes + (note,))
     bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L, aero)
     w = 2 * np.pi * modes.frequencies_hz
