@@ -313,36 +313,51 @@ def _taken(lam: np.ndarray, taken: list) -> np.ndarray:
     return np.any(np.abs(lam[:, None] - t[None, :]) <= 1e-3 * scale, axis=1)
 
 
-def _by_frequency(lam: np.ndarray, rank: int) -> int:
-    """Nastran's choice at a cold start: the ``rank``-th root in frequency order, the real
-    roots (zero frequency) counted as one slot (their least stable root)."""
-    real = np.abs(lam.imag) <= 1e-9 * np.maximum(np.abs(lam), 1.0)
-    osc = np.flatnonzero(~real)
-    slots = list(osc[np.argsort(np.abs(lam.imag[osc]))])
-    if real.any():
-        r = np.flatnonzero(real)
-        slots.insert(0, int(r[np.argmax(lam.real[r])]))
-    return int(slots[min(rank, len(slots) - 1)])
-
-
-def _pk_mode(m, gaf, rho, V, k0, ref, interpolation, eps, taken=(), rank=None):
+def _pk_mode(m, gaf, rho, V, k0, ref, interpolation, eps, taken=()):
     """Nastran's k iteration for one mode: (p, vector, k, converged). The root: the one whose
-    eigenvector correlates best with ``ref`` (the mode's vector at the previous point), or,
-    with ``rank`` (the first point), the ``rank``-th in frequency order as Nastran sorts them;
-    roots in ``taken`` (claimed by the modes solved before at this point) are not chosen
-    again."""
+    eigenvector correlates best with ``ref`` (the mode's vector at the previous point, or at
+    the first point its root at k = 0, :func:`_cold_start`); roots in ``taken`` (claimed by
+    the modes solved before at this point) are not chosen again."""
     b, k = gaf.b_ref, k0
     for _ in range(MAX_K_ITER):
         lam, vec = _pk_roots(m, gaf, rho, V, k, interpolation)
         score = mac_matrix(ref[:, None], vec)[0]
         score = score - 0.05 * np.abs(np.abs(lam.imag) * b / V - k) / max(k, 1e-3)
         score = score - 10.0 * _taken(lam, list(taken))
-        j = int(np.argmax(score)) if rank is None else _by_frequency(lam, rank)
+        j = int(np.argmax(score))
         k_new = abs(lam[j].imag) * b / V
         if abs(k_new - k) < eps * max(1.0, k):
             return lam[j], vec[:, j], k_new, True
         k = k_new
     return lam[j], vec[:, j], k_new, False
+
+
+#: a root |p| below this fraction of the largest is a free rigid body's zero root (plunge of
+#: a free-free model: no aerodynamic stiffness), which Nastran does not print.
+ZERO_ROOT = 1e-8
+
+
+def _cold_start(m, gaf, rho, V, interpolation):
+    """The first point's start (Nastran's order in an f06 FLUTTER SUMMARY, e.g. pyNastran's
+    bah_plane_qhh.f06): the roots of Eq. 2-124 at k = 0, zero roots dropped; the real ones
+    first (ascending), converged at k = 0 as they are; then the oscillatory ones by frequency,
+    each the reference (vector and k = |Im p| b / V) from which its mode's k iteration starts.
+    Real roots come in pairs that take the place of a conjugate pair (a divergent and a
+    convergent aperiodic root); as of a conjugate pair one root is kept: the larger half of
+    them (the f06 lists the three positive of asekit's six real roots of BAH at Mach 0,
+    4774 m/s). Returns (k0, references, n_real, roots in that order)."""
+    lam, vec = _pk_roots(m, gaf, rho, V, 0.0, interpolation)
+    scale = max(float(np.abs(lam).max(initial=0.0)), 1e-300)
+    keep = np.abs(lam) > ZERO_ROOT * scale
+    real = keep & (np.abs(lam.imag) <= 1e-9 * np.maximum(np.abs(lam), 1.0))
+    r = np.flatnonzero(real)
+    r = r[np.argsort(lam.real[r])][r.size // 2:]
+    osc = np.flatnonzero(keep & ~real)
+    order = np.r_[r, osc[np.argsort(np.abs(lam.imag[osc]))]].astype(int)
+    n = m.n_modes
+    order = np.r_[order, np.flatnonzero(~keep)][:n]      # too few roots: zero roots last
+    return (np.abs(lam.imag[order]) * gaf.b_ref / V, vec[:, order].T, min(r.size, n),
+            lam[order])
 
 
 def _pk_point(m, gaf, rho, V, k_prev, v_prev, interpolation, eps, cold=False):
@@ -351,10 +366,14 @@ def _pk_point(m, gaf, rho, V, k_prev, v_prev, interpolation, eps, cold=False):
     vec = np.empty((n, n), complex)
     k = np.empty(n)
     conv = np.empty(n, bool)
-    for j in range(n):
+    n_real = 0
+    if cold:
+        k_prev, v_prev, n_real, lam0 = _cold_start(m, gaf, rho, V, interpolation)
+        p[:n_real], vec[:n_real], k[:n_real], conv[:n_real] = (lam0[:n_real],
+                                                               v_prev[:n_real], 0.0, True)
+    for j in range(n_real, n):
         p[j], vec[j], k[j], conv[j] = _pk_mode(m, gaf, rho, V, k_prev[j], v_prev[j],
-                                               interpolation, eps, p[:j],
-                                               rank=j if cold else None)
+                                               interpolation, eps, p[:j])
     return p, vec, k, conv
 
 
@@ -366,16 +385,11 @@ def _pk_sweep(m, gaf_of, points, interpolation, eps, method):
     X = np.empty((n_pt, n, n), complex)
     Kr = np.empty((n_pt, n))
     C = np.empty((n_pt, n), bool)
-    v_prev = np.eye(n, dtype=complex)
-    omega0 = _structural_omegas(m)
-    k_prev = None
+    v_prev = k_prev = None                      # the first point starts cold (_cold_start)
     for i, (rho, mach, V) in enumerate(points):
         gaf = gaf_of(mach)
-        cold = k_prev is None
-        if cold:
-            k_prev = omega0 * gaf.b_ref / V
         P[i], X[i], Kr[i], C[i] = _pk_point(m, gaf, rho, V, k_prev, v_prev, interpolation, eps,
-                                            cold)
+                                            cold=k_prev is None)
         k_prev, v_prev = Kr[i], X[i]
     dens = np.array([p[0] for p in points], float)
     machs = np.array([np.nan if p[1] is None else p[1] for p in points], float)
@@ -490,8 +504,15 @@ def _lerp(a, b, t):
     return float(a + t * (b - a))
 
 
+#: |g| at or below this is neutral, not unstable: a mode with no aerodynamic force (e.g. an
+#: in-plane mode of a wing: g = +-1e-16 at every velocity, in Nastran's f06 as in asekit)
+#: must not "cross" at every sign change of round-off.
+G_NEUTRAL = 1e-9
+
+
 def _column_crossings(res: NastranFlutterResult, j: int) -> list[NastranCrossing]:
     g, V, f = res.damping_g[:, j], res.velocity[:, j], res.frequency_hz[:, j]
+    g = np.where(np.abs(g) <= G_NEUTRAL, 0.0, g)
     ok = np.isfinite(g) & np.isfinite(V)
     idx = np.flatnonzero(ok)
     out = []
@@ -531,12 +552,45 @@ def crossings(res: NastranFlutterResult) -> list[NastranCrossing]:
     return sorted(out, key=lambda c: c.speed)
 
 
+def f06_damping(p, velocity, b_ref) -> np.ndarray:
+    """The DAMPING column of Nastran's PK / PKNL FLUTTER SUMMARY for roots p (1/s) at
+    velocity V: g = 2 Re p / |Im p| for an oscillatory root (MSC Aeroelastic User's Guide Eq.
+    2-124, p = omega (gamma + i), g = 2 gamma; not clipped), and for a real root (printed with
+    frequency 0) g = 2 b p / (V ln 2), b the reference semichord: the f06 of pyNastran's
+    bah_plane_qhh deck satisfies this in all its 102 real-root rows to 1.1e-5 (ln 2 printed as
+    0.69314), i.e. 1 / g is the number of reference chords flown while the root's amplitude
+    halves (p < 0) or doubles (p > 0).
+
+    Parameters
+    ----------
+    p : complex roots (1/s), any shape; velocity : V (m/s), broadcast with p;
+    b_ref : reference semichord (m).
+
+    Returns
+    -------
+    g, the shape of p.
+
+    Examples
+    --------
+    >>> f06_damping([-2.0 + 40.0j, 0.5 + 0j], 10.0, 2.0).round(6).tolist()
+    [-0.1, 0.288539]
+    """
+    p = np.asarray(p, complex)
+    V = np.broadcast_to(np.asarray(velocity, float), p.shape)
+    real = np.abs(p.imag) <= 1e-9 * np.maximum(np.abs(p), 1.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(real, 2 * b_ref * p.real / (V * np.log(2.0)),
+                        2 * p.real / np.where(real, 1.0, np.abs(p.imag)))
+
+
 def _summary_row(res, i, j) -> str:
     k = res.k[i, j]
     inv = 1.0 / k if k > 0 else np.inf
     lam = res.eigenvalue[i, j]
+    g = (f06_damping(lam, res.velocity[i, j], res.b_ref) if res.method in ("PK", "PKNL")
+         else res.damping_g[i, j])
     return (f"{k:10.4f} {inv:12.4E} {res.density[i]:11.4E} {res.mach[i]:7.4f} "
-            f"{res.velocity[i, j]:12.4E} {res.damping_g[i, j]:12.4E} "
+            f"{res.velocity[i, j]:12.4E} {g:12.4E} "
             f"{res.frequency_hz[i, j]:12.4E} {lam.real:12.4E} {lam.imag:12.4E}")
 
 
@@ -560,8 +614,9 @@ def flutter_summary(res: NastranFlutterResult, nvalue: int | None = None,
                     velocity_unit: str = "m/s") -> str:
     """Nastran's FLUTTER SUMMARY as text: one block per mode (``POINT = j``, the first
     ``nvalue`` modes, Nastran's NVALUE), one row per point: KFREQ, 1./KFREQ, DENSITY, MACH,
-    VELOCITY, DAMPING (g), FREQUENCY (Hz), the complex eigenvalue (PK: p; K: lambda); then
-    the eigenvectors of the points whose FLFACT velocity was negative.
+    VELOCITY, DAMPING (g; PK / PKNL as Nastran prints it, :func:`f06_damping`), FREQUENCY
+    (Hz), the complex eigenvalue (PK: p; K: lambda); then the eigenvectors of the points whose
+    FLFACT velocity was negative.
 
     Examples
     --------

@@ -88,8 +88,10 @@ def _run_stick(args, path) -> int:
     except ValueError as exc:
         return _error(_named(path.name, exc))
     f = [float(x) for x in run.modes.frequencies_hz]
-    s = {"deck": str(path), "modes_hz": f, "flutter": bdf.flutter_rows(list(run.results))}
+    s = {"deck": str(path), "modes_hz": f, "flutter": bdf.flutter_rows(list(run.results)),
+         "notes": list(run.modes.notes)}
     text = (f"{path.name}: stick model, modes (Hz) " + ", ".join(f"{x:.4g}" for x in f)
+            + "".join(f"\nnote: {n}" for n in run.modes.notes)
             + "\n\n" + bdf.format_flutter_summary(list(run.results)))
     _write_outputs(args, s, text, write_text_atomic)
     return 0

@@ -24,6 +24,7 @@ Reader API (shared with :mod:`asekit.io.bdf_beam`)
 The aerodynamic and solution readers are public so that the stick-model reader uses the same
 code: :func:`need_pynastran`, :class:`Deck` (one import's units and notes),
 :func:`read_aero_card` (AERO / AEROS), :func:`check_caero1` and :func:`deck_boxes` (CAERO1),
+:func:`aero_axes` and :func:`deck_boxes_aero` (boxes in a rotated ACSID, stick decks),
 :func:`read_mkaero1`, :func:`read_flutter` (FLUTTER + FLFACT), :func:`case_value` (case
 control) and :func:`solve_request` (one FLUTTER card with its own method).
 
@@ -1332,28 +1333,68 @@ def _read_tabdmp1(model, deck: Deck):
     return tuple((float(f) / deck.T, float(v)) for f, v in zip(tab.x, g))
 
 
-def _check_acsid(model, card: str, aero) -> None:
+def _check_acsid(model, card: str, aero, rotated: bool = False) -> None:
     """AERO / AEROS ACSID: the aerodynamic system's x axis is the flow direction (MSC QRG,
-    AERO); asekit's CAERO1 boxes take the flow along basic +X and the normal along basic Z, so
-    an ACSID whose axes are not basic's (e.g. flow along -X) is refused, not misread."""
+    AERO). It must be rectangular (CORD1R / CORD2R). A plate deck's CAERO1 boxes take the flow
+    along basic +X and the normal along basic Z, so there (``rotated`` False) an ACSID whose
+    axes are not basic's (e.g. flow along -X) is refused, not misread; a stick deck builds its
+    boxes in the ACSID's axes (:func:`aero_axes`, ``rotated`` True)."""
     acsid = int(getattr(aero, "acsid", 0) or 0)
     if acsid == 0:
         return
-    axes = np.asarray(model.coords[acsid].beta(), float)
-    if not np.allclose(axes, np.eye(3), atol=1e-9):
+    coord = model.coords.get(acsid)
+    if coord is None or coord.type not in ("CORD1R", "CORD2R"):
+        kind = "undefined" if coord is None else coord.type
+        raise BdfError(f"{card} ACSID = {acsid}: a {kind} system; the aerodynamic system must "
+                       f"be rectangular (CORD1R / CORD2R)")
+    axes = np.asarray(coord.beta(), float)
+    if not rotated and not np.allclose(axes, np.eye(3), atol=1e-9):
         raise BdfError(f"{card} ACSID = {acsid}: its x axis (the flow) is "
                        f"{tuple(np.round(axes[0], 6).tolist())} and z axis "
                        f"{tuple(np.round(axes[2], 6).tolist())} in basic; asekit takes the flow "
-                       f"along basic +X and z up (ACSID 0 or a system with basic's axes)")
+                       f"along basic +X and z up in a plate (CQUAD4) deck (ACSID 0 or a system "
+                       f"with basic's axes; a CBAR stick deck may rotate it)")
 
 
-def read_aero_card(deck: Deck):
+def aero_axes(model) -> np.ndarray:
+    """The axes of AERO / AEROS ACSID in basic (rows: the flow direction x, y, the normal z).
+
+    MSC Nastran Quick Reference Guide, AERO / AEROS field ACSID: the aerodynamic coordinate
+    system, whose x axis is the flow; CAERO1 chords X12, X43 lie along it. A point of basic
+    coordinates p has aerodynamic (rotated, same origin) coordinates R p, R this matrix.
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF``, cross-referenced.
+
+    Returns
+    -------
+    R : (3, 3) orthonormal, identity for ACSID 0 or no AERO / AEROS card.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> aero_axes(NS(aero=NS(acsid=0), aeros=None)).tolist()[0]
+    [1.0, 0.0, 0.0]
+    """
+    aero = model.aero or model.aeros
+    acsid = int(getattr(aero, "acsid", 0) or 0) if aero is not None else 0
+    if acsid == 0:
+        return np.eye(3)
+    _check_acsid(model, "AERO" if model.aero is not None else "AEROS", aero, rotated=True)
+    return np.asarray(model.coords[acsid].beta(), float)
+
+
+def read_aero_card(deck: Deck, rotated_acsid: bool = False):
     """AERO / AEROS: the reference semichord, reference density and symmetry (public reader
-    API); SYMXY (ground effect) and an ACSID whose axes are not basic's refused.
+    API); SYMXY (ground effect) and a non-rectangular ACSID refused, and an ACSID whose axes
+    are not basic's unless ``rotated_acsid`` (the caller then builds its boxes in
+    :func:`aero_axes`).
 
     Parameters
     ----------
     deck : :class:`Deck`
+    rotated_acsid : bool, accept a rectangular ACSID whose axes are not basic's.
 
     Returns
     -------
@@ -1383,7 +1424,7 @@ def read_aero_card(deck: Deck):
     if int(getattr(aero, "sym_xy", 0) or 0) != 0:
         raise BdfError("SYMXY (ground effect) is not supported")
     card = "AERO" if model.aero is not None else "AEROS"
-    _check_acsid(model, card, aero)
+    _check_acsid(model, card, aero, rotated_acsid)
     rho_ref = (_check_range(deck, "AERO RHOREF", model.aero.rho_ref, "fluid density")
                if model.aero is not None else None)
     refc = _check_range(deck, f"{card} REFC", aero.cref, "length")
@@ -1515,9 +1556,11 @@ def _divisions(caero, n, aefact, name):
     return f
 
 
-def _caero1_boxes(c, L):
+def _caero1_boxes(c, L, axes=None):
     """One CAERO1 (with PAERO1) as box corners (n, 4, 3) m and Nastran box ids, ordered
-    spanwise from the root (the box ids run chordwise first from P1).
+    spanwise from the root (the box ids run chordwise first from P1). With ``axes`` (the
+    ACSID's, :func:`aero_axes`) the corners are in the aerodynamic system's axes (x the flow,
+    chords along it); without, in basic (chords along basic x).
 
     +--------+-----+-----+----+-------+--------+--------+--------+------+
     |   1    |  2  |  3  | 4  |   5   |   6    |   7    |   8    |  9   |
@@ -1528,6 +1571,8 @@ def _caero1_boxes(c, L):
     +--------+-----+-----+----+-------+--------+--------+--------+------+
     """
     p1, _, _, p4 = (np.asarray(p, float) for p in c.get_points())
+    if axes is not None:
+        p1, p4 = axes @ p1, axes @ p4
     eta = _divisions(c, c.nspan, c.lspan_ref if c.lspan else None, "SPAN")
     xi = _divisions(c, c.nchord, c.lchord_ref if c.lchord else None, "CHORD")
     flip = p4[1] < p1[1]
@@ -1624,6 +1669,58 @@ def deck_boxes(model, L, z0):
     c[:, :, 2] = 0.0                                 # the structural plane is z = 0 in asekit
     return BoxMesh(c, np.concatenate(strip), np.concatenate(surface), tuple(names)), \
         np.concatenate(ids)
+
+
+def deck_boxes_aero(model, L):
+    """Every CAERO1 of a deck as one :class:`BoxMesh` in the axes of AERO / AEROS ACSID
+    (public reader API; the stick-deck path, whose beam splines carry the surfaces' heights).
+
+    The doublet lattice (Albano and Rodden 1969; nonplanar, Rodden, Giesing and Kalman 1971)
+    is solved in the aerodynamic system (MSC Nastran Aeroelastic Analysis User's Guide, Sec.
+    2.2: x the flow, CAERO1 chords along x): the corners are R p, R = :func:`aero_axes`, so a
+    deck whose ACSID points the flow along basic -X gives the same boxes as the same deck
+    rotated to basic axes. Surfaces may lie in different planes z = const of that system (a
+    tail above the wing), not across them.
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF``, cross-referenced (CAERO1 with PAERO1, AEFACT, ACSID).
+    L : float, one deck length unit in m.
+
+    Returns
+    -------
+    mesh : :class:`BoxMesh` (aerodynamic axes, m), one surface per CAERO1 in id order.
+    box_ids : (n_boxes,) int, the Nastran box ids.
+    axes : (3, 3), R.
+
+    Raises
+    ------
+    BdfError
+        A CAERO type other than CAERO1, or a CAERO1 not in a plane z = const of ACSID
+        (dihedral in the aerodynamic system).
+    """
+    R = aero_axes(model)
+    acsid = int(getattr(model.aero or model.aeros, "acsid", 0) or 0)
+    corners, strip, surface, ids, names = [], [], [], [], []
+    s0 = 0
+    for i, cid in enumerate(sorted(model.caeros)):
+        c = model.caeros[cid]
+        if c.type != "CAERO1":
+            raise BdfError(f"{c.type} {cid} is not supported (CAERO1)")
+        p1, _, _, p4 = (R @ np.asarray(p, float) for p in c.get_points())
+        if abs(p1[2] - p4[2]) > 1e-9 * max(1.0, abs(p4[1] - p1[1])):
+            raise BdfError(f"CAERO1 {cid}: P1 and P4 are not in one x-y plane of the "
+                           f"aerodynamic system (AERO ACSID = {acsid}): dihedral is not "
+                           f"supported")
+        box, bid, ns, nc = _caero1_boxes(c, L, R)
+        corners.append(box)
+        strip.append(s0 + np.repeat(np.arange(ns), nc))
+        surface.append(np.full(ns * nc, i))
+        ids.append(bid)
+        names.append(f"CAERO1 {cid}")
+        s0 += ns
+    return BoxMesh(np.concatenate(corners), np.concatenate(strip), np.concatenate(surface),
+                   tuple(names)), np.concatenate(ids), R
 
 
 def _splined_boxes(model, s) -> set:

@@ -40,7 +40,7 @@ cards are read elsewhere (:mod:`asekit.io.bdf`); here they are ignored.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -52,7 +52,7 @@ from asekit.io.bdf import (
     Deck,
     case_value,
     check_caero1,
-    deck_boxes,
+    deck_boxes_aero,
     need_pynastran,
     read_aero_card,
     read_flutter,
@@ -779,6 +779,93 @@ def stick_modes(model: StickModel, n_modes: int = 6) -> StickModes:
                       shapes=full)
 
 
+def _rigid_body_vectors(model: StickModel) -> np.ndarray:
+    """(6 n, 6): unit rigid-body motions of every grid (translations along basic x, y, z and
+    rotations about basic x, y, z through the origin), in each grid's CD components."""
+    U = np.zeros((model.K.shape[0], 6))
+    for i, (r, R) in enumerate(zip(model.xyz, model.cd_axes)):
+        for d in range(6):
+            t, rot = np.zeros(3), np.zeros(3)
+            if d < 3:
+                t[d] = 1.0
+            else:
+                rot[d - 3] = 1.0
+                t = np.cross(rot, r)
+            U[NODE_DOF * i:NODE_DOF * i + 3, d] = R @ t
+            U[NODE_DOF * i + 3:NODE_DOF * i + 6, d] = R @ rot
+    return U
+
+
+def residual_vector_modes(model: StickModel, modes: StickModes, n_total: int) -> StickModes:
+    """The modal basis augmented to ``n_total`` modes by residual vectors for inertia-relief
+    loads (MSC Nastran case control RESVEC, INRLOD; the basis a SOL 145 deck gets when PARAM
+    LMODES exceeds the EIGR / EIGRL ND).
+
+    Loads: the inertia of the six rigid-body accelerations, f_d = M u_d (u_d a unit
+    translation or rotation of the whole model), with inertia relief against the free
+    rigid-body modes phi_r (f <- f - M phi_r phi_r^T f, so that K u = f is consistent). Static
+    responses u_d (solved with K + M phi_r phi_r^T M, nonsingular and equal to K on them) are
+    made M-orthogonal to the eigenvectors; the Rayleigh-Ritz eigenproblem on their span gives
+    the augmented modes, lowest first (MSC Nastran Dynamic Analysis User's Guide, residual
+    vectors). On pyNastran's bah_plane_qhh deck (8 eigenvectors, grid 1 free in plunge and
+    pitch) this gives the f06's "AFTER AUGMENTATION OF RESIDUAL VECTORS" 41.22899, 56.55734,
+    120.5794, 180.3152 Hz to 1e-6.
+
+    Parameters
+    ----------
+    model : :class:`StickModel`; modes : its eigenvectors (:func:`stick_modes`);
+    n_total : modes wanted (LMODES); at most len(modes) + the independent residual vectors.
+
+    Returns
+    -------
+    StickModes, the eigenvectors followed by the residual-vector modes (mass-normalised).
+
+    Examples
+    --------
+    A clamped two-bar cantilever (E I = m = L = 1), one eigenvector plus one residual vector:
+    the augmented frequency lies above the first and no higher than the exact second mode.
+
+    >>> from asekit.structure.frame import BarSection, global_bar_matrices
+    >>> sec = BarSection(1e6, 1.0, 1.0, 1.0, 1.0)
+    >>> K, M = np.zeros((18, 18)), np.zeros((18, 18))
+    >>> for a, b in ((0, 1), (1, 2)):
+    ...     k, m = global_bar_matrices([0.5 * a, 0, 0], [0.5 * b, 0, 0], [0, 0, 1], sec)
+    ...     ix = np.r_[6 * a:6 * a + 6, 6 * b:6 * b + 6]
+    ...     K[np.ix_(ix, ix)] += k
+    ...     M[np.ix_(ix, ix)] += m
+    >>> sm = StickModel(np.array([1, 2, 3]), np.array([[0, 0, 0], [.5, 0, 0], [1, 0, 0]]),
+    ...                 np.array([np.eye(3)] * 3), K, M, tuple(range(6)), True)
+    >>> m1, m2 = stick_modes(sm, 1), stick_modes(sm, 2)
+    >>> f = residual_vector_modes(sm, m1, 2).frequencies_hz
+    >>> bool(f[0] == m1.frequencies_hz[0] and f[1] >= m2.frequencies_hz[1] * (1 - 1e-9))
+    True
+    """
+    n_eig = modes.shapes.shape[1]
+    if n_total <= n_eig:
+        return modes
+    free, Tr = model.free, model.reduction()
+    K, M = Tr.T @ model.K @ Tr, Tr.T @ model.M @ Tr
+    phi = modes.shapes[free]
+    f_hz = modes.frequencies_hz
+    rigid = phi[:, f_hz <= 1e-5 * max(float(f_hz.max()), 1e-300)]
+    F = Tr.T @ (model.M @ _rigid_body_vectors(model))
+    F = F - M @ rigid @ (rigid.T @ F)
+    U = np.linalg.solve(K + M @ rigid @ rigid.T @ M, F)
+    U = U - phi @ (phi.T @ M @ U)
+    w, Q = np.linalg.eigh(U.T @ M @ U)
+    ok = w > 1e-10 * max(float(w.max()), 1e-300)
+    if not ok.any():
+        return modes
+    V = U @ (Q[:, ok] / np.sqrt(w[ok]))
+    lam, X = sla.eigh(V.T @ K @ V, V.T @ M @ V)
+    n_add = min(n_total - n_eig, lam.size)
+    R = V @ X[:, :n_add]
+    R = R / np.sqrt(np.einsum("ij,ik,kj->j", R, M, R))
+    return replace(modes, frequencies_hz=np.r_[f_hz, np.sqrt(np.clip(lam[:n_add], 0.0, None))
+                                                / (2 * np.pi)],
+                   shapes=np.c_[modes.shapes, Tr @ R])
+
+
 # ---------------------------------------------------------------------------------------------
 # SPLINE2 (beam spline) and the deck's flutter requests
 # ---------------------------------------------------------------------------------------------
@@ -850,24 +937,50 @@ def beam_axis_spline(s_nodes, points_s, points_x, ex_flow: float, ey_flow: float
     return H, D
 
 
-def _check_spline2(s) -> None:
+def _check_spline2(s) -> bool:
+    """SPLINE2 USAGE BOTH; True when DZ / DTHX / DTHY ask for smoothing (> 0: attachment
+    flexibility), which :func:`_check_rigid_stations` then accepts only where it changes
+    nothing."""
+    smooth = False
     for name, v in (("DZ", s.dz), ("DTHX", s.dthx), ("DTHY", s.dthy)):
         if v not in (0, 0.0):
-            raise BdfError(f"SPLINE2 {s.eid}: {name} = {v!r} is not supported (0.0: attached, "
-                           f"no smoothing)")
+            if v is None or v < 0:
+                raise BdfError(f"SPLINE2 {s.eid}: {name} = {v!r} is not supported (>= 0.0)")
+            smooth = True
     if str(s.usage or "BOTH").upper() != "BOTH":
         raise BdfError(f"SPLINE2 {s.eid}: USAGE = {s.usage!r} is not supported (BOTH)")
+    return smooth
 
 
-def _spline2_station_matrix(model, s, sm: StickModel, L: float):
+def _check_rigid_stations(s, st: np.ndarray, q: np.ndarray) -> None:
+    """A smoothing SPLINE2 (DZ, DTHX or DTHY > 0) is accepted where its grids move rigidly in
+    every mode (w linear in s, theta_x = dw/ds and theta_y constant, to 1e-8): a beam spline
+    fits such data with no strain energy and no attachment force, so smoothing and
+    interpolating splines coincide (MSC Aeroelastic Analysis User's Guide, Sec. 2.3)."""
+    n = st.size
+    w, tx, ty = q[:n], q[n:2 * n], q[2 * n:]
+    span = max(float(np.ptp(st)), 1e-12)
+    A = np.c_[np.ones(n), st - st.mean()]
+    coef = np.linalg.lstsq(A, w, rcond=None)[0]
+    scale = np.abs(w).max(0) / span + np.abs(tx).max(0) + np.abs(ty).max(0) + 1e-300
+    err = np.max(np.r_[np.abs(A @ coef - w) / span, np.abs(tx - coef[1]), np.abs(ty - ty[:1])]
+                 / scale, axis=0)
+    if n < 2 or np.max(err) > 1e-8:
+        raise BdfError(f"SPLINE2 {s.eid}: DZ/DTHX/DTHY = {s.dz!r}/{s.dthx!r}/{s.dthy!r} "
+                       f"(smoothing) is supported only where the SETG grids move rigidly; "
+                       f"0.0 (attached) otherwise")
+
+
+def _spline2_station_matrix(model, s, sm: StickModel, L: float, aero=None):
     """(3 n_g, 6 n_nodes) map from the model's DOFs to the spline stations' (w, theta_x,
-    theta_y), the stations (sorted, m), the spline frame (rows e_x, e_y, e_z) and its origin."""
+    theta_y), the stations (sorted, m), the spline frame (rows e_x, e_y, e_z) and its origin;
+    ``aero`` the ACSID axes (rows, basic), whose z the spline's z must be along."""
     c = model.coords[s.cid] if s.cid else None
     axes = np.asarray(c.beta(), float) if c is not None else np.eye(3)
     origin = (np.asarray(c.origin, float) if c is not None else np.zeros(3)) * L
-    if abs(axes[2, 2]) < 1 - 1e-6:
+    if abs(axes[2] @ (np.eye(3) if aero is None else aero)[2]) < 1 - 1e-6:
         raise BdfError(f"SPLINE2 {s.eid}: CID = {s.cid}: the spline's z axis must be normal "
-                       f"to the boxes (basic z)")
+                       f"to the boxes (the z axis of AERO ACSID)")
     grids = [int(g) for g in model.sets[s.setg].ids]
     idx = [int(np.flatnonzero(sm.node_ids == g)[0]) for g in grids]
     st = (sm.xyz[idx] - origin) @ axes[1]
@@ -886,10 +999,17 @@ def _spline2_station_matrix(model, s, sm: StickModel, L: float):
     return S, st[order], axes, origin
 
 
-def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L: float):
+def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L: float,
+                      aero=None):
     """The modes on the boxes through the deck's SPLINE2 cards (each box on one spline):
-    :func:`beam_axis_spline` at the control points (h, dh/dx) and load points (h)."""
+    :func:`beam_axis_spline` at the control points (h, dh/dx) and load points (h).
+
+    ``aero`` (rows: the ACSID's axes in basic, :func:`asekit.io.bdf.aero_axes`; default basic)
+    is the frame of ``mesh``: a box point p_a is at basic p_a R, the flow X is R's first row
+    (so the spline axes' X components are e_x . R_x, e_y . R_x) and h, dh/dX are along R's z:
+    the spline's w (along its own z) times sign(e_z . R_z)."""
     from asekit.aero.spline import BoxModes
+    R = np.eye(3) if aero is None else np.asarray(aero, float)
     n_b, n_m = len(box_ids), modes.shapes.shape[1]
     h_cp, d_cp, h_lp = np.zeros((n_b, n_m)), np.zeros((n_b, n_m)), np.zeros((n_b, n_m))
     done = np.zeros(n_b, bool)
@@ -897,16 +1017,20 @@ def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L
     for s in model.splines.values():
         if s.type != "SPLINE2":
             raise BdfError(f"{s.type} {s.eid}: a stick deck's splines must be SPLINE2")
-        _check_spline2(s)
+        smooth = _check_spline2(s)
         rows = [pos[b] for b in range(int(s.box1), int(s.box2) + 1) if b in pos]
-        S, st, axes, o = _spline2_station_matrix(model, s, sm, L)
+        S, st, axes, o = _spline2_station_matrix(model, s, sm, L, R)
         q = S @ modes.shapes
+        if smooth:
+            _check_rigid_stations(s, st, q)
+        sz = float(np.sign(axes[2] @ R[2]))
         for pts, out, dout in ((mesh.control_point, h_cp, d_cp), (mesh.load_point, h_lp, None)):
-            rel = pts[rows] - o
-            H, D = beam_axis_spline(st, rel @ axes[1], rel @ axes[0], axes[0, 0], axes[1, 0])
-            out[rows] = H @ q
+            rel = pts[rows] @ R - o
+            H, D = beam_axis_spline(st, rel @ axes[1], rel @ axes[0], axes[0] @ R[0],
+                                    axes[1] @ R[0])
+            out[rows] = sz * (H @ q)
             if dout is not None:
-                dout[rows] = D @ q
+                dout[rows] = sz * (D @ q)
         done[rows] = True
     if not done.all():
         raise BdfError(f"boxes {[int(b) for b in np.asarray(box_ids)[~done][:10]]} are on no "
@@ -915,22 +1039,64 @@ def spline2_box_modes(model, sm: StickModel, modes: StickModes, mesh, box_ids, L
 
 
 def requested_mode_count(model) -> int:
-    """The number of modes a stick deck asks for: PARAM LMODES (> 0), else the ND of its
-    first EIGR / EIGRL, else 6.
+    """The number of eigenvectors a stick deck asks for: PARAM LMODES (> 0), else the ND of its
+    first EIGR / EIGRL, else 6; never more than that ND when both are given.
+
+    Nastran fills the LMODES modes beyond the ND eigenvectors with residual vectors (case
+    control RESVEC, on by default in SOL 145: pyNastran's bah_plane_qhh.f06, "REAL EIGENVALUES
+    (AFTER AUGMENTATION OF RESIDUAL VECTORS)", 8 eigenvectors + 4 residual vectors, of which
+    LMODES 10 keeps 2, at 41.23 and 56.56 Hz); :func:`stick_flutter` adds them with
+    :func:`residual_vector_modes` (:func:`lmodes_beyond_nd`). Taking further eigenvectors
+    instead (24.3 and 32.1 Hz there) would be neither Nastran's basis nor the deck's ND.
 
     Examples
     --------
     >>> from types import SimpleNamespace as NS
     >>> requested_mode_count(NS(params={}, methods={10: NS(nd=4)}))
     4
+    >>> requested_mode_count(NS(params={"LMODES": NS(values=[10])}, methods={1: NS(nd=8)}))
+    8
     """
+    nd = next((int(m.nd) for m in model.methods.values() if getattr(m, "nd", None)), None)
     p = model.params.get("LMODES")
     if p is not None and int(p.values[0]) > 0:
-        return int(p.values[0])
-    for m in model.methods.values():
-        if getattr(m, "nd", None):
-            return int(m.nd)
-    return 6
+        return int(p.values[0]) if nd is None else min(int(p.values[0]), nd)
+    return 6 if nd is None else nd
+
+
+def _resvec_off(model) -> bool:
+    """Case control RESVEC = NO (or NOINRL: no inertia-relief residual vectors)."""
+    cc = getattr(model, "case_control_deck", None)
+    for sc in ([] if cc is None else [cc.subcases.get(1), cc.subcases.get(0)]):
+        try:
+            value, options = sc.get_parameter("RESVEC")[:2]
+        except (AttributeError, KeyError):          # no subcase, or no RESVEC in it
+            continue
+        words = " ".join(str(x) for x in [value, *(options or [])]).upper()
+        return bool(set(words.replace(",", " ").replace("(", " ").replace(")", " ").split())
+                    & {"NO", "NOINRL"})
+    return False
+
+
+def lmodes_beyond_nd(model) -> tuple[int, str | None]:
+    """(LMODES, note) when a deck's PARAM LMODES exceeds its EIGR / EIGRL ND and residual
+    vectors are not switched off (RESVEC = NO / NOINRL), else (the eigenvector count, None).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> n, note = lmodes_beyond_nd(NS(params={"LMODES": NS(values=[10])}, methods={1: NS(nd=8)},
+    ...                                case_control_deck=None))
+    >>> n, note[:31]
+    (10, 'PARAM LMODES 10 > EIGR/EIGRL ND')
+    """
+    p = model.params.get("LMODES")
+    n = requested_mode_count(model)
+    if p is None or int(p.values[0]) <= n or _resvec_off(model):
+        return n, None
+    lm = int(p.values[0])
+    return lm, (f"PARAM LMODES {lm} > EIGR/EIGRL ND {n}: modes {n + 1}-{lm} are residual vectors "
+                f"for inertia-relief loads (Nastran's RESVEC default, INRLOD)")
 
 
 @dataclass(frozen=True)
@@ -994,16 +1160,20 @@ def stick_flutter(path, units: str = "SI", ks=None) -> StickFlutter:
     deck = Deck(model, Path(path).name, L, Mu, T)
     if not model.caeros or not model.flutters:
         raise BdfError(f"{deck.name}: no CAERO1 or no FLUTTER card: nothing to run")
-    b_ref, rho_ref, symmetric = read_aero_card(deck)      # ACSID first: the flow axis
+    b_ref, rho_ref, symmetric = read_aero_card(deck, rotated_acsid=True)  # the flow axis
     for c in model.caeros.values():
         check_caero1(deck, c)
-    mesh, box_ids = deck_boxes(model, L, 0.0)
+    mesh, box_ids, aero = deck_boxes_aero(model, L)        # in ACSID's axes, nonplanar
     machs, table_ks = read_mkaero1(model, deck)
     requests = [read_flutter(model, f, rho_ref, deck) for f in model.flutters.values()]
     fm = case_value(model, "FMETHOD")
     requests.sort(key=lambda r: r.sid != fm)
     modes = stick_modes(sm, requested_mode_count(model))
-    bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L)
+    n_lmodes, note = lmodes_beyond_nd(model)
+    if note:
+        modes = residual_vector_modes(sm, modes, n_lmodes)
+        modes = replace(modes, notes=modes.notes + (note,))
+    bm = spline2_box_modes(model, sm, modes, mesh, box_ids, L, aero)
     w = 2 * np.pi * modes.frequencies_hz
     modal = modal_arrays(M=np.eye(w.size), K=np.diag(w ** 2))
     ks = np.asarray(table_ks if ks is None else ks, float)
