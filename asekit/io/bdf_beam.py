@@ -1099,9 +1099,9 @@ def write_beam_bdf(beam, path, element: str = "CBAR") -> Path:
     Rf[free, free] = R[free, free]
     lines = ["SOL 103", "CEND", "SPC = 1", "METHOD = 1", "BEGIN BULK",
              "$ written by asekit.io.bdf_beam.write_beam_bdf (SI)"]
-    for i, x in enumerate(beam.nodes):
+    for i, x in enumerate(beam.nodes.tolist()):       # Python floats: repr without np.float64
         lines.append(f"GRID,{i + 1},,{x[0]!r},{x[1]!r},{x[2]!r}")
-    v = beam.frame[2]
+    v = np.asarray(beam.frame[2], float).tolist()
     for e, sec in enumerate(beam.sections):
         lines.append(f"{element},{e + 1},{e + 1},{e + 1},{e + 2},{v[0]!r},{v[1]!r},{v[2]!r}")
         lines += _section_lines(element, e + 1, sec)
