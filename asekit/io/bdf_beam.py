@@ -24,7 +24,10 @@ matrices.
   six components, CMB of GB dependent), eliminated by the rigid-link transformation
   u_d = u_i + theta_i x (x_d - x_i), theta_d = theta_i (Przemieniecki Sec. 11.7; in the grids'
   CD systems), K_r = T^T K T, M_r = T^T M T; chains (a dependent DOF independent elsewhere)
-  resolved by substitution in dependency order, cycles and SPC on a dependent DOF refused.
+  resolved by substitution in dependency order, cycles and SPC on a dependent DOF refused,
+- RBE3 (REFGRID's REFC components dependent on the weighted least-squares rigid fit of the
+  independent grids' WTi / Ci / Gi,j components, :func:`rbe3_weights`; the UM alternative
+  refused), eliminated and chained as RBE2 / RBAR.
 
 The element is :mod:`asekit.structure.frame` (Przemieniecki 1968 Eqs. 5.116 and 11.41, rotated
 by the direction cosines, Eq. 6.26). Every grid carries six DOFs (T1, T2, T3, R1, R2, R3) in its
@@ -32,7 +35,7 @@ displacement system CD, as Nastran's g-set: with R_cd the rows of CD's axes in b
 basic-frame matrices become K_cd = T^T K_basic T, T = diag(R_cd^T, R_cd^T) per grid.
 Massless DOFs are condensed statically (exact for them: no inertia) before the eigen-solution.
 
-Other structural cards (CROD, RBE3, PBEAML, shells, ...) are refused with the card and its
+Other structural cards (CROD, RBE1, PBEAML, shells, ...) are refused with the card and its
 first id; an unsupported field is refused with card, id and field. Aerodynamic and solution
 cards are read elsewhere (:mod:`asekit.io.bdf`); here they are ignored.
 """
@@ -63,11 +66,12 @@ from asekit.structure.frame import BarSection, global_bar_matrices
 
 #: structural cards a stick deck may hold (others are refused).
 STICK_CARDS = ("GRID", "CORD2R", "CORD1R", "CORD2C", "CORD2S", "CBAR", "PBAR", "MAT1",
-               "CMASS2", "CONM2", "SPC", "SPC1", "RBE2", "RBAR", "CBEAM", "PBEAM", "PBARL")
+               "CMASS2", "CONM2", "SPC", "SPC1", "RBE2", "RBAR", "RBE3", "CBEAM", "PBEAM",
+               "PBARL")
 
 #: structural cards refused in a stick deck (asekit cannot represent them here).
 REFUSED_CARDS = ("PBEAML", "CROD", "CONROD", "PROD", "CTUBE",
-                 "RBE1", "RBE3", "RROD", "MPC", "CELAS1", "CELAS2", "CELAS3",
+                 "RBE1", "RROD", "MPC", "CELAS1", "CELAS2", "CELAS3",
                  "CELAS4", "CMASS1", "CMASS3", "CMASS4", "CONM1", "CQUAD4", "CTRIA3", "CQUAD8",
                  "CTRIA6", "CSHEAR", "CHEXA", "CPENTA", "CTETRA", "CBUSH", "CDAMP1", "CDAMP2",
                  "CVISC", "SPOINT", "EPOINT", "GENEL", "SPCD", "SUPORT")
@@ -87,8 +91,8 @@ class StickModel:
         system (N/m, N, N m; kg, kg m, kg m^2).
     fixed : sorted constrained DOFs (SPC, SPC1, GRID PS); coupled : the consistent bar mass
         (PARAM COUPMASS > 0) or lumped; notes : what was read and how; path, units.
-    rigid : (dependent DOF, ((independent DOF, coefficient), ...)) per DOF an RBE2 / RBAR
-        makes dependent.
+    rigid : (dependent DOF, ((independent DOF, coefficient), ...)) per DOF an RBE2 / RBAR /
+        RBE3 makes dependent.
     """
 
     node_ids: np.ndarray
@@ -157,7 +161,7 @@ def card_ids(model, card: str) -> list:
 
 #: the structural cards of each pyNastran container a stick deck may hold.
 _ALLOWED = {"elements": ("CBAR", "CBEAM"), "masses": ("CMASS2", "CONM2"),
-            "rigid_elements": ("RBE2", "RBAR"), "properties": ("PBAR", "PBEAM", "PBARL")}
+            "rigid_elements": ("RBE2", "RBAR", "RBE3"), "properties": ("PBAR", "PBEAM", "PBARL")}
 
 #: the line elements a stick deck's structure is made of.
 BAR_CARDS = ("CBAR", "CBEAM")
@@ -172,7 +176,7 @@ def _refuse_cards(model, name: str) -> None:
     if bad:
         listed = ", ".join(f"{c} (x{n}, first id {i})" for c, n, i in bad)
         raise BdfError(f"{name}: the stick-model import cannot represent {listed}; it reads "
-                       f"CBAR/CBEAM with PBAR/PBEAM/PBARL and MAT1, CMASS2, CONM2, RBE2, RBAR, "
+                       f"CBAR/CBEAM with PBAR/PBEAM/PBARL and MAT1, CMASS2, CONM2, RBE2, RBAR, RBE3, "
                        f"SPC/SPC1 and GRID PS")
     if not any(card_ids(model, c) for c in BAR_CARDS):
         raise BdfError(f"{name}: no CBAR or CBEAM element: not a stick model")
@@ -582,8 +586,131 @@ def _resolve_chains(dep: dict, who: dict, ids) -> dict:
     return done
 
 
+def rbe3_weights(x_ref, x_ind, comps, weights, axes_ind=None) -> np.ndarray:
+    """The RBE3 interpolation: the reference grid's six rigid-body DOFs (basic) from the
+    independent grids' weighted components, as a weighted least-squares fit.
+
+    MSC Nastran Quick Reference Guide, RBE3 ("defines the motion at a reference grid point as
+    the weighted average of the motions at a set of other grid points"; remark: the
+    independent components must be able to react the reference grid's rigid-body motion) and
+    the MSC Nastran Reference Manual's RBE3 description (MSC.Nastran 2005 seminar NAS105,
+    Sec. 2 "RBE3: how it works"): with S_i the rigid-body map of the reference grid's motion
+    u_ref = (u, theta) to grid i's six DOFs,
+
+        S_i = A_i [[I, -S(x_i - x_ref)], [0, I]],   A_i = diag(R_i, R_i) (basic -> grid i's CD),
+
+    P_i the rows of grid i's components C_i and W_i = WT_i diag(1 translation, L_c^2
+    rotation) (L_c the mean distance of the independent grids from the reference grid, which
+    makes a rotational weight comparable with a translational one), the reference motion is
+    the least-squares fit of a rigid motion to the independent motions,
+
+        u_ref = (sum_i G_i^T W_i G_i)^-1 sum_i G_i^T W_i u_i,   G_i = P_i S_i.
+
+    It is the transpose of the load distribution F_i = W_i G_i (sum G^T W G)^-1 F_ref, so an
+    RBE3 carries loads and mass without stiffening: a rigid motion of the independent grids
+    gives the same rigid motion at the reference grid (u_i = G_i u_ref is fitted exactly).
+
+    Parameters
+    ----------
+    x_ref : (3,) reference grid position (basic, m).
+    x_ind : (n, 3) independent grid positions (basic, m).
+    comps : n component lists (1-6, each grid's CD system).
+    weights : (n,) WT of each grid (> 0).
+    axes_ind : (n, 3, 3) rows of each grid's CD axes in basic (default basic).
+
+    Returns
+    -------
+    (6, sum len(comps)) : u_ref (basic: T1-T3, R1-R3) from the independent components, in the
+        order grid by grid, component by component.
+
+    Raises
+    ------
+    ValueError
+        When sum G^T W G is singular (the independent components cannot react the reference
+        grid's rigid-body motion, e.g. translations of collinear grids only).
+
+    Examples
+    --------
+    Four equally weighted grids around the origin: the reference moves with their mean.
+
+    >>> x = [[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]]
+    >>> W = rbe3_weights([0, 0, 0], x, [[1, 2, 3]] * 4, [1.0] * 4)
+    >>> W[2].round(12).tolist()[2::3]               # u_z of the reference from the four u_z
+    [0.25, 0.25, 0.25, 0.25]
+    """
+    x_ref = np.asarray(x_ref, float)
+    x_ind = np.atleast_2d(np.asarray(x_ind, float))
+    n = x_ind.shape[0]
+    axes_ind = np.array([np.eye(3)] * n) if axes_ind is None else np.asarray(axes_ind, float)
+    wt = np.asarray(weights, float)
+    if wt.shape != (n,) or len(comps) != n or not np.all(wt > 0):
+        raise ValueError("weights must hold one WT > 0 per independent grid, and comps one "
+                         "component list per grid")
+    lc = float(np.mean(np.linalg.norm(x_ind - x_ref, axis=1)))
+    rows, wdiag = [], []
+    for i in range(n):
+        S = np.eye(6)
+        S[:3, 3:] = -_skew(x_ind[i] - x_ref)
+        G = np.kron(np.eye(2), axes_ind[i]) @ S
+        for c in comps[i]:
+            rows.append(G[int(c) - 1])
+            wdiag.append(wt[i] * (1.0 if int(c) <= 3 else lc * lc))
+    G = np.array(rows)
+    GW = G.T * np.array(wdiag)
+    N = GW @ G
+    if np.linalg.matrix_rank(N, tol=1e-10 * max(np.abs(N).max(), 1e-300)) < 6:
+        raise ValueError("the independent grids' components cannot react the reference grid's "
+                         "rigid-body motion (e.g. translations of collinear grids only: add a "
+                         "rotation to Ci, MSC QRG RBE3 remark)")
+    return np.linalg.solve(N, GW)
+
+
+def _rbe3_link(dep: dict, r, index, xyz, axes, who: dict) -> None:
+    """RBE3 (:func:`rbe3_weights`): the REFC components (CD) of REFGRID as dependent rows of
+    the independent grids' weighted components; the UM alternative and a REFGRID that is also
+    independent are refused naming the card and field."""
+    what = f"RBE3 {r.eid}"
+    if r.Gmi:
+        raise BdfError(f"{what}: UM (GM1 = {r.Gmi[0]}) is not supported (blank: the REFC "
+                       f"components of REFGRID are the dependent ones)")
+    ref = int(r.refgrid)
+    grids, comps, wts = [], [], []
+    for wt, c, gs in zip(r.weights, r.comps, r.Gijs):
+        for g in gs:
+            g = int(g)
+            if g == ref:
+                raise BdfError(f"{what}: REFGRID {ref} is also an independent grid Gi,j "
+                               f"(Nastran refuses it too)")
+            if g not in index:
+                raise BdfError(f"{what}: Gi,j = {g} is not a GRID")
+            if not (wt is not None and float(wt) > 0):
+                raise BdfError(f"{what}: WT = {wt!r} of G {g} must be > 0")
+            grids.append(index[g])
+            comps.append(_components(c))
+            wts.append(float(wt))
+    if ref not in index:
+        raise BdfError(f"{what}: REFGRID = {ref} is not a GRID")
+    d = index[ref]
+    try:
+        Wb = rbe3_weights(xyz[d], xyz[grids], comps, wts, axes[grids])
+    except ValueError as exc:
+        raise BdfError(f"{what}: {exc}") from None
+    Wc = np.kron(np.eye(2), axes[d]) @ Wb               # the reference grid's CD components
+    cols = [NODE_DOF * g + c - 1 for g, cs in zip(grids, comps) for c in cs]
+    for c in _components(r.refc):
+        row = NODE_DOF * d + c - 1
+        if row in dep:
+            raise BdfError(f"{what}: REFC component {c} of REFGRID {ref} is already dependent "
+                           f"on another rigid element")
+        acc = {}
+        for j, v in zip(cols, Wc[c - 1]):
+            acc[j] = acc.get(j, 0.0) + float(v)
+        dep[row] = tuple((j, v) for j, v in sorted(acc.items()) if abs(v) > 1e-15)
+        who[row] = what
+
+
 def _rigid_links(model, index, xyz, axes, fixed: set, ids) -> tuple:
-    """RBE2 / RBAR as dependent DOF rows (module docstring)."""
+    """RBE2 / RBAR / RBE3 as dependent DOF rows (module docstring)."""
     dep, who = {}, {}
     for eid in sorted(model.rigid_elements):
         r = model.rigid_elements[eid]
@@ -598,8 +725,10 @@ def _rigid_links(model, index, xyz, axes, fixed: set, ids) -> tuple:
                                f"(CNA 123456, CNB and CMA blank)")
             _link(dep, f"RBAR {eid}", index[r.ga], index[r.gb], _components(r.cmb or "123456"),
                   xyz, axes, who)
+        elif r.type == "RBE3":
+            _rbe3_link(dep, r, index, xyz, axes, who)
         else:
-            raise BdfError(f"{r.type} {eid} is not supported (RBE2, RBAR)")
+            raise BdfError(f"{r.type} {eid} is not supported (RBE2, RBAR, RBE3)")
     dep = _resolve_chains(dep, who, ids)
     if fixed & set(dep):
         d = min(fixed & set(dep))

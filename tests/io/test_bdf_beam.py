@@ -107,8 +107,8 @@ def test_pt145_modes_match_its_f06():
 
 
 def test_refused_cards_and_fields_are_named(tmp_path):
-    deck = _cantilever(tmp_path / "r.bdf", extra=("RBE3,500,,1,123456,1.0,123,2,3",))
-    with pytest.raises(BdfError, match=r"RBE3 \(x1, first id 500\)"):
+    deck = _cantilever(tmp_path / "r.bdf", extra=("RBE1,500,1,123456,,,,,,", ",UM,2,123456",))
+    with pytest.raises(BdfError, match=r"RBE1 \(x1, first id 500\)"):
         read_stick_deck(deck)
     deck = _cantilever(tmp_path / "o.bdf", offt="BGG")
     with pytest.raises(BdfError, match="CBAR 1: OFFT"):
