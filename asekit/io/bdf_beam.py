@@ -586,16 +586,17 @@ def _resolve_chains(dep: dict, who: dict, ids) -> dict:
     return done
 
 
-def rbe3_weights(x_ref, x_ind, comps, weights, axes_ind=None) -> np.ndarray:
-    """The RBE3 interpolation: the reference grid's six rigid-body DOFs (basic) from the
-    independent grids' weighted components, as a weighted least-squares fit.
+def rbe3_weights(x_ref, x_ind, comps, weights, axes_ind=None, refc=(1, 2, 3, 4, 5, 6),
+                 axes_ref=None) -> np.ndarray:
+    """The RBE3 interpolation: the reference grid's REFC components from the independent grids'
+    weighted components, as a weighted least-squares fit of a rigid motion.
 
     MSC Nastran Quick Reference Guide, RBE3 ("defines the motion at a reference grid point as
     the weighted average of the motions at a set of other grid points"; remark: the
-    independent components must be able to react the reference grid's rigid-body motion) and
-    the MSC Nastran Reference Manual's RBE3 description (MSC.Nastran 2005 seminar NAS105,
-    Sec. 2 "RBE3: how it works"): with S_i the rigid-body map of the reference grid's motion
-    u_ref = (u, theta) to grid i's six DOFs,
+    independent components must be able to react the rigid-body motion of the REFC
+    components) and the MSC Nastran Reference Manual's RBE3 description (MSC.Nastran 2005
+    seminar NAS105, Sec. 2 "RBE3: how it works"): with S_i the rigid-body map of the reference
+    grid's motion u_ref = (u, theta) (basic) to grid i's six DOFs,
 
         S_i = A_i [[I, -S(x_i - x_ref)], [0, I]],   A_i = diag(R_i, R_i) (basic -> grid i's CD),
 
@@ -604,11 +605,14 @@ def rbe3_weights(x_ref, x_ind, comps, weights, axes_ind=None) -> np.ndarray:
     makes a rotational weight comparable with a translational one), the reference motion is
     the least-squares fit of a rigid motion to the independent motions,
 
-        u_ref = (sum_i G_i^T W_i G_i)^-1 sum_i G_i^T W_i u_i,   G_i = P_i S_i.
+        u_ref = N^+ sum_i G_i^T W_i u_i,   N = sum_i G_i^T W_i G_i,   G_i = P_i S_i,
 
-    It is the transpose of the load distribution F_i = W_i G_i (sum G^T W G)^-1 F_ref, so an
-    RBE3 carries loads and mass without stiffening: a rigid motion of the independent grids
-    gives the same rigid motion at the reference grid (u_i = G_i u_ref is fitted exactly).
+    and REFC component c (row a_c of A_ref) is a_c u_ref. N may be singular (a planar model's
+    out-of-plane components react only its out-of-plane motion): a_c must then be normal to
+    N's null space (every least-squares fit gives component c the same value), else it is
+    refused. The constraint is the transpose of the load distribution F_i = W_i G_i N^+ F_ref,
+    so an RBE3 carries loads and mass without stiffening: a rigid motion of the independent
+    grids gives the same rigid motion at the reference grid (u_i = G_i u_ref fits exactly).
 
     Parameters
     ----------
@@ -617,31 +621,34 @@ def rbe3_weights(x_ref, x_ind, comps, weights, axes_ind=None) -> np.ndarray:
     comps : n component lists (1-6, each grid's CD system).
     weights : (n,) WT of each grid (> 0).
     axes_ind : (n, 3, 3) rows of each grid's CD axes in basic (default basic).
+    refc : the reference grid's dependent components (1-6, its CD system).
+    axes_ref : (3, 3) rows of the reference grid's CD axes in basic (default basic).
 
     Returns
     -------
-    (6, sum len(comps)) : u_ref (basic: T1-T3, R1-R3) from the independent components, in the
-        order grid by grid, component by component.
+    (len(refc), sum len(comps)) : the REFC components from the independent components, in
+        the order grid by grid, component by component.
 
     Raises
     ------
     ValueError
-        When sum G^T W G is singular (the independent components cannot react the reference
-        grid's rigid-body motion, e.g. translations of collinear grids only).
+        When a REFC component is not determined (the independent components cannot react its
+        rigid-body motion, e.g. translations of collinear grids only).
 
     Examples
     --------
     Four equally weighted grids around the origin: the reference moves with their mean.
 
     >>> x = [[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]]
-    >>> W = rbe3_weights([0, 0, 0], x, [[1, 2, 3]] * 4, [1.0] * 4)
-    >>> W[2].round(12).tolist()[2::3]               # u_z of the reference from the four u_z
+    >>> W = rbe3_weights([0, 0, 0], x, [[1, 2, 3]] * 4, [1.0] * 4, refc=[3])
+    >>> W[0].round(12).tolist()[2::3]               # u_z of the reference from the four u_z
     [0.25, 0.25, 0.25, 0.25]
     """
     x_ref = np.asarray(x_ref, float)
     x_ind = np.atleast_2d(np.asarray(x_ind, float))
     n = x_ind.shape[0]
     axes_ind = np.array([np.eye(3)] * n) if axes_ind is None else np.asarray(axes_ind, float)
+    A_ref = np.kron(np.eye(2), np.eye(3) if axes_ref is None else np.asarray(axes_ref, float))
     wt = np.asarray(weights, float)
     if wt.shape != (n,) or len(comps) != n or not np.all(wt > 0):
         raise ValueError("weights must hold one WT > 0 per independent grid, and comps one "
@@ -655,14 +662,18 @@ def rbe3_weights(x_ref, x_ind, comps, weights, axes_ind=None) -> np.ndarray:
         for c in comps[i]:
             rows.append(G[int(c) - 1])
             wdiag.append(wt[i] * (1.0 if int(c) <= 3 else lc * lc))
-    G = np.array(rows)
+    G = np.array(rows).reshape(-1, 6)
     GW = G.T * np.array(wdiag)
-    N = GW @ G
-    if np.linalg.matrix_rank(N, tol=1e-10 * max(np.abs(N).max(), 1e-300)) < 6:
-        raise ValueError("the independent grids' components cannot react the reference grid's "
-                         "rigid-body motion (e.g. translations of collinear grids only: add a "
-                         "rotation to Ci, MSC QRG RBE3 remark)")
-    return np.linalg.solve(N, GW)
+    lam, V = np.linalg.eigh(GW @ G)
+    tol = 1e-10 * max(float(lam.max(initial=0.0)), 1e-300)
+    null, keep = V[:, lam <= tol], lam > tol
+    a = A_ref[[int(c) - 1 for c in refc]]
+    if null.size and np.abs(a @ null).max() > 1e-8:
+        raise ValueError("the independent grids' components cannot react the reference "
+                         "grid's rigid-body motion in REFC (e.g. translations of collinear "
+                         "grids only: add a rotation to Ci, MSC QRG RBE3 remark)")
+    Ninv = (V[:, keep] / lam[keep]) @ V[:, keep].T
+    return a @ Ninv @ GW
 
 
 def _rbe3_link(dep: dict, r, index, xyz, axes, who: dict) -> None:
@@ -674,6 +685,8 @@ def _rbe3_link(dep: dict, r, index, xyz, axes, who: dict) -> None:
         raise BdfError(f"{what}: UM (GM1 = {r.Gmi[0]}) is not supported (blank: the REFC "
                        f"components of REFGRID are the dependent ones)")
     ref = int(r.refgrid)
+    if ref not in index:
+        raise BdfError(f"{what}: REFGRID = {ref} is not a GRID")
     grids, comps, wts = [], [], []
     for wt, c, gs in zip(r.weights, r.comps, r.Gijs):
         for g in gs:
@@ -688,22 +701,20 @@ def _rbe3_link(dep: dict, r, index, xyz, axes, who: dict) -> None:
             grids.append(index[g])
             comps.append(_components(c))
             wts.append(float(wt))
-    if ref not in index:
-        raise BdfError(f"{what}: REFGRID = {ref} is not a GRID")
     d = index[ref]
+    refc = _components(r.refc)
     try:
-        Wb = rbe3_weights(xyz[d], xyz[grids], comps, wts, axes[grids])
+        Wc = rbe3_weights(xyz[d], xyz[grids], comps, wts, axes[grids], refc, axes[d])
     except ValueError as exc:
         raise BdfError(f"{what}: {exc}") from None
-    Wc = np.kron(np.eye(2), axes[d]) @ Wb               # the reference grid's CD components
     cols = [NODE_DOF * g + c - 1 for g, cs in zip(grids, comps) for c in cs]
-    for c in _components(r.refc):
+    for c, wrow in zip(refc, Wc):
         row = NODE_DOF * d + c - 1
         if row in dep:
             raise BdfError(f"{what}: REFC component {c} of REFGRID {ref} is already dependent "
                            f"on another rigid element")
         acc = {}
-        for j, v in zip(cols, Wc[c - 1]):
+        for j, v in zip(cols, wrow):
             acc[j] = acc.get(j, 0.0) + float(v)
         dep[row] = tuple((j, v) for j, v in sorted(acc.items()) if abs(v) > 1e-15)
         who[row] = what

@@ -195,3 +195,37 @@ def test_unsupported_rbe3_is_named(tmp_path, card, match):
     deck = _deck(tmp_path / "u.bdf", [_grid(99, [0.3, 0.1, 0.0]), card])
     with pytest.raises(BdfError, match=match):
         read_stick_deck(deck)
+
+
+@pytest.mark.parametrize("extra,match", [
+    ("GRID,99,1,0.3,5.72,0.0,1\nRBE3,500,,99,345,1.0,345,10,11", r"RBE3 500: a case's"),
+    ("CMASS2,30,1.0-6,10,3,11,3", r"CMASS2 30: .*only a one-grid CMASS2 on a rotation"),
+])
+def test_convert_refuses_what_a_case_cannot_hold(tmp_path, capsys, extra, match):
+    """``asekit convert`` of PT145 with an RBE3 (its out-of-plane components on the planar
+    deck: read, N singular in-plane only) or a two-grid CMASS2 (read as the scalar element
+    m [[1, -1], [-1, 1]]): the deck reads, the case format has neither (one line, exit 2)."""
+    import re
+
+    from asekit.cli.main import main
+    from asekit.util.paths import DATA_DIR
+
+    text = (DATA_DIR / "benchmarks" / "pt145" / "pt145.bdf").read_text()
+    deck = tmp_path / "p.bdf"
+    deck.write_text(text.replace("PARAM   COUPMASS1", extra + "\nPARAM   COUPMASS1", 1))
+    sm = read_stick_deck(deck, units="in-lbf-s")
+    if "RBE3" in extra:
+        assert len(sm.rigid) == 3
+    else:                                  # 1e-6 lbf s^2/in between the two z translations
+        (tmp_path / "b.bdf").write_text(text)
+        dM = sm.M - read_stick_deck(tmp_path / "b.bdf", units="in-lbf-s").M
+        i, j = sm.dof(10, 3), sm.dof(11, 3)
+        m = 1e-6 * 4.4482216152605 / 0.0254
+        np.testing.assert_allclose(dM[np.ix_([i, j], [i, j])], m * np.array([[1, -1], [-1, 1]]),
+                                   rtol=1e-9)
+        dM[np.ix_([i, j], [i, j])] = 0.0
+        assert np.abs(dM).max() == 0.0
+    assert main(["convert", str(deck), str(tmp_path / "x.toml"), "--units", "in-lbf-s"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and re.search(match, err[0])
+    assert not (tmp_path / "x.toml").exists()
