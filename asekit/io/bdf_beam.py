@@ -62,15 +62,19 @@ from asekit.io.bdf import (
     read_mkaero1,
     solve_request,
 )
-from asekit.structure.frame import BarSection, global_bar_matrices
+from asekit.structure.frame import (
+    BarSection,
+    global_bar_matrices,
+    global_tapered_bar_matrices,
+)
 
 #: structural cards a stick deck may hold (others are refused).
 STICK_CARDS = ("GRID", "CORD2R", "CORD1R", "CORD2C", "CORD2S", "CBAR", "PBAR", "MAT1",
                "CMASS2", "CONM2", "SPC", "SPC1", "RBE2", "RBAR", "RBE3", "CBEAM", "PBEAM",
-               "PBARL")
+               "PBARL", "PBEAML")
 
 #: structural cards refused in a stick deck (asekit cannot represent them here).
-REFUSED_CARDS = ("PBEAML", "CROD", "CONROD", "PROD", "CTUBE",
+REFUSED_CARDS = ("CROD", "CONROD", "PROD", "CTUBE",
                  "RBE1", "RROD", "MPC", "CELAS1", "CELAS2", "CELAS3",
                  "CELAS4", "CMASS1", "CMASS3", "CMASS4", "CONM1", "CQUAD4", "CTRIA3", "CQUAD8",
                  "CTRIA6", "CSHEAR", "CHEXA", "CPENTA", "CTETRA", "CBUSH", "CDAMP1", "CDAMP2",
@@ -161,7 +165,8 @@ def card_ids(model, card: str) -> list:
 
 #: the structural cards of each pyNastran container a stick deck may hold.
 _ALLOWED = {"elements": ("CBAR", "CBEAM"), "masses": ("CMASS2", "CONM2"),
-            "rigid_elements": ("RBE2", "RBAR", "RBE3"), "properties": ("PBAR", "PBEAM", "PBARL")}
+            "rigid_elements": ("RBE2", "RBAR", "RBE3"),
+            "properties": ("PBAR", "PBEAM", "PBARL", "PBEAML")}
 
 #: the line elements a stick deck's structure is made of.
 BAR_CARDS = ("CBAR", "CBEAM")
@@ -176,7 +181,7 @@ def _refuse_cards(model, name: str) -> None:
     if bad:
         listed = ", ".join(f"{c} (x{n}, first id {i})" for c, n, i in bad)
         raise BdfError(f"{name}: the stick-model import cannot represent {listed}; it reads "
-                       f"CBAR/CBEAM with PBAR/PBEAM/PBARL and MAT1, CMASS2, CONM2, RBE2, RBAR, RBE3, "
+                       f"CBAR/CBEAM with PBAR/PBEAM/PBARL/PBEAML and MAT1, CMASS2, CONM2, RBE2, RBAR, RBE3, "
                        f"SPC/SPC1 and GRID PS")
     if not any(card_ids(model, c) for c in BAR_CARDS):
         raise BdfError(f"{name}: no CBAR or CBEAM element: not a stick model")
@@ -264,28 +269,42 @@ _PBEAM_ZERO = ("s1", "s2", "nsia", "nsib", "cwa", "cwb", "m1a", "m2a", "m1b", "m
                "n2a", "n1b", "n2b")
 
 
-def _pbeam_values(p) -> tuple:
-    """PBEAM of constant section: (A, I1, I2, J, NSM, K1, K2) of end A in deck units; every
-    station equal to end A, I12 = 0 and the :data:`_PBEAM_ZERO` fields 0, else refused naming
-    the field (MSC QRG PBEAM: K1, K2 default 1.0, the shear stiffness K G A; 0.0 neglects
-    the shear flexibility)."""
+def _pbeam_stations(p) -> tuple:
+    """PBEAM: (x/XB stations, rows (A, I1, I2, J, NSM) per station, K1, K2) in deck units.
+
+    End A, the intermediate stations and end B as pyNastran reads them (a blank end B equal
+    to end A: MSC QRG PBEAM remark 5); x/XB strictly ascending from 0.0 to 1.0; I12 = 0 and
+    the :data:`_PBEAM_ZERO` fields 0 at every station, else refused naming the field (MSC QRG
+    PBEAM: K1, K2 default 1.0, the shear stiffness K G A; 0.0 neglects the shear
+    flexibility)."""
+    xs = np.atleast_1d(np.asarray(getattr(p, "xxb", [0.0]), float))
     vals = {name: np.atleast_1d(np.asarray(getattr(p, key), float)) for name, key in
             (("A", "A"), ("I1", "i1"), ("I2", "i2"), ("J", "j"), ("NSM", "nsm"),
              ("I12", "i12"))}
-    for name, v in vals.items():
-        if np.any(v != v[0]):
-            raise BdfError(f"PBEAM {p.pid}: {name} varies along the beam "
-                           f"({', '.join(f'{x:g}' for x in v)}); only a constant section "
-                           f"is supported")
-    if vals["I12"][0]:
-        raise BdfError(f"PBEAM {p.pid}: I12 = {vals['I12'][0]:g} is not supported (0: "
-                       f"principal axes)")
+    if np.any(vals["I12"]):
+        raise BdfError(f"PBEAM {p.pid}: I12 = {vals['I12'][vals['I12'] != 0][0]:g} is not "
+                       f"supported (0: principal axes)")
     for key in _PBEAM_ZERO:
         x = float(getattr(p, key) or 0.0)
         if x != 0.0:
             raise BdfError(f"PBEAM {p.pid}: {key.upper()} = {x:g} is not supported (0.0)")
-    return (*(float(vals[n][0]) for n in ("A", "I1", "I2", "J", "NSM")),
-            _shear_factor(p, "k1"), _shear_factor(p, "k2"))
+    rows = np.column_stack([vals[n] for n in ("A", "I1", "I2", "J", "NSM")])
+    xs, rows = _stations(xs, rows, f"PBEAM {p.pid}")
+    return xs, rows, _shear_factor(p, "k1"), _shear_factor(p, "k2")
+
+
+def _stations(xs, rows, where: str):
+    """The stations x/XB (ascending from 0.0; end B at 1.0 added equal to the last one when
+    absent) and their rows, refused naming ``where`` when not strictly ascending in [0, 1]."""
+    xs = np.asarray(xs, float)
+    if xs.size != rows.shape[0]:
+        raise BdfError(f"{where}: {xs.size} stations X/XB for {rows.shape[0]} sections")
+    if xs[0] != 0.0 or np.any(np.diff(xs) <= 0) or xs[-1] > 1.0:
+        raise BdfError(f"{where}: X/XB = {xs.tolist()} must ascend strictly from 0.0 (end A) "
+                       f"to 1.0 (end B)")
+    if xs[-1] < 1.0:
+        xs, rows = np.r_[xs, 1.0], np.vstack([rows, rows[-1]])
+    return xs, rows
 
 
 #: PBARL section types :func:`pbarl_section` evaluates, with their number of dimensions.
@@ -402,13 +421,109 @@ def _pbarl_values(p) -> tuple:
     return (*pbarl_section(p.beam_type, p.dim, f"PBARL {p.pid}"), float(p.nsm or 0.0), 0.0, 0.0)
 
 
-_SECTION_VALUES = {"PBAR": _pbar_values, "PBEAM": _pbeam_values, "PBARL": _pbarl_values}
+def _pbeaml_stations(p) -> tuple:
+    """PBEAML: (x/XB stations, rows (DIM1..DIMn, NSM) per station, 0, 0) in deck units, the
+    section type one of :data:`PBARL_TYPES` (shared with PBARL, :func:`pbarl_section`, which
+    checks every station's dimensions); GROUP MSCBML0 only; no shear flexibility (as PBARL)."""
+    where = f"PBEAML {p.pid}"
+    group = str(getattr(p, "group", "MSCBML0") or "MSCBML0").strip().upper()
+    if group != "MSCBML0":
+        raise BdfError(f"{where}: GROUP = {group!r} is not supported (MSCBML0, the standard "
+                       f"beam library)")
+    dims = np.atleast_2d(np.asarray(p.dim, float))
+    nsm = np.atleast_1d(np.asarray(p.nsm, float))
+    for d in dims:
+        pbarl_section(p.beam_type, d, where)
+    xs, rows = _stations(p.xxb, np.column_stack([dims, nsm]), where)
+    return xs, rows, 0.0, 0.0
+
+
+def _single_station(values):
+    """A PBAR / PBARL as one station: (x/XB = [0, 1], rows (A, I1, I2, J, NSM) twice, K1, K2)."""
+    row = np.asarray(values[:5], float)
+    return np.array([0.0, 1.0]), np.vstack([row, row]), values[5], values[6]
+
+
+#: per property card: (x/XB stations, rows, K1, K2) and the row -> (A, I1, I2, J, NSM) map.
+_STATIONS = {"PBAR": lambda p: _single_station(_pbar_values(p)),
+             "PBARL": lambda p: _single_station(_pbarl_values(p)),
+             "PBEAM": _pbeam_stations, "PBEAML": _pbeaml_stations}
 #: the properties each line element may reference (MSC QRG CBAR / CBEAM PID).
-_ELEMENT_PROPERTIES = {"CBAR": ("PBAR", "PBARL"), "CBEAM": ("PBEAM", "PBARL")}
+_ELEMENT_PROPERTIES = {"CBAR": ("PBAR", "PBARL"), "CBEAM": ("PBEAM", "PBARL", "PBEAML")}
+
+
+def _row_values(p):
+    """Row of :data:`_STATIONS` -> (A, I1, I2, J, NSM) of property ``p``."""
+    if p.type == "PBEAML":
+        return lambda r: (*pbarl_section(p.beam_type, r[:-1], f"PBEAML {p.pid}"), r[-1])
+    return lambda r: tuple(r)
+
+
+def _si_section(values, k1, k2, mat, deck_units) -> BarSection:
+    """(A, I1, I2, J, NSM) in deck units + MAT1 -> :class:`BarSection` (SI)."""
+    L, Mu, T, wt = deck_units
+    A, i1, i2, j, nsm = (float(v) for v in values)
+    E, G, rho = mat.e, mat.g, mat.rho or 0.0
+    stress = Mu / (L * T * T)                      # deck pressure in Pa
+    gas = [k * G * A * stress * L ** 2 if k else math.inf for k in (k1, k2)]
+    return BarSection(ea=E * A * stress * L ** 2, gj=G * j * stress * L ** 4,
+                      ei1=E * i1 * stress * L ** 4, ei2=E * i2 * stress * L ** 4,
+                      mass=(rho * A + (nsm or 0.0)) * wt * Mu / L, gas1=gas[0], gas2=gas[1])
+
+
+def bar_stations(model, pid: int, eid: int, deck_units, card: str = "CBAR"):
+    """The section of a CBAR / CBEAM along it: PBAR / PBARL (uniform), PBEAM (stations x/XB,
+    each property linearly interpolated between them) or PBEAML (stations, the dimensions
+    DIMi and NSM linearly interpolated, the section from :func:`pbarl_section` at each point)
+    + MAT1, in SI.
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF``, cross-referenced.
+    pid, eid : the element's PID and id; card : "CBAR" or "CBEAM" (which properties it takes).
+    deck_units : (L m, Mu kg, T s, PARAM WTMASS) of one deck unit.
+
+    Returns
+    -------
+    (breaks, section_at, uniform) : the stations (ascending, 0.0 ... 1.0), a callable
+        xi -> :class:`~asekit.structure.frame.BarSection` (EA = E A, GJ = G J, EI1 = E I1,
+        EI2 = E I2 in N, N m^2; mass = (rho A + NSM) WTMASS in kg/m; K G A from K1 / K2) and
+        whether every station is the same.
+
+    Raises
+    ------
+    BdfError
+        Naming the card, its id and the field asekit cannot represent.
+    """
+    p = model.properties[pid]
+    if p.type not in _ELEMENT_PROPERTIES[card]:
+        raise BdfError(f"{card} {eid}: PID {pid} is a {p.type}; a {card} takes "
+                       f"{' or '.join(_ELEMENT_PROPERTIES[card])}")
+    xs, rows, k1, k2 = _STATIONS[p.type](p)
+    to_values = _row_values(p)
+    for r in rows:
+        A = to_values(r)[0]
+        if not A > 0:
+            raise BdfError(f"{p.type} {pid}: A = {A!r} must be > 0")
+    mat = model.materials[p.mid]
+    if mat.type != "MAT1":
+        raise BdfError(f"{p.type} {pid}: MID {p.mid} is a {mat.type}; only MAT1 is supported")
+    E, G = mat.e, mat.g
+    if not (E and E > 0 and G is not None and G >= 0):
+        raise BdfError(f"MAT1 {p.mid}: E must be > 0 and G >= 0, got E = {E!r}, G = {G!r}")
+    if (k1 or k2) and not G > 0:
+        raise BdfError(f"{p.type} {pid}: K1 / K2 (shear flexibility) need MAT1 {p.mid} G > 0")
+
+    def section_at(xi: float) -> BarSection:
+        r = np.array([np.interp(xi, xs, col) for col in rows.T])
+        return _si_section(to_values(r), k1, k2, mat, deck_units)
+
+    return xs, section_at, bool(np.all(rows == rows[0]))
 
 
 def bar_section(model, pid: int, eid: int, deck_units, card: str = "CBAR") -> BarSection:
-    """PBAR / PBEAM / PBARL + MAT1 of a CBAR / CBEAM as SI section properties.
+    """PBAR / PBEAM / PBARL / PBEAML + MAT1 of a CBAR / CBEAM of uniform section as SI section
+    properties (:func:`bar_stations`).
 
     Parameters
     ----------
@@ -425,29 +540,15 @@ def bar_section(model, pid: int, eid: int, deck_units, card: str = "CBAR") -> Ba
     Raises
     ------
     BdfError
-        Naming the card, its id and the field asekit cannot represent.
+        Naming the card, its id and the field asekit cannot represent, or a section that
+        varies along the element (a tapered PBEAM / PBEAML).
     """
-    L, Mu, T, wt = deck_units
-    p = model.properties[pid]
-    if p.type not in _ELEMENT_PROPERTIES[card]:
-        raise BdfError(f"{card} {eid}: PID {pid} is a {p.type}; a {card} takes "
-                       f"{' or '.join(_ELEMENT_PROPERTIES[card])}")
-    A, i1, i2, j, nsm, k1, k2 = _SECTION_VALUES[p.type](p)
-    if not A > 0:
-        raise BdfError(f"{p.type} {pid}: A = {A!r} must be > 0")
-    mat = model.materials[p.mid]
-    if mat.type != "MAT1":
-        raise BdfError(f"{p.type} {pid}: MID {p.mid} is a {mat.type}; only MAT1 is supported")
-    E, G, rho = mat.e, mat.g, mat.rho or 0.0
-    if not (E and E > 0 and G is not None and G >= 0):
-        raise BdfError(f"MAT1 {p.mid}: E must be > 0 and G >= 0, got E = {E!r}, G = {G!r}")
-    stress = Mu / (L * T * T)                      # deck pressure in Pa
-    if (k1 or k2) and not G > 0:
-        raise BdfError(f"{p.type} {pid}: K1 / K2 (shear flexibility) need MAT1 {p.mid} G > 0")
-    gas = [k * G * A * stress * L ** 2 if k else math.inf for k in (k1, k2)]
-    return BarSection(ea=E * A * stress * L ** 2, gj=G * j * stress * L ** 4,
-                      ei1=E * i1 * stress * L ** 4, ei2=E * i2 * stress * L ** 4,
-                      mass=(rho * A + (nsm or 0.0)) * wt * Mu / L, gas1=gas[0], gas2=gas[1])
+    xs, section_at, uniform = bar_stations(model, pid, eid, deck_units, card)
+    if not uniform:
+        p = model.properties[pid]
+        raise BdfError(f"{p.type} {pid}: the section varies along the beam (stations X/XB "
+                       f"{xs.tolist()}); only a uniform section is supported here")
+    return section_at(0.0)
 
 
 def _add_bars(model, K, M, index, xyz, axes, coupled, deck_units) -> None:
@@ -457,8 +558,12 @@ def _add_bars(model, K, M, index, xyz, axes, coupled, deck_units) -> None:
         ia, ib = index[e.ga], index[e.gb]
         v = bar_orientation(model, e, lambda g: axes[index[g]], lambda g: xyz[index[g]])
         try:
-            sec = bar_section(model, e.pid, eid, deck_units, e.type)
-            Ke, Me = global_bar_matrices(xyz[ia], xyz[ib], v, sec, coupled)
+            xs, section_at, uniform = bar_stations(model, e.pid, eid, deck_units, e.type)
+            if uniform:
+                Ke, Me = global_bar_matrices(xyz[ia], xyz[ib], v, section_at(0.0), coupled)
+            else:
+                Ke, Me = global_tapered_bar_matrices(xyz[ia], xyz[ib], v, section_at, xs,
+                                                     coupled)
         except BdfError:
             raise
         except ValueError as exc:

@@ -159,7 +159,9 @@ def test_goland_wing_as_a_cbeam_deck_reads_back_to_its_modes(tmp_path):
 @pytest.mark.parametrize("elements,props,match", [
     (_elements("CBEAM"), _pbeam(k="0.0,0.0") + [",0.0,0.0,0.0,0.0,0.0,0.0,0.0,0.1"],
      r"PBEAM 1: N2B = 0.1 is not supported"),
-    (_elements("CBEAM"), _pbeam(a2=2 * A), r"PBEAM 1: A varies along the beam"),
+    (_elements("CBEAM"), [f"PBEAM,1,1,{A!r},{I1!r},{I2!r},0.0,{J!r}", PBEAM_TAIL[0],
+                          f",YESA,1.0,{A!r},{I1!r},{I2!r},1e-10,{J!r}", ",0.0,0.0"],
+     r"PBEAM 1: I12 = 1e-10 is not supported"),
     (_elements("CBEAM"), [f"PBAR,1,1,{A!r},{I1!r},{I2!r},{J!r}"],
      r"CBEAM 1: PID 1 is a PBAR; a CBEAM takes PBEAM or PBARL"),
     (_elements("CBEAM", "\n,,,0.0,0.1,0.0"), _pbeam(), r"CBEAM 1: offsets WA/WB"),
