@@ -8,11 +8,14 @@ matrices.
 - CBAR (orientation vector X1-X3 in GA's displacement system, or G0; OFFT blank, GGG, or the
   old integer flag 1 "X1-X3 is a vector"; pin flags PA/PB and offsets WA/WB refused),
 - PBAR (A, I1, I2, J, NSM; I12 refused) with MAT1 (E, G, RHO),
-- CBEAM as the same Euler-Bernoulli bar (orientation as CBAR; OFFT blank or GGG, BIT, pin
-  flags, offsets WA/WB and warping scalar points SA/SB refused) with PBEAM of constant section
-  (every station's A, I1, I2, J, NSM equal to end A's; I12, the shear factors K1/K2 (0.0: shear
-  flexibility neglected, as the Euler-Bernoulli element has none), shear relief S1/S2, NSI,
-  warping CW and the NSM / neutral-axis offsets M1-N2 must be 0),
+- CBEAM as the same bar (orientation as CBAR; OFFT blank or GGG, BIT, pin flags, offsets
+  WA/WB and warping scalar points SA/SB refused) with PBEAM (A, I1, I2, J, NSM at end A, the
+  intermediate stations X/XB and end B, each linearly interpolated between stations; a
+  station differing from end A makes the element tapered,
+  :func:`asekit.structure.frame.tapered_bar_matrices`; K1/K2 the shear factors (0.0: shear
+  flexibility neglected); I12, shear relief S1/S2, NSI, warping CW and the NSM / neutral-axis
+  offsets M1-N2 must be 0) or PBEAML (GROUP MSCBML0, the PBARL types below through
+  :func:`pbarl_section`, the dimensions DIMi and NSM linearly interpolated between stations),
 - PBARL of type BAR, ROD, TUBE, BOX or (doubly symmetric) I with GROUP MSCBML0, its A, I1, I2
   and J from the closed forms of :func:`pbarl_section` (dimensions as the MSC Nastran Quick
   Reference Guide's PBARL figures define them),

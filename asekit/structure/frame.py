@@ -23,6 +23,11 @@ and T = diag(R, R, R, R) (12 x 12), u_local = T u_global and
     K_global = T^T K_local T,  M_global = T^T M_local T          (Przemieniecki Eq. 6.26),
 
 so the element's frequencies do not depend on how the structure is placed in space. SI units.
+
+A bar whose section varies along it (Nastran's tapered PBEAM / PBEAML):
+:func:`tapered_bar_matrices`, its stiffness from the flexibility of the element clamped at one
+end (exact for end loads whatever the variation), its mass from the same shape functions with
+the mass per length under the integral.
 """
 
 from __future__ import annotations
