@@ -310,6 +310,12 @@ def _stations(xs, rows, where: str):
     return xs, rows
 
 
+#: shear factors K1 = K2 the beam library gives a PBARL / PBEAML section: ROD 0.9, as
+#: Simcenter Nastran 2019.2 echoes a PBARL / PBEAML ROD as a PBAR / PBEAM (user information
+#: message 4379 in pyNastran's models/beam_modes/beam_modes.f06, data/benchmarks/beam_modes);
+#: the other types' factors are not known here and are 0.0 (no shear flexibility).
+_LIBRARY_SHEAR = {"ROD": 0.9}
+
 #: PBARL section types :func:`pbarl_section` evaluates, with their number of dimensions.
 PBARL_TYPES = {"BAR": 2, "ROD": 1, "TUBE": 2, "BOX": 4, "I": 6}
 
@@ -415,19 +421,20 @@ _PBARL_FORMS = {"BAR": _bar_form, "ROD": _tube_form, "TUBE": _tube_form, "BOX": 
 
 
 def _pbarl_values(p) -> tuple:
-    """PBARL: (A, I1, I2, J, NSM, 0, 0) in deck units (:func:`pbarl_section`; no shear
-    flexibility: PBARL has no K1 / K2 field); GROUP MSCBML0 only."""
+    """PBARL: (A, I1, I2, J, NSM, K, K) in deck units (:func:`pbarl_section`; K the library's
+    shear factor, :data:`_LIBRARY_SHEAR`: PBARL has no K1 / K2 field); GROUP MSCBML0 only."""
     group = str(getattr(p, "group", "MSCBML0") or "MSCBML0").strip().upper()
     if group != "MSCBML0":
         raise BdfError(f"PBARL {p.pid}: GROUP = {group!r} is not supported (MSCBML0, the "
                        f"standard beam library)")
-    return (*pbarl_section(p.beam_type, p.dim, f"PBARL {p.pid}"), float(p.nsm or 0.0), 0.0, 0.0)
+    k = _LIBRARY_SHEAR.get(str(p.beam_type).upper(), 0.0)
+    return (*pbarl_section(p.beam_type, p.dim, f"PBARL {p.pid}"), float(p.nsm or 0.0), k, k)
 
 
 def _pbeaml_stations(p) -> tuple:
     """PBEAML: (x/XB stations, rows (DIM1..DIMn, NSM) per station, 0, 0) in deck units, the
     section type one of :data:`PBARL_TYPES` (shared with PBARL, :func:`pbarl_section`, which
-    checks every station's dimensions); GROUP MSCBML0 only; no shear flexibility (as PBARL)."""
+    checks every station's dimensions); GROUP MSCBML0 only; shear factors as PBARL's."""
     where = f"PBEAML {p.pid}"
     group = str(getattr(p, "group", "MSCBML0") or "MSCBML0").strip().upper()
     if group != "MSCBML0":
@@ -438,7 +445,8 @@ def _pbeaml_stations(p) -> tuple:
     for d in dims:
         pbarl_section(p.beam_type, d, where)
     xs, rows = _stations(p.xxb, np.column_stack([dims, nsm]), where)
-    return xs, rows, 0.0, 0.0
+    k = _LIBRARY_SHEAR.get(str(p.beam_type).upper(), 0.0)
+    return xs, rows, k, k
 
 
 def _single_station(values):
@@ -462,8 +470,9 @@ def _row_values(p):
     return lambda r: tuple(r)
 
 
-def _si_section(values, k1, k2, mat, deck_units) -> BarSection:
-    """(A, I1, I2, J, NSM) in deck units + MAT1 -> :class:`BarSection` (SI)."""
+def _si_section(values, k1, k2, mat, deck_units, polar: bool = False) -> BarSection:
+    """(A, I1, I2, J, NSM) in deck units + MAT1 -> :class:`BarSection` (SI); ``polar``: the
+    section's polar mass moment rho (I1 + I2) on the twist (a CBEAM's, not a CBAR's)."""
     L, Mu, T, wt = deck_units
     A, i1, i2, j, nsm = (float(v) for v in values)
     E, G, rho = mat.e, mat.g, mat.rho or 0.0
@@ -471,7 +480,8 @@ def _si_section(values, k1, k2, mat, deck_units) -> BarSection:
     gas = [k * G * A * stress * L ** 2 if k else math.inf for k in (k1, k2)]
     return BarSection(ea=E * A * stress * L ** 2, gj=G * j * stress * L ** 4,
                       ei1=E * i1 * stress * L ** 4, ei2=E * i2 * stress * L ** 4,
-                      mass=(rho * A + (nsm or 0.0)) * wt * Mu / L, gas1=gas[0], gas2=gas[1])
+                      mass=(rho * A + (nsm or 0.0)) * wt * Mu / L, gas1=gas[0], gas2=gas[1],
+                      polar=rho * (i1 + i2) * wt * Mu * L if polar else 0.0)
 
 
 def bar_stations(model, pid: int, eid: int, deck_units, card: str = "CBAR"):
@@ -490,8 +500,9 @@ def bar_stations(model, pid: int, eid: int, deck_units, card: str = "CBAR"):
     -------
     (breaks, section_at, uniform) : the stations (ascending, 0.0 ... 1.0), a callable
         xi -> :class:`~asekit.structure.frame.BarSection` (EA = E A, GJ = G J, EI1 = E I1,
-        EI2 = E I2 in N, N m^2; mass = (rho A + NSM) WTMASS in kg/m; K G A from K1 / K2) and
-        whether every station is the same.
+        EI2 = E I2 in N, N m^2; mass = (rho A + NSM) WTMASS in kg/m; K G A from K1 / K2; a
+        CBEAM's polar mass moment rho (I1 + I2) WTMASS in kg m) and whether every station is
+        the same.
 
     Raises
     ------
@@ -519,7 +530,7 @@ def bar_stations(model, pid: int, eid: int, deck_units, card: str = "CBAR"):
 
     def section_at(xi: float) -> BarSection:
         r = np.array([np.interp(xi, xs, col) for col in rows.T])
-        return _si_section(to_values(r), k1, k2, mat, deck_units)
+        return _si_section(to_values(r), k1, k2, mat, deck_units, card == "CBEAM")
 
     return xs, section_at, bool(np.all(rows == rows[0]))
 

@@ -158,7 +158,7 @@ def _sections(model, sm: StickModel, index, order, e1, deck_units, name: str) ->
         else:
             raise BdfError(f"{e.type} {eid}: orientation vector X1-X3 / G0 is oblique to the "
                            f"plane z = 0: plane 1 must be the flap or the chord plane")
-        out[a] = (sec.ea, sec.gj, flap, chord, sec.mass, 0.0, 0.0)
+        out[a] = (sec.ea, sec.gj, flap, chord, sec.mass, sec.polar, 0.0)
     if any(x is None for x in out):
         raise BdfError(f"{name}: GRIDs without a bar between them: a case's beam is one chain")
     return out

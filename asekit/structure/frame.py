@@ -13,9 +13,12 @@ K G A per plane its shear parameter Phi, Timoshenko's shear flexibility, as Nast
 K1 / K2 and PBAR K1 / K2 ask). Mass: the consistent ("coupled")
 matrix of the same shape functions, Przemieniecki Eq. 11.41 for axial and transverse motion, or
 the lumped one, m L / 2 on each node's three translations (Nastran's default for the CBAR,
-PARAM COUPMASS < 1). Neither carries a polar (torsional) mass moment: a bar's mass is m = rho A
-+ NSM per length on its axis, as Nastran's CBAR has it (its PBAR has no polar-inertia field;
-torsional inertia is given by point masses).
+PARAM COUPMASS < 1). A CBAR carries no polar (torsional) mass moment: its mass is m = rho A
++ NSM per length on its axis (its PBAR has no polar-inertia field; torsional inertia is given by
+point masses). A CBEAM carries I_p = rho (I1 + I2) per length on its twist, with the same
+linear shape (I_p L / 6 [[2, 1], [1, 2]], or I_p L / 2 on each end when lumped): Simcenter
+Nastran 2019.2's lumped modes of pyNastran's beam_modes deck (data/benchmarks/beam_modes) have
+it on the CBEAM and not on the CBARs.
 
 Global matrices: with the direction-cosine matrix R (rows e_x, e_y, e_z in the global frame)
 and T = diag(R, R, R, R) (12 x 12), u_local = T u_global and
@@ -56,6 +59,8 @@ class BarSection:
     mass : mass per length m = rho A + NSM (kg/m), >= 0.
     gas1, gas2 : transverse shear stiffness K G A of plane 1 and plane 2 (N), > 0; inf
         (default) neglects the shear flexibility (Euler-Bernoulli).
+    polar : polar mass moment of inertia per length about the axis, rho (I1 + I2) (kg m),
+        >= 0 (default 0: Nastran's CBAR has none; its CBEAM has it).
 
     Examples
     --------
@@ -70,10 +75,11 @@ class BarSection:
     mass: float
     gas1: float = math.inf
     gas2: float = math.inf
+    polar: float = 0.0
 
     def __post_init__(self):
         object.__setattr__(self, "ea", positive("ea", self.ea))
-        for name in ("gj", "ei1", "ei2", "mass"):
+        for name in ("gj", "ei1", "ei2", "mass", "polar"):
             object.__setattr__(self, name, in_range(name, getattr(self, name), 0.0, True))
         for name in ("gas1", "gas2"):
             v = float(getattr(self, name))
@@ -151,7 +157,8 @@ def bar_matrices(section: BarSection, length: float, coupled: bool = True):
     Returns
     -------
     (K, M) : (12, 12) symmetric arrays (SI). Blocks: axial E A / L [[1, -1], [-1, 1]] with
-        mass m L / 6 [[2, 1], [1, 2]] (coupled); torsion G J / L, no mass; plane 1 (u2, r3 =
+        mass m L / 6 [[2, 1], [1, 2]] (coupled); torsion G J / L with mass I_p L / 6
+        [[2, 1], [1, 2]] (lumped I_p L / 2 each; I_p = ``polar``, 0 for a CBAR); plane 1 (u2, r3 =
         u2') with E I1 and plane 2 (u3, r2 = -u3') with E I2 by Hermite cubics.
 
     Examples
@@ -169,6 +176,8 @@ def bar_matrices(section: BarSection, length: float, coupled: bool = True):
     M[np.ix_(ax, ax)] = (s.mass * L / 6 * np.array([[2.0, 1.0], [1.0, 2.0]]) if coupled
                          else np.diag([s.mass * L / 2] * 2))
     K[np.ix_(tw, tw)] = s.gj / L * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    M[np.ix_(tw, tw)] = (s.polar * L / 6 * np.array([[2.0, 1.0], [1.0, 2.0]]) if coupled
+                         else np.diag([s.polar * L / 2] * 2))
     for dofs, ei, sign, gas in (([1, 5, 7, 11], s.ei1, 1.0, s.gas1),
                                 ([2, 4, 8, 10], s.ei2, -1.0, s.gas2)):
         k, m = _bending(ei, s.mass, L, sign, coupled, gas)
@@ -263,8 +272,9 @@ def tapered_bar_matrices(section_at, length: float, breaks=(0.0, 1.0), coupled: 
 
     axial stiffness 1 / int 1 / (E A) dx and torsional 1 / int 1 / (G J) dx. Mass: the
     consistent matrix of the uniform bar's shape functions with m(x) (Przemieniecki Eq. 11.41
-    with m under the integral: int m N^T N dx, Hermite cubics across, linear along), or the
-    lumped one, int m (1 - xi) dx and int m xi dx on A's and B's translations. Integrals by
+    with m under the integral: int m N^T N dx, Hermite cubics across, linear along and in
+    twist with the polar inertia), or the lumped one, int m (1 - xi) dx and int m xi dx on
+    A's and B's translations (and the polar inertia likewise on their twists). Integrals by
     composite Gauss-Legendre quadrature, each interval between ``breaks`` (the stations where
     the section's interpolation changes slope) in four pieces of ``n_gauss`` points (the
     flexibility of a linear E I from 1 to 1/27 along the bar to 1e-10).
@@ -301,7 +311,7 @@ def tapered_bar_matrices(section_at, length: float, breaks=(0.0, 1.0), coupled: 
     xi, wq = _gauss_points(breaks, int(n_gauss))
     secs = [section_at(float(x)) for x in xi]
     val = {k: np.array([getattr(s, k) for s in secs], float)
-           for k in ("ea", "gj", "ei1", "ei2", "mass", "gas1", "gas2")}
+           for k in ("ea", "gj", "ei1", "ei2", "mass", "gas1", "gas2", "polar")}
     if np.any(val["ea"] <= 0):
         raise ValueError("the section's ea must be > 0 along the bar")
     dx = wq * L
@@ -327,13 +337,17 @@ def tapered_bar_matrices(section_at, length: float, breaks=(0.0, 1.0), coupled: 
         if coupled:
             s = np.diag([1.0, sign, 1.0, sign])
             M[np.ix_(dofs, dofs)] = s @ ((N * (m * dx)) @ N.T) @ s
+    ip = val["polar"]
     if coupled:
         M[np.ix_(ax, ax)] = (lin * (m * dx)) @ lin.T
+        M[np.ix_(tw, tw)] = (lin * (ip * dx)) @ lin.T
     else:
         mab = (lin * (m * dx)).sum(axis=1)
-        for node, mm in enumerate(mab):
+        pab = (lin * (ip * dx)).sum(axis=1)
+        for node, (mm, pp) in enumerate(zip(mab, pab)):
             for c in range(3):
                 M[6 * node + c, 6 * node + c] = mm
+            M[6 * node + 3, 6 * node + 3] = pp
     return K, M
 
 
