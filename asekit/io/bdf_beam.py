@@ -8,7 +8,7 @@ matrices.
 - CBAR (orientation vector X1-X3 in GA's displacement system, or G0; OFFT blank, GGG, or the
   old integer flag 1 "X1-X3 is a vector"; pin flags PA/PB and offsets WA/WB refused),
 - PBAR (A, I1, I2, J, NSM; I12 refused) with MAT1 (E, G, RHO),
-- CBEAM as the same bar (orientation as CBAR; OFFT blank or GGG, BIT, pin flags, offsets
+- CBEAM as the same bar plus its polar mass rho (I1 + I2) on the twist (orientation as CBAR; OFFT blank or GGG, BIT, pin flags, offsets
   WA/WB and warping scalar points SA/SB refused) with PBEAM (A, I1, I2, J, NSM at end A, the
   intermediate stations X/XB and end B, each linearly interpolated between stations; a
   station differing from end A makes the element tapered,
@@ -18,7 +18,8 @@ matrices.
   :func:`pbarl_section`, the dimensions DIMi and NSM linearly interpolated between stations),
 - PBARL of type BAR, ROD, TUBE, BOX or (doubly symmetric) I with GROUP MSCBML0, its A, I1, I2
   and J from the closed forms of :func:`pbarl_section` (dimensions as the MSC Nastran Quick
-  Reference Guide's PBARL figures define them),
+  Reference Guide's PBARL figures define them) and the library's shear factor
+  (:data:`_LIBRARY_SHEAR`: ROD 0.9, the others none),
 - CMASS2 (scalar mass on a grid component, or between two), CONM2 (mass and inertia with
   offset, CID 0 or blank),
 - SPC1 / SPC (zero enforced value) of the case control's SPC set, PARAM COUPMASS (> 0: the
