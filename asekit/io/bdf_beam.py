@@ -722,7 +722,9 @@ def rbe3_weights(x_ref, x_ind, comps, weights, axes_ind=None, refc=(1, 2, 3, 4, 
 
     P_i the rows of grid i's components C_i and W_i = WT_i diag(1 translation, L_c^2
     rotation) (L_c the mean distance of the independent grids from the reference grid, which
-    makes a rotational weight comparable with a translational one), the reference motion is
+    makes a rotational weight comparable with a translational one; asekit's reading of MSC's
+    description, not compared with an f06: it matters only with rotations in Ci and a fit that
+    is not exact), the reference motion is
     the least-squares fit of a rigid motion to the independent motions,
 
         u_ref = N^+ sum_i G_i^T W_i u_i,   N = sum_i G_i^T W_i G_i,   G_i = P_i S_i,
