@@ -8,14 +8,18 @@ matrices.
 - CBAR (orientation vector X1-X3 in GA's displacement system, or G0; OFFT blank, GGG, or the
   old integer flag 1 "X1-X3 is a vector"; pin flags PA/PB and offsets WA/WB refused),
 - PBAR (A, I1, I2, J, NSM; I12 refused) with MAT1 (E, G, RHO),
-- CBEAM as the same Euler-Bernoulli bar (orientation as CBAR; OFFT blank or GGG, BIT, pin
-  flags, offsets WA/WB and warping scalar points SA/SB refused) with PBEAM of constant section
-  (every station's A, I1, I2, J, NSM equal to end A's; I12, the shear factors K1/K2 (0.0: shear
-  flexibility neglected, as the Euler-Bernoulli element has none), shear relief S1/S2, NSI,
-  warping CW and the NSM / neutral-axis offsets M1-N2 must be 0),
+- CBEAM as the same bar plus its polar mass rho (I1 + I2) on the twist (orientation as CBAR; OFFT blank or GGG, BIT, pin flags, offsets
+  WA/WB and warping scalar points SA/SB refused) with PBEAM (A, I1, I2, J, NSM at end A, the
+  intermediate stations X/XB and end B, each linearly interpolated between stations; a
+  station differing from end A makes the element tapered,
+  :func:`asekit.structure.frame.tapered_bar_matrices`; K1/K2 the shear factors (0.0: shear
+  flexibility neglected); I12, shear relief S1/S2, NSI, warping CW and the NSM / neutral-axis
+  offsets M1-N2 must be 0) or PBEAML (GROUP MSCBML0, the PBARL types below through
+  :func:`pbarl_section`, the dimensions DIMi and NSM linearly interpolated between stations),
 - PBARL of type BAR, ROD, TUBE, BOX or (doubly symmetric) I with GROUP MSCBML0, its A, I1, I2
   and J from the closed forms of :func:`pbarl_section` (dimensions as the MSC Nastran Quick
-  Reference Guide's PBARL figures define them),
+  Reference Guide's PBARL figures define them) and the library's shear factor
+  (:data:`_LIBRARY_SHEAR`: ROD 0.9, the others none),
 - CMASS2 (scalar mass on a grid component, or between two), CONM2 (mass and inertia with
   offset, CID 0 or blank),
 - SPC1 / SPC (zero enforced value) of the case control's SPC set, PARAM COUPMASS (> 0: the
@@ -24,7 +28,10 @@ matrices.
   six components, CMB of GB dependent), eliminated by the rigid-link transformation
   u_d = u_i + theta_i x (x_d - x_i), theta_d = theta_i (Przemieniecki Sec. 11.7; in the grids'
   CD systems), K_r = T^T K T, M_r = T^T M T; chains (a dependent DOF independent elsewhere)
-  resolved by substitution in dependency order, cycles and SPC on a dependent DOF refused.
+  resolved by substitution in dependency order, cycles and SPC on a dependent DOF refused,
+- RBE3 (REFGRID's REFC components dependent on the weighted least-squares rigid fit of the
+  independent grids' WTi / Ci / Gi,j components, :func:`rbe3_weights`; the UM alternative
+  refused), eliminated and chained as RBE2 / RBAR.
 
 The element is :mod:`asekit.structure.frame` (Przemieniecki 1968 Eqs. 5.116 and 11.41, rotated
 by the direction cosines, Eq. 6.26). Every grid carries six DOFs (T1, T2, T3, R1, R2, R3) in its
@@ -32,7 +39,7 @@ displacement system CD, as Nastran's g-set: with R_cd the rows of CD's axes in b
 basic-frame matrices become K_cd = T^T K_basic T, T = diag(R_cd^T, R_cd^T) per grid.
 Massless DOFs are condensed statically (exact for them: no inertia) before the eigen-solution.
 
-Other structural cards (CROD, RBE3, PBEAML, shells, ...) are refused with the card and its
+Other structural cards (CROD, RBE1, PBEAML, shells, ...) are refused with the card and its
 first id; an unsupported field is refused with card, id and field. Aerodynamic and solution
 cards are read elsewhere (:mod:`asekit.io.bdf`); here they are ignored.
 """
@@ -59,15 +66,20 @@ from asekit.io.bdf import (
     read_mkaero1,
     solve_request,
 )
-from asekit.structure.frame import BarSection, global_bar_matrices
+from asekit.structure.frame import (
+    BarSection,
+    global_bar_matrices,
+    global_tapered_bar_matrices,
+)
 
 #: structural cards a stick deck may hold (others are refused).
 STICK_CARDS = ("GRID", "CORD2R", "CORD1R", "CORD2C", "CORD2S", "CBAR", "PBAR", "MAT1",
-               "CMASS2", "CONM2", "SPC", "SPC1", "RBE2", "RBAR", "CBEAM", "PBEAM", "PBARL")
+               "CMASS2", "CONM2", "SPC", "SPC1", "RBE2", "RBAR", "RBE3", "CBEAM", "PBEAM",
+               "PBARL", "PBEAML")
 
 #: structural cards refused in a stick deck (asekit cannot represent them here).
-REFUSED_CARDS = ("PBEAML", "CROD", "CONROD", "PROD", "CTUBE",
-                 "RBE1", "RBE3", "RROD", "MPC", "CELAS1", "CELAS2", "CELAS3",
+REFUSED_CARDS = ("CROD", "CONROD", "PROD", "CTUBE",
+                 "RBE1", "RROD", "MPC", "CELAS1", "CELAS2", "CELAS3",
                  "CELAS4", "CMASS1", "CMASS3", "CMASS4", "CONM1", "CQUAD4", "CTRIA3", "CQUAD8",
                  "CTRIA6", "CSHEAR", "CHEXA", "CPENTA", "CTETRA", "CBUSH", "CDAMP1", "CDAMP2",
                  "CVISC", "SPOINT", "EPOINT", "GENEL", "SPCD", "SUPORT")
@@ -87,8 +99,8 @@ class StickModel:
         system (N/m, N, N m; kg, kg m, kg m^2).
     fixed : sorted constrained DOFs (SPC, SPC1, GRID PS); coupled : the consistent bar mass
         (PARAM COUPMASS > 0) or lumped; notes : what was read and how; path, units.
-    rigid : (dependent DOF, ((independent DOF, coefficient), ...)) per DOF an RBE2 / RBAR
-        makes dependent.
+    rigid : (dependent DOF, ((independent DOF, coefficient), ...)) per DOF an RBE2 / RBAR /
+        RBE3 makes dependent.
     """
 
     node_ids: np.ndarray
@@ -157,7 +169,8 @@ def card_ids(model, card: str) -> list:
 
 #: the structural cards of each pyNastran container a stick deck may hold.
 _ALLOWED = {"elements": ("CBAR", "CBEAM"), "masses": ("CMASS2", "CONM2"),
-            "rigid_elements": ("RBE2", "RBAR"), "properties": ("PBAR", "PBEAM", "PBARL")}
+            "rigid_elements": ("RBE2", "RBAR", "RBE3"),
+            "properties": ("PBAR", "PBEAM", "PBARL", "PBEAML")}
 
 #: the line elements a stick deck's structure is made of.
 BAR_CARDS = ("CBAR", "CBEAM")
@@ -172,7 +185,7 @@ def _refuse_cards(model, name: str) -> None:
     if bad:
         listed = ", ".join(f"{c} (x{n}, first id {i})" for c, n, i in bad)
         raise BdfError(f"{name}: the stick-model import cannot represent {listed}; it reads "
-                       f"CBAR/CBEAM with PBAR/PBEAM/PBARL and MAT1, CMASS2, CONM2, RBE2, RBAR, "
+                       f"CBAR/CBEAM with PBAR/PBEAM/PBARL/PBEAML and MAT1, CMASS2, CONM2, RBE2, RBAR, RBE3, "
                        f"SPC/SPC1 and GRID PS")
     if not any(card_ids(model, c) for c in BAR_CARDS):
         raise BdfError(f"{name}: no CBAR or CBEAM element: not a stick model")
@@ -260,29 +273,49 @@ _PBEAM_ZERO = ("s1", "s2", "nsia", "nsib", "cwa", "cwb", "m1a", "m2a", "m1b", "m
                "n2a", "n1b", "n2b")
 
 
-def _pbeam_values(p) -> tuple:
-    """PBEAM of constant section: (A, I1, I2, J, NSM, K1, K2) of end A in deck units; every
-    station equal to end A, I12 = 0 and the :data:`_PBEAM_ZERO` fields 0, else refused naming
-    the field (MSC QRG PBEAM: K1, K2 default 1.0, the shear stiffness K G A; 0.0 neglects
-    the shear flexibility)."""
+def _pbeam_stations(p) -> tuple:
+    """PBEAM: (x/XB stations, rows (A, I1, I2, J, NSM) per station, K1, K2) in deck units.
+
+    End A, the intermediate stations and end B as pyNastran reads them (a blank end B equal
+    to end A: MSC QRG PBEAM remark 5); x/XB strictly ascending from 0.0 to 1.0; I12 = 0 and
+    the :data:`_PBEAM_ZERO` fields 0 at every station, else refused naming the field (MSC QRG
+    PBEAM: K1, K2 default 1.0, the shear stiffness K G A; 0.0 neglects the shear
+    flexibility)."""
+    xs = np.atleast_1d(np.asarray(getattr(p, "xxb", [0.0]), float))
     vals = {name: np.atleast_1d(np.asarray(getattr(p, key), float)) for name, key in
             (("A", "A"), ("I1", "i1"), ("I2", "i2"), ("J", "j"), ("NSM", "nsm"),
              ("I12", "i12"))}
-    for name, v in vals.items():
-        if np.any(v != v[0]):
-            raise BdfError(f"PBEAM {p.pid}: {name} varies along the beam "
-                           f"({', '.join(f'{x:g}' for x in v)}); only a constant section "
-                           f"is supported")
-    if vals["I12"][0]:
-        raise BdfError(f"PBEAM {p.pid}: I12 = {vals['I12'][0]:g} is not supported (0: "
-                       f"principal axes)")
+    if np.any(vals["I12"]):
+        raise BdfError(f"PBEAM {p.pid}: I12 = {vals['I12'][vals['I12'] != 0][0]:g} is not "
+                       f"supported (0: principal axes)")
     for key in _PBEAM_ZERO:
         x = float(getattr(p, key) or 0.0)
         if x != 0.0:
             raise BdfError(f"PBEAM {p.pid}: {key.upper()} = {x:g} is not supported (0.0)")
-    return (*(float(vals[n][0]) for n in ("A", "I1", "I2", "J", "NSM")),
-            _shear_factor(p, "k1"), _shear_factor(p, "k2"))
+    rows = np.column_stack([vals[n] for n in ("A", "I1", "I2", "J", "NSM")])
+    xs, rows = _stations(xs, rows, f"PBEAM {p.pid}")
+    return xs, rows, _shear_factor(p, "k1"), _shear_factor(p, "k2")
 
+
+def _stations(xs, rows, where: str):
+    """The stations x/XB (ascending from 0.0; end B at 1.0 added equal to the last one when
+    absent) and their rows, refused naming ``where`` when not strictly ascending in [0, 1]."""
+    xs = np.asarray(xs, float)
+    if xs.size != rows.shape[0]:
+        raise BdfError(f"{where}: {xs.size} stations X/XB for {rows.shape[0]} sections")
+    if xs[0] != 0.0 or np.any(np.diff(xs) <= 0) or xs[-1] > 1.0:
+        raise BdfError(f"{where}: X/XB = {xs.tolist()} must ascend strictly from 0.0 (end A) "
+                       f"to 1.0 (end B)")
+    if xs[-1] < 1.0:
+        xs, rows = np.r_[xs, 1.0], np.vstack([rows, rows[-1]])
+    return xs, rows
+
+
+#: shear factors K1 = K2 the beam library gives a PBARL / PBEAML section: ROD 0.9, as
+#: Simcenter Nastran 2019.2 echoes a PBARL / PBEAML ROD as a PBAR / PBEAM (user information
+#: message 4379 in pyNastran's models/beam_modes/beam_modes.f06, data/benchmarks/beam_modes);
+#: the other types' factors are not known here and are 0.0 (no shear flexibility).
+_LIBRARY_SHEAR = {"ROD": 0.9}
 
 #: PBARL section types :func:`pbarl_section` evaluates, with their number of dimensions.
 PBARL_TYPES = {"BAR": 2, "ROD": 1, "TUBE": 2, "BOX": 4, "I": 6}
@@ -389,22 +422,123 @@ _PBARL_FORMS = {"BAR": _bar_form, "ROD": _tube_form, "TUBE": _tube_form, "BOX": 
 
 
 def _pbarl_values(p) -> tuple:
-    """PBARL: (A, I1, I2, J, NSM, 0, 0) in deck units (:func:`pbarl_section`; no shear
-    flexibility: PBARL has no K1 / K2 field); GROUP MSCBML0 only."""
+    """PBARL: (A, I1, I2, J, NSM, K, K) in deck units (:func:`pbarl_section`; K the library's
+    shear factor, :data:`_LIBRARY_SHEAR`: PBARL has no K1 / K2 field); GROUP MSCBML0 only."""
     group = str(getattr(p, "group", "MSCBML0") or "MSCBML0").strip().upper()
     if group != "MSCBML0":
         raise BdfError(f"PBARL {p.pid}: GROUP = {group!r} is not supported (MSCBML0, the "
                        f"standard beam library)")
-    return (*pbarl_section(p.beam_type, p.dim, f"PBARL {p.pid}"), float(p.nsm or 0.0), 0.0, 0.0)
+    k = _LIBRARY_SHEAR.get(str(p.beam_type).upper(), 0.0)
+    return (*pbarl_section(p.beam_type, p.dim, f"PBARL {p.pid}"), float(p.nsm or 0.0), k, k)
 
 
-_SECTION_VALUES = {"PBAR": _pbar_values, "PBEAM": _pbeam_values, "PBARL": _pbarl_values}
+def _pbeaml_stations(p) -> tuple:
+    """PBEAML: (x/XB stations, rows (DIM1..DIMn, NSM) per station, 0, 0) in deck units, the
+    section type one of :data:`PBARL_TYPES` (shared with PBARL, :func:`pbarl_section`, which
+    checks every station's dimensions); GROUP MSCBML0 only; shear factors as PBARL's."""
+    where = f"PBEAML {p.pid}"
+    group = str(getattr(p, "group", "MSCBML0") or "MSCBML0").strip().upper()
+    if group != "MSCBML0":
+        raise BdfError(f"{where}: GROUP = {group!r} is not supported (MSCBML0, the standard "
+                       f"beam library)")
+    dims = np.atleast_2d(np.asarray(p.dim, float))
+    nsm = np.atleast_1d(np.asarray(p.nsm, float))
+    for d in dims:
+        pbarl_section(p.beam_type, d, where)
+    xs, rows = _stations(p.xxb, np.column_stack([dims, nsm]), where)
+    k = _LIBRARY_SHEAR.get(str(p.beam_type).upper(), 0.0)
+    return xs, rows, k, k
+
+
+def _single_station(values):
+    """A PBAR / PBARL as one station: (x/XB = [0, 1], rows (A, I1, I2, J, NSM) twice, K1, K2)."""
+    row = np.asarray(values[:5], float)
+    return np.array([0.0, 1.0]), np.vstack([row, row]), values[5], values[6]
+
+
+#: per property card: (x/XB stations, rows, K1, K2) and the row -> (A, I1, I2, J, NSM) map.
+_STATIONS = {"PBAR": lambda p: _single_station(_pbar_values(p)),
+             "PBARL": lambda p: _single_station(_pbarl_values(p)),
+             "PBEAM": _pbeam_stations, "PBEAML": _pbeaml_stations}
 #: the properties each line element may reference (MSC QRG CBAR / CBEAM PID).
-_ELEMENT_PROPERTIES = {"CBAR": ("PBAR", "PBARL"), "CBEAM": ("PBEAM", "PBARL")}
+_ELEMENT_PROPERTIES = {"CBAR": ("PBAR", "PBARL"), "CBEAM": ("PBEAM", "PBARL", "PBEAML")}
+
+
+def _row_values(p):
+    """Row of :data:`_STATIONS` -> (A, I1, I2, J, NSM) of property ``p``."""
+    if p.type == "PBEAML":
+        return lambda r: (*pbarl_section(p.beam_type, r[:-1], f"PBEAML {p.pid}"), r[-1])
+    return lambda r: tuple(r)
+
+
+def _si_section(values, k1, k2, mat, deck_units, polar: bool = False) -> BarSection:
+    """(A, I1, I2, J, NSM) in deck units + MAT1 -> :class:`BarSection` (SI); ``polar``: the
+    section's polar mass moment rho (I1 + I2) on the twist (a CBEAM's, not a CBAR's)."""
+    L, Mu, T, wt = deck_units
+    A, i1, i2, j, nsm = (float(v) for v in values)
+    E, G, rho = mat.e, mat.g, mat.rho or 0.0
+    stress = Mu / (L * T * T)                      # deck pressure in Pa
+    gas = [k * G * A * stress * L ** 2 if k else math.inf for k in (k1, k2)]
+    return BarSection(ea=E * A * stress * L ** 2, gj=G * j * stress * L ** 4,
+                      ei1=E * i1 * stress * L ** 4, ei2=E * i2 * stress * L ** 4,
+                      mass=(rho * A + (nsm or 0.0)) * wt * Mu / L, gas1=gas[0], gas2=gas[1],
+                      polar=rho * (i1 + i2) * wt * Mu * L if polar else 0.0)
+
+
+def bar_stations(model, pid: int, eid: int, deck_units, card: str = "CBAR"):
+    """The section of a CBAR / CBEAM along it: PBAR / PBARL (uniform), PBEAM (stations x/XB,
+    each property linearly interpolated between them) or PBEAML (stations, the dimensions
+    DIMi and NSM linearly interpolated, the section from :func:`pbarl_section` at each point)
+    + MAT1, in SI.
+
+    Parameters
+    ----------
+    model : pyNastran ``BDF``, cross-referenced.
+    pid, eid : the element's PID and id; card : "CBAR" or "CBEAM" (which properties it takes).
+    deck_units : (L m, Mu kg, T s, PARAM WTMASS) of one deck unit.
+
+    Returns
+    -------
+    (breaks, section_at, uniform) : the stations (ascending, 0.0 ... 1.0), a callable
+        xi -> :class:`~asekit.structure.frame.BarSection` (EA = E A, GJ = G J, EI1 = E I1,
+        EI2 = E I2 in N, N m^2; mass = (rho A + NSM) WTMASS in kg/m; K G A from K1 / K2; a
+        CBEAM's polar mass moment rho (I1 + I2) WTMASS in kg m) and whether every station is
+        the same.
+
+    Raises
+    ------
+    BdfError
+        Naming the card, its id and the field asekit cannot represent.
+    """
+    p = model.properties[pid]
+    if p.type not in _ELEMENT_PROPERTIES[card]:
+        raise BdfError(f"{card} {eid}: PID {pid} is a {p.type}; a {card} takes "
+                       f"{' or '.join(_ELEMENT_PROPERTIES[card])}")
+    xs, rows, k1, k2 = _STATIONS[p.type](p)
+    to_values = _row_values(p)
+    for r in rows:
+        A = to_values(r)[0]
+        if not A > 0:
+            raise BdfError(f"{p.type} {pid}: A = {A!r} must be > 0")
+    mat = model.materials[p.mid]
+    if mat.type != "MAT1":
+        raise BdfError(f"{p.type} {pid}: MID {p.mid} is a {mat.type}; only MAT1 is supported")
+    E, G = mat.e, mat.g
+    if not (E and E > 0 and G is not None and G >= 0):
+        raise BdfError(f"MAT1 {p.mid}: E must be > 0 and G >= 0, got E = {E!r}, G = {G!r}")
+    if (k1 or k2) and not G > 0:
+        raise BdfError(f"{p.type} {pid}: K1 / K2 (shear flexibility) need MAT1 {p.mid} G > 0")
+
+    def section_at(xi: float) -> BarSection:
+        r = np.array([np.interp(xi, xs, col) for col in rows.T])
+        return _si_section(to_values(r), k1, k2, mat, deck_units, card == "CBEAM")
+
+    return xs, section_at, bool(np.all(rows == rows[0]))
 
 
 def bar_section(model, pid: int, eid: int, deck_units, card: str = "CBAR") -> BarSection:
-    """PBAR / PBEAM / PBARL + MAT1 of a CBAR / CBEAM as SI section properties.
+    """PBAR / PBEAM / PBARL / PBEAML + MAT1 of a CBAR / CBEAM of uniform section as SI section
+    properties (:func:`bar_stations`).
 
     Parameters
     ----------
@@ -421,29 +555,15 @@ def bar_section(model, pid: int, eid: int, deck_units, card: str = "CBAR") -> Ba
     Raises
     ------
     BdfError
-        Naming the card, its id and the field asekit cannot represent.
+        Naming the card, its id and the field asekit cannot represent, or a section that
+        varies along the element (a tapered PBEAM / PBEAML).
     """
-    L, Mu, T, wt = deck_units
-    p = model.properties[pid]
-    if p.type not in _ELEMENT_PROPERTIES[card]:
-        raise BdfError(f"{card} {eid}: PID {pid} is a {p.type}; a {card} takes "
-                       f"{' or '.join(_ELEMENT_PROPERTIES[card])}")
-    A, i1, i2, j, nsm, k1, k2 = _SECTION_VALUES[p.type](p)
-    if not A > 0:
-        raise BdfError(f"{p.type} {pid}: A = {A!r} must be > 0")
-    mat = model.materials[p.mid]
-    if mat.type != "MAT1":
-        raise BdfError(f"{p.type} {pid}: MID {p.mid} is a {mat.type}; only MAT1 is supported")
-    E, G, rho = mat.e, mat.g, mat.rho or 0.0
-    if not (E and E > 0 and G is not None and G >= 0):
-        raise BdfError(f"MAT1 {p.mid}: E must be > 0 and G >= 0, got E = {E!r}, G = {G!r}")
-    stress = Mu / (L * T * T)                      # deck pressure in Pa
-    if (k1 or k2) and not G > 0:
-        raise BdfError(f"{p.type} {pid}: K1 / K2 (shear flexibility) need MAT1 {p.mid} G > 0")
-    gas = [k * G * A * stress * L ** 2 if k else math.inf for k in (k1, k2)]
-    return BarSection(ea=E * A * stress * L ** 2, gj=G * j * stress * L ** 4,
-                      ei1=E * i1 * stress * L ** 4, ei2=E * i2 * stress * L ** 4,
-                      mass=(rho * A + (nsm or 0.0)) * wt * Mu / L, gas1=gas[0], gas2=gas[1])
+    xs, section_at, uniform = bar_stations(model, pid, eid, deck_units, card)
+    if not uniform:
+        p = model.properties[pid]
+        raise BdfError(f"{p.type} {pid}: the section varies along the beam (stations X/XB "
+                       f"{xs.tolist()}); only a uniform section is supported here")
+    return section_at(0.0)
 
 
 def _add_bars(model, K, M, index, xyz, axes, coupled, deck_units) -> None:
@@ -453,8 +573,12 @@ def _add_bars(model, K, M, index, xyz, axes, coupled, deck_units) -> None:
         ia, ib = index[e.ga], index[e.gb]
         v = bar_orientation(model, e, lambda g: axes[index[g]], lambda g: xyz[index[g]])
         try:
-            sec = bar_section(model, e.pid, eid, deck_units, e.type)
-            Ke, Me = global_bar_matrices(xyz[ia], xyz[ib], v, sec, coupled)
+            xs, section_at, uniform = bar_stations(model, e.pid, eid, deck_units, e.type)
+            if uniform:
+                Ke, Me = global_bar_matrices(xyz[ia], xyz[ib], v, section_at(0.0), coupled)
+            else:
+                Ke, Me = global_tapered_bar_matrices(xyz[ia], xyz[ib], v, section_at, xs,
+                                                     coupled)
         except BdfError:
             raise
         except ValueError as exc:
@@ -582,8 +706,144 @@ def _resolve_chains(dep: dict, who: dict, ids) -> dict:
     return done
 
 
+def rbe3_weights(x_ref, x_ind, comps, weights, axes_ind=None, refc=(1, 2, 3, 4, 5, 6),
+                 axes_ref=None) -> np.ndarray:
+    """The RBE3 interpolation: the reference grid's REFC components from the independent grids'
+    weighted components, as a weighted least-squares fit of a rigid motion.
+
+    MSC Nastran Quick Reference Guide, RBE3 ("defines the motion at a reference grid point as
+    the weighted average of the motions at a set of other grid points"; remark: the
+    independent components must be able to react the rigid-body motion of the REFC
+    components) and the MSC Nastran Reference Manual's RBE3 description (MSC.Nastran 2005
+    seminar NAS105, Sec. 2 "RBE3: how it works"): with S_i the rigid-body map of the reference
+    grid's motion u_ref = (u, theta) (basic) to grid i's six DOFs,
+
+        S_i = A_i [[I, -S(x_i - x_ref)], [0, I]],   A_i = diag(R_i, R_i) (basic -> grid i's CD),
+
+    P_i the rows of grid i's components C_i and W_i = WT_i diag(1 translation, L_c^2
+    rotation) (L_c the mean distance of the independent grids from the reference grid, which
+    makes a rotational weight comparable with a translational one; asekit's reading of MSC's
+    description, not compared with an f06: it matters only with rotations in Ci and a fit that
+    is not exact), the reference motion is
+    the least-squares fit of a rigid motion to the independent motions,
+
+        u_ref = N^+ sum_i G_i^T W_i u_i,   N = sum_i G_i^T W_i G_i,   G_i = P_i S_i,
+
+    and REFC component c (row a_c of A_ref) is a_c u_ref. N may be singular (a planar model's
+    out-of-plane components react only its out-of-plane motion): a_c must then be normal to
+    N's null space (every least-squares fit gives component c the same value), else it is
+    refused. The constraint is the transpose of the load distribution F_i = W_i G_i N^+ F_ref,
+    so an RBE3 carries loads and mass without stiffening: a rigid motion of the independent
+    grids gives the same rigid motion at the reference grid (u_i = G_i u_ref fits exactly).
+
+    Parameters
+    ----------
+    x_ref : (3,) reference grid position (basic, m).
+    x_ind : (n, 3) independent grid positions (basic, m).
+    comps : n component lists (1-6, each grid's CD system).
+    weights : (n,) WT of each grid (> 0).
+    axes_ind : (n, 3, 3) rows of each grid's CD axes in basic (default basic).
+    refc : the reference grid's dependent components (1-6, its CD system).
+    axes_ref : (3, 3) rows of the reference grid's CD axes in basic (default basic).
+
+    Returns
+    -------
+    (len(refc), sum len(comps)) : the REFC components from the independent components, in
+        the order grid by grid, component by component.
+
+    Raises
+    ------
+    ValueError
+        When a REFC component is not determined (the independent components cannot react its
+        rigid-body motion, e.g. translations of collinear grids only).
+
+    Examples
+    --------
+    Four equally weighted grids around the origin: the reference moves with their mean.
+
+    >>> x = [[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]]
+    >>> W = rbe3_weights([0, 0, 0], x, [[1, 2, 3]] * 4, [1.0] * 4, refc=[3])
+    >>> W[0].round(12).tolist()[2::3]               # u_z of the reference from the four u_z
+    [0.25, 0.25, 0.25, 0.25]
+    """
+    x_ref = np.asarray(x_ref, float)
+    x_ind = np.atleast_2d(np.asarray(x_ind, float))
+    n = x_ind.shape[0]
+    axes_ind = np.array([np.eye(3)] * n) if axes_ind is None else np.asarray(axes_ind, float)
+    A_ref = np.kron(np.eye(2), np.eye(3) if axes_ref is None else np.asarray(axes_ref, float))
+    wt = np.asarray(weights, float)
+    if wt.shape != (n,) or len(comps) != n or not np.all(wt > 0):
+        raise ValueError("weights must hold one WT > 0 per independent grid, and comps one "
+                         "component list per grid")
+    lc = float(np.mean(np.linalg.norm(x_ind - x_ref, axis=1)))
+    rows, wdiag = [], []
+    for i in range(n):
+        S = np.eye(6)
+        S[:3, 3:] = -_skew(x_ind[i] - x_ref)
+        G = np.kron(np.eye(2), axes_ind[i]) @ S
+        for c in comps[i]:
+            rows.append(G[int(c) - 1])
+            wdiag.append(wt[i] * (1.0 if int(c) <= 3 else lc * lc))
+    G = np.array(rows).reshape(-1, 6)
+    GW = G.T * np.array(wdiag)
+    lam, V = np.linalg.eigh(GW @ G)
+    tol = 1e-10 * max(float(lam.max(initial=0.0)), 1e-300)
+    null, keep = V[:, lam <= tol], lam > tol
+    a = A_ref[[int(c) - 1 for c in refc]]
+    if null.size and np.abs(a @ null).max() > 1e-8:
+        raise ValueError("the independent grids' components cannot react the reference "
+                         "grid's rigid-body motion in REFC (e.g. translations of collinear "
+                         "grids only: add a rotation to Ci, MSC QRG RBE3 remark)")
+    Ninv = (V[:, keep] / lam[keep]) @ V[:, keep].T
+    return a @ Ninv @ GW
+
+
+def _rbe3_link(dep: dict, r, index, xyz, axes, who: dict) -> None:
+    """RBE3 (:func:`rbe3_weights`): the REFC components (CD) of REFGRID as dependent rows of
+    the independent grids' weighted components; the UM alternative and a REFGRID that is also
+    independent are refused naming the card and field."""
+    what = f"RBE3 {r.eid}"
+    if r.Gmi:
+        raise BdfError(f"{what}: UM (GM1 = {r.Gmi[0]}) is not supported (blank: the REFC "
+                       f"components of REFGRID are the dependent ones)")
+    ref = int(r.refgrid)
+    if ref not in index:
+        raise BdfError(f"{what}: REFGRID = {ref} is not a GRID")
+    grids, comps, wts = [], [], []
+    for wt, c, gs in zip(r.weights, r.comps, r.Gijs):
+        for g in gs:
+            g = int(g)
+            if g == ref:
+                raise BdfError(f"{what}: REFGRID {ref} is also an independent grid Gi,j "
+                               f"(Nastran refuses it too)")
+            if g not in index:
+                raise BdfError(f"{what}: Gi,j = {g} is not a GRID")
+            if not (wt is not None and float(wt) > 0):
+                raise BdfError(f"{what}: WT = {wt!r} of G {g} must be > 0")
+            grids.append(index[g])
+            comps.append(_components(c))
+            wts.append(float(wt))
+    d = index[ref]
+    refc = _components(r.refc)
+    try:
+        Wc = rbe3_weights(xyz[d], xyz[grids], comps, wts, axes[grids], refc, axes[d])
+    except ValueError as exc:
+        raise BdfError(f"{what}: {exc}") from None
+    cols = [NODE_DOF * g + c - 1 for g, cs in zip(grids, comps) for c in cs]
+    for c, wrow in zip(refc, Wc):
+        row = NODE_DOF * d + c - 1
+        if row in dep:
+            raise BdfError(f"{what}: REFC component {c} of REFGRID {ref} is already dependent "
+                           f"on another rigid element")
+        acc = {}
+        for j, v in zip(cols, wrow):
+            acc[j] = acc.get(j, 0.0) + float(v)
+        dep[row] = tuple((j, v) for j, v in sorted(acc.items()) if abs(v) > 1e-15)
+        who[row] = what
+
+
 def _rigid_links(model, index, xyz, axes, fixed: set, ids) -> tuple:
-    """RBE2 / RBAR as dependent DOF rows (module docstring)."""
+    """RBE2 / RBAR / RBE3 as dependent DOF rows (module docstring)."""
     dep, who = {}, {}
     for eid in sorted(model.rigid_elements):
         r = model.rigid_elements[eid]
@@ -598,8 +858,10 @@ def _rigid_links(model, index, xyz, axes, fixed: set, ids) -> tuple:
                                f"(CNA 123456, CNB and CMA blank)")
             _link(dep, f"RBAR {eid}", index[r.ga], index[r.gb], _components(r.cmb or "123456"),
                   xyz, axes, who)
+        elif r.type == "RBE3":
+            _rbe3_link(dep, r, index, xyz, axes, who)
         else:
-            raise BdfError(f"{r.type} {eid} is not supported (RBE2, RBAR)")
+            raise BdfError(f"{r.type} {eid} is not supported (RBE2, RBAR, RBE3)")
     dep = _resolve_chains(dep, who, ids)
     if fixed & set(dep):
         d = min(fixed & set(dep))
@@ -1269,9 +1531,9 @@ def write_beam_bdf(beam, path, element: str = "CBAR") -> Path:
     Rf[free, free] = R[free, free]
     lines = ["SOL 103", "CEND", "SPC = 1", "METHOD = 1", "BEGIN BULK",
              "$ written by asekit.io.bdf_beam.write_beam_bdf (SI)"]
-    for i, x in enumerate(beam.nodes):
+    for i, x in enumerate(beam.nodes.tolist()):       # Python floats: repr without np.float64
         lines.append(f"GRID,{i + 1},,{x[0]!r},{x[1]!r},{x[2]!r}")
-    v = beam.frame[2]
+    v = np.asarray(beam.frame[2], float).tolist()
     for e, sec in enumerate(beam.sections):
         lines.append(f"{element},{e + 1},{e + 1},{e + 1},{e + 2},{v[0]!r},{v[1]!r},{v[2]!r}")
         lines += _section_lines(element, e + 1, sec)

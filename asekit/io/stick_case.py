@@ -32,7 +32,7 @@ card check of the stick reader applies) and writes what the case format can expr
 - ``modes.count``: PARAM LMODES, else EIGR / EIGRL ND, else 6.
 
 Anything else is refused in one line naming the card, its id and the field: rigid elements
-(RBE2 / RBAR), a lumped bar mass, GRIDs off one straight line in z = 0, an axis pointing
+(RBE2 / RBAR / RBE3), a lumped bar mass, GRIDs off one straight line in z = 0, an axis pointing
 inboard, an oblique orientation vector, other constraints, a translational or two-grid
 CMASS2 (so a deck from :func:`asekit.io.bdf_beam.write_beam_bdf`, whose CMASS2 pairs carry a
 consistent polar inertia, is refused), SPLINE1 / SPLINE4 or a SPLINE2 off the axis or on a
@@ -158,7 +158,7 @@ def _sections(model, sm: StickModel, index, order, e1, deck_units, name: str) ->
         else:
             raise BdfError(f"{e.type} {eid}: orientation vector X1-X3 / G0 is oblique to the "
                            f"plane z = 0: plane 1 must be the flap or the chord plane")
-        out[a] = (sec.ea, sec.gj, flap, chord, sec.mass, 0.0, 0.0)
+        out[a] = (sec.ea, sec.gj, flap, chord, sec.mass, sec.polar, 0.0)
     if any(x is None for x in out):
         raise BdfError(f"{name}: GRIDs without a bar between them: a case's beam is one chain")
     return out
@@ -218,7 +218,7 @@ def _structure(path, units: str, name: str):
     sm = read_stick_deck(path, units)
     model = need_pynastran()(debug=None)
     model.read_bdf(str(path), xref=True)
-    for card in ("RBE2", "RBAR"):
+    for card in ("RBE2", "RBAR", "RBE3"):
         if card_ids(model, card):
             raise BdfError(f"{card} {card_ids(model, card)[0]}: a case's [[beam]] has no rigid "
                            f"links")
@@ -311,7 +311,7 @@ def _flight(requests, f_hz, b_ref: float) -> dict:
     if not vel:
         ks = [k for r in requests for k in r.reduced_frequencies if k > 0]
         w = 2 * math.pi * np.asarray(f_hz, float)
-        lo, hi = w.min() * b_ref / max(ks), w.max() * b_ref / min(ks)
+        lo, hi = float(w.min() * b_ref / max(ks)), float(w.max() * b_ref / min(ks))
         return {"densities": dens, "velocities": {"min": lo, "max": hi,
                                                   "step": (hi - lo) / KE_SWEEP_STEPS}}
     return {"densities": dens, "velocities": vel}

@@ -13,9 +13,12 @@ K G A per plane its shear parameter Phi, Timoshenko's shear flexibility, as Nast
 K1 / K2 and PBAR K1 / K2 ask). Mass: the consistent ("coupled")
 matrix of the same shape functions, Przemieniecki Eq. 11.41 for axial and transverse motion, or
 the lumped one, m L / 2 on each node's three translations (Nastran's default for the CBAR,
-PARAM COUPMASS < 1). Neither carries a polar (torsional) mass moment: a bar's mass is m = rho A
-+ NSM per length on its axis, as Nastran's CBAR has it (its PBAR has no polar-inertia field;
-torsional inertia is given by point masses).
+PARAM COUPMASS < 1). A CBAR carries no polar (torsional) mass moment: its mass is m = rho A
++ NSM per length on its axis (its PBAR has no polar-inertia field; torsional inertia is given by
+point masses). A CBEAM carries I_p = rho (I1 + I2) per length on its twist, with the same
+linear shape (I_p L / 6 [[2, 1], [1, 2]], or I_p L / 2 on each end when lumped): Simcenter
+Nastran 2019.2's lumped modes of pyNastran's beam_modes deck (data/benchmarks/beam_modes) have
+it on the CBEAM and not on the CBARs.
 
 Global matrices: with the direction-cosine matrix R (rows e_x, e_y, e_z in the global frame)
 and T = diag(R, R, R, R) (12 x 12), u_local = T u_global and
@@ -23,6 +26,11 @@ and T = diag(R, R, R, R) (12 x 12), u_local = T u_global and
     K_global = T^T K_local T,  M_global = T^T M_local T          (Przemieniecki Eq. 6.26),
 
 so the element's frequencies do not depend on how the structure is placed in space. SI units.
+
+A bar whose section varies along it (Nastran's tapered PBEAM / PBEAML):
+:func:`tapered_bar_matrices`, its stiffness from the flexibility of the element clamped at one
+end (exact for end loads whatever the variation), its mass from the same shape functions with
+the mass per length under the integral.
 """
 
 from __future__ import annotations
@@ -51,6 +59,8 @@ class BarSection:
     mass : mass per length m = rho A + NSM (kg/m), >= 0.
     gas1, gas2 : transverse shear stiffness K G A of plane 1 and plane 2 (N), > 0; inf
         (default) neglects the shear flexibility (Euler-Bernoulli).
+    polar : polar mass moment of inertia per length about the axis, rho (I1 + I2) (kg m),
+        >= 0 (default 0: Nastran's CBAR has none; its CBEAM has it).
 
     Examples
     --------
@@ -65,10 +75,11 @@ class BarSection:
     mass: float
     gas1: float = math.inf
     gas2: float = math.inf
+    polar: float = 0.0
 
     def __post_init__(self):
         object.__setattr__(self, "ea", positive("ea", self.ea))
-        for name in ("gj", "ei1", "ei2", "mass"):
+        for name in ("gj", "ei1", "ei2", "mass", "polar"):
             object.__setattr__(self, name, in_range(name, getattr(self, name), 0.0, True))
         for name in ("gas1", "gas2"):
             v = float(getattr(self, name))
@@ -146,7 +157,8 @@ def bar_matrices(section: BarSection, length: float, coupled: bool = True):
     Returns
     -------
     (K, M) : (12, 12) symmetric arrays (SI). Blocks: axial E A / L [[1, -1], [-1, 1]] with
-        mass m L / 6 [[2, 1], [1, 2]] (coupled); torsion G J / L, no mass; plane 1 (u2, r3 =
+        mass m L / 6 [[2, 1], [1, 2]] (coupled); torsion G J / L with mass I_p L / 6
+        [[2, 1], [1, 2]] (lumped I_p L / 2 each; I_p = ``polar``, 0 for a CBAR); plane 1 (u2, r3 =
         u2') with E I1 and plane 2 (u3, r2 = -u3') with E I2 by Hermite cubics.
 
     Examples
@@ -164,6 +176,8 @@ def bar_matrices(section: BarSection, length: float, coupled: bool = True):
     M[np.ix_(ax, ax)] = (s.mass * L / 6 * np.array([[2.0, 1.0], [1.0, 2.0]]) if coupled
                          else np.diag([s.mass * L / 2] * 2))
     K[np.ix_(tw, tw)] = s.gj / L * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    M[np.ix_(tw, tw)] = (s.polar * L / 6 * np.array([[2.0, 1.0], [1.0, 2.0]]) if coupled
+                         else np.diag([s.polar * L / 2] * 2))
     for dofs, ei, sign, gas in (([1, 5, 7, 11], s.ei1, 1.0, s.gas1),
                                 ([2, 4, 8, 10], s.ei2, -1.0, s.gas2)):
         k, m = _bending(ei, s.mass, L, sign, coupled, gas)
@@ -204,4 +218,154 @@ def global_bar_matrices(xa, xb, v, section: BarSection, coupled: bool = True):
     """
     L, R = bar_frame(xa, xb, v)
     K, M = bar_matrices(section, L, coupled)
+    return rotate(K, R), rotate(M, R)
+
+
+# ---------------------------------------------------------------------------------------------
+# a bar whose section varies along it (Nastran's tapered PBEAM / PBEAML)
+# ---------------------------------------------------------------------------------------------
+def _gauss_points(breaks, n: int, parts: int = 4):
+    """Composite Gauss-Legendre points and weights on [0, 1]: each interval between
+    ``breaks`` cut into ``parts`` equal pieces of n points (the flexibility integrands
+    1 / EI are not polynomials: a strong taper puts their pole near the interval)."""
+    g, w = np.polynomial.legendre.leggauss(n)
+    xs, ws = [], []
+    for a0, b0 in zip(breaks[:-1], breaks[1:]):
+        cuts = np.linspace(a0, b0, parts + 1)
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            xs.append(a + (b - a) * (g + 1) / 2)
+            ws.append((b - a) / 2 * w)
+    return np.concatenate(xs), np.concatenate(ws)
+
+
+def _hermite(xi, L):
+    """Cubic Hermite functions (w1, w1', w2, w2') on xi in [0, 1] of a bar of length L."""
+    return np.array([1 - 3 * xi ** 2 + 2 * xi ** 3, L * (xi - 2 * xi ** 2 + xi ** 3),
+                     3 * xi ** 2 - 2 * xi ** 3, L * (xi ** 3 - xi ** 2)])
+
+
+def _end_flexibility_stiffness(f11, f12, f22, L, sign):
+    """(4, 4) stiffness of one bending plane, DOFs (w1, r1, w2, r2), r = sign w', from the
+    flexibility (f11, f12, f22) of end B of the bar clamped at A, loads (P, M) -> (w, w'):
+    K_BB = F^-1 and, with the rigid-body map R = [[1, L], [0, 1]] of end A's (w, w') to
+    end B, K = [[R^T K_BB R, -R^T K_BB], [-K_BB R, K_BB]] (equilibrium of the free body)."""
+    Kbb = np.linalg.inv(np.array([[f11, f12], [f12, f22]]))
+    R = np.array([[1.0, L], [0.0, 1.0]])
+    k = np.block([[R.T @ Kbb @ R, -R.T @ Kbb], [-Kbb @ R, Kbb]])
+    s = np.diag([1.0, sign, 1.0, sign])
+    return s @ k @ s
+
+
+def tapered_bar_matrices(section_at, length: float, breaks=(0.0, 1.0), coupled: bool = True,
+                         n_gauss: int = 16):
+    """Local stiffness and mass (12 x 12) of a bar whose section varies along it, DOFs and
+    frame as :func:`bar_matrices` (which it reproduces for a uniform section).
+
+    Stiffness from the flexibility of the bar clamped at end A under end-B loads, exact for a
+    bar loaded only at its ends whatever the variation (the force method: complementary
+    energy of the end loads' internal forces, Przemieniecki 1968 Ch. 5, the cantilever
+    flexibility inverted and completed by equilibrium as in its derivation of Eq. 5.116):
+    per bending plane, with x from A and xi = x / L,
+
+        f11 = int (L - x)^2 / EI dx + int 1 / (K G A) dx,  f12 = int (L - x) / EI dx,
+        f22 = int 1 / EI dx,
+
+    axial stiffness 1 / int 1 / (E A) dx and torsional 1 / int 1 / (G J) dx. Mass: the
+    consistent matrix of the uniform bar's shape functions with m(x) (Przemieniecki Eq. 11.41
+    with m under the integral: int m N^T N dx, Hermite cubics across, linear along and in
+    twist with the polar inertia), or the lumped one, int m (1 - xi) dx and int m xi dx on
+    A's and B's translations (and the polar inertia likewise on their twists). Integrals by
+    composite Gauss-Legendre quadrature, each interval between ``breaks`` (the stations where
+    the section's interpolation changes slope) in four pieces of ``n_gauss`` points (the
+    flexibility of a linear E I from 1 to 1/27 along the bar to 1e-10).
+
+    Parameters
+    ----------
+    section_at : callable xi -> :class:`BarSection` (xi in [0, 1], 0 at A).
+    length : L (m), > 0.
+    breaks : ascending stations from 0.0 to 1.0 (the section is smooth between them).
+    coupled : consistent (True) or lumped mass.
+    n_gauss : quadrature points per piece (>= 2).
+
+    Returns
+    -------
+    (K, M) : (12, 12) symmetric arrays (SI).
+
+    Examples
+    --------
+    A uniform section gives the uniform bar:
+
+    >>> s = BarSection(2.0, 1.0, 3.0, 4.0, 5.0)
+    >>> K, M = tapered_bar_matrices(lambda xi: s, 1.5)
+    >>> K0, M0 = bar_matrices(s, 1.5)
+    >>> bool(np.allclose(K, K0, rtol=1e-12) and np.allclose(M, M0, rtol=1e-12))
+    True
+    """
+    L = positive("length", length)
+    breaks = np.asarray(breaks, float)
+    if (breaks.ndim != 1 or breaks.size < 2 or breaks[0] != 0.0 or breaks[-1] != 1.0
+            or np.any(np.diff(breaks) <= 0)):
+        raise ValueError(f"breaks must ascend strictly from 0.0 to 1.0, got {breaks.tolist()}")
+    if int(n_gauss) < 2:
+        raise ValueError(f"n_gauss must be >= 2, got {n_gauss}")
+    xi, wq = _gauss_points(breaks, int(n_gauss))
+    secs = [section_at(float(x)) for x in xi]
+    val = {k: np.array([getattr(s, k) for s in secs], float)
+           for k in ("ea", "gj", "ei1", "ei2", "mass", "gas1", "gas2", "polar")}
+    if np.any(val["ea"] <= 0):
+        raise ValueError("the section's ea must be > 0 along the bar")
+    dx = wq * L
+    K, M = np.zeros((12, 12)), np.zeros((12, 12))
+    ax, tw = np.array([0, 6]), np.array([3, 9])
+    unit = np.array([[1.0, -1.0], [-1.0, 1.0]])
+    K[np.ix_(ax, ax)] = unit / np.sum(dx / val["ea"])
+    with np.errstate(divide="ignore"):
+        flex_gj = np.sum(dx / val["gj"])
+    K[np.ix_(tw, tw)] = unit * (1.0 / flex_gj if np.isfinite(flex_gj) else 0.0)
+    m = val["mass"]
+    N = _hermite(xi, L)
+    lin = np.array([1 - xi, xi])
+    for dofs, ei, gas, sign in (([1, 5, 7, 11], val["ei1"], val["gas1"], 1.0),
+                                ([2, 4, 8, 10], val["ei2"], val["gas2"], -1.0)):
+        if np.all(ei > 0):
+            arm = L * (1 - xi)
+            f11 = np.sum(dx * arm ** 2 / ei) + np.sum(dx / gas)
+            K[np.ix_(dofs, dofs)] = _end_flexibility_stiffness(
+                f11, np.sum(dx * arm / ei), np.sum(dx / ei), L, sign)
+        elif np.any(ei > 0):
+            raise ValueError("a bending stiffness that vanishes on part of the bar only")
+        if coupled:
+            s = np.diag([1.0, sign, 1.0, sign])
+            M[np.ix_(dofs, dofs)] = s @ ((N * (m * dx)) @ N.T) @ s
+    ip = val["polar"]
+    if coupled:
+        M[np.ix_(ax, ax)] = (lin * (m * dx)) @ lin.T
+        M[np.ix_(tw, tw)] = (lin * (ip * dx)) @ lin.T
+    else:
+        mab = (lin * (m * dx)).sum(axis=1)
+        pab = (lin * (ip * dx)).sum(axis=1)
+        for node, (mm, pp) in enumerate(zip(mab, pab)):
+            for c in range(3):
+                M[6 * node + c, 6 * node + c] = mm
+            M[6 * node + 3, 6 * node + 3] = pp
+    return K, M
+
+
+def global_tapered_bar_matrices(xa, xb, v, section_at, breaks=(0.0, 1.0),
+                                coupled: bool = True):
+    """:func:`tapered_bar_matrices` in the global frame (:func:`bar_frame`, :func:`rotate`).
+
+    Returns
+    -------
+    (K, M) : (12, 12) arrays, DOFs (u_x, u_y, u_z, r_x, r_y, r_z) of A then B (SI).
+
+    Examples
+    --------
+    >>> s = BarSection(1.0, 1.0, 1.0, 1.0, 1.0)
+    >>> K, M = global_tapered_bar_matrices([0, 0, 0], [1, 1, 0], [0, 0, 1], lambda xi: s)
+    >>> round(float(M[np.ix_([2, 8], [2, 8])].sum()), 12)
+    1.414213562373
+    """
+    L, R = bar_frame(xa, xb, v)
+    K, M = tapered_bar_matrices(section_at, L, breaks, coupled)
     return rotate(K, R), rotate(M, R)

@@ -47,9 +47,9 @@ def _cantilever(path, R=np.eye(3), extra=(), offt=""):
     """A cantilever CBAR deck along R's first row, plane-1 vector R's third row."""
     lines = ["SOL 103", "CEND", "SPC = 1", "BEGIN BULK"]
     for i in range(NEL + 1):
-        x = R[0] * LEN * i / NEL
+        x = (R[0] * LEN * i / NEL).tolist()
         lines.append(f"GRID,{i + 1},,{x[0]!r},{x[1]!r},{x[2]!r}")
-    v = R[2]
+    v = R[2].tolist()
     for i in range(NEL):
         lines.append(f"CBAR,{i + 1},1,{i + 1},{i + 2},{v[0]!r},{v[1]!r},{v[2]!r},{offt}")
     lines += [f"PBAR,1,1,{A!r},{I1!r},{I2!r},{J!r}", f"MAT1,1,{E!r},,{NU!r},{RHO!r}",
@@ -107,8 +107,8 @@ def test_pt145_modes_match_its_f06():
 
 
 def test_refused_cards_and_fields_are_named(tmp_path):
-    deck = _cantilever(tmp_path / "r.bdf", extra=("RBE3,500,,1,123456,1.0,123,2,3",))
-    with pytest.raises(BdfError, match=r"RBE3 \(x1, first id 500\)"):
+    deck = _cantilever(tmp_path / "r.bdf", extra=("RBE1,500,1,123456,,,,,,", ",UM,2,123456",))
+    with pytest.raises(BdfError, match=r"RBE1 \(x1, first id 500\)"):
         read_stick_deck(deck)
     deck = _cantilever(tmp_path / "o.bdf", offt="BGG")
     with pytest.raises(BdfError, match="CBAR 1: OFFT"):
@@ -279,12 +279,12 @@ def test_chained_rigid_links_equal_the_combined_offset_mass(tmp_path):
     (rigid kinematics compose: Przemieniecki 1968 Sec. 11.7), and so do the modes."""
     tip, mid, dep = NEL + 1, NEL + 2, NEL + 3
     o1, o2 = np.array([0.02, 0.15, -0.04]), np.array([0.01, 0.05, 0.09])
-    off = o1 + o2
+    off = (o1 + o2).tolist()
     mt = 2 * RHO * A * LEN
     direct = _cantilever(tmp_path / "d.bdf", extra=(f"CONM2,99,{tip},,{mt!r},{off[0]!r},"
                                                     f"{off[1]!r},{off[2]!r}",))
     cd = "CORD2R,5,,0.0,0.0,0.0,0.3,0.4,0.8\n,0.9,-0.1,0.2"
-    xm, xd = np.array([LEN, 0.0, 0.0]) + o1, np.array([LEN, 0.0, 0.0]) + off
+    xm, xd = (np.array([LEN, 0.0, 0.0]) + o1).tolist(), (np.array([LEN, 0.0, 0.0]) + off).tolist()
     linked = _cantilever(tmp_path / "l.bdf", extra=(
         cd, f"GRID,{mid},,{xm[0]!r},{xm[1]!r},{xm[2]!r},5",
         f"GRID,{dep},,{xd[0]!r},{xd[1]!r},{xd[2]!r}", f"CONM2,99,{dep},,{mt!r}",
@@ -333,7 +333,7 @@ def test_orientation_vector_is_read_in_the_grids_cd_system(tmp_path):
     R = _rotation(0.7, -0.4, 1.1)
     f0 = stick_modes(read_stick_deck(_cantilever(tmp_path / "a.bdf")), 6).frequencies_hz
     text = _cantilever(tmp_path / "r.bdf", R).read_text()
-    a, c = R[2], R[0]                  # a point on the z axis and one in the x-z plane
+    a, c = R[2].tolist(), R[0].tolist()  # a point on the z axis and one in the x-z plane
     cord = f"CORD2R,7,,0.0,0.0,0.0,{a[0]!r},{a[1]!r},{a[2]!r}\n,{c[0]!r},{c[1]!r},{c[2]!r}"
     lines = []
     for line in text.splitlines():
