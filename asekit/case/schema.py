@@ -1023,13 +1023,7 @@ def _control_surfaces(raw, panels) -> tuple[ControlSurfaceSpec, ...]:
     names = [c.name for c in out]
     if len(set(names)) != len(names):
         raise CaseError(f"control_surface[].name must be unique, got {names}")
-    elastic = [i for i, c in enumerate(out) if c.kind == "elastic"]
-    if elastic and len(elastic) < len(out):      # several elastic side by side: issue 25
-        rigid = next(i for i, c in enumerate(out) if c.kind != "elastic")
-        raise CaseError(f"control_surface[{rigid}].kind = \"{out[rigid].kind}\" cannot be "
-                        f"mixed with the elastic control_surface[{elastic[0]}]: give every "
-                        f"surface of the case the same kind (\"rigid\" or \"elastic\")")
-    _check_nesting(out)
+    _check_nesting(out)          # rigid and elastic surfaces may be mixed (issue 25)
     return out
 
 
