@@ -595,6 +595,50 @@ def _mixed_balance(m, unbalance, balance, hm, cb, col, kinds) -> None:
         m += bm.mass * np.outer(v, v)
 
 
+def link_surfaces(fm: FlapModel, links) -> FlapModel:
+    """The model with linked hinge coordinates (MSC Nastran's AELINK; a geared tab,
+    delta_tab = G delta_flap): x = T_x x_free with T_x = diag(I, T) and T the surfaces'
+    gearing matrix (:func:`asekit.aero.control_surface.gearing_matrix`), so that
+    M' = T_x^T M T_x, K' = T_x^T K T_x, C' = T_x^T C T_x (the kinetic and strain energies of
+    the constrained motion; Cook, Malkus, Plesha & Witt, 2002, Sec. 9.2) and the box modes
+    B' = B T_x (a free surface's column carries its slaves' deflections, G times theirs).
+
+    The free surfaces' inertia is the linked motion's, I' = I_m + 2 G M_ms + G^2 I_s, their
+    unbalance S' = S_m + G S_s, their hinge stiffness k' = k_m + G^2 k_s (a slave's own
+    hinge spring, if any, is strained by the gearing), ``names`` the free surfaces'.
+
+    Examples
+    --------
+    Two uncoupled unit hinges, the second geared to the first by G = 2:
+
+    >>> from asekit.aero.spline import BoxModes
+    >>> from asekit.aeroelastic.statespace import ModalArrays
+    >>> z = np.zeros((1, 3))
+    >>> fm = FlapModel(ModalArrays(np.eye(3), np.diag([1.0, 4.0, 0.0]), np.zeros((3, 3)), 0),
+    ...                BoxModes(z, z, z), np.ones(2), np.array([0.1, 0.2]), np.ones(2), 1,
+    ...                ("flap", "tab"))
+    >>> lk = link_surfaces(fm, [(1, 0, 2.0)])
+    >>> lk.names, lk.inertia.tolist(), round(float(lk.static_unbalance[0]), 12)
+    (('flap',), [5.0], 0.5)
+    """
+    from asekit.aero.control_surface import gearing_matrix
+
+    n_s = len(fm.names)
+    T, free = gearing_matrix(n_s, links)
+    n = fm.n_wing
+    tx = np.zeros((n + n_s, n + free.size))
+    tx[:n, :n] = np.eye(n)
+    tx[n:, n:] = T
+    m, k, c = (tx.T @ np.asarray(a, float) @ tx for a in (fm.modal.M, fm.modal.K, fm.modal.C))
+    box = BoxModes(fm.box_modes.h_cp @ tx, fm.box_modes.dhdx_cp @ tx, fm.box_modes.h_lp @ tx)
+    inertia = np.diag(m[n:, n:]).copy()
+    k_h = np.diag(k[n:, n:])
+    return FlapModel(ModalArrays(m, k, c, fm.modal.n_rigid), box, inertia,
+                     T.T @ np.asarray(fm.static_unbalance, float),
+                     np.sqrt(k_h / inertia) / (2.0 * math.pi), n,
+                     tuple(fm.names[i] for i in free))
+
+
 @dataclass(frozen=True)
 class StaticEffectiveness:
     """Steady flexible-to-rigid effectiveness of each surface: ``dynamic_pressure`` (n_q,) Pa;
