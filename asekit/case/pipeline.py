@@ -1349,10 +1349,21 @@ def control_surface_model(case: Case):
     per control surface, its hinge spring, damper and balance masses
     (:func:`asekit.aeroelastic.control_surface.flap_modal_model`); for ``kind = "elastic"``
     the plate released along the hinge, reduced to fixed-hinge modes plus the hinge rotation
-    (:func:`_elastic_surface_model`). Memoised on the case."""
+    (:func:`_elastic_surface_model`). Linked surfaces (``linked_to``, ``gear_ratio``: AELINK)
+    are eliminated: each moves with its master, whose coordinate carries it
+    (:func:`asekit.aeroelastic.control_surface.link_surfaces`; ``names`` the free surfaces).
+    Memoised on the case."""
+    hm = control_surface_mesh(case)
+    if _surface_links(case):
+        from asekit.aeroelastic.control_surface import link_surfaces
+        return link_surfaces(_unlinked_surface_model(case, hm), _surface_links(case))
+    return _unlinked_surface_model(case, hm)
+
+
+def _unlinked_surface_model(case: Case, hm):
+    """:func:`control_surface_model` with every surface free."""
     from asekit.aeroelastic.control_surface import BalanceMass, flap_modal_model
 
-    hm = control_surface_mesh(case)
     cs = case.control_surfaces
     if any(c.kind == "elastic" for c in cs):
         return _elastic_surface_model(case, hm)
@@ -1361,6 +1372,14 @@ def control_surface_model(case: Case):
                     for (x, y), m in c.mass_balance)
     return flap_modal_model(modal_model(case), m_fe, hm, [c.hinge_stiffness for c in cs],
                             [c.hinge_damping for c in cs], balance)
+
+
+def _surface_links(case: Case) -> tuple:
+    """The case's AELINK links, (slave, master, gear_ratio) surface indices
+    (``control_surface[i].linked_to``, :func:`asekit.aero.control_surface.gearing_matrix`)."""
+    names = [c.name for c in case.control_surfaces]
+    return tuple((i, names.index(c.linked_to), c.gear_ratio)
+                 for i, c in enumerate(case.control_surfaces) if c.linked_to)
 
 
 @dataclass(frozen=True)
@@ -1430,7 +1449,7 @@ def control_surfaces(case: Case) -> tuple[ControlSurfaceRow, ...]:
     for mach in case.aero.machs:
         if mach >= 1.0:
             continue
-        d = steady_control_derivatives(hm, mach, symmetric=wall)
+        d = steady_control_derivatives(hm, mach, symmetric=wall, links=_surface_links(case))
         se = static_effectiveness(fm, hm, mach, 0.5 * rho * u_lim ** 2, n_q=41,
                                   image="antisymmetric" if wall else "none")
         u_r = se.reversal_speed(rho)
@@ -1684,15 +1703,21 @@ def control_surface_hinge_loads(case: Case) -> tuple[HingeLoadRow, ...]:
 
     hm = control_surface_mesh(case)
     wall = case.aero.symmetry == "wall"
+    links = _surface_links(case)
+    free = [i for i in range(len(hm.surfaces)) if i not in {k[0] for k in links}]
     derivs = {}
     rows = []
     for m, h, rho, u, basis in _hinge_load_points(case):
         if m not in derivs:
-            derivs[m] = steady_control_derivatives(hm, m, symmetric=wall)
+            derivs[m] = steady_control_derivatives(hm, m, symmetric=wall, links=links)
         q = 0.5 * rho * u * u
-        h_d, h_a = dimensional_hinge_moments(hm, derivs[m], q)
-        rows += [HingeLoadRow(s.name, m, h, rho, u, q, float(h_d[i]), float(h_a[i]), basis)
-                 for i, s in enumerate(hm.surfaces)]
+        if links:                       # the free surfaces, each with its geared surfaces
+            sc = np.array([hm.surface_area(i) * hm.mean_chord(i) for i in free])
+            h_d, h_a = q * sc * derivs[m].Ch_delta, q * sc * derivs[m].Ch_alpha
+        else:
+            h_d, h_a = dimensional_hinge_moments(hm, derivs[m], q)
+        rows += [HingeLoadRow(hm.surfaces[i].name, m, h, rho, u, q, float(h_d[j]),
+                              float(h_a[j]), basis) for j, i in enumerate(free)]
     return tuple(rows)
 
 
