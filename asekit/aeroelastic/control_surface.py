@@ -49,6 +49,12 @@ the hinge line) for the constraint mode; the elastic kind computes both from the
 plate, so the surface's inertia and unbalance are its elements' exactly and its side edges are
 free.
 
+Rigid and elastic surfaces in one model (:func:`mixed_flap_modal_model`): the elastic ones
+released and reduced as above, the rigid ones' hinge rotations added as the rigid kind's, every
+hinge coordinate coupled to the others through the mass. Linked surfaces (Nastran's AELINK, a
+geared tab delta_t = G delta_f: :func:`link_surfaces`) are eliminated by the gearing
+transformation.
+
 The strip-theory closed forms are :func:`strip_theory_effectiveness` and
 :func:`strip_theory_reversal_q`; on a uniform torsion beam with its elastic axis 5 % of the chord
 behind the quarter chord, the vortex lattice's q_R tends to them as the aspect ratio grows
