@@ -14,6 +14,7 @@ The tests run on a coarse copy (8 x 8 elements and boxes, Mach 0, 2-30 m/s; the 
 ailerons' edges still on element lines).
 """
 
+import dataclasses
 import math
 import tomllib
 
@@ -86,6 +87,25 @@ def test_each_surface_keeps_its_single_kind_inertia_and_unbalance(mixed):
     assert fm.static_unbalance[0] == pytest.approx(MASS * C_F / 2, rel=1e-7)
     np.testing.assert_allclose(fm.hinge_frequency_hz,
                                np.sqrt(0.25 / fm.inertia) / (2 * math.pi), rtol=1e-12)
+
+
+def test_a_balance_mass_on_the_rigid_surface_is_the_rigid_kinds():
+    """0.1 kg 3 cm ahead of the rigid aileron's hinge (d = -0.03 m): its I_h and S gain
+    exactly m d^2 and m d, as the rigid kind alone with the same mass; the elastic one's stay."""
+    def with_mass(name, **kw):
+        c = _coarse(name, **kw)
+        cs = list(c.control_surfaces)
+        cs[-1] = dataclasses.replace(cs[-1], mass_balance=(((0.195, 1.05), 0.1),))
+        return P.control_surface_model(dataclasses.replace(c, control_surfaces=tuple(cs)))
+    bare = P.control_surface_model(_coarse("mixed"))
+    fm = with_mass("mixed_balanced")
+    alone = with_mass("rigid_alone_balanced", keep=(1,))
+    assert fm.inertia[1] - bare.inertia[1] == pytest.approx(0.1 * 0.03 ** 2, rel=1e-9)
+    assert fm.static_unbalance[1] - bare.static_unbalance[1] == pytest.approx(-0.003, rel=1e-9)
+    assert fm.inertia[0] == bare.inertia[0]
+    assert fm.inertia[1] == pytest.approx(alone.inertia[0], rel=1e-12)
+    assert fm.static_unbalance[1] == pytest.approx(alone.static_unbalance[0], rel=1e-12)
+    assert np.all(np.linalg.eigvalsh(fm.modal.M) > 0)
 
 
 def test_the_elastic_block_is_the_elastic_kind_alone(mixed):
