@@ -492,10 +492,10 @@ def thin_airfoil_hinge_moment(hinge_chord_fraction: float, deflected_chord_fract
     Glauert's series summed in closed form (Glauert, *The Elements of Aerofoil and Airscrew
     Theory*, 1926, Ch. VII: A_0 = delta (pi - theta_t) / pi, A_n = 2 delta sin(n theta_t) /
     (n pi), DeltaCp = 4 (A_0 cot(theta/2) + sum A_n sin(n theta)), and
-    sum sin(n a) sin(n b) / n = ln|sin((a + b)/2) / sin((a - b)/2)| / 2),
+    sum sin(n a) sin(n b) / n = ln abs(sin((a + b)/2) / sin((a - b)/2)) / 2),
 
         DeltaCp = 4 delta [(pi - theta_t) / pi cot(theta/2)
-                           + ln|sin((theta + theta_t)/2) / sin((theta - theta_t)/2)| / pi],
+                           + ln abs(sin((theta + theta_t)/2) / sin((theta - theta_t)/2)) / pi],
 
     and H / q = -int_{x_f}^{c} (x - x_f) DeltaCp dx, integrated here in theta by the
     Gauss-Legendre rule with ``n`` points on each side of theta_t (the logarithm integrable).
