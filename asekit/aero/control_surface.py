@@ -49,7 +49,8 @@ from asekit.util.validate import in_range, integer
 __all__ = ["ControlSurface", "HingedMesh", "hinged_mesh", "nesting", "deflection_modes", "hinge_moments",
            "steady_control_derivatives", "ControlDerivatives", "glauert_flap_effectiveness",
            "oscillatory_control_coefficients", "thin_airfoil_flap_derivatives",
-           "dimensional_hinge_moments", "mean_aerodynamic_chord"]
+           "dimensional_hinge_moments", "mean_aerodynamic_chord", "gearing_matrix",
+           "thin_airfoil_hinge_moment"]
 
 
 @dataclass(frozen=True)
@@ -440,11 +441,107 @@ def mean_aerodynamic_chord(mesh: BoxMesh) -> tuple[float, float]:
     return float(np.sum(x_le * c * w) / np.sum(c * w)) + 0.25 * c_ref, c_ref
 
 
+def gearing_matrix(n_surfaces: int, links=()) -> tuple[np.ndarray, np.ndarray]:
+    """The linear links between control-surface deflections (MSC Nastran's AELINK; a geared
+    tab: delta_tab = G delta_flap; Rodden & Johnson, *MSC/NASTRAN Aeroelastic Analysis User's
+    Guide*, 1994, Sec. 3.5): delta = T delta_free.
+
+    Parameters
+    ----------
+    n_surfaces : the surfaces' count (>= 1).
+    links : (slave, master, gear) triples, surface indices: delta_slave = gear delta_master
+        (gear finite, any sign: > 0 the tab deflects with the flap, < 0 against it, a balance
+        tab). A slave is linked once and is no master; a master is not linked itself.
+
+    Returns
+    -------
+    T : (n_surfaces, n_free) the gearing matrix, identity rows for the free surfaces.
+    free : (n_free,) the free surfaces' indices, ascending.
+
+    Examples
+    --------
+    >>> T, free = gearing_matrix(2, [(1, 0, -0.5)])
+    >>> T.tolist(), free.tolist()
+    ([[1.0], [-0.5]], [0])
+    """
+    n = integer("n_surfaces", n_surfaces, low=1)
+    slaves = [int(k[0]) for k in links]
+    for slave, master, gear in links:
+        if not (0 <= slave < n and 0 <= master < n) or slave == master or master in slaves \
+                or slaves.count(slave) > 1 or not math.isfinite(gear):
+            raise ValueError(f"links must be (slave, master, gear) with two different surface "
+                             f"indices in [0, {n - 1}], each slave linked once and no master "
+                             f"a slave, gear finite; got {tuple(links)}")
+    free = np.array([i for i in range(n) if i not in slaves], int)
+    T = np.zeros((n, free.size))
+    T[free, np.arange(free.size)] = 1.0
+    for slave, master, gear in links:
+        T[slave, int(np.flatnonzero(free == master)[0])] = float(gear)
+    return T, free
+
+
+def thin_airfoil_hinge_moment(hinge_chord_fraction: float, deflected_chord_fraction: float,
+                              n: int = 1000) -> float:
+    """2-D thin-airfoil hinge-moment coefficient C_h = H / (q c_f^2) (per rad, trailing edge
+    down positive) about a hinge at ``1 - hinge_chord_fraction`` of the chord (c_f the chord
+    aft of it) of the load of a deflected trailing-edge segment of chord fraction
+    ``deflected_chord_fraction``: the flap's own C_h delta when both are equal, the flap's
+    hinge moment per rad of its tab's deflection when the tab is the shorter segment.
+
+    The load of a segment deflected by delta from theta_t (cos theta_t = 1 - 2 x_t / c) is
+    Glauert's series summed in closed form (Glauert, *The Elements of Aerofoil and Airscrew
+    Theory*, 1926, Ch. VII: A_0 = delta (pi - theta_t) / pi, A_n = 2 delta sin(n theta_t) /
+    (n pi), DeltaCp = 4 (A_0 cot(theta/2) + sum A_n sin(n theta)), and
+    sum sin(n a) sin(n b) / n = ln abs(sin((a + b)/2) / sin((a - b)/2)) / 2),
+
+        DeltaCp = 4 delta [(pi - theta_t) / pi cot(theta/2)
+                           + ln abs(sin((theta + theta_t)/2) / sin((theta - theta_t)/2)) / pi],
+
+    and H / q = -int_{x_f}^{c} (x - x_f) DeltaCp dx, integrated here in theta by the
+    Gauss-Legendre rule with ``n`` points on each side of theta_t (the logarithm integrable).
+
+    Examples
+    --------
+    A 25 %-chord flap (Theodorsen's steady value, NACA Report 496, is -0.944 per rad):
+
+    >>> round(thin_airfoil_hinge_moment(0.25, 0.25), 3)
+    -0.944
+    """
+    from scipy.special import roots_legendre
+
+    e_f = in_range("hinge_chord_fraction", hinge_chord_fraction, 0.0, high=1.0)
+    e_t = in_range("deflected_chord_fraction", deflected_chord_fraction, 0.0, high=1.0)
+    n = integer("n", n, low=8)
+    th_t = math.acos(1.0 - 2.0 * (1.0 - e_t))
+    th_f = math.acos(1.0 - 2.0 * (1.0 - e_f))
+    x_f = 1.0 - e_f
+    g, w = roots_legendre(n)
+
+    def integral(a, b):
+        th = 0.5 * (b - a) * g + 0.5 * (a + b)
+        dcp = 4.0 * ((math.pi - th_t) / math.pi / np.tan(0.5 * th)
+                     + np.log(np.abs(np.sin(0.5 * (th + th_t)) / np.sin(0.5 * (th - th_t))))
+                     / math.pi)
+        x = 0.5 * (1.0 - np.cos(th))
+        return float(np.sum(w * -(x - x_f) * dcp * 0.5 * np.sin(th)) * 0.5 * (b - a))
+
+    pieces = [th_f, th_t, math.pi] if th_t > th_f else [th_f, math.pi]
+    h = sum(integral(a, b) for a, b in zip(pieces[:-1], pieces[1:]))
+    return h / (e_f * e_f)
+
+
 def steady_control_derivatives(hm: HingedMesh, mach: float, symmetric: bool = False,
                                reference_area: float | None = None,
-                               moment_reference: tuple | None = None) -> ControlDerivatives:
+                               moment_reference: tuple | None = None,
+                               links=()) -> ControlDerivatives:
     """dCL/d alpha, dCL/d delta, dCm/d alpha, dCm/d delta, C_h alpha and C_h delta of every
     surface from the vortex lattice (:mod:`asekit.aero.vlm`) at Mach ``mach`` (0 <= M < 1).
+
+    With ``links`` (:func:`gearing_matrix`: a geared tab, delta_slave = G delta_master) the
+    derivatives are those of the free surfaces only, each deflected with its slaves: dCL/d
+    delta = CL_master + G CL_slave, and C_h delta the master's hinge moment under that
+    motion, its own C_h plus G times the slave's load on the master's hinge (the classic
+    reduction of a flap's hinge moment by a balance tab, G < 0).
 
     The angle of attack is w/U = -1 on every box, a deflection the steady normalwash of
     :func:`deflection_modes`; CL = sum DeltaCp A n_z / S (S the panel's area, doubled with
@@ -466,6 +563,8 @@ def steady_control_derivatives(hm: HingedMesh, mach: float, symmetric: bool = Fa
     mesh = hm.mesh
     nz = mesh.normal[:, 2]
     modes = deflection_modes(hm)
+    if links:
+        return _geared_derivatives(hm, mach, symmetric, reference_area, moment_reference, links)
     wash = np.column_stack([-nz, modes.normalwash(0.0, 1.0).real])
     cp = steady_pressure(mesh, mach, wash, symmetric)
     lift = (mesh.area * nz) @ cp
@@ -486,6 +585,34 @@ def steady_control_derivatives(hm: HingedMesh, mach: float, symmetric: bool = Fa
     return ControlDerivatives(float(mach), s, float(lift[0] / s), lift[1:] / s,
                               h[:, 0] / sc, h[np.arange(n_s), 1 + np.arange(n_s)] / sc,
                               float(cm[0]), cm[1:], (float(x_ref), float(c_ref)))
+
+
+def _geared_derivatives(hm, mach, symmetric, reference_area, moment_reference, links):
+    """:func:`steady_control_derivatives` with the deflections geared by ``links``."""
+    from asekit.aero.vlm import steady_pressure
+
+    mesh = hm.mesh
+    nz = mesh.normal[:, 2]
+    T, free = gearing_matrix(len(hm.surfaces), links)
+    wash = np.column_stack([-nz, deflection_modes(hm).normalwash(0.0, 1.0).real @ T])
+    cp = steady_pressure(mesh, mach, wash, symmetric)
+    lift = (mesh.area * nz) @ cp
+    x_ref, c_ref = (mean_aerodynamic_chord(mesh) if moment_reference is None else
+                    (float(moment_reference[0]), in_range("moment_reference[1]",
+                                                          moment_reference[1], 0.0)))
+    pitch = -((mesh.load_point[:, 0] - x_ref) * mesh.area * nz) @ cp
+    s = float(np.sum(mesh.area))
+    if symmetric:
+        lift, pitch = 2.0 * lift, 2.0 * pitch
+        s *= 2.0
+    if reference_area is not None:
+        s = in_range("reference_area", reference_area, 0.0)
+    h = hinge_moments(hm, cp)[free]                     # (n_free, 1 + n_free)
+    sc = np.array([hm.surface_area(i) * hm.mean_chord(i) for i in free])
+    cm = pitch / (s * c_ref)
+    return ControlDerivatives(float(mach), s, float(lift[0] / s), lift[1:] / s,
+                              h[:, 0] / sc, h[np.arange(free.size), 1 + np.arange(free.size)]
+                              / sc, float(cm[0]), cm[1:], (float(x_ref), float(c_ref)))
 
 
 def oscillatory_control_coefficients(hm: HingedMesh, mach: float, k, b_ref: float,

@@ -49,6 +49,12 @@ the hinge line) for the constraint mode; the elastic kind computes both from the
 plate, so the surface's inertia and unbalance are its elements' exactly and its side edges are
 free.
 
+Rigid and elastic surfaces in one model (:func:`mixed_flap_modal_model`): the elastic ones
+released and reduced as above, the rigid ones' hinge rotations added as the rigid kind's, every
+hinge coordinate coupled to the others through the mass. Linked surfaces (Nastran's AELINK, a
+geared tab delta_t = G delta_f: :func:`link_surfaces`) are eliminated by the gearing
+transformation.
+
 The strip-theory closed forms are :func:`strip_theory_effectiveness` and
 :func:`strip_theory_reversal_q`; on a uniform torsion beam with its elastic axis 5 % of the chord
 behind the quarter chord, the vortex lattice's q_R tends to them as the aspect ratio grows
@@ -347,15 +353,53 @@ def elastic_flap_modal_model(released, M_split, hm: HingedMesh, n_modes: int,
     >>> round(1e3 * float(fm.static_unbalance[0]), 2), round(1e3 * float(fm.inertia[0]), 3)
     (9.11, 0.456)
     """
-    from asekit.structure.hinge import hinge_constraint_modes
-    from asekit.structure.modes import ModalModel, with_damping
-
-    n_modes = integer("n_modes", n_modes, low=1)
     n_s = len(hm.surfaces)
     if released.hinge_index.size != n_s or (n_s > 1 and len(released.splits) != n_s):
         raise ValueError(f"elastic_flap_modal_model needs one 'single' hinge release per "
                          f"surface ({n_s} surfaces, {released.hinge_index.size} hinge "
                          f"rotations)")
+    cb = _craig_bampton(released, n_modes, modal_damping_ratio, structural_g, dense_limit)
+    n = cb.wing.M.shape[0]
+    flap = replace(cb.wing, frequencies_hz=np.zeros(n_s), M=np.eye(n_s), K=np.zeros((n_s, n_s)),
+                   C=np.zeros((n_s, n_s)), shapes=cb.shapes[:, :, n:])
+    bw, bf = fe_spline(cb.wing, hm.mesh), fe_spline(flap, hm.mesh)
+    box = BoxModes(np.hstack([bw.h_cp, bf.h_cp]), np.hstack([bw.dhdx_cp, bf.dhdx_cp]),
+                   np.hstack([bw.h_lp, bf.h_lp]))
+    split = released.split.mesh
+    u_psi = released.T @ cb.psi
+    w_unit = np.zeros(3 * split.n_nodes)
+    w_unit[0::3] = 1.0
+    inertia = np.diag(cb.M[n:, n:]).copy()
+    unbalance = -(w_unit @ (M_split @ u_psi))
+    k_h = np.asarray(released.hinge_stiffness, float)
+    f_h = np.sqrt(k_h / inertia) / (2.0 * math.pi)
+    return FlapModel(ModalArrays(cb.M, cb.K, cb.C, 0), box, inertia, unbalance, f_h,
+                     n, tuple(s.name for s in hm.surfaces))
+
+
+@dataclass(frozen=True)
+class _Reduction:
+    """Craig & Bampton's reduction of a released plate (:func:`_craig_bampton`): ``M``, ``K``,
+    ``C`` over (zeta, delta); ``psi`` the constraint modes on the released DOFs; ``shapes``
+    (n_nodes, 3, n + n_e) every column on the split mesh; ``wing`` the fixed-hinge modes as a
+    :class:`asekit.structure.modes.ModalModel` (damped)."""
+
+    M: np.ndarray
+    K: np.ndarray
+    C: np.ndarray
+    psi: np.ndarray
+    shapes: np.ndarray
+    wing: object
+
+
+def _craig_bampton(released, n_modes, modal_damping_ratio, structural_g,
+                   dense_limit) -> _Reduction:
+    """The reduction of :func:`elastic_flap_modal_model` (its docstring), without the boxes."""
+    from asekit.structure.hinge import hinge_constraint_modes
+    from asekit.structure.modes import ModalModel, with_damping
+
+    n_modes = integer("n_modes", n_modes, low=1)
+    n_s = released.hinge_index.size
     R = np.asarray(released.hinge_index)
     o = np.setdiff1d(np.arange(released.K.shape[0]), R)
     K_oo, M_oo = released.K[o][:, o], released.M[o][:, o]
@@ -393,20 +437,212 @@ def elastic_flap_modal_model(released, M_split, hm: HingedMesh, n_modes: int,
                       f"{split.n_elements}-element plate, hinge released")
     wing = with_damping(wing, modal_damping_ratio, structural_g)
     c_aug[:n, :n] += wing.C
-    flap = replace(wing, frequencies_hz=np.zeros(n_s), M=np.eye(n_s), K=np.zeros((n_s, n_s)),
-                   C=np.zeros((n_s, n_s)), shapes=shapes[:, :, n:])
-    bw, bf = fe_spline(wing, hm.mesh), fe_spline(flap, hm.mesh)
-    box = BoxModes(np.hstack([bw.h_cp, bf.h_cp]), np.hstack([bw.dhdx_cp, bf.dhdx_cp]),
-                   np.hstack([bw.h_lp, bf.h_lp]))
-    u_psi = released.T @ psi
+    return _Reduction(m_aug, k_aug, c_aug, psi, shapes, wing)
+
+
+def mixed_flap_modal_model(released, M_split, hm: HingedMesh, kinds, n_modes: int,
+                           hinge_stiffness, hinge_damping=0.0, balance=(),
+                           modal_damping_ratio=None, structural_g=None,
+                           dense_limit: int = 3000) -> FlapModel:
+    """The modal model of a wing with rigid and elastic control surfaces in one model (an
+    elastic aileron inboard and a rigid one outboard).
+
+    The elastic surfaces are released along their hinges and reduced by Craig & Bampton's
+    method exactly as in :func:`elastic_flap_modal_model` (AIAA J. 6(7), 1968, Eqs. 5-9:
+    fixed-hinge modes Phi and constraint modes psi_k of the released plate, in which the rigid
+    surfaces are part of the plate); each rigid surface j adds its rigid rotation U_j about its
+    hinge as the rigid kind builds it (:func:`flap_rotation_vector`, on the split mesh's nodes
+    by their coordinates, so that a node on the rigid surface's edge rotates with it as in
+    :func:`flap_modal_model`; Rodden & Johnson 1994, Sec. 3.5). With B = [Phi, Psi, U] on the
+    finite-element DOFs (u = B x),
+
+        M = [[M_cb, Phi_Psi^T M_fe U], [U^T M_fe Phi_Psi, U^T M_fe U]] + balance masses,
+        K = diag(K_cb, k_h,j),   C = diag(C_cb, c_h,j),
+
+    M_cb, K_cb, C_cb the Craig-Bampton blocks (:func:`elastic_flap_modal_model`), M_fe the
+    split mesh's mass: every pair of hinge coordinates is coupled through the mass
+    (:attr:`FlapModel.hinge_mass_matrix`), the rigid rotations through the hinge springs only
+    (the rigid kind's assumption). A rigid surface's inertia U_j^T M_fe U_j and unbalance are
+    those of :func:`flap_modal_model` on the unsplit mesh (the split only duplicates nodes:
+    M_unsplit = S^T M_fe S for the duplication S, and U_j = S U_j,unsplit).
+
+    Parameters
+    ----------
+    released : :class:`asekit.structure.hinge.ReleasedHinge` of the supported wing, the
+        elastic surfaces released (:func:`asekit.structure.hinge.release_hinges`, in their
+        order in ``hm``), their springs and dampers in it.
+    M_split : the unreduced mass matrix of ``released.split.mesh`` (point masses and the
+        elastic surfaces' balance masses included).
+    hm : the boxes with every surface, rigid and elastic, in case order.
+    kinds : "rigid" or "elastic" per surface of ``hm``.
+    n_modes : fixed-hinge modes kept (>= 1).
+    hinge_stiffness, hinge_damping : k_h (N m/rad) and c_h (N m s/rad) per surface of ``hm``
+        (scalar or one per surface; used for the rigid surfaces).
+    balance : :class:`BalanceMass` items on the rigid surfaces (index in ``hm``): a mass at
+        (x_b, y_b) moves with the wing's columns at that point and by -d_b with its surface.
+    modal_damping_ratio, structural_g, dense_limit : as :func:`elastic_flap_modal_model`.
+
+    Returns
+    -------
+    FlapModel : the wing's fixed-hinge modes, then one hinge coordinate per surface in the
+    order of ``hm``; box modes the splined structure for the wing modes and the elastic
+    surfaces' psi, :func:`asekit.aero.control_surface.deflection_modes` for the rigid ones.
+
+    Examples
+    --------
+    The aluminium plate wing of :func:`flap_modal_model`, an elastic aileron over 50-75 % of
+    the span and a rigid one over 75-100 %. The rigid aileron's 0.3 m plate strip has
+    S = m c_f / 2 = 4.56 g m and I = m c_f^2 / 3 = 0.228 g m^2 (m = 0.1215 kg); its rigid
+    rotation lumps the hinge nodes half and the edge nodes whole, as :func:`flap_modal_model`
+    on the unsplit mesh, and gives 5.13 g m and 0.247 g m^2.
+
+    >>> from asekit.aero.boxes import TrapezoidSurface
+    >>> from asekit.aero.control_surface import ControlSurface, hinged_mesh
+    >>> from asekit.geometry import Material, Planform, Thickness
+    >>> from asekit.structure.assembly import assemble, clamped_edge
+    >>> from asekit.structure.hinge import release_hinge, split_at_hinge
+    >>> from asekit.structure.mesh import panels_mesh
+    >>> pm = panels_mesh([Planform((0, 0), 0.3, (0, 1.2), 0.3)], Thickness(0.002, 0.002), 8, [16])
+    >>> hm = hinged_mesh(TrapezoidSurface((0, 0), 0.3, (0, 1.2), 0.3, 8, 16),
+    ...                  [ControlSurface("in", 0.75, 0.75, 0.5, 0.75),
+    ...                   ControlSurface("out", 0.75, 0.75, 0.75, 1.0)])
+    >>> hs = split_at_hinge(pm, surface_elements(pm, hm, 0), (0.225, 0.6), (0.0, 1.0))
+    >>> K, M = assemble(hs.mesh, Material(70e9, 0.3, 2700.0))
+    >>> K0, M0 = assemble(pm, Material(70e9, 0.3, 2700.0))
+    >>> rh = release_hinge(hs, K, M, 0.25, support=clamped_edge(pm, K0, M0).T)
+    >>> fm = mixed_flap_modal_model(rh, M, hm, ("elastic", "rigid"), 4, 0.25)
+    >>> fm.names, fm.hinge_mass_matrix.shape
+    (('in', 'out'), (2, 2))
+    >>> round(1e3 * float(fm.static_unbalance[1]), 2), round(1e3 * float(fm.inertia[1]), 3)
+    (5.13, 0.247)
+    """
+    kinds = tuple(kinds)
+    n_s = len(hm.surfaces)
+    if len(kinds) != n_s or any(k not in ("rigid", "elastic") for k in kinds):
+        raise ValueError(f"kinds must give 'rigid' or 'elastic' for each of the {n_s} "
+                         f"surfaces, got {kinds}")
+    el = [i for i, k in enumerate(kinds) if k == "elastic"]
+    rg = [i for i, k in enumerate(kinds) if k == "rigid"]
+    if released.hinge_index.size != len(el) or (len(el) > 1 and len(released.splits) != len(el)):
+        raise ValueError(f"mixed_flap_modal_model needs one 'single' hinge release per elastic "
+                         f"surface ({len(el)} elastic, {released.hinge_index.size} hinge "
+                         f"rotations)")
+    k_h = np.broadcast_to(np.asarray(hinge_stiffness, float), (n_s,)).copy()
+    c_h = np.broadcast_to(np.asarray(hinge_damping, float), (n_s,)).copy()
+    for nm, v in (("hinge_stiffness", k_h), ("hinge_damping", c_h)):
+        for x in v:
+            in_range(nm, x, 0.0, inclusive=True)
+    cb = _craig_bampton(released, n_modes, modal_damping_ratio, structural_g, dense_limit)
+    n, n_e = cb.wing.M.shape[0], len(el)
+    split = released.split.mesh
+    u_cb = cb.shapes.reshape(3 * split.n_nodes, n + n_e)
+    u_r = np.column_stack([flap_rotation_vector(split.nodes, hm, j) for j in rg]) if rg \
+        else np.zeros((3 * split.n_nodes, 0))
+    mu = np.hstack([u_cb, u_r]).T @ (M_split @ u_r)            # (n + n_s, n_r)
+    m = np.zeros((n + n_s, n + n_s))
+    m[:n + n_e, :n + n_e] = cb.M
+    m[:, n + n_e:] = mu
+    m[n + n_e:, :n + n_e] = mu[:n + n_e].T
+    k = np.zeros_like(m)
+    k[:n + n_e, :n + n_e] = cb.K
+    k[n + n_e:, n + n_e:] = np.diag(k_h[rg])
+    c = np.zeros_like(m)
+    c[:n + n_e, :n + n_e] = cb.C
+    c[n + n_e:, n + n_e:] = np.diag(c_h[rg])
     w_unit = np.zeros(3 * split.n_nodes)
     w_unit[0::3] = 1.0
-    inertia = np.diag(m_aug[n:, n:]).copy()
-    unbalance = -(w_unit @ (M_split @ u_psi))
-    k_h = np.asarray(released.hinge_stiffness, float)
-    f_h = np.sqrt(k_h / inertia) / (2.0 * math.pi)
-    return FlapModel(ModalArrays(m_aug, k_aug, c_aug, 0), box, inertia, unbalance, f_h,
-                     n, tuple(s.name for s in hm.surfaces))
+    unbalance = -(w_unit @ (M_split @ np.hstack([u_cb[:, n:], u_r])))
+    col = {j: n + p for p, j in enumerate(el + rg)}              # surface -> its column
+    _mixed_balance(m, unbalance, balance, hm, cb, col, kinds)
+    order = np.r_[np.arange(n), [col[j] for j in range(n_s)]].astype(int)
+    m, k, c = (a[np.ix_(order, order)] for a in (m, k, c))
+    unbalance = unbalance[order[n:] - n]
+    inertia = np.diag(m[n:, n:]).copy()
+    k_all = np.array([released.hinge_stiffness[el.index(j)] if kinds[j] == "elastic"
+                      else k_h[j] for j in range(n_s)], float)
+    flap = replace(cb.wing, frequencies_hz=np.zeros(n_e), M=np.eye(n_e), K=np.zeros((n_e, n_e)),
+                   C=np.zeros((n_e, n_e)), shapes=cb.shapes[:, :, n:])
+    bw, be, br = fe_spline(cb.wing, hm.mesh), fe_spline(flap, hm.mesh), deflection_modes(hm)
+    cols = [np.hstack([getattr(bw, a)] + [getattr(be, a)[:, [el.index(j)]]
+                                          if kinds[j] == "elastic" else getattr(br, a)[:, [j]]
+                                          for j in range(n_s)])
+            for a in ("h_cp", "dhdx_cp", "h_lp")]
+    f_h = np.sqrt(k_all / inertia) / (2.0 * math.pi)
+    return FlapModel(ModalArrays(m, k, c, 0), BoxModes(*cols), inertia, unbalance, f_h, n,
+                     tuple(s.name for s in hm.surfaces))
+
+
+def _mixed_balance(m, unbalance, balance, hm, cb, col, kinds) -> None:
+    """Add the rigid surfaces' balance masses to ``m`` and ``unbalance`` in place
+    (:func:`mixed_flap_modal_model`: a point mass moving with the wing's and the elastic
+    surfaces' columns at its point and by -d_b with its rigid surface, and with its parent's
+    rotation when the surface is a tab; ``col`` each surface's column in ``m``)."""
+    n_s = len(kinds)
+    if not balance:
+        return
+    parents = nesting(hm.surfaces)
+    everything = replace(cb.wing, shapes=cb.shapes)
+    n_cb = cb.shapes.shape[2]
+    n = cb.wing.M.shape[0]
+    for bm in balance:
+        if not isinstance(bm, BalanceMass) or not 0 <= bm.surface < n_s \
+                or kinds[bm.surface] != "rigid":
+            raise ValueError(f"balance must hold BalanceMass items on rigid surfaces (index in "
+                             f"[0, {n_s - 1}]), got {bm!r}")
+        h, _ = mode_shapes_at(everything, np.array([[bm.x, bm.y]]))
+        v = np.zeros(m.shape[0])
+        v[:n_cb] = h[0]
+        for j in (bm.surface, parents[bm.surface]):
+            if j < 0:
+                continue
+            d = float(hm.distance_aft(j, np.array([[bm.x, bm.y, 0.0]]))[0])
+            v[col[j]] = -d
+            unbalance[col[j] - n] += bm.mass * d
+        m += bm.mass * np.outer(v, v)
+
+
+def link_surfaces(fm: FlapModel, links) -> FlapModel:
+    """The model with linked hinge coordinates (MSC Nastran's AELINK; a geared tab,
+    delta_tab = G delta_flap): x = T_x x_free with T_x = diag(I, T) and T the surfaces'
+    gearing matrix (:func:`asekit.aero.control_surface.gearing_matrix`), so that
+    M' = T_x^T M T_x, K' = T_x^T K T_x, C' = T_x^T C T_x (the kinetic and strain energies of
+    the constrained motion; Cook, Malkus, Plesha & Witt, 2002, Sec. 9.2) and the box modes
+    B' = B T_x (a free surface's column carries its slaves' deflections, G times theirs).
+
+    The free surfaces' inertia is the linked motion's, I' = I_m + 2 G M_ms + G^2 I_s, their
+    unbalance S' = S_m + G S_s, their hinge stiffness k' = k_m + G^2 k_s (a slave's own
+    hinge spring, if any, is strained by the gearing), ``names`` the free surfaces'.
+
+    Examples
+    --------
+    Two uncoupled unit hinges, the second geared to the first by G = 2:
+
+    >>> from asekit.aero.spline import BoxModes
+    >>> from asekit.aeroelastic.statespace import ModalArrays
+    >>> z = np.zeros((1, 3))
+    >>> fm = FlapModel(ModalArrays(np.eye(3), np.diag([1.0, 4.0, 0.0]), np.zeros((3, 3)), 0),
+    ...                BoxModes(z, z, z), np.ones(2), np.array([0.1, 0.2]), np.ones(2), 1,
+    ...                ("flap", "tab"))
+    >>> lk = link_surfaces(fm, [(1, 0, 2.0)])
+    >>> lk.names, lk.inertia.tolist(), round(float(lk.static_unbalance[0]), 12)
+    (('flap',), [5.0], 0.5)
+    """
+    from asekit.aero.control_surface import gearing_matrix
+
+    n_s = len(fm.names)
+    T, free = gearing_matrix(n_s, links)
+    n = fm.n_wing
+    tx = np.zeros((n + n_s, n + free.size))
+    tx[:n, :n] = np.eye(n)
+    tx[n:, n:] = T
+    m, k, c = (tx.T @ np.asarray(a, float) @ tx for a in (fm.modal.M, fm.modal.K, fm.modal.C))
+    box = BoxModes(fm.box_modes.h_cp @ tx, fm.box_modes.dhdx_cp @ tx, fm.box_modes.h_lp @ tx)
+    inertia = np.diag(m[n:, n:]).copy()
+    k_h = np.diag(k[n:, n:])
+    return FlapModel(ModalArrays(m, k, c, fm.modal.n_rigid), box, inertia,
+                     T.T @ np.asarray(fm.static_unbalance, float),
+                     np.sqrt(k_h / inertia) / (2.0 * math.pi), n,
+                     tuple(fm.names[i] for i in free))
 
 
 @dataclass(frozen=True)

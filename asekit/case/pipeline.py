@@ -1349,10 +1349,21 @@ def control_surface_model(case: Case):
     per control surface, its hinge spring, damper and balance masses
     (:func:`asekit.aeroelastic.control_surface.flap_modal_model`); for ``kind = "elastic"``
     the plate released along the hinge, reduced to fixed-hinge modes plus the hinge rotation
-    (:func:`_elastic_surface_model`). Memoised on the case."""
+    (:func:`_elastic_surface_model`). Linked surfaces (``linked_to``, ``gear_ratio``: AELINK)
+    are eliminated: each moves with its master, whose coordinate carries it
+    (:func:`asekit.aeroelastic.control_surface.link_surfaces`; ``names`` the free surfaces).
+    Memoised on the case."""
+    hm = control_surface_mesh(case)
+    if _surface_links(case):
+        from asekit.aeroelastic.control_surface import link_surfaces
+        return link_surfaces(_unlinked_surface_model(case, hm), _surface_links(case))
+    return _unlinked_surface_model(case, hm)
+
+
+def _unlinked_surface_model(case: Case, hm):
+    """:func:`control_surface_model` with every surface free."""
     from asekit.aeroelastic.control_surface import BalanceMass, flap_modal_model
 
-    hm = control_surface_mesh(case)
     cs = case.control_surfaces
     if any(c.kind == "elastic" for c in cs):
         return _elastic_surface_model(case, hm)
@@ -1361,6 +1372,14 @@ def control_surface_model(case: Case):
                     for (x, y), m in c.mass_balance)
     return flap_modal_model(modal_model(case), m_fe, hm, [c.hinge_stiffness for c in cs],
                             [c.hinge_damping for c in cs], balance)
+
+
+def _surface_links(case: Case) -> tuple:
+    """The case's AELINK links, (slave, master, gear_ratio) surface indices
+    (``control_surface[i].linked_to``, :func:`asekit.aero.control_surface.gearing_matrix`)."""
+    names = [c.name for c in case.control_surfaces]
+    return tuple((i, names.index(c.linked_to), c.gear_ratio)
+                 for i, c in enumerate(case.control_surfaces) if c.linked_to)
 
 
 @dataclass(frozen=True)
@@ -1430,7 +1449,7 @@ def control_surfaces(case: Case) -> tuple[ControlSurfaceRow, ...]:
     for mach in case.aero.machs:
         if mach >= 1.0:
             continue
-        d = steady_control_derivatives(hm, mach, symmetric=wall)
+        d = steady_control_derivatives(hm, mach, symmetric=wall, links=_surface_links(case))
         se = static_effectiveness(fm, hm, mach, 0.5 * rho * u_lim ** 2, n_q=41,
                                   image="antisymmetric" if wall else "none")
         u_r = se.reversal_speed(rho)
@@ -1511,15 +1530,17 @@ def control_surface_flutter(case: Case) -> tuple[ControlSurfaceFlutterRow, ...]:
     return tuple(rows)
 
 
-def _elastic_splits(case: Case, hm):
+def _elastic_splits(case: Case, hm, which=None):
     """Each elastic surface's plate elements and the mesh split at all their hinges
-    (:func:`asekit.structure.hinge.split_at_hinges`), the case's errors naming the key."""
+    (:func:`asekit.structure.hinge.split_at_hinges`), the case's errors naming the key;
+    ``which`` the indices of the surfaces split (None: all)."""
     from asekit.aeroelastic.control_surface import surface_elements
     from asekit.structure.hinge import split_at_hinges
 
     mesh = structural_mesh(case)
+    idx = list(range(len(case.control_surfaces))) if which is None else list(which)
     flaps = []
-    for i in range(len(case.control_surfaces)):
+    for i in idx:
         try:
             flaps.append(surface_elements(mesh, hm, i))
         except ValueError as exc:
@@ -1528,12 +1549,12 @@ def _elastic_splits(case: Case, hm):
                             f"lines fall there)") from None
     for n in range(1, len(flaps) + 1):     # surface by surface, so the error names its key
         try:
-            splits = split_at_hinges(mesh, flaps[:n], hm.hinge_point[:n, :2],
-                                     hm.hinge_axis[:n, :2])
+            splits = split_at_hinges(mesh, flaps[:n], hm.hinge_point[idx[:n], :2],
+                                     hm.hinge_axis[idx[:n], :2])
         except ValueError as exc:
-            raise CaseError(f"control_surface[{n - 1}].hinge_chord_fraction / span_fraction: "
-                            f"{exc} (choose panel.n_chord, n_span or their spacing so that "
-                            f"node lines fall there)") from None
+            raise CaseError(f"control_surface[{idx[n - 1]}].hinge_chord_fraction / "
+                            f"span_fraction: {exc} (choose panel.n_chord, n_span or their "
+                            f"spacing so that node lines fall there)") from None
     return flaps, splits
 
 
@@ -1545,20 +1566,25 @@ def _elastic_surface_model(case: Case, hm):
     :func:`asekit.structure.hinge.hinge_balance_mass`) reduced to the wing's ``modes`` count of
     fixed-hinge modes plus the hinge rotations
     (:func:`asekit.aeroelastic.control_surface.elastic_flap_modal_model`). Several elastic
-    surfaces side by side are allowed; the schema refuses mixing them with rigid ones."""
+    surfaces side by side are allowed, and rigid surfaces beside them
+    (:func:`_mixed_surface_model`: only the elastic ones are split and released)."""
     from asekit.aeroelastic.control_surface import elastic_flap_modal_model
     from asekit.structure.hinge import hinge_balance_mass, release_hinges
 
     cs = case.control_surfaces
+    el = [i for i, c in enumerate(cs) if c.kind == "elastic"]
     if case.structure is not None or modal_model(case).n_rigid:
-        raise CaseError("control_surface[0].kind = \"elastic\" needs a plate case file whose "
-                        "support has no rigid mode (clamped, or modes.keep_rigid = false)")
-    flaps, splits = _elastic_splits(case, hm)
+        raise CaseError(f"control_surface[{el[0]}].kind = \"elastic\" needs a plate case file "
+                        f"whose support has no rigid mode (clamped, or modes.keep_rigid = "
+                        f"false)")
+    mixed = len(el) < len(cs)
+    flaps, splits = _elastic_splits(case, hm, el if mixed else None)
     system = supported_system(case)
     support = system.T
     held = np.asarray(abs(support).sum(axis=1)).ravel()[0::3] == 0     # w held, per node
     n0 = splits[0].n_original
-    for i, (c, flap, split) in enumerate(zip(cs, flaps, splits)):
+    for i, flap, split in zip(el, flaps, splits):
+        c = cs[i]
         own = np.unique(split.mesh.elements[flap])
         own = own[own < n0]
         if np.any(held[own]):
@@ -1571,23 +1597,42 @@ def _elastic_surface_model(case: Case, hm):
     if case.point_masses:
         M = (M + point_mass_matrix(mesh, [(p.position, p.mass, p.inertia)
                                           for p in case.point_masses])).tocsr()
-    for i, (c, split) in enumerate(zip(cs, splits)):
-        for (x, y), m_b in c.mass_balance:          # on rigid arms from the surface's hinge
+    for i, split in zip(el, splits):
+        for (x, y), m_b in cs[i].mass_balance:      # on rigid arms from the surface's hinge
             d_b = float(hm.distance_aft(i, np.array([[x, y, 0.0]]))[0])
             M = (M + hinge_balance_mass(split, (x, y), d_b, m_b)).tocsr()
     K0, M0 = mass_and_stiffness(case)          # the support's own springs and masses
-    released = release_hinges(splits, K, M, [c.hinge_stiffness for c in cs],
-                              [c.hinge_damping for c in cs], support=support,
+    released = release_hinges(splits, K, M, [cs[i].hinge_stiffness for i in el],
+                              [cs[i].hinge_damping for i in el], support=support,
                               support_stiffness=system.K - support.T @ K0 @ support,
                               support_mass=system.M - support.T @ M0 @ support)
     model = modal_model(case)
     d = case.damping
     try:
+        if mixed:
+            return _mixed_surface_model(case, hm, released, M, len(model.frequencies_hz))
         return elastic_flap_modal_model(released, M, hm, len(model.frequencies_hz),
                                         d.modal_damping_ratio, d.structural_g)
     except ValueError as exc:
         path = "control_surface[0]" if len(cs) == 1 else "control_surface"
         raise CaseError(f"{path}: {exc}") from None
+
+
+def _mixed_surface_model(case: Case, hm, released, M, n_modes: int):
+    """Rigid and elastic surfaces in one case (issue 25): the released plate of the elastic
+    ones (:func:`_elastic_surface_model`) with the rigid surfaces' hinge rotations, springs,
+    dampers and balance masses as the rigid kind builds them
+    (:func:`asekit.aeroelastic.control_surface.mixed_flap_modal_model`)."""
+    from asekit.aeroelastic.control_surface import BalanceMass, mixed_flap_modal_model
+
+    cs = case.control_surfaces
+    balance = tuple(BalanceMass(i, x, y, m) for i, c in enumerate(cs) if c.kind == "rigid"
+                    for (x, y), m in c.mass_balance)
+    d = case.damping
+    return mixed_flap_modal_model(released, M, hm, [c.kind for c in cs], n_modes,
+                                  [c.hinge_stiffness for c in cs],
+                                  [c.hinge_damping for c in cs], balance,
+                                  d.modal_damping_ratio, d.structural_g)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1658,15 +1703,21 @@ def control_surface_hinge_loads(case: Case) -> tuple[HingeLoadRow, ...]:
 
     hm = control_surface_mesh(case)
     wall = case.aero.symmetry == "wall"
+    links = _surface_links(case)
+    free = [i for i in range(len(hm.surfaces)) if i not in {k[0] for k in links}]
     derivs = {}
     rows = []
     for m, h, rho, u, basis in _hinge_load_points(case):
         if m not in derivs:
-            derivs[m] = steady_control_derivatives(hm, m, symmetric=wall)
+            derivs[m] = steady_control_derivatives(hm, m, symmetric=wall, links=links)
         q = 0.5 * rho * u * u
-        h_d, h_a = dimensional_hinge_moments(hm, derivs[m], q)
-        rows += [HingeLoadRow(s.name, m, h, rho, u, q, float(h_d[i]), float(h_a[i]), basis)
-                 for i, s in enumerate(hm.surfaces)]
+        if links:                       # the free surfaces, each with its geared surfaces
+            sc = np.array([hm.surface_area(i) * hm.mean_chord(i) for i in free])
+            h_d, h_a = q * sc * derivs[m].Ch_delta, q * sc * derivs[m].Ch_alpha
+        else:
+            h_d, h_a = dimensional_hinge_moments(hm, derivs[m], q)
+        rows += [HingeLoadRow(hm.surfaces[i].name, m, h, rho, u, q, float(h_d[j]),
+                              float(h_a[j]), basis) for j, i in enumerate(free)]
     return tuple(rows)
 
 

@@ -117,6 +117,9 @@ UNITS = {
                           "from the finite-element mass of its hinge mode)",
     "static_unbalance_kgm": "kg m (the surface's first mass moment about its hinge line; > 0: "
                             "centre of mass aft of the hinge)",
+    "hinge_mass_matrix": "kg m^2 (the hinge coordinates' block of the modal mass, surfaces in "
+                         "case order: the inertias I_h on the diagonal, the surfaces' inertial "
+                         "coupling off it)",
 }
 # the actuator loop on a control surface (issue 25, control_surface_ase rows)
 UNITS.update({
@@ -161,6 +164,7 @@ class Analysis:
     control_ase: tuple = ()
     control_freeplay: tuple = ()
     tsd_validity: tuple = ()     # issue 29: asekit.aero.tsd3d.TsdValidity per Mach ("tsd")
+    control_hinge_mass: object = None    # issue 25: FlapModel.hinge_mass_matrix (kg m^2)
 
 
 @contextlib.contextmanager
@@ -232,10 +236,12 @@ def run_analysis(case: Case, progress: bool = False) -> Analysis:
         with _stage("the actuator loop on the control surface", progress):
             control_ase = P.control_surface_ase(case)
         sec["control_surface_ase"] = time.perf_counter() - t
+    hinge_mass = (P.control_surface_model(case).hinge_mass_matrix if case.control_surfaces
+                  else None)
     return Analysis(case, modal, db, fa, ase, sec, gust=gust, control=control,
                     control_flutter=control_flutter, control_hinge=control_hinge,
                     control_ase=control_ase, control_freeplay=control_freeplay,
-                    tsd_validity=P.tsd_validity(case))
+                    tsd_validity=P.tsd_validity(case), control_hinge_mass=hinge_mass)
 
 
 def _f(v):
@@ -303,6 +309,8 @@ def summary(a: Analysis) -> dict:
              "unstable_at_first_point": r.unstable_at_first_point}
             for r in a.control_flutter]
         out.update(hinge_load_json(getattr(a, "control_hinge", ())))
+        if getattr(a, "control_hinge_mass", None) is not None:    # issue 25: inertial coupling
+            out["hinge_mass_matrix"] = [[float(x) for x in row] for row in a.control_hinge_mass]
         out.update(control_ase_json(getattr(a, "control_ase", ())))
     if getattr(a, "tsd_validity", ()):         # issue 29: the TSD's validity per Mach
         out["tsd_validity"] = [tsd_validity_json(v) for v in a.tsd_validity]

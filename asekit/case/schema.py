@@ -167,6 +167,8 @@ class ControlSurfaceSpec:
     mass_balance: tuple[tuple[tuple[float, float], float], ...] = ()
     actuator: SurfaceActuatorSpec | None = None
     freeplay_deg: float = 0.0          # hinge freeplay half-width (deg), 0: none
+    linked_to: str = ""                # AELINK: the name of the surface this one is geared to
+    gear_ratio: float = 0.0            # delta_this = gear_ratio delta_linked_to (with linked_to)
 
 
 @dataclass(frozen=True)
@@ -982,8 +984,14 @@ def _one_control_surface(t: _Table, i: int, panels) -> ControlSurfaceSpec:
         raise CaseError(f"{path}.span_fraction must be [start, end] with 0 <= start < end "
                         f"<= 1, got {list(span)}")
     kind = t.string("kind", CONTROL_SURFACE_KINDS, default="rigid")
-    k_h = t.number("hinge_stiffness", required=True, low=0.0, low_open=False, high=1e12,
-                   unit="N m/rad")
+    linked = t.text("linked_to", "")
+    gear = t.number("gear_ratio", None if linked else 0.0, required=bool(linked), low=-10.0,
+                    low_open=False, high=10.0)
+    if gear and not linked:
+        raise CaseError(f"{path}.gear_ratio needs {path}.linked_to (the surface it is geared "
+                        f"to)")
+    k_h = t.number("hinge_stiffness", 0.0, required=not linked, low=0.0, low_open=False,
+                   high=1e12, unit="N m/rad")
     c_h = t.number("hinge_damping", 0.0, low=0.0, low_open=False, high=1e12,
                    unit="N m s/rad")
     balance = _mass_balance(t, path, panels)
@@ -994,7 +1002,7 @@ def _one_control_surface(t: _Table, i: int, panels) -> ControlSurfaceSpec:
                         "(the freeplay is in the hinge spring)")
     t.done()
     return ControlSurfaceSpec(name, panel, hinge, span, kind, k_h, c_h, balance, actuator,
-                              freeplay)
+                              freeplay, linked, gear)
 
 
 def _surface_actuator(t: _Table | None) -> SurfaceActuatorSpec | None:
@@ -1023,14 +1031,30 @@ def _control_surfaces(raw, panels) -> tuple[ControlSurfaceSpec, ...]:
     names = [c.name for c in out]
     if len(set(names)) != len(names):
         raise CaseError(f"control_surface[].name must be unique, got {names}")
-    elastic = [i for i, c in enumerate(out) if c.kind == "elastic"]
-    if elastic and len(elastic) < len(out):      # several elastic side by side: issue 25
-        rigid = next(i for i, c in enumerate(out) if c.kind != "elastic")
-        raise CaseError(f"control_surface[{rigid}].kind = \"{out[rigid].kind}\" cannot be "
-                        f"mixed with the elastic control_surface[{elastic[0]}]: give every "
-                        f"surface of the case the same kind (\"rigid\" or \"elastic\")")
-    _check_nesting(out)
+    _check_nesting(out)          # rigid and elastic surfaces may be mixed (issue 25)
+    _check_links(out)
     return out
+
+
+def _check_links(out) -> None:
+    """``linked_to`` / ``gear_ratio`` (AELINK, issue 25): a linked surface names another,
+    unlinked surface; a case with links has no actuator or freeplay (not modelled)."""
+    names = [c.name for c in out]
+    for i, c in enumerate(out):
+        if not c.linked_to:
+            continue
+        path = f"control_surface[{i}]"
+        if c.linked_to not in names or c.linked_to == c.name:
+            raise CaseError(f"{path}.linked_to = {c.linked_to!r} must name another control "
+                            f"surface of the case, one of {[n for n in names if n != c.name]}")
+        if out[names.index(c.linked_to)].linked_to:
+            raise CaseError(f"{path}.linked_to = {c.linked_to!r} is itself linked: link to a "
+                            f"free surface (no chains)")
+        for j, d in enumerate(out):
+            key = "actuator" if d.actuator is not None else "freeplay_deg"
+            if d.actuator is not None or d.freeplay_deg > 0:
+                raise CaseError(f"control_surface[{j}].{key} cannot be combined with linked "
+                                f"surfaces ({path}.linked_to): not modelled")
 
 
 def _check_nesting(out) -> None:
