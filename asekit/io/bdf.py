@@ -74,7 +74,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -1647,28 +1647,40 @@ def deck_boxes(model, L, z0):
     BdfError
         A CAERO type other than CAERO1, or a surface off the plane.
     """
+    def in_plane(cid, p1, p4):
+        if abs(p1[2] - p4[2]) > 1e-9 * max(1.0, abs(p4[1] - p1[1])) \
+                or abs(p1[2] * L - z0) > 1e-6 * max(1.0, abs(z0)):
+            raise BdfError(f"CAERO1 {cid}: the surface must lie in the structure's plane "
+                           f"z = {z0 / L:g} (no dihedral)")
+
+    mesh, ids = _caero1_mesh(model, L, None, in_plane)
+    c = mesh.corners.copy()
+    c[:, :, 2] = 0.0                                 # the structural plane is z = 0 in asekit
+    return replace(mesh, corners=c), ids
+
+
+def _caero1_mesh(model, L, axes, check):
+    """Every CAERO1 of a deck, in id order, as one :class:`BoxMesh` and its Nastran box ids:
+    the corners in ``axes`` (:func:`_caero1_boxes`), ``check(cid, p1, p4)`` (P1 and P4 in
+    those axes) raising :class:`BdfError` for a surface the caller cannot represent."""
+    R = np.eye(3) if axes is None else axes
     corners, strip, surface, ids, names = [], [], [], [], []
     s0 = 0
     for i, cid in enumerate(sorted(model.caeros)):
         c = model.caeros[cid]
         if c.type != "CAERO1":
             raise BdfError(f"{c.type} {cid} is not supported (CAERO1)")
-        p1, p4 = (np.asarray(p, float) for p in (c.get_points()[0], c.get_points()[3]))
-        if abs(p1[2] - p4[2]) > 1e-9 * max(1.0, abs(p4[1] - p1[1])) \
-                or abs(p1[2] * L - z0) > 1e-6 * max(1.0, abs(z0)):
-            raise BdfError(f"CAERO1 {cid}: the surface must lie in the structure's plane "
-                           f"z = {z0 / L:g} (no dihedral)")
-        box, bid, ns, nc = _caero1_boxes(c, L)
+        p1, _, _, p4 = (R @ np.asarray(p, float) for p in c.get_points())
+        check(cid, p1, p4)
+        box, bid, ns, nc = _caero1_boxes(c, L, axes)
         corners.append(box)
         strip.append(s0 + np.repeat(np.arange(ns), nc))
         surface.append(np.full(ns * nc, i))
         ids.append(bid)
         names.append(f"CAERO1 {cid}")
         s0 += ns
-    c = np.concatenate(corners)
-    c[:, :, 2] = 0.0                                 # the structural plane is z = 0 in asekit
-    return BoxMesh(c, np.concatenate(strip), np.concatenate(surface), tuple(names)), \
-        np.concatenate(ids)
+    return BoxMesh(np.concatenate(corners), np.concatenate(strip), np.concatenate(surface),
+                   tuple(names)), np.concatenate(ids)
 
 
 def deck_boxes_aero(model, L):
@@ -1701,26 +1713,15 @@ def deck_boxes_aero(model, L):
     """
     R = aero_axes(model)
     acsid = int(getattr(model.aero or model.aeros, "acsid", 0) or 0)
-    corners, strip, surface, ids, names = [], [], [], [], []
-    s0 = 0
-    for i, cid in enumerate(sorted(model.caeros)):
-        c = model.caeros[cid]
-        if c.type != "CAERO1":
-            raise BdfError(f"{c.type} {cid} is not supported (CAERO1)")
-        p1, _, _, p4 = (R @ np.asarray(p, float) for p in c.get_points())
+
+    def flat(cid, p1, p4):
         if abs(p1[2] - p4[2]) > 1e-9 * max(1.0, abs(p4[1] - p1[1])):
             raise BdfError(f"CAERO1 {cid}: P1 and P4 are not in one x-y plane of the "
                            f"aerodynamic system (AERO ACSID = {acsid}): dihedral is not "
                            f"supported")
-        box, bid, ns, nc = _caero1_boxes(c, L, R)
-        corners.append(box)
-        strip.append(s0 + np.repeat(np.arange(ns), nc))
-        surface.append(np.full(ns * nc, i))
-        ids.append(bid)
-        names.append(f"CAERO1 {cid}")
-        s0 += ns
-    return BoxMesh(np.concatenate(corners), np.concatenate(strip), np.concatenate(surface),
-                   tuple(names)), np.concatenate(ids), R
+
+    mesh, ids = _caero1_mesh(model, L, R, flat)
+    return mesh, ids, R
 
 
 def _splined_boxes(model, s) -> set:
