@@ -165,10 +165,9 @@ def _covers(s: ControlSurface, e0: float, e1: float) -> bool:
     return s.span_start <= e0 + 1e-12 and s.span_end >= e1 - 1e-12
 
 
-def _segment_hinges(surfaces, e0: float, e1: float, default: float, parents=None):
+def _segment_hinges(surfaces, e0: float, e1: float, default: float, parents):
     """(index of the top-level surface covering [e0, e1] or -1, hinge fraction at e0, at e1);
     ``parents`` (:func:`nesting`) leaves the nested surfaces (tabs) out."""
-    parents = [-1] * len(surfaces) if parents is None else parents
     for i, s in enumerate(surfaces):
         if parents[i] < 0 and _covers(s, e0, e1):
             return (i, *_hinge_at(s, e0, e1))
@@ -189,12 +188,22 @@ def _nested_in(child: ControlSurface, parent: ControlSurface) -> bool:
     return child.hinge_inboard > p0 + 1e-9 and child.hinge_outboard > p1 + 1e-9
 
 
+class NestingError(ValueError):
+    """:func:`nesting`'s refusal; ``surfaces`` holds the indices of the surfaces it names (the
+    overlapping pair, earlier first; or the tab, its flap and the flap's own flap)."""
+
+    def __init__(self, message: str, surfaces: tuple):
+        super().__init__(message)
+        self.surfaces = tuple(surfaces)
+
+
 def nesting(surfaces) -> tuple:
     """The parent of each control surface: the index of the surface it is a tab on (its span
     inside the parent's and its hinge aft of the parent's hinge), -1 for a surface on the
     wing. Surfaces whose spans overlap must be nested so, one level deep (a tab on a flap,
     not a tab on a tab); a tab rotates about its own hinge relative to its parent and with the
-    parent about the parent's hinge. Raises ValueError naming the surfaces otherwise.
+    parent about the parent's hinge. Raises :class:`NestingError` (a ValueError) naming the
+    surfaces otherwise.
 
     Examples
     --------
@@ -209,20 +218,21 @@ def nesting(surfaces) -> tuple:
             if b.span_start >= a.span_end - 1e-12 or a.span_start >= b.span_end - 1e-12:
                 continue
             if not (_nested_in(a, b) or _nested_in(b, a)):
-                raise ValueError(
+                raise NestingError(
                     f"control surfaces '{b.name}' and '{a.name}' overlap in span "
                     f"({b.span_start:g}-{b.span_end:g} and {a.span_start:g}-{a.span_end:g}): "
                     f"give each its own span range, or nest one in the other (a tab: its "
-                    f"span inside the flap's and its hinge aft of the flap's)")
+                    f"span inside the flap's and its hinge aft of the flap's)", (j, i))
     for i, a in enumerate(surfaces):          # the innermost surface a tab lies in
         hosts = [j for j, b in enumerate(surfaces) if j != i and _nested_in(a, b)]
         if hosts:
             parents[i] = min(hosts, key=lambda j: surfaces[j].flap_chord_fraction)
     for i, p in enumerate(parents):
         if p >= 0 and parents[p] >= 0:
-            raise ValueError(f"control surface '{surfaces[i].name}' is a tab on "
-                             f"'{surfaces[p].name}', itself a tab on "
-                             f"'{surfaces[parents[p]].name}': one level of nesting only")
+            raise NestingError(f"control surface '{surfaces[i].name}' is a tab on "
+                               f"'{surfaces[p].name}', itself a tab on "
+                               f"'{surfaces[parents[p]].name}': one level of nesting only",
+                               (i, p, parents[p]))
     return tuple(parents)
 
 

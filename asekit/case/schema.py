@@ -1060,23 +1060,21 @@ def _check_links(out) -> None:
 def _check_nesting(out) -> None:
     """Surfaces on one panel whose spans overlap must be a tab on a flap
     (:func:`asekit.aero.control_surface.nesting`), both of kind "rigid"."""
-    from asekit.aero.control_surface import ControlSurface, nesting
+    from asekit.aero.control_surface import ControlSurface, NestingError, nesting
 
     surf = [ControlSurface(c.name, *c.hinge_chord_fraction, *c.span_fraction) for c in out]
     for panel in sorted({c.panel for c in out}):
         idx = [i for i, c in enumerate(out) if c.panel == panel]
-        for n, i in enumerate(idx):              # name the first pair that cannot be nested
-            for j in idx[:n]:
-                try:
-                    nesting([surf[j], surf[i]])
-                except ValueError as exc:
-                    raise CaseError(f"control_surface[{i}].span_fraction "
-                                    f"{list(out[i].span_fraction)} overlaps control_surface[{j}] "
-                                    f"({out[j].name!r}) on panel {panel}: {exc}") from None
         try:
             parents = nesting([surf[i] for i in idx])
-        except ValueError as exc:
-            raise CaseError(f"control_surface on panel {panel}: {exc}") from None
+        except NestingError as exc:
+            named = [idx[k] for k in exc.surfaces]
+            if len(named) == 2:                  # the first pair that cannot be nested
+                j, i = named
+                raise CaseError(f"control_surface[{i}].span_fraction "
+                                f"{list(out[i].span_fraction)} overlaps control_surface[{j}] "
+                                f"({out[j].name!r}) on panel {panel}: {exc}") from None
+            raise CaseError(f"control_surface[{named[0]}] on panel {panel}: {exc}") from None
         for k, p in enumerate(parents):
             i = idx[k]
             if p >= 0 and "elastic" in (out[i].kind, out[idx[p]].kind):
