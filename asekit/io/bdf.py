@@ -1902,7 +1902,9 @@ def _read_aesurf(deck: Deck, a) -> DeckControlSurface:
 
 def _read_aelinks(model, surfaces, notes) -> tuple:
     """AELINK: (label of the dependent, ((independent label, coefficient), ...)) kept and
-    reported; asekit deflects each surface on its own (the links are not applied).
+    reported; one surface geared to one other becomes the case's ``linked_to`` /
+    ``gear_ratio`` (:func:`_gears`), any other link is not applied (each surface deflects on
+    its own).
 
     +--------+-------+--------+-------+-------+-------+-------+-------+-------+
     |   1    |   2   |   3    |   4   |   5   |   6   |   7   |   8   |   9   |
@@ -1922,11 +1924,18 @@ def _read_aelinks(model, surfaces, notes) -> tuple:
             out.append((str(k.label), tuple((str(n), float(v)) for n, v in
                                             zip(k.independent_labels,
                                                 k.linking_coefficients))))
-    if out:
-        notes.append("AELINK read and kept, not applied: asekit reports each AESURF as its own "
-                     "control surface (" + "; ".join(
+    gears = _gears(out)
+    kept = [(d, ind) for d, ind in out if d not in gears]
+    if gears:
+        notes.append("AELINK applied: " + "; ".join(
+            f"{d} geared to {g['linked_to']} (gear ratio {g['gear_ratio']:g})"
+            for d, g in gears.items()) + " (control_surface[].linked_to / gear_ratio)")
+    if kept:
+        notes.append("AELINK read and kept, not applied (asekit gears one surface to one "
+                     "other, |C1| <= 10, no chains): asekit reports each of these AESURF as its "
+                     "own control surface (" + "; ".join(
                          f"{d} = " + " + ".join(f"{v:g} {n}" for n, v in ind)
-                         for d, ind in out) + ")")
+                         for d, ind in kept) + ")")
     return tuple(out)
 
 
@@ -2421,9 +2430,19 @@ def _control_specs(bdf: BdfModel) -> tuple:
     """The AESURF cards as ``[[control_surface]]`` specs: rigid, on a free hinge (AESURF gives
     no hinge stiffness: 0 N m/rad)."""
     from asekit.case.schema import ControlSurfaceSpec
+    gears = _gears(bdf.aelinks)
     return tuple(ControlSurfaceSpec(s.label, s.caero_index, s.hinge_chord_fraction,
-                                    s.span_fraction, "rigid", 0.0, 0.0)
+                                    s.span_fraction, "rigid", 0.0, 0.0,
+                                    **gears.get(s.label, {}))
                  for s in bdf.control_surfaces)
+
+
+def _gears(aelinks) -> dict:
+    """The AELINKs a case can hold (``linked_to`` / ``gear_ratio``, issue 25): one surface
+    geared to one other, |C1| <= 10, the master itself not geared; {label: keywords}."""
+    one = {d: ind[0] for d, ind in aelinks if len(ind) == 1 and ind[0][0] != d
+           and abs(ind[0][1]) <= 10.0}
+    return {d: {"linked_to": m, "gear_ratio": c} for d, (m, c) in one.items() if m not in one}
 
 
 def deck_case(bdf: BdfModel, name: str | None = None) -> Case:
@@ -2886,8 +2905,17 @@ def _control_surface_cards(model, case, ids) -> None:
     sense), an AELIST of its boxes and an AESURF (CREFC its mean chord aft of the hinge,
     CREFS its area). AESURF has no hinge stiffness, damping or balance field: those are not
     written (a re-import has a free hinge). AESURFS (the structural grids of a separately
-    modelled surface) does not apply to asekit's rigid surfaces and is not written."""
+    modelled surface) does not apply to asekit's rigid surfaces and is not written. A surface
+    geared to another (``linked_to``, ``gear_ratio``) is an AELINK ALWAYS (LABLD the geared
+    surface, LABL1 its master, C1 the gear ratio). Elastic surfaces are refused (the plate
+    is not released along the hinge in the export)."""
     labels = _aesurf_labels(case)
+    for i, c in enumerate(case.control_surfaces):
+        if c.kind != "rigid":
+            raise ValueError(f"control_surface[{i}].kind = {c.kind!r}: the export writes AESURF "
+                             f"(a rigid surface on the plate's boxes) and does not release the "
+                             f"plate along the hinge, so the deck would hold a different "
+                             f"structure; export a case whose surfaces are kind = \"rigid\"")
     hm = pl.control_surface_mesh(case)
     _check_caero1_mesh(hm, case)
     eid0 = 100001
@@ -2902,6 +2930,11 @@ def _control_surface_cards(model, case, ids) -> None:
         model.add_aelist(sid, [eid0 + int(b) for b in np.flatnonzero(hm.on_surface[i])])
         model.add_aesurf(sid, labels[i], sid, sid, crefc=hm.mean_chord(i),
                          crefs=hm.surface_area(i))
+    names = [c.name for c in case.control_surfaces]
+    for i, c in enumerate(case.control_surfaces):     # a geared surface: AELINK (issue 25)
+        if c.linked_to:
+            model.add_aelink("ALWAYS", labels[i], [labels[names.index(c.linked_to)]],
+                             [float(c.gear_ratio)])
 
 
 def _flutter_cards(model, case, ids) -> None:

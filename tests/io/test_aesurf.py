@@ -253,3 +253,34 @@ def test_export_refuses_a_hinge_that_is_not_one_caero1(tmp_path):
     cs = dataclasses.replace(src.control_surfaces[0], hinge_chord_fraction=(0.7, 0.8))
     with pytest.raises(ValueError, match=r"control_surface\[\]\.hinge_chord_fraction"):
         B.case_bdf(dataclasses.replace(src, control_surfaces=(cs,)))
+
+
+def test_a_geared_surface_exports_as_aelink_and_reads_back_geared(tmp_path):
+    """``linked_to`` / ``gear_ratio`` (issue 25) is written as AELINK ALWAYS (LABLD the geared
+    surface, LABL1 its master, C1 the ratio) and read back as the same link; an AELINK that
+    is not one surface geared to one other (the module's self-link) stays a note."""
+    src = _declarative(k_h=0.5)
+    a = src.control_surfaces[0]
+    flap = dataclasses.replace(a, name="flap", span_fraction=(0.1, 0.45))
+    geared = dataclasses.replace(a, linked_to="flap", gear_ratio=-0.5)
+    case = dataclasses.replace(src, control_surfaces=(flap, geared))
+    path = B.write_case_bdf(case, tmp_path / "geared.bdf")
+    assert any(line.startswith("AELINK") for line in path.read_text().splitlines())
+    bdf = _read_deck(path)
+    assert bdf.aelinks == (("AILERON", (("FLAP", -0.5),)),)
+    assert any(n.startswith("AELINK applied: AILERON geared to FLAP") for n in bdf.notes)
+    specs = B.deck_case(bdf).control_surfaces
+    assert [(s.name, s.linked_to, s.gear_ratio) for s in specs] == [
+        ("FLAP", "", 0.0), ("AILERON", "FLAP", -0.5)]
+    self_link = B.deck_case(_read_deck(_aileron_deck(tmp_path))).control_surfaces
+    assert [(s.linked_to, s.gear_ratio) for s in self_link] == [("", 0.0)]
+
+
+def test_export_refuses_an_elastic_surface():
+    """AESURF is a rigid surface on the plate's boxes; the export does not release the plate
+    along an elastic surface's hinge, so it refuses the case naming the key (it used to write
+    the unreleased plate silently)."""
+    src = _declarative(k_h=0.5)
+    cs = dataclasses.replace(src.control_surfaces[0], kind="elastic")
+    with pytest.raises(ValueError, match=r"control_surface\[0\]\.kind = 'elastic'"):
+        B.case_bdf(dataclasses.replace(src, control_surfaces=(cs,)))
