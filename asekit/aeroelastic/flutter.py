@@ -1109,29 +1109,31 @@ def match_point_table(modal, gaf_for_mach, machs, altitudes, velocities, kind="f
     if densities is not None and len(np.atleast_1d(densities)) != len(altitudes):
         raise ValueError(f"densities must have one value per altitude ({len(altitudes)}), "
                          f"got {len(np.atleast_1d(densities))}")
-    rows = []
+    rows, points = [], []
     for mach in np.atleast_1d(machs):
         g = gaf_for_mach(mach)
         for ia, h in enumerate(altitudes):
             atm = standard_atmosphere(h)
-            rho = float(atm.density) if densities is None else float(
-                np.atleast_1d(densities)[ia])
-            a = float(atm.speed_of_sound)
-            res = pk_flutter(modal, g, rho, velocities)
-            inst = first_of(pk_instabilities(res, modal, g), kind)
-            if inst is None:
-                rows.append(MatchPointRow(mach, h, rho, a, None, None, None, None))
-            else:
-                ueq = inst.speed * np.sqrt(rho / 1.225)
-                rows.append(MatchPointRow(mach, h, rho, a, inst.speed, inst.frequency_hz,
-                                          float(ueq), inst.speed / a, inst.kind,
-                                          inst.at_first_point))
-                if inst.at_first_point:
-                    warnings.warn(f"match point Mach {mach:g}, altitude {h:g} m: "
-                                  f"{inst.describe()}, only a bound; velocities starting "
-                                  f"below {float(np.atleast_1d(velocities)[0]):g} m/s "
-                                  "(match_point_table's argument) locate it",
-                                  RuntimeWarning, stacklevel=2)
+            rho = float(atm.density) if densities is None else positive(
+                f"densities[{ia}]", np.atleast_1d(densities)[ia])
+            points.append((mach, h, g, rho, float(atm.speed_of_sound)))
+    # every Mach x altitude sweep solved together (issue 23), each equal to its pk_flutter
+    results = pk_flutter_many(modal, [(g, rho) for _, _, g, rho, _ in points], velocities)
+    for (mach, h, g, rho, a), res in zip(points, results):
+        inst = first_of(pk_instabilities(res, modal, g), kind)
+        if inst is None:
+            rows.append(MatchPointRow(mach, h, rho, a, None, None, None, None))
+        else:
+            ueq = inst.speed * np.sqrt(rho / 1.225)
+            rows.append(MatchPointRow(mach, h, rho, a, inst.speed, inst.frequency_hz,
+                                      float(ueq), inst.speed / a, inst.kind,
+                                      inst.at_first_point))
+            if inst.at_first_point:
+                warnings.warn(f"match point Mach {mach:g}, altitude {h:g} m: "
+                              f"{inst.describe()}, only a bound; velocities starting "
+                              f"below {float(np.atleast_1d(velocities)[0]):g} m/s "
+                              "(match_point_table's argument) locate it",
+                              RuntimeWarning, stacklevel=2)
     return rows
 
 

@@ -36,7 +36,7 @@ from asekit.aeroelastic.flutter import (
     TabulatedGaf,
     divergence_speeds,
     first_of,
-    pk_flutter,
+    pk_flutter_many,
     pk_instabilities,
 )
 from asekit.atmosphere import standard_atmosphere
@@ -101,11 +101,15 @@ def _compute(model, boxes, ks, b_ref) -> dict:
     first = np.full((len(MACHS), n_h), np.nan)
     first_kind = np.zeros((len(MACHS), n_h), int)          # 0 none, 1 flutter, 2 divergence
     diverg = np.full((len(MACHS), n_h), np.nan)
+    gafs = [TabulatedGaf(ks, q[im], b_ref, mach=mach) for im, mach in enumerate(MACHS)]
+    rhos = [float(standard_atmosphere(h).density) for h in ALTITUDES]
+    # the 33 sweeps solved together (issue 23: pk_flutter_many, each equal to its pk_flutter)
+    sweeps = pk_flutter_many(model, [(g, rho) for g in gafs for rho in rhos], VELOCITIES)
     for im, mach in enumerate(MACHS):
-        gaf = TabulatedGaf(ks, q[im], b_ref, mach=mach)
+        gaf = gafs[im]
         for ih, h in enumerate(ALTITUDES):
-            rho = float(standard_atmosphere(h).density)
-            res = pk_flutter(model, gaf, rho, VELOCITIES)
+            rho = rhos[ih]
+            res = sweeps[im * len(ALTITUDES) + ih]
             inst = pk_instabilities(res, model, gaf)
             fl, fi = first_of(inst, "flutter"), first_of(inst)
             if fl is not None:
