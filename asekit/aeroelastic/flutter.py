@@ -502,10 +502,12 @@ def _same_root(r: _Roots) -> list[tuple[int, int]]:
     """Pairs of tracked columns that hold the same root (equal to 1e-6 of its magnitude, their
     eigenvectors correlated above 0.99)."""
     a = np.abs(r.p)
-    close = np.triu(np.abs(r.p[:, None] - r.p[None, :])
-                    <= 1e-6 * np.maximum(np.maximum(a[:, None], a[None, :]), 1e-12), 1)
-    return [(int(i), int(j)) for i, j in np.argwhere(close)
-            if _mac(r.v[i], r.v[j][:, None])[0] > 0.99]
+    i, j = np.triu_indices(a.size, 1)
+    close = np.abs(r.p[i] - r.p[j]) <= 1e-6 * np.maximum(np.maximum(a[i], a[j]), 1e-12)
+    if not close.any():                   # the usual case: no pair to correlate
+        return []
+    return [(int(ii), int(jj)) for ii, jj in zip(i[close], j[close])
+            if _mac(r.v[ii], r.v[jj][:, None])[0] > 0.99]
 
 
 def _step_accepted(prev: _Roots, new: _Roots, fraction: float, min_mac: float) -> bool:
@@ -835,6 +837,24 @@ def _run_lanes(stack: _PkStack, U, starts, tol, max_iter, fraction, min_mac, max
     is the one it takes alone. Returns [(path airspeeds, roots, forced steps)] per lane."""
     gens = [_pk_path(prob, U, start, tol, max_iter, fraction, min_mac, max_halvings)
             for prob, start in zip(stack.probs, starts)]
+
+    def solve(lanes, requests):
+        sizes = [prev.p.size for _, prev in requests]
+        rows = np.repeat(np.array(lanes, int), sizes)
+        u_rows = np.repeat(np.array([u for u, _ in requests], float), sizes)
+        omega = np.concatenate([np.abs(prev.p.imag) for _, prev in requests])
+        refs = np.concatenate([prev.v for _, prev in requests])
+        solved = stack.solve_rows(rows, u_rows, omega, refs, tol, max_iter)
+        parts = [np.split(a, np.cumsum(sizes)[:-1]) for a in solved]
+        return [_Roots(*(np.array(a[i]) for a in parts)) for i in range(len(lanes))]
+
+    return _lockstep(gens, solve)
+
+
+def _lockstep(gens, solve):
+    """Run generators in lock-step: each yields a request and is sent its answer; at each
+    round ``solve(lanes, requests)`` answers the pending request of every unfinished generator
+    at once (a list, in order). Returns the generators' return values, in order."""
     out, pending = [None] * len(gens), {}
 
     def advance(lane, value):
@@ -848,16 +868,8 @@ def _run_lanes(stack: _PkStack, U, starts, tol, max_iter, fraction, min_mac, max
         advance(lane, None)
     while pending:
         lanes = list(pending)
-        sizes = [pending[ln][1].p.size for ln in lanes]
-        rows = np.repeat(np.array(lanes, int), sizes)
-        u_rows = np.repeat(np.array([pending[ln][0] for ln in lanes], float), sizes)
-        omega = np.concatenate([np.abs(pending[ln][1].p.imag) for ln in lanes])
-        refs = np.concatenate([pending[ln][1].v for ln in lanes])
-        solved = stack.solve_rows(rows, u_rows, omega, refs, tol, max_iter)
-        cuts = np.cumsum(sizes)[:-1]
-        parts = [np.split(a, cuts) for a in solved]
-        for i, lane in enumerate(lanes):
-            advance(lane, _Roots(*(np.array(a[i]) for a in parts)))
+        for lane, answer in zip(lanes, solve(lanes, [pending[ln] for ln in lanes])):
+            advance(lane, answer)
     return out
 
 
@@ -926,16 +938,93 @@ def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = No
     U0). Two tracked columns that report the same crossing (same speed within tolerance, same
     frequency, correlated eigenvectors) give one instability, the lower column's.
     """
+    prob = _refine_problem(result, modal, gaf, include_rigid, interpolation) if refine else None
+    (found,) = _lockstep([_instabilities(result, prob)], _refine_answers([prob]))
+    return found
+
+
+def pk_instabilities_many(results, modal, gafs, refine: bool = True,
+                          include_rigid: bool = False, interpolation: str = "linear"
+                          ) -> list[list[Instability]]:
+    """:func:`pk_instabilities` of several sweeps of one modal model (``results[i]`` the
+    sweep of ``gafs[i]``, e.g. from :func:`pk_flutter_many`), the crossings of all sweeps
+    refined together: every Brent iteration's k-iteration of every sweep is one batched
+    eigen call (issue 23). Brent's method runs step for step as
+    :func:`scipy.optimize.brentq` (:func:`_brent`), so list ``i`` equals
+    ``pk_instabilities(results[i], modal, gafs[i], ...)``.
+
+    Returns
+    -------
+    list of lists of :class:`Instability`, one list per sweep, each sorted by speed.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from asekit.aero.gaf import TabulatedGaf
+    >>> from asekit.aeroelastic.statespace import ModalArrays
+    >>> modal = ModalArrays(M=np.eye(2), K=np.diag([1.0, 4.0]), C=np.zeros((2, 2)), n_rigid=0)
+    >>> gaf = TabulatedGaf(np.array([0.0, 1.0]), np.array([[[0, 1.0], [-2.0, 0]]] * 2), 1.0)
+    >>> res = pk_flutter_many(modal, [(gaf, 1.0), (gaf, 2.0)], np.linspace(0.5, 3.0, 11))
+    >>> [[round(s.speed, 4) for s in found]
+    ...  for found in pk_instabilities_many(res, modal, [gaf, gaf])]
+    [[1.4565], [1.0299]]
+
+    (the hand-derived coalescence U_f = sqrt(2 q_f / rho), q_f = |k1 - k2| / (2 sqrt(-a d))
+    = 1.0607 for K = diag(k1, k2), Q = [[0, a], [d, 0]]: 1.4565 and 1.0299).
+    """
+    results, gafs = list(results), list(gafs)
+    if len(results) != len(gafs):
+        raise ValueError(f"gafs must hold one TabulatedGaf per result ({len(results)}), got "
+                         f"{len(gafs)}")
+    probs = [_refine_problem(r, modal, g, include_rigid, interpolation) if refine else None
+             for r, g in zip(results, gafs)]
+    return _lockstep([_instabilities(r, p) for r, p in zip(results, probs)],
+                     _refine_answers(probs))
+
+
+def _refine_problem(result: PkResult, modal, gaf, include_rigid: bool, interpolation: str):
+    """The :class:`_PkProblem` on which a sweep's crossings are refined (None without
+    ``modal`` or ``gaf``)."""
+    if modal is None or gaf is None:
+        return None
+    m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
+    M, K, C, _ = _elastic_part(m, gaf.Q, include_rigid)
+    sel = slice(0, m.n_modes) if (include_rigid or m.n_rigid == 0) else slice(
+        m.n_rigid, m.n_modes)
+    return _PkProblem(M, K, C, TabulatedGaf(gaf.k, gaf.Q[:, sel, sel], gaf.b_ref),
+                      result.density, interpolation)
+
+
+def _refine_answers(probs):
+    """The ``solve`` of :func:`_lockstep` for the refinement: request (u, w0, v) of lane l is
+    answered by (p, vector) of the root converged from (w0, v) at u on ``probs[l]``
+    (:meth:`_PkProblem.solve_mode`); the pending requests of all lanes are one batched
+    k-iteration when the problems stack (one :class:`_PkStack`)."""
+    live = [p for p in probs if p is not None]
+    try:
+        stack = _PkStack(live) if live else None
+        where = {id(p): i for i, p in enumerate(live)}
+    except ValueError:                      # lanes of different sizes: one by one
+        stack = None
+
+    def solve(lanes, requests):
+        if stack is None:
+            return [probs[ln].solve_mode(u, w0, v)[:2] for ln, (u, w0, v) in
+                    zip(lanes, requests)]
+        rows = np.array([where[id(probs[ln])] for ln in lanes], int)
+        p, vec, _, _, _ = stack.solve_rows(rows, np.array([u for u, _, _ in requests], float),
+                                           np.array([w0 for _, w0, _ in requests], float),
+                                           np.array([v for _, _, v in requests]))
+        return list(zip(p, vec))
+
+    return solve
+
+
+def _instabilities(result: PkResult, prob: _PkProblem | None):
+    """The body of :func:`pk_instabilities` as a generator of refinement requests
+    (:func:`_refine_crossing`; none when ``prob`` is None). Returns the instabilities."""
     found = []
     U, Pp, Vp, _ = result.path()
-    prob = None
-    if refine and modal is not None and gaf is not None:
-        m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
-        M, K, C, _ = _elastic_part(m, gaf.Q, include_rigid)
-        sel = slice(0, m.n_modes) if (include_rigid or m.n_rigid == 0) else slice(
-            m.n_rigid, m.n_modes)
-        prob = _PkProblem(M, K, C, TabulatedGaf(gaf.k, gaf.Q[:, sel, sel], gaf.b_ref),
-                          result.density, interpolation)
     tol = crossing_tolerance(result.p)
     for jt in range(Pp.shape[1]):
         p = Pp[:, jt]
@@ -951,7 +1040,7 @@ def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = No
                 continue
             spread = float(U[i] - U[i - 1])
             if prob is not None:
-                refined = _refine_on_path(prob, result, U, i, jt, tol)
+                refined = yield from _refine_on_path(result, U, i, jt, tol)
                 if refined is not None:
                     us, f, vec, divergent, spread = refined
                     kind = "divergence" if divergent else kind
@@ -962,45 +1051,101 @@ def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = No
     return _one_per_root(sorted(found, key=lambda s: s.speed))
 
 
-def _refine_on_path(prob: _PkProblem, result: PkResult, U: np.ndarray, i: int, jt: int,
-                    tol: float):
+def _refine_on_path(result: PkResult, U: np.ndarray, i: int, jt: int, tol: float):
     """The crossing of column ``jt`` bracketed by path points i-1 and i, refined
     (:func:`_refine_crossing`). When the bracket is a sub-step, the refinement over the whole
     requested step that holds it (from the requested end, as a sweep without sub-steps does) is
     tried first and kept when it lands inside the sub-step bracket: the same crossing, and the
-    same number bit for bit as without step control; else the sub-step bracket is refined."""
+    same number bit for bit as without step control; else the sub-step bracket is refined.
+    A generator of :func:`_refine_crossing`'s requests."""
     _, Pp, Vp, _ = result.path()
     Ur = result.velocities
     r = int(np.searchsorted(Ur, U[i]))
     if r > 0 and not (U[i - 1] == Ur[r - 1] and U[i] == Ur[r]):
-        wide = _refine_crossing(prob, Ur[r - 1], Ur[r], result.p[r, jt], result.vectors[r, jt],
-                                tol)
+        wide = yield from _refine_crossing(Ur[r - 1], Ur[r], result.p[r, jt],
+                                           result.vectors[r, jt], tol)
         if wide is not None and U[i - 1] - wide[4] <= wide[0] <= U[i] + wide[4]:
             return wide
-    return _refine_crossing(prob, U[i - 1], U[i], Pp[i, jt], Vp[i, jt], tol)
+    return (yield from _refine_crossing(U[i - 1], U[i], Pp[i, jt], Vp[i, jt], tol))
 
 
-def _refine_crossing(prob: _PkProblem, ua: float, ub: float, p_b: complex, v_b: np.ndarray,
-                     tol: float):
+def _refine_crossing(ua: float, ub: float, p_b: complex, v_b: np.ndarray, tol: float):
     """Brent's method on Re p(U) - tol in [ua, ub], the root continued from its unstable end
     (p_b, v_b at ub: at an undamped coalescence the sub-critical vector correlates equally with
-    the stable and the unstable partner). Returns (U*, f* Hz, vector, divergence?, xtol) or
-    None when Re p does not change sign in the bracket."""
+    the stable and the unstable partner). A generator: each evaluation yields the request
+    ``(u, w0, v_b)`` (converge the root from circular frequency w0 = |Im p_b| and vector v_b at
+    airspeed u) and is sent back ``(p, vector)``. Returns (U*, f* Hz, vector, divergence?,
+    xtol) or None when Re p does not change sign in the bracket."""
     w0 = abs(p_b.imag)
     xtol = REFINE_RTOL * ub
-
-    def re_p(u):
-        # Re p - tol: an undamped sub-critical root (Re = 0 +- rounding) stays < 0
-        return prob.solve_mode(u, w0, v_b)[0].real - tol
-
+    brent = _brent(float(ua), float(ub), xtol)
+    u = next(brent)
     try:
-        us = optimize.brentq(re_p, ua, ub, xtol=xtol)
-    except ValueError:
+        while True:
+            p, _ = yield u, w0, v_b
+            # Re p - tol: an undamped sub-critical root (Re = 0 +- rounding) stays < 0
+            u = brent.send(float(p.real - tol))
+    except StopIteration as stop:
+        us = stop.value
+    if us is None:
         return None
-    pz, vec, _, _ = prob.solve_mode(us, w0, v_b)
+    pz, vec = yield us, w0, v_b
     f = abs(pz.imag) / (2 * np.pi)
     divergent = abs(pz.imag) <= 1e-6 * max(abs(pz), 1e-9) and f < 1e-6
     return float(us), f, vec, divergent, float(xtol + 4 * np.finfo(float).eps * abs(us))
+
+
+def _brent(xa: float, xb: float, xtol: float, rtol: float = 4 * np.finfo(float).eps,
+           maxiter: int = 100):
+    """Brent's root finder (R. P. Brent, "Algorithms for Minimization without Derivatives",
+    Prentice-Hall 1973, ch. 4: bisection safeguarding inverse quadratic / linear
+    interpolation) as a generator: it yields each abscissa x and is sent f(x); it returns the
+    root, or None when f(xa) and f(xb) have the same sign. The steps and the stopping test
+    (|half bracket| < (xtol + rtol |x|) / 2) are those of :func:`scipy.optimize.brentq` with
+    its default rtol and maxiter, so that it visits the same abscissae and returns the same
+    root (a batched refinement then equals the one-sweep one). RuntimeError when maxiter is
+    spent, as brentq's."""
+    xpre, xcur = xa, xb
+    fpre = yield xpre
+    fcur = yield xcur
+    if fpre * fcur > 0:
+        return None
+    if fpre == 0:
+        return xpre
+    if fcur == 0:
+        return xcur
+    xblk = fblk = spre = scur = 0.0
+    for _ in range(maxiter):
+        if fpre * fcur < 0:
+            xblk, fblk = xpre, fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):
+            xpre, xcur, xblk = xcur, xblk, xcur
+            fpre, fcur, fblk = fcur, fblk, fcur
+        delta = (xtol + rtol * abs(xcur)) / 2
+        sbis = (xblk - xcur) / 2
+        if fcur == 0 or abs(sbis) < delta:
+            return xcur
+        spre, scur = _brent_step(xpre, xcur, xblk, fpre, fcur, fblk, spre, scur, sbis, delta)
+        xpre, fpre = xcur, fcur
+        xcur += scur if abs(scur) > delta else (delta if sbis > 0 else -delta)
+        fcur = yield xcur
+    raise RuntimeError(f"Brent's method did not converge in {maxiter} iterations")
+
+
+def _brent_step(xpre, xcur, xblk, fpre, fcur, fblk, spre, scur, sbis, delta):
+    """One step choice of :func:`_brent`: (previous step, step) -- the interpolated step when
+    it is short enough, else bisection."""
+    if abs(spre) > delta and abs(fcur) < abs(fpre):
+        if xpre == xblk:                                        # secant
+            stry = -fcur * (xcur - xpre) / (fcur - fpre)
+        else:                                                   # inverse quadratic
+            dpre = (fpre - fcur) / (xpre - xcur)
+            dblk = (fblk - fcur) / (xblk - xcur)
+            stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+        if 2 * abs(stry) < min(abs(spre), 3 * abs(sbis) - delta):
+            return scur, stry
+    return sbis, sbis
 
 
 def _one_per_root(found: list[Instability]) -> list[Instability]:
@@ -1119,8 +1264,9 @@ def match_point_table(modal, gaf_for_mach, machs, altitudes, velocities, kind="f
             points.append((mach, h, g, rho, float(atm.speed_of_sound)))
     # every Mach x altitude sweep solved together (issue 23), each equal to its pk_flutter
     results = pk_flutter_many(modal, [(g, rho) for _, _, g, rho, _ in points], velocities)
-    for (mach, h, g, rho, a), res in zip(points, results):
-        inst = first_of(pk_instabilities(res, modal, g), kind)
+    found = pk_instabilities_many(results, modal, [g for _, _, g, _, _ in points])
+    for (mach, h, g, rho, a), insts in zip(points, found):
+        inst = first_of(insts, kind)
         if inst is None:
             rows.append(MatchPointRow(mach, h, rho, a, None, None, None, None))
         else:

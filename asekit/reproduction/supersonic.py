@@ -37,7 +37,7 @@ from asekit.aeroelastic.flutter import (
     divergence_speeds,
     first_of,
     pk_flutter_many,
-    pk_instabilities,
+    pk_instabilities_many,
 )
 from asekit.atmosphere import standard_atmosphere
 from asekit.case import pipeline
@@ -105,12 +105,11 @@ def _compute(model, boxes, ks, b_ref) -> dict:
     rhos = [float(standard_atmosphere(h).density) for h in ALTITUDES]
     # the 33 sweeps solved together (issue 23: pk_flutter_many, each equal to its pk_flutter)
     sweeps = pk_flutter_many(model, [(g, rho) for g in gafs for rho in rhos], VELOCITIES)
+    found = pk_instabilities_many(sweeps, model, [g for g in gafs for _ in rhos])
     for im, mach in enumerate(MACHS):
-        gaf = gafs[im]
         for ih, h in enumerate(ALTITUDES):
             rho = rhos[ih]
-            res = sweeps[im * len(ALTITUDES) + ih]
-            inst = pk_instabilities(res, model, gaf)
+            inst = found[im * len(ALTITUDES) + ih]
             fl, fi = first_of(inst, "flutter"), first_of(inst)
             if fl is not None:
                 flutter[im, ih] = (fl.speed, fl.frequency_hz)

@@ -15,13 +15,16 @@ imaginary part (so that the interpolation in k matters); two densities.
 
 import numpy as np
 import pytest
+from scipy import optimize
 
 from asekit.aeroelastic.flutter import (
     TabulatedGaf,
+    _brent,
     first_of,
     pk_flutter,
     pk_flutter_many,
     pk_instabilities,
+    pk_instabilities_many,
 )
 from asekit.aeroelastic.statespace import modal_arrays
 
@@ -70,10 +73,44 @@ def test_batched_equals_sweep_by_sweep_exactly(sweeps):
     assert len(many) == len(conditions) == 4
     for a, b in zip(many, one):
         _same_result(a, b)
-    for (g, _), a, b in zip(conditions, many, one):
-        ia, ib = pk_instabilities(a, modal, g), pk_instabilities(b, modal, g)
-        assert [(s.kind, s.mode, s.speed, s.frequency_hz, s.at_first_point) for s in ia] == \
-            [(s.kind, s.mode, s.speed, s.frequency_hz, s.at_first_point) for s in ib]
+    batched = pk_instabilities_many(many, modal, [g for g, _ in conditions])
+    for (g, _), a, b, ia in zip(conditions, many, one, batched):
+        ib = pk_instabilities(b, modal, g)
+        assert ia and [_key(s) for s in ia] == [_key(s) for s in ib]
+        assert [_key(s) for s in pk_instabilities(a, modal, g)] == [_key(s) for s in ib]
+
+
+def _key(s):
+    return (s.kind, s.mode, s.speed, s.frequency_hz, s.at_first_point, s.speed_tolerance)
+
+
+def _run_brent(f, a, b, xtol):
+    gen = _brent(a, b, xtol)
+    x, calls = next(gen), 0
+    try:
+        while True:
+            calls += 1
+            x = gen.send(f(x))
+    except StopIteration as stop:
+        return stop.value, calls
+
+
+@pytest.mark.parametrize("f, a, b", [
+    (lambda x: x ** 3 - 2.0 * x - 5.0, 2.0, 3.0),          # Wallis's cubic, root 2.0945515
+    (lambda x: np.cos(x) - x, 0.0, 1.0),
+    (lambda x: np.exp(x) - 1e3, 0.0, 10.0),
+    (lambda x: np.sign(x - 0.3) * abs(x - 0.3) ** 0.5, 0.0, 1.0),   # bisection steps
+    (lambda x: np.tanh(50.0 * (x - 0.71)) - 0.2, 0.0, 1.0),
+])
+def test_generator_brent_is_scipy_brentq_step_for_step(f, a, b):
+    """The lock-step refinement's Brent (a generator) returns scipy.optimize.brentq's root bit
+    for bit, with the same number of evaluations, so that a batched refinement equals the
+    one-sweep one; same-sign brackets give None (brentq: ValueError)."""
+    for xtol in (1e-12, 1e-6, 1e-3):
+        ref, info = optimize.brentq(f, a, b, xtol=xtol, full_output=True)
+        root, calls = _run_brent(f, a, b, xtol)
+        assert root == ref and calls == info.function_calls
+    assert _run_brent(lambda x: x * x + 1.0, -1.0, 1.0, 1e-9)[0] is None
 
 
 def test_batched_physics_first_point_and_hand_derived_flutter(sweeps):
