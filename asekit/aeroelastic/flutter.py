@@ -369,6 +369,7 @@ class _PkStack:
         kk = p0.gaf.k
         self._vector = all(p.interp == "linear" and np.array_equal(p.gaf.k, kk)
                            for p in self.probs)
+        self._one = len(self.probs) == 1      # one lane: broadcast its arrays, no gathers
         if self._vector:
             self._kk = kk
             self._mqr = np.stack([p._mqr for p in self.probs])       # (L, n_k, n, n)
@@ -386,6 +387,9 @@ class _PkStack:
         kq = np.minimum(np.maximum(ks, self._kmin), self._kmax)
         j = np.minimum(np.maximum(np.searchsorted(kk, kq) - 1, 0), kk.size - 2)
         t = ((kq - kk[j]) / (kk[j + 1] - kk[j]))[:, None, None]
+        if self._one:
+            mqr, mqik = self._mqr[0], self._mqik[0]
+            return ((1 - t) * mqr[j] + t * mqr[j + 1], (1 - t) * mqik[j] + t * mqik[j + 1])
         return ((1 - t) * self._mqr[lanes, j] + t * self._mqr[lanes, j + 1],
                 (1 - t) * self._mqik[lanes, j] + t * self._mqik[lanes, j + 1])
 
@@ -395,11 +399,14 @@ class _PkStack:
         :func:`numpy.linalg.eig` of the m first-order system matrices."""
         mqr, mqik = self._parts(lanes, ks)
         n, m = self.n, mqr.shape[0]
-        rho = self.rho[lanes]
+        if self._one:                 # the same numbers, broadcast instead of gathered
+            rho, b, mk, mc = self.rho[0], self.b[0], self._mk[0], self._mc[0]
+        else:
+            rho, b, mk, mc = self.rho[lanes], self.b[lanes], self._mk[lanes], self._mc[lanes]
         A = np.zeros((m, 2 * n, 2 * n))
         A[:, :n, n:] = self._eye
-        A[:, n:, :n] = self._mk[lanes] + ((0.5 * rho) * U ** 2)[:, None, None] * mqr
-        A[:, n:, n:] = self._mc[lanes] + ((0.5 * rho * self.b[lanes]) * U)[:, None, None] * mqik
+        A[:, n:, :n] = mk + ((0.5 * rho) * U ** 2)[:, None, None] * mqr
+        A[:, n:, n:] = mc + ((0.5 * rho * b) * U)[:, None, None] * mqik
         lam, vec = np.linalg.eig(A)
         return lam, vec[:, :n, :]
 
