@@ -509,12 +509,13 @@ def _same_root(r: _Roots) -> list[tuple[int, int]]:
     """Pairs of tracked columns that hold the same root (equal to 1e-6 of its magnitude, their
     eigenvectors correlated above 0.99)."""
     a = np.abs(r.p)
-    i, j = np.triu_indices(a.size, 1)
-    close = np.abs(r.p[i] - r.p[j]) <= 1e-6 * np.maximum(np.maximum(a[i], a[j]), 1e-12)
-    if not close.any():                   # the usual case: no pair to correlate
+    close = (np.abs(r.p[:, None] - r.p[None, :])
+             <= 1e-6 * np.maximum(np.maximum(a[:, None], a[None, :]), 1e-12))
+    close.flat[::a.size + 1] = False      # not a pair: a root and itself
+    if not close.any():                   # the usual case: nothing to correlate
         return []
-    return [(int(ii), int(jj)) for ii, jj in zip(i[close], j[close])
-            if _mac(r.v[ii], r.v[jj][:, None])[0] > 0.99]
+    return [(int(i), int(j)) for i, j in np.argwhere(np.triu(close, 1))
+            if _mac(r.v[i], r.v[j][:, None])[0] > 0.99]
 
 
 def _step_accepted(prev: _Roots, new: _Roots, fraction: float, min_mac: float) -> bool:
