@@ -650,6 +650,11 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
     -------
     :class:`PkResult` at the requested velocities, with the path and the step control's
     thresholds.
+
+    See Also
+    --------
+    pk_flutter_many : several (gaf, density) sweeps of one model solved together, each
+        result equal to this function's (issue 23: the envelope's sweeps in one batch).
     """
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
     rho = positive("density", density)
