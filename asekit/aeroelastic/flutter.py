@@ -858,8 +858,8 @@ def _run_lanes(stack: _PkStack, U, starts, tol, max_iter, fraction, min_mac, max
         omega = np.concatenate([np.abs(prev.p.imag) for _, prev in requests])
         refs = np.concatenate([prev.v for _, prev in requests])
         solved = stack.solve_rows(rows, u_rows, omega, refs, tol, max_iter)
-        parts = [np.split(a, np.cumsum(sizes)[:-1]) for a in solved]
-        return [_Roots(*(np.array(a[i]) for a in parts)) for i in range(len(lanes))]
+        ends = np.cumsum(sizes).tolist()
+        return [_Roots(*(a[e - n:e].copy() for a in solved)) for e, n in zip(ends, sizes)]
 
     return _lockstep(gens, solve)
 
