@@ -11,16 +11,31 @@ sweep, and all 33 together by :func:`~asekit.aeroelastic.flutter.pk_flutter_many
 checksum of the flutter speeds (identical both ways, checked) so that two commits can be
 compared for identical results.
 
-Measured on the project's 2-core machine (shared with other jobs), one BLAS thread:
+Measured (issue 23) on the project's 2-core machine, shared with five other engineers' jobs
+(load average 7-10, so every CPU figure is inflated by contention; compare ratios within one
+run), one BLAS thread, the fin's 6 modes (5 elastic: 10 x 10 first-order eigenproblems).
+"before" is ec4989b (a555367's per-sweep batching: every tracked root of one sweep at one
+airspeed in one eig), run from a copy of that commit in the same session:
 
-==========================================  ==========  ============  ===============
-version                                     CPU (s)     LAPACK calls  eigenproblems
-==========================================  ==========  ============  ===============
-per root (before a555367)                   --          75727         75727
-a555367, one airspeed batched (per sweep)   8.22        17211         68967
-this commit, sweep by sweep                 see below   17211         68967
-this commit, 33 sweeps batched              see below   see below     68967
-==========================================  ==========  ============  ===============
+=============================================  =========  ==========  ===============
+run (same session, back to back)               before     batched     ratio (CPU)
+=============================================  =========  ==========  ===============
+33 sweeps + first flutter, CPU s               10.19      4.26        2.39x
+the same, wall s                               17.32      8.56        2.02x
+eigen calls (eigenproblems)                    17211      851         (68967 both)
+LAPACK floor: 67600 eig 10x10 alone, CPU s     --         3.34        --
+=============================================  =========  ==========  ===============
+
+Other runs: before 8.99 / 9.45 s CPU vs batched 3.70 / 3.60 s (2.4-2.6x); before 11.38 s vs
+4.22 s (2.7x, floor 3.28 s). The flutter speeds are identical (the printed checksum) before and
+after. The 5x goal is out of reach while every k-iteration solves a full LAPACK eigenproblem:
+the eigenproblems alone (the "LAPACK floor" line, the same count in stacks of 130) take 3.3 s
+of the 4.3 s, so no grouping of them can make the sweeps more than 10.19 / 3.34 = 3.1x faster
+than before; what is left above the floor is each sweep's step control (MAC and root-identity
+tests, about 0.5 s) and the crossings' refinement. Going further needs fewer or cheaper
+eigenproblems (eigenvalues only inside the k-iteration, or a Newton / inverse iteration on the
+one tracked root), which changes the iterates and so the results at the k-iteration's
+tolerance: not done, since the results must stay those of the one-sweep solver.
 """
 
 import time
