@@ -183,8 +183,13 @@ def cold_reproduce() -> int:
     8-11, so CPU seconds are inflated by contention): before the batched p-k (ec4989b) 59.9 s
     user CPU, 3 min 57 s wall, supersonic chapter 60.8 s wall; with pk_flutter_many /
     pk_instabilities_many 51.3 s user CPU, 2 min 47 s wall, supersonic 23.2 s wall; all 151
-    reproduced quantities identical. The run stays far above 15 s CPU: the design chapter
-    (48-62 s wall), ase, flutter and structure bound it, not p-k."""
+    reproduced quantities identical. With the flutter chapter's and the case pipeline's sweeps
+    batched too, ``--cold``: 42.4 s CPU, 181 s wall (servo 19.1, structure 17.0, aero 3.3,
+    flutter 29.7, ase 31.8, supersonic 32.3, freeplay 10.8, design 29.6 s wall). The run stays
+    far above 15 s CPU and p-k no longer bounds it: a cProfile of the cold run (inflated 7x by
+    the profiler and the load) puts the p-k sweeps at 17 % of the time, the rest in the GAF
+    databases (DLM and supersonic pressures, ~15 %), the fictitious-mass modal models (~10 %),
+    minimum-state fits (~8 %), Nyquist margins and the H-infinity design (~7 % each)."""
     import resource
 
     with tempfile.TemporaryDirectory() as tmp:
