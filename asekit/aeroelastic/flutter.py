@@ -274,6 +274,7 @@ class _PkProblem:
         self._mk, self._mc = -self.Minv @ K, -self.Minv @ C
         self._kmin, self._kmax = float(kk[0]), float(kk[-1])
         self._eye = np.eye(self.n)
+        self._stack = None
 
     def _parts(self, ks: np.ndarray):
         """M^-1 Re Q(k) and M^-1 Im Q(k) / k at the reduced frequencies ``ks`` (m,), each
@@ -300,14 +301,15 @@ class _PkProblem:
         and each reduced frequency of ``ks`` (m,): the m first-order system matrices are
         stacked and solved by one call of :func:`numpy.linalg.eig` (issue 23: one LAPACK
         call per batch instead of one Python round trip per root)."""
-        mqr, mqik = self._parts(np.asarray(ks, float))
-        n, m = self.n, mqr.shape[0]
-        A = np.zeros((m, 2 * n, 2 * n))
-        A[:, :n, n:] = self._eye
-        A[:, n:, :n] = self._mk + (0.5 * self.rho * U ** 2) * mqr
-        A[:, n:, n:] = self._mc + (0.5 * self.rho * self.gaf.b_ref * U) * mqik
-        lam, vec = np.linalg.eig(A)
-        return lam, vec[:, :n, :]
+        ks = np.asarray(ks, float)
+        return self.stack.eig_rows(np.zeros(ks.size, int), np.full(ks.size, float(U)), ks)
+
+    @property
+    def stack(self) -> _PkStack:
+        """This problem as the one lane of a :class:`_PkStack` (built once)."""
+        if self._stack is None:
+            self._stack = _PkStack([self])
+        return self._stack
 
     def solve_mode(self, U, omega_guess, ref, tol=1e-7, max_iter=60):
         """Converge one root: returns (p, vector, k, converged)."""
@@ -336,7 +338,85 @@ class _PkProblem:
         nearest other root of its last eigenproblem (other real roots not counted when p is
         real; inf when there is none).
         """
-        b = self.gaf.b_ref
+        omega = np.asarray(omega_guess, float)
+        return self.stack.solve_rows(np.zeros(omega.size, int), np.full(omega.size, float(U)),
+                                     omega, np.asarray(refs), tol, max_iter)
+
+
+class _PkStack:
+    """Several p-k problems (lanes: :class:`_PkProblem` of one modal model at different GAF
+    tables and densities) solved together, row by row (issue 23, "p-k batched"): each row is
+    one root of one lane at its own airspeed, and one k-iteration of every row is one stacked
+    :func:`numpy.linalg.eig`. The arithmetic of each row is that of the row alone (elementwise
+    blends of the lane's tabulated M^-1 Re Q(k_j), M^-1 Im Q(k_j) / k_j; Eq. 3.12), so a row's
+    result does not depend on the other rows of the batch.
+
+    Lanes need the same number of modes; linear interpolation is vectorised over the rows
+    when every lane has the same reduced-frequency table (else, and for other
+    interpolations, each row is interpolated by its own lane)."""
+
+    def __init__(self, probs):
+        self.probs = list(probs)
+        p0 = self.probs[0]
+        if any(p.n != p0.n for p in self.probs):
+            raise ValueError("the p-k lanes must have the same number of modes")
+        self.n = p0.n
+        self.rho = np.array([p.rho for p in self.probs], float)
+        self.b = np.array([p.gaf.b_ref for p in self.probs], float)
+        self._mk = np.stack([p._mk for p in self.probs])
+        self._mc = np.stack([p._mc for p in self.probs])
+        self._eye = np.eye(self.n)
+        kk = p0.gaf.k
+        self._vector = all(p.interp == "linear" and np.array_equal(p.gaf.k, kk)
+                           for p in self.probs)
+        self._one = len(self.probs) == 1      # one lane: broadcast its arrays, no gathers
+        if self._vector:
+            self._kk = kk
+            self._mqr = np.stack([p._mqr for p in self.probs])       # (L, n_k, n, n)
+            self._mqik = np.stack([p._mqik for p in self.probs])
+            self._kmin, self._kmax = float(kk[0]), float(kk[-1])
+
+    def _parts(self, lanes: np.ndarray, ks: np.ndarray):
+        """M^-1 Re Q(k) and M^-1 Im Q(k) / k of row i's lane at ``ks[i]``, each (m, n, n)
+        (:meth:`_PkProblem._parts`, linear in k, clamped to the table)."""
+        if not self._vector:
+            parts = [self.probs[ln]._parts(np.array([k])) for ln, k in zip(lanes, ks)]
+            return (np.concatenate([a for a, _ in parts]),
+                    np.concatenate([c for _, c in parts]))
+        kk = self._kk
+        kq = np.minimum(np.maximum(ks, self._kmin), self._kmax)
+        j = np.minimum(np.maximum(np.searchsorted(kk, kq) - 1, 0), kk.size - 2)
+        t = ((kq - kk[j]) / (kk[j + 1] - kk[j]))[:, None, None]
+        if self._one:
+            mqr, mqik = self._mqr[0], self._mqik[0]
+            return ((1 - t) * mqr[j] + t * mqr[j + 1], (1 - t) * mqik[j] + t * mqik[j + 1])
+        return ((1 - t) * self._mqr[lanes, j] + t * self._mqr[lanes, j + 1],
+                (1 - t) * self._mqik[lanes, j] + t * self._mqik[lanes, j + 1])
+
+    def eig_rows(self, lanes: np.ndarray, U: np.ndarray, ks: np.ndarray):
+        """The roots (m, 2n) and modal eigenvectors (m, n, 2n) of Eq. (3.12) for row i at
+        lane ``lanes[i]``, airspeed ``U[i]`` and reduced frequency ``ks[i]``: one stacked
+        :func:`numpy.linalg.eig` of the m first-order system matrices."""
+        mqr, mqik = self._parts(lanes, ks)
+        n, m = self.n, mqr.shape[0]
+        if self._one:                 # the same numbers, broadcast instead of gathered
+            rho, b, mk, mc = self.rho[0], self.b[0], self._mk[0], self._mc[0]
+        else:
+            rho, b, mk, mc = self.rho[lanes], self.b[lanes], self._mk[lanes], self._mc[lanes]
+        A = np.zeros((m, 2 * n, 2 * n))
+        A[:, :n, n:] = self._eye
+        A[:, n:, :n] = mk + ((0.5 * rho) * U ** 2)[:, None, None] * mqr
+        A[:, n:, n:] = mc + ((0.5 * rho * b) * U)[:, None, None] * mqik
+        lam, vec = np.linalg.eig(A)
+        return lam, vec[:, :n, :]
+
+    def solve_rows(self, lanes: np.ndarray, U: np.ndarray, omega_guess: np.ndarray,
+                   refs: np.ndarray, tol=1e-7, max_iter=60):
+        """Converge m roots together, row i in lane ``lanes[i]`` at airspeed ``U[i]``
+        (Hassig's k-iteration of :meth:`_PkProblem.solve_roots`, each row on its own): the
+        rows not yet converged are iterated by one :meth:`eig_rows` per iteration. Returns
+        ``(p (m,), vectors (m, n), k (m,), converged (m,), spacing (m,))``."""
+        b = self.b[lanes]
         omega = np.maximum(np.asarray(omega_guess, float), 0.0)
         m = omega.size
         p_out, v_out = np.zeros(m, complex), np.zeros((m, self.n), complex)
@@ -344,11 +424,11 @@ class _PkProblem:
         active = np.arange(m)
         last_w, last_f = np.full(m, np.nan), np.full(m, np.nan)
         for it in range(max_iter):
-            om = omega[active]
-            lam, vec = self.eig_batch(U, om * b / U)
+            om, ua, ba = omega[active], U[active], b[active]
+            lam, vec = self.eig_rows(lanes[active], ua, om * ba / ua)
             p, v, sp = _pick_roots(lam, vec, refs[active], om)
             om_new = np.abs(p.imag)
-            conv = np.abs(om_new - om) <= tol * np.maximum(np.maximum(om_new, 1e-6 * U / b),
+            conv = np.abs(om_new - om) <= tol * np.maximum(np.maximum(om_new, 1e-6 * ua / ba),
                                                            1e-12)
             done = conv | (it == max_iter - 1)
             idx = active[done]
@@ -429,9 +509,12 @@ def _same_root(r: _Roots) -> list[tuple[int, int]]:
     """Pairs of tracked columns that hold the same root (equal to 1e-6 of its magnitude, their
     eigenvectors correlated above 0.99)."""
     a = np.abs(r.p)
-    close = np.triu(np.abs(r.p[:, None] - r.p[None, :])
-                    <= 1e-6 * np.maximum(np.maximum(a[:, None], a[None, :]), 1e-12), 1)
-    return [(int(i), int(j)) for i, j in np.argwhere(close)
+    close = (np.abs(r.p[:, None] - r.p[None, :])
+             <= 1e-6 * np.maximum(np.maximum(a[:, None], a[None, :]), 1e-12))
+    close.flat[::a.size + 1] = False      # not a pair: a root and itself
+    if not close.any():                   # the usual case: nothing to correlate
+        return []
+    return [(int(i), int(j)) for i, j in np.argwhere(np.triu(close, 1))
             if _mac(r.v[i], r.v[j][:, None])[0] > 0.99]
 
 
@@ -479,13 +562,17 @@ def _continue(prob: _PkProblem, ua: float, prev: _Roots, ub: float, tol, max_ite
     columns made distinct by :func:`_reassign`); after an accepted step the next trial is twice
     as long. Returns the accepted points [(u, roots), ...] ending at ``ub`` and the number of
     forced steps.
+
+    A generator (issue 23): each trial step yields ``(u, prev)`` and is sent back the tracked
+    roots at u continued from ``prev`` (:func:`_solve_all`), so that :func:`_run_lanes` can
+    solve the trial steps of many sweeps in one batch.
     """
     points, forced, direct = [], 0, None
     h_min = (ub - ua) / 2.0 ** max_halvings
     u, h = ua, ub - ua
     while u < ub:
         un = ub if u + h >= ub else u + h
-        new = _solve_all(prob, un, prev, tol, max_iter)
+        new = yield un, prev
         if direct is None:
             direct = new                  # the whole step, as a sweep without step control
         if not _step_accepted(prev, new, fraction, min_mac):
@@ -563,11 +650,82 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
     -------
     :class:`PkResult` at the requested velocities, with the path and the step control's
     thresholds.
+
+    See Also
+    --------
+    pk_flutter_many : several (gaf, density) sweeps of one model solved together, each
+        result equal to this function's (issue 23: the envelope's sweeps in one batch).
     """
     m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
     rho = positive("density", density)
     U = _ascending("velocities", velocities)
     _pressure_ok(rho, U)
+    opts = _pk_options(max_iter, tol, step_fraction, min_mac, max_halvings, interpolation)
+    lane = _pk_lane(m, gaf, rho, U, include_rigid, interpolation, modes)
+    (run,) = _run_lanes(_PkStack([lane.prob]), U, [lane.start], *opts)
+    return _pk_result(m, lane, U, run, include_rigid, opts)
+
+
+@small_dense
+def pk_flutter_many(modal, conditions, velocities, modes=None, include_rigid: bool = False,
+                    interpolation: str = "linear", tol: float = 1e-7, max_iter: int = 60,
+                    step_fraction: float = STEP_FRACTION, min_mac: float = MIN_MAC,
+                    max_halvings: int = MAX_HALVINGS) -> list[PkResult]:
+    """:func:`pk_flutter` of one modal model at several flight conditions, solved together.
+
+    ``conditions`` is a sequence of ``(gaf, density)`` pairs (a Mach number's
+    :class:`TabulatedGaf` and an air density, kg/m^3 or the model's unit), each swept over the
+    same ``velocities``. The sweeps are independent: each runs Eq. (3.12)'s continuation with
+    its own step control, but at every round the pending trial step of every sweep (all its
+    tracked roots at its next airspeed) is one batched k-iteration, each iteration one stacked
+    :func:`numpy.linalg.eig` over all sweeps' unconverged roots (issue 23, "p-k batched"). The
+    arithmetic of each root is that of its sweep alone, so result ``i`` equals
+    ``pk_flutter(modal, *conditions[i], velocities, ...)``. The other arguments are
+    :func:`pk_flutter`'s, shared by every condition.
+
+    Returns
+    -------
+    list of :class:`PkResult`, one per condition, in order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from asekit.aero.gaf import TabulatedGaf
+    >>> from asekit.aeroelastic.statespace import ModalArrays
+    >>> modal = ModalArrays(M=np.eye(2), K=np.diag([1.0, 4.0]), C=np.zeros((2, 2)), n_rigid=0)
+    >>> ks = np.array([0.0, 1.0])
+    >>> Q = np.array([[[0.0, 0.5], [-0.5, 0.0]]] * 2, complex)   # a circulatory coupling
+    >>> gaf = TabulatedGaf(ks, Q, 1.0)
+    >>> many = pk_flutter_many(modal, [(gaf, 1.0), (gaf, 2.0)], [0.5, 1.0])
+    >>> one = pk_flutter(modal, gaf, 2.0, [0.5, 1.0])
+    >>> bool(np.array_equal(many[1].p, one.p))
+    True
+    """
+    m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
+    U = _ascending("velocities", velocities)
+    opts = _pk_options(max_iter, tol, step_fraction, min_mac, max_halvings, interpolation)
+    try:
+        pairs = [tuple(c) for c in conditions]
+    except TypeError:
+        raise TypeError("conditions must be a sequence of (gaf, density) pairs, got "
+                        f"{type(conditions).__name__}") from None
+    if not pairs or any(len(c) != 2 for c in pairs):
+        raise ValueError("conditions must be a non-empty sequence of (gaf, density) pairs")
+    lanes = []
+    for i, (gaf, density) in enumerate(pairs):
+        lanes.append(_pk_lane(m, gaf, positive(f"conditions[{i}] density", density), U,
+                              include_rigid, interpolation, modes, f"conditions[{i}] "))
+    runs = _run_lanes(_PkStack([ln.prob for ln in lanes]), U, [ln.start for ln in lanes],
+                      *opts)
+    results = []
+    for ln, run in zip(lanes, runs):
+        results.append(_pk_result(m, ln, U, run, include_rigid, opts))
+    return results
+
+
+def _pk_options(max_iter, tol, step_fraction, min_mac, max_halvings, interpolation):
+    """pk_flutter's solver options, checked: (tol, max_iter, step_fraction, min_mac,
+    max_halvings); errors name the argument and its range."""
     max_iter = _count("max_iter", max_iter)
     tol = positive("tol", tol)
     step_fraction = _fraction("step_fraction", step_fraction, 0.0, 1.0, low_open=True)
@@ -577,10 +735,31 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
         raise ValueError(f"max_halvings must be an integer in [0, 30], got {max_halvings}")
     if interpolation not in ("linear", "cubic"):
         raise ValueError(f"interpolation must be 'linear' or 'cubic', got {interpolation!r}")
+    return tol, max_iter, step_fraction, min_mac, max_halvings
+
+
+@dataclass(frozen=True)
+class _PkLane:
+    """One p-k sweep's problem (:class:`_PkProblem`), structural circular frequencies w
+    (ascending, rad/s), tracked ``modes`` and the structural roots it starts from."""
+
+    prob: _PkProblem
+    w: np.ndarray
+    modes: np.ndarray
+    start: _Roots
+    mach: float | None
+    b_ref: float
+
+
+def _pk_lane(m: ModalArrays, gaf, rho: float, U: np.ndarray, include_rigid: bool,
+             interpolation: str, modes, where: str = "") -> _PkLane:
+    """The checked set-up of one sweep of :func:`pk_flutter` (``where`` prefixes the names of
+    the arguments in errors, e.g. "conditions[2] ")."""
+    _pressure_ok(rho, U)
     if not isinstance(gaf, TabulatedGaf):
-        raise TypeError(f"gaf must be a TabulatedGaf, got {type(gaf).__name__}")
+        raise TypeError(f"{where}gaf must be a TabulatedGaf, got {type(gaf).__name__}")
     if gaf.Q.shape[1] != m.n_modes:
-        raise ValueError(f"gaf has {gaf.Q.shape[1]} modes, the modal model {m.n_modes}")
+        raise ValueError(f"{where}gaf has {gaf.Q.shape[1]} modes, the modal model {m.n_modes}")
     M, K, C, _ = _elastic_part(m, gaf.Q, include_rigid)
     sel = slice(0, m.n_modes) if (include_rigid or m.n_rigid == 0) else slice(m.n_rigid,
                                                                                m.n_modes)
@@ -593,20 +772,28 @@ def pk_flutter(modal, gaf: TabulatedGaf, density: float, velocities, modes=None,
     modes = np.arange(M.shape[0]) if modes is None else np.atleast_1d(np.asarray(modes, int))
     if np.any(modes < 0) or np.any(modes >= M.shape[0]):
         raise ValueError(f"modes must be indices in [0, {M.shape[0] - 1}], got {modes}")
-    path_u, path, forced = _pk_path(prob, U, _structural_roots(w, phi, modes), tol, max_iter,
-                                    step_fraction, min_mac, max_halvings)
+    return _PkLane(prob, w, modes, _structural_roots(w, phi, modes), gaf.mach, gaf.b_ref)
+
+
+def _pk_result(m: ModalArrays, lane: _PkLane, U: np.ndarray, run, include_rigid: bool,
+               opts) -> PkResult:
+    """The :class:`PkResult` of one lane's path ``run`` = (path airspeeds, roots, forced)."""
+    tol, max_iter, step_fraction, min_mac, _ = opts
+    path_u, path, forced = run
     at = np.searchsorted(path_u, U)                       # the requested points on the path
     P = np.array([r.p for r in path])
     V = np.array([r.v for r in path])
     conv = np.array([r.ok for r in path])
     KK = np.array([r.k for r in path])
     n_r = m.n_rigid if include_rigid else 0
-    _warn_unconverged(U, conv[at], modes, n_r, max_iter, tol, int((~conv).sum()))
+    _warn_unconverged(U, conv[at], lane.modes, n_r, max_iter, tol, int((~conv).sum()),
+                      stacklevel=5)
     return PkResult(velocities=U, p=P[at], k=KK[at], vectors=V[at], converged=conv[at],
-                    structural_frequencies_hz=w[modes] / (2 * np.pi), density=rho,
-                    mach=gaf.mach, b_ref=gaf.b_ref, modes=modes, n_rigid=n_r,
-                    path_velocities=path_u, path_p=P, path_vectors=V, path_converged=conv,
-                    step_fraction=step_fraction, min_mac=min_mac, forced_steps=forced)
+                    structural_frequencies_hz=lane.w[lane.modes] / (2 * np.pi),
+                    density=lane.prob.rho, mach=lane.mach, b_ref=lane.b_ref,
+                    modes=lane.modes, n_rigid=n_r, path_velocities=path_u, path_p=P,
+                    path_vectors=V, path_converged=conv, step_fraction=step_fraction,
+                    min_mac=min_mac, forced_steps=forced)
 
 
 def _fraction(name: str, value, lo: float, hi: float, low_open: bool = False,
@@ -638,12 +825,13 @@ def _structural_roots(w: np.ndarray, phi: np.ndarray, modes: np.ndarray) -> _Roo
 def _pk_path(prob, U, start: _Roots, tol, max_iter, fraction, min_mac, max_halvings):
     """The continuation from U = 0 through every requested airspeed: (path airspeeds,
     [roots per path point], forced steps). Points below U[0] (the way from the structural
-    roots) are not kept."""
+    roots) are not kept. A generator of trial steps like :func:`_continue` (run it with
+    :func:`_run_lanes`)."""
     path_u, path, forced = [], [], 0
     ua, prev = 0.0, start
     for u in U:
-        points, nf = _continue(prob, ua, prev, float(u), tol, max_iter, fraction, min_mac,
-                               max_halvings)
+        points, nf = yield from _continue(prob, ua, prev, float(u), tol, max_iter, fraction,
+                                          min_mac, max_halvings)
         forced += nf
         if ua == 0.0:
             points = points[-1:]
@@ -654,7 +842,52 @@ def _pk_path(prob, U, start: _Roots, tol, max_iter, fraction, min_mac, max_halvi
     return path_u, path, forced
 
 
-def _warn_unconverged(U, conv, modes, n_r, max_iter, tol, n_path_bad):
+def _run_lanes(stack: _PkStack, U, starts, tol, max_iter, fraction, min_mac, max_halvings):
+    """The p-k paths (:func:`_pk_path`) of every lane of ``stack`` from its structural roots
+    ``starts[l]``, advanced together: at each round, the pending trial step of every unfinished
+    lane (its tracked roots continued to its next airspeed) is one batched k-iteration
+    (:meth:`_PkStack.solve_rows`). Each lane's step control runs on its own, so a lane's path
+    is the one it takes alone. Returns [(path airspeeds, roots, forced steps)] per lane."""
+    gens = [_pk_path(prob, U, start, tol, max_iter, fraction, min_mac, max_halvings)
+            for prob, start in zip(stack.probs, starts)]
+
+    def solve(lanes, requests):
+        sizes = [prev.p.size for _, prev in requests]
+        rows = np.repeat(np.array(lanes, int), sizes)
+        u_rows = np.repeat(np.array([u for u, _ in requests], float), sizes)
+        omega = np.concatenate([np.abs(prev.p.imag) for _, prev in requests])
+        refs = np.concatenate([prev.v for _, prev in requests])
+        solved = stack.solve_rows(rows, u_rows, omega, refs, tol, max_iter)
+        ends = np.cumsum(sizes).tolist()
+        return [_Roots(*(a[e - n:e].copy() for a in solved)) for e, n in zip(ends, sizes)]
+
+    return _lockstep(gens, solve)
+
+
+def _lockstep(gens, solve):
+    """Run generators in lock-step: each yields a request and is sent its answer; at each
+    round ``solve(lanes, requests)`` answers the pending request of every unfinished generator
+    at once (a list, in order). Returns the generators' return values, in order."""
+    out, pending = [None] * len(gens), {}
+
+    def advance(lane, value):
+        try:
+            pending[lane] = gens[lane].send(value)
+        except StopIteration as stop:
+            out[lane] = stop.value
+            pending.pop(lane, None)
+
+    for lane in range(len(gens)):
+        advance(lane, None)
+    while pending:
+        lanes = list(pending)
+        for lane, answer in zip(lanes, solve(lanes, [pending[ln] for ln in lanes])):
+            advance(lane, answer)
+    return out
+
+
+def _warn_unconverged(U, conv, modes, n_r, max_iter, tol, n_path_bad,
+                      stacklevel: int = 4):
     """FlutterConvergenceWarning naming the (mode, airspeed) points whose k-iteration did not
     converge (``conv`` at the requested points; ``n_path_bad`` counts the whole path)."""
     if conv.all() and n_path_bad == 0:
@@ -678,7 +911,7 @@ def _warn_unconverged(U, conv, modes, n_r, max_iter, tol, n_path_bad):
     warnings.warn(f"p-k: the k-iteration did not converge within {max_iter} iterations "
                   f"(relative frequency change still above {tol:g}) {where}; from Python, "
                   "pk_flutter(..., max_iter=N) allows more iterations",
-                  FlutterConvergenceWarning, stacklevel=4)  # past @small_dense
+                  FlutterConvergenceWarning, stacklevel=stacklevel)  # past @small_dense
 
 
 def _crossings(U, sigma, freq_hz, real_mask, tol: float = 0.0):
@@ -718,16 +951,93 @@ def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = No
     U0). Two tracked columns that report the same crossing (same speed within tolerance, same
     frequency, correlated eigenvectors) give one instability, the lower column's.
     """
+    prob = _refine_problem(result, modal, gaf, include_rigid, interpolation) if refine else None
+    (found,) = _lockstep([_instabilities(result, prob)], _refine_answers([prob]))
+    return found
+
+
+def pk_instabilities_many(results, modal, gafs, refine: bool = True,
+                          include_rigid: bool = False, interpolation: str = "linear"
+                          ) -> list[list[Instability]]:
+    """:func:`pk_instabilities` of several sweeps of one modal model (``results[i]`` the
+    sweep of ``gafs[i]``, e.g. from :func:`pk_flutter_many`), the crossings of all sweeps
+    refined together: every Brent iteration's k-iteration of every sweep is one batched
+    eigen call (issue 23). Brent's method runs step for step as
+    :func:`scipy.optimize.brentq` (:func:`_brent`), so list ``i`` equals
+    ``pk_instabilities(results[i], modal, gafs[i], ...)``.
+
+    Returns
+    -------
+    list of lists of :class:`Instability`, one list per sweep, each sorted by speed.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from asekit.aero.gaf import TabulatedGaf
+    >>> from asekit.aeroelastic.statespace import ModalArrays
+    >>> modal = ModalArrays(M=np.eye(2), K=np.diag([1.0, 4.0]), C=np.zeros((2, 2)), n_rigid=0)
+    >>> gaf = TabulatedGaf(np.array([0.0, 1.0]), np.array([[[0, 1.0], [-2.0, 0]]] * 2), 1.0)
+    >>> res = pk_flutter_many(modal, [(gaf, 1.0), (gaf, 2.0)], np.linspace(0.5, 3.0, 11))
+    >>> [[round(s.speed, 4) for s in found]
+    ...  for found in pk_instabilities_many(res, modal, [gaf, gaf])]
+    [[1.4565], [1.0299]]
+
+    (the hand-derived coalescence U_f = sqrt(2 q_f / rho), q_f = |k1 - k2| / (2 sqrt(-a d))
+    = 1.0607 for K = diag(k1, k2), Q = [[0, a], [d, 0]]: 1.4565 and 1.0299).
+    """
+    results, gafs = list(results), list(gafs)
+    if len(results) != len(gafs):
+        raise ValueError(f"gafs must hold one TabulatedGaf per result ({len(results)}), got "
+                         f"{len(gafs)}")
+    probs = [_refine_problem(r, modal, g, include_rigid, interpolation) if refine else None
+             for r, g in zip(results, gafs)]
+    return _lockstep([_instabilities(r, p) for r, p in zip(results, probs)],
+                     _refine_answers(probs))
+
+
+def _refine_problem(result: PkResult, modal, gaf, include_rigid: bool, interpolation: str):
+    """The :class:`_PkProblem` on which a sweep's crossings are refined (None without
+    ``modal`` or ``gaf``)."""
+    if modal is None or gaf is None:
+        return None
+    m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
+    M, K, C, _ = _elastic_part(m, gaf.Q, include_rigid)
+    sel = slice(0, m.n_modes) if (include_rigid or m.n_rigid == 0) else slice(
+        m.n_rigid, m.n_modes)
+    return _PkProblem(M, K, C, TabulatedGaf(gaf.k, gaf.Q[:, sel, sel], gaf.b_ref),
+                      result.density, interpolation)
+
+
+def _refine_answers(probs):
+    """The ``solve`` of :func:`_lockstep` for the refinement: request (u, w0, v) of lane l is
+    answered by (p, vector) of the root converged from (w0, v) at u on ``probs[l]``
+    (:meth:`_PkProblem.solve_mode`); the pending requests of all lanes are one batched
+    k-iteration when the problems stack (one :class:`_PkStack`)."""
+    live = [p for p in probs if p is not None]
+    try:
+        stack = _PkStack(live) if live else None
+        where = {id(p): i for i, p in enumerate(live)}
+    except ValueError:                      # lanes of different sizes: one by one
+        stack = None
+
+    def solve(lanes, requests):
+        if stack is None:
+            return [probs[ln].solve_mode(u, w0, v)[:2] for ln, (u, w0, v) in
+                    zip(lanes, requests)]
+        rows = np.array([where[id(probs[ln])] for ln in lanes], int)
+        p, vec, _, _, _ = stack.solve_rows(rows, np.array([u for u, _, _ in requests], float),
+                                           np.array([w0 for _, w0, _ in requests], float),
+                                           np.array([v for _, _, v in requests]))
+        return list(zip(p, vec))
+
+    return solve
+
+
+def _instabilities(result: PkResult, prob: _PkProblem | None):
+    """The body of :func:`pk_instabilities` as a generator of refinement requests
+    (:func:`_refine_crossing`; none when ``prob`` is None). Returns the instabilities."""
     found = []
     U, Pp, Vp, _ = result.path()
-    prob = None
-    if refine and modal is not None and gaf is not None:
-        m = modal if isinstance(modal, ModalArrays) else modal_arrays(modal)
-        M, K, C, _ = _elastic_part(m, gaf.Q, include_rigid)
-        sel = slice(0, m.n_modes) if (include_rigid or m.n_rigid == 0) else slice(
-            m.n_rigid, m.n_modes)
-        prob = _PkProblem(M, K, C, TabulatedGaf(gaf.k, gaf.Q[:, sel, sel], gaf.b_ref),
-                          result.density, interpolation)
     tol = crossing_tolerance(result.p)
     for jt in range(Pp.shape[1]):
         p = Pp[:, jt]
@@ -743,7 +1053,7 @@ def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = No
                 continue
             spread = float(U[i] - U[i - 1])
             if prob is not None:
-                refined = _refine_on_path(prob, result, U, i, jt, tol)
+                refined = yield from _refine_on_path(result, U, i, jt, tol)
                 if refined is not None:
                     us, f, vec, divergent, spread = refined
                     kind = "divergence" if divergent else kind
@@ -754,45 +1064,101 @@ def pk_instabilities(result: PkResult, modal=None, gaf: TabulatedGaf | None = No
     return _one_per_root(sorted(found, key=lambda s: s.speed))
 
 
-def _refine_on_path(prob: _PkProblem, result: PkResult, U: np.ndarray, i: int, jt: int,
-                    tol: float):
+def _refine_on_path(result: PkResult, U: np.ndarray, i: int, jt: int, tol: float):
     """The crossing of column ``jt`` bracketed by path points i-1 and i, refined
     (:func:`_refine_crossing`). When the bracket is a sub-step, the refinement over the whole
     requested step that holds it (from the requested end, as a sweep without sub-steps does) is
     tried first and kept when it lands inside the sub-step bracket: the same crossing, and the
-    same number bit for bit as without step control; else the sub-step bracket is refined."""
+    same number bit for bit as without step control; else the sub-step bracket is refined.
+    A generator of :func:`_refine_crossing`'s requests."""
     _, Pp, Vp, _ = result.path()
     Ur = result.velocities
     r = int(np.searchsorted(Ur, U[i]))
     if r > 0 and not (U[i - 1] == Ur[r - 1] and U[i] == Ur[r]):
-        wide = _refine_crossing(prob, Ur[r - 1], Ur[r], result.p[r, jt], result.vectors[r, jt],
-                                tol)
+        wide = yield from _refine_crossing(Ur[r - 1], Ur[r], result.p[r, jt],
+                                           result.vectors[r, jt], tol)
         if wide is not None and U[i - 1] - wide[4] <= wide[0] <= U[i] + wide[4]:
             return wide
-    return _refine_crossing(prob, U[i - 1], U[i], Pp[i, jt], Vp[i, jt], tol)
+    return (yield from _refine_crossing(U[i - 1], U[i], Pp[i, jt], Vp[i, jt], tol))
 
 
-def _refine_crossing(prob: _PkProblem, ua: float, ub: float, p_b: complex, v_b: np.ndarray,
-                     tol: float):
+def _refine_crossing(ua: float, ub: float, p_b: complex, v_b: np.ndarray, tol: float):
     """Brent's method on Re p(U) - tol in [ua, ub], the root continued from its unstable end
     (p_b, v_b at ub: at an undamped coalescence the sub-critical vector correlates equally with
-    the stable and the unstable partner). Returns (U*, f* Hz, vector, divergence?, xtol) or
-    None when Re p does not change sign in the bracket."""
+    the stable and the unstable partner). A generator: each evaluation yields the request
+    ``(u, w0, v_b)`` (converge the root from circular frequency w0 = |Im p_b| and vector v_b at
+    airspeed u) and is sent back ``(p, vector)``. Returns (U*, f* Hz, vector, divergence?,
+    xtol) or None when Re p does not change sign in the bracket."""
     w0 = abs(p_b.imag)
     xtol = REFINE_RTOL * ub
-
-    def re_p(u):
-        # Re p - tol: an undamped sub-critical root (Re = 0 +- rounding) stays < 0
-        return prob.solve_mode(u, w0, v_b)[0].real - tol
-
+    brent = _brent(float(ua), float(ub), xtol)
+    u = next(brent)
     try:
-        us = optimize.brentq(re_p, ua, ub, xtol=xtol)
-    except ValueError:
+        while True:
+            p, _ = yield u, w0, v_b
+            # Re p - tol: an undamped sub-critical root (Re = 0 +- rounding) stays < 0
+            u = brent.send(float(p.real - tol))
+    except StopIteration as stop:
+        us = stop.value
+    if us is None:
         return None
-    pz, vec, _, _ = prob.solve_mode(us, w0, v_b)
+    pz, vec = yield us, w0, v_b
     f = abs(pz.imag) / (2 * np.pi)
     divergent = abs(pz.imag) <= 1e-6 * max(abs(pz), 1e-9) and f < 1e-6
     return float(us), f, vec, divergent, float(xtol + 4 * np.finfo(float).eps * abs(us))
+
+
+def _brent(xa: float, xb: float, xtol: float, rtol: float = 4 * np.finfo(float).eps,
+           maxiter: int = 100):
+    """Brent's root finder (R. P. Brent, "Algorithms for Minimization without Derivatives",
+    Prentice-Hall 1973, ch. 4: bisection safeguarding inverse quadratic / linear
+    interpolation) as a generator: it yields each abscissa x and is sent f(x); it returns the
+    root, or None when f(xa) and f(xb) have the same sign. The steps and the stopping test
+    (|half bracket| < (xtol + rtol |x|) / 2) are those of :func:`scipy.optimize.brentq` with
+    its default rtol and maxiter, so that it visits the same abscissae and returns the same
+    root (a batched refinement then equals the one-sweep one). RuntimeError when maxiter is
+    spent, as brentq's."""
+    xpre, xcur = xa, xb
+    fpre = yield xpre
+    fcur = yield xcur
+    if fpre * fcur > 0:
+        return None
+    if fpre == 0:
+        return xpre
+    if fcur == 0:
+        return xcur
+    xblk = fblk = spre = scur = 0.0
+    for _ in range(maxiter):
+        if fpre * fcur < 0:
+            xblk, fblk = xpre, fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):
+            xpre, xcur, xblk = xcur, xblk, xcur
+            fpre, fcur, fblk = fcur, fblk, fcur
+        delta = (xtol + rtol * abs(xcur)) / 2
+        sbis = (xblk - xcur) / 2
+        if fcur == 0 or abs(sbis) < delta:
+            return xcur
+        spre, scur = _brent_step(xpre, xcur, xblk, fpre, fcur, fblk, spre, scur, sbis, delta)
+        xpre, fpre = xcur, fcur
+        xcur += scur if abs(scur) > delta else (delta if sbis > 0 else -delta)
+        fcur = yield xcur
+    raise RuntimeError(f"Brent's method did not converge in {maxiter} iterations")
+
+
+def _brent_step(xpre, xcur, xblk, fpre, fcur, fblk, spre, scur, sbis, delta):
+    """One step choice of :func:`_brent`: (previous step, step) -- the interpolated step when
+    it is short enough, else bisection."""
+    if abs(spre) > delta and abs(fcur) < abs(fpre):
+        if xpre == xblk:                                        # secant
+            stry = -fcur * (xcur - xpre) / (fcur - fpre)
+        else:                                                   # inverse quadratic
+            dpre = (fpre - fcur) / (xpre - xcur)
+            dblk = (fblk - fcur) / (xblk - xcur)
+            stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+        if 2 * abs(stry) < min(abs(spre), 3 * abs(sbis) - delta):
+            return scur, stry
+    return sbis, sbis
 
 
 def _one_per_root(found: list[Instability]) -> list[Instability]:
@@ -901,29 +1267,32 @@ def match_point_table(modal, gaf_for_mach, machs, altitudes, velocities, kind="f
     if densities is not None and len(np.atleast_1d(densities)) != len(altitudes):
         raise ValueError(f"densities must have one value per altitude ({len(altitudes)}), "
                          f"got {len(np.atleast_1d(densities))}")
-    rows = []
+    rows, points = [], []
     for mach in np.atleast_1d(machs):
         g = gaf_for_mach(mach)
         for ia, h in enumerate(altitudes):
             atm = standard_atmosphere(h)
-            rho = float(atm.density) if densities is None else float(
-                np.atleast_1d(densities)[ia])
-            a = float(atm.speed_of_sound)
-            res = pk_flutter(modal, g, rho, velocities)
-            inst = first_of(pk_instabilities(res, modal, g), kind)
-            if inst is None:
-                rows.append(MatchPointRow(mach, h, rho, a, None, None, None, None))
-            else:
-                ueq = inst.speed * np.sqrt(rho / 1.225)
-                rows.append(MatchPointRow(mach, h, rho, a, inst.speed, inst.frequency_hz,
-                                          float(ueq), inst.speed / a, inst.kind,
-                                          inst.at_first_point))
-                if inst.at_first_point:
-                    warnings.warn(f"match point Mach {mach:g}, altitude {h:g} m: "
-                                  f"{inst.describe()}, only a bound; velocities starting "
-                                  f"below {float(np.atleast_1d(velocities)[0]):g} m/s "
-                                  "(match_point_table's argument) locate it",
-                                  RuntimeWarning, stacklevel=2)
+            rho = float(atm.density) if densities is None else positive(
+                f"densities[{ia}]", np.atleast_1d(densities)[ia])
+            points.append((mach, h, g, rho, float(atm.speed_of_sound)))
+    # every Mach x altitude sweep solved together (issue 23), each equal to its pk_flutter
+    results = pk_flutter_many(modal, [(g, rho) for _, _, g, rho, _ in points], velocities)
+    found = pk_instabilities_many(results, modal, [g for _, _, g, _, _ in points])
+    for (mach, h, g, rho, a), insts in zip(points, found):
+        inst = first_of(insts, kind)
+        if inst is None:
+            rows.append(MatchPointRow(mach, h, rho, a, None, None, None, None))
+        else:
+            ueq = inst.speed * np.sqrt(rho / 1.225)
+            rows.append(MatchPointRow(mach, h, rho, a, inst.speed, inst.frequency_hz,
+                                      float(ueq), inst.speed / a, inst.kind,
+                                      inst.at_first_point))
+            if inst.at_first_point:
+                warnings.warn(f"match point Mach {mach:g}, altitude {h:g} m: "
+                              f"{inst.describe()}, only a bound; velocities starting "
+                              f"below {float(np.atleast_1d(velocities)[0]):g} m/s "
+                              "(match_point_table's argument) locate it",
+                              RuntimeWarning, stacklevel=2)
     return rows
 
 

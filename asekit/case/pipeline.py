@@ -986,7 +986,8 @@ def flutter(case: Case, progress: bool = False, db: GafDatabase | None = None) -
     if progress:
         from tqdm.auto import tqdm
         pairs = tqdm(pairs, desc="p-k flutter (Mach x condition)", leave=False)
-    results = [analyse_condition(case, db, m, c, model) for m, c in pairs]
+    results = ([analyse_condition(case, db, m, c, model) for m, c in pairs] if progress
+               else _conditions_together(case, db, pairs, model))
     div = []
     for m in case.aero.machs:
         Q0 = db.at(m).Q[0].real
@@ -1927,3 +1928,32 @@ def control_surface_freeplay(case: Case) -> tuple[ControlSurfaceFreeplayRow, ...
             rows.append(ControlSurfaceFreeplayRow(c.name, float(mach), float(rho),
                                                   float(c.freeplay_deg), onset, first, uf))
     return tuple(rows)
+
+
+# --------------------------------------------------------------------------------------------
+# issue 23 (p-k batched): every Mach x flight condition p-k sweep of a case solved together
+# --------------------------------------------------------------------------------------------
+@_door("the flutter solution", _FLUTTER)
+def _conditions_together(case: Case, db: GafDatabase, pairs, model) -> list:
+    """:func:`analyse_condition` of every (mach, condition) of ``pairs``, the same results:
+    with the p-k method (``flutter.method = "pk"``) the sweeps are solved together
+    (:func:`asekit.aeroelastic.flutter.pk_flutter_many`, then
+    :func:`~asekit.aeroelastic.flutter.pk_instabilities_many`; each sweep's result equals its
+    own p-k bit for bit), any other method condition by condition."""
+    from asekit.aeroelastic.flutter import pk_flutter_many, pk_instabilities_many
+
+    method = flutter_method(case.flutter.method)
+    if getattr(method, "name", None) != "pk" or len(pairs) < 2:
+        return [analyse_condition(case, db, m, c, model) for m, c in pairs]
+    U = np.asarray(case.flight.velocities, float)
+    gafs = [db.at(m) for m, _ in pairs]
+    sweeps = pk_flutter_many(model, [(g, c.density) for g, (_, c) in zip(gafs, pairs)], U)
+    results = []
+    for (m, c), pk, inst in zip(pairs, sweeps, pk_instabilities_many(sweeps, model, gafs)):
+        start = [i for i in inst if i.at_first_point]
+        crossings = [i for i in inst if not i.at_first_point]
+        results.append(ConditionResult(float(m), c, pk, tuple(inst),
+                                       first_of(crossings, "flutter"),
+                                       first_of(crossings, "divergence"), bool(start),
+                                       start[0].mode if start else None))
+    return results

@@ -25,7 +25,9 @@ from asekit.aeroelastic.flutter import (
     initial_state,
     matched_mach,
     pk_flutter,
+    pk_flutter_many,
     pk_instabilities,
+    pk_instabilities_many,
     root_locus,
     root_locus_instabilities,
     simulate_free_response,
@@ -76,6 +78,19 @@ def analyse_condition(modal, db, mach: float, altitude: float, velocities=VELOCI
     return {"density": rho, "gaf": gaf, "pk": res, "instabilities": inst,
             "flutter": first_of(inst, "flutter"), "divergence": first_of(inst, "divergence"),
             "first": first_of(inst)}
+
+
+def analyse_conditions(modal, db, points, velocities=VELOCITIES) -> list[dict]:
+    """:func:`analyse_condition` at every (Mach, altitude) of ``points``, the p-k sweeps
+    solved together (issue 23: :func:`asekit.aeroelastic.flutter.pk_flutter_many` and
+    :func:`~asekit.aeroelastic.flutter.pk_instabilities_many`; each equal to its own sweep)."""
+    rhos = [float(standard_atmosphere(h).density) for _, h in points]
+    gafs = [db.at(mach) for mach, _ in points]
+    sweeps = pk_flutter_many(modal, list(zip(gafs, rhos)), velocities)
+    found = pk_instabilities_many(sweeps, modal, gafs)
+    return [{"density": rho, "gaf": gaf, "pk": res, "instabilities": inst,
+             "flutter": first_of(inst, "flutter"), "divergence": first_of(inst, "divergence"),
+             "first": first_of(inst)} for rho, gaf, res, inst in zip(rhos, gafs, sweeps, found)]
 
 
 def time_domain_first(modal, fit, rho: float, velocities=np.arange(100.0, 461.0, 10.0)):
@@ -150,9 +165,11 @@ def run(figures: bool = False) -> ChapterResult:
     db, modal = data
     sweep_note = "1976 std atm; sweep 100-460 m/s"
     conds = {}
+    together = iter(analyse_conditions(modal, db, [(mach, h) for mach in MACHS.values()
+                                                   for h in ALTITUDES]))
     for mk, mach in MACHS.items():
         for h in ALTITUDES:
-            c = analyse_condition(modal, db, mach, h)
+            c = next(together)
             conds[(mk, h)] = c
             fl = c["flutter"]
             note = sweep_note if fl is None else f"{fl.describe()}; {sweep_note}"

@@ -36,8 +36,8 @@ from asekit.aeroelastic.flutter import (
     TabulatedGaf,
     divergence_speeds,
     first_of,
-    pk_flutter,
-    pk_instabilities,
+    pk_flutter_many,
+    pk_instabilities_many,
 )
 from asekit.atmosphere import standard_atmosphere
 from asekit.case import pipeline
@@ -101,12 +101,15 @@ def _compute(model, boxes, ks, b_ref) -> dict:
     first = np.full((len(MACHS), n_h), np.nan)
     first_kind = np.zeros((len(MACHS), n_h), int)          # 0 none, 1 flutter, 2 divergence
     diverg = np.full((len(MACHS), n_h), np.nan)
+    gafs = [TabulatedGaf(ks, q[im], b_ref, mach=mach) for im, mach in enumerate(MACHS)]
+    rhos = [float(standard_atmosphere(h).density) for h in ALTITUDES]
+    # the 33 sweeps solved together (issue 23: pk_flutter_many, each equal to its pk_flutter)
+    sweeps = pk_flutter_many(model, [(g, rho) for g in gafs for rho in rhos], VELOCITIES)
+    found = pk_instabilities_many(sweeps, model, [g for g in gafs for _ in rhos])
     for im, mach in enumerate(MACHS):
-        gaf = TabulatedGaf(ks, q[im], b_ref, mach=mach)
         for ih, h in enumerate(ALTITUDES):
-            rho = float(standard_atmosphere(h).density)
-            res = pk_flutter(model, gaf, rho, VELOCITIES)
-            inst = pk_instabilities(res, model, gaf)
+            rho = rhos[ih]
+            inst = found[im * len(ALTITUDES) + ih]
             fl, fi = first_of(inst, "flutter"), first_of(inst)
             if fl is not None:
                 flutter[im, ih] = (fl.speed, fl.frequency_hz)
