@@ -142,7 +142,7 @@ def build_parser() -> argparse.ArgumentParser:
                           "its mu bound (about a minute)")
     rep.add_argument("--transonic", action="store_true",
                      help="also compute the fin through the transonic gap with the TSD "
-                          "(M 0.8-1.2) if it is not cached (about 5 CPU-minutes)")
+                          "(M 0.8-1.2) if it is not cached (a few CPU-minutes)")
     rep.set_defaults(func=_reproduce, parser=rep)
     add_analyse(sub)
     add_sweep(sub)

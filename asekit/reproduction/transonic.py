@@ -30,11 +30,43 @@ of the fin's case (:func:`tsd_case`) that differs from the envelope's in four st
   602 Hz modes moves the DLM's flutter speed by 0.02 % (224.55 against 224.50 m/s, M 0.8,
   wall, measured).
 
+Results (2026-12-04; sea level; the TSD on 4 x 4 boxes, 8 x 4 cells; flutter speed m/s,
+frequency Hz, Re Q_cc 1e-4 m^3/rad, similarity K of the background, supersonic nodes):
+
+====  =====  =====  =====  =====  ====
+M     U_f    f_f    Q_cc   K      sup.
+====  =====  =====  =====  =====  ====
+0.80  230.5  126.4  10.68   5.57     0
+0.90  223.4  125.3  11.61   2.51     0
+0.95  217.9  117.8  11.81   1.20    41
+1.00  227.3  122.0  10.63   0.00  1842
+1.05  233.5  119.6   8.52  -1.10  6871
+1.10  236.9  116.6   5.11  -2.13  6912
+1.15  234.3  113.3   2.30  -3.08  6912
+1.20  230.5  111.3   0.54  -3.97  6912
+====  =====  =====  =====  =====  ====
+
+Joins (same wall, boxes, k, modes): the DLM 224.6 m/s at M 0.8 (TSD +2.6 %), 222.6 at
+M 0.9 (+0.3 %); the Mach box 223.0 at M 1.15 (+5.1 %), 217.5 at M 1.2 (+6.0 %). The TSD's
+linear limit (zero thickness) gives 228.5, 218.2, 226.1, 211.8 m/s at M 0.8, 0.95, 1.05, 1.2
+(+1.8 % and -2.6 % from the joins): the dip at M 0.95 (-5.5 % from M 0.8) is there without
+thickness too (compressibility, not a shock: the 2.56 % section's pocket at M 0.95 is 41
+nodes); the thickness raises the supersonic flutter speeds (+3.3 % at M 1.05, +8.9 % at 1.2).
+Q_cc: TSD 10.68 against the DLM's 10.33 at M 0.8 (+3.4 %); at M 1.2 0.54 against the Mach
+box's -5.04 (zero thickness: -2.0): the centre of pressure lies near the shaft there, so
+Q_cc is a small difference, and the TSD puts it further forward (not explained yet; the
+first-order supersonic operator's one-cell lag would move it aft).
+The isolated fin (no wall) flutters at 210.8 m/s (M 0.8, DLM) and 259.6 m/s (M 1.2, Mach
+box) with these boxes: the wall lowers the supersonic flutter speed by 16 % and raises the
+subsonic one by 7 %, so the TSD curve sits apart from the envelope's isolated-fin curves.
+
 The GAFs come from :func:`asekit.case.pipeline.gaf_database` of :func:`tsd_case` (cached in
 the user cache, entry by entry, like every case's GAFs; the steady backgrounds too); the p-k
 results of :func:`transonic_envelope` are cached as ``transonic_envelope.npz`` keyed by a
-fingerprint. The first computation takes tens of minutes on a shared 2-core machine (about
-2-3 CPU-minutes per Mach); it runs only when asked for (:func:`transonic_study_requested`:
+fingerprint. The first computation takes 11-18 CPU-seconds per Mach for the GAFs (7 k, the
+grid's 38 x 12 x 16 = 7296 nodes; more above M 1, where the steady continuation takes more
+steps), about 9 min wall in all with the p-k on the loaded shared 2-core machine of
+2026-12-04; it runs only when asked for (:func:`transonic_study_requested`:
 ``python -m asekit reproduce --transonic`` or ``ASEKIT_TRANSONIC_STUDY=1``); otherwise a
 cached result is used or the rows say how to compute them.
 """
@@ -73,11 +105,11 @@ REDUCED_FREQUENCIES = (0.001, 0.1, 0.2, 0.3, 0.45, 0.65, 1.0)
 MODE_F_MAX = 400.0
 #: The linear methods at the joins: Mach -> method (same boxes, k, modes and wall).
 JOINS = {0.8: "dlm", 0.9: "dlm", 1.15: "supersonic", 1.2: "supersonic"}
-_FORMAT = 1
+_FORMAT = 2          # 2: the validity per Mach
 
 
 def transonic_study_requested() -> bool:
-    """Whether the (tens of minutes) transonic study may be computed in this run:
+    """Whether the (minutes-long) transonic study may be computed in this run:
     ``ASEKIT_TRANSONIC_STUDY=1`` (set by ``python -m asekit reproduce --transonic``). Without
     it a cached result is still used."""
     return os.environ.get("ASEKIT_TRANSONIC_STUDY", "") == "1"
@@ -191,7 +223,10 @@ def _compute(case) -> dict:
                                     method=JOINS[float(m)])
             linear[ij, iw] = _flutter_rows(model, ks, b_ref, m, ql)
             linear_qcc[ij, iw] = ql[0, 0, 0].real
+    valid = pipeline.tsd_validity(case)      # the cached backgrounds' similarity and pockets
     return {"machs": np.asarray(case.aero.machs, float), "Q": q, "flutter": flutter,
+            "similarity": np.array([v.similarity for v in valid]),
+            "supersonic_points": np.array([v.supersonic_points for v in valid]),
             "Qcc": q[:, 0, 0, 0].real, "join_machs": join_machs, "linear": linear,
             "linear_Qcc": linear_qcc, "gaf_cpu_s": cpu, "failed": np.array(failed, str),
             "mode_hz": np.asarray(model.frequencies_hz, float)}
@@ -215,6 +250,8 @@ def transonic_envelope(compute: bool | None = None, case=None) -> dict | None:
         none], n_alt, 3) and ``linear_Qcc`` (n_join, 2) of the linear methods, ``gaf_cpu_s``
         (n_M,) (CPU seconds of each Mach's GAFs when computed; near 0 when cached),
         ``failed`` (reasons of the Machs without a converged background: NaN rows),
+        ``similarity`` and ``supersonic_points`` per Mach (the background's
+        :class:`asekit.aero.tsd3d.TsdValidity`),
         ``altitudes``, ``thickness_ratio``.
     """
     case = tsd_case() if case is None else case

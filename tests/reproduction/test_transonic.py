@@ -38,10 +38,13 @@ def test_the_gap_joins_the_linear_methods():
     """The TSD's sea-level flutter speeds through the gap, against the DLM (M 0.8, 0.9) and the
     Mach-box method (M 1.15, 1.2) with the same root wall, boxes, k and modes. The TSD carries
     the 2.56 % biconvex background and is first order on its 8 x 4-cell grid, so the joins
-    are not exact: the tolerances below are about twice the measured differences (see
-    the module's rows; 15 % at the subsonic join, 10 % at the supersonic one). Every Mach
-    has a converged background and a flutter point in the sweep. Minutes the first time
-    (the GAFs are cached)."""
+    are not exact. Measured (2026-12-04): TSD 230.5, 223.4, 234.3, 230.5 m/s against DLM
+    224.6, 222.6 and Mach box 223.0, 217.5 m/s: +2.6 %, +0.3 %, +5.1 %, +6.0 %; with zero
+    thickness the TSD's linear limit gives 228.5 m/s at M 0.8 (+1.8 %) and 211.8 m/s at M 1.2
+    (-2.6 %): the supersonic excess is the thickness background's. Tolerances about twice
+    the measured: 6 % subsonic, 12 % supersonic. Every Mach has a converged background and a
+    flutter point in the sweep. About 10 min the first time on a loaded 2-core machine (the
+    GAFs and the result are cached)."""
     env = T.transonic_envelope(compute=True)
     assert env is not None and np.atleast_1d(env["failed"]).size == 0
     speed = env["flutter"][:, 0, 0]
@@ -49,5 +52,5 @@ def test_the_gap_joins_the_linear_methods():
     machs = list(env["machs"])
     for ij, m in enumerate(env["join_machs"]):
         lin = env["linear"][ij, 0, 0, 0]
-        tol = 0.15 if m < 1 else 0.10
+        tol = 0.06 if m < 1 else 0.12
         assert abs(speed[machs.index(m)] / lin - 1) < tol, (m, speed[machs.index(m)], lin)
