@@ -314,7 +314,7 @@ def quantities(env: dict | None) -> list:
     for im, m in enumerate(env["machs"]):
         fl = env["flutter"][im, 0]
         note = (f"TSD, biconvex {100 * tau:.2f} % stand-in, root wall, {BOXES[0]} x {BOXES[1]}"
-                f" boxes, CPU {float(env['gaf_cpu_s'][im]):.0f} s")
+                f" boxes; GAF CPU this run {float(env['gaf_cpu_s'][im]):.0f} s")
         note = failed.get(f"M {m:g}", note)
         rows.append(Quantity(f"flutter.envelope.tsd.{_key(m)}.h0.speed_ms", num(fl[0]), "m/s",
                              note))
