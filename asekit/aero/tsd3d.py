@@ -758,7 +758,8 @@ def harmonic_tsd3d(background: Tsd3dSolution, modes, kappa: float) -> HarmonicTs
         A0 = 1 - M^2 - (gamma + 1) M^2 phi0_x,                                         (3)
 
     differenced as the steady operator (the background's Murman-Cole switches for the x term,
-    central phi1_x). On z = 0+: phi1_z = w/U = dh/dx + i kappa h on the wing (h the upward
+    phi1_x of the time term central, backward at supersonic nodes since issue 29 tsdfin,
+    :func:`_time_term`). On z = 0+: phi1_z = w/U = dh/dx + i kappa h on the wing (h the upward
     displacement of the mode), phi1 = 0 off the wing and wake (antisymmetry), and on the wake
     a continuous pressure phi1_x + i kappa phi1 = 0, solved exactly along the wake
     (phi1 = phi1_TE exp(-i kappa (x - x_TE)): the jump is convected and the trailing edge
