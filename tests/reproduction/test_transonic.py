@@ -54,3 +54,12 @@ def test_the_gap_joins_the_linear_methods():
         lin = env["linear"][ij, 0, 0, 0]
         tol = 0.06 if m < 1 else 0.12
         assert abs(speed[machs.index(m)] / lin - 1) < tol, (m, speed[machs.index(m)], lin)
+
+
+def test_reproduce_takes_the_transonic_flag():
+    """``reproduce --transonic`` is the opt-in (it sets ASEKIT_TRANSONIC_STUDY for the chapter)."""
+    from asekit.cli.main import build_parser
+
+    p = build_parser()
+    assert p.parse_args(["reproduce", "--transonic"]).transonic is True
+    assert p.parse_args(["reproduce"]).transonic is False
