@@ -56,6 +56,11 @@ Q_cc: TSD 10.68 against the DLM's 10.33 at M 0.8 (+3.4 %); at M 1.2 0.54 against
 box's -5.04 (zero thickness: -2.0): the centre of pressure lies near the shaft there, so
 Q_cc is a small difference, and the TSD puts it further forward (not explained yet; the
 first-order supersonic operator's one-cell lag would move it aft).
+Grid check (6 x 6 boxes, a 12 x 6-cell grid, same k and modes; 58, 67, 160 CPU-s at M 0.8,
+0.95, 1.2): the TSD 229.0, 218.3, 237.3 m/s (128.6, 120.9, 114.1 Hz) against the DLM's 228.4
+at M 0.8 (+0.2 %) and the Mach box's 220.2 at M 1.2 (+7.8 %) on those boxes: the subsonic
+join converges, the supersonic one does not close (the thickness background's excess stays;
+its Q_cc 0.0035 against -4.50). The dip at M 0.95 stays (218.3 m/s).
 The isolated fin (no wall) flutters at 210.8 m/s (M 0.8, DLM) and 259.6 m/s (M 1.2, Mach
 box) with these boxes: the wall lowers the supersonic flutter speed by 16 % and raises the
 subsonic one by 7 %, so the TSD curve sits apart from the envelope's isolated-fin curves.
