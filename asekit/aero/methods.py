@@ -8,7 +8,7 @@ pressure-per-normalwash matrices of every method.
 - ``"supersonic"``: the Mach-box lifting-surface method (:mod:`asekit.aero.supersonic`, M > 1);
 - ``"piston"``: piston theory (:mod:`asekit.aero.piston`, M > 1, warns outside its bound);
 - ``"tsd"``: the time-linearised transonic small-disturbance method
-  (:mod:`asekit.aero.tsd3d`, 0 < M < 1, the transonic gap 0.9 < M < 1 included without the
+  (:mod:`asekit.aero.tsd3d`, 0 < M < 1.3, the transonic gap 0.9 < M < 1.15 included without the
   gap's warning: it models the nonlinear steady background; options ``section`` (a
   (shape, thickness_ratio) pair, "biconvex" only) and ``grid_options``);
 - ``"auto"``: the DLM for M <= DLM_MACH_MAX (0.9), the supersonic method for
@@ -85,9 +85,11 @@ def _piston_matrices(mesh, mach, ks, b_ref, symmetric=False, kernel="quartic", *
     return piston_pressure_matrices(mesh, mach, ks, b_ref, **options)
 
 
-#: The TSD method's Mach range: subsonic free streams, 0 < M < 1 (tsd3d has no supersonic
-#: free stream yet), the transonic gap's subsonic part included.
-TSD_MACHS = MachRange(0.0, 1.0, False, False, "subsonic and transonic")
+#: The TSD method's Mach range: 0 < M < 1.3 (:func:`asekit.aero.tsd.tsd_mach`), the whole
+#: transonic gap included: supersonic free streams since issue 29's tsdfin step (type-dependent
+#: differencing upwind everywhere, the time term too; the lift of a rectangular wing at M 1.2
+#: within 6 % of the exact linear value on 8 chordwise cells, tests/aero/test_tsd_supersonic.py).
+TSD_MACHS = MachRange(0.0, 1.3, False, False, "subsonic, transonic and low supersonic")
 #: The aerofoil sections the TSD accepts (``aero.section.shape``).
 TSD_SECTIONS = ("biconvex",)
 
@@ -247,8 +249,8 @@ AERO_METHODS: dict[str, AeroMethod] = {
                          _piston_matrices, _matrix_operators(_piston_matrices), 0.0,
                          _dlm_box_chord),
     "tsd": AeroMethod("tsd", "time-linearised transonic small disturbance (Batina 1989), "
-                      "0 < M < 1 including the transonic gap", TSD_MACHS, "method='tsd'",
-                      "; use method='supersonic' or 'piston' above M 1", False, _tsd_matrices,
+                      "0 < M < 1.3 including the transonic gap", TSD_MACHS, "method='tsd'",
+                      "; use method='supersonic' or 'piston' above M 1.3", False, _tsd_matrices,
                       _matrix_operators(_tsd_matrices), 0.0, _dlm_box_chord, True),
 }
 #: The method names (the registry's keys).

@@ -60,13 +60,30 @@ k = 0 and zero thickness the lift GAFs are +30 %, +7.1 %, +1.9 % from the DLM's 
 12 x 6, 16 x 8 cells (issue 29, tsdswept; tests/aero/test_tsd_swept.py; the rectangular
 aspect-ratio-3 wing: +7.2 %, +3.7 %, +2.0 %, Richardson-extrapolated 12/16 within 0.1 % of
 the DLM's extrapolated lift). Not yet: camber /
-incidence backgrounds (steady lift and wake), supersonic free streams. ``method = "tsd"`` of the
+incidence backgrounds (steady lift and wake). ``method = "tsd"`` of the
 registry (:mod:`asekit.aero.methods`) wraps :func:`tsd_pressure_matrices` on the grid of
 :func:`mesh_grid_options` (limit :data:`MAX_NODES`); :func:`tsd_validity` states the
 similarity parameter and shock presence of a background. On the coarse grids of unit tests
 the continuation can stall at a strong shock (4 % biconvex at M 0.95 on 8 x 4 cells:
 residual 8e-3 after 60, 150 and 300 steps). The sparse LU costs grow as about n^1.5-2 in 3-D: about 1e4 nodes solve in a second
 (real) or a few seconds (the complex harmonic system), 4e4 nodes in tens of seconds.
+
+Supersonic free streams, 1 < M < 1.3 (issue 29, tsdfin: the fin's envelope through the
+gap). The Murman-Cole switch is then upwind at every node off the pockets of subsonic flow, so
+the x-operator is the first-order backward one of the supersonic wave equation; the harmonic
+problem's time term -2 i kappa M^2 phi1_x is backward there too (:func:`_time_term`). The
+far boundaries need no special treatment: the inflow plane is undisturbed (phi = 0 steady,
+phi1_x = 0 harmonic), and the upper and outboard boundaries (phi = 0 steady; the acoustic
+condition's K = kappa M / sqrt(max(1 - M^2, 1e-6)) makes them nearly phi1 = 0 above M 1)
+reflect Mach waves that return to z = 0 at least 2 beta far root chords downstream of where
+they left, behind the wing for beta > 1 / (2 far) (M > 1.0035 with far 6). Measured (zero
+thickness, rectangular wing of aspect ratio 4, tests/aero/test_tsd_supersonic.py): the lift at
+M 1.2 is 5.6 %, 4.7 %, 3.9 % below the exact linear value on 8, 12, 16 chordwise cells (first
+order: the upwind operator lags the pressure by about a cell), the harmonic GAFs at k 0.3
+within 9.2 % of asekit's Mach-box method on 8 cells (18 % with a central time term). The
+steady background converges at M 1.0 and 1.05 on the lifting grids (``edges="faces"``); a
+free stream of exactly M 1 has no linear limit (a0 = 0), so only a thick section's
+background is defined there.
 
 Examples
 --------
@@ -646,6 +663,20 @@ def _surface_sets(planform: TsdPlanform, grid: Tsd3dGrid):
     return wing, wake
 
 
+def _time_term(kappa: float, mach: float, vol: np.ndarray, span: np.ndarray, x: np.ndarray,
+               i: np.ndarray, mu: np.ndarray):
+    """The term -2 i kappa M^2 phi1_x of Eq. (3) times the cell volume at nodes ``i``: central
+    (phi_{i+1} - phi_{i-1}) / (x_{i+1} - x_{i-1}) where the background is subsonic (mu 0), the
+    backward (phi_i - phi_{i-1}) / (x_i - x_{i-1}) where it is supersonic (mu 1), as the
+    Murman-Cole switch does for the x-flux (issue 29, tsdfin: a central difference there
+    reaches one node downstream, against the supersonic domain of dependence). Returns the
+    coefficients ((of phi_{i+1}, negated), (of phi_{i-1})) and the diagonal's (negated)."""
+    m = mu[i]
+    c = 2j * kappa * mach ** 2 * vol / span * (1.0 - m)
+    back = 2j * kappa * mach ** 2 * vol / (x[i] - x[i - 1])[:, None, None] * m
+    return (c, c + back), back
+
+
 def _lifting_matrix(background: Tsd3dSolution, kappa: float, wing, wake):
     """The time-linearised operator (Eq. 3 of :mod:`asekit.aero.tsd` in 3-D) with its
     boundary rows, over all nodes (i, j, k) -> (i n_y + j) n_z + k."""
@@ -659,10 +690,12 @@ def _lifting_matrix(background: Tsd3dSolution, kappa: float, wing, wake):
     i = np.arange(1, nx - 1)
     vol = op.vol[i]
     span = (grid.x[i + 1] - grid.x[i - 1])[:, None, None]
-    t = 2j * kappa * mach ** 2 * vol / span
+    mu0 = op.switches(background.phi)
+    t, diag = _time_term(kappa, mach, vol, span, grid.x, i, mu0)
     rows = np.concatenate([node[i].ravel()] * 3)
     cols = np.concatenate([node[i].ravel(), node[i + 1].ravel(), node[i - 1].ravel()])
-    vals = np.concatenate([(vol * mach ** 2 * kappa ** 2).ravel(), -t.ravel(), t.ravel()])
+    vals = np.concatenate([(vol * mach ** 2 * kappa ** 2 - diag).ravel(), -t[0].ravel(),
+                           t[1].ravel()])
     # radiation through the outboard and upper faces, phi_n + i K phi = 0 with the acoustic
     # wavenumber K = kappa M / beta of Eq. (3) (after phi = psi exp(i kappa M^2 x / beta^2) it
     # is beta^2 psi_xx + psi_yy + psi_zz + K^2 psi = 0; first-order Sommerfeld condition:
@@ -677,7 +710,6 @@ def _lifting_matrix(background: Tsd3dSolution, kappa: float, wing, wake):
                                            top.shape).ravel(),
                            np.broadcast_to(-1j * k_ac * op.hx[i, None] * op.hz[None, :],
                                            side.shape).ravel()])
-    mu0 = op.switches(background.phi)
     K = (op.x_jacobian(a, mu0, complex) + op.lap
          + sparse.coo_matrix((vals, (rows, cols)), shape=(n, n)).tocsr())
     if op.cross is not None:        # the cross-flow terms linearised about phi0 (tsdswept)
@@ -726,7 +758,8 @@ def harmonic_tsd3d(background: Tsd3dSolution, modes, kappa: float) -> HarmonicTs
         A0 = 1 - M^2 - (gamma + 1) M^2 phi0_x,                                         (3)
 
     differenced as the steady operator (the background's Murman-Cole switches for the x term,
-    central phi1_x). On z = 0+: phi1_z = w/U = dh/dx + i kappa h on the wing (h the upward
+    phi1_x of the time term central, backward at supersonic nodes since issue 29 tsdfin,
+    :func:`_time_term`). On z = 0+: phi1_z = w/U = dh/dx + i kappa h on the wing (h the upward
     displacement of the mode), phi1 = 0 off the wing and wake (antisymmetry), and on the wake
     a continuous pressure phi1_x + i kappa phi1 = 0, solved exactly along the wake
     (phi1 = phi1_TE exp(-i kappa (x - x_TE)): the jump is convected and the trailing edge
@@ -1081,7 +1114,7 @@ def tsd_validity(background: Tsd3dSolution, thickness_ratio: float) -> TsdValidi
 #: Version of the TSD's GAFs (part of a case's GAF database fingerprint): 2 since issue 29's
 #: tsdswept step (the cross-flow terms; box_pressures sampling each grid row between its own
 #: edge nodes).
-TSD_GAF_FORMAT = 2
+TSD_GAF_FORMAT = 3        # 3: the time term upwind at supersonic points (issue 29, tsdfin)
 #: Version of the cached steady backgrounds (part of their key).
 STEADY_FORMAT = 2        # 2: the cross-flow flag in the key (issue 29, tsdswept)
 

@@ -218,7 +218,7 @@ class AeroSpec:
     at the root); method: a key of :data:`asekit.aero.methods.AERO_METHODS` ("dlm" doublet
     lattice M < 1, "supersonic" Mach boxes M > 1, "piston" M > 1, "auto" by Mach), each Mach of
     ``machs`` inside its range; "tsd" the time-linearised transonic small disturbance,
-    0 < M < 1 with the gap, which needs ``section`` = (shape, thickness_ratio) (``aero.section``,
+    0 < M < 1.3 with the gap, which needs ``section`` = (shape, thickness_ratio) (``aero.section``,
     "biconvex" only) and ``symmetry = "wall"``.
     """
 

@@ -88,6 +88,8 @@ def _reproduce(args) -> int:
         os.environ["ASEKIT_CONVERGED_STUDY"] = "1"
     if getattr(args, "robust", False):     # asekit.reproduction.design.robust_study_requested
         os.environ["ASEKIT_ROBUST_STUDY"] = "1"
+    if getattr(args, "transonic", False):  # asekit.reproduction.transonic (issue 29, tsdfin)
+        os.environ["ASEKIT_TRANSONIC_STUDY"] = "1"
     import matplotlib
     matplotlib.use("Agg")
     from asekit.reproduction.driver import ChapterFailed, reproduce
@@ -138,6 +140,9 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--robust", action="store_true",
                      help="also check the H-infinity design on the 45 conditions and compute "
                           "its mu bound (about a minute)")
+    rep.add_argument("--transonic", action="store_true",
+                     help="also compute the fin through the transonic gap with the TSD "
+                          "(M 0.8-1.2) if it is not cached (a few CPU-minutes)")
     rep.set_defaults(func=_reproduce, parser=rep)
     add_analyse(sub)
     add_sweep(sub)

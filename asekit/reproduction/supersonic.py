@@ -11,7 +11,10 @@ rigid pitch + elastic modes), GAFs over :func:`asekit.case.pipeline.reduced_freq
 Reproduce keys: ``aero.Qcc_steady_m3.M12/.M20/.M30`` (Re Q_cc at k 0.001, m^3/rad, positive
 de-centering), ``flutter.pk.M12.h0.speed_ms`` (and ``.M20.``, ``.M30.``; None when no flutter is
 found in the sweep, with the first instability in ``flutter.first_instability.pk.M..``),
-``supersonic.torque.required_stall_Nm`` and ``supersonic.torque.worst_mach``.
+``supersonic.torque.required_stall_Nm`` and ``supersonic.torque.worst_mach``; the transonic
+gap by the TSD (issue 29, :mod:`asekit.reproduction.transonic`, computed with ``--transonic``):
+``flutter.envelope.tsd.M080.h0.speed_ms`` ... ``.M120.``, ``.freq_hz``,
+``aero.Qcc_steady_m3.tsd.M..`` and the joins ``flutter.envelope.tsd.join.M..``.
 
 The GAFs and p-k results (about 30 s to compute) are cached outside the repository, in
 the user cache directory (``$ASEKIT_CACHE_DIR``, default ``~/.cache/asekit``; ``supersonic_envelope.npz``), keyed by a fingerprint of
@@ -226,9 +229,13 @@ def run(figures: bool = False) -> ChapterResult:
                       f"{tq['q_cc']:.3g} m^3 (thesis design point M 0.6 sea level)"))
     q.append(Quantity("supersonic.torque.worst_mach", tq["mach"], "-",
                       f"largest |q Q_cc| among supersonic Mach numbers, at {tq['altitude']:.0f} m"))
+    # issue 29 (tsdfin): the transonic gap by the TSD, computed only when asked (--transonic)
+    from asekit.reproduction import transonic
+    tsd = transonic.transonic_envelope()
+    q.extend(transonic.quantities(tsd))
     figs = {}
     if figures:
-        figs = {"supersonic_flutter_vs_mach": fig_flutter_vs_mach(env),
+        figs = {"supersonic_flutter_vs_mach": fig_flutter_vs_mach(env, tsd=tsd),
                 "supersonic_qcc_vs_mach": fig_qcc_vs_mach(env)}
     return ChapterResult("supersonic", tuple(q), figs)
 
@@ -239,8 +246,10 @@ def _gap(ax):
                label="transonic gap (linear theory not trusted)")
 
 
-def fig_flutter_vs_mach(env=None):
-    """Flutter and divergence speed vs Mach at each altitude, with the flight speed M a(h)."""
+def fig_flutter_vs_mach(env=None, tsd=None):
+    """Flutter and divergence speed vs Mach at each altitude, with the flight speed M a(h);
+    with ``tsd`` (:func:`asekit.reproduction.transonic.transonic_envelope`) the TSD's flutter
+    speeds through the gap and the linear methods' with its root wall at the joins."""
     env = envelope() if env is None else env
     fig, ax = new_figure("Fin flutter and divergence across the envelope")
     m = env["machs"]
@@ -251,6 +260,9 @@ def fig_flutter_vs_mach(env=None):
         ax.plot(m, env["flight_speed"][:, ih], ":", color=line.get_color(),
                 label=f"flight speed M a, {h:.0f} m")
     _gap(ax)
+    if tsd is not None:                      # issue 29 (tsdfin)
+        from asekit.reproduction.transonic import fig_gap
+        fig_gap(tsd, ax)
     ax.set_xlabel("Mach number (-)")
     ax.set_ylabel("speed (m/s)")
     ax.set_ylim(0, 1700)
