@@ -931,7 +931,8 @@ def _response(A, B, C, f_hz):
                      for f in f_hz])
 
 
-def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8) -> FlightLFT:
+def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8,
+               lowrank: float | None = None) -> FlightLFT:
     """Mach 0.4-0.6 and 0-5000 m as real parameters: OPLOOP 3's state matrix A (B and C do not
     depend on the flight condition) fitted by least squares (:func:`asekit.ase.robust.
     fit_polynomial`) in :data:`FLIGHT_MONOMIALS` of the normalised :data:`FLIGHT_PARAMETERS` on
@@ -942,7 +943,10 @@ def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8) -> Fli
     envelope itself. The fit error is not hidden: ``cover`` is the
     largest relative response error of the LFT against the direct model over the grid and the
     (n_grid - 1)^2 cell centres (also off the fit's samples), to be covered by a complex
-    output-multiplicative block."""
+    output-multiplicative block. ``lowrank``: the relative tolerance of the low-rank LFT
+    (:func:`asekit.ase.robust.lowrank_polynomial_lft`; None: :func:`asekit.ase.robust.
+    polynomial_lft` at ``rtol``); the part it drops is measured in ``cover`` with the fit
+    error."""
     from asekit.ase import robust
 
     data = load() if data is None else data
@@ -956,7 +960,8 @@ def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8) -> Fli
     lo, hi = P.min(axis=0), P.max(axis=0)
     D = (P - (hi + lo) / 2) / ((hi - lo) / 2)
     A0, terms, _ = robust.fit_polynomial(D, [plants[p][0] for p in pts], FLIGHT_MONOMIALS)
-    lft = robust.polynomial_lft(A0, terms, FLIGHT_PARAMETERS, rtol)
+    lft = robust.polynomial_lft(A0, terms, FLIGHT_PARAMETERS, rtol) if lowrank is None \
+        else robust.lowrank_polynomial_lft(A0, terms, FLIGHT_PARAMETERS, lowrank)
     _, B, C = plants[pts[0]]
     out = FlightLFT(lft, B, C, lo, hi, f, np.zeros(len(f)), tuple(pts + mid))
     cover = np.zeros(len(f))
