@@ -6,8 +6,7 @@ Fan, Tits & Doyle, IEEE TAC 36(1), 1991)."""
 import numpy as np
 import pytest
 
-from asekit.ase.mu import (Block, full_dg_upper_bound, lower_bound, mixed_upper_bound,
-                           upper_bound)
+from asekit.ase.mu import Block, full_dg_upper_bound, lower_bound, mixed_upper_bound, upper_bound
 
 
 def similar(rng, eigenvalues):
