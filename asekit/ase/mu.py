@@ -49,6 +49,14 @@ bound 0 (the G term drives the eigenvalue negative), which the complex bound can
 bound is exact for rank-one M (Young, "The rank one mixed mu problem and 'Kharitonov-type'
 analysis", Automatica 30(12), 1994), whose mu has the closed form of :func:`rank_one_mu`.
 
+The diagonal D and G are a subset of the commutant of a repeated scalar block delta I_r, whose
+D may be any Hermitian positive definite r x r and G any Hermitian r x r:
+:func:`full_dg_upper_bound` optimises over the full set (D = T^H T, block-diagonal T, module
+text of the function), which reaches mu = max |real eigenvalue| of a diagonalisable M under one
+repeated real scalar, and rho(M) under a repeated complex one, where the diagonal scalings
+stay far above for a non-normal M. It is meant for the small repeated blocks of a low-rank LFT
+(:func:`asekit.ase.robust.lowrank_polynomial_lft`): 4 r^2 real variables per real block.
+
 Plain numpy/scipy; no toolbox needed.
 """
 
@@ -389,13 +397,14 @@ def full_dg_upper_bound(M, blocks, start=None, maxiter: int = 200):
     T = t I on full blocks), N = T M T^-1 and Gh = T^-H G T^-1 the condition is
     lambda_max(N^H N + j (Gh N - N^H Gh)) <= beta^2, and Gh ranges over the same set as G;
     so every (T, Gh) gives a valid bound, and the optimiser (L-BFGS on a smoothed
-    lambda_max, analytic gradient; :func:`_full_dg_eig`) only tightens it. A repeated real
+    lambda_max, analytic gradient; :func:`_full_dg_eig`; limited memory: thousands of
+    variables for blocks of a few tens) only tightens it. A repeated real
     block with a diagonalisable M = S diag(lambda) S^-1 reaches mu = max |lambda| over the real
     eigenvalues (T = S^-1, Gh diagonal), which no diagonal D gives for a non-normal M.
 
     ``start``: (d, g) as returned by :func:`mixed_upper_bound` (default: computed here), the
-    diagonal starting point, so the result never exceeds that bound; ``maxiter``: BFGS
-    iterations per smoothing stage (five stages, the softmax width from lambda_max itself down
+    diagonal starting point, so the result never exceeds that bound; ``maxiter``: (L-)BFGS
+    iterations per smoothing stage (BFGS up to 400 variables, L-BFGS above) (five stages, the softmax width from lambda_max itself down
     to 1e-10 of it). Returns (bound, T, Gh).
 
     Examples
@@ -423,6 +432,11 @@ def full_dg_upper_bound(M, blocks, start=None, maxiter: int = 200):
     z0 = _full_pack(T0, G0, layout)
     scale = max(float(np.linalg.norm(M, 2)) ** 2, 1e-300)
     seen = {}
+    if len(z0) <= 400:                 # dense BFGS (its update is O(n^3) per iteration)
+        method, opts = "BFGS", {"maxiter": maxiter, "gtol": 1e-12}
+    else:
+        method, opts = "L-BFGS-B", {"maxiter": maxiter, "gtol": 1e-12, "ftol": 1e-15,
+                                    "maxcor": 30}
 
     def f(z, t):
         lam, smooth, grad = _full_dg_eig(M, z, layout, t * scale)
@@ -436,8 +450,8 @@ def full_dg_upper_bound(M, blocks, start=None, maxiter: int = 200):
         f(z0, 1.0)
         for t in (1.0, 1e-2, 1e-4, 1e-7, 1e-10):      # smoothing continuation, relative to
             rel = max(seen["lam"] / scale, 1e-9)      # the current lambda_max
-            z = minimize(f, seen["z"], args=(t * rel,), jac=True, method="BFGS",
-                         options={"maxiter": maxiter, "gtol": 1e-12}).x
+            z = minimize(f, seen["z"], args=(t * rel,), jac=True, method=method,
+                         options=opts).x
             f(z, 1.0)
         best_z, best = seen["z"], seen["lam"] / scale
     except _Done as done:

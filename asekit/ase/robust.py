@@ -40,7 +40,12 @@ a linear fractional transformation (:func:`fit_polynomial` on sampled plants, th
 :func:`polynomial_lft`; Zhou, Doyle & Glover, "Robust and optimal control", 1996, Sec. 10.2;
 Lind & Brenner, "Robust aeroservoelastic stability analysis", 1999, Ch. 5): each monomial's
 coefficient matrix is rank-factorised and a degree-two monomial becomes a chain of two
-scalars, so every parameter is one repeated real scalar block (``Uncertainty.lft``).
+scalars, so every parameter is one repeated real scalar block (``Uncertainty.lft``). A
+parameter's block size is the rank of the coefficient matrices it multiplies;
+:func:`lowrank_polynomial_lft` shares one column space among the terms with the same first
+factor and truncates every SVD at a stated relative tolerance, with a bound on the dropped part
+(which then belongs in the complex fit-error cover), and
+:func:`asekit.ase.mu.full_dg_upper_bound` bounds mu with full D and G on those smaller blocks.
 
 SI units (rad, V, s, rad/s).
 """
