@@ -1107,10 +1107,14 @@ def hinf_quantities(data) -> list[Quantity]:
 
 def _mu_real_quantity(mu) -> Quantity:
     """The ``ase.design.hinf.mu_peak_real`` row from :func:`hinf_mu_real`."""
+    how = {"full": "full D-G bound", "per_block": "complex D bound, one scale per block"}
+    margin = (f"stable for {1 / mu['mu_peak']:.2g} x the stated uncertainty"
+              if mu["mu_peak"] < 1 else "no certificate (bound >= 1)")
     return Quantity("ase.design.hinf.mu_peak_real", mu["mu_peak"], "-",
-                    f"upper bound with Mach and altitude as real parameters (quadratic LFT, "
-                    f"blocks {mu['sizes']}, fit error <= {mu['fit_cover']:.2f} as a complex "
-                    f"cover) at {mu['f_peak_hz']:.0f} Hz; alone: shaft and elastic frequencies "
+                    f"upper bound with Mach and altitude as real parameters (low-rank "
+                    f"quadratic LFT, blocks {mu['sizes']}, fit error <= "
+                    f"{mu['fit_cover']:.2f} as a complex cover) at {mu['f_peak_hz']:.0f} Hz, "
+                    f"{how[mu['bound']]}: {margin}; alone: shaft and elastic frequencies "
                     f"{mu['mu_peak_parameters']:.3g}, Mach-altitude LFT "
                     f"{mu['mu_peak_flight']:.3g} at {mu['f_peak_flight_hz']:.0f} Hz, fit cover "
-                    f"{mu['mu_peak_fit']:.3g} (complex D bounds)")
+                    f"{mu['mu_peak_fit']:.3g}")

@@ -132,3 +132,18 @@ def test_lowrank_flight_lft_has_small_blocks_and_a_measured_cover(data):
     for d in [(-1.0, -1.0), (1.0, -1.0), (0.3, 0.7), (-0.5, 1.0)]:
         diff = robust.lft_state_matrix(low.lft, d) - robust.lft_state_matrix(full.lft, d)
         assert np.linalg.norm(diff, 2) <= low.lft.truncation * (1 + 1e-9) + 1e-6 * scale
+
+
+def test_mu_real_row_states_the_margin_only_below_one():
+    """The ``ase.design.hinf.mu_peak_real`` note says "stable for 1/mu times the stated
+    uncertainty" only when the bound is below 1 (issue 26), else that there is no certificate;
+    it names the bound used."""
+    r = {"mu_peak": 0.8, "f_peak_hz": 155.0, "sizes": (40, 48), "fit_cover": 0.9,
+         "bound": "full", "mu_peak_parameters": 0.7, "mu_peak_flight": 0.6,
+         "f_peak_flight_hz": 95.0, "mu_peak_fit": 0.2}
+    q = dz._mu_real_quantity(r)
+    assert q.value == 0.8 and "stable for 1.2 x" in q.note and "full D-G" in q.note
+    q = dz._mu_real_quantity(dict(r, mu_peak=3.0, bound="per_block"))
+    assert "no certificate" in q.note and "stable for" not in q.note
+    with pytest.raises(ValueError, match="bound"):
+        dz.hinf_mu_real(None, data=object(), bound="diagonal")
