@@ -142,7 +142,7 @@ def test_mu_real_row_states_the_margin_only_below_one():
          "bound": "full", "mu_peak_parameters": 0.7, "mu_peak_flight": 0.6,
          "f_peak_flight_hz": 95.0, "mu_peak_fit": 0.2}
     q = dz._mu_real_quantity(r)
-    assert q.value == 0.8 and "stable for 1.2 x" in q.note and "full D-G" in q.note
+    assert q.asekit == 0.8 and "stable for 1.2 x" in q.note and "full D-G" in q.note
     q = dz._mu_real_quantity(dict(r, mu_peak=3.0, bound="per_block"))
     assert "no certificate" in q.note and "stable for" not in q.note
     with pytest.raises(ValueError, match="bound"):
