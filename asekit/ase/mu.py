@@ -49,6 +49,14 @@ bound 0 (the G term drives the eigenvalue negative), which the complex bound can
 bound is exact for rank-one M (Young, "The rank one mixed mu problem and 'Kharitonov-type'
 analysis", Automatica 30(12), 1994), whose mu has the closed form of :func:`rank_one_mu`.
 
+The diagonal D and G are a subset of the commutant of a repeated scalar block delta I_r, whose
+D may be any Hermitian positive definite r x r and G any Hermitian r x r:
+:func:`full_dg_upper_bound` optimises over the full set (D = T^H T, block-diagonal T, module
+text of the function), which reaches mu = max |real eigenvalue| of a diagonalisable M under one
+repeated real scalar, and rho(M) under a repeated complex one, where the diagonal scalings
+stay far above for a non-normal M. It is meant for the small repeated blocks of a low-rank LFT
+(:func:`asekit.ase.robust.lowrank_polynomial_lft`): 4 r^2 real variables per real block.
+
 Plain numpy/scipy; no toolbox needed.
 """
 
@@ -297,6 +305,162 @@ def mixed_upper_bound(M, blocks, x0=None, g0=None, per_block: bool = False):
     g = np.zeros(n)
     g[ir] = best_z[m:]
     return bound, d, g
+
+
+def _full_layout(blocks):
+    """(slice, kind, number of T parameters, number of G parameters) per block for
+    :func:`full_dg_upper_bound`: a full block's T = e^x I (1), a repeated scalar's T any complex
+    r x r (2 r^2), a real block's Gh = (Y + Y^H) / 2 with Y any complex r x r (2 r^2)."""
+    out = []
+    for b, s in zip(blocks, _slices(blocks)):
+        r2 = 2 * b.size * b.size
+        out.append((s, b.kind, 1 if b.kind == "full" else r2, r2 if b.kind == "real" else 0))
+    return out
+
+
+def _full_unpack(z, layout, n):
+    T, G = np.zeros((n, n), complex), np.zeros((n, n), complex)
+    k = 0
+    for s, kind, nt, _ in layout:
+        r = s.stop - s.start
+        if kind == "full":
+            T[s, s] = math.exp(z[k]) * np.eye(r)
+        else:
+            T[s, s] = (z[k:k + nt // 2] + 1j * z[k + nt // 2:k + nt]).reshape(r, r)
+        k += nt
+    for s, kind, _, ng in layout:
+        if ng:
+            r = s.stop - s.start
+            Y = (z[k:k + ng // 2] + 1j * z[k + ng // 2:k + ng]).reshape(r, r)
+            G[s, s] = 0.5 * (Y + Y.conj().T)
+            k += ng
+    return T, G
+
+
+def _full_pack(T, G, layout):
+    zt, zg = [], []
+    for s, kind, _, ng in layout:
+        Tb = T[s, s]
+        if kind == "full":
+            zt.append([math.log(abs(Tb[0, 0]))])
+        else:
+            zt += [Tb.real.ravel(), Tb.imag.ravel()]
+        if ng:
+            zg += [G[s, s].real.ravel(), G[s, s].imag.ravel()]
+    return np.concatenate(zt + zg)
+
+
+def _full_dg_eig(M, z, layout, t):
+    """lambda_max of Phi = N^H N + j (Gh N - N^H Gh), N = T M T^-1 (block-diagonal T and
+    Hermitian Gh of :func:`_full_unpack`), its softmax majorant (as :func:`_dg_eig`) and the
+    majorant's gradient in z: with W = V diag(softmax) V^H, dN = E N - N E for dT = E T, so
+    d lambda = Re tr(R E), R = 2 (N Q - Q N), Q = W (N^H + j Gh), and d lambda / dGh =
+    S = j (N W - W N^H) (Hermitian)."""
+    n = M.shape[0]
+    T, G = _full_unpack(z, layout, n)
+    Ti = np.zeros_like(T)
+    for s, _, _, _ in layout:
+        Ti[s, s] = np.linalg.inv(T[s, s])
+    N = T @ M @ Ti
+    NH = N.conj().T
+    Phi = NH @ N + 1j * (G @ N - NH @ G)
+    lam, V = np.linalg.eigh(0.5 * (Phi + Phi.conj().T))
+    e = np.exp((lam - lam[-1]) / t)
+    w = e / e.sum()
+    smooth = lam[-1] + t * math.log(e.sum())
+    W = (V * w) @ V.conj().T
+    Q = W @ (NH + 1j * G)
+    Gam = Ti @ (2 * (N @ Q - Q @ N))                # d lambda = Re tr(Gam dT)
+    S = 1j * (N @ W - W @ NH)                       # d lambda = Re tr(S dY)
+    gt, gg = [], []
+    for s, kind, _, ng in layout:
+        Gb = Gam[s, s]
+        if kind == "full":
+            gt.append([float(np.real(np.trace(Gb @ T[s, s])))])
+        else:
+            gt += [Gb.real.T.ravel(), -Gb.imag.T.ravel()]
+        if ng:
+            gg += [S[s, s].real.T.ravel(), -S[s, s].imag.T.ravel()]
+    return float(lam[-1]), smooth, np.concatenate(gt + gg)
+
+
+def full_dg_upper_bound(M, blocks, start=None, maxiter: int = 200):
+    """The mixed-mu upper bound with full D-G scalings on the repeated scalar blocks (Fan,
+    Tits & Doyle, IEEE TAC 36(1), 1991; Young, Newlin & Doyle, IJRNC 5, 1995):
+
+        mu(M) <= beta  if  M^H D M + j (G M - M^H G) - beta^2 D <= 0
+
+    for some D > 0 and G = G^H in the commutants: D = d I on a full block, any Hermitian
+    positive definite r x r on a repeated (real or complex) scalar block delta I_r, G any
+    Hermitian r x r on a real repeated block and zero elsewhere (the diagonal D, G of
+    :func:`mixed_upper_bound` are a subset). With D = T^H T (T block-diagonal, invertible,
+    T = t I on full blocks), N = T M T^-1 and Gh = T^-H G T^-1 the condition is
+    lambda_max(N^H N + j (Gh N - N^H Gh)) <= beta^2, and Gh ranges over the same set as G;
+    so every (T, Gh) gives a valid bound, and the optimiser (L-BFGS on a smoothed
+    lambda_max, analytic gradient; :func:`_full_dg_eig`; limited memory: thousands of
+    variables for blocks of a few tens) only tightens it. A repeated real
+    block with a diagonalisable M = S diag(lambda) S^-1 reaches mu = max |lambda| over the real
+    eigenvalues (T = S^-1, Gh diagonal), which no diagonal D gives for a non-normal M.
+
+    ``start``: (d, g) as returned by :func:`mixed_upper_bound` (default: computed here), the
+    diagonal starting point, so the result never exceeds that bound; ``maxiter``: (L-)BFGS
+    iterations per smoothing stage (BFGS up to 400 variables, L-BFGS above) (five stages, the softmax width from lambda_max itself down
+    to 1e-10 of it). Returns (bound, T, Gh).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> S = np.array([[1.0, 2.0, 0.0], [0.0, 1.0, 1.0], [1.0, 0.0, 1.0]])
+    >>> L = np.array([[0.5, 0.0, 0.0], [0.0, 0.3, 0.8], [0.0, -0.8, 0.3]])
+    >>> M = S @ L @ np.linalg.inv(S)       # eigenvalues 0.5, 0.3 +- 0.8j: mu = 0.5 for delta I_3
+    >>> round(full_dg_upper_bound(M, [Block(3, "real")])[0], 6)
+    0.5
+    >>> round(mixed_upper_bound(M, [Block(3, "real")])[0], 2)     # diagonal D and G
+    1.17
+    """
+    from scipy.optimize import minimize
+
+    M, blocks = _check(M, blocks)
+    n = M.shape[0]
+    layout = _full_layout(blocks)
+    if start is None:
+        b0, d, g = mixed_upper_bound(M, blocks)
+    else:
+        d, g = (np.asarray(x, float) for x in start)
+        b0 = None
+    T0, G0 = np.diag(d.astype(complex)), np.diag(g.astype(complex))
+    z0 = _full_pack(T0, G0, layout)
+    scale = max(float(np.linalg.norm(M, 2)) ** 2, 1e-300)
+    seen = {}
+    if len(z0) <= 400:                 # dense BFGS (its update is O(n^3) per iteration)
+        method, opts = "BFGS", {"maxiter": maxiter, "gtol": 1e-12}
+    else:
+        method, opts = "L-BFGS-B", {"maxiter": maxiter, "gtol": 1e-12, "ftol": 1e-15,
+                                    "maxcor": 30}
+
+    def f(z, t):
+        lam, smooth, grad = _full_dg_eig(M, z, layout, t * scale)
+        if lam < seen.get("lam", math.inf):
+            seen["lam"], seen["z"] = lam, np.array(z)
+        if lam <= 0:
+            raise _Done(z)
+        return smooth / scale, grad / scale
+
+    try:
+        f(z0, 1.0)
+        for t in (1.0, 1e-2, 1e-4, 1e-7, 1e-10):      # smoothing continuation, relative to
+            rel = max(seen["lam"] / scale, 1e-9)      # the current lambda_max
+            z = minimize(f, seen["z"], args=(t * rel,), jac=True, method=method,
+                         options=opts).x
+            f(z, 1.0)
+        best_z, best = seen["z"], seen["lam"] / scale
+    except _Done as done:
+        best_z, best = done.z, 0.0
+    bound = math.sqrt(max(best, 0.0) * scale)
+    if b0 is not None:
+        bound = min(bound, b0)
+    T, G = _full_unpack(best_z, layout, n)
+    return bound, T, G
 
 
 def rank_one_mu(u, v, blocks) -> float:

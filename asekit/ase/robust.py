@@ -40,7 +40,12 @@ a linear fractional transformation (:func:`fit_polynomial` on sampled plants, th
 :func:`polynomial_lft`; Zhou, Doyle & Glover, "Robust and optimal control", 1996, Sec. 10.2;
 Lind & Brenner, "Robust aeroservoelastic stability analysis", 1999, Ch. 5): each monomial's
 coefficient matrix is rank-factorised and a degree-two monomial becomes a chain of two
-scalars, so every parameter is one repeated real scalar block (``Uncertainty.lft``).
+scalars, so every parameter is one repeated real scalar block (``Uncertainty.lft``). A
+parameter's block size is the rank of the coefficient matrices it multiplies;
+:func:`lowrank_polynomial_lft` shares one column space among the terms with the same first
+factor and truncates every SVD at a stated relative tolerance, with a bound on the dropped part
+(which then belongs in the complex fit-error cover), and
+:func:`asekit.ase.mu.full_dg_upper_bound` bounds mu with full D and G on those smaller blocks.
 
 SI units (rad, V, s, rad/s).
 """
@@ -432,6 +437,10 @@ class ParametricLFT:
     Dzw: np.ndarray
     names: tuple
     sizes: tuple
+    #: an upper bound of the 2-norm of A_poly(delta) - A(delta) over the unit box (the
+    #: singular values dropped by :func:`lowrank_polynomial_lft`; 0 for :func:`polynomial_lft`
+    #: at its numerical-rank tolerance)
+    truncation: float = 0.0
 
     @property
     def blocks(self) -> tuple:
@@ -538,3 +547,100 @@ def fit_polynomial(deltas, As, monomials):
     coef = coef.reshape(-1, *As.shape[1:])
     return coef[0], tuple(zip(mons, coef[1:])), As - (Phi @ coef.reshape(len(coef), -1)
                                                       ).reshape(As.shape)
+
+
+def _truncated_svd(X, rtol):
+    """X ~ U S V^T kept to the singular values above rtol x the largest; returns (U, S V^T,
+    the first dropped singular value (0 if none))."""
+    u, s, vh = np.linalg.svd(np.asarray(X, float), full_matrices=False)
+    if s[0] == 0:
+        raise ValueError("a coefficient matrix is zero: the parameter does not enter the plant")
+    r = int(np.sum(s > rtol * s[0]))
+    return u[:, :r], s[:r, None] * vh[:r], float(s[r]) if r < len(s) else 0.0
+
+
+def lowrank_polynomial_lft(A0, terms, names, rtol: float = 1e-3) -> ParametricLFT:
+    """A low-order LFT of A(delta) = A0 + sum_k m_k(delta) dA_k (monomials of degree 1 or 2, as
+    :func:`polynomial_lft`): a real parameter's repeated-block size is the rank of the
+    coefficient matrices it multiplies (Zhou, Doyle & Glover 1996, Sec. 10.2; Morton & McAfoos,
+    "A mu-test for robustness analysis of a real-parameter variation problem", ACC 1985;
+    Belcastro's LFT order reduction), so the matrices are factored by a truncated SVD and the
+    terms sharing their first parameter share one column space:
+
+        A(delta) ~ A0 + sum_i delta_i U_i [ sum_{k: m_k = delta_i} W_k
+                                            + sum_{k: m_k = delta_i delta_j, j >= i} delta_j P_k Q_k^T ],
+
+    with H_i = [dA_k for the terms whose lowest-index factor is i] ~ U_i U_i^T H_i (U_i its
+    left singular vectors above ``rtol`` x its largest singular value), W_k = U_i^T dA_k, and
+    for a degree-two term W_k ~ P_k Q_k^T (truncated likewise). Channels: an outer delta_i
+    channel (size rank U_i: z = sum W_k x + sum P_k w_inner, x' += U_i w) and one inner delta_j
+    channel per degree-two term (z = Q_k^T x); the inner channels feed only outer ones, so
+    I - Dzw Delta is always invertible. Block size of delta_i: rank(U_i) + the ranks of the
+    degree-two terms whose second factor is delta_i.
+
+    The dropped part is bounded over the unit box |delta_i| <= 1 by ``truncation`` =
+    sum_i sigma_drop(H_i) sqrt(n_i) + sum_k sigma_drop(W_k) (n_i the number of terms in H_i;
+    ||(I - U U^T) H_i [m_1 I; ...]|| <= sigma_drop(H_i) ||m||_2, |m_k| <= 1): it belongs in
+    the complex cover of the fit error (measured against this LFT, never the exact
+    polynomial), so the mu bound stays a bound. ``rtol``: the relative tolerance of every
+    truncation (1e-8: the numerical rank, no truncation to speak of).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> u, v = np.array([[1.0], [2.0]]), np.array([[1.0], [-1.0]])
+    >>> terms = [((1, 0), u @ v.T), ((0, 1), 3 * u @ v.T), ((1, 1), u @ v.T)]
+    >>> lft = lowrank_polynomial_lft(np.eye(2), terms, ("a", "b"))
+    >>> lft.sizes, polynomial_lft(np.eye(2), terms, ("a", "b")).sizes
+    ((1, 2), (2, 2))
+    >>> A = np.eye(2) + (0.5 + 3 * -0.2 + 0.5 * -0.2) * (u @ v.T)
+    >>> bool(np.allclose(lft_state_matrix(lft, [0.5, -0.2]), A)), bool(lft.truncation < 1e-12)
+    (True, True)
+    """
+    A0 = np.atleast_2d(np.asarray(A0, float))
+    n, k = A0.shape[0], len(names)
+    if not 0 < rtol < 1:
+        raise ValueError(f"rtol must be in (0, 1), got {rtol}")
+    groups = {}                                    # outer parameter -> [(inner or None, dA)]
+    for powers, dA in terms:
+        idx = sorted(_monomial(powers, k))
+        groups.setdefault(idx[0], []).append((idx[1] if len(idx) == 2 else None,
+                                              np.asarray(dA, float)))
+    outer, inner, bound = {}, [], 0.0              # inner: (param j, outer i, P, Q)
+    for i, items in groups.items():
+        U, _, drop = _truncated_svd(np.hstack([dA for _, dA in items]), rtol)
+        bound += drop * math.sqrt(len(items))
+        lin = np.zeros((U.shape[1], n))
+        for j, dA in items:
+            W = U.T @ dA
+            if j is None:
+                lin += W
+            elif np.any(W):
+                P, Qt, drop = _truncated_svd(W, rtol)
+                bound += drop
+                inner.append((j, i, P, Qt))
+        outer[i] = (U, lin)
+    # channel order: by parameter; within one, the outer channel first, then the inner ones
+    chans = []                                     # (param, kind, ref)
+    for p in range(k):
+        if p in outer:
+            chans.append((p, "outer", p))
+        chans.extend((p, "inner", c) for c, t in enumerate(inner) if t[0] == p)
+    start, pos = {}, 0
+    for ch in chans:
+        start[ch[1:]] = pos
+        pos += outer[ch[2]][0].shape[1] if ch[1] == "outer" else inner[ch[2]][2].shape[1]
+    Bw, Cz, Dzw = np.zeros((n, pos)), np.zeros((pos, n)), np.zeros((pos, pos))
+    for i, (U, lin) in outer.items():
+        s = slice(start["outer", i], start["outer", i] + U.shape[1])
+        Bw[:, s], Cz[s] = U, lin
+    for c, (j, i, P, Qt) in enumerate(inner):
+        s = slice(start["inner", c], start["inner", c] + P.shape[1])
+        Cz[s] = Qt
+        Dzw[start["outer", i]:start["outer", i] + P.shape[0], s] = P
+    sizes = tuple(sum(outer[p][0].shape[1] if kind == "outer" else inner[ref][2].shape[1]
+                      for q, kind, ref in chans if q == p) for p in range(k))
+    if min(sizes) == 0:
+        raise ValueError("every parameter must appear in a term with a non-zero dA")
+    return ParametricLFT(A0=A0, Bw=Bw, Cz=Cz, Dzw=Dzw, names=tuple(names), sizes=sizes,
+                         truncation=bound)

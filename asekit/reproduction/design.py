@@ -931,7 +931,8 @@ def _response(A, B, C, f_hz):
                      for f in f_hz])
 
 
-def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8) -> FlightLFT:
+def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8,
+               lowrank: float | None = None) -> FlightLFT:
     """Mach 0.4-0.6 and 0-5000 m as real parameters: OPLOOP 3's state matrix A (B and C do not
     depend on the flight condition) fitted by least squares (:func:`asekit.ase.robust.
     fit_polynomial`) in :data:`FLIGHT_MONOMIALS` of the normalised :data:`FLIGHT_PARAMETERS` on
@@ -942,7 +943,10 @@ def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8) -> Fli
     envelope itself. The fit error is not hidden: ``cover`` is the
     largest relative response error of the LFT against the direct model over the grid and the
     (n_grid - 1)^2 cell centres (also off the fit's samples), to be covered by a complex
-    output-multiplicative block."""
+    output-multiplicative block. ``lowrank``: the relative tolerance of the low-rank LFT
+    (:func:`asekit.ase.robust.lowrank_polynomial_lft`; None: :func:`asekit.ase.robust.
+    polynomial_lft` at ``rtol``); the part it drops is measured in ``cover`` with the fit
+    error."""
     from asekit.ase import robust
 
     data = load() if data is None else data
@@ -956,7 +960,8 @@ def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8) -> Fli
     lo, hi = P.min(axis=0), P.max(axis=0)
     D = (P - (hi + lo) / 2) / ((hi - lo) / 2)
     A0, terms, _ = robust.fit_polynomial(D, [plants[p][0] for p in pts], FLIGHT_MONOMIALS)
-    lft = robust.polynomial_lft(A0, terms, FLIGHT_PARAMETERS, rtol)
+    lft = robust.polynomial_lft(A0, terms, FLIGHT_PARAMETERS, rtol) if lowrank is None \
+        else robust.lowrank_polynomial_lft(A0, terms, FLIGHT_PARAMETERS, lowrank)
     _, B, C = plants[pts[0]]
     out = FlightLFT(lft, B, C, lo, hi, f, np.zeros(len(f)), tuple(pts + mid))
     cover = np.zeros(len(f))
@@ -968,31 +973,66 @@ def flight_lft(data=None, n_grid: int = 5, f_hz=None, rtol: float = 1e-8) -> Fli
 
 
 #: The frequencies (Hz) of :func:`hinf_mu_real` in ``reproduce --robust``: a coarse grid over
-#: the loop's band and the two elastic modes (about a minute per frequency at this size).
+#: the loop's band and the two elastic modes (the full D-G bound of :func:`hinf_mu_real` on the
+#: low-rank LFT: 6.56 at 155 Hz, 13 min for the nine on a loaded 2-core machine, issue 26).
 MU_REAL_HZ = (1.0, 10.0, 50.0, 95.0, 130.0, 145.0, 155.0, 200.0, 300.0)
 
 
+#: The relative SVD tolerance of the low-rank flight LFT (:func:`asekit.ase.robust.
+#: lowrank_polynomial_lft) in :func:`hinf_mu_real`. Measured on the 5 x 5 fit (issue 26):
+#: blocks (12, 18) at 1e-3 but a fit-error cover of 8.6 at 144 Hz (its mu alone 1.7: the
+#: dropped directions carry the lightly damped modes' flight dependence); 3e-5: (32, 36),
+#: cover 3.8; 1e-5: (40, 48), cover 0.898 (0.897 with the per-term LFT's (80, 116)).
+LOWRANK_RTOL = 1e-5
+
+#: L-BFGS iterations per smoothing stage of :func:`asekit.ase.mu.full_dg_upper_bound` in
+#: :func:`hinf_mu_real`. Measured (issue 26): the Mach-altitude blocks alone at 95 Hz reach
+#: 2.60 after 300 and 1.20 after 1200 (1 Hz: 2.46 and 1.21): the bound is not converged at 300.
+MU_REAL_MAXITER = 1500                 # nine frequencies: 20 min on a loaded 2-core machine
+
+
+def _real_bound(M, blocks, bound, maxiter=MU_REAL_MAXITER):
+    """One upper bound of mu at M: "per_block" the complex D bound with one scale per block
+    (valid for real blocks too), "full" :func:`asekit.ase.mu.full_dg_upper_bound` (full D and
+    Hermitian G per repeated block, from the mixed D-G point with one D per block)."""
+    from asekit.ase.mu import full_dg_upper_bound, mixed_upper_bound, upper_bound
+
+    if bound == "per_block":
+        return upper_bound(M, blocks, per_block=True)[0]
+    b0, d, g = mixed_upper_bound(M, blocks, per_block=True)
+    return min(b0, full_dg_upper_bound(M, blocks, start=(d, g), maxiter=maxiter)[0])
+
+
 def hinf_mu_real(controller, data=None, f_hz=MU_REAL_HZ, n_mixed: int = 0,
-                 n_grid: int = 5) -> dict:
+                 n_grid: int = 5, lowrank: float | None = LOWRANK_RTOL,
+                 bound: str = "full") -> dict:
     """Robust stability with Mach and altitude as real parameters (issue 26, the description
     that replaces :func:`hinf_mu`'s complex cover of the envelope): the shaft and
-    elastic-frequency blocks of :func:`hinf_uncertainty` (about the design condition), the four
+    elastic-frequency blocks of :func:`hinf_uncertainty` (about the design condition), the
     real repeated-scalar blocks of :func:`flight_lft` and one complex output-multiplicative
-    block covering its measured fit error, about the LFT's centre plant A0. At every
-    frequency the complex D bound with one scale per block (:func:`asekit.ase.mu.upper_bound`
-    with ``per_block``, valid for real blocks too: the LFT's repeated blocks have about a
-    hundred entries each, and one scale per entry takes minutes per frequency); at the
-    ``n_mixed`` frequencies where it is largest also the mixed D-G bound, the smaller kept: an
-    upper bound of mu at each grid frequency. Returns ``{"f_hz", "upper", "mu_peak", "f_peak_hz", "blocks", "M", "sizes",
-    "fit_cover", "mixed_hz"}`` and, from :func:`asekit.ase.robust.mu_subsets` with the
-    complex D bound, ``mu_peak_<part>`` / ``f_peak_<part>_hz`` for the parts "parameters"
-    (shaft, frequencies), "flight" (the LFT) and "fit" (the fit-error cover)."""
-    from asekit.ase import robust
-    from asekit.ase.mu import mixed_upper_bound, upper_bound
+    block covering its measured fit error (with the part the low-rank LFT drops), about the
+    LFT's centre plant A0.
 
+    ``lowrank``: the SVD tolerance of the low-rank LFT (:data:`LOWRANK_RTOL`; None: the
+    per-term LFT of :func:`asekit.ase.robust.polynomial_lft`, blocks of about a hundred).
+    ``bound``: "full" (default) the full D-G bound of :func:`asekit.ase.mu.full_dg_upper_bound`
+    at every frequency; "per_block" the complex D bound with one scale per block (the only one
+    affordable at the per-term sizes), then at the ``n_mixed`` frequencies where it is largest
+    also the mixed D-G bound with one D per block, the smaller kept. Either way an upper bound
+    of mu at each grid frequency. Returns ``{"f_hz", "upper", "mu_peak", "f_peak_hz",
+    "blocks", "M", "sizes", "fit_cover", "truncation", "bound", "mixed_hz"}`` and, with the
+    same bound on the blocks of one part only, ``mu_peak_<part>`` / ``f_peak_<part>_hz`` /
+    ``upper_<part>`` for the parts "parameters" (shaft, frequencies), "flight" (the LFT) and
+    "fit" (the fit-error cover)."""
+    from asekit.ase import robust
+    from asekit.ase.mu import mixed_upper_bound
+
+    if bound not in ("full", "per_block"):
+        raise ValueError(f"bound must be 'full' or 'per_block', got {bound!r}")
     data = load() if data is None else data
     f = np.asarray(f_hz, float)
-    fl = flight_lft(data, n_grid=n_grid, f_hz=np.logspace(0, np.log10(490.0), 300))
+    fl = flight_lft(data, n_grid=n_grid, f_hz=np.logspace(0, np.log10(490.0), 300),
+                    lowrank=lowrank)
     fit_cover = float(fl.cover.max())
     fl = replace(fl, cover_hz=f, cover=np.interp(f, fl.cover_hz, fl.cover))
     _, _, _, unc0 = hinf_uncertainty(data, f)
@@ -1000,21 +1040,21 @@ def hinf_mu_real(controller, data=None, f_hz=MU_REAL_HZ, n_mixed: int = 0,
                              cover=fl.cover, cover_name="flight LFT fit error")
     Ms, blocks = robust.loop_matrix(fl.lft.A0, fl.B, fl.C, robust.digital_gain(controller),
                                     unc, f, HINF_DELAY)
-    up = np.array([upper_bound(M, blocks, per_block=True)[0] for M in Ms])
-    mixed = np.argsort(up)[::-1][:max(0, int(n_mixed))]
+    up = np.array([_real_bound(M, blocks, bound) for M in Ms])
+    mixed = np.argsort(up)[::-1][:max(0, int(n_mixed))] if bound == "per_block" else []
     for i in mixed:
         up[i] = min(up[i], mixed_upper_bound(Ms[i], blocks, per_block=True)[0])
     i = int(np.argmax(up))
     n, k = len(unc.parameters), len(fl.lft.sizes)
     out = {"f_hz": f, "upper": up, "mu_peak": float(up[i]), "f_peak_hz": float(f[i]),
            "blocks": blocks, "M": Ms, "sizes": fl.lft.sizes, "fit_cover": fit_cover,
-           "mixed_hz": f[mixed]}
+           "truncation": fl.lft.truncation, "bound": bound, "mixed_hz": f[mixed]}
     parts = {"parameters": range(n), "flight": range(n, n + k), "fit": [n + k]}
     for name, keep in parts.items():
         idx = np.concatenate([np.arange(sum(b.size for b in blocks[:j]),
                                         sum(b.size for b in blocks[:j + 1])) for j in keep])
         sub = [blocks[j] for j in keep]
-        u = np.array([upper_bound(M[np.ix_(idx, idx)], sub, per_block=True)[0] for M in Ms])
+        u = np.array([_real_bound(M[np.ix_(idx, idx)], sub, bound) for M in Ms])
         out[f"mu_peak_{name}"], out[f"f_peak_{name}_hz"] = float(u.max()), float(f[u.argmax()])
         out[f"upper_{name}"] = u
     return out
@@ -1069,10 +1109,14 @@ def hinf_quantities(data) -> list[Quantity]:
 
 def _mu_real_quantity(mu) -> Quantity:
     """The ``ase.design.hinf.mu_peak_real`` row from :func:`hinf_mu_real`."""
+    how = {"full": "full D-G bound", "per_block": "complex D bound, one scale per block"}
+    margin = (f"stable for {1 / mu['mu_peak']:.2g} x the stated uncertainty"
+              if mu["mu_peak"] < 1 else "no certificate (bound >= 1)")
     return Quantity("ase.design.hinf.mu_peak_real", mu["mu_peak"], "-",
-                    f"upper bound with Mach and altitude as real parameters (quadratic LFT, "
-                    f"blocks {mu['sizes']}, fit error <= {mu['fit_cover']:.2f} as a complex "
-                    f"cover) at {mu['f_peak_hz']:.0f} Hz; alone: shaft and elastic frequencies "
+                    f"upper bound with Mach and altitude as real parameters (low-rank "
+                    f"quadratic LFT, blocks {mu['sizes']}, fit error <= "
+                    f"{mu['fit_cover']:.2f} as a complex cover) at {mu['f_peak_hz']:.0f} Hz, "
+                    f"{how[mu['bound']]}: {margin}; alone: shaft and elastic frequencies "
                     f"{mu['mu_peak_parameters']:.3g}, Mach-altitude LFT "
                     f"{mu['mu_peak_flight']:.3g} at {mu['f_peak_flight_hz']:.0f} Hz, fit cover "
-                    f"{mu['mu_peak_fit']:.3g} (complex D bounds)")
+                    f"{mu['mu_peak_fit']:.3g}")

@@ -110,3 +110,40 @@ def test_flight_lft_reproduces_the_fin_over_the_envelope(data):
         lam = np.linalg.eigvals(A_dir).real.max()
         lam_l = np.linalg.eigvals(robust.lft_state_matrix(fl.lft, d)).real.max()
         assert lam_l == pytest.approx(lam, rel=0.05)
+
+
+def test_lowrank_flight_lft_has_small_blocks_and_a_measured_cover(data):
+    """The low-rank LFT of the same fit (dz.flight_lft(lowrank=dz.LOWRANK_RTOL), issue 26):
+    repeated blocks (40, 48) against the per-term LFT's (80, 116) (measured; each quadratic
+    term has rank 29 at 1e-8), the dropped part bounded (``truncation``, below 1e-2 of the
+    largest coefficient) and inside the measured fit-error cover, which stays the stated 15 %
+    at the 3 x 3 grid's points."""
+    f = np.logspace(0, np.log10(490.0), 60)
+    full = dz.flight_lft(data, n_grid=3, f_hz=f)
+    low = dz.flight_lft(data, n_grid=3, f_hz=f, lowrank=dz.LOWRANK_RTOL)
+    assert sum(low.lft.sizes) <= 0.5 * sum(full.lft.sizes)
+    assert max(low.lft.sizes) <= 48
+    scale = max(np.linalg.norm(low.lft.Bw[:, i]) * np.linalg.norm(low.lft.Cz[i])
+                for i in range(low.lft.Bw.shape[1]))
+    assert 0 < low.lft.truncation < 1e-2 * scale
+    assert np.all(low.cover >= 0) and low.cover.max() < 0.15
+    # the low-rank LFT stays within its truncation bound of the per-term one inside the box
+    from asekit.ase import robust
+    for d in [(-1.0, -1.0), (1.0, -1.0), (0.3, 0.7), (-0.5, 1.0)]:
+        diff = robust.lft_state_matrix(low.lft, d) - robust.lft_state_matrix(full.lft, d)
+        assert np.linalg.norm(diff, 2) <= low.lft.truncation * (1 + 1e-9) + 1e-6 * scale
+
+
+def test_mu_real_row_states_the_margin_only_below_one():
+    """The ``ase.design.hinf.mu_peak_real`` note says "stable for 1/mu times the stated
+    uncertainty" only when the bound is below 1 (issue 26), else that there is no certificate;
+    it names the bound used."""
+    r = {"mu_peak": 0.8, "f_peak_hz": 155.0, "sizes": (40, 48), "fit_cover": 0.9,
+         "bound": "full", "mu_peak_parameters": 0.7, "mu_peak_flight": 0.6,
+         "f_peak_flight_hz": 95.0, "mu_peak_fit": 0.2}
+    q = dz._mu_real_quantity(r)
+    assert q.asekit == 0.8 and "stable for 1.2 x" in q.note and "full D-G" in q.note
+    q = dz._mu_real_quantity(dict(r, mu_peak=3.0, bound="per_block"))
+    assert "no certificate" in q.note and "stable for" not in q.note
+    with pytest.raises(ValueError, match="bound"):
+        dz.hinf_mu_real(None, data=object(), bound="diagonal")
