@@ -767,8 +767,10 @@ def _hinf_cached(plant, w):
         return robust.HinfDesign(full, float(meta["gamma"]), w), K
     except CacheError:
         pass
-    d = robust.hinf_2dof(plant, w, delay=HINF_DELAY, design_order=HINF_DESIGN_ORDER)
-    K = robust.reduce_controller(d.continuous, HINF_ORDER)
+    from asekit.util.blas import one_blas_thread
+    with one_blas_thread():      # bit for bit whatever the process's BLAS threads (the cache)
+        d = robust.hinf_2dof(plant, w, delay=HINF_DELAY, design_order=HINF_DESIGN_ORDER)
+        K = robust.reduce_controller(d.continuous, HINF_ORDER)
     mats = [np.asarray(x, float) for s in (d.continuous, K) for x in (s.A, s.B, s.C, s.D)]
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
