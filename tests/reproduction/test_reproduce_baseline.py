@@ -37,6 +37,12 @@ check with the 300 Hz sensor and 1e-4 rad RMS seeded measurement noise, 20 reali
 added on 2026-12-03 (session 38) from ``python -m asekit reproduce --only design --json``; no other
 value changed beyond roundoff.
 
+``ase.design.hinf.steady_error_pct`` moved from 0.025506896009419577 to 0.025506899864014
+(1.5e-7 relative) on 2026-12-04 (stop 39) when the H-infinity synthesis was put under one
+BLAS thread (reproduction.design._hinf_cached: the cached design is then bit-identical
+whatever the writing process's threads); the new value is the one CI's run of that commit
+printed.
+
 Eight p-k rows moved by 1.8e-9 to 5.3e-7 relative on 2026-12-03 with issue 23's batched,
 secant-accelerated k-iteration (its tolerance is 1e-7 relative in frequency, so the converged
 roots may move by that much): ``flutter.damping.pk``, ``flutter.structural_g.pk``,
