@@ -572,38 +572,7 @@ def steady_control_derivatives(hm: HingedMesh, mach: float, symmetric: bool = Fa
 
     mesh = hm.mesh
     nz = mesh.normal[:, 2]
-    modes = deflection_modes(hm)
-    if links:
-        return _geared_derivatives(hm, mach, symmetric, reference_area, moment_reference, links)
-    wash = np.column_stack([-nz, modes.normalwash(0.0, 1.0).real])
-    cp = steady_pressure(mesh, mach, wash, symmetric)
-    lift = (mesh.area * nz) @ cp
-    x_ref, c_ref = (mean_aerodynamic_chord(mesh) if moment_reference is None else
-                    (float(moment_reference[0]), in_range("moment_reference[1]",
-                                                          moment_reference[1], 0.0)))
-    pitch = -((mesh.load_point[:, 0] - x_ref) * mesh.area * nz) @ cp
-    s = float(np.sum(mesh.area))
-    if symmetric:
-        lift, pitch = 2.0 * lift, 2.0 * pitch
-        s *= 2.0
-    if reference_area is not None:
-        s = in_range("reference_area", reference_area, 0.0)
-    h = hinge_moments(hm, cp)                       # (n_surfaces, 1 + n_surfaces)
-    sc = np.array([hm.surface_area(i) * hm.mean_chord(i) for i in range(len(hm.surfaces))])
-    n_s = len(hm.surfaces)
-    cm = pitch / (s * c_ref)
-    return ControlDerivatives(float(mach), s, float(lift[0] / s), lift[1:] / s,
-                              h[:, 0] / sc, h[np.arange(n_s), 1 + np.arange(n_s)] / sc,
-                              float(cm[0]), cm[1:], (float(x_ref), float(c_ref)))
-
-
-def _geared_derivatives(hm, mach, symmetric, reference_area, moment_reference, links):
-    """:func:`steady_control_derivatives` with the deflections geared by ``links``."""
-    from asekit.aero.vlm import steady_pressure
-
-    mesh = hm.mesh
-    nz = mesh.normal[:, 2]
-    T, free = gearing_matrix(len(hm.surfaces), links)
+    T, free = gearing_matrix(len(hm.surfaces), links)    # identity without links
     wash = np.column_stack([-nz, deflection_modes(hm).normalwash(0.0, 1.0).real @ T])
     cp = steady_pressure(mesh, mach, wash, symmetric)
     lift = (mesh.area * nz) @ cp
@@ -617,7 +586,7 @@ def _geared_derivatives(hm, mach, symmetric, reference_area, moment_reference, l
         s *= 2.0
     if reference_area is not None:
         s = in_range("reference_area", reference_area, 0.0)
-    h = hinge_moments(hm, cp)[free]                     # (n_free, 1 + n_free)
+    h = hinge_moments(hm, cp)[free]                 # (n_free, 1 + n_free)
     sc = np.array([hm.surface_area(i) * hm.mean_chord(i) for i in free])
     cm = pitch / (s * c_ref)
     return ControlDerivatives(float(mach), s, float(lift[0] / s), lift[1:] / s,
